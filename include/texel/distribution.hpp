@@ -1,0 +1,75 @@
+// The texel-frequency distribution (rendering.md §4, §5).
+//
+// Lognormal in two parameterizations:
+//  - moments (default, the source's): Central Pitch is the mean m and
+//    Irregularity the standard deviation s of the frequency in cpm;
+//    sigma² = ln(1 + s²/m²), mu = ln m − sigma²/2 (MATLAB lognrnd's mapping).
+//  - log [choice, extension]: Central Pitch is the median exp(mu) and
+//    Irregularity the standard deviation of 10·log10(f) in dB, so
+//    sigma = I·ln(10)/10 and I must be >= 0.
+// Draws outside [f_min, f_max] are re-drawn (truncated distribution, default)
+// or clamped [choice]. Quantization rounds to a log grid q dB apart.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "texel/random.hpp"
+#include "texel/units.hpp"
+
+namespace texel {
+
+enum class Parameterization { moments, log };
+enum class OutOfBand { redraw, clamp };
+
+std::string_view to_string(Parameterization p);
+std::string_view to_string(OutOfBand o);
+/// Parse "moments" / "log"; throws InvalidArgument naming `field`.
+Parameterization parse_parameterization(std::string_view text, std::string_view field = "parameterization");
+OutOfBand parse_out_of_band(std::string_view text, std::string_view field = "out_of_band");
+
+struct PitchDistributionConfig {
+  Decibels central_pitch{10.0};                 ///< dB re 1 cpm; -20 … 19.7 dB on the reference device
+  Decibels irregularity{-5.0};                  ///< dB re 1 cpm (moments) or dB of log-spread (log, >= 0)
+  Parameterization parameterization = Parameterization::moments;
+  OutOfBand out_of_band = OutOfBand::redraw;
+  CyclesPerMm band_min{0.01};                   ///< lowest renderable frequency (cpm), > 0
+  CyclesPerMm band_max{94.33962264150944};      ///< highest (cpm): the grid's Nyquist frequency
+  double quantization_db = 0.0;                 ///< 0 = off; else grid spacing in dB, > 0
+};
+
+/// A validated, prepared distribution. Value type; draw() is pure.
+class PitchDistribution {
+public:
+  /// Validates the config; throws InvalidArgument if a value is out of range
+  /// or the band [band_min, band_max] holds less than `min_band_mass` of the
+  /// distribution (a drawing loop would then almost never terminate).
+  explicit PitchDistribution(const PitchDistributionConfig& config);
+
+  /// Frequency (cpm) of draw `index` for `seed`: a pure function.
+  [[nodiscard]] double draw(std::uint64_t seed, std::uint64_t index) const;
+
+  [[nodiscard]] double mu() const { return mu_; }        ///< mean of ln f
+  [[nodiscard]] double sigma() const { return sigma_; }  ///< standard deviation of ln f
+  /// Fraction of the untruncated distribution inside the band.
+  [[nodiscard]] double band_mass() const { return band_mass_; }
+  [[nodiscard]] const PitchDistributionConfig& config() const { return config_; }
+
+  /// Round a frequency to the q-dB grid, kept inside the band (a grid value
+  /// above band_max steps down by q, below band_min steps up).
+  [[nodiscard]] double quantize(double f_cpm) const;
+
+  static constexpr double min_band_mass = 1e-3;
+  /// Draw attempts per texel before the redraw gives up and clamps. With the
+  /// band mass >= 1e-3 the chance of reaching it is below 1e-40.
+  static constexpr std::uint64_t max_attempts = 1u << 17;
+
+private:
+  PitchDistributionConfig config_;
+  double mu_ = 0.0;
+  double sigma_ = 0.0;
+  double band_mass_ = 1.0;
+};
+
+}  // namespace texel

@@ -1,0 +1,38 @@
+// File I/O shared by every front door: atomic writes (never a half-written
+// output), whole-file reads, and the array formats Texel exchanges (.npy,
+// .csv). Errors are IoError / FormatError naming the path.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace texel {
+
+/// Reads a whole file; throws IoError naming the path.
+std::string read_file(const std::string& path);
+/// Writes `data` to a temporary file beside `path`, then renames it over
+/// `path`: readers see the old file or the new one, never a partial one.
+void write_file_atomic(const std::string& path, std::string_view data);
+void write_file_atomic(const std::string& path, std::span<const std::byte> data);
+/// Throws IoError if `path`'s directory does not exist or is not writable,
+/// so a command can fail before doing any work.
+void check_writable(const std::string& path);
+
+/// Lower-case extension including compound ones: "a.texel.json" -> ".texel.json".
+std::string output_extension(const std::string& path);
+
+/// NumPy .npy (format 1.0, little-endian float64, 1-D).
+std::string npy_bytes(std::span<const double> values);
+/// Reads a 1-D or single-column .npy of float64/float32/int16/uint16 (little-endian).
+std::vector<double> parse_npy(std::string_view bytes, std::string_view origin);
+
+/// Two-column CSV with a header: "position_mm,amplitude" and one row per sample.
+std::string csv_columns(std::string_view header_a, std::string_view header_b, std::span<const double> a,
+                        std::span<const double> b);
+/// Reads a two-column numeric CSV (optional header), returning the columns.
+std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::string_view text, std::string_view origin);
+
+}  // namespace texel

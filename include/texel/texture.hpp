@@ -1,0 +1,120 @@
+// Textures: device-independent functions of position.
+//
+// `Texture` is the prepared, immutable form every renderer, encoder and player
+// consumes: amplitude in [0, 1] at positions along the swipe axis, measured
+// from the texture's own origin (0 mm = left edge of its region). Positions
+// outside [0, length) are at rest (0).
+//
+// `TexelSpec` is the configuration of a multi-scale Texel texture
+// (rendering.md §3–§7): the fine texture is defined by (pitch distribution,
+// texel length, seed) alone; the coarse profile and strengths shape its
+// envelope. `TexelTexture` is its prepared form: per-texel frequency, start
+// phase and envelope, computed once (texel k's draw depends only on k, so this
+// is O(texels), not O(samples)); rendering any window is then a pure function
+// of the sample's position.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "texel/coarse.hpp"
+#include "texel/distribution.hpp"
+#include "texel/grid.hpp"
+#include "texel/units.hpp"
+
+namespace texel {
+
+/// A prepared texture. Implementations are immutable and safe to share
+/// between threads.
+class Texture {
+public:
+  virtual ~Texture() = default;
+  /// Length of the textured span (mm); positions beyond it are at rest.
+  [[nodiscard]] virtual Millimetres length() const = 0;
+  /// Amplitudes at grid positions first, first+1, ... (grid positions are in
+  /// the texture's own coordinates). Same values whatever the window.
+  virtual void render(const Grid& grid, std::int64_t first, std::span<double> out) const = 0;
+  /// Short human-readable description, e.g. "texel P=10 dB I=-5 dB L=0.25 mm".
+  [[nodiscard]] virtual std::string describe() const = 0;
+};
+
+enum class PhaseMode { continuous, reset };
+enum class Fill { whole_texels, partial_final_texel };
+
+std::string_view to_string(PhaseMode m);
+std::string_view to_string(Fill f);
+PhaseMode parse_phase_mode(std::string_view text, std::string_view field = "phase");
+Fill parse_fill(std::string_view text, std::string_view field = "fill");
+
+/// Everything that defines a Texel texture. Defaults are the studies' values.
+struct TexelSpec {
+  Decibels central_pitch{10.0};        ///< dB re 1 cpm
+  Decibels irregularity{-5.0};         ///< dB (see Parameterization)
+  Millimetres texel_length{0.25};      ///< mm, > 0; keep below ~1 mm for fine texture
+  std::uint64_t seed = 1;              ///< the random draw
+  Parameterization parameterization = Parameterization::moments;
+  OutOfBand out_of_band = OutOfBand::redraw;
+  CyclesPerMm band_min{0.01};          ///< cpm; the source's hardware floor
+  CyclesPerMm band_max{0.0};           ///< cpm; 0 = the rendering grid's Nyquist frequency
+  double quantization_db = 0.0;        ///< 0 = off, else > 0 dB
+  PhaseMode phase = PhaseMode::continuous;
+  Fill fill = Fill::whole_texels;
+  double coarse_strength = 0.0;        ///< C in [0, 1]
+  double fine_strength = 1.0;          ///< F in [0, 1]
+  CoarseProfile coarse = ConstantProfile{};
+};
+
+/// Validates every field; throws InvalidArgument naming field, value and range.
+void validate(const TexelSpec& spec);
+
+/// One texel of a prepared texture.
+struct Texel {
+  double start_mm;        ///< left edge, k·L
+  double frequency_cpm;   ///< f_k after truncation and quantization
+  double phase_cycles;    ///< oscillation phase at start_mm, in cycles [0, 1)
+  double envelope;        ///< e_k = 1 − C·(1 − c_k)
+};
+
+class TexelTexture final : public Texture {
+public:
+  /// Prepares `spec` over `length`. `nyquist` is the rendering grid's Nyquist
+  /// frequency, used as band_max when spec.band_max is 0. Allocates.
+  TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerMm nyquist);
+
+  [[nodiscard]] Millimetres length() const override { return length_; }
+  void render(const Grid& grid, std::int64_t first, std::span<double> out) const override;
+  [[nodiscard]] std::string describe() const override;
+
+  [[nodiscard]] const TexelSpec& spec() const { return spec_; }
+  [[nodiscard]] const std::vector<Texel>& texels() const { return texels_; }
+  [[nodiscard]] const PitchDistribution& distribution() const { return distribution_; }
+  /// End of the textured span: texel count · L, or the length with a partial final texel.
+  [[nodiscard]] double textured_end_mm() const { return end_mm_; }
+
+  /// Index of the texel containing position x (mm), or -1 if none.
+  [[nodiscard]] std::int64_t texel_at(double x_mm) const;
+  /// Slow, obviously-correct single-sample evaluation (for tests and players).
+  [[nodiscard]] double amplitude_at(double x_mm) const;
+
+  /// Positions within this distance below a texel boundary count as on it, so
+  /// that k·L computed in floating point lands in texel k (1 picometre).
+  static constexpr double boundary_tolerance_mm = 1e-9;
+
+private:
+  TexelSpec spec_;
+  Millimetres length_;
+  PitchDistribution distribution_;
+  std::vector<Texel> texels_;
+  std::vector<double> offset_;  // e_k·(1 − F/2)
+  std::vector<double> gain_;    // e_k·F/2
+  double end_mm_ = 0.0;
+};
+
+/// Number of texels a span of `length` holds under `fill`.
+std::size_t texel_count(Millimetres length, Millimetres texel_length, Fill fill);
+
+}  // namespace texel

@@ -1,0 +1,156 @@
+#include "texel/coarse.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "texel/detail/format.hpp"
+#include "texel/detmath.hpp"
+#include "texel/error.hpp"
+
+namespace texel {
+namespace {
+
+using detail::num;
+
+void check_unit_interval(double v, const std::string& field) {
+  if (!(v >= 0.0 && v <= 1.0)) throw InvalidArgument(field + " is " + num(v) + "; allowed: 0 … 1");
+}
+
+double interpolate_points(const std::vector<std::pair<double, double>>& pts, double x) {
+  if (x <= pts.front().first) return pts.front().second;
+  if (x >= pts.back().first) return pts.back().second;
+  std::size_t lo = 0;
+  std::size_t hi = pts.size() - 1;
+  while (hi - lo > 1) {
+    const std::size_t mid = (lo + hi) / 2;
+    (pts[mid].first <= x ? lo : hi) = mid;
+  }
+  const double t = (x - pts[lo].first) / (pts[hi].first - pts[lo].first);
+  return pts[lo].second + t * (pts[hi].second - pts[lo].second);
+}
+
+double interpolate_sampled(const SampledProfile& p, double x) {
+  const double pos = x / p.spacing_mm;
+  if (pos <= 0.0) return p.values.front();
+  const double last = static_cast<double>(p.values.size() - 1);
+  if (pos >= last) return p.values.back();
+  const double i = std::floor(pos);
+  const auto k = static_cast<std::size_t>(i);
+  const double t = pos - i;
+  return p.values[k] + t * (p.values[k + 1] - p.values[k]);
+}
+
+struct Validator {
+  void operator()(const ConstantProfile& p) const { check_unit_interval(p.value, "coarse.value"); }
+  void operator()(const SineProfile& p) const {
+    if (!(std::isfinite(p.period.value()) && p.period.value() > 0.0))
+      throw InvalidArgument("coarse.period_mm is " + num(p.period.value()) + " mm; it must be a finite number > 0");
+    if (!std::isfinite(p.phase_deg)) throw InvalidArgument("coarse.phase_deg is " + num(p.phase_deg) + "; it must be finite");
+  }
+  void operator()(const ValuesProfile& p) const {
+    if (p.values.empty()) throw InvalidArgument("coarse.values is empty; give one value in 0 … 1 per texel");
+    for (std::size_t i = 0; i < p.values.size(); ++i) check_unit_interval(p.values[i], "coarse.values[" + std::to_string(i) + "]");
+  }
+  void operator()(const PointsProfile& p) const {
+    if (p.points.empty()) throw InvalidArgument("coarse.points is empty; give at least one [position_mm, value] pair");
+    for (std::size_t i = 0; i < p.points.size(); ++i) {
+      const auto& [x, v] = p.points[i];
+      const std::string at = "coarse.points[" + std::to_string(i) + "]";
+      if (!std::isfinite(x)) throw InvalidArgument(at + " position is " + num(x) + " mm; it must be finite");
+      check_unit_interval(v, at + " value");
+      if (i > 0 && !(x > p.points[i - 1].first))
+        throw InvalidArgument(at + " position " + num(x) + " mm does not increase (previous " + num(p.points[i - 1].first) +
+                              " mm); positions must be strictly increasing");
+    }
+  }
+  void operator()(const SampledProfile& p) const {
+    if (!(std::isfinite(p.spacing_mm) && p.spacing_mm > 0.0))
+      throw InvalidArgument("coarse.spacing_mm is " + num(p.spacing_mm) + " mm; it must be a finite number > 0");
+    if (p.values.empty()) throw InvalidArgument("coarse sampled profile has no values");
+    for (std::size_t i = 0; i < p.values.size(); ++i) check_unit_interval(p.values[i], "coarse.samples[" + std::to_string(i) + "]");
+  }
+};
+
+}  // namespace
+
+void validate(const CoarseProfile& profile) { std::visit(Validator{}, profile); }
+
+std::string kind_name(const CoarseProfile& profile) {
+  struct Namer {
+    std::string operator()(const ConstantProfile&) const { return "constant"; }
+    std::string operator()(const SineProfile&) const { return "sine"; }
+    std::string operator()(const ValuesProfile&) const { return "values"; }
+    std::string operator()(const PointsProfile&) const { return "points"; }
+    std::string operator()(const SampledProfile&) const { return "sampled"; }
+  };
+  return std::visit(Namer{}, profile);
+}
+
+std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t count) {
+  validate(profile);
+  std::vector<double> c(count);
+  const double L = texel_length.value();
+  auto centre = [L](std::size_t k) { return (static_cast<double>(k) + 0.5) * L; };
+  if (const auto* k = std::get_if<ConstantProfile>(&profile)) {
+    std::fill(c.begin(), c.end(), k->value);
+  } else if (const auto* s = std::get_if<SineProfile>(&profile)) {
+    for (std::size_t i = 0; i < count; ++i) {
+      const double cycles = centre(i) / s->period.value() + s->phase_deg / 360.0;
+      c[i] = 0.5 + 0.5 * detmath::sin_cycles(cycles);
+    }
+  } else if (const auto* v = std::get_if<ValuesProfile>(&profile)) {
+    if (v->values.size() < count)
+      throw InvalidArgument("coarse.values has " + std::to_string(v->values.size()) + " values but the texture has " +
+                            std::to_string(count) + " texels; give one value per texel");
+    std::copy_n(v->values.begin(), count, c.begin());
+  } else if (const auto* p = std::get_if<PointsProfile>(&profile)) {
+    for (std::size_t i = 0; i < count; ++i) c[i] = interpolate_points(p->points, centre(i));
+  } else if (const auto* sp = std::get_if<SampledProfile>(&profile)) {
+    for (std::size_t i = 0; i < count; ++i) c[i] = interpolate_sampled(*sp, centre(i));
+  }
+  // sin_cycles may overshoot 1 by an ulp; keep c in [0, 1] exactly.
+  for (double& x : c) x = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
+  return c;
+}
+
+PointsProfile read_profile_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError("cannot read coarse profile '" + path + "'");
+  PointsProfile profile;
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos || line[0] == '#') continue;
+    std::replace(line.begin(), line.end(), ';', ',');
+    const auto comma = line.find(',');
+    const std::string where = path + ":" + std::to_string(line_no);
+    if (comma == std::string::npos) throw FormatError(where + ": expected 'position_mm,value', got '" + line + "'");
+    const std::string a = line.substr(0, comma);
+    const std::string b = line.substr(comma + 1);
+    double x = 0.0;
+    double v = 0.0;
+    const auto pa = std::from_chars(a.data() + a.find_first_not_of(" \t"), a.data() + a.size(), x);
+    const auto bstart = b.find_first_not_of(" \t");
+    const auto pb = bstart == std::string::npos ? std::from_chars_result{b.data(), std::errc::invalid_argument}
+                                                : std::from_chars(b.data() + bstart, b.data() + b.size(), v);
+    if (pa.ec != std::errc() || pb.ec != std::errc()) {
+      if (profile.points.empty() && line_no == 1) continue;  // header row
+      throw FormatError(where + ": expected two numbers 'position_mm,value', got '" + line + "'");
+    }
+    profile.points.emplace_back(x, v);
+  }
+  if (profile.points.empty()) throw FormatError(path + ": no position_mm,value rows");
+  try {
+    validate(CoarseProfile{profile});
+  } catch (const InvalidArgument& e) {
+    throw FormatError(path + ": " + e.what());
+  }
+  return profile;
+}
+
+}  // namespace texel

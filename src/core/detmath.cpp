@@ -1,0 +1,136 @@
+// Deterministic exp/log and the normal quantile (see detmath.hpp for why).
+#include "texel/detmath.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace texel::detmath {
+namespace {
+
+// fdlibm's split of ln 2: the high part has trailing zero bits, so k·ln2_hi
+// is exact for |k| < 2^11.
+constexpr double ln2_hi = 6.93147180369123816490e-01;
+constexpr double ln2_lo = 1.90821492927058770002e-10;
+constexpr double inv_ln2 = 1.44269504088896338700e+00;
+constexpr double ln10 = 2.30258509299404568402;
+
+}  // namespace
+
+double log(double x) {
+  if (std::isnan(x) || x < 0.0) return std::numeric_limits<double>::quiet_NaN();
+  if (x == 0.0) return -std::numeric_limits<double>::infinity();
+  if (std::isinf(x)) return x;
+  // Decompose x = m·2^e with m in [sqrt(1/2), sqrt(2)), exactly, via the bits.
+  int e = 0;
+  std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+  if ((bits >> 52) == 0) {  // subnormal: scale into the normal range first
+    x *= 0x1.0p54;
+    e -= 54;
+    bits = std::bit_cast<std::uint64_t>(x);
+  }
+  e += static_cast<int>((bits >> 52) & 0x7FF) - 1023;
+  double m = std::bit_cast<double>((bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL);  // [1, 2)
+  if (m > 1.4142135623730951) {
+    m *= 0.5;
+    e += 1;
+  }
+  // log m = 2·atanh(s), s = (m−1)/(m+1), |s| <= 0.1716: odd series to s^23.
+  const double s = (m - 1.0) / (m + 1.0);
+  const double s2 = s * s;
+  double p = 1.0 / 23.0;
+  p = p * s2 + 1.0 / 21.0;
+  p = p * s2 + 1.0 / 19.0;
+  p = p * s2 + 1.0 / 17.0;
+  p = p * s2 + 1.0 / 15.0;
+  p = p * s2 + 1.0 / 13.0;
+  p = p * s2 + 1.0 / 11.0;
+  p = p * s2 + 1.0 / 9.0;
+  p = p * s2 + 1.0 / 7.0;
+  p = p * s2 + 1.0 / 5.0;
+  p = p * s2 + 1.0 / 3.0;
+  const double log_m = 2.0 * s + 2.0 * s * s2 * p;
+  const double de = static_cast<double>(e);
+  return de * ln2_hi + (log_m + de * ln2_lo);
+}
+
+double exp(double x) {
+  if (std::isnan(x)) return x;
+  if (x > 709.782712893384) return std::numeric_limits<double>::infinity();
+  if (x < -745.1332191019412) return 0.0;
+  // x = k·ln2 + r, |r| <= ln2/2; e^r by Taylor to r^14 (error < 1e-18).
+  const double k = round_even(x * inv_ln2);
+  const double r = (x - k * ln2_hi) - k * ln2_lo;
+  double p = 1.0 / 87178291200.0;  // 1/14!
+  p = p * r + 1.0 / 6227020800.0;
+  p = p * r + 1.0 / 479001600.0;
+  p = p * r + 1.0 / 39916800.0;
+  p = p * r + 1.0 / 3628800.0;
+  p = p * r + 1.0 / 362880.0;
+  p = p * r + 1.0 / 40320.0;
+  p = p * r + 1.0 / 5040.0;
+  p = p * r + 1.0 / 720.0;
+  p = p * r + 1.0 / 120.0;
+  p = p * r + 1.0 / 24.0;
+  p = p * r + 1.0 / 6.0;
+  p = p * r + 0.5;
+  p = p * r + 1.0;
+  p = p * r + 1.0;
+  // Scaling by a power of two is exact (ldexp is an IEEE-exact operation).
+  return std::ldexp(p, static_cast<int>(k));
+}
+
+double pow10(double x) { return exp(x * ln10); }
+
+double normal_quantile(double p) {
+  if (!(p > 0.0 && p < 1.0)) {
+    if (p == 0.0) return -std::numeric_limits<double>::infinity();
+    if (p == 1.0) return std::numeric_limits<double>::infinity();
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  // Wichura, Algorithm AS241 (PPND16), Applied Statistics 37 (1988) 477–484.
+  const double q = p - 0.5;
+  if (std::fabs(q) <= 0.425) {
+    const double r = 0.180625 - q * q;
+    const double num = (((((((2.5090809287301226727e+3 * r + 3.3430575583588128105e+4) * r +
+                             6.7265770927008700853e+4) * r + 4.5921953931549871457e+4) * r +
+                           1.3731693765509461125e+4) * r + 1.9715909503065514427e+3) * r +
+                         1.3314166789178437745e+2) * r + 3.3871328727963666080e+0);
+    const double den = (((((((5.2264952788528545610e+3 * r + 2.8729085735721942674e+4) * r +
+                             3.9307895800092710610e+4) * r + 2.1213794301586595867e+4) * r +
+                           5.3941960214247511077e+3) * r + 6.8718700749205790830e+2) * r +
+                         4.2313330701600911252e+1) * r + 1.0);
+    return q * num / den;
+  }
+  double r = q < 0.0 ? p : 1.0 - p;
+  r = std::sqrt(-log(r));  // sqrt is correctly rounded by IEEE-754
+  double value = 0.0;
+  if (r <= 5.0) {
+    r -= 1.6;
+    const double num = (((((((7.74545014278341407640e-4 * r + 2.27238449892691845833e-2) * r +
+                             2.41780725177450611770e-1) * r + 1.27045825245236838258e+0) * r +
+                           3.64784832476320460504e+0) * r + 5.76949722146069140550e+0) * r +
+                         4.63033784615654529590e+0) * r + 1.42343711074968357734e+0);
+    const double den = (((((((1.05075007164441684324e-9 * r + 5.47593808499534494600e-4) * r +
+                             1.51986665636164571966e-2) * r + 1.48103976427480074590e-1) * r +
+                           6.89767334985100004550e-1) * r + 1.67638483018380384940e+0) * r +
+                         2.05319162663775882187e+0) * r + 1.0);
+    value = num / den;
+  } else {
+    r -= 5.0;
+    const double num = (((((((2.01033439929228813265e-7 * r + 2.71155556874348757815e-5) * r +
+                             1.24266094738807843860e-3) * r + 2.65321895265761230930e-2) * r +
+                           2.96560571828504891230e-1) * r + 1.78482653991729133580e+0) * r +
+                         5.46378491116411436990e+0) * r + 6.65790464350110377720e+0);
+    const double den = (((((((2.04426310338993978564e-15 * r + 1.42151175831644588870e-7) * r +
+                             1.84631831751005468180e-5) * r + 7.86869131145613259100e-4) * r +
+                           1.48753612908506148525e-2) * r + 1.36929880922735805310e-1) * r +
+                         5.99832206555887937690e-1) * r + 1.0);
+    value = num / den;
+  }
+  return q < 0.0 ? -value : value;
+}
+
+double normal_cdf(double z) { return 0.5 * std::erfc(-z * 0.70710678118654752440); }
+
+}  // namespace texel::detmath

@@ -1,0 +1,271 @@
+#include "texel/device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+
+#include "texel/detail/format.hpp"
+#include "texel/detail/json_fields.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+
+namespace texel {
+namespace {
+
+using detail::num;
+
+struct Embedded {
+  const char* name;
+  const char* text;
+};
+constexpr Embedded builtin_profiles[] = {
+#include "builtin_devices.inc"
+};
+
+}  // namespace
+
+std::string_view to_string(SampleFormat f) {
+  switch (f) {
+    case SampleFormat::u16le: return "u16le";
+    case SampleFormat::u8: return "u8";
+    case SampleFormat::f32le: return "f32le";
+    case SampleFormat::f64le: return "f64le";
+  }
+  return "?";
+}
+
+SampleFormat parse_sample_format(std::string_view text, std::string_view field) {
+  for (auto f : {SampleFormat::u16le, SampleFormat::u8, SampleFormat::f32le, SampleFormat::f64le})
+    if (text == to_string(f)) return f;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: u16le, u8, f32le, f64le");
+}
+
+std::size_t bytes_per_sample(SampleFormat f) {
+  switch (f) {
+    case SampleFormat::u16le: return 2;
+    case SampleFormat::u8: return 1;
+    case SampleFormat::f32le: return 4;
+    case SampleFormat::f64le: return 8;
+  }
+  return 0;
+}
+
+void validate(const DeviceProfile& p) {
+  const std::string at = "device '" + p.name + "': ";
+  if (p.name.empty()) throw InvalidArgument("device profile has an empty name");
+  if (!(std::isfinite(p.spacing_mm) && p.spacing_mm > 0.0))
+    throw InvalidArgument(at + "spacing_mm is " + num(p.spacing_mm) + " mm; it must be a finite number > 0");
+  constexpr std::int64_t max_samples = std::int64_t{1} << 34;
+  if (p.samples < 1 || p.samples > max_samples)
+    throw InvalidArgument(at + "samples is " + std::to_string(p.samples) + "; allowed: 1 … " + std::to_string(max_samples));
+  if (!(std::isfinite(p.refresh_hz) && p.refresh_hz > 0.0))
+    throw InvalidArgument(at + "refresh_hz is " + num(p.refresh_hz) + "; it must be a finite number > 0");
+  if (!(std::isfinite(p.band_min_cpm) && p.band_min_cpm > 0.0))
+    throw InvalidArgument(at + "band_min_cpm is " + num(p.band_min_cpm) + "; it must be > 0");
+  if (!(std::isfinite(p.band_max_cpm) && p.band_max_cpm >= 0.0) || (p.band_max_cpm > 0.0 && p.band_max_cpm <= p.band_min_cpm))
+    throw InvalidArgument(at + "band_max_cpm is " + num(p.band_max_cpm) + "; allowed: 0 (Nyquist) or above band_min_cpm");
+  if (p.band_max_cpm > p.nyquist_cpm() * (1 + 1e-12))
+    throw InvalidArgument(at + "band_max_cpm " + num(p.band_max_cpm) + " cpm is above the grid's Nyquist frequency " +
+                          num(p.nyquist_cpm()) + " cpm");
+  if (p.band_min_cpm >= p.band_top_cpm())
+    throw InvalidArgument(at + "band_min_cpm " + num(p.band_min_cpm) + " cpm is not below the band's top " + num(p.band_top_cpm()) + " cpm");
+  double prev_end = 0.0;
+  for (const auto& r : p.layout) {
+    if (!(r.start_mm >= prev_end - 1e-9 && r.length_mm > 0.0 && r.start_mm + r.length_mm <= p.length_mm() + 1e-3))
+      throw InvalidArgument(at + "layout region '" + r.name + "' (" + num(r.start_mm) + " mm + " + num(r.length_mm) +
+                            " mm) must lie inside 0 … " + num(p.length_mm()) + " mm, in order, without overlap");
+    prev_end = r.start_mm + r.length_mm;
+  }
+}
+
+DeviceProfile parse_device_profile(std::string_view json_text, std::string_view origin) {
+  const nlohmann::json j = detail::parse_json(json_text, origin);
+  try {
+    detail::JsonObject o(j, "");
+    DeviceProfile p;
+    p.name = o.string("name");
+    p.description = o.string_or("description", "");
+    p.samples = o.integer("samples", 1, std::int64_t{1} << 34);
+    p.spacing_mm = o.number("spacing_mm", 1e-9, 1e6);
+    p.format = parse_sample_format(o.string("format"), "format");
+    p.refresh_hz = o.number("refresh_hz", 1e-6, 1e9);
+    p.band_min_cpm = o.number_or("band_min_cpm", 0.01, 1e-12, 1e12);
+    p.band_max_cpm = o.number_or("band_max_cpm", 0.0, 0.0, 1e12);
+    if (o.has("layout")) {
+      const auto& arr = o.raw("layout");
+      if (!arr.is_array()) throw FormatError("layout must be an array of regions");
+      for (std::size_t i = 0; i < arr.size(); ++i) {
+        detail::JsonObject r(arr[i], "layout[" + std::to_string(i) + "]");
+        RegionLayout reg;
+        reg.name = r.string("name");
+        reg.start_mm = r.number("start_mm", 0.0, 1e9);
+        reg.length_mm = r.number("length_mm", 1e-9, 1e9);
+        r.finish();
+        p.layout.push_back(reg);
+      }
+    } else {
+      o.skip("layout");
+    }
+    o.finish();
+    validate(p);
+    return p;
+  } catch (const Error& e) {
+    throw FormatError(std::string(origin) + ": " + e.what());
+  }
+}
+
+std::string device_profile_json(const DeviceProfile& p) {
+  nlohmann::ordered_json j;
+  j["name"] = p.name;
+  j["description"] = p.description;
+  j["samples"] = p.samples;
+  j["spacing_mm"] = p.spacing_mm;
+  j["format"] = std::string(to_string(p.format));
+  j["refresh_hz"] = p.refresh_hz;
+  j["band_min_cpm"] = p.band_min_cpm;
+  j["band_max_cpm"] = p.band_max_cpm;
+  j["layout"] = nlohmann::ordered_json::array();
+  for (const auto& r : p.layout) j["layout"].push_back({{"name", r.name}, {"start_mm", r.start_mm}, {"length_mm", r.length_mm}});
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::string> builtin_device_names() {
+  std::vector<std::string> names;
+  for (const auto& e : builtin_profiles) names.emplace_back(e.name);
+  return names;
+}
+
+DeviceProfile load_device(std::string_view name_or_path) {
+  const std::string key(name_or_path);
+  if (key.empty()) throw InvalidArgument("device name is empty");
+  for (const auto& e : builtin_profiles)
+    if (key == e.name) return parse_device_profile(e.text, "built-in device '" + key + "'");
+  const bool looks_like_path = key.find('/') != std::string::npos || key.ends_with(".json");
+  if (looks_like_path) return parse_device_profile(read_file(key), key);
+  if (const char* dirs = std::getenv("TEXEL_DEVICE_PATH")) {
+    std::string_view rest(dirs);
+    while (!rest.empty()) {
+      const auto colon = rest.find(':');
+      const std::string dir(rest.substr(0, colon));
+      rest = colon == std::string_view::npos ? std::string_view{} : rest.substr(colon + 1);
+      if (dir.empty()) continue;
+      const auto candidate = std::filesystem::path(dir) / (key + ".json");
+      std::error_code ec;
+      if (std::filesystem::is_regular_file(candidate, ec)) return parse_device_profile(read_file(candidate.string()), candidate.string());
+    }
+  }
+  std::string known;
+  for (const auto& n : builtin_device_names()) known += (known.empty() ? "" : ", ") + n;
+  throw InvalidArgument("unknown device '" + key + "'; built-in devices: " + known +
+                        " (or give a path to a profile .json, or put NAME.json in a TEXEL_DEVICE_PATH directory)");
+}
+
+DeviceProfile with_grid(DeviceProfile p, std::optional<double> length_mm, std::optional<double> spacing_mm) {
+  if (spacing_mm) {
+    if (!(std::isfinite(*spacing_mm) && *spacing_mm > 0.0))
+      throw InvalidArgument("spacing is " + num(*spacing_mm) + " mm; it must be a finite number > 0");
+  }
+  if (length_mm) {
+    if (!(std::isfinite(*length_mm) && *length_mm > 0.0))
+      throw InvalidArgument("length is " + num(*length_mm) + " mm; it must be a finite number > 0");
+  }
+  if (!length_mm && !spacing_mm) return p;
+  const double length = length_mm ? *length_mm : p.length_mm();
+  const double spacing = spacing_mm ? *spacing_mm : p.spacing_mm;
+  const double count = std::round(length / spacing);
+  if (!(count >= 1.0) || count > static_cast<double>(std::int64_t{1} << 34))
+    throw InvalidArgument("length " + num(length) + " mm at spacing " + num(spacing) + " mm gives " + num(count) +
+                          " samples; allowed: 1 … 17179869184");
+  p.samples = static_cast<std::int64_t>(count);
+  p.spacing_mm = spacing;
+  if (p.band_max_cpm > p.nyquist_cpm()) p.band_max_cpm = 0.0;
+  std::erase_if(p.layout, [&](const RegionLayout& r) { return r.start_mm + r.length_mm > p.length_mm() + 1e-3; });
+  validate(p);
+  return p;
+}
+
+void encode_u16(std::span<const double> a, std::span<std::uint16_t> out) {
+  const std::size_t n = std::min(a.size(), out.size());
+  for (std::size_t i = 0; i < n; ++i) out[i] = to_u16(a[i]);
+}
+
+void encode_f32(std::span<const double> a, std::span<float> out) {
+  const std::size_t n = std::min(a.size(), out.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = a[i] > 0.0 ? (a[i] < 1.0 ? a[i] : 1.0) : 0.0;
+    out[i] = static_cast<float>(v);
+  }
+}
+
+void encode_samples(SampleFormat format, std::span<const double> a, std::span<std::byte> out) {
+  static_assert(std::endian::native == std::endian::little, "Texel's encoders assume a little-endian host");
+  const std::size_t n = a.size();
+  if (out.size() < n * bytes_per_sample(format)) throw InvalidArgument("encode_samples: output buffer too small");
+  switch (format) {
+    case SampleFormat::u16le: {
+      // Encode through an aligned stack block: `out` may be unaligned for uint16.
+      std::uint16_t block[1024];
+      for (std::size_t i = 0; i < n; i += 1024) {
+        const std::size_t len = std::min<std::size_t>(1024, n - i);
+        encode_u16(a.subspan(i, len), std::span<std::uint16_t>(block, len));
+        std::memcpy(out.data() + 2 * i, block, 2 * len);
+      }
+      break;
+    }
+    case SampleFormat::u8:
+      for (std::size_t i = 0; i < n; ++i) {
+        const double v = a[i] > 0.0 ? (a[i] < 1.0 ? a[i] : 1.0) : 0.0;
+        out[i] = static_cast<std::byte>(static_cast<std::uint8_t>(v * 255.0 + 0.5));
+      }
+      break;
+    case SampleFormat::f32le: {
+      float block[1024];
+      for (std::size_t i = 0; i < n; i += 1024) {
+        const std::size_t len = std::min<std::size_t>(1024, n - i);
+        encode_f32(a.subspan(i, len), std::span<float>(block, len));
+        std::memcpy(out.data() + 4 * i, block, 4 * len);
+      }
+      break;
+    }
+    case SampleFormat::f64le:
+      for (std::size_t i = 0; i < n; ++i) {
+        const double v = a[i] > 0.0 ? (a[i] < 1.0 ? a[i] : 1.0) : 0.0;
+        std::memcpy(out.data() + 8 * i, &v, 8);
+      }
+      break;
+  }
+}
+
+std::vector<double> decode_samples(SampleFormat format, std::span<const std::byte> bytes) {
+  const std::size_t w = bytes_per_sample(format);
+  if (bytes.size() % w != 0)
+    throw FormatError("device data of " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
+                      std::string(to_string(format)) + " samples (" + std::to_string(w) + " bytes each)");
+  const std::size_t n = bytes.size() / w;
+  std::vector<double> a(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::byte* p = bytes.data() + i * w;
+    switch (format) {
+      case SampleFormat::u16le: {
+        std::uint16_t v;
+        std::memcpy(&v, p, 2);
+        a[i] = v / 65535.0;
+        break;
+      }
+      case SampleFormat::u8: a[i] = static_cast<double>(std::to_integer<std::uint8_t>(*p)) / 255.0; break;
+      case SampleFormat::f32le: {
+        float v;
+        std::memcpy(&v, p, 4);
+        a[i] = v;
+        break;
+      }
+      case SampleFormat::f64le: std::memcpy(&a[i], p, 8); break;
+    }
+  }
+  return a;
+}
+
+}  // namespace texel

@@ -1,0 +1,125 @@
+#include "texel/distribution.hpp"
+
+#include <cmath>
+
+#include "texel/detail/format.hpp"
+#include "texel/detmath.hpp"
+#include "texel/error.hpp"
+
+namespace texel {
+namespace {
+
+using detail::num;
+
+constexpr double ln10_over_10 = 0.230258509299404568402;  // ln(10)/10
+constexpr double ten_over_ln10 = 4.34294481903251827651;
+
+double db_of(double cpm) { return ten_over_ln10 * detmath::log(cpm); }
+double cpm_of(double db) { return detmath::exp(db * ln10_over_10); }
+
+void require_finite(double v, std::string_view field, std::string_view unit) {
+  if (!std::isfinite(v))
+    throw InvalidArgument(std::string(field) + " is " + num(v) + " " + std::string(unit) + "; it must be a finite number");
+}
+
+}  // namespace
+
+std::string_view to_string(Parameterization p) { return p == Parameterization::moments ? "moments" : "log"; }
+std::string_view to_string(OutOfBand o) { return o == OutOfBand::redraw ? "redraw" : "clamp"; }
+
+Parameterization parse_parameterization(std::string_view text, std::string_view field) {
+  if (text == "moments") return Parameterization::moments;
+  if (text == "log") return Parameterization::log;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: moments, log");
+}
+
+OutOfBand parse_out_of_band(std::string_view text, std::string_view field) {
+  if (text == "redraw") return OutOfBand::redraw;
+  if (text == "clamp") return OutOfBand::clamp;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: redraw, clamp");
+}
+
+PitchDistribution::PitchDistribution(const PitchDistributionConfig& config) : config_(config) {
+  const double p_db = config.central_pitch.value();
+  const double i_db = config.irregularity.value();
+  const double lo = config.band_min.value();
+  const double hi = config.band_max.value();
+  require_finite(p_db, "central_pitch_db", "dB");
+  require_finite(i_db, "irregularity_db", "dB");
+  if (!(std::isfinite(lo) && lo > 0.0))
+    throw InvalidArgument("band_min_cpm is " + num(lo) + " cpm; it must be a finite number > 0");
+  if (!(std::isfinite(hi) && hi > lo))
+    throw InvalidArgument("band_max_cpm is " + num(hi) + " cpm; it must be finite and above band_min_cpm (" + num(lo) + " cpm)");
+  const double q = config.quantization_db;
+  if (!(std::isfinite(q) && q >= 0.0 && q <= 20.0))
+    throw InvalidArgument("quantization_db is " + num(q) + " dB; allowed: 0 (off) or a step in (0, 20] dB");
+  if (p_db < -40.0 || p_db > 40.0)
+    throw InvalidArgument("central_pitch_db is " + num(p_db) + " dB; allowed: -40 … 40 dB (0.0001 … 10000 cpm)");
+  if (i_db > 40.0 || (config.parameterization == Parameterization::moments && i_db < -60.0))
+    throw InvalidArgument("irregularity_db is " + num(i_db) + " dB; allowed: -60 … 40 dB");
+
+  const double lo_db = db_of(lo);
+  const double hi_db = db_of(hi);
+  if (p_db < lo_db - 1e-9 || p_db > hi_db + 1e-9)
+    throw InvalidArgument("central_pitch_db is " + num(p_db) + " dB (" + num(cpm_of(p_db)) + " cpm), outside the renderable band " +
+                          detail::fixed(lo_db, 2) + " … " + detail::fixed(hi_db, 2) + " dB (" + num(lo) + " … " + num(hi) +
+                          " cpm; the top is the grid's Nyquist frequency unless set)");
+
+  if (config.parameterization == Parameterization::moments) {
+    const double m = cpm_of(p_db);
+    const double s = cpm_of(i_db);
+    const double ratio = s / m;
+    const double sigma2 = detmath::log(1.0 + ratio * ratio);
+    sigma_ = std::sqrt(sigma2);
+    mu_ = detmath::log(m) - 0.5 * sigma2;
+  } else {
+    if (i_db < 0.0)
+      throw InvalidArgument("irregularity_db is " + num(i_db) +
+                            " dB; with parameterization 'log' it is the standard deviation of 10·log10(f) and must be >= 0 dB");
+    mu_ = p_db * ln10_over_10;
+    sigma_ = i_db * ln10_over_10;
+  }
+
+  if (sigma_ > 0.0) {
+    const double a = (detmath::log(lo) - mu_) / sigma_;
+    const double b = (detmath::log(hi) - mu_) / sigma_;
+    band_mass_ = detmath::normal_cdf(b) - detmath::normal_cdf(a);
+  } else {
+    const double f = detmath::exp(mu_);
+    band_mass_ = (f >= lo && f <= hi) ? 1.0 : 0.0;
+  }
+  if (config.out_of_band == OutOfBand::redraw && band_mass_ < min_band_mass)
+    throw InvalidArgument("the pitch distribution (central_pitch_db " + num(p_db) + " dB, irregularity_db " + num(i_db) +
+                          " dB) has only " + num(band_mass_) + " of its mass inside the band " + num(lo) + " … " + num(hi) +
+                          " cpm; at least " + num(min_band_mass) + " is needed (narrow the irregularity or use out_of_band clamp)");
+}
+
+double PitchDistribution::quantize(double f) const {
+  const double q = config_.quantization_db;
+  if (q <= 0.0) return f;
+  const double lo = config_.band_min.value();
+  const double hi = config_.band_max.value();
+  double n = std::round(db_of(f) / q);
+  double fq = cpm_of(q * n);
+  if (fq > hi) fq = cpm_of(q * (n - 1.0));
+  if (fq < lo) fq = cpm_of(q * (n + 1.0));
+  // A band narrower than one step holds no grid value: keep the clamped draw.
+  if (fq > hi || fq < lo) fq = f < lo ? lo : (f > hi ? hi : f);
+  return fq;
+}
+
+double PitchDistribution::draw(std::uint64_t seed, std::uint64_t index) const {
+  const CounterRng rng(seed, Stream::frequency);
+  const double lo = config_.band_min.value();
+  const double hi = config_.band_max.value();
+  const std::uint64_t base = index * max_attempts;
+  double f = 0.0;
+  for (std::uint64_t attempt = 0; attempt < max_attempts; ++attempt) {
+    f = detmath::exp(mu_ + sigma_ * rng.normal(base + attempt));
+    if (config_.out_of_band == OutOfBand::clamp || (f >= lo && f <= hi)) break;
+  }
+  f = f < lo ? lo : (f > hi ? hi : f);
+  return quantize(f);
+}
+
+}  // namespace texel

@@ -1,0 +1,80 @@
+#include "texel/surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel {
+
+using detail::num;
+
+Surface::Surface(Grid grid, std::vector<Region> regions) : grid_(grid), regions_(std::move(regions)) {
+  if (!(grid_.spacing_mm > 0.0) || grid_.count < 0) throw InvalidArgument("surface grid must have spacing > 0 and count >= 0");
+  const double total = grid_.length_mm();
+  std::sort(regions_.begin(), regions_.end(), [](const Region& a, const Region& b) { return a.start_mm < b.start_mm; });
+  for (std::size_t i = 0; i < regions_.size(); ++i) {
+    const Region& r = regions_[i];
+    const std::string name = "region '" + (r.name.empty() ? std::to_string(i) : r.name) + "'";
+    if (!r.texture) throw InvalidArgument(name + " has no texture");
+    if (!(std::isfinite(r.start_mm) && r.start_mm >= 0.0))
+      throw InvalidArgument(name + " start_mm is " + num(r.start_mm) + " mm; allowed: 0 … " + num(total) + " mm");
+    if (!(std::isfinite(r.length_mm) && r.length_mm > 0.0))
+      throw InvalidArgument(name + " length_mm is " + num(r.length_mm) + " mm; it must be > 0");
+    // 1 µm of slack: layouts written with rounded decimals (50.88 + 50.88).
+    if (r.start_mm + r.length_mm > total + 1e-3)
+      throw InvalidArgument(name + " ends at " + num(r.start_mm + r.length_mm) + " mm, past the device's active length " +
+                            num(total) + " mm");
+    if (i > 0 && r.start_mm < regions_[i - 1].start_mm + regions_[i - 1].length_mm - 1e-9)
+      throw InvalidArgument(name + " starts at " + num(r.start_mm) + " mm, inside the previous region (which ends at " +
+                            num(regions_[i - 1].start_mm + regions_[i - 1].length_mm) + " mm); regions must not overlap");
+  }
+}
+
+void Surface::render(std::int64_t first, std::span<double> out) const {
+  std::fill(out.begin(), out.end(), 0.0);
+  const auto n = static_cast<std::int64_t>(out.size());
+  for (const Region& r : regions_) {
+    // Samples i with start <= position(i) < start + length belong to r.
+    const double end_mm = r.start_mm + r.length_mm;
+    auto inside = [&](std::int64_t i) {
+      const double x = grid_.position(i);
+      return x >= r.start_mm && x < end_mm;
+    };
+    std::int64_t a = std::max<std::int64_t>(first, static_cast<std::int64_t>(std::floor((r.start_mm - grid_.origin_mm) / grid_.spacing_mm)) - 1);
+    while (a < first + n && !inside(a)) ++a;
+    if (a >= first + n) continue;
+    std::int64_t b = a;
+    const auto est = static_cast<std::int64_t>(std::ceil((end_mm - grid_.origin_mm) / grid_.spacing_mm)) + 1;
+    b = std::clamp(est, a, first + n);
+    while (b > a && !inside(b - 1)) --b;
+    while (b < first + n && inside(b)) ++b;
+    // The region's texture sees positions from its own origin.
+    const Grid local{grid_.origin_mm - r.start_mm, grid_.spacing_mm, grid_.count};
+    r.texture->render(local, a, out.subspan(static_cast<std::size_t>(a - first), static_cast<std::size_t>(b - a)));
+  }
+}
+
+std::vector<double> Surface::render() const {
+  std::vector<double> map(static_cast<std::size_t>(grid_.count));
+  render(0, map);
+  return map;
+}
+
+std::vector<std::byte> Surface::render_native(SampleFormat format) const {
+  const auto count = static_cast<std::size_t>(grid_.count);
+  const std::size_t width = bytes_per_sample(format);
+  std::vector<std::byte> bytes(count * width);
+  constexpr std::size_t chunk = 4096;  // stays in L1 between render and encode
+  std::vector<double> scratch(chunk);
+  for (std::size_t i = 0; i < count; i += chunk) {
+    const std::size_t len = std::min(chunk, count - i);
+    std::span<double> s(scratch.data(), len);
+    render(static_cast<std::int64_t>(i), s);
+    encode_samples(format, s, std::span<std::byte>(bytes.data() + i * width, len * width));
+  }
+  return bytes;
+}
+
+}  // namespace texel

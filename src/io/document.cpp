@@ -1,0 +1,291 @@
+#include "texel/document.hpp"
+
+#include <cmath>
+
+#include "texel/detail/format.hpp"
+#include "texel/detail/json_fields.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+
+namespace texel {
+namespace {
+
+using detail::JsonObject;
+using nlohmann::json;
+using ordered = nlohmann::ordered_json;
+
+constexpr const char* format_tag = "texel-document";
+
+CoarseProfile parse_coarse(const json& j, const std::string& path) {
+  JsonObject o(j, path);
+  const std::string kind = o.string("kind");
+  CoarseProfile profile;
+  if (kind == "constant") {
+    profile = ConstantProfile{o.number_or("value", 1.0, 0.0, 1.0)};
+  } else if (kind == "sine") {
+    SineProfile s;
+    s.period = Millimetres(o.number("period_mm", 1e-9, 1e9));
+    s.phase_deg = o.number_or("phase_deg", 0.0, -1e9, 1e9);
+    profile = s;
+  } else if (kind == "values") {
+    const auto& arr = o.raw("values");
+    if (!arr.is_array() || arr.empty()) throw FormatError(o.field("values") + " must be a non-empty array of numbers in 0 … 1");
+    ValuesProfile v;
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      if (!arr[i].is_number()) throw FormatError(o.field("values") + "[" + std::to_string(i) + "] must be a number");
+      v.values.push_back(arr[i].get<double>());
+    }
+    profile = std::move(v);
+  } else if (kind == "points") {
+    const auto& arr = o.raw("points");
+    if (!arr.is_array() || arr.empty()) throw FormatError(o.field("points") + " must be a non-empty array of [position_mm, value] pairs");
+    PointsProfile p;
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      const auto& pt = arr[i];
+      if (!pt.is_array() || pt.size() != 2 || !pt[0].is_number() || !pt[1].is_number())
+        throw FormatError(o.field("points") + "[" + std::to_string(i) + "] must be a pair [position_mm, value], got " + pt.dump());
+      p.points.emplace_back(pt[0].get<double>(), pt[1].get<double>());
+    }
+    profile = std::move(p);
+  } else {
+    throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: constant, sine, values, points");
+  }
+  o.finish();
+  try {
+    validate(profile);
+  } catch (const InvalidArgument& e) {
+    throw FormatError(path + ": " + e.what());
+  }
+  return profile;
+}
+
+ordered coarse_json(const CoarseProfile& profile) {
+  ordered j;
+  j["kind"] = kind_name(profile);
+  if (const auto* c = std::get_if<ConstantProfile>(&profile)) {
+    j["value"] = c->value;
+  } else if (const auto* s = std::get_if<SineProfile>(&profile)) {
+    j["period_mm"] = s->period.value();
+    j["phase_deg"] = s->phase_deg;
+  } else if (const auto* v = std::get_if<ValuesProfile>(&profile)) {
+    j["values"] = v->values;
+  } else if (const auto* p = std::get_if<PointsProfile>(&profile)) {
+    j["points"] = ordered::array();
+    for (const auto& [x, y] : p->points) j["points"].push_back({x, y});
+  } else if (const auto* sp = std::get_if<SampledProfile>(&profile)) {
+    // A sampled profile is written as points, which the parser reads back.
+    j["kind"] = "points";
+    j["points"] = ordered::array();
+    for (std::size_t i = 0; i < sp->values.size(); ++i) j["points"].push_back({static_cast<double>(i) * sp->spacing_mm, sp->values[i]});
+  }
+  return j;
+}
+
+template <class Enum, class Parse>
+Enum enum_field(JsonObject& o, std::string_view key, Enum fallback, Parse parse) {
+  if (!o.has(key)) {
+    o.skip(key);
+    return fallback;
+  }
+  const std::string text = o.string(key);
+  try {
+    return parse(text, o.field(key));
+  } catch (const InvalidArgument& e) {
+    throw FormatError(e.what());
+  }
+}
+
+TexelSpec parse_texel(const json& j, const std::string& path) {
+  JsonObject o(j, path);
+  const std::string kind = o.string("kind");
+  if (kind != "texel") throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: texel");
+  TexelSpec s;
+  s.central_pitch = Decibels(o.number("central_pitch_db", -40.0, 40.0));
+  s.irregularity = Decibels(o.number("irregularity_db", -60.0, 40.0));
+  s.texel_length = Millimetres(o.number("texel_length_mm", 1e-6, 1000.0));
+  s.seed = o.uint64("seed");
+  s.parameterization = enum_field(o, "parameterization", s.parameterization, parse_parameterization);
+  s.out_of_band = enum_field(o, "out_of_band", s.out_of_band, parse_out_of_band);
+  s.band_min = CyclesPerMm(o.number_or("band_min_cpm", s.band_min.value(), 1e-12, 1e12));
+  s.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, 1e12));
+  s.quantization_db = o.number_or("quantization_db", 0.0, 0.0, 20.0);
+  s.phase = enum_field(o, "phase", s.phase, parse_phase_mode);
+  s.fill = enum_field(o, "fill", s.fill, parse_fill);
+  s.coarse_strength = o.number_or("coarse_strength", 0.0, 0.0, 1.0);
+  s.fine_strength = o.number_or("fine_strength", 1.0, 0.0, 1.0);
+  if (o.has("coarse")) s.coarse = parse_coarse(o.raw("coarse"), o.field("coarse"));
+  else o.skip("coarse");
+  o.finish();
+  try {
+    validate(s);
+  } catch (const InvalidArgument& e) {
+    throw FormatError(path + ": " + e.what());
+  }
+  return s;
+}
+
+ordered texel_json(const TexelSpec& s) {
+  ordered j;
+  j["kind"] = "texel";
+  j["central_pitch_db"] = s.central_pitch.value();
+  j["irregularity_db"] = s.irregularity.value();
+  j["texel_length_mm"] = s.texel_length.value();
+  j["seed"] = s.seed;
+  j["parameterization"] = std::string(to_string(s.parameterization));
+  j["out_of_band"] = std::string(to_string(s.out_of_band));
+  j["band_min_cpm"] = s.band_min.value();
+  j["band_max_cpm"] = s.band_max.value();
+  j["quantization_db"] = s.quantization_db;
+  j["phase"] = std::string(to_string(s.phase));
+  j["fill"] = std::string(to_string(s.fill));
+  j["coarse_strength"] = s.coarse_strength;
+  j["fine_strength"] = s.fine_strength;
+  j["coarse"] = coarse_json(s.coarse);
+  return j;
+}
+
+bool is_builtin_unchanged(const DeviceProfile& d) {
+  for (const auto& name : builtin_device_names())
+    if (name == d.name) return device_profile_json(load_device(name)) == device_profile_json(d);
+  return false;
+}
+
+}  // namespace
+
+Document parse_document(std::string_view text, std::string_view origin) {
+  const json j = detail::parse_json(text, origin);
+  const std::string where(origin);
+  try {
+    JsonObject o(j, "");
+    Document doc;
+    const std::string tag = o.string("format");
+    if (tag != format_tag) throw FormatError("format is '" + tag + "'; expected '" + std::string(format_tag) + "'");
+    doc.version = static_cast<int>(o.integer("version", 1, 1000));
+    if (doc.version > Document::current_version)
+      throw FormatError("version is " + std::to_string(doc.version) + "; this build of Texel reads versions up to " +
+                        std::to_string(Document::current_version) + " (upgrade Texel)");
+    doc.description = o.string_or("description", "");
+    const auto& dev = o.raw("device");
+    if (dev.is_string()) {
+      try {
+        doc.device = load_device(dev.get<std::string>());
+      } catch (const InvalidArgument& e) {
+        throw FormatError(std::string("device: ") + e.what());
+      }
+    } else if (dev.is_object()) {
+      doc.device = parse_device_profile(dev.dump(), "device");
+      doc.device_inline = true;
+    } else {
+      throw FormatError("device must be a device name or an inline profile object, got " + JsonObject::type_of(dev));
+    }
+    if (o.has("device_grid")) {
+      JsonObject g(o.raw("device_grid"), "device_grid");
+      const auto length = g.optional_number("length_mm", 1e-9, 1e9);
+      const auto spacing = g.optional_number("spacing_mm", 1e-9, 1e6);
+      g.finish();
+      try {
+        doc.device = with_grid(doc.device, length, spacing);
+      } catch (const InvalidArgument& e) {
+        throw FormatError(std::string("device_grid: ") + e.what());
+      }
+    } else {
+      o.skip("device_grid");
+    }
+    const bool has_texture = o.has("texture");
+    const bool has_regions = o.has("regions");
+    if (has_texture == has_regions) throw FormatError("give exactly one of 'texture' (whole device) or 'regions'");
+    if (has_texture) {
+      o.skip("regions");
+      RegionSpec r;
+      r.texel = parse_texel(o.raw("texture"), "texture");
+      doc.regions.push_back(std::move(r));
+    } else {
+      o.skip("texture");
+      const auto& arr = o.raw("regions");
+      if (!arr.is_array() || arr.empty()) throw FormatError("regions must be a non-empty array");
+      for (std::size_t i = 0; i < arr.size(); ++i) {
+        const std::string path = "regions[" + std::to_string(i) + "]";
+        JsonObject r(arr[i], path);
+        RegionSpec spec;
+        spec.name = r.string_or("name", "");
+        spec.start_mm = r.number_or("start_mm", 0.0, 0.0, 1e9);
+        spec.length_mm = r.optional_number("length_mm", 1e-9, 1e9);
+        spec.texel = parse_texel(r.raw("texture"), path + ".texture");
+        r.finish();
+        doc.regions.push_back(std::move(spec));
+      }
+    }
+    o.finish();
+    (void)prepare_surface(doc);  // layout and distribution errors surface at load time
+    return doc;
+  } catch (const Error& e) {
+    throw FormatError(where + ": " + e.what());
+  }
+}
+
+Document load_document(const std::string& path) { return parse_document(read_file(path), path); }
+
+std::string document_json(const Document& doc) {
+  ordered j;
+  j["format"] = format_tag;
+  j["version"] = doc.version;
+  if (!doc.description.empty()) j["description"] = doc.description;
+  if (doc.device_inline || !is_builtin_unchanged(doc.device)) {
+    j["device"] = ordered::parse(device_profile_json(doc.device));
+  } else {
+    j["device"] = doc.device.name;
+  }
+  const bool whole = doc.regions.size() == 1 && doc.regions[0].start_mm == 0.0 && !doc.regions[0].length_mm &&
+                     doc.regions[0].name.empty();
+  if (whole) {
+    j["texture"] = texel_json(doc.regions[0].texel);
+  } else {
+    j["regions"] = ordered::array();
+    for (const auto& r : doc.regions) {
+      ordered rj;
+      if (!r.name.empty()) rj["name"] = r.name;
+      rj["start_mm"] = r.start_mm;
+      if (r.length_mm) rj["length_mm"] = *r.length_mm;
+      rj["texture"] = texel_json(r.texel);
+      j["regions"].push_back(std::move(rj));
+    }
+  }
+  return j.dump(2) + "\n";
+}
+
+void save_document(const Document& doc, const std::string& path) { write_file_atomic(path, document_json(doc)); }
+
+Document make_document(const DeviceProfile& device, const TexelSpec& spec) {
+  Document doc;
+  doc.device = device;
+  RegionSpec r;
+  r.texel = spec;
+  doc.regions.push_back(std::move(r));
+  return doc;
+}
+
+Surface prepare_surface(const Document& doc) {
+  if (doc.regions.empty()) throw InvalidArgument("document has no regions");
+  const Grid grid = doc.device.grid();
+  std::vector<Region> regions;
+  for (std::size_t i = 0; i < doc.regions.size(); ++i) {
+    const RegionSpec& spec = doc.regions[i];
+    const std::string label = doc.regions.size() == 1 ? std::string() : "region " + std::to_string(i) + ": ";
+    Region r;
+    r.name = spec.name;
+    r.start_mm = spec.start_mm;
+    r.length_mm = spec.length_mm ? *spec.length_mm : grid.length_mm() - spec.start_mm;
+    if (!(r.length_mm > 0.0))
+      throw InvalidArgument(label + "start_mm " + detail::num(spec.start_mm) + " mm is at or past the device's end (" +
+                            detail::num(grid.length_mm()) + " mm)");
+    try {
+      r.texture = std::make_shared<TexelTexture>(spec.texel, Millimetres(r.length_mm), CyclesPerMm(doc.device.band_top_cpm()));
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(label + e.what());
+    }
+    regions.push_back(std::move(r));
+  }
+  return Surface(grid, std::move(regions));
+}
+
+}  // namespace texel

@@ -1,0 +1,232 @@
+#include "texel/io.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel {
+namespace fs = std::filesystem;
+
+std::string read_file(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw IoError("cannot read '" + path + "': it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError("cannot read '" + path + "': " + std::strerror(errno));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw IoError("error while reading '" + path + "'");
+  return ss.str();
+}
+
+void check_writable(const std::string& path) {
+  if (path.empty()) throw IoError("output path is empty");
+  const fs::path p(path);
+  std::error_code ec;
+  if (fs::is_directory(p, ec)) throw IoError("cannot write '" + path + "': it is a directory");
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec)) throw IoError("cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0) throw IoError("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
+}
+
+void write_file_atomic(const std::string& path, std::string_view data) {
+  check_writable(path);
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  std::string tmpl = (dir / ("." + p.filename().string() + ".tmp-XXXXXX")).string();
+  const int fd = ::mkstemp(tmpl.data());
+  if (fd < 0) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
+  const char* ptr = data.data();
+  std::size_t left = data.size();
+  while (left > 0) {
+    const ssize_t w = ::write(fd, ptr, left);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmpl.c_str());
+      throw IoError("cannot write '" + path + "': " + why);
+    }
+    ptr += w;
+    left -= static_cast<std::size_t>(w);
+  }
+  // mkstemp creates 0600; give the file the usual permissions (umask applies).
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::fchmod(fd, 0666 & ~mask);
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const std::string why = std::strerror(errno);
+    ::unlink(tmpl.c_str());
+    throw IoError("cannot write '" + path + "': " + why);
+  }
+  if (std::rename(tmpl.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    ::unlink(tmpl.c_str());
+    throw IoError("cannot write '" + path + "': " + why);
+  }
+}
+
+void write_file_atomic(const std::string& path, std::span<const std::byte> data) {
+  write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
+}
+
+std::string output_extension(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  for (auto& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* compound : {".texel.json"})
+    if (name.size() > std::strlen(compound) && name.ends_with(compound)) return compound;
+  const auto dot = name.rfind('.');
+  return dot == std::string::npos || dot == 0 ? std::string() : name.substr(dot);
+}
+
+std::string npy_bytes(std::span<const double> values) {
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(values.size()) + ",), }";
+  // Magic (6) + version (2) + header length (2) + header, padded with spaces
+  // and a final newline to a multiple of 64 bytes (NEP 1).
+  const std::size_t unpadded = 10 + header.size() + 1;
+  header.append((64 - unpadded % 64) % 64, ' ');
+  header.push_back('\n');
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out.push_back(static_cast<char>(header.size() & 0xFF));
+  out.push_back(static_cast<char>((header.size() >> 8) & 0xFF));
+  out += header;
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return out;
+}
+
+std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
+  const std::string where(origin);
+  if (b.size() < 10 || b.substr(0, 6) != std::string_view("\x93NUMPY", 6)) throw FormatError(where + ": not a .npy file (bad magic)");
+  const auto major = static_cast<unsigned char>(b[6]);
+  std::size_t header_len = 0;
+  std::size_t offset = 0;
+  if (major == 1) {
+    header_len = static_cast<unsigned char>(b[8]) | (static_cast<std::size_t>(static_cast<unsigned char>(b[9])) << 8);
+    offset = 10;
+  } else if (major == 2 || major == 3) {
+    if (b.size() < 12) throw FormatError(where + ": truncated .npy header");
+    header_len = 0;
+    for (int i = 0; i < 4; ++i) header_len |= static_cast<std::size_t>(static_cast<unsigned char>(b[8 + i])) << (8 * i);
+    offset = 12;
+  } else {
+    throw FormatError(where + ": unsupported .npy version " + std::to_string(major));
+  }
+  if (b.size() < offset + header_len) throw FormatError(where + ": truncated .npy header");
+  const std::string header(b.substr(offset, header_len));
+  const std::size_t data_at = offset + header_len;
+  auto value_of = [&](const std::string& key) -> std::string {
+    const auto k = header.find("'" + key + "'");
+    if (k == std::string::npos) throw FormatError(where + ": .npy header lacks '" + key + "'");
+    auto v = header.find(':', k);
+    if (v == std::string::npos) throw FormatError(where + ": malformed .npy header");
+    ++v;
+    while (v < header.size() && header[v] == ' ') ++v;
+    if (header[v] == '(') return header.substr(v, header.find(')', v) - v + 1);
+    const auto end = header.find_first_of(",}", v);
+    return header.substr(v, end - v);
+  };
+  std::string descr = value_of("descr");
+  std::erase(descr, '\'');
+  std::erase(descr, ' ');
+  if (value_of("fortran_order").find("True") != std::string::npos) {
+    // A 1-D or (n,1) array reads the same either way; checked via shape below.
+  }
+  const std::string shape = value_of("shape");
+  std::vector<std::size_t> dims;
+  for (std::size_t i = 0; i < shape.size();) {
+    if (std::isdigit(static_cast<unsigned char>(shape[i]))) {
+      std::size_t v = 0;
+      auto r = std::from_chars(shape.data() + i, shape.data() + shape.size(), v);
+      dims.push_back(v);
+      i = static_cast<std::size_t>(r.ptr - shape.data());
+    } else {
+      ++i;
+    }
+  }
+  std::size_t n = 1;
+  int non_unit = 0;
+  for (auto d : dims) {
+    n *= d;
+    if (d != 1) ++non_unit;
+  }
+  if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
+  std::size_t width = 0;
+  if (descr == "<f8") width = 8;
+  else if (descr == "<f4") width = 4;
+  else if (descr == "<u2" || descr == "<i2") width = 2;
+  else if (descr == "|u1" || descr == "<u1") width = 1;
+  else throw FormatError(where + ": .npy dtype '" + descr + "' is not supported (use float64, float32, int16, uint16 or uint8)");
+  if (b.size() - data_at != n * width)
+    throw FormatError(where + ": .npy data holds " + std::to_string(b.size() - data_at) + " bytes, shape needs " + std::to_string(n * width));
+  std::vector<double> out(n);
+  const char* p = b.data() + data_at;
+  for (std::size_t i = 0; i < n; ++i, p += width) {
+    if (descr == "<f8") std::memcpy(&out[i], p, 8);
+    else if (descr == "<f4") { float f; std::memcpy(&f, p, 4); out[i] = f; }
+    else if (descr == "<u2") { std::uint16_t u; std::memcpy(&u, p, 2); out[i] = u / 65535.0; }
+    else if (descr == "<i2") { std::int16_t s; std::memcpy(&s, p, 2); out[i] = s / 32768.0; }
+    else out[i] = static_cast<unsigned char>(*p) / 255.0;
+  }
+  return out;
+}
+
+std::string csv_columns(std::string_view ha, std::string_view hb, std::span<const double> a, std::span<const double> b) {
+  std::string out;
+  out.reserve(a.size() * 28 + 32);
+  out.append(ha).append(",").append(hb).append("\n");
+  char buf[64];
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    auto r = std::to_chars(buf, buf + sizeof buf, a[i]);
+    out.append(buf, r.ptr);
+    out.push_back(',');
+    r = std::to_chars(buf, buf + sizeof buf, b[i]);
+    out.append(buf, r.ptr);
+    out.push_back('\n');
+  }
+  return out;
+}
+
+std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::string_view text, std::string_view origin) {
+  std::vector<double> a;
+  std::vector<double> b;
+  std::size_t line_no = 0;
+  while (!text.empty()) {
+    const auto nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty() || line[0] == '#') continue;
+    const auto comma = line.find_first_of(",;\t");
+    auto parse = [](std::string_view s, double& v) {
+      while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+      while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+      auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+      return r.ec == std::errc() && r.ptr == s.data() + s.size();
+    };
+    double x = 0.0;
+    double y = 0.0;
+    const bool ok = comma != std::string_view::npos && parse(line.substr(0, comma), x) && parse(line.substr(comma + 1), y);
+    if (!ok) {
+      if (a.empty() && line_no == 1) continue;  // header
+      throw FormatError(std::string(origin) + ":" + std::to_string(line_no) + ": expected two numbers, got '" + std::string(line) + "'");
+    }
+    a.push_back(x);
+    b.push_back(y);
+  }
+  if (a.empty()) throw FormatError(std::string(origin) + ": no numeric rows");
+  return {std::move(a), std::move(b)};
+}
+
+}  // namespace texel
