@@ -1,0 +1,157 @@
+// texel info: what a document or a rendered file holds.
+// texel devices: the device profiles Texel knows.
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <numeric>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+
+namespace texel::cli {
+namespace {
+
+using detail::num;
+using ordered = nlohmann::ordered_json;
+
+ordered stats(const std::vector<double>& v) {
+  ordered j;
+  j["samples"] = v.size();
+  if (v.empty()) return j;
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  j["min"] = *lo;
+  j["max"] = *hi;
+  j["mean"] = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  return j;
+}
+
+ordered document_info(const Document& doc, const std::string& path) {
+  const Surface surface = prepare_surface(doc);
+  ordered j;
+  j["file"] = path;
+  j["kind"] = "texel-document";
+  j["version"] = doc.version;
+  if (!doc.description.empty()) j["description"] = doc.description;
+  j["device"] = {{"name", doc.device.name},
+                 {"samples", doc.device.samples},
+                 {"spacing_mm", doc.device.spacing_mm},
+                 {"length_mm", doc.device.length_mm()},
+                 {"format", std::string(to_string(doc.device.format))},
+                 {"native_bytes", doc.device.native_bytes()},
+                 {"nyquist_cpm", doc.device.nyquist_cpm()}};
+  j["document_bytes"] = document_json(doc).size();
+  j["regions"] = ordered::array();
+  for (const auto& r : surface.regions()) {
+    ordered rj{{"name", r.name}, {"start_mm", r.start_mm}, {"length_mm", r.length_mm}, {"texture", r.texture->describe()}};
+    if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
+      const auto& s = t->spec();
+      rj["texels"] = t->texels().size();
+      rj["central_pitch_db"] = s.central_pitch.value();
+      rj["irregularity_db"] = s.irregularity.value();
+      rj["texel_length_mm"] = s.texel_length.value();
+      rj["seed"] = s.seed;
+      rj["parameterization"] = std::string(to_string(s.parameterization));
+      rj["quantization_db"] = s.quantization_db;
+      rj["coarse"] = kind_name(s.coarse);
+      rj["coarse_strength"] = s.coarse_strength;
+      rj["fine_strength"] = s.fine_strength;
+      rj["band_mass"] = t->distribution().band_mass();
+    }
+    j["regions"].push_back(rj);
+  }
+  return j;
+}
+
+void print_text(const ordered& j, int indent = 0) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string pad(static_cast<std::size_t>(indent), ' ');
+    if (it->is_object()) {
+      std::cout << pad << it.key() << ":\n";
+      print_text(*it, indent + 2);
+    } else if (it->is_array()) {
+      std::cout << pad << it.key() << ":\n";
+      int i = 0;
+      for (const auto& e : *it) {
+        std::cout << pad << "  [" << i++ << "]\n";
+        if (e.is_object()) print_text(e, indent + 4);
+        else std::cout << pad << "    " << e.dump() << "\n";
+      }
+    } else {
+      std::cout << pad << it.key() << ": " << (it->is_string() ? it->get<std::string>() : it->dump()) << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+void register_info(CLI::App& app) {
+  struct Args {
+    std::string file;
+    std::optional<std::string> device;
+    bool json = false;
+  };
+  auto args = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand("info", "Describe a texture document or a rendered file (.bin needs --device)");
+  cmd->add_option("file", args->file, "A .texel.json, .bin, .csv or .npy file")->required();
+  cmd->add_option("--device", args->device, "Device of a .bin file [tpad]");
+  cmd->add_flag("--json", args->json, "Print JSON");
+  cmd->callback([args] {
+    const std::string ext = output_extension(args->file);
+    ordered j;
+    if (ext == ".texel.json" || ext == ".json") {
+      j = document_info(load_document(args->file), args->file);
+    } else if (ext == ".bin") {
+      const DeviceProfile d = load_device(args->device.value_or("tpad"));
+      const std::string bytes = read_file(args->file);
+      const auto data = decode_samples(d.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
+      j["file"] = args->file;
+      j["kind"] = "device-native";
+      j["device"] = d.name;
+      j["format"] = std::string(to_string(d.format));
+      j["bytes"] = bytes.size();
+      j["matches_device"] = static_cast<std::int64_t>(data.size()) == d.samples;
+      j["length_mm"] = static_cast<double>(data.size()) * d.spacing_mm;
+      j["amplitude"] = stats(data);
+    } else if (ext == ".npy") {
+      j["file"] = args->file;
+      j["kind"] = "npy";
+      j["amplitude"] = stats(parse_npy(read_file(args->file), args->file));
+    } else if (ext == ".csv") {
+      auto [x, a] = parse_csv_columns(read_file(args->file), args->file);
+      j["file"] = args->file;
+      j["kind"] = "csv";
+      j["first_mm"] = x.front();
+      j["last_mm"] = x.back();
+      j["amplitude"] = stats(a);
+    } else {
+      throw InvalidArgument("info: '" + args->file + "' has extension '" + ext + "'; allowed: .texel.json, .bin, .csv, .npy");
+    }
+    if (args->json) print_json(j);
+    else print_text(j);
+  });
+}
+
+void register_devices(CLI::App& app) {
+  auto json = std::make_shared<bool>(false);
+  auto* cmd = app.add_subcommand("devices", "List the built-in device profiles");
+  cmd->add_flag("--json", *json, "Print the profiles as JSON");
+  cmd->callback([json] {
+    ordered all = ordered::array();
+    for (const auto& name : builtin_device_names()) {
+      const DeviceProfile d = load_device(name);
+      if (*json) {
+        all.push_back(ordered::parse(device_profile_json(d)));
+      } else {
+        std::cout << d.name << ": " << d.samples << " samples x " << num(d.spacing_mm) << " mm = " << num(d.length_mm()) << " mm, "
+                  << to_string(d.format) << ", " << num(d.refresh_hz) << " Hz, Nyquist " << detail::fixed(d.nyquist_cpm(), 2)
+                  << " cpm\n    " << d.description << "\n";
+      }
+    }
+    if (*json) print_json(all);
+  });
+}
+
+}  // namespace texel::cli

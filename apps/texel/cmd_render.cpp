@@ -1,0 +1,110 @@
+// texel render: a Texel texture (from a document and/or flags) to a device
+// file, CSV, NumPy array, document or plot.
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <numeric>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "render_output.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+
+namespace texel::cli {
+namespace {
+
+struct RenderArgs {
+  std::optional<std::string> document;
+  TextureOptions texture;
+  DeviceOptions device;
+  std::string output;
+  std::optional<std::string> texels_csv;
+  bool json = false;
+};
+
+std::string texels_csv(const Surface& surface) {
+  const bool many = surface.regions().size() > 1;
+  std::string out = many ? "index,start_mm,frequency_cpm,amplitude,region\n" : "index,start_mm,frequency_cpm,amplitude\n";
+  for (std::size_t r = 0; r < surface.regions().size(); ++r) {
+    const auto& region = surface.regions()[r];
+    const auto* t = dynamic_cast<const TexelTexture*>(region.texture.get());
+    if (!t) continue;
+    for (std::size_t k = 0; k < t->texels().size(); ++k) {
+      const Texel& x = t->texels()[k];
+      out += std::to_string(k) + "," + detail::num(region.start_mm + x.start_mm) + "," + detail::num(x.frequency_cpm) + "," +
+             detail::num(x.envelope);
+      if (many) out += "," + (region.name.empty() ? std::to_string(r) : region.name);
+      out += "\n";
+    }
+  }
+  return out;
+}
+
+nlohmann::ordered_json summary(const Document& doc, const Surface& surface, const std::vector<double>& map, const RenderArgs& a) {
+  nlohmann::ordered_json j;
+  j["output"] = a.output;
+  if (a.texels_csv) j["texels_csv"] = *a.texels_csv;
+  j["device"] = doc.device.name;
+  j["samples"] = surface.grid().count;
+  j["spacing_mm"] = surface.grid().spacing_mm;
+  j["length_mm"] = surface.grid().length_mm();
+  j["format"] = std::string(to_string(doc.device.format));
+  j["device_bytes"] = doc.device.native_bytes();
+  j["document_bytes"] = document_json(doc).size();
+  double mean = map.empty() ? 0.0 : std::accumulate(map.begin(), map.end(), 0.0) / static_cast<double>(map.size());
+  j["mean_amplitude"] = mean;
+  j["regions"] = nlohmann::ordered_json::array();
+  for (const auto& r : surface.regions()) {
+    nlohmann::ordered_json rj;
+    rj["name"] = r.name;
+    rj["start_mm"] = r.start_mm;
+    rj["length_mm"] = r.length_mm;
+    rj["texture"] = r.texture->describe();
+    if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
+      const auto& tx = t->texels();
+      double m = 0.0, s2 = 0.0;
+      for (const auto& x : tx) m += x.frequency_cpm;
+      m /= static_cast<double>(std::max<std::size_t>(tx.size(), 1));
+      for (const auto& x : tx) s2 += (x.frequency_cpm - m) * (x.frequency_cpm - m);
+      rj["texels"] = tx.size();
+      rj["frequency_mean_cpm"] = m;
+      rj["frequency_sd_cpm"] = tx.size() > 1 ? std::sqrt(s2 / static_cast<double>(tx.size() - 1)) : 0.0;
+      rj["band_mass"] = t->distribution().band_mass();
+    }
+    j["regions"].push_back(rj);
+  }
+  return j;
+}
+
+}  // namespace
+
+void register_render(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  auto* cmd = app.add_subcommand("render", "Render a Texel texture for a device");
+  cmd->add_option("document", args->document, "A texture document (.texel.json); flags override its values");
+  add_texture_options(*cmd, args->texture);
+  add_device_options(*cmd, args->device);
+  cmd->add_option("-o,--output", args->output, "Output: .bin (device native), .csv, .npy, .texel.json, .png or .svg")->required();
+  cmd->add_option("--texels", args->texels_csv, "Also write one row per texel: index,start_mm,frequency_cpm,amplitude");
+  cmd->add_flag("--json", args->json, "Print a JSON summary on stdout");
+  cmd->callback([args] {
+    output_kind(args->output);  // reject a bad extension before any work
+    check_writable(args->output);
+    if (args->texels_csv) {
+      if (output_extension(*args->texels_csv) != ".csv")
+        throw InvalidArgument("--texels '" + *args->texels_csv + "' must be a .csv file");
+      check_writable(*args->texels_csv);
+    }
+    const Document doc = build_document(args->document, args->device, args->texture);
+    const Surface surface = prepare_surface(doc);
+    const std::vector<double> map = render_map(surface);
+    std::vector<PendingFile> extra;
+    if (args->texels_csv) extra.push_back({*args->texels_csv, texels_csv(surface)});
+    write_rendered(args->output, doc, surface, map, texel_frequencies(surface), std::move(extra));
+    if (args->json) print_json(summary(doc, surface, map, *args));
+  });
+}
+
+}  // namespace texel::cli

@@ -1,0 +1,14 @@
+// Every subcommand registers itself here; main() calls them in order.
+// A subcommand's callback runs the work and throws texel::Error on bad input.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace texel::cli {
+
+void register_render(CLI::App& app);
+void register_info(CLI::App& app);
+void register_demo(CLI::App& app);
+void register_devices(CLI::App& app);
+
+}  // namespace texel::cli

@@ -1,0 +1,86 @@
+// Shared pieces of the texel command: texture options, output writers and
+// the progress line. Commands are thin: parse, call the library, format.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "texel/document.hpp"
+
+namespace texel::cli {
+
+/// Options that set or override a Texel texture's parameters.
+struct TextureOptions {
+  std::optional<double> central_pitch_db;
+  std::optional<double> irregularity_db;
+  std::optional<double> texel_length_mm;
+  std::optional<std::uint64_t> seed;
+  std::optional<double> quantization_db;
+  std::optional<std::string> phase;
+  std::optional<std::string> parameterization;
+  std::optional<std::string> out_of_band;
+  std::optional<std::string> fill;
+  std::optional<double> band_min_cpm;
+  std::optional<double> band_max_cpm;
+  std::optional<double> coarse_strength;
+  std::optional<double> fine_strength;
+  std::optional<double> coarse_sine_mm;
+  std::optional<double> coarse_phase_deg;
+  std::optional<std::string> coarse_profile;
+};
+
+/// Options that pick and reshape the device.
+struct DeviceOptions {
+  std::optional<std::string> device;
+  std::optional<double> length_mm;
+  std::optional<double> spacing_mm;
+};
+
+void add_texture_options(CLI::App& cmd, TextureOptions& o);
+void add_device_options(CLI::App& cmd, DeviceOptions& o);
+
+/// Applies the options to a spec (throws InvalidArgument on bad values).
+void apply(const TextureOptions& o, TexelSpec& spec);
+/// Resolves the device: the document's (if any), replaced by --device, reshaped by --length/--spacing.
+DeviceProfile resolve_device(const DeviceOptions& o, const DeviceProfile* current);
+
+/// Loads DOC or builds a default one, then applies device and texture options.
+Document build_document(const std::optional<std::string>& doc_path, const DeviceOptions& d, const TextureOptions& t);
+
+/// Output formats of a rendered surface, picked by the output's extension.
+enum class OutputKind { bin, csv, npy, document, png, svg };
+/// Throws InvalidArgument naming the extension and the allowed ones.
+OutputKind output_kind(const std::string& path);
+
+/// The prepared outputs of one render, written only once all are ready.
+struct PendingFile {
+  std::string path;
+  std::string bytes;
+};
+/// Writes every pending file atomically; if one fails, removes the ones this
+/// call already wrote so a failed command leaves no partial output.
+void commit_files(const std::vector<PendingFile>& files);
+
+/// A one-line progress indicator on stderr, only when stderr is a terminal.
+class Progress {
+public:
+  explicit Progress(std::string label);
+  ~Progress();
+  void update(double fraction);
+  void done();
+
+private:
+  std::string label_;
+  bool active_ = false;
+  int last_percent_ = -1;
+};
+
+/// Prints `j` to stdout, indented.
+void print_json(const nlohmann::ordered_json& j);
+
+}  // namespace texel::cli

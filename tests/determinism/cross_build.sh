@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Determinism across builds (issue #2, item 7): the demo set's device files
+# must be byte-identical whether Texel is built with GCC or clang, at -O0 or
+# -O3, and with the baseline x86-64 SIMD width or the host's widest
+# (-march=native: AVX2/AVX-512 where present). Each configuration builds only
+# the texel command, renders the demo set and compares SHA-256 digests with
+# the reviewed golden list tests/golden/demo.sha256.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+golden="$root/tests/golden/demo.sha256"
+work="$root/build-det"
+jobs=$(nproc 2>/dev/null || echo 2)
+mkdir -p "$work"
+
+configs=(
+  "gcc-O0:g++:-O0"
+  "gcc-O3-native:g++:-O3 -march=native"
+  "clang-O0:clang++:-O0"
+  "clang-O3:clang++:-O3"
+)
+fail=0
+for c in "${configs[@]}"; do
+  IFS=: read -r name cxx flags <<<"$c"
+  dir="$work/$name"
+  cmake -S "$root" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_CXX_FLAGS="$flags" \
+    -DTEXEL_BUILD_TESTS=OFF -DTEXEL_BUILD_BENCH=OFF >/dev/null
+  cmake --build "$dir" -j "$jobs" --target texel_cli >/dev/null
+  rm -rf "$dir/demo"
+  "$dir/bin/texel" demo --no-plots --out "$dir/demo" >/dev/null
+  (cd "$dir/demo" && sha256sum -- *.bin) >"$dir/demo.sha256"
+  if diff -u "$golden" "$dir/demo.sha256" >"$dir/diff.txt"; then
+    echo "determinism: $name ($cxx $flags): $(wc -l <"$golden") demo files identical to the golden digests"
+  else
+    echo "determinism: $name ($cxx $flags) DIFFERS from $golden:"
+    cat "$dir/diff.txt"
+    fail=1
+  fi
+done
+if [ "$fail" -ne 0 ]; then
+  echo "1 failed: builds disagree"
+  exit 1
+fi
+echo "${#configs[@]} passed, 0 failed"
