@@ -58,11 +58,11 @@ struct Axis {
 /// per pixel column; unsorted ones are drawn point by point (slower, same
 /// picture). A non-finite y breaks the line.
 struct LineSeries {
-  std::vector<double> x;       ///< data units of the panel's x axis
-  std::vector<double> y;       ///< same length as x
-  std::optional<Rgb> colour;   ///< unset: the panel's next palette colour
-  double width_px = 1.25;      ///< stroke width, px (0.1 … 20)
-  std::string label;           ///< legend text; empty = not in the legend
+  std::vector<double> x;      ///< data units of the panel's x axis
+  std::vector<double> y;      ///< same length as x
+  std::optional<Rgb> colour;  ///< unset: the panel's next palette colour
+  double width_px = 1.25;     ///< stroke width, px (0.1 … 20)
+  std::string label;          ///< legend text; empty = not in the legend
 };
 
 /// Markers at (x[i], y[i]), optionally on stems from `baseline` (peak lists).
@@ -87,8 +87,8 @@ struct Histogram {
 
 /// A labelled vertical line across the plot area (e.g. "central pitch").
 struct VerticalMarker {
-  double x = 0.0;                  ///< x data units; outside the axis range: not drawn
-  std::string label;               ///< drawn at the top of the line; empty = none
+  double x = 0.0;     ///< x data units; outside the axis range: not drawn
+  std::string label;  ///< drawn at the top of the line; empty = none
   Rgb colour{0.25, 0.25, 0.25};
   bool dashed = true;
 };
@@ -113,11 +113,11 @@ struct Panel {
 /// their left edge and those in one row their top and bottom, so stacked
 /// panels line up.
 struct Figure {
-  int width_px = 1000;   ///< 64 … 16384 px (SVG: CSS px)
-  int height_px = 700;   ///< 64 … 16384 px
-  std::string title;     ///< above all panels; empty = none
-  int columns = 1;       ///< >= 1
-  double font_px = 13.0; ///< base text size, 4 … 72 px; titles are larger, ticks smaller
+  int width_px = 1000;    ///< 64 … 16384 px (SVG: CSS px)
+  int height_px = 700;    ///< 64 … 16384 px
+  std::string title;      ///< above all panels; empty = none
+  int columns = 1;        ///< >= 1
+  double font_px = 13.0;  ///< base text size, 4 … 72 px; titles are larger, ticks smaller
   std::vector<Panel> panels;
 };
 
@@ -125,8 +125,8 @@ struct Figure {
 /// row-major in `columns` columns. Every cell is as large as the largest
 /// figure; a smaller one is centred in its cell.
 struct FigureGrid {
-  std::string title;  ///< above all cells; empty = none
-  int columns = 3;    ///< >= 1
+  std::string title;      ///< above all cells; empty = none
+  int columns = 3;        ///< >= 1
   double font_px = 16.0;  ///< size of `title`, px
   std::vector<Figure> cells;
 };
@@ -202,7 +202,6 @@ void plot_map(const MapPlot& plot, const std::string& path);
 
 /// Draws an atlas of map_cell_figure cells, `columns` per row, to `path`
 /// (.png or .svg), atomically; `title` above all cells (empty = none).
-void plot_map_grid(std::span<const MapPlot> plots, const std::string& path, int columns = 3,
-                   const std::string& title = {});
+void plot_map_grid(std::span<const MapPlot> plots, const std::string& path, int columns = 3, const std::string& title = {});
 
 }  // namespace texel

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -111,15 +112,17 @@ std::vector<Tick> log_ticks(double lo, double hi, bool db_labels, int target) {
       for (int m = 2; m <= 9; ++m) {
         const double v = m * p;
         if (!in_range(v)) continue;
-        if (label_25 && (m == 2 || m == 5)) ticks.push_back(label(v));
-        else ticks.push_back({v, {}, {}, false});
+        if (label_25 && (m == 2 || m == 5))
+          ticks.push_back(label(v));
+        else
+          ticks.push_back({v, {}, {}, false});
       }
     }
     std::sort(ticks.begin(), ticks.end(), [](const Tick& a, const Tick& b) { return a.value < b.value; });
     return ticks;
   }
   // Less than two powers of ten inside: 1-2-5 multiples, else a linear scale.
-  for (int d = static_cast<int>(std::floor(l0)) ; d <= static_cast<int>(std::ceil(l1)); ++d)
+  for (int d = static_cast<int>(std::floor(l0)); d <= static_cast<int>(std::ceil(l1)); ++d)
     for (const double m : {1.0, 2.0, 5.0}) {
       const double v = m * std::pow(10.0, d);
       if (in_range(v)) ticks.push_back(label(v));
@@ -185,8 +188,8 @@ void check_panel(const Panel& p, const std::string& name) {
 void check_figure(const Figure& f, const std::string& name) {
   const auto side = [&](const char* what, int v) {
     if (v < min_side_px || v > max_side_px)
-      throw InvalidArgument(name + "." + what + " is " + std::to_string(v) + "; allowed " + std::to_string(min_side_px) +
-                            " … " + std::to_string(max_side_px));
+      throw InvalidArgument(name + "." + what + " is " + std::to_string(v) + "; allowed " + std::to_string(min_side_px) + " … " +
+                            std::to_string(max_side_px));
   };
   side("width_px", f.width_px);
   side("height_px", f.height_px);
@@ -228,7 +231,7 @@ const Rgb grid_colour{0.88, 0.88, 0.88};
 
 /// Thin wrapper over a cairo_t: colours, text with alignment, measurement.
 class Painter {
-public:
+ public:
   explicit Painter(cairo_t* cr) : cr_(cr) {
     cairo_font_options_t* opts = cairo_font_options_create();
     // Unhinted metrics: text measures the same in PNG and SVG.
@@ -279,7 +282,23 @@ public:
   }
   void rect(const Rect& r) const { cairo_rectangle(cr_, r.x, r.y, r.w, r.h); }
 
-private:
+  /// `s` fitted into `max_w` px: the font shrinks down to 70 % of `size_px`,
+  /// then the text is cut with an ellipsis. Selects the font it fits with.
+  [[nodiscard]] std::string fit(std::string s, double max_w, double size_px, bool bold) const {
+    font(size_px, bold);
+    const double w = width(s);
+    if (w <= max_w) return s;
+    const double shrunk = std::max(size_px * 0.7, size_px * max_w / w);
+    font(shrunk, bold);
+    // Cut whole UTF-8 characters (continuation bytes, then the lead byte).
+    while (!s.empty() && width(s + "\u2026") > max_w) {
+      while (!s.empty() && (static_cast<unsigned char>(s.back()) & 0xC0) == 0x80) s.pop_back();
+      if (!s.empty()) s.pop_back();
+    }
+    return s + "\u2026";
+  }
+
+ private:
   cairo_t* cr_;
 };
 
@@ -321,8 +340,8 @@ struct Range {
 };
 
 /// The final range of an axis: fixed ends from the Axis, the rest from the
-/// data with a margin (`pad` of the span; 0 keeps the data tight).
-std::pair<double, double> resolve_range(const Axis& axis, Range data, double pad) {
+/// data with margins (`pad_lo`, `pad_hi` of the span; 0 keeps the data tight).
+std::pair<double, double> resolve_range(const Axis& axis, Range data, double pad_lo, double pad_hi) {
   const bool log = axis.scale == AxisScale::log10;
   if (data.empty()) data = log ? Range{1.0, 10.0} : Range{0.0, 1.0};
   if (axis.min) {
@@ -336,23 +355,30 @@ std::pair<double, double> resolve_range(const Axis& axis, Range data, double pad
   if (!(a < b)) {
     // One value (or a fixed end past the data): open a unit-wide window.
     const double half = log ? 0.5 : std::max(0.5, std::abs(a) * 0.1);
-    if (axis.min && !axis.max) b = a + 2 * half;
-    else if (axis.max && !axis.min) a = b - 2 * half;
-    else a -= half, b += half;
+    if (axis.min && !axis.max)
+      b = a + 2 * half;
+    else if (axis.max && !axis.min)
+      a = b - 2 * half;
+    else
+      a -= half, b += half;
     return {from(a), from(b)};
   }
   const double span = b - a;
-  if (!axis.min && !data.anchored_lo) a -= pad * span;
-  if (!axis.max) b += pad * span;
+  if (!axis.min && !data.anchored_lo) a -= pad_lo * span;
+  if (!axis.max) b += pad_hi * span;
   return {from(a), from(b)};
 }
 
 // -------------------------------------------------------------- decimation
 
+constexpr double columns_per_px = 4.0;
+
 /// Pixel-space vertices of a polyline, NaN x marking a break. Sorted input is
-/// cut to the visible x range by binary search and reduced, per pixel column,
-/// to the first, min, max and last point in index order: the stroked result
-/// covers exactly the pixels the full line would.
+/// cut to the visible x range by binary search and reduced, per column, to
+/// the first, min, max and last point in index order (the M4 scheme of
+/// Jugel et al., VLDB 2014: exact for aliased 1-px lines). Columns are a
+/// quarter pixel wide because antialiased strokes resolve sub-pixel
+/// position; at 16 vertices per pixel of width the path stays tiny.
 std::vector<std::pair<double, double>> line_vertices(const LineSeries& s, const Scale& xs, const Scale& ys) {
   std::vector<std::pair<double, double>> out;
   const std::size_t n = s.x.size();
@@ -367,16 +393,18 @@ std::vector<std::pair<double, double>> line_vertices(const LineSeries& s, const 
     i1 = static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(n), (hi - s.x.begin()) + 1));
   }
   const double width_px = std::abs(xs.p1 - xs.p0);
-  const bool decimate = sorted && static_cast<double>(i1 - i0) > 4.0 * width_px;
-  out.reserve(decimate ? static_cast<std::size_t>(4 * width_px) + 16 : i1 - i0);
+  const bool decimate = sorted && static_cast<double>(i1 - i0) > 4.0 * columns_per_px * width_px;
+  out.reserve(decimate ? static_cast<std::size_t>(4.0 * columns_per_px * width_px) + 16 : i1 - i0);
   const auto brk = [&] {
     if (!out.empty() && !std::isnan(out.back().first)) out.emplace_back(nan, nan);
   };
   if (!decimate) {
     for (std::size_t i = i0; i < i1; ++i) {
       const double px = xs(s.x[i]), py = ys(s.y[i]);
-      if (std::isnan(px) || std::isnan(py)) brk();
-      else out.emplace_back(px, py);
+      if (std::isnan(px) || std::isnan(py))
+        brk();
+      else
+        out.emplace_back(px, py);
     }
     return out;
   }
@@ -402,7 +430,7 @@ std::vector<std::pair<double, double>> line_vertices(const LineSeries& s, const 
       brk();
       continue;
     }
-    const double col = std::floor(px);
+    const double col = std::floor(px * columns_per_px);
     if (c.open && col != c.col) flush();
     if (!c.open) {
       c = Column{true, col, i, i, i, i, py, py};
@@ -427,7 +455,7 @@ struct Swatch {
 /// Everything about a panel that is known before it is placed.
 struct PanelPlan {
   const Panel* panel = nullptr;
-  Rect cell;                      // the panel's share of the figure
+  Rect cell;  // the panel's share of the figure
   double xlo = 0, xhi = 1, ylo = 0, yhi = 1;
   std::vector<Tick> xticks, yticks;
   std::vector<Rgb> line_colours, stem_colours, hist_colours;
@@ -452,7 +480,8 @@ void plan_ranges(PanelPlan& pp) {
     for (const double v : s.x) xr.add(v, xlog);
   for (const auto& h : p.histograms)
     for (const double v : h.edges) xr.add(v, xlog);
-  std::tie(pp.xlo, pp.xhi) = resolve_range(p.x, xr, only_lines ? 0.0 : 0.04);
+  const double xpad = only_lines ? 0.0 : 0.04;
+  std::tie(pp.xlo, pp.xhi) = resolve_range(p.x, xr, xpad, xpad);
 
   // y from the points inside the chosen x range, so an excerpt autoscales to itself.
   Range yr;
@@ -475,7 +504,9 @@ void plan_ranges(PanelPlan& pp) {
       if (yr.lo >= 0) yr.anchored_lo = true;
     }
   }
-  std::tie(pp.ylo, pp.yhi) = resolve_range(p.y, yr, 0.05);
+  // Headroom for marker labels, which sit at the top of the plot.
+  const bool labelled_markers = std::any_of(p.markers.begin(), p.markers.end(), [](const auto& m) { return !m.label.empty(); });
+  std::tie(pp.ylo, pp.yhi) = resolve_range(p.y, yr, 0.05, labelled_markers ? 0.14 : 0.05);
 }
 
 void plan_colours(PanelPlan& pp) {
@@ -628,7 +659,19 @@ void draw_axes(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Sca
   cairo_stroke(cr);
 }
 
-void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Scale& xs, const Scale& ys) {
+using Vertices = std::vector<std::pair<double, double>>;
+
+/// Where a vertical marker's label goes: right of the line at the top of the
+/// plot, or left of it where there is no room on the right.
+Rect marker_label_box(const VerticalMarker& m, double x, const Rect& r, const Painter& pa, const Fonts& f) {
+  pa.font(f.small);
+  const double w = pa.width(m.label), h = pa.line_height();
+  const bool left = x + 4 + w > r.right() - 2;
+  return {left ? x - 4 - w : x + 4, r.y + 4, w, h};
+}
+
+void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Scale& xs, const Scale& ys,
+                 const std::vector<Vertices>& line_px) {
   cairo_t* cr = pa.cr();
   const Panel& p = *pp.panel;
   const Rect& r = pp.plot;
@@ -672,33 +715,42 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
     cairo_stroke(cr);
     cairo_set_dash(cr, nullptr, 0, 0);
     if (!m.label.empty()) {
-      pa.font(f.small);
-      const double w = pa.width(m.label);
-      const bool left = x + 4 + w > r.right() - 2;  // no room to the right
-      const double tx = left ? x - 4 : x + 4;
+      const Rect b = marker_label_box(m, x, r, pa, f);  // also selects the font
       cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
-      cairo_rectangle(cr, left ? tx - w - 2 : tx - 2, r.y + 3, w + 4, pa.line_height() + 2);
+      cairo_rectangle(cr, b.x - 2, b.y - 1, b.w + 4, b.h + 2);
       cairo_fill(cr);
       pa.colour(m.colour);
-      pa.text(m.label, tx, r.y + 4, left ? HAlign::right : HAlign::left, VAlign::top);
+      pa.text(m.label, b.x, b.y, HAlign::left, VAlign::top);
     }
   }
 
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  // Stroked in chunks: Cairo tessellates a path as a whole, and a dense
+  // envelope crosses itself so often that one path costs seconds. Chunks
+  // overlap only at their shared vertex, invisible under a round join.
+  constexpr std::size_t chunk = 512;
   for (std::size_t i = 0; i < p.lines.size(); ++i) {
-    const auto v = line_vertices(p.lines[i], xs, ys);
+    pa.colour(pp.line_colours[i]);
+    cairo_set_line_width(cr, p.lines[i].width_px);
     bool pen_down = false;
-    for (const auto& [x, y] : v) {
+    std::size_t in_path = 0;
+    for (const auto& [x, y] : line_px[i]) {
       if (std::isnan(x)) {
         pen_down = false;
         continue;
       }
-      if (pen_down) cairo_line_to(cr, x, y);
-      else cairo_move_to(cr, x, y);
+      if (pen_down) {
+        cairo_line_to(cr, x, y);
+        if (++in_path >= chunk) {
+          cairo_stroke(cr);
+          cairo_move_to(cr, x, y);
+          in_path = 0;
+        }
+      } else {
+        cairo_move_to(cr, x, y);
+      }
       pen_down = true;
     }
-    pa.colour(pp.line_colours[i]);
-    cairo_set_line_width(cr, p.lines[i].width_px);
     cairo_stroke(cr);
   }
 
@@ -730,7 +782,10 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
   cairo_restore(cr);
 }
 
-void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f) {
+/// The legend goes in the plot corner that hides the fewest drawn points
+/// (top right on a tie), which is where a reader expects it.
+void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Scale& xs, const Scale& ys,
+                 const std::vector<Vertices>& line_px) {
   const auto entries = legend_entries(pp);
   if (!pp.panel->legend || entries.size() < 2) return;
   cairo_t* cr = pa.cr();
@@ -740,8 +795,34 @@ void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f) {
   double w = 0;
   for (const auto& e : entries) w = std::max(w, pa.width(e.label));
   const double pad = f.small * 0.5;
-  const Rect box{pp.plot.right() - 8 - (w + sw + 3 * pad), pp.plot.y + 8, w + sw + 3 * pad,
-                 lh * static_cast<double>(entries.size()) + 2 * pad * 0.6};
+  const double bw = w + sw + 3 * pad, bh = lh * static_cast<double>(entries.size()) + 2 * pad * 0.6;
+  const Rect& r = pp.plot;
+  std::vector<std::pair<double, double>> marker_spans;  // x extent of each marker with its label
+  for (const auto& m : pp.panel->markers) {
+    const double x = xs(m.x);
+    if (std::isnan(x)) continue;
+    const Rect lb = m.label.empty() ? Rect{x, 0, 0, 0} : marker_label_box(m, x, r, pa, f);
+    marker_spans.emplace_back(std::min(x, lb.x), std::max(x, lb.right()));
+  }
+  pa.font(f.small);
+  const Rect corners[] = {{r.right() - 8 - bw, r.y + 8, bw, bh},
+                          {r.x + 8, r.y + 8, bw, bh},
+                          {r.right() - 8 - bw, r.bottom() - 8 - bh, bw, bh},
+                          {r.x + 8, r.bottom() - 8 - bh, bw, bh}};
+  const auto hidden = [&](const Rect& b) {
+    std::size_t n = 0;
+    const auto in = [&](double x, double y) { return x >= b.x && x <= b.right() && y >= b.y && y <= b.bottom(); };
+    for (const auto& v : line_px)
+      for (const auto& [x, y] : v) n += in(x, y);
+    for (const auto& s : pp.panel->stems)
+      for (std::size_t k = 0; k < s.x.size(); ++k) n += in(xs(s.x[k]), ys(s.y[k])) ? 10 : 0;
+    for (const auto& [x0, x1] : marker_spans) n += x1 >= b.x - 2 && x0 <= b.right() + 2 ? 50 : 0;
+    return n;
+  };
+  Rect box = corners[0];
+  std::size_t best = hidden(box);
+  for (const Rect& c : corners)
+    if (const std::size_t h = hidden(c); h < best) best = h, box = c;
   cairo_set_source_rgba(cr, 1, 1, 1, 0.88);
   pa.rect(box);
   cairo_fill_preserve(cr);
@@ -793,9 +874,9 @@ void draw_figure(const Painter& pa, const Figure& fig, const Rect& area) {
   const double outer = f.base * 0.5;
   double top = area.y + outer;
   if (!fig.title.empty()) {
-    pa.font(f.base * 1.3, true);
+    const std::string title = pa.fit(fig.title, area.w - 2 * outer, f.base * 1.3, true);
     pa.colour(text_colour);
-    pa.text(fig.title, area.x + area.w / 2, top, HAlign::centre, VAlign::top);
+    pa.text(title, area.x + area.w / 2, top, HAlign::centre, VAlign::top);
     top += pa.line_height() + f.base * 0.2;
   }
   const std::size_t n = fig.panels.size();
@@ -841,13 +922,15 @@ void draw_figure(const Painter& pa, const Figure& fig, const Rect& area) {
     const Scale xs(pp.xlo, pp.xhi, pp.plot.x, pp.plot.right(), pp.panel->x.scale == AxisScale::log10);
     const Scale ys(pp.ylo, pp.yhi, pp.plot.bottom(), pp.plot.y, pp.panel->y.scale == AxisScale::log10);
     if (!pp.panel->title.empty()) {
-      pa.font(f.title, true);
+      const std::string title = pa.fit(pp.panel->title, pp.plot.w, f.title, true);
       pa.colour(text_colour);
-      pa.text(pp.panel->title, pp.plot.x, pp.plot.y - f.base * 0.45, HAlign::left, VAlign::bottom);
+      pa.text(title, pp.plot.x, pp.plot.y - f.base * 0.45, HAlign::left, VAlign::bottom);
     }
     draw_axes(pp, pa, f, xs, ys);
-    draw_series(pp, pa, f, xs, ys);
-    draw_legend(pp, pa, f);
+    std::vector<Vertices> line_px;
+    for (const auto& s : pp.panel->lines) line_px.push_back(line_vertices(s, xs, ys));
+    draw_series(pp, pa, f, xs, ys, line_px);
+    draw_legend(pp, pa, f, xs, ys, line_px);
   }
   cairo_restore(cr);
 }
@@ -895,7 +978,8 @@ struct GridGeometry {
 
 GridGeometry grid_geometry(const FigureGrid& g) {
   if (g.columns < 1) throw InvalidArgument("grid.columns is " + std::to_string(g.columns) + "; must be >= 1");
-  if (!(g.font_px >= 4 && g.font_px <= 72)) throw InvalidArgument("grid.font_px is " + detail::num(g.font_px) + "; allowed 4 … 72");
+  if (!(g.font_px >= 4 && g.font_px <= 72))
+    throw InvalidArgument("grid.font_px is " + detail::num(g.font_px) + "; allowed 4 … 72");
   if (g.cells.empty()) throw InvalidArgument("grid.cells is empty; needs at least one figure");
   GridGeometry geo;
   for (std::size_t i = 0; i < g.cells.size(); ++i) {
@@ -921,10 +1005,9 @@ GridGeometry grid_geometry(const FigureGrid& g) {
 // ------------------------------------------------------------------- public
 
 Rgb palette_colour(std::size_t i) {
-  static constexpr Rgb tableau10[] = {
-      {0.122, 0.467, 0.706}, {1.000, 0.498, 0.055}, {0.173, 0.627, 0.173}, {0.839, 0.153, 0.157},
-      {0.580, 0.404, 0.741}, {0.549, 0.337, 0.294}, {0.890, 0.467, 0.761}, {0.498, 0.498, 0.498},
-      {0.737, 0.741, 0.133}, {0.090, 0.745, 0.812}};
+  static constexpr Rgb tableau10[] = {{0.122, 0.467, 0.706}, {1.000, 0.498, 0.055}, {0.173, 0.627, 0.173}, {0.839, 0.153, 0.157},
+                                      {0.580, 0.404, 0.741}, {0.549, 0.337, 0.294}, {0.890, 0.467, 0.761}, {0.498, 0.498, 0.498},
+                                      {0.737, 0.741, 0.133}, {0.090, 0.745, 0.812}};
   return tableau10[i % std::size(tableau10)];
 }
 
@@ -965,8 +1048,8 @@ Histogram make_histogram(std::span<const double> values, std::size_t bins, AxisS
     h.edges[i] = log ? std::pow(10.0, e) : e;
   }
   for (const double v : t) {
-    const auto k = static_cast<std::size_t>(std::clamp((v - lo) / (hi - lo) * static_cast<double>(bins), 0.0,
-                                                       static_cast<double>(bins - 1)));
+    const auto k = static_cast<std::size_t>(
+        std::clamp((v - lo) / (hi - lo) * static_cast<double>(bins), 0.0, static_cast<double>(bins - 1)));
     h.counts[k] += 1.0;
   }
   return h;
@@ -991,9 +1074,9 @@ std::string render_figure_grid(const FigureGrid& grid, PlotFormat format) {
   const GridGeometry geo = grid_geometry(grid);
   return encode(format, geo.width, geo.height, [&](const Painter& pa) {
     if (!grid.title.empty()) {
-      pa.font(grid.font_px, true);
+      const std::string title = pa.fit(grid.title, geo.width - 2 * grid.font_px, grid.font_px, true);
       pa.colour(text_colour);
-      pa.text(grid.title, geo.width / 2.0, geo.title_h / 2.0, HAlign::centre, VAlign::middle);
+      pa.text(title, geo.width / 2.0, geo.title_h / 2.0, HAlign::centre, VAlign::middle);
     }
     for (std::size_t i = 0; i < grid.cells.size(); ++i) {
       const Figure& f = grid.cells[i];
@@ -1055,7 +1138,12 @@ Panel histogram_panel(const MapPlot& m, std::string title) {
     // Keep the marker in view even when the draw missed the central pitch.
     p.x.min = std::min(h.edges.front(), m.central_pitch_cpm / 1.25);
     p.x.max = std::max(h.edges.back(), m.central_pitch_cpm * 1.25);
-    p.markers.push_back({m.central_pitch_cpm, "central pitch " + detail::fixed(m.central_pitch_cpm, 3) + " cpm", {0.2, 0.2, 0.2}, true});
+    char cpm[32];
+    std::snprintf(cpm, sizeof cpm, "%.3g", m.central_pitch_cpm);
+    p.markers.push_back({m.central_pitch_cpm,
+                         "central pitch " + std::string(cpm) + " cpm (" + db_text(m.central_pitch_cpm) + ")",
+                         {0.2, 0.2, 0.2},
+                         true});
   }
   p.histograms.push_back(std::move(h));
   return p;
