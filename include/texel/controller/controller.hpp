@@ -1,0 +1,352 @@
+// The reference display controller: the firmware side of the serial protocol
+// (docs/serial-protocol.md). It receives maps from the host, reads the
+// finger position (from its own sensor or from the host's stream) and writes
+// the friction amplitude at the display's refresh rate (8,333 Hz on `tpad`),
+// as the TPaD's microcontroller does (rendering.md §8).
+//
+// Portable C++20 for a microcontroller: no heap, no exceptions, no RTTI
+// needed at run time, no standard library beyond <cstdint>/<cstring>. All
+// storage is inside the object (sized by the template parameters), so
+// firmware declares one `static Controller<…> c(hal, info);` and calls
+// c.poll() in its main loop. The hardware is reached only through Hal.
+//
+// Robustness: a corrupted or partial frame is dropped and the decoder
+// resynchronises on the next sync; a map is uploaded into a staging buffer
+// and only installed when its CRC-32 checks, so the controller always keeps
+// its last good map; a link that goes down is counted and retried, and
+// streamed positions that stop arriving for stream_timeout_us put the output
+// at rest rather than freezing a stale amplitude.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+#include "texel/serial_protocol.hpp"
+
+namespace texel::controller {
+
+/// The hardware abstraction: everything the controller touches.
+class Hal {
+public:
+  /// Monotonic microseconds (wraps at 2³²; the controller handles the wrap).
+  virtual std::uint32_t micros() = 0;
+  /// Non-blocking read of up to `max` bytes: the count read (0 = none),
+  /// or < 0 if the link is down (unplugged cable, closed pty).
+  virtual int serial_read(std::uint8_t* buf, int max) = 0;
+  /// Writes all `n` bytes; false if the link is down.
+  virtual bool serial_write(const std::uint8_t* buf, int n) = 0;
+  /// The display's own finger sensor: true and the position if it has one;
+  /// false to use positions streamed by the host.
+  virtual bool read_position(std::int32_t& x_nm, bool& touch) = 0;
+  /// Sets the friction amplitude (0 = at rest, 65535 = full).
+  virtual void write_amplitude(std::uint16_t amplitude) = 0;
+  /// Idles until about `t_us` (or returns early when bytes arrive).
+  virtual void idle_until(std::uint32_t t_us) = 0;
+
+protected:
+  ~Hal() = default;
+};
+
+struct Info {
+  const char* name = "texel-reference";      ///< reported in HELLO_REPLY (≤ 32 bytes used)
+  std::uint32_t refresh_mhz = 8333000;       ///< output rate in millihertz (8,333 Hz)
+  std::uint32_t stream_timeout_us = 200000;  ///< streamed position/drive older than this: output at rest
+};
+
+enum class Mode : std::uint8_t { idle = 0, position = 1, drive = 2 };
+
+/// Counters and state, for STATUS and for tests.
+struct Status {
+  std::uint8_t selected = serial::no_map;
+  Mode mode = Mode::idle;
+  std::uint16_t amplitude = 0;
+  std::int32_t x_nm = 0;
+  bool touch = false;
+  std::uint32_t frames_ok = 0;
+  std::uint32_t frames_bad = 0;   ///< CRC and length errors
+  std::uint32_t nacks = 0;
+  std::uint32_t link_errors = 0;  ///< times the link was found down
+  std::uint32_t ticks = 0;        ///< output updates
+  serial::ErrorCode last_error = serial::ErrorCode::none;
+};
+
+template <std::size_t MaxSamples = 32768, std::size_t Slots = 2>
+class Controller {
+  static_assert(Slots >= 1 && Slots < serial::no_map, "1 … 254 map slots");
+
+public:
+  static constexpr std::size_t max_samples = MaxSamples;
+  static constexpr std::size_t slots = Slots;
+
+  Controller(Hal& hal, const Info& info) : hal_(hal), info_(info) {
+    start_us_ = hal_.micros();
+    next_tick_us_ = start_us_;
+  }
+
+  /// One pass of the main loop: drains the serial port, answers frames and,
+  /// when a refresh tick is due, updates the output. Never blocks.
+  void poll() {
+    drain_serial();
+    const std::uint32_t now = hal_.micros();
+    if (static_cast<std::int32_t>(now - next_tick_us_) >= 0) {
+      tick(now);
+      ++tick_count_;
+      next_tick_us_ = start_us_ + tick_offset_us(tick_count_);
+      if (static_cast<std::int32_t>(now - next_tick_us_) > 0) {
+        // Fell behind (host scheduling, a long map copy): skip the missed
+        // ticks instead of bursting through them.
+        const std::uint64_t behind = (static_cast<std::uint64_t>(now - next_tick_us_) * info_.refresh_mhz) / 1000000000ull + 1;
+        tick_count_ += behind;
+        next_tick_us_ = start_us_ + tick_offset_us(tick_count_);
+      }
+    }
+  }
+
+  /// Runs poll() until should_stop() is true, idling between ticks.
+  template <class Stop>
+  void run(Stop&& should_stop) {
+    while (!should_stop()) {
+      poll();
+      hal_.idle_until(next_tick_us_);
+    }
+  }
+
+  [[nodiscard]] const Status& status() const { return status_; }
+  [[nodiscard]] bool link_up() const { return link_up_; }
+  /// Samples held in slot `id` (0 if empty or out of range).
+  [[nodiscard]] std::uint32_t map_samples(std::uint8_t id) const { return id < Slots ? maps_[id].samples : 0; }
+  /// Sample i of slot id (for tests).
+  [[nodiscard]] std::uint16_t map_value(std::uint8_t id, std::uint32_t i) const {
+    return id < Slots && i < maps_[id].samples ? maps_[id].data[i] : 0;
+  }
+
+private:
+  struct Map {
+    std::uint32_t samples = 0;  // 0 = empty
+    std::uint32_t spacing_nm = 0;
+    std::int32_t origin_nm = 0;
+    std::uint16_t data[MaxSamples];
+  };
+
+  [[nodiscard]] std::uint32_t tick_offset_us(std::uint64_t k) const {
+    return static_cast<std::uint32_t>((k * 1000000000ull) / info_.refresh_mhz);
+  }
+
+  void drain_serial() {
+    std::uint8_t buf[256];
+    for (int rounds = 0; rounds < 64; ++rounds) {  // bounded work per poll
+      const int n = hal_.serial_read(buf, static_cast<int>(sizeof buf));
+      if (n < 0) {
+        if (link_up_) {
+          ++status_.link_errors;
+          link_up_ = false;
+          decoder_.reset();  // a half frame from before the break is worthless
+        }
+        return;
+      }
+      link_up_ = true;
+      if (n == 0) break;
+      last_byte_us_ = hal_.micros();
+      decoder_.feed(
+          buf, static_cast<std::size_t>(n), [this](const serial::Frame& f) { handle(f); },
+          [this](serial::ErrorCode e) { bad_frame(e); });
+    }
+    // A partial frame that has stalled for 50 ms will never complete.
+    if (decoder_.buffered() > 0 && static_cast<std::int32_t>(hal_.micros() - last_byte_us_) > 50000) {
+      decoder_.expire([this](const serial::Frame& f) { handle(f); }, [this](serial::ErrorCode e) { bad_frame(e); });
+      last_byte_us_ = hal_.micros();
+    }
+  }
+
+  void bad_frame(serial::ErrorCode e) {
+    ++status_.frames_bad;
+    status_.last_error = e;
+  }
+
+  void tick(std::uint32_t now) {
+    std::int32_t x = 0;
+    bool touch = false;
+    bool fresh = true;
+    if (hal_.read_position(x, touch)) {
+      status_.mode = status_.mode == Mode::drive ? Mode::drive : Mode::position;
+    } else {
+      x = stream_x_nm_;
+      touch = stream_touch_;
+      fresh = static_cast<std::uint32_t>(now - stream_us_) <= info_.stream_timeout_us;
+    }
+    std::uint16_t a = 0;
+    if (status_.mode == Mode::drive) {
+      a = fresh ? drive_ : 0;
+    } else if (touch && fresh && status_.selected < Slots) {
+      const Map& m = maps_[status_.selected];
+      // Nearest sample, as the TPaD's firmware does: its sensor resolution
+      // equals the map spacing.
+      const std::int64_t rel = static_cast<std::int64_t>(x) - m.origin_nm;
+      if (rel >= 0) {
+        const std::int64_t idx = (rel + m.spacing_nm / 2) / m.spacing_nm;
+        if (idx < static_cast<std::int64_t>(m.samples)) a = m.data[idx];
+      }
+    }
+    status_.x_nm = x;
+    status_.touch = touch;
+    status_.amplitude = a;
+    ++status_.ticks;
+    hal_.write_amplitude(a);
+  }
+
+  void send(serial::Type type, std::uint8_t seq, const std::uint8_t* payload, std::size_t n) {
+    const std::size_t len = serial::encode_frame(type, seq, payload, n, tx_);
+    if (!hal_.serial_write(tx_, static_cast<int>(len))) {
+      if (link_up_) ++status_.link_errors;
+      link_up_ = false;
+    }
+  }
+  void ack(const serial::Frame& f) {
+    const std::uint8_t p[1] = {static_cast<std::uint8_t>(f.type)};
+    send(serial::Type::ack, f.seq, p, 1);
+  }
+  void nack(const serial::Frame& f, serial::ErrorCode e, std::uint32_t detail = 0) {
+    std::uint8_t p[6] = {static_cast<std::uint8_t>(f.type), static_cast<std::uint8_t>(e)};
+    serial::put_u32(p + 2, detail);
+    ++status_.nacks;
+    status_.last_error = e;
+    send(serial::Type::nack, f.seq, p, 6);
+  }
+
+  void handle(const serial::Frame& f) {
+    using serial::ErrorCode;
+    using serial::Type;
+    ++status_.frames_ok;
+    const std::uint8_t* p = f.payload;
+    switch (f.type) {
+      case Type::hello: {
+        if (f.length != 1) return nack(f, ErrorCode::bad_length);
+        if (p[0] != serial::protocol_version) return nack(f, ErrorCode::bad_version, serial::protocol_version);
+        std::uint8_t r[12 + 32];
+        r[0] = serial::protocol_version;
+        r[1] = static_cast<std::uint8_t>(Slots);
+        serial::put_u32(r + 2, static_cast<std::uint32_t>(MaxSamples));
+        serial::put_u32(r + 6, info_.refresh_mhz);
+        serial::put_u16(r + 10, static_cast<std::uint16_t>(serial::max_payload));
+        std::size_t name_len = std::strlen(info_.name);
+        if (name_len > 32) name_len = 32;
+        std::memcpy(r + 12, info_.name, name_len);
+        return send(Type::hello_reply, f.seq, r, 12 + name_len);
+      }
+      case Type::map_begin: {
+        if (f.length != 14) return nack(f, ErrorCode::bad_length);
+        const std::uint8_t id = p[0];
+        const std::uint32_t samples = serial::get_u32(p + 2);
+        const std::uint32_t spacing = serial::get_u32(p + 6);
+        upload_active_ = false;
+        if (id >= Slots) return nack(f, ErrorCode::unknown_map, Slots);
+        if (p[1] != 0) return nack(f, ErrorCode::unsupported_format);
+        if (samples > MaxSamples) return nack(f, ErrorCode::oversize_map, static_cast<std::uint32_t>(MaxSamples));
+        if (samples == 0 || spacing == 0) return nack(f, ErrorCode::bad_value);
+        staging_.samples = samples;
+        staging_.spacing_nm = spacing;
+        staging_.origin_nm = serial::get_i32(p + 10);
+        upload_id_ = id;
+        upload_next_ = 0;
+        upload_crc_ = 0;
+        upload_active_ = true;
+        return ack(f);
+      }
+      case Type::map_data: {
+        if (f.length < 7 || (f.length - 5) % 2 != 0) return nack(f, ErrorCode::bad_length);
+        if (!upload_active_ || p[0] != upload_id_) return nack(f, ErrorCode::no_upload);
+        const std::uint32_t first = serial::get_u32(p + 1);
+        const std::uint32_t n = (f.length - 5u) / 2u;
+        if (first != upload_next_) return nack(f, ErrorCode::out_of_order, upload_next_);
+        if (n > staging_.samples - upload_next_) return nack(f, ErrorCode::oversize_map, staging_.samples);
+        for (std::uint32_t i = 0; i < n; ++i) staging_.data[first + i] = serial::get_u16(p + 5 + 2 * i);
+        upload_crc_ = serial::crc32(p + 5, 2u * n, upload_crc_);
+        upload_next_ += n;
+        return ack(f);
+      }
+      case Type::map_end: {
+        if (f.length != 5) return nack(f, ErrorCode::bad_length);
+        if (!upload_active_ || p[0] != upload_id_) return nack(f, ErrorCode::no_upload);
+        upload_active_ = false;
+        if (upload_next_ != staging_.samples) return nack(f, ErrorCode::out_of_order, upload_next_);
+        if (serial::get_u32(p + 1) != upload_crc_) return nack(f, ErrorCode::map_checksum, upload_crc_);
+        Map& dst = maps_[upload_id_];
+        dst.samples = staging_.samples;
+        dst.spacing_nm = staging_.spacing_nm;
+        dst.origin_nm = staging_.origin_nm;
+        std::memcpy(dst.data, staging_.data, sizeof(std::uint16_t) * staging_.samples);
+        return ack(f);
+      }
+      case Type::select: {
+        if (f.length != 1) return nack(f, ErrorCode::bad_length);
+        if (p[0] != serial::no_map && (p[0] >= Slots || maps_[p[0]].samples == 0))
+          return nack(f, ErrorCode::unknown_map);
+        status_.selected = p[0];
+        status_.mode = Mode::position;
+        return ack(f);
+      }
+      case Type::position: {
+        if (f.length != 5) return bad_stream(f);
+        stream_x_nm_ = serial::get_i32(p);
+        stream_touch_ = p[4] != 0;
+        stream_us_ = hal_.micros();
+        status_.mode = Mode::position;
+        return;
+      }
+      case Type::drive: {
+        if (f.length != 2) return bad_stream(f);
+        drive_ = serial::get_u16(p);
+        stream_us_ = hal_.micros();
+        status_.mode = Mode::drive;
+        return;
+      }
+      case Type::status_request: {
+        if (f.length != 0) return nack(f, ErrorCode::bad_length);
+        std::uint8_t r[26];
+        r[0] = status_.selected;
+        r[1] = static_cast<std::uint8_t>(status_.mode);
+        serial::put_u16(r + 2, status_.amplitude);
+        serial::put_i32(r + 4, status_.x_nm);
+        r[8] = status_.touch ? 1 : 0;
+        serial::put_u32(r + 9, status_.frames_ok);
+        serial::put_u32(r + 13, status_.frames_bad);
+        r[17] = static_cast<std::uint8_t>(status_.last_error);
+        serial::put_u32(r + 18, status_.selected < Slots ? maps_[status_.selected].samples : 0);
+        serial::put_u32(r + 22, static_cast<std::uint32_t>(hal_.micros() - start_us_) / 1000u);
+        return send(Type::status, f.seq, r, sizeof r);
+      }
+      default: return nack(f, ErrorCode::unknown_type);
+    }
+  }
+
+  // Streamed frames are never answered (the host does not wait); a malformed
+  // one is only counted.
+  void bad_stream(const serial::Frame&) {
+    ++status_.frames_bad;
+    status_.last_error = serial::ErrorCode::bad_length;
+  }
+
+  Hal& hal_;
+  Info info_;
+  Status status_{};
+  serial::Decoder decoder_{};
+  std::uint8_t tx_[serial::max_frame]{};
+  Map maps_[Slots]{};
+  Map staging_{};
+  bool upload_active_ = false;
+  std::uint8_t upload_id_ = 0;
+  std::uint32_t upload_next_ = 0;
+  std::uint32_t upload_crc_ = 0;
+  std::int32_t stream_x_nm_ = 0;
+  bool stream_touch_ = false;
+  std::uint32_t stream_us_ = 0;
+  std::uint16_t drive_ = 0;
+  bool link_up_ = true;
+  std::uint32_t start_us_ = 0;
+  std::uint32_t last_byte_us_ = 0;
+  std::uint32_t next_tick_us_ = 0;
+  std::uint64_t tick_count_ = 0;
+};
+
+}  // namespace texel::controller

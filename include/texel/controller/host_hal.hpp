@@ -1,0 +1,50 @@
+// A host (POSIX) implementation of the controller's Hal: the serial port is
+// a file descriptor (a real UART, or one end of a pseudo-terminal), the clock
+// is std::chrono::steady_clock, and the "actuator" records the last amplitude
+// written. Used by `texel controller` and by the host ↔ controller tests.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "texel/controller/controller.hpp"
+
+namespace texel::controller {
+
+class HostHal final : public Hal {
+public:
+  /// Takes ownership of `fd` (set non-blocking here).
+  explicit HostHal(int fd);
+  ~HostHal();
+  HostHal(const HostHal&) = delete;
+  HostHal& operator=(const HostHal&) = delete;
+
+  std::uint32_t micros() override;
+  int serial_read(std::uint8_t* buf, int max) override;
+  bool serial_write(const std::uint8_t* buf, int n) override;
+  bool read_position(std::int32_t& x_nm, bool& touch) override;
+  void write_amplitude(std::uint16_t amplitude) override;
+  void idle_until(std::uint32_t t_us) override;
+
+  /// Optional local finger sensor (tests); unset = positions come from the host.
+  std::function<bool(std::int32_t&, bool&)> sensor;
+  /// The last amplitude written and how many writes.
+  std::atomic<std::uint16_t> amplitude{0};
+  std::atomic<std::uint64_t> writes{0};
+  /// Closes the descriptor (simulates unplugging the display).
+  void close_link();
+
+private:
+  int fd_ = -1;
+  bool down_ = false;
+};
+
+/// Opens a serial device or pty path read/write, non-blocking, raw 8N1 at
+/// `baud` (ignored by pseudo-terminals). Throws IoError naming the path.
+int open_serial_port(const std::string& path, int baud = 921600);
+/// Puts a terminal descriptor in raw mode (no echo, no line discipline).
+void make_raw(int fd, int baud = 921600);
+
+}  // namespace texel::controller

@@ -1,0 +1,224 @@
+// The real-time player: finger positions in, drive values out.
+//
+// config → prepare → process (style.md). A PlayerMap is the prepared,
+// immutable amplitude map of a whole surface (all regions) on its device
+// grid; a Player is built from a PlayerConfig (allocating everything it will
+// ever need), then process() turns the finger stream into output samples at a
+// fixed rate: the device refresh rate (8,333 Hz for `tpad`) or an audio rate.
+//
+// Threads. Exactly one control thread calls set_map / push / set_gain /
+// set_carrier / collect, and exactly one real-time thread calls process.
+// Finger samples and parameter commands reach process() through a
+// fixed-capacity SPSC queue (spsc_queue.hpp); a new map arrives through an
+// atomic pointer exchange and replaces the old one with a crossfade; the
+// old map goes back through a second SPSC queue and is freed by collect() on
+// the control thread — never in process().
+//
+// Finger model. Samples are consumed in time order. At output time t the
+// player looks at τ = t + prediction_s: between two known samples the
+// position is interpolated linearly; past the newest sample it is
+// extrapolated with the smoothed finger velocity for at most
+// extrapolate_s (the latency predictor; the public TPaD tablet software
+// predicts 20 ms ahead), then held. Off-line rendering simply queues
+// samples ahead of time, so the same code interpolates a whole trace.
+//
+// Map sampling. At audio rates a finger at 100 mm/s moves 0.002 mm per
+// sample, less than one map sample (0.0053 mm on `tpad`), so the map is
+// interpolated linearly between grid samples ("chunked" sampling) instead of
+// stepping from sample to sample. Trade-off: a spatial frequency f felt at
+// speed v above the output Nyquist rate (f·v > rate/2) aliases; the
+// vibration low-pass cannot remove what sampling folded down.
+//
+// Output modes (PlayerConfig::mode):
+//   amplitude  a(x) in [0, 1], for friction displays (0 = at rest);
+//   vibration  2·(a(x) band-passed): a one-pole DC blocker (high-pass at
+//              highpass_hz) and a 2nd-order Butterworth low-pass (lowpass_hz,
+//              default 0.4·rate), so the output is zero-mean; a full-range
+//              fine texture gives ±1; clipped to [−1, 1];
+//   carrier    a(x)·sin(2π·f_c·t) from a phase accumulator, for displays fed
+//              from a signal generator or amplifier.
+// Touch and lift fade the output in and out with a raised-cosine ramp of
+// touch_ramp_s (no click); a finger beyond the surface counts as lifted.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "texel/finger.hpp"
+#include "texel/grid.hpp"
+#include "texel/spsc_queue.hpp"
+
+namespace texel {
+
+class Surface;
+class Texture;
+
+/// An immutable amplitude map on a uniform grid, in device coordinates (mm).
+class PlayerMap {
+public:
+  /// `values` holds one amplitude in [0, 1] per grid sample; grid.count must
+  /// equal values.size() and be >= 1. Throws InvalidArgument otherwise.
+  PlayerMap(Grid grid, std::vector<float> values);
+  /// The whole device map of a surface, all regions (gaps at rest).
+  static std::unique_ptr<const PlayerMap> from_surface(const Surface& surface);
+  /// A single texture laid on `grid` (texture coordinates = grid positions).
+  static std::unique_ptr<const PlayerMap> from_texture(const Texture& texture, const Grid& grid);
+
+  [[nodiscard]] const Grid& grid() const { return grid_; }
+  [[nodiscard]] std::span<const float> values() const { return values_; }
+  /// Linear interpolation between grid samples; positions beyond the ends
+  /// take the nearest end value (the caller decides what "off the surface"
+  /// means). Real-time safe.
+  [[nodiscard]] float sample(double x_mm) const noexcept;
+  /// True if x lies on the surface: [origin, origin + count·spacing).
+  [[nodiscard]] bool on_surface(double x_mm) const noexcept;
+
+private:
+  Grid grid_;
+  std::vector<float> values_;
+  double inv_spacing_ = 0.0;
+};
+
+enum class OutputMode { amplitude, vibration, carrier };
+std::string_view to_string(OutputMode m);
+OutputMode parse_output_mode(std::string_view text, std::string_view field = "output");
+
+struct PlayerConfig {
+  double rate_hz = 48000.0;        ///< output rate (s⁻¹), 100 … 384000; tpad: 8333
+  OutputMode mode = OutputMode::amplitude;
+  double gain = 1.0;               ///< output gain, 0 … 1 (changes are ramped over one block)
+  double carrier_hz = 250.0;       ///< carrier mode: carrier frequency (Hz), 0 … rate/2
+  double prediction_s = 0.0;       ///< latency compensation: look-ahead (s), 0 … 0.1 (TPaD tablet: 0.02)
+  double extrapolate_s = 0.03;     ///< longest extrapolation past the newest sample (s), >= prediction_s
+  double velocity_smoothing_s = 0.01;  ///< time constant of the velocity estimate (s), > 0
+  double touch_ramp_s = 0.005;     ///< fade in on touch / out on lift (s), 0.0005 … 1
+  double crossfade_s = 0.02;       ///< crossfade when a new map is swapped in (s), 0.0005 … 1
+  double highpass_hz = 20.0;       ///< vibration: DC-blocker corner (Hz), 0.1 … rate/4
+  double lowpass_hz = 0.0;         ///< vibration: low-pass corner (Hz); 0 = 0.4·rate; at most 0.45·rate
+};
+/// Throws InvalidArgument naming the field, the value and the allowed range.
+void validate(const PlayerConfig& config);
+
+/// A command for process(): a finger sample or a parameter change.
+struct PlayerEvent {
+  enum class Kind : std::uint8_t { finger, gain, carrier };
+  Kind kind = Kind::finger;
+  FingerSample finger{};
+  double value = 0.0;  ///< gain or carrier frequency
+};
+
+/// What process() reports for one block.
+struct BlockInfo {
+  float peak = 0.0f;        ///< largest |output| in the block
+  double position_mm = 0.0; ///< finger position at the block's end (after prediction)
+  bool touching = false;    ///< finger down at the block's end
+  bool crossfading = false;
+};
+
+class Player {
+public:
+  static constexpr std::size_t event_capacity = 4096;
+  static constexpr std::size_t retire_capacity = 16;
+
+  /// prepare: validates `config` and allocates all state; `map` may be null
+  /// (silence until set_map).
+  explicit Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map = nullptr);
+  /// Frees every map. Call only after the real-time thread has stopped.
+  ~Player();
+  Player(const Player&) = delete;
+  Player& operator=(const Player&) = delete;
+
+  [[nodiscard]] const PlayerConfig& config() const { return config_; }
+
+  // -------------------------------------------------------- control thread
+  /// Swaps in a new map; process() crossfades to it. If a previous map was
+  /// still waiting (never seen by process) it is freed here. Also collect()s.
+  void set_map(std::unique_ptr<const PlayerMap> map);
+  /// Queues a finger sample (time-ordered); false if the queue is full.
+  bool push(const FingerSample& s) { return events_.try_push(PlayerEvent{PlayerEvent::Kind::finger, s, 0.0}); }
+  /// Queues a gain change (clamped to [0, 1], ramped over one block).
+  bool set_gain(double gain);
+  /// Queues a carrier-frequency change (clamped to [0, rate/2]).
+  bool set_carrier(double hz);
+  /// Frees maps process() has retired. Returns how many.
+  std::size_t collect();
+  /// Free slots in the event queue (approximate while process() runs).
+  [[nodiscard]] std::size_t event_space() const { return event_capacity - events_.size(); }
+
+  // ------------------------------------------------------- real-time thread
+  /// Fills `out` with the next out.size() samples and, if `position_mm` is
+  /// not empty (same size as out), the finger position used for each.
+  ///
+  /// Real-time safe: never allocates, frees, locks, logs, throws or does
+  /// I/O; bounded work per sample. Out-of-range parameters were clamped when
+  /// queued.
+  BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept;
+
+  // ------------------------------------------------------------ any thread
+  /// Output samples produced so far.
+  [[nodiscard]] std::uint64_t samples() const { return samples_done_.load(std::memory_order_relaxed); }
+  [[nodiscard]] double time_s() const { return static_cast<double>(samples()) / config_.rate_hz; }
+
+private:
+  struct Biquad {
+    double b0 = 1, b1 = 0, b2 = 0, a1 = 0, a2 = 0;
+    double z1 = 0, z2 = 0;
+    double operator()(double x) noexcept {
+      const double y = b0 * x + z1;
+      z1 = b1 * x - a1 * y + z2;
+      z2 = b2 * x - a2 * y;
+      return y;
+    }
+  };
+
+  void take_events(double tau) noexcept;
+  double finger_position(double tau) noexcept;
+
+  PlayerConfig config_;
+  SpscQueue<PlayerEvent, event_capacity> events_;
+  SpscQueue<const PlayerMap*, retire_capacity> retired_;
+  std::atomic<const PlayerMap*> pending_{nullptr};
+  std::atomic<std::uint64_t> samples_done_{0};
+
+  // Real-time state (touched only by process()).
+  const PlayerMap* current_ = nullptr;
+  const PlayerMap* fading_ = nullptr;         // the map being faded out (null: from silence)
+  const PlayerMap* retire_waiting_ = nullptr; // retired while the retire queue was full
+  bool crossfading_ = false;
+  double fade_pos_ = 1.0;              // 0 → 1 over crossfade_s
+  double fade_step_ = 0.0;
+  FingerSample last_{};                // newest consumed sample
+  bool have_last_ = false;
+  double velocity_ = 0.0;              // smoothed mm/s
+  double touch_level_ = 0.0;           // 0 … 1 before shaping
+  double touch_step_ = 0.0;
+  double gain_ = 1.0, gain_target_ = 1.0;
+  double carrier_inc_ = 0.0, carrier_inc_target_ = 0.0;  // cycles per sample
+  double carrier_phase_ = 0.0;                            // cycles [0, 1)
+  double dc_x1_ = 0.0, dc_y1_ = 0.0, dc_r_ = 0.0;
+  Biquad lowpass_{};
+  std::uint64_t n_ = 0;
+};
+
+/// Off-line rendering of a whole trace through a Player: queues the trace
+/// ahead of time (so every position is interpolated between known samples),
+/// processes `frames` samples in `block`-sized blocks and returns them;
+/// `positions`, if given, receives the position used for each sample.
+std::vector<float> render_trace(const PlayerMap& map, const PlayerConfig& config, std::span<const FingerSample> trace,
+                                std::size_t frames, std::vector<float>* positions = nullptr, std::size_t block = 64);
+
+/// Magnitude spectrum of a signal (Hann window, zero-padded to a power of
+/// two): bin k at k·rate/n Hz. Used by --plot and the tests.
+struct SignalSpectrum {
+  std::vector<double> frequency_hz;
+  std::vector<double> magnitude;
+  [[nodiscard]] double peak_hz(double min_hz = 0.0) const;
+};
+SignalSpectrum signal_spectrum(std::span<const float> signal, double rate_hz);
+
+}  // namespace texel

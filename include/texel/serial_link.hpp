@@ -1,0 +1,97 @@
+// The host end of the serial protocol (docs/serial-protocol.md): talks to a
+// friction display (or the reference controller over a pseudo-terminal) to
+// upload maps, select one, and stream finger positions or drive values.
+//
+// Requests (HELLO, MAP_*, SELECT, STATUS) wait for their reply with a
+// timeout and are retried; a NACK becomes a SerialError carrying the
+// display's error code; a link that goes away (unplugged cable, closed pty)
+// becomes an IoError naming the port — never a crash.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "texel/error.hpp"
+#include "texel/serial_protocol.hpp"
+
+namespace texel {
+
+class PlayerMap;
+
+/// The display refused a request (NACK).
+class SerialError : public IoError {
+public:
+  SerialError(const std::string& what, serial::ErrorCode error_code, std::uint32_t error_detail)
+      : IoError(what), code(error_code), detail(error_detail) {}
+  serial::ErrorCode code;
+  std::uint32_t detail;
+};
+
+struct DisplayInfo {
+  int version = 0;
+  int slots = 0;
+  std::uint32_t max_samples = 0;
+  double refresh_hz = 0.0;
+  std::size_t max_payload = 0;
+  std::string name;
+};
+
+struct DisplayStatus {
+  int selected = -1;            ///< -1: none
+  int mode = 0;                 ///< 0 idle, 1 position, 2 drive
+  std::uint16_t amplitude = 0;
+  double x_mm = 0.0;
+  bool touch = false;
+  std::uint32_t frames_ok = 0;
+  std::uint32_t frames_bad = 0;
+  serial::ErrorCode last_error = serial::ErrorCode::none;
+  std::uint32_t map_samples = 0;
+  std::uint32_t uptime_ms = 0;
+};
+
+class SerialLink {
+public:
+  /// Opens `path` (a tty or pty), raw 8N1 at `baud`. Throws IoError.
+  explicit SerialLink(const std::string& path, int baud = 921600);
+  /// Adopts an open descriptor (closed by the destructor); `name` is used in messages.
+  SerialLink(int fd, std::string name);
+  ~SerialLink();
+  SerialLink(const SerialLink&) = delete;
+  SerialLink& operator=(const SerialLink&) = delete;
+
+  /// Reply timeout per attempt (ms) and attempts per request.
+  int timeout_ms = 300;
+  int attempts = 3;
+
+  DisplayInfo hello();
+  /// Uploads amplitudes (clamped to [0, 1], encoded round(a·65535)) into slot `id`.
+  void upload_map(std::uint8_t id, std::span<const float> amplitudes, double spacing_mm, double origin_mm = 0.0);
+  void upload_map(std::uint8_t id, const PlayerMap& map);
+  /// Uploads raw u16 samples (for tests of the display's checks).
+  void upload_raw(std::uint8_t id, std::span<const std::uint16_t> samples, std::uint32_t spacing_nm, std::int32_t origin_nm,
+                  bool corrupt_crc = false);
+  void select(std::uint8_t id);
+  /// Streams (no reply). Throw IoError if the link is gone.
+  void stream_position(double x_mm, bool touch);
+  void stream_drive(double amplitude);
+  DisplayStatus status();
+  /// Sends raw bytes (tests: garbage, truncated frames).
+  void send_raw(std::span<const std::uint8_t> bytes);
+
+  [[nodiscard]] const std::string& name() const { return name_; }
+
+private:
+  std::uint8_t send(serial::Type type, const std::uint8_t* payload, std::size_t n);
+  /// Sends a request and waits for its reply; returns the reply's payload.
+  std::string request(serial::Type type, const std::uint8_t* payload, std::size_t n, serial::Type expect,
+                      const char* what);
+  void write_all(const std::uint8_t* p, std::size_t n);
+
+  int fd_ = -1;
+  std::string name_;
+  std::uint8_t seq_ = 0;
+  serial::Decoder decoder_{};
+};
+
+}  // namespace texel

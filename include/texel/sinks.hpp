@@ -1,0 +1,105 @@
+// Where the player's output goes: files (WAV through libsndfile, CSV), a
+// sound card (PortAudio), a `null` backend that runs the same real-time loop
+// without hardware (CI has no sound card), and a serial-attached friction
+// display (serial_link.hpp).
+//
+// A Backend owns the real-time thread that calls Player::process: the
+// PortAudio callback, a paced thread for `null`, or the streaming thread for
+// serial. Statistics are published through relaxed atomics (real-time safe)
+// for a level meter on the control thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "texel/player.hpp"
+
+namespace texel {
+
+enum class WavEncoding { pcm16, pcm24, float32 };
+
+/// Writes a mono WAV atomically (temporary + rename). Samples are clipped to
+/// [−1, 1] by the PCM encodings. Throws IoError naming the path.
+void write_wav(const std::string& path, std::span<const float> samples, double rate_hz,
+               WavEncoding encoding = WavEncoding::pcm16);
+/// Reads a WAV's first channel (tests, tools). Throws IoError / FormatError.
+std::vector<float> read_wav(const std::string& path, double* rate_hz = nullptr);
+
+/// "time_s,position_mm,output" with one row per output sample.
+std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output);
+
+/// Live statistics of a running backend.
+struct BackendStats {
+  std::uint64_t blocks = 0;
+  double worst_block_s = 0.0;   ///< longest process() call
+  double total_block_s = 0.0;   ///< sum of process() calls
+  float peak = 0.0f;            ///< peak |output| since the last take_peak()
+  std::uint64_t underruns = 0;  ///< sound card or pacing deadlines missed
+  double position_mm = 0.0;
+  bool touching = false;
+};
+
+class Backend {
+public:
+  virtual ~Backend() = default;
+  /// Starts calling player.process() on the backend's real-time thread.
+  virtual void start(Player& player) = 0;
+  /// Stops and joins; safe to call twice.
+  virtual void stop() = 0;
+  /// A one-line description ("null 48000 Hz, 64 frames").
+  [[nodiscard]] virtual std::string describe() const = 0;
+  /// An error the real-time side met (e.g. the serial link dropped); empty if none.
+  [[nodiscard]] virtual std::string error() const { return {}; }
+
+  /// Snapshot of the statistics; resets the peak.
+  BackendStats stats();
+
+protected:
+  /// Called by implementations after each block (relaxed atomics only).
+  void record(const BlockInfo& info, double seconds) noexcept;
+  void record_underrun() noexcept { underruns_.fetch_add(1, std::memory_order_relaxed); }
+
+private:
+  std::atomic<std::uint64_t> blocks_{0};
+  std::atomic<std::uint64_t> worst_ns_{0};
+  std::atomic<std::uint64_t> total_ns_{0};
+  std::atomic<float> peak_{0.0f};
+  std::atomic<std::uint64_t> underruns_{0};
+  std::atomic<double> position_{0.0};
+  std::atomic<bool> touching_{false};
+};
+
+/// Runs the player in real time with no output device: a thread wakes every
+/// block period and processes one block into a scratch buffer.
+std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames);
+
+struct AudioOptions {
+  std::string device;            ///< PortAudio device index or name substring; empty = default output
+  double rate_hz = 48000.0;
+  std::size_t block_frames = 64; ///< frames per buffer
+  double latency_s = 0.0;        ///< suggested latency; 0 = the device's low default
+};
+/// A sound-card output through PortAudio. Throws IoError if PortAudio or the
+/// device cannot be opened (naming the device and listing the outputs).
+std::unique_ptr<Backend> make_audio_backend(const AudioOptions& options);
+/// Names of PortAudio's output devices, "index: name (host API, channels)".
+std::vector<std::string> audio_output_devices();
+
+enum class SerialStream { position, drive };
+struct SerialOptions {
+  std::string path;
+  int baud = 921600;
+  double rate_hz = 1000.0;  ///< frames streamed per second
+  SerialStream stream = SerialStream::position;
+};
+/// A serial friction display: start() says HELLO, uploads `map` to slot 0,
+/// selects it, then streams the player's finger position (or its output as
+/// drive values) at options.rate_hz. Link failures end streaming and are
+/// reported by error(). Throws IoError / SerialError from the set-up.
+std::unique_ptr<Backend> make_serial_backend(const SerialOptions& options, const PlayerMap& map);
+
+}  // namespace texel

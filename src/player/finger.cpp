@@ -1,0 +1,200 @@
+// Finger sources (simulated swipes, CSV traces) and swipe measures.
+#include "texel/finger.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+
+namespace texel {
+
+using detail::num;
+
+std::string_view to_string(SwipePattern p) {
+  return p == SwipePattern::constant ? "constant" : "back-and-forth";
+}
+
+SwipePattern parse_swipe_pattern(std::string_view text, std::string_view field) {
+  if (text == "constant") return SwipePattern::constant;
+  if (text == "back-and-forth" || text == "back_and_forth") return SwipePattern::back_and_forth;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: constant, back-and-forth");
+}
+
+namespace {
+
+void require(bool ok, std::string_view field, double v, std::string_view allowed) {
+  if (!ok) throw InvalidArgument("swipe: " + std::string(field) + " is " + num(v) + "; " + std::string(allowed));
+}
+
+// One stroke from 0 to `extent` with a half-cosine speed profile at both ends
+// (rest → v over turn/2, cruise, v → rest over turn/2). Distance covered while
+// accelerating: d = v·turn/π. If the extent is too short for that, the turn
+// is shortened so the finger just reaches full speed at the middle.
+struct Stroke {
+  double v, turn, d, cruise, duration;
+  Stroke(double speed, double extent, double turn_s) : v(speed), turn(turn_s) {
+    d = v * turn / std::numbers::pi;
+    if (2 * d > extent) {
+      turn = extent * std::numbers::pi / (2 * v);
+      d = extent / 2;
+    }
+    cruise = extent - 2 * d;
+    duration = turn + cruise / v;
+  }
+  [[nodiscard]] double at(double u) const {
+    const double half = turn / 2;
+    if (u <= 0) return 0;
+    if (u < half) return d * (1 - std::cos(std::numbers::pi * u / turn));
+    if (u < half + cruise / v) return d + v * (u - half);
+    if (u < duration) return d + cruise + d * std::sin(std::numbers::pi * (u - half - cruise / v) / turn);
+    return 2 * d + cruise;
+  }
+};
+
+}  // namespace
+
+std::vector<FingerSample> simulate_swipe(const SwipeConfig& c) {
+  require(std::isfinite(c.speed_mm_s) && c.speed_mm_s > 0, "speed_mm_s", c.speed_mm_s, "it must be a finite speed > 0 mm/s");
+  require(std::isfinite(c.duration_s) && c.duration_s > 0 && c.duration_s <= 86400, "duration_s", c.duration_s,
+          "allowed: > 0 … 86400 s");
+  require(std::isfinite(c.rate_hz) && c.rate_hz > 0 && c.rate_hz <= 1e6, "rate_hz", c.rate_hz, "allowed: > 0 … 1e6 Hz");
+  require(std::isfinite(c.turn_s) && c.turn_s >= 0 && c.turn_s <= 10, "turn_s", c.turn_s, "allowed: 0 … 10 s");
+  require(std::isfinite(c.lead_in_s) && c.lead_in_s >= 0, "lead_in_s", c.lead_in_s, "it must be >= 0 s");
+  require(std::isfinite(c.start_mm), "start_mm", c.start_mm, "it must be finite");
+  const double extent = c.extent_mm > 0 ? c.extent_mm : c.surface_mm - c.start_mm;
+  require(std::isfinite(extent) && extent > 0, "extent_mm", extent,
+          "the swipe's extent must be > 0 mm (set extent_mm, or a start inside the surface)");
+  const double samples_d = std::floor(c.duration_s * c.rate_hz) + 1;
+  require(samples_d <= 5e7, "duration_s·rate_hz", samples_d, "at most 5e7 trace samples");
+
+  std::vector<FingerSample> trace(static_cast<std::size_t>(samples_d));
+  const double v = c.speed_mm_s;
+  // Constant: repeated one-way strokes at speed v; between strokes the finger
+  // is lifted for max(turn_s, 2 samples) and lands again at start_mm.
+  const double stroke_s = extent / v;
+  const double gap_s = std::max(c.turn_s, 2.0 / c.rate_hz);
+  const Stroke stroke(v, extent, c.turn_s);
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    const double t = static_cast<double>(i) / c.rate_hz;
+    FingerSample& s = trace[i];
+    s.t_s = t;
+    const double u = t - c.lead_in_s;
+    if (u < 0) {
+      s.x_mm = c.start_mm;
+      s.touch = false;
+      continue;
+    }
+    if (c.pattern == SwipePattern::constant) {
+      const double period = stroke_s + gap_s;
+      const double in = u - std::floor(u / period) * period;
+      if (in < stroke_s) {
+        s.x_mm = c.start_mm + v * in;
+        s.touch = true;
+      } else {
+        s.x_mm = c.start_mm + extent;
+        s.touch = false;
+      }
+    } else {
+      const double period = 2 * stroke.duration;
+      const double in = u - std::floor(u / period) * period;
+      s.x_mm = c.start_mm + (in < stroke.duration ? stroke.at(in) : extent - stroke.at(in - stroke.duration));
+      s.touch = true;
+    }
+  }
+  return trace;
+}
+
+namespace {
+
+bool parse_double(std::string_view text, double& out) {
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r')) text.remove_suffix(1);
+  if (text.empty()) return false;
+  if (text.front() == '+') text.remove_prefix(1);
+  const auto res = std::from_chars(text.data(), text.data() + text.size(), out);
+  return res.ec == std::errc() && res.ptr == text.data() + text.size();
+}
+
+}  // namespace
+
+std::vector<FingerSample> parse_trace_csv(std::string_view text, std::string_view origin) {
+  std::vector<FingerSample> trace;
+  std::size_t line_no = 0;
+  const std::string where(origin);
+  while (!text.empty()) {
+    const std::size_t nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty() || line.front() == '#') continue;
+    double cols[3] = {0, 0, 1};
+    int n = 0;
+    bool numeric = true;
+    std::size_t pos = 0;
+    while (true) {
+      const std::size_t comma = line.find(',', pos);
+      const std::string_view cell = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+      if (n >= 3) throw FormatError(where + ":" + std::to_string(line_no) + ": more than 3 columns; expected time_s,position_mm[,touch]");
+      if (!parse_double(cell, cols[n])) numeric = false;
+      ++n;
+      if (comma == std::string_view::npos) break;
+      pos = comma + 1;
+    }
+    if (!numeric) {
+      if (trace.empty() && line_no == 1) continue;  // header
+      throw FormatError(where + ":" + std::to_string(line_no) + ": '" + std::string(line) +
+                        "' is not numeric; expected time_s,position_mm[,touch]");
+    }
+    if (n < 2) throw FormatError(where + ":" + std::to_string(line_no) + ": 1 column; expected time_s,position_mm[,touch]");
+    if (!std::isfinite(cols[0]) || !std::isfinite(cols[1]))
+      throw FormatError(where + ":" + std::to_string(line_no) + ": time and position must be finite");
+    if (!trace.empty() && cols[0] < trace.back().t_s)
+      throw FormatError(where + ":" + std::to_string(line_no) + ": time " + num(cols[0]) + " s is earlier than the previous " +
+                        num(trace.back().t_s) + " s; times must not decrease");
+    if (n == 3 && cols[2] != 0 && cols[2] != 1)
+      throw FormatError(where + ":" + std::to_string(line_no) + ": touch is " + num(cols[2]) + "; allowed 0 or 1");
+    trace.push_back(FingerSample{cols[0], cols[1], cols[2] != 0});
+  }
+  if (trace.empty()) throw FormatError(where + ": no samples; expected rows of time_s,position_mm[,touch]");
+  return trace;
+}
+
+std::vector<FingerSample> load_trace_csv(const std::string& path) { return parse_trace_csv(read_file(path), path); }
+
+std::string trace_csv(std::span<const FingerSample> trace) {
+  std::string out = "time_s,position_mm,touch\n";
+  for (const auto& s : trace) out += num(s.t_s) + "," + num(s.x_mm) + "," + (s.touch ? "1\n" : "0\n");
+  return out;
+}
+
+SwipeMeasures swipe_measures(std::span<const FingerSample> trace, double still_below_mm_s) {
+  SwipeMeasures m;
+  double sum = 0, sum2 = 0;
+  for (std::size_t i = 1; i < trace.size(); ++i) {
+    const FingerSample& a = trace[i - 1];
+    const FingerSample& b = trace[i];
+    const double dt = b.t_s - a.t_s;
+    if (!a.touch || !b.touch || !(dt > 0)) continue;
+    const double v = (b.x_mm - a.x_mm) / dt;
+    const double speed = std::fabs(v);
+    ++m.intervals;
+    sum += speed;
+    sum2 += speed * speed;
+    m.touched_s += dt;
+    m.distance_mm += std::fabs(b.x_mm - a.x_mm);
+    if (speed >= still_below_mm_s && speed > 0) (v > 0 ? m.moving_right : m.moving_left)++;
+  }
+  if (m.intervals == 0) return m;
+  const auto n = static_cast<double>(m.intervals);
+  m.mean_speed_mm_s = sum / n;
+  m.sd_speed_mm_s = m.intervals > 1 ? std::sqrt(std::max(0.0, (sum2 - sum * sum / n) / (n - 1))) : 0.0;
+  m.directional_proportion = (static_cast<double>(m.moving_right) - static_cast<double>(m.moving_left)) / n;
+  return m;
+}
+
+}  // namespace texel

@@ -1,0 +1,317 @@
+// The real-time player (see include/texel/player.hpp for the model).
+#include "texel/player.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/surface.hpp"
+#include "texel/texture.hpp"
+
+namespace texel {
+
+using detail::num;
+
+// ------------------------------------------------------------------ PlayerMap
+
+PlayerMap::PlayerMap(Grid grid, std::vector<float> values) : grid_(grid), values_(std::move(values)) {
+  if (grid_.count < 1 || static_cast<std::size_t>(grid_.count) != values_.size())
+    throw InvalidArgument("player map: grid has " + std::to_string(grid_.count) + " samples but " +
+                          std::to_string(values_.size()) + " values were given; they must match and be >= 1");
+  if (!(std::isfinite(grid_.spacing_mm) && grid_.spacing_mm > 0))
+    throw InvalidArgument("player map: spacing_mm is " + num(grid_.spacing_mm) + "; it must be a finite number > 0");
+  inv_spacing_ = 1.0 / grid_.spacing_mm;
+}
+
+std::unique_ptr<const PlayerMap> PlayerMap::from_surface(const Surface& surface) {
+  const std::vector<double> map = surface.render();
+  return std::make_unique<const PlayerMap>(surface.grid(), std::vector<float>(map.begin(), map.end()));
+}
+
+std::unique_ptr<const PlayerMap> PlayerMap::from_texture(const Texture& texture, const Grid& grid) {
+  std::vector<double> map(static_cast<std::size_t>(grid.count));
+  texture.render(grid, 0, map);
+  return std::make_unique<const PlayerMap>(grid, std::vector<float>(map.begin(), map.end()));
+}
+
+float PlayerMap::sample(double x_mm) const noexcept {
+  const double u = (x_mm - grid_.origin_mm) * inv_spacing_;
+  const std::int64_t last = grid_.count - 1;
+  if (!(u > 0.0)) return values_.front();  // also NaN
+  if (u >= static_cast<double>(last)) return values_[static_cast<std::size_t>(last)];
+  const auto i = static_cast<std::int64_t>(u);
+  const double frac = u - static_cast<double>(i);
+  const float a = values_[static_cast<std::size_t>(i)];
+  const float b = values_[static_cast<std::size_t>(i + 1)];
+  return static_cast<float>(a + (b - a) * frac);
+}
+
+bool PlayerMap::on_surface(double x_mm) const noexcept {
+  return x_mm >= grid_.origin_mm && x_mm < grid_.origin_mm + grid_.length_mm();
+}
+
+// --------------------------------------------------------------- PlayerConfig
+
+std::string_view to_string(OutputMode m) {
+  switch (m) {
+    case OutputMode::amplitude: return "amplitude";
+    case OutputMode::vibration: return "vibration";
+    case OutputMode::carrier: return "carrier";
+  }
+  return "amplitude";
+}
+
+OutputMode parse_output_mode(std::string_view text, std::string_view field) {
+  if (text == "amplitude") return OutputMode::amplitude;
+  if (text == "vibration") return OutputMode::vibration;
+  if (text == "carrier") return OutputMode::carrier;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: amplitude, vibration, carrier");
+}
+
+namespace {
+void check_range(std::string_view field, double v, double lo, double hi, std::string_view unit) {
+  if (!(std::isfinite(v) && v >= lo && v <= hi))
+    throw InvalidArgument("player: " + std::string(field) + " is " + num(v) + "; allowed " + num(lo) + " … " + num(hi) +
+                          (unit.empty() ? "" : " " + std::string(unit)));
+}
+}  // namespace
+
+void validate(const PlayerConfig& c) {
+  check_range("rate_hz", c.rate_hz, 100.0, 384000.0, "Hz");
+  check_range("gain", c.gain, 0.0, 1.0, "");
+  check_range("carrier_hz", c.carrier_hz, 0.0, c.rate_hz / 2, "Hz");
+  check_range("prediction_s", c.prediction_s, 0.0, 0.1, "s");
+  check_range("extrapolate_s", c.extrapolate_s, c.prediction_s, 1.0, "s");
+  check_range("velocity_smoothing_s", c.velocity_smoothing_s, 1e-4, 1.0, "s");
+  check_range("touch_ramp_s", c.touch_ramp_s, 0.0005, 1.0, "s");
+  check_range("crossfade_s", c.crossfade_s, 0.0005, 1.0, "s");
+  check_range("highpass_hz", c.highpass_hz, 0.1, c.rate_hz / 4, "Hz");
+  if (c.lowpass_hz != 0.0) check_range("lowpass_hz", c.lowpass_hz, 1.0, 0.45 * c.rate_hz, "Hz (0 = 0.4·rate)");
+}
+
+// --------------------------------------------------------------------- Player
+
+Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map) : config_(config) {
+  validate(config_);
+  const double rate = config_.rate_hz;
+  current_ = map.release();
+  fade_step_ = 1.0 / (config_.crossfade_s * rate);
+  touch_step_ = 1.0 / (config_.touch_ramp_s * rate);
+  gain_ = gain_target_ = config_.gain;
+  carrier_inc_ = carrier_inc_target_ = config_.carrier_hz / rate;
+  dc_r_ = std::exp(-2.0 * std::numbers::pi * config_.highpass_hz / rate);
+  // RBJ cookbook low-pass, Q = 1/√2 (Butterworth): flat pass band, −3 dB at fc.
+  const double fc = config_.lowpass_hz > 0 ? config_.lowpass_hz : 0.4 * rate;
+  const double w0 = 2.0 * std::numbers::pi * fc / rate;
+  const double alpha = std::sin(w0) / std::numbers::sqrt2;
+  const double cw = std::cos(w0);
+  const double a0 = 1.0 + alpha;
+  lowpass_.b0 = (1.0 - cw) / 2.0 / a0;
+  lowpass_.b1 = (1.0 - cw) / a0;
+  lowpass_.b2 = lowpass_.b0;
+  lowpass_.a1 = -2.0 * cw / a0;
+  lowpass_.a2 = (1.0 - alpha) / a0;
+}
+
+Player::~Player() {
+  collect();
+  delete pending_.exchange(nullptr);
+  delete current_;
+  delete fading_;
+  delete retire_waiting_;
+}
+
+void Player::set_map(std::unique_ptr<const PlayerMap> map) {
+  // Whoever takes a pointer out of pending_ owns it: process() has never
+  // seen a map we get back here, so freeing it on this thread is safe.
+  delete pending_.exchange(map.release(), std::memory_order_acq_rel);
+  collect();
+}
+
+bool Player::set_gain(double gain) {
+  if (!std::isfinite(gain)) gain = 0.0;
+  return events_.try_push(PlayerEvent{PlayerEvent::Kind::gain, {}, std::clamp(gain, 0.0, 1.0)});
+}
+
+bool Player::set_carrier(double hz) {
+  if (!std::isfinite(hz)) hz = 0.0;
+  return events_.try_push(PlayerEvent{PlayerEvent::Kind::carrier, {}, std::clamp(hz, 0.0, config_.rate_hz / 2)});
+}
+
+std::size_t Player::collect() {
+  std::size_t n = 0;
+  const PlayerMap* m = nullptr;
+  while (retired_.try_pop(m)) {
+    delete m;
+    ++n;
+  }
+  return n;
+}
+
+// Consumes every queued event up to time tau (parameter commands as they are
+// reached). Real-time safe.
+void Player::take_events(double tau) noexcept {
+  while (const PlayerEvent* e = events_.front()) {
+    switch (e->kind) {
+      case PlayerEvent::Kind::gain: gain_target_ = e->value; break;
+      case PlayerEvent::Kind::carrier: carrier_inc_target_ = e->value / config_.rate_hz; break;
+      case PlayerEvent::Kind::finger: {
+        const FingerSample& s = e->finger;
+        if (!(s.t_s <= tau)) return;  // a future sample: keep it for interpolation
+        if (have_last_ && last_.touch && s.touch && s.t_s > last_.t_s) {
+          const double dt = s.t_s - last_.t_s;
+          const double v = (s.x_mm - last_.x_mm) / dt;
+          const double k = std::min(1.0, dt / config_.velocity_smoothing_s);
+          velocity_ += k * (v - velocity_);
+        } else if (!s.touch || !have_last_ || !last_.touch) {
+          velocity_ = 0.0;
+        }
+        last_ = s;
+        have_last_ = true;
+        break;
+      }
+    }
+    events_.pop();
+  }
+}
+
+double Player::finger_position(double tau) noexcept {
+  if (!have_last_) return 0.0;
+  const PlayerEvent* e = events_.front();
+  if (last_.touch && e && e->kind == PlayerEvent::Kind::finger && e->finger.touch && e->finger.t_s > last_.t_s) {
+    const double f = (tau - last_.t_s) / (e->finger.t_s - last_.t_s);
+    return last_.x_mm + (e->finger.x_mm - last_.x_mm) * f;
+  }
+  if (!last_.touch) return last_.x_mm;
+  const double ahead = std::clamp(tau - last_.t_s, 0.0, config_.extrapolate_s);
+  return last_.x_mm + velocity_ * ahead;
+}
+
+// Real-time safe: never allocates, frees, locks, logs, throws or does I/O.
+// Maps are only exchanged (pending_) and handed back (retired_); events are
+// popped from a fixed-size ring; all arithmetic is on members.
+BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) noexcept {
+  BlockInfo info;
+  const std::size_t frames = out.size();
+  if (frames == 0) return info;
+  const bool want_positions = position_mm.size() >= frames;
+
+  // A map that could not be handed back last time (retire queue full) must
+  // go first; until then no new map is taken, so nothing is ever freed here.
+  if (retire_waiting_ && retired_.try_push(retire_waiting_)) retire_waiting_ = nullptr;
+  if (!crossfading_ && !retire_waiting_) {
+    if (const PlayerMap* next = pending_.exchange(nullptr, std::memory_order_acq_rel)) {
+      fading_ = current_;
+      current_ = next;
+      crossfading_ = true;
+      fade_pos_ = 0.0;
+    }
+  }
+
+  const double rate = config_.rate_hz;
+  // Commands queued before this block take effect now, ramped over it.
+  take_events(static_cast<double>(n_) / rate + config_.prediction_s);
+  const double gain_step = (gain_target_ - gain_) / static_cast<double>(frames);
+  const double inc_step = (carrier_inc_target_ - carrier_inc_) / static_cast<double>(frames);
+  const double gain_end = gain_target_;
+  const double inc_end = carrier_inc_target_;
+  float peak = 0.0f;
+  double x = 0.0;
+  bool touching = false;
+
+  for (std::size_t i = 0; i < frames; ++i, ++n_) {
+    const double t = static_cast<double>(n_) / rate;
+    const double tau = t + config_.prediction_s;
+    take_events(tau);
+    x = finger_position(tau);
+    touching = have_last_ && last_.touch && (current_ == nullptr || current_->on_surface(x));
+
+    // Map value under the finger, crossfaded (raised cosine) during a swap.
+    double a = current_ ? current_->sample(x) : 0.0;
+    if (crossfading_) {
+      const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * fade_pos_);
+      const double old = fading_ ? fading_->sample(x) : 0.0;
+      a = old + (a - old) * w;
+      fade_pos_ += fade_step_;
+      if (fade_pos_ >= 1.0) {
+        crossfading_ = false;
+        if (fading_ && !retired_.try_push(fading_)) retire_waiting_ = fading_;
+        fading_ = nullptr;
+      }
+    }
+
+    // Touch / lift ramp (raised cosine: the largest step per sample is
+    // π/2 · touch_step_ of the output, no click).
+    const bool was_silent = touch_level_ <= 0.0;
+    touch_level_ = touching ? std::min(1.0, touch_level_ + touch_step_) : std::max(0.0, touch_level_ - touch_step_);
+    const double env = 0.5 - 0.5 * std::cos(std::numbers::pi * touch_level_);
+
+    gain_ += gain_step;
+    double y = 0.0;
+    switch (config_.mode) {
+      case OutputMode::amplitude: y = a; break;
+      case OutputMode::carrier: {
+        y = a * std::sin(2.0 * std::numbers::pi * carrier_phase_);
+        carrier_inc_ += inc_step;
+        carrier_phase_ += carrier_inc_;
+        carrier_phase_ -= std::floor(carrier_phase_);
+        break;
+      }
+      case OutputMode::vibration: {
+        if (was_silent && touching) {
+          // Touch-down from rest: start the filters in their steady state for
+          // the value under the finger, so landing does not thump.
+          lowpass_.z2 = (lowpass_.b2 - lowpass_.a2) * a;
+          lowpass_.z1 = (lowpass_.b1 - lowpass_.a1) * a + lowpass_.z2;
+          dc_x1_ = a;
+          dc_y1_ = 0.0;
+        }
+        const double lp = lowpass_(a);
+        const double hp = lp - dc_x1_ + dc_r_ * dc_y1_;
+        dc_x1_ = lp;
+        dc_y1_ = hp;
+        y = 2.0 * hp;
+        break;
+      }
+    }
+    y *= env * gain_;
+    if (config_.mode != OutputMode::amplitude) y = std::clamp(y, -1.0, 1.0);
+    const auto yf = static_cast<float>(y);
+    out[i] = yf;
+    if (want_positions) position_mm[i] = static_cast<float>(x);
+    peak = std::max(peak, std::fabs(yf));
+  }
+  gain_ = gain_end;
+  carrier_inc_ = inc_end;
+  samples_done_.store(n_, std::memory_order_relaxed);
+
+  info.peak = peak;
+  info.position_mm = x;
+  info.touching = touching;
+  info.crossfading = crossfading_;
+  return info;
+}
+
+// ------------------------------------------------------------------ off-line
+
+std::vector<float> render_trace(const PlayerMap& map, const PlayerConfig& config, std::span<const FingerSample> trace,
+                                std::size_t frames, std::vector<float>* positions, std::size_t block) {
+  if (block == 0) throw InvalidArgument("render_trace: block is 0; it must be >= 1");
+  Player player(config, std::make_unique<const PlayerMap>(map));
+  std::vector<float> out(frames);
+  if (positions) positions->assign(frames, 0.0f);
+  std::size_t next = 0;
+  for (std::size_t done = 0; done < frames;) {
+    while (next < trace.size() && player.push(trace[next])) ++next;
+    const std::size_t n = std::min(block, frames - done);
+    player.process(std::span(out).subspan(done, n),
+                   positions ? std::span(*positions).subspan(done, n) : std::span<float>{});
+    done += n;
+  }
+  return out;
+}
+
+}  // namespace texel

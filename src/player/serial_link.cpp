@@ -1,0 +1,209 @@
+// Host end of the serial protocol (see serial_link.hpp).
+#include "texel/serial_link.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include "texel/controller/host_hal.hpp"
+#include "texel/player.hpp"
+
+namespace texel {
+
+using serial::ErrorCode;
+using serial::Type;
+
+SerialLink::SerialLink(const std::string& path, int baud)
+    : fd_(controller::open_serial_port(path, baud)), name_(path) {}
+
+SerialLink::SerialLink(int fd, std::string name) : fd_(fd), name_(std::move(name)) {
+  const int flags = fcntl(fd_, F_GETFL);
+  if (flags >= 0) fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
+}
+
+SerialLink::~SerialLink() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void SerialLink::write_all(const std::uint8_t* p, std::size_t n) {
+  std::size_t done = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  while (done < n) {
+    const ssize_t w = ::write(fd_, p + done, n - done);
+    if (w > 0) {
+      done += static_cast<std::size_t>(w);
+      continue;
+    }
+    if (w < 0 && (errno == EAGAIN || errno == EINTR)) {
+      if (std::chrono::steady_clock::now() > deadline)
+        throw IoError("serial link " + name_ + ": the display is not reading (write timed out)");
+      pollfd pf{fd_, POLLOUT, 0};
+      ::poll(&pf, 1, 5);
+      continue;
+    }
+    throw IoError("serial link " + name_ + ": the display is disconnected (write: " +
+                  std::string(w < 0 ? std::strerror(errno) : "nothing written") + ")");
+  }
+}
+
+std::uint8_t SerialLink::send(Type type, const std::uint8_t* payload, std::size_t n) {
+  std::uint8_t frame[serial::max_frame];
+  const std::uint8_t seq = seq_++;
+  const std::size_t len = serial::encode_frame(type, seq, payload, n, frame);
+  write_all(frame, len);
+  return seq;
+}
+
+void SerialLink::send_raw(std::span<const std::uint8_t> bytes) { write_all(bytes.data(), bytes.size()); }
+
+std::string SerialLink::request(Type type, const std::uint8_t* payload, std::size_t n, Type expect, const char* what) {
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    const std::uint8_t seq = send(type, payload, n);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+    bool got = false;
+    std::string reply;
+    Type reply_type{};
+    while (!got) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+      if (left <= 0) break;
+      pollfd pf{fd_, POLLIN, 0};
+      const int r = ::poll(&pf, 1, static_cast<int>(left));
+      if (r < 0 && errno == EINTR) continue;
+      if (r == 0) break;
+      std::uint8_t buf[512];
+      const ssize_t got_n = ::read(fd_, buf, sizeof buf);
+      if (got_n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+      if (got_n <= 0)
+        throw IoError("serial link " + name_ + ": the display is disconnected (read: " +
+                      std::string(got_n < 0 ? std::strerror(errno) : "end of file") + ") during " + what);
+      decoder_.feed(
+          buf, static_cast<std::size_t>(got_n),
+          [&](const serial::Frame& f) {
+            if (got || f.seq != seq) return;  // a late reply to an earlier attempt
+            if (f.type == expect || f.type == Type::nack) {
+              got = true;
+              reply_type = f.type;
+              reply.assign(reinterpret_cast<const char*>(f.payload), f.length);
+            }
+          },
+          [](ErrorCode) {});
+    }
+    if (!got) continue;  // timed out: retry
+    if (reply_type == Type::nack) {
+      const auto* p = reinterpret_cast<const std::uint8_t*>(reply.data());
+      const auto code = reply.size() >= 2 ? static_cast<ErrorCode>(p[1]) : ErrorCode::none;
+      const std::uint32_t detail = reply.size() >= 6 ? serial::get_u32(p + 2) : 0;
+      throw SerialError("serial link " + name_ + ": the display refused " + what + ": " + serial::describe(code) +
+                            " (code " + std::to_string(static_cast<int>(code)) + ", detail " + std::to_string(detail) + ")",
+                        code, detail);
+    }
+    return reply;
+  }
+  throw IoError("serial link " + name_ + ": no reply to " + what + " after " + std::to_string(attempts) + " attempts of " +
+                std::to_string(timeout_ms) + " ms (is the display connected and running?)");
+}
+
+DisplayInfo SerialLink::hello() {
+  const std::uint8_t p[1] = {serial::protocol_version};
+  const std::string r = request(Type::hello, p, 1, Type::hello_reply, "HELLO");
+  if (r.size() < 12) throw IoError("serial link " + name_ + ": HELLO_REPLY has " + std::to_string(r.size()) + " bytes; expected >= 12");
+  const auto* b = reinterpret_cast<const std::uint8_t*>(r.data());
+  DisplayInfo info;
+  info.version = b[0];
+  info.slots = b[1];
+  info.max_samples = serial::get_u32(b + 2);
+  info.refresh_hz = serial::get_u32(b + 6) / 1000.0;
+  info.max_payload = serial::get_u16(b + 10);
+  info.name = r.substr(12);
+  return info;
+}
+
+void SerialLink::upload_raw(std::uint8_t id, std::span<const std::uint16_t> samples, std::uint32_t spacing_nm,
+                            std::int32_t origin_nm, bool corrupt_crc) {
+  std::uint8_t begin[14] = {id, 0};
+  serial::put_u32(begin + 2, static_cast<std::uint32_t>(samples.size()));
+  serial::put_u32(begin + 6, spacing_nm);
+  serial::put_i32(begin + 10, origin_nm);
+  request(Type::map_begin, begin, sizeof begin, Type::ack, "MAP_BEGIN");
+  std::uint8_t chunk[serial::max_payload];
+  std::uint32_t crc = 0;
+  for (std::size_t first = 0; first < samples.size(); first += serial::samples_per_chunk) {
+    const std::size_t n = std::min(serial::samples_per_chunk, samples.size() - first);
+    chunk[0] = id;
+    serial::put_u32(chunk + 1, static_cast<std::uint32_t>(first));
+    for (std::size_t i = 0; i < n; ++i) serial::put_u16(chunk + 5 + 2 * i, samples[first + i]);
+    crc = serial::crc32(chunk + 5, 2 * n, crc);
+    try {
+      request(Type::map_data, chunk, 5 + 2 * n, Type::ack, "MAP_DATA");
+    } catch (const SerialError& e) {
+      // A retried chunk whose first ACK was lost: the display already has it.
+      if (!(e.code == ErrorCode::out_of_order && e.detail == first + n)) throw;
+    }
+  }
+  std::uint8_t end[5] = {id};
+  serial::put_u32(end + 1, corrupt_crc ? ~crc : crc);
+  request(Type::map_end, end, sizeof end, Type::ack, "MAP_END");
+}
+
+void SerialLink::upload_map(std::uint8_t id, std::span<const float> amplitudes, double spacing_mm, double origin_mm) {
+  if (!(std::isfinite(spacing_mm) && spacing_mm > 0 && spacing_mm * 1e6 < 4.2e9))
+    throw InvalidArgument("serial: map spacing is " + std::to_string(spacing_mm) + " mm; allowed > 0 … 4200 mm");
+  std::vector<std::uint16_t> s(amplitudes.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double a = std::isfinite(amplitudes[i]) ? std::clamp(static_cast<double>(amplitudes[i]), 0.0, 1.0) : 0.0;
+    s[i] = static_cast<std::uint16_t>(a * 65535.0 + 0.5);
+  }
+  upload_raw(id, s, static_cast<std::uint32_t>(std::lround(spacing_mm * 1e6)),
+             static_cast<std::int32_t>(std::lround(origin_mm * 1e6)));
+}
+
+void SerialLink::upload_map(std::uint8_t id, const PlayerMap& map) {
+  upload_map(id, map.values(), map.grid().spacing_mm, map.grid().origin_mm);
+}
+
+void SerialLink::select(std::uint8_t id) {
+  const std::uint8_t p[1] = {id};
+  request(Type::select, p, 1, Type::ack, "SELECT");
+}
+
+void SerialLink::stream_position(double x_mm, bool touch) {
+  std::uint8_t p[5];
+  const double nm = std::isfinite(x_mm) ? std::clamp(x_mm * 1e6, -2.1e9, 2.1e9) : 0.0;
+  serial::put_i32(p, static_cast<std::int32_t>(std::lround(nm)));
+  p[4] = touch ? 1 : 0;
+  send(Type::position, p, sizeof p);
+}
+
+void SerialLink::stream_drive(double amplitude) {
+  std::uint8_t p[2];
+  const double a = std::isfinite(amplitude) ? std::clamp(amplitude, 0.0, 1.0) : 0.0;
+  serial::put_u16(p, static_cast<std::uint16_t>(a * 65535.0 + 0.5));
+  send(Type::drive, p, sizeof p);
+}
+
+DisplayStatus SerialLink::status() {
+  const std::string r = request(Type::status_request, nullptr, 0, Type::status, "STATUS");
+  if (r.size() < 26) throw IoError("serial link " + name_ + ": STATUS has " + std::to_string(r.size()) + " bytes; expected 26");
+  const auto* b = reinterpret_cast<const std::uint8_t*>(r.data());
+  DisplayStatus s;
+  s.selected = b[0] == serial::no_map ? -1 : b[0];
+  s.mode = b[1];
+  s.amplitude = serial::get_u16(b + 2);
+  s.x_mm = serial::get_i32(b + 4) / 1e6;
+  s.touch = b[8] != 0;
+  s.frames_ok = serial::get_u32(b + 9);
+  s.frames_bad = serial::get_u32(b + 13);
+  s.last_error = static_cast<ErrorCode>(b[17]);
+  s.map_samples = serial::get_u32(b + 18);
+  s.uptime_ms = serial::get_u32(b + 22);
+  return s;
+}
+
+}  // namespace texel

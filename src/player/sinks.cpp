@@ -1,0 +1,349 @@
+// File sinks (WAV, CSV) and the real-time backends: null, PortAudio, serial.
+#include "texel/sinks.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <thread>
+
+#include <portaudio.h>
+#include <sndfile.h>
+#include <unistd.h>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+#include "texel/serial_link.hpp"
+
+namespace texel {
+
+using Clock = std::chrono::steady_clock;
+
+// ----------------------------------------------------------------- files
+
+void write_wav(const std::string& path, std::span<const float> samples, double rate_hz, WavEncoding encoding) {
+  if (!(rate_hz >= 1 && rate_hz <= 1e6)) throw InvalidArgument("wav: rate is " + detail::num(rate_hz) + " Hz; allowed 1 … 1e6");
+  check_writable(path);
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  SF_INFO info{};
+  info.samplerate = static_cast<int>(std::lround(rate_hz));
+  info.channels = 1;
+  info.format = SF_FORMAT_WAV | (encoding == WavEncoding::pcm16   ? SF_FORMAT_PCM_16
+                                 : encoding == WavEncoding::pcm24 ? SF_FORMAT_PCM_24
+                                                                  : SF_FORMAT_FLOAT);
+  SNDFILE* f = sf_open(tmp.c_str(), SFM_WRITE, &info);
+  if (!f) throw IoError("cannot write '" + path + "': " + sf_strerror(nullptr));
+  // Clip rather than let libsndfile wrap out-of-range floats.
+  sf_command(f, SFC_SET_CLIPPING, nullptr, SF_TRUE);
+  const sf_count_t n = static_cast<sf_count_t>(samples.size());
+  const sf_count_t written = n ? sf_writef_float(f, samples.data(), n) : 0;
+  const std::string err = written == n ? "" : sf_strerror(f);
+  if (sf_close(f) != 0 || written != n) {
+    std::remove(tmp.c_str());
+    throw IoError("cannot write '" + path + "': " + (err.empty() ? "write failed" : err));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string e = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw IoError("cannot write '" + path + "': " + e);
+  }
+}
+
+std::vector<float> read_wav(const std::string& path, double* rate_hz) {
+  SF_INFO info{};
+  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
+  if (!f) throw IoError("cannot read '" + path + "': " + sf_strerror(nullptr));
+  std::vector<float> all(static_cast<std::size_t>(info.frames) * static_cast<std::size_t>(info.channels));
+  const sf_count_t got = sf_readf_float(f, all.data(), info.frames);
+  sf_close(f);
+  if (got != info.frames) throw FormatError("'" + path + "': truncated audio data");
+  std::vector<float> out(static_cast<std::size_t>(info.frames));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = all[i * static_cast<std::size_t>(info.channels)];
+  if (rate_hz) *rate_hz = info.samplerate;
+  return out;
+}
+
+std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output) {
+  std::string out = "time_s,position_mm,output\n";
+  out.reserve(out.size() + output.size() * 32);
+  char buf[96];
+  for (std::size_t i = 0; i < output.size(); ++i) {
+    const int n = std::snprintf(buf, sizeof buf, "%.9g,%.7g,%.7g\n", static_cast<double>(i) / rate_hz,
+                                i < positions_mm.size() ? static_cast<double>(positions_mm[i]) : 0.0,
+                                static_cast<double>(output[i]));
+    out.append(buf, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+// --------------------------------------------------------------- Backend
+
+BackendStats Backend::stats() {
+  BackendStats s;
+  s.blocks = blocks_.load(std::memory_order_relaxed);
+  s.worst_block_s = static_cast<double>(worst_ns_.load(std::memory_order_relaxed)) * 1e-9;
+  s.total_block_s = static_cast<double>(total_ns_.load(std::memory_order_relaxed)) * 1e-9;
+  s.peak = peak_.exchange(0.0f, std::memory_order_relaxed);
+  s.underruns = underruns_.load(std::memory_order_relaxed);
+  s.position_mm = position_.load(std::memory_order_relaxed);
+  s.touching = touching_.load(std::memory_order_relaxed);
+  return s;
+}
+
+// Real-time safe: relaxed atomic loads and stores only.
+void Backend::record(const BlockInfo& info, double seconds) noexcept {
+  const auto ns = static_cast<std::uint64_t>(seconds * 1e9);
+  blocks_.fetch_add(1, std::memory_order_relaxed);
+  total_ns_.fetch_add(ns, std::memory_order_relaxed);
+  if (ns > worst_ns_.load(std::memory_order_relaxed)) worst_ns_.store(ns, std::memory_order_relaxed);
+  if (info.peak > peak_.load(std::memory_order_relaxed)) peak_.store(info.peak, std::memory_order_relaxed);
+  position_.store(info.position_mm, std::memory_order_relaxed);
+  touching_.store(info.touching, std::memory_order_relaxed);
+}
+
+namespace {
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// ------------------------------------------------------------------ null
+
+class NullBackend final : public Backend {
+public:
+  NullBackend(double rate, std::size_t block) : rate_(rate), buffer_(block) {
+    if (!(rate >= 100 && rate <= 384000)) throw InvalidArgument("null backend: rate is " + detail::num(rate) + " Hz; allowed 100 … 384000");
+    if (block < 1 || block > 65536) throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
+  }
+  ~NullBackend() override { stop(); }
+  void start(Player& player) override {
+    stop();
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void stop() override {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
+  [[nodiscard]] std::string describe() const override {
+    return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
+  }
+
+private:
+  void loop(Player& player) {
+    const auto period = std::chrono::duration<double>(static_cast<double>(buffer_.size()) / rate_);
+    const auto t0 = Clock::now();
+    for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
+      const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(k));
+      if (Clock::now() > deadline + std::chrono::duration_cast<Clock::duration>(period)) record_underrun();
+      std::this_thread::sleep_until(deadline);
+      const auto b0 = Clock::now();
+      const BlockInfo info = player.process(buffer_);
+      record(info, seconds_since(b0));
+    }
+  }
+  double rate_;
+  std::vector<float> buffer_;
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+};
+
+// ------------------------------------------------------------- PortAudio
+
+void pa_check(PaError e, const std::string& what) {
+  if (e != paNoError) throw IoError("audio: " + what + ": " + Pa_GetErrorText(e));
+}
+
+class PaSession {
+public:
+  PaSession() {
+    // PortAudio probes every host API on initialisation and some (ALSA, JACK)
+    // print to stderr when no server or card exists; silence them.
+    std::fflush(stderr);
+    const int saved = ::dup(2);
+    std::FILE* devnull = std::fopen("/dev/null", "w");
+    if (devnull && saved >= 0) ::dup2(::fileno(devnull), 2);
+    const PaError e = Pa_Initialize();
+    if (saved >= 0) {
+      ::dup2(saved, 2);
+      ::close(saved);
+    }
+    if (devnull) std::fclose(devnull);
+    pa_check(e, "cannot initialise PortAudio");
+  }
+  ~PaSession() { Pa_Terminate(); }
+  PaSession(const PaSession&) = delete;
+  PaSession& operator=(const PaSession&) = delete;
+};
+
+std::vector<std::string> list_outputs() {
+  std::vector<std::string> out;
+  const int n = Pa_GetDeviceCount();
+  for (int i = 0; i < n; ++i) {
+    const PaDeviceInfo* d = Pa_GetDeviceInfo(i);
+    if (!d || d->maxOutputChannels < 1) continue;
+    const PaHostApiInfo* h = Pa_GetHostApiInfo(d->hostApi);
+    out.push_back(std::to_string(i) + ": " + d->name + " (" + (h ? h->name : "?") + ", " +
+                  std::to_string(d->maxOutputChannels) + " ch, default " + detail::num(d->defaultSampleRate) + " Hz)");
+  }
+  return out;
+}
+
+class AudioBackend final : public Backend {
+public:
+  explicit AudioBackend(const AudioOptions& o) : options_(o) {
+    PaDeviceIndex dev = paNoDevice;
+    if (o.device.empty()) {
+      dev = Pa_GetDefaultOutputDevice();
+    } else {
+      char* end = nullptr;
+      const long idx = std::strtol(o.device.c_str(), &end, 10);
+      if (end && *end == '\0' && idx >= 0 && idx < Pa_GetDeviceCount()) {
+        dev = static_cast<PaDeviceIndex>(idx);
+      } else {
+        for (int i = 0; i < Pa_GetDeviceCount(); ++i) {
+          const PaDeviceInfo* d = Pa_GetDeviceInfo(i);
+          if (d && d->maxOutputChannels > 0 && std::string(d->name).find(o.device) != std::string::npos) {
+            dev = i;
+            break;
+          }
+        }
+      }
+    }
+    if (dev == paNoDevice || !Pa_GetDeviceInfo(dev) || Pa_GetDeviceInfo(dev)->maxOutputChannels < 1) {
+      std::string list;
+      for (const auto& s : list_outputs()) list += (list.empty() ? "" : "; ") + s;
+      throw IoError("audio: no output device '" + (o.device.empty() ? std::string("default") : o.device) +
+                    "'; outputs: " + (list.empty() ? "none (use --backend null)" : list));
+    }
+    const PaDeviceInfo* info = Pa_GetDeviceInfo(dev);
+    device_name_ = info->name;
+    PaStreamParameters p{};
+    p.device = dev;
+    p.channelCount = 1;
+    p.sampleFormat = paFloat32;
+    p.suggestedLatency = o.latency_s > 0 ? o.latency_s : info->defaultLowOutputLatency;
+    pa_check(Pa_OpenStream(&stream_, nullptr, &p, o.rate_hz, static_cast<unsigned long>(o.block_frames), paClipOff,
+                           &AudioBackend::callback, this),
+             "cannot open '" + device_name_ + "' at " + detail::num(o.rate_hz) + " Hz, " + std::to_string(o.block_frames) +
+                 " frames");
+  }
+  ~AudioBackend() override {
+    stop();
+    if (stream_) Pa_CloseStream(stream_);
+  }
+  void start(Player& player) override {
+    player_ = &player;
+    pa_check(Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
+  }
+  void stop() override {
+    if (stream_ && Pa_IsStreamActive(stream_) == 1) Pa_StopStream(stream_);
+  }
+  [[nodiscard]] std::string describe() const override {
+    return "audio '" + device_name_ + "', " + detail::num(options_.rate_hz) + " Hz, " + std::to_string(options_.block_frames) +
+           " frames per block";
+  }
+
+private:
+  // PortAudio's callback: calls only the real-time-safe process() and
+  // relaxed atomics.
+  static int callback(const void*, void* output, unsigned long frames, const PaStreamCallbackTimeInfo*,
+                      PaStreamCallbackFlags flags, void* self_ptr) {
+    auto* self = static_cast<AudioBackend*>(self_ptr);
+    if (flags & paOutputUnderflow) self->record_underrun();
+    const auto t0 = Clock::now();
+    const BlockInfo info = self->player_->process(std::span(static_cast<float*>(output), frames));
+    self->record(info, seconds_since(t0));
+    return paContinue;
+  }
+  PaSession session_;  // initialised before the stream, terminated after it
+  AudioOptions options_;
+  PaStream* stream_ = nullptr;
+  Player* player_ = nullptr;
+  std::string device_name_;
+};
+
+// ---------------------------------------------------------------- serial
+
+class SerialBackend final : public Backend {
+public:
+  SerialBackend(const SerialOptions& o, const PlayerMap& map) : options_(o), link_(o.path, o.baud) {
+    if (!(o.rate_hz >= 1 && o.rate_hz <= 20000))
+      throw InvalidArgument("serial backend: rate is " + detail::num(o.rate_hz) + " Hz; allowed 1 … 20000");
+    info_ = link_.hello();
+    if (o.stream == SerialStream::position) {
+      link_.upload_map(0, map);
+      link_.select(0);
+    }
+  }
+  ~SerialBackend() override { stop(); }
+  void start(Player& player) override {
+    stop();
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void stop() override {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
+  [[nodiscard]] std::string describe() const override {
+    return "serial " + options_.path + " → '" + info_.name + "' (protocol " + std::to_string(info_.version) + ", " +
+           detail::num(info_.refresh_hz) + " Hz refresh), streaming " +
+           (options_.stream == SerialStream::position ? "positions" : "drive values") + " at " + detail::num(options_.rate_hz) + " Hz";
+  }
+  [[nodiscard]] std::string error() const override {
+    std::lock_guard lock(error_mutex_);
+    return error_;
+  }
+
+private:
+  // The streaming thread does I/O by nature; process() itself stays
+  // real-time safe, and errors end the loop instead of escaping the thread.
+  void loop(Player& player) {
+    const auto period = std::chrono::duration<double>(1.0 / options_.rate_hz);
+    const auto t0 = Clock::now();
+    float out[1];
+    float pos[1];
+    try {
+      for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
+        std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(k)));
+        const auto b0 = Clock::now();
+        const BlockInfo info = player.process(out, pos);
+        record(info, seconds_since(b0));
+        if (options_.stream == SerialStream::position) link_.stream_position(pos[0], info.touching);
+        else link_.stream_drive(out[0]);
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(error_mutex_);
+      error_ = e.what();
+    }
+  }
+  SerialOptions options_;
+  SerialLink link_;
+  DisplayInfo info_;
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+  mutable std::mutex error_mutex_;
+  std::string error_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames) {
+  return std::make_unique<NullBackend>(rate_hz, block_frames);
+}
+
+std::unique_ptr<Backend> make_audio_backend(const AudioOptions& options) { return std::make_unique<AudioBackend>(options); }
+
+std::vector<std::string> audio_output_devices() {
+  PaSession session;
+  return list_outputs();
+}
+
+std::unique_ptr<Backend> make_serial_backend(const SerialOptions& options, const PlayerMap& map) {
+  return std::make_unique<SerialBackend>(options, map);
+}
+
+}  // namespace texel

@@ -1,0 +1,433 @@
+// The real-time player: analytic spectra, interpolation, prediction, ramps,
+// crossfades, regions, off-surface positions; finger sources and measures;
+// file sinks and the null backend.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <numbers>
+#include <numeric>
+#include <thread>
+
+#include "texel/document.hpp"
+#include "texel/error.hpp"
+#include "texel/finger.hpp"
+#include "texel/player.hpp"
+#include "texel/sinks.hpp"
+#include "texel/spsc_queue.hpp"
+
+using namespace texel;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+std::unique_ptr<const PlayerMap> make_map(double length_mm, double spacing_mm, const std::function<double(double)>& f) {
+  Grid g{0.0, spacing_mm, static_cast<std::int64_t>(std::llround(length_mm / spacing_mm))};
+  std::vector<float> v(static_cast<std::size_t>(g.count));
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(f(g.position(static_cast<std::int64_t>(i))));
+  return std::make_unique<const PlayerMap>(g, std::move(v));
+}
+
+std::vector<FingerSample> line(double t0, double t1, double x0, double v, double rate, bool touch = true) {
+  std::vector<FingerSample> s;
+  for (double t = t0; t <= t1 + 1e-12; t += 1.0 / rate) s.push_back({t, x0 + v * (t - t0), touch});
+  return s;
+}
+
+float max_step(std::span<const float> y, std::size_t from = 0, std::size_t to = SIZE_MAX) {
+  float m = 0;
+  for (std::size_t i = std::max<std::size_t>(from, 1); i < std::min(to, y.size()); ++i) m = std::max(m, std::fabs(y[i] - y[i - 1]));
+  return m;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ queue
+
+TEST(SpscQueue, FifoFullEmpty) {
+  SpscQueue<int, 4> q;
+  int v = 0;
+  EXPECT_FALSE(q.try_pop(v));
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(q.try_push(i));
+  EXPECT_FALSE(q.try_push(9));
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(q.try_pop(v));
+    EXPECT_EQ(v, i);
+  }
+  EXPECT_EQ(q.front(), nullptr);
+}
+
+TEST(SpscQueue, TwoThreadsKeepOrder) {
+  SpscQueue<std::uint64_t, 64> q;
+  constexpr std::uint64_t n = 50000;
+  std::thread producer([&] {
+    for (std::uint64_t i = 0; i < n;) {
+      if (q.try_push(i)) ++i;
+      else std::this_thread::yield();  // 2 shared cores: do not starve the consumer
+    }
+  });
+  std::uint64_t expect = 0, v = 0;
+  while (expect < n) {
+    if (q.try_pop(v)) {
+      ASSERT_EQ(v, expect++);
+    } else {
+      std::this_thread::yield();
+    }
+  }
+  producer.join();
+}
+
+// --------------------------------------------------------------- spectra
+
+TEST(Player, PureFiveCpmAt100MmPerSecondIs500Hz) {
+  // a(x) = (1 + sin 2π·5x)/2 over 300 mm; a constant 100 mm/s swipe feels 500 Hz.
+  auto map = make_map(300, 0.005, [](double x) { return 0.5 + 0.5 * std::sin(2 * pi * 5 * x); });
+  const auto trace = line(0.0, 2.5, 10.0, 100.0, 1000.0);
+  for (OutputMode mode : {OutputMode::amplitude, OutputMode::vibration}) {
+    PlayerConfig c;
+    c.rate_hz = 48000;
+    c.mode = mode;
+    const auto out = render_trace(*map, c, trace, 2 * 48000);
+    const auto spec = signal_spectrum(std::span(out).subspan(4800), c.rate_hz);
+    const double bin = spec.frequency_hz[1];
+    EXPECT_NEAR(spec.peak_hz(50.0), 500.0, bin) << to_string(mode);
+  }
+}
+
+TEST(Player, VibrationIsZeroMeanAndBounded) {
+  auto map = make_map(300, 0.005, [](double x) { return 0.7 + 0.3 * std::sin(2 * pi * 3 * x); });
+  PlayerConfig c;
+  c.mode = OutputMode::vibration;
+  const auto out = render_trace(*map, c, line(0, 2, 5, 100, 1000), 96000);
+  const double mean = std::accumulate(out.begin() + 9600, out.end(), 0.0) / static_cast<double>(out.size() - 9600);
+  EXPECT_LT(std::fabs(mean), 0.01);
+  for (float y : out) ASSERT_LE(std::fabs(y), 1.0f);
+  // 2·(0.3 sin) → amplitude 0.6 in the pass band.
+  const auto spec = signal_spectrum(std::span(out).subspan(9600), c.rate_hz);
+  const double peak = *std::max_element(spec.magnitude.begin(), spec.magnitude.end());
+  EXPECT_NEAR(peak, 0.6, 0.03);
+}
+
+TEST(Player, CarrierIsAmplitudeModulatedSine) {
+  auto map = make_map(300, 0.01, [](double) { return 1.0; });
+  PlayerConfig c;
+  c.mode = OutputMode::carrier;
+  c.carrier_hz = 1000;
+  const auto out = render_trace(*map, c, line(0, 1, 5, 100, 1000), 48000);
+  const auto spec = signal_spectrum(std::span(out).subspan(4800), c.rate_hz);
+  EXPECT_NEAR(spec.peak_hz(), 1000.0, spec.frequency_hz[1]);
+  EXPECT_NEAR(*std::max_element(out.begin() + 4800, out.end()), 1.0f, 1e-3);
+}
+
+// ------------------------------------------------------- finger handling
+
+TEST(Player, InterpolatesPositionsBetweenSamples) {
+  // Samples at 100 Hz with a changing speed; every output position must lie
+  // on the straight line between the two samples around it.
+  std::vector<FingerSample> trace;
+  for (int k = 0; k <= 100; ++k) {
+    const double t = k / 100.0;
+    trace.push_back({t, 10 + 20 * t + 15 * t * t, true});
+  }
+  auto map = make_map(100, 0.01, [](double) { return 0.5; });
+  PlayerConfig c;
+  c.rate_hz = 8000;
+  std::vector<float> pos;
+  render_trace(*map, c, trace, 7999, &pos);
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    const double t = static_cast<double>(i) / c.rate_hz;
+    const auto k = static_cast<std::size_t>(std::floor(t * 100.0 + 1e-9));
+    const auto& a = trace[k];
+    const auto& b = trace[std::min(k + 1, trace.size() - 1)];
+    const double expect = b.t_s > a.t_s ? a.x_mm + (b.x_mm - a.x_mm) * (t - a.t_s) / (b.t_s - a.t_s) : a.x_mm;
+    ASSERT_NEAR(pos[i], expect, 1e-4) << "t=" << t;
+  }
+}
+
+TEST(Player, PredictorCompensatesLatency) {
+  // Real-time feed: a 1 kHz sensor whose samples reach the player only once
+  // their time has passed. With a 20 ms look-ahead the played position
+  // tracks where the finger is 20 ms later (constant speed: exactly).
+  auto map = make_map(200, 0.01, [](double) { return 0.5; });
+  PlayerConfig c;
+  c.rate_hz = 48000;
+  c.prediction_s = 0.02;
+  c.extrapolate_s = 0.03;
+  Player p(c, std::make_unique<const PlayerMap>(*map));
+  std::vector<float> out(48), pos(48);
+  std::size_t next = 0;
+  const auto trace = line(0, 1, 10, 100, 1000);
+  double worst = 0;
+  for (int b = 0; b < 900; ++b) {
+    const double now = p.time_s();
+    while (next < trace.size() && trace[next].t_s <= now) p.push(trace[next++]);
+    p.process(out, pos);
+    if (b > 100)
+      for (std::size_t i = 0; i < pos.size(); ++i) {
+        const double t = now + static_cast<double>(i) / c.rate_hz;
+        worst = std::max(worst, std::fabs(pos[i] - (10 + 100 * (t + 0.02))));
+      }
+  }
+  EXPECT_LT(worst, 0.02);  // mm; float positions
+}
+
+TEST(Player, TouchAndLiftRampWithoutClicks) {
+  auto map = make_map(100, 0.01, [](double) { return 1.0; });
+  PlayerConfig c;
+  c.rate_hz = 48000;
+  c.touch_ramp_s = 0.005;
+  std::vector<FingerSample> trace{{0.0, 10, false}, {0.1, 10, true}, {0.3, 30, true}, {0.30001, 30, false}};
+  const auto out = render_trace(*map, c, trace, 24000);
+  // Raised-cosine ramp of N samples: largest step π/(2N) of the full scale.
+  const float bound = static_cast<float>(pi / (2 * c.touch_ramp_s * c.rate_hz)) * 1.01f;
+  EXPECT_LE(max_step(out), bound);
+  EXPECT_EQ(out[4799], 0.0f);                 // before touch
+  EXPECT_NEAR(out[4800 + 240 + 10], 1.0f, 1e-6);  // fully on after the ramp
+  EXPECT_EQ(out.back(), 0.0f);                // at rest after lift
+  // Vibration mode over a textured map: lift and touch stay within the same bound plus the texture's own slope.
+  auto tex = make_map(100, 0.005, [](double x) { return 0.5 + 0.5 * std::sin(2 * pi * 2 * x); });
+  c.mode = OutputMode::vibration;
+  const auto vib = render_trace(*tex, c, trace, 24000);
+  const float texture_step = static_cast<float>(2 * pi * 2 * 100 / c.rate_hz);  // 2·0.5·2π f v / rate
+  EXPECT_LE(max_step(vib), bound + texture_step);
+}
+
+TEST(Player, OffTheSurfaceIsAtRest) {
+  auto map = make_map(50, 0.01, [](double) { return 0.8; });
+  PlayerConfig c;
+  c.rate_hz = 10000;
+  // Lands at 40 mm, runs off the right end at 50 mm (0.1 s), keeps going.
+  const auto out = render_trace(*map, c, line(0, 0.3, 40, 100, 1000), 3000);
+  EXPECT_NEAR(out[900], 0.8f, 1e-6);
+  EXPECT_EQ(out[2000], 0.0f);
+  EXPECT_LE(max_step(out), static_cast<float>(pi / (2 * c.touch_ramp_s * c.rate_hz) * 0.8 * 1.01));
+  // Left of the surface: never touches.
+  const auto left = render_trace(*map, c, line(0, 0.1, -20, 10, 1000), 1000);
+  EXPECT_EQ(*std::max_element(left.begin(), left.end()), 0.0f);
+}
+
+TEST(Player, RegionBoundaryMatchesTheSurfaceMap) {
+  // tpad's layout: a different texture on each half; the player's output is
+  // the surface map, linearly interpolated, across the boundary at 50.88 mm.
+  Document doc = make_document(load_device("tpad"), TexelSpec{});
+  doc.regions.clear();
+  RegionSpec left, right;
+  left.name = "left";
+  left.length_mm = 50.88;
+  left.texel.central_pitch = Decibels(5);
+  right.name = "right";
+  right.start_mm = 50.88;
+  right.length_mm = 50.88;
+  right.texel.central_pitch = Decibels(15);
+  right.texel.seed = 7;
+  doc.regions = {left, right};
+  const Surface surface = prepare_surface(doc);
+  const auto map = PlayerMap::from_surface(surface);
+  const std::vector<double> ref = surface.render();
+  PlayerConfig c;
+  c.rate_hz = 48000;
+  std::vector<float> pos;
+  const auto out = render_trace(*map, c, line(0, 0.2, 45, 50, 1000), 9600, &pos);
+  for (std::size_t i = 1000; i < out.size(); ++i) {
+    const double x = 45 + 50 * static_cast<double>(i) / c.rate_hz;
+    ASSERT_NEAR(pos[i], x, 1e-4);
+    const double u = x / surface.grid().spacing_mm;
+    const auto k = static_cast<std::size_t>(u);
+    const double expect = ref[k] + (ref[k + 1] - ref[k]) * (u - static_cast<double>(k));
+    ASSERT_NEAR(out[i], expect, 1e-5) << "x=" << x;
+  }
+  // Both textures are felt: 3.16 cpm and 31.6 cpm at 50 mm/s.
+  const auto before = signal_spectrum(std::span(out).subspan(1000, 4000), c.rate_hz);
+  const auto after = signal_spectrum(std::span(out).subspan(9600 - 2400), c.rate_hz);
+  EXPECT_NEAR(before.peak_hz(50), 158, 40);
+  EXPECT_NEAR(after.peak_hz(50), 1581, 100);
+}
+
+TEST(Player, CrossfadesOnSwapAndRetiresTheOldMap) {
+  PlayerConfig c;
+  c.rate_hz = 48000;
+  c.crossfade_s = 0.02;
+  Player p(c, make_map(100, 0.01, [](double) { return 0.2; }));
+  p.push({0.0, 50, true});
+  std::vector<float> out(64), all;
+  for (int b = 0; b < 100; ++b) {
+    if (b == 50) p.set_map(make_map(100, 0.01, [](double) { return 0.8; }));
+    p.process(out);
+    all.insert(all.end(), out.begin(), out.end());
+  }
+  EXPECT_NEAR(all[3199], 0.2f, 1e-6);
+  EXPECT_NEAR(all.back(), 0.8f, 1e-6);
+  const float bound = static_cast<float>(pi / (2 * c.crossfade_s * c.rate_hz) * 0.6 * 1.01);
+  EXPECT_LE(max_step(all, 3200), bound);
+  for (std::size_t i = 3201; i < all.size(); ++i) ASSERT_GE(all[i], all[i - 1] - 1e-7f);  // monotonic
+  EXPECT_EQ(p.collect(), 1u);
+}
+
+TEST(Player, RapidSwapsCoalesceAndNeverLeak) {
+  PlayerConfig c;
+  Player p(c);
+  p.push({0.0, 5, true});
+  std::vector<float> out(64);
+  for (int i = 0; i < 200; ++i) {
+    p.set_map(make_map(10, 0.01, [i](double) { return (i % 10) / 10.0; }));
+    p.process(out);
+  }
+  for (int i = 0; i < 100; ++i) p.process(out);
+  p.collect();
+  EXPECT_NEAR(out.back(), 0.9f, 1e-6);
+}
+
+TEST(Player, GainChangesAreRampedOverOneBlock) {
+  PlayerConfig c;
+  Player p(c, make_map(100, 0.01, [](double) { return 1.0; }));
+  p.push({0.0, 50, true});
+  std::vector<float> out(64);
+  for (int b = 0; b < 20; ++b) p.process(out);
+  p.set_gain(0.5);
+  p.process(out);
+  EXPECT_NEAR(out.front(), 1.0f - 0.5f / 64, 1e-5);
+  EXPECT_NEAR(out.back(), 0.5f, 1e-5);
+  EXPECT_LE(max_step(out), 0.5f / 64 + 1e-6f);
+  p.set_gain(7.0);  // clamped, not thrown
+  p.process(out);
+  EXPECT_NEAR(out.back(), 1.0f, 1e-5);
+}
+
+TEST(Player, ConfigIsValidated) {
+  PlayerConfig c;
+  c.rate_hz = 10;
+  EXPECT_THROW(Player{c}, InvalidArgument);
+  c = {};
+  c.crossfade_s = 0;
+  EXPECT_THROW(validate(c), InvalidArgument);
+  c = {};
+  c.lowpass_hz = 30000;
+  EXPECT_THROW(validate(c), InvalidArgument);
+  EXPECT_THROW(parse_output_mode("loud"), InvalidArgument);
+  EXPECT_THROW(PlayerMap(Grid{0, 0.1, 3}, std::vector<float>(2)), InvalidArgument);
+}
+
+// -------------------------------------------------------- finger sources
+
+TEST(Finger, ConstantSwipeAndMeasures) {
+  SwipeConfig s;
+  s.speed_mm_s = 100;
+  s.surface_mm = 101.76;
+  s.duration_s = 3;
+  const auto trace = simulate_swipe(s);
+  const SwipeMeasures m = swipe_measures(trace);
+  EXPECT_NEAR(m.mean_speed_mm_s, 100, 1e-6);
+  EXPECT_NEAR(m.sd_speed_mm_s, 0, 1e-6);
+  EXPECT_DOUBLE_EQ(m.directional_proportion, 1.0);
+  // Lifts at the far end and lands again at the start.
+  EXPECT_FALSE(trace[1050].touch);
+  EXPECT_TRUE(trace[1200].touch);
+}
+
+TEST(Finger, BackAndForthTurnsSmoothly) {
+  SwipeConfig s;
+  s.pattern = SwipePattern::back_and_forth;
+  s.speed_mm_s = 100;
+  s.start_mm = 10;
+  s.extent_mm = 80;
+  s.turn_s = 0.1;
+  s.duration_s = 10;
+  const auto trace = simulate_swipe(s);
+  double lo = 1e9, hi = -1e9, max_acc = 0;
+  for (std::size_t i = 2; i < trace.size(); ++i) {
+    lo = std::min(lo, trace[i].x_mm);
+    hi = std::max(hi, trace[i].x_mm);
+    const double a = (trace[i].x_mm - 2 * trace[i - 1].x_mm + trace[i - 2].x_mm) * 1e6;
+    max_acc = std::max(max_acc, std::fabs(a));
+  }
+  EXPECT_NEAR(lo, 10, 1e-4);
+  EXPECT_NEAR(hi, 90, 1e-3);
+  EXPECT_LT(max_acc, 1.05 * pi * 100 / 0.1);  // peak π·v/turn mm/s²
+  const SwipeMeasures m = swipe_measures(trace);
+  EXPECT_NEAR(m.directional_proportion, 0.0, 0.02);
+  EXPECT_GT(m.sd_speed_mm_s, 5);
+  EXPECT_LT(m.mean_speed_mm_s, 100);
+  EXPECT_GT(m.mean_speed_mm_s, 80);
+}
+
+TEST(Finger, MeasuresSkipLiftedIntervalsAndStillSamples) {
+  std::vector<FingerSample> t{{0, 0, true}, {1, 10, true}, {2, 10, true}, {3, 0, true}, {4, 50, false}, {5, 60, false}};
+  const SwipeMeasures m = swipe_measures(t, 1.0);
+  EXPECT_EQ(m.intervals, 3u);
+  EXPECT_EQ(m.moving_right, 1u);
+  EXPECT_EQ(m.moving_left, 1u);
+  EXPECT_NEAR(m.mean_speed_mm_s, 20.0 / 3, 1e-12);
+  EXPECT_DOUBLE_EQ(m.directional_proportion, 0.0);
+  EXPECT_EQ(swipe_measures(std::vector<FingerSample>{}).intervals, 0u);
+}
+
+TEST(Finger, TraceCsvRoundTripAndErrors) {
+  SwipeConfig s;
+  s.surface_mm = 50;
+  s.duration_s = 0.05;
+  s.lead_in_s = 0.01;
+  const auto trace = simulate_swipe(s);
+  const auto back = parse_trace_csv(trace_csv(trace), "t.csv");
+  ASSERT_EQ(back.size(), trace.size());
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].t_s, trace[i].t_s);
+    EXPECT_EQ(back[i].x_mm, trace[i].x_mm);
+    EXPECT_EQ(back[i].touch, trace[i].touch);
+  }
+  EXPECT_EQ(parse_trace_csv("0,1\n0.1,2\n", "x").size(), 2u);  // touch defaults to 1
+  EXPECT_THROW(parse_trace_csv("", "x"), FormatError);
+  EXPECT_THROW(parse_trace_csv("0,1\n-1,2\n", "x"), FormatError);  // time goes back
+  EXPECT_THROW(parse_trace_csv("0,1,3\n", "x"), FormatError);      // touch not 0/1
+  EXPECT_THROW(parse_trace_csv("0,1\n1,abc\n", "x"), FormatError);
+  EXPECT_THROW(parse_trace_csv("0,1,1,1\n", "x"), FormatError);
+  EXPECT_THROW(parse_trace_csv("0,nan\n", "x"), FormatError);
+  SwipeConfig bad;
+  bad.speed_mm_s = 0;
+  bad.surface_mm = 10;
+  EXPECT_THROW(simulate_swipe(bad), InvalidArgument);
+  EXPECT_THROW(parse_swipe_pattern("zigzag"), InvalidArgument);
+}
+
+// ----------------------------------------------------------------- sinks
+
+TEST(Sinks, WavRoundTripIsAtomic) {
+  const auto dir = std::filesystem::temp_directory_path() / ("texel-wav-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::vector<float> s(4800);
+  for (std::size_t i = 0; i < s.size(); ++i) s[i] = 0.5f * std::sin(2 * pi * 440 * i / 48000.0);
+  const std::string path = (dir / "a.wav").string();
+  write_wav(path, s, 48000, WavEncoding::float32);
+  double rate = 0;
+  const auto back = read_wav(path, &rate);
+  EXPECT_EQ(rate, 48000);
+  ASSERT_EQ(back.size(), s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) ASSERT_EQ(back[i], s[i]);
+  write_wav(path, s, 48000);  // pcm16 over the old file
+  EXPECT_NEAR(read_wav(path)[100], s[100], 1.0 / 32768);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);  // no temporaries left
+  EXPECT_THROW(write_wav((dir / "no" / "b.wav").string(), s, 48000), IoError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Sinks, SignalCsvHasOneRowPerSample) {
+  const std::vector<float> pos{1, 2}, out{0.25f, 0.5f};
+  EXPECT_EQ(signal_csv(1000, pos, out), "time_s,position_mm,output\n0,1,0.25\n0.001,2,0.5\n");
+}
+
+TEST(Sinks, NullBackendRunsInRealTime) {
+  PlayerConfig c;
+  Player p(c, make_map(100, 0.01, [](double) { return 0.5; }));
+  p.push({0.0, 10, true});
+  auto backend = make_null_backend(48000, 64);
+  backend->start(p);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  backend->stop();
+  const BackendStats s = backend->stats();
+  EXPECT_GT(s.blocks, 50u);
+  EXPECT_LT(s.blocks, 400u);
+  EXPECT_GT(s.worst_block_s, 0.0);
+  EXPECT_TRUE(s.touching);
+}
