@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   texel::cli::register_info(app);
   texel::cli::register_demo(app);
   texel::cli::register_devices(app);
+  texel::cli::register_reference(app);
+  texel::cli::register_spectrum(app);
+  texel::cli::register_atlas(app);
   try {
     app.parse(argc, argv);
     return 0;

@@ -15,22 +15,31 @@
 #include <vector>
 
 #include "texel/device.hpp"
+#include "texel/reference.hpp"
 #include "texel/surface.hpp"
 #include "texel/texture.hpp"
 
 namespace texel {
 
-/// The texture a region holds. Only Texel textures in format version 1;
-/// later kinds (references) extend this.
+/// The texture a region holds: a Texel texture (format version 1) or, from
+/// version 2, a reference texture ("kind": "reference"); a Texel texture's
+/// coarse profile may also be a reference (the coarse-study test texture).
 struct RegionSpec {
   std::string name;                   ///< optional label, e.g. "left"
   double start_mm = 0.0;
   std::optional<double> length_mm;    ///< none = to the end of the device
-  TexelSpec texel;
+  TexelSpec texel;                    ///< used when `reference` is empty
+  /// Set: the region holds this reference instead of a Texel rendering.
+  std::optional<ReferenceSpec> reference;
+  /// Set (Texel regions only): the coarse profile is this reference, prepared
+  /// over the region on the device grid; it replaces texel.coarse.
+  std::optional<ReferenceSpec> coarse_reference;
 };
 
 struct Document {
-  static constexpr int current_version = 1;
+  /// Version 2 adds references; documents without them are still written as
+  /// version 1, so older readers keep reading them.
+  static constexpr int current_version = 2;
   int version = current_version;
   DeviceProfile device;               ///< resolved profile (by name or inline)
   bool device_inline = false;         ///< written inline rather than by name
@@ -46,6 +55,10 @@ void save_document(const Document& doc, const std::string& path);
 
 /// A document holding one Texel texture over the whole device.
 Document make_document(const DeviceProfile& device, const TexelSpec& spec);
+/// A document holding one reference texture over the whole device.
+Document make_reference_document(const DeviceProfile& device, const ReferenceSpec& spec);
+/// The lowest format version that can hold `doc` (1, or 2 with references).
+int required_version(const Document& doc);
 
 /// Prepares every region's texture for the document's device grid.
 Surface prepare_surface(const Document& doc);

@@ -16,6 +16,80 @@ using ordered = nlohmann::ordered_json;
 
 constexpr const char* format_tag = "texel-document";
 
+/// {"kind": "reference", "name": ..., "seed": ..., "params": {...}}; values
+/// are typed by the generator's parameter list (numbers, arrays, words).
+ReferenceSpec parse_reference(JsonObject& o) {
+  ReferenceSpec spec;
+  spec.name = o.string("name");
+  const ReferenceInfo* info = nullptr;
+  try {
+    info = &reference_info(spec.name);
+  } catch (const InvalidArgument& e) {
+    throw FormatError(o.field("name") + ": " + e.what());
+  }
+  spec.seed = o.uint64_or("seed", 1);
+  if (o.has("params")) {
+    const auto& pj = o.raw("params");
+    if (!pj.is_object()) throw FormatError(o.field("params") + " must be an object of parameter values");
+    for (auto it = pj.begin(); it != pj.end(); ++it) {
+      const std::string field = o.field("params") + "." + it.key();
+      const ReferenceParam* param = nullptr;
+      for (const auto& p : info->params)
+        if (p.key == it.key()) param = &p;
+      if (!param) {
+        std::string keys;
+        for (const auto& p : info->params) keys += (keys.empty() ? "" : ", ") + p.key;
+        throw FormatError(field + " is not a parameter of reference '" + spec.name + "' (its parameters: " + keys + ")");
+      }
+      const json& v = it.value();
+      switch (param->kind) {
+        case ReferenceParamKind::number:
+        case ReferenceParamKind::integer:
+          if (!v.is_number()) throw FormatError(field + " must be a number, got " + JsonObject::type_of(v));
+          spec.params[it.key()] = v.get<double>();
+          break;
+        case ReferenceParamKind::list: {
+          if (!v.is_array()) throw FormatError(field + " must be an array of numbers, got " + JsonObject::type_of(v));
+          std::vector<double> values;
+          for (std::size_t i = 0; i < v.size(); ++i) {
+            if (!v[i].is_number()) throw FormatError(field + "[" + std::to_string(i) + "] must be a number");
+            values.push_back(v[i].get<double>());
+          }
+          spec.params[it.key()] = std::move(values);
+          break;
+        }
+        case ReferenceParamKind::choice:
+          if (!v.is_string()) throw FormatError(field + " must be a string, got " + JsonObject::type_of(v));
+          spec.params[it.key()] = v.get<std::string>();
+          break;
+      }
+    }
+  } else {
+    o.skip("params");
+  }
+  try {
+    validate(spec);
+  } catch (const InvalidArgument& e) {
+    throw FormatError(o.where() + ": " + e.what());
+  }
+  return spec;
+}
+
+ordered reference_json(const ReferenceSpec& spec) {
+  ordered j;
+  j["kind"] = "reference";
+  j["name"] = spec.name;
+  j["seed"] = spec.seed;
+  ordered params = ordered::object();
+  for (const auto& [key, value] : spec.params) {
+    if (const auto* d = std::get_if<double>(&value)) params[key] = *d;
+    else if (const auto* l = std::get_if<std::vector<double>>(&value)) params[key] = *l;
+    else params[key] = std::get<std::string>(value);
+  }
+  j["params"] = std::move(params);
+  return j;
+}
+
 CoarseProfile parse_coarse(const json& j, const std::string& path) {
   JsonObject o(j, path);
   const std::string kind = o.string("kind");
@@ -48,7 +122,7 @@ CoarseProfile parse_coarse(const json& j, const std::string& path) {
     }
     profile = std::move(p);
   } else {
-    throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: constant, sine, values, points");
+    throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: constant, sine, values, points, reference");
   }
   o.finish();
   try {
@@ -95,10 +169,17 @@ Enum enum_field(JsonObject& o, std::string_view key, Enum fallback, Parse parse)
   }
 }
 
-TexelSpec parse_texel(const json& j, const std::string& path) {
+/// A region's texture: a Texel texture (possibly with a reference as its
+/// coarse profile) or a reference.
+void parse_texture(const json& j, const std::string& path, RegionSpec& region) {
   JsonObject o(j, path);
   const std::string kind = o.string("kind");
-  if (kind != "texel") throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: texel");
+  if (kind == "reference") {
+    region.reference = parse_reference(o);
+    o.finish();
+    return;
+  }
+  if (kind != "texel") throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: texel, reference");
   TexelSpec s;
   s.central_pitch = Decibels(o.number("central_pitch_db", -40.0, 40.0));
   s.irregularity = Decibels(o.number("irregularity_db", -60.0, 40.0));
@@ -113,18 +194,29 @@ TexelSpec parse_texel(const json& j, const std::string& path) {
   s.fill = enum_field(o, "fill", s.fill, parse_fill);
   s.coarse_strength = o.number_or("coarse_strength", 0.0, 0.0, 1.0);
   s.fine_strength = o.number_or("fine_strength", 1.0, 0.0, 1.0);
-  if (o.has("coarse")) s.coarse = parse_coarse(o.raw("coarse"), o.field("coarse"));
-  else o.skip("coarse");
+  if (o.has("coarse")) {
+    const json& cj = o.raw("coarse");
+    if (cj.is_object() && cj.contains("kind") && cj["kind"] == "reference") {
+      JsonObject c(cj, o.field("coarse"));
+      c.skip("kind");
+      region.coarse_reference = parse_reference(c);
+      c.finish();
+    } else {
+      s.coarse = parse_coarse(cj, o.field("coarse"));
+    }
+  } else {
+    o.skip("coarse");
+  }
   o.finish();
   try {
     validate(s);
   } catch (const InvalidArgument& e) {
     throw FormatError(path + ": " + e.what());
   }
-  return s;
+  region.texel = s;
 }
 
-ordered texel_json(const TexelSpec& s) {
+ordered texel_json(const TexelSpec& s, const std::optional<ReferenceSpec>& coarse_reference) {
   ordered j;
   j["kind"] = "texel";
   j["central_pitch_db"] = s.central_pitch.value();
@@ -140,7 +232,7 @@ ordered texel_json(const TexelSpec& s) {
   j["fill"] = std::string(to_string(s.fill));
   j["coarse_strength"] = s.coarse_strength;
   j["fine_strength"] = s.fine_strength;
-  j["coarse"] = coarse_json(s.coarse);
+  j["coarse"] = coarse_reference ? reference_json(*coarse_reference) : coarse_json(s.coarse);
   return j;
 }
 
@@ -197,7 +289,7 @@ Document parse_document(std::string_view text, std::string_view origin) {
     if (has_texture) {
       o.skip("regions");
       RegionSpec r;
-      r.texel = parse_texel(o.raw("texture"), "texture");
+      parse_texture(o.raw("texture"), "texture", r);
       doc.regions.push_back(std::move(r));
     } else {
       o.skip("texture");
@@ -210,7 +302,7 @@ Document parse_document(std::string_view text, std::string_view origin) {
         spec.name = r.string_or("name", "");
         spec.start_mm = r.number_or("start_mm", 0.0, 0.0, 1e9);
         spec.length_mm = r.optional_number("length_mm", 1e-9, 1e9);
-        spec.texel = parse_texel(r.raw("texture"), path + ".texture");
+        parse_texture(r.raw("texture"), path + ".texture", spec);
         r.finish();
         doc.regions.push_back(std::move(spec));
       }
@@ -228,7 +320,7 @@ Document load_document(const std::string& path) { return parse_document(read_fil
 std::string document_json(const Document& doc) {
   ordered j;
   j["format"] = format_tag;
-  j["version"] = doc.version;
+  j["version"] = required_version(doc);
   if (!doc.description.empty()) j["description"] = doc.description;
   if (doc.device_inline || !is_builtin_unchanged(doc.device)) {
     j["device"] = ordered::parse(device_profile_json(doc.device));
@@ -237,8 +329,11 @@ std::string document_json(const Document& doc) {
   }
   const bool whole = doc.regions.size() == 1 && doc.regions[0].start_mm == 0.0 && !doc.regions[0].length_mm &&
                      doc.regions[0].name.empty();
+  const auto texture_json = [](const RegionSpec& r) {
+    return r.reference ? reference_json(*r.reference) : texel_json(r.texel, r.coarse_reference);
+  };
   if (whole) {
-    j["texture"] = texel_json(doc.regions[0].texel);
+    j["texture"] = texture_json(doc.regions[0]);
   } else {
     j["regions"] = ordered::array();
     for (const auto& r : doc.regions) {
@@ -246,7 +341,7 @@ std::string document_json(const Document& doc) {
       if (!r.name.empty()) rj["name"] = r.name;
       rj["start_mm"] = r.start_mm;
       if (r.length_mm) rj["length_mm"] = *r.length_mm;
-      rj["texture"] = texel_json(r.texel);
+      rj["texture"] = texture_json(r);
       j["regions"].push_back(std::move(rj));
     }
   }
@@ -264,6 +359,21 @@ Document make_document(const DeviceProfile& device, const TexelSpec& spec) {
   return doc;
 }
 
+Document make_reference_document(const DeviceProfile& device, const ReferenceSpec& spec) {
+  Document doc;
+  doc.device = device;
+  RegionSpec r;
+  r.reference = spec;
+  doc.regions.push_back(std::move(r));
+  return doc;
+}
+
+int required_version(const Document& doc) {
+  for (const auto& r : doc.regions)
+    if (r.reference || r.coarse_reference) return 2;
+  return 1;
+}
+
 Surface prepare_surface(const Document& doc) {
   if (doc.regions.empty()) throw InvalidArgument("document has no regions");
   const Grid grid = doc.device.grid();
@@ -279,7 +389,17 @@ Surface prepare_surface(const Document& doc) {
       throw InvalidArgument(label + "start_mm " + detail::num(spec.start_mm) + " mm is at or past the device's end (" +
                             detail::num(grid.length_mm()) + " mm)");
     try {
-      r.texture = std::make_shared<TexelTexture>(spec.texel, Millimetres(r.length_mm), CyclesPerMm(doc.device.band_top_cpm()));
+      // The texture's own coordinates: 0 mm at the region's left edge (as Surface::render passes them).
+      const Grid local{grid.origin_mm - r.start_mm, grid.spacing_mm, grid.count};
+      if (spec.reference) {
+        r.texture = std::make_shared<ReferenceTexture>(*spec.reference, Millimetres(r.length_mm), local);
+      } else if (spec.coarse_reference) {
+        TexelSpec texel = spec.texel;
+        texel.coarse = reference_profile(*spec.coarse_reference, Millimetres(r.length_mm), grid.spacing_mm);
+        r.texture = std::make_shared<TexelTexture>(texel, Millimetres(r.length_mm), CyclesPerMm(doc.device.band_top_cpm()));
+      } else {
+        r.texture = std::make_shared<TexelTexture>(spec.texel, Millimetres(r.length_mm), CyclesPerMm(doc.device.band_top_cpm()));
+      }
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(label + e.what());
     }

@@ -1,0 +1,328 @@
+// texel spectrum: magnitude spectrum, Welch PSD, peak list, spectral
+// centroids, spread and band energies of any map the CLI writes or reads,
+// with a temporal-frequency view for a swipe speed and the researchers'
+// figure (6 mm excerpt above a log-frequency spectrum).
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "render_output.hpp"
+#include "spectrum_common.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+#include "texel/plot.hpp"
+
+namespace texel::cli {
+namespace {
+
+using detail::fixed;
+using detail::num;
+using ordered = nlohmann::ordered_json;
+
+double db_of(double cpm) { return 10.0 * std::log10(cpm); }
+
+/// Checks that CSV positions are uniformly spaced (to 0.1 % of a step) and returns the step.
+double uniform_spacing(const std::vector<double>& x, const std::string& path) {
+  if (x.size() < 2) throw FormatError(path + ": needs at least 2 rows to know the sample spacing");
+  const double step = (x.back() - x.front()) / static_cast<double>(x.size() - 1);
+  if (!(step > 0.0)) throw FormatError(path + ": positions must increase");
+  for (std::size_t i = 1; i < x.size(); ++i)
+    if (std::abs((x[i] - x[i - 1]) - step) > 1e-3 * step)
+      throw FormatError(path + ": row " + std::to_string(i + 1) + " position " + num(x[i]) +
+                        " mm breaks the uniform spacing of " + num(step) + " mm (spectra need uniformly sampled maps)");
+  return step;
+}
+
+std::pair<double, double> parse_band(const std::string& text) {
+  const auto colon = text.find(':');
+  auto number = [&](std::string_view t) {
+    double v = 0.0;
+    const auto res = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (t.empty() || res.ec != std::errc() || res.ptr != t.data() + t.size())
+      throw InvalidArgument("--band '" + text + "' must be LOW:HIGH in cycles/mm, e.g. 1:10");
+    return v;
+  };
+  if (colon == std::string::npos) throw InvalidArgument("--band '" + text + "' must be LOW:HIGH in cycles/mm, e.g. 1:10");
+  const double lo = number(std::string_view(text).substr(0, colon));
+  const double hi = number(std::string_view(text).substr(colon + 1));
+  if (!(lo >= 0.0 && hi > lo && std::isfinite(hi)))
+    throw InvalidArgument("--band '" + text + "' needs 0 <= LOW < HIGH (cycles/mm)");
+  return {lo, hi};
+}
+
+struct Args {
+  std::string file;
+  std::optional<std::string> device;
+  std::optional<double> spacing;
+  std::optional<std::string> region;
+  std::optional<double> swipe_speed;
+  bool json = false;
+  std::optional<std::string> output;
+  std::optional<std::string> spectrum_csv;
+  std::optional<std::string> psd_csv;
+  std::string window = "blackman-harris";
+  int zero_pad = 4;
+  double threshold_db = -40.0;
+  std::size_t max_peaks = 32;
+  std::size_t welch_segment = 0;
+  double welch_overlap = 0.5;
+  std::vector<std::string> bands;
+  double excerpt_mm = 6.0;
+};
+
+ordered report_json(const Args& a, const LoadedSignal& sig, const SpectralReport& r) {
+  // A plain flag and value rather than optional<MmPerSecond>: GCC 12 warns
+  // (falsely) about the optional's payload inside nlohmann's conversions.
+  const bool has_speed = a.swipe_speed.has_value();
+  const MmPerSecond speed(a.swipe_speed.value_or(1.0));
+  const MmPerSecond* v = has_speed ? &speed : nullptr;
+  ordered j;
+  j["file"] = a.file;
+  j["source"] = sig.source;
+  j["samples"] = sig.samples.size();
+  j["spacing_mm"] = sig.spacing_mm;
+  j["length_mm"] = static_cast<double>(sig.samples.size()) * sig.spacing_mm;
+  j["nyquist_cpm"] = 0.5 / sig.spacing_mm;
+  j["resolution_cpm"] = r.spectrum.resolution_cpm;
+  j["window"] = std::string(to_string(r.spectrum.window));
+  j["nfft"] = r.spectrum.nfft;
+  if (v) j["swipe_speed_mm_s"] = v->value();
+  j["mean_amplitude"] = r.mean;
+  j["rms_amplitude"] = r.rms;
+  j["peak_threshold_db"] = a.threshold_db;
+  j["peaks"] = ordered::array();
+  for (const auto& p : r.peaks) {
+    ordered pj;
+    pj["frequency_cpm"] = p.frequency.value();
+    pj["frequency_db"] = db_of(p.frequency.value());
+    if (v) pj["frequency_hz"] = temporal(p.frequency, *v).value();
+    pj["amplitude"] = p.amplitude;
+    pj["level_db"] = p.level_db;
+    j["peaks"].push_back(pj);
+  }
+  const auto& s = r.summary;
+  ordered sj;
+  sj["centroid_cpm"] = s.centroid.value();
+  sj["log_centroid_db"] = s.log_centroid.value();
+  sj["log_centroid_cpm"] = std::pow(10.0, s.log_centroid.value() / 10.0);
+  sj["spread_cpm"] = s.spread.value();
+  sj["log_spread_db"] = s.log_spread_db;
+  if (v) {
+    sj["centroid_hz"] = temporal(s.centroid, *v).value();
+    sj["log_centroid_hz"] = temporal(CyclesPerMm(std::pow(10.0, s.log_centroid.value() / 10.0)), *v).value();
+    sj["spread_hz"] = s.spread.value() * v->value();
+  }
+  j["summary"] = sj;
+  j["bands"] = ordered::array();
+  for (const auto& b : r.bands) {
+    ordered bj{{"lo_cpm", b.lo_cpm}, {"hi_cpm", b.hi_cpm}};
+    if (v) {
+      bj["lo_hz"] = b.lo_cpm * v->value();
+      bj["hi_hz"] = b.hi_cpm * v->value();
+    }
+    bj["mean_square"] = b.mean_square;
+    bj["fraction"] = b.fraction;
+    j["bands"].push_back(bj);
+  }
+  j["welch"] = {{"window", "hann"},
+                {"segment_samples", r.psd.segment},
+                {"segments", r.psd.segments},
+                {"bin_cpm", r.psd.bin_cpm}};
+  return j;
+}
+
+void print_report(const Args& a, const LoadedSignal& sig, const SpectralReport& r) {
+  const std::optional<double> v = a.swipe_speed;
+  std::cout << a.file << ": " << sig.samples.size() << " samples × " << num(sig.spacing_mm) << " mm ("
+            << fixed(static_cast<double>(sig.samples.size()) * sig.spacing_mm, 2) << " mm), " << sig.source << "\n";
+  std::cout << "resolution " << num(r.spectrum.resolution_cpm) << " cpm, Nyquist " << fixed(0.5 / sig.spacing_mm, 2) << " cpm, window "
+            << to_string(r.spectrum.window) << "\n";
+  std::cout << "peaks (within " << num(a.threshold_db) << " dB of the highest):\n";
+  std::cout << "  frequency_cpm      dB re 1 cpm   amplitude   level_dB" << (v ? "   frequency_Hz" : "") << "\n";
+  for (const auto& p : r.peaks) {
+    std::cout << "  " << std::setw(13) << fixed(p.frequency.value(), 4) << std::setw(14) << fixed(db_of(p.frequency.value()), 2)
+              << std::setw(12) << fixed(p.amplitude, 5) << std::setw(11) << fixed(p.level_db, 2);
+    if (v) std::cout << std::setw(15) << fixed(p.frequency.value() * *v, 2);
+    std::cout << "\n";
+  }
+  const auto& s = r.summary;
+  std::cout << "spectral centroid " << fixed(s.centroid.value(), 4) << " cpm" << (v ? " (" + fixed(s.centroid.value() * *v, 2) + " Hz)" : "")
+            << ", log-frequency centroid " << fixed(s.log_centroid.value(), 2) << " dB re 1 cpm ("
+            << fixed(std::pow(10.0, s.log_centroid.value() / 10.0), 4) << " cpm)\n";
+  std::cout << "spectral spread " << fixed(s.spread.value(), 4) << " cpm, log spread " << fixed(s.log_spread_db, 2) << " dB\n";
+  std::cout << "band energy (mean-square amplitude, share):\n";
+  for (const auto& b : r.bands)
+    std::cout << "  " << std::setw(8) << num(b.lo_cpm) << " … " << std::setw(8) << fixed(b.hi_cpm, 4) << " cpm  "
+              << std::setw(12) << num(b.mean_square) << "  " << fixed(100.0 * b.fraction, 2) << " %\n";
+}
+
+}  // namespace
+
+LoadedSignal load_signal(const std::string& path, const std::optional<std::string>& device, const std::optional<double>& spacing_mm,
+                         const std::optional<std::string>& region) {
+  const std::string ext = output_extension(path);
+  if (spacing_mm && !(std::isfinite(*spacing_mm) && *spacing_mm > 0.0))
+    throw InvalidArgument("--spacing is " + num(*spacing_mm) + "; it must be a finite number of mm > 0");
+  if (region && ext != ".texel.json") throw InvalidArgument("--region applies to .texel.json documents only");
+  LoadedSignal sig;
+  if (ext == ".bin") {
+    if (!device) throw InvalidArgument("'" + path + "' is device-native: name its device with --device (e.g. --device tpad)");
+    const DeviceProfile d = load_device(*device);
+    const std::string bytes = read_file(path);
+    const std::size_t width = bytes_per_sample(d.format);
+    if (bytes.size() % width != 0)
+      throw FormatError(path + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of " + std::string(to_string(d.format)) +
+                        " samples for device " + d.name);
+    sig.samples = decode_samples(d.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
+    sig.spacing_mm = spacing_mm.value_or(d.spacing_mm);
+    sig.source = "device " + d.name + " (" + std::string(to_string(d.format)) + ")";
+  } else if (ext == ".csv") {
+    auto [x, a] = parse_csv_columns(read_file(path), path);
+    sig.spacing_mm = uniform_spacing(x, path);
+    sig.origin_mm = x.front();
+    sig.samples = std::move(a);
+    sig.source = "csv";
+  } else if (ext == ".npy") {
+    sig.samples = parse_npy(read_file(path), path);
+    if (spacing_mm) sig.spacing_mm = *spacing_mm;
+    else if (device) sig.spacing_mm = load_device(*device).spacing_mm;
+    else throw InvalidArgument("'" + path + "' carries no sample spacing: give --device or --spacing");
+    sig.source = "npy";
+  } else if (ext == ".texel.json" || ext == ".json") {
+    Document doc = load_document(path);
+    if (device || spacing_mm) {
+      DeviceOptions o;
+      o.device = device;
+      o.spacing_mm = spacing_mm;
+      doc.device = resolve_device(o, &doc.device);
+    }
+    const Surface surface = prepare_surface(doc);
+    std::vector<double> map = render_map(surface);
+    const Grid& g = surface.grid();
+    sig.spacing_mm = g.spacing_mm;
+    sig.source = "document on device " + doc.device.name;
+    if (region) {
+      const auto& regions = surface.regions();
+      const Region* chosen = nullptr;
+      for (std::size_t i = 0; i < regions.size(); ++i)
+        if (regions[i].name == *region || std::to_string(i) == *region) chosen = &regions[i];
+      if (!chosen) {
+        std::string names;
+        for (std::size_t i = 0; i < regions.size(); ++i) names += (names.empty() ? "" : ", ") + (regions[i].name.empty() ? std::to_string(i) : regions[i].name);
+        throw InvalidArgument("--region '" + *region + "' is not in " + path + "; its regions: " + names);
+      }
+      std::vector<double> part;
+      for (std::int64_t i = 0; i < g.count; ++i) {
+        const double x = g.position(i);
+        if (x >= chosen->start_mm && x < chosen->start_mm + chosen->length_mm) {
+          if (part.empty()) sig.origin_mm = x;
+          part.push_back(map[static_cast<std::size_t>(i)]);
+        }
+      }
+      map = std::move(part);
+      sig.source += ", region " + *region;
+    }
+    sig.samples = std::move(map);
+  } else {
+    throw InvalidArgument("spectrum: '" + path + "' has extension '" + ext + "'; allowed: .bin (with --device), .csv, .npy, .texel.json");
+  }
+  if (sig.samples.size() < 16)
+    throw InvalidArgument("'" + path + "' holds " + std::to_string(sig.samples.size()) + " samples; a spectrum needs at least 16");
+  return sig;
+}
+
+SpectrumPlot make_spectrum_plot(const std::string& title, const LoadedSignal& sig, const SpectralReport& r,
+                                std::optional<double> swipe_speed_mm_s) {
+  SpectrumPlot p;
+  p.title = title;
+  const double length = static_cast<double>(sig.samples.size()) * sig.spacing_mm;
+  p.excerpt_mm = std::min(6.0, length);
+  const auto n = std::min(sig.samples.size(), static_cast<std::size_t>(std::ceil(p.excerpt_mm / sig.spacing_mm)) + 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    p.positions_mm.push_back(sig.origin_mm + static_cast<double>(i) * sig.spacing_mm);
+    p.amplitudes.push_back(sig.samples[i]);
+  }
+  p.spectrum = r.spectrum;
+  p.peaks = r.peaks;
+  p.swipe_speed_mm_s = swipe_speed_mm_s;
+  return p;
+}
+
+void register_spectrum(CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand("spectrum", "Spectrum of a texture map: peaks, centroids, spread, band energy, plot");
+  cmd->add_option("file", a->file, "A .bin (with --device), .csv, .npy (with --device or --spacing) or .texel.json")->required();
+  cmd->add_option("--device", a->device, "Device of a .bin file; sample spacing of a .npy; re-targets a document");
+  cmd->add_option("--spacing", a->spacing, "Sample spacing, mm (overrides the device's)");
+  cmd->add_option("--region", a->region, "Analyse one region of a document (name or index)");
+  cmd->add_option("--swipe-speed", a->swipe_speed, "Finger speed, mm/s: adds temporal frequencies (Hz = cycles/mm × mm/s)");
+  cmd->add_flag("--json", a->json, "Print the report as JSON");
+  cmd->add_option("-o,--output", a->output, "Plot: .png or .svg (excerpt on top, spectrum below on a log-frequency axis)");
+  cmd->add_option("--spectrum-csv", a->spectrum_csv, "Also write frequency_cpm,magnitude rows");
+  cmd->add_option("--psd-csv", a->psd_csv, "Also write frequency_cpm,psd rows (Welch, a²/(cycle/mm))");
+  const std::string g = "Analysis";
+  cmd->add_option("--window", a->window, "Magnitude-spectrum window: blackman-harris | hann | flat-top | rectangular [blackman-harris]")->group(g);
+  cmd->add_option("--zero-pad", a->zero_pad, "Zero padding factor 1 … 16 [4]")->group(g);
+  cmd->add_option("--threshold", a->threshold_db, "Peak threshold, dB below the highest peak [-40]")->group(g);
+  cmd->add_option("--max-peaks", a->max_peaks, "Most peaks to list [32]")->group(g);
+  cmd->add_option("--welch-segment", a->welch_segment, "Welch segment, samples (0 = auto, about a quarter of the map) [0]")->group(g);
+  cmd->add_option("--welch-overlap", a->welch_overlap, "Welch overlap, 0 … 0.95 [0.5]")->group(g);
+  cmd->add_option("--band", a->bands, "Band for band energy, LOW:HIGH in cycles/mm (repeatable) [decades]")->group(g);
+  cmd->callback([a] {
+    // Validate everything cheap before reading or rendering anything.
+    if (a->output) {
+      const PlotFormat f = plot_format_for_path(*a->output);
+      (void)f;
+      check_writable(*a->output);
+    }
+    for (const auto* p : {&a->spectrum_csv, &a->psd_csv})
+      if (*p) {
+        if (output_extension(**p) != ".csv") throw InvalidArgument("'" + **p + "' must be a .csv file");
+        check_writable(**p);
+      }
+    if (a->swipe_speed && !(std::isfinite(*a->swipe_speed) && *a->swipe_speed > 0.0))
+      throw InvalidArgument("--swipe-speed is " + num(*a->swipe_speed) + "; it must be a finite speed in mm/s > 0");
+    if (a->max_peaks < 1 || a->max_peaks > 100000) throw InvalidArgument("--max-peaks is " + std::to_string(a->max_peaks) + "; allowed: 1 … 100000");
+    if (!(a->threshold_db <= 0.0 && a->threshold_db >= -300.0))
+      throw InvalidArgument("--threshold is " + num(a->threshold_db) + " dB; allowed: -300 … 0");
+    AnalysisOptions opt;
+    opt.spectrum.window = parse_window(a->window, "--window");
+    opt.spectrum.zero_pad = a->zero_pad;
+    if (a->zero_pad < 1 || a->zero_pad > 16) throw InvalidArgument("--zero-pad is " + std::to_string(a->zero_pad) + "; allowed: 1 … 16");
+    opt.welch.segment = a->welch_segment;
+    opt.welch.overlap = a->welch_overlap;
+    if (!(a->welch_overlap >= 0.0 && a->welch_overlap <= 0.95))
+      throw InvalidArgument("--welch-overlap is " + num(a->welch_overlap) + "; allowed: 0 … 0.95");
+    opt.peaks.threshold_db = a->threshold_db;
+    opt.peaks.max_peaks = a->max_peaks;
+    for (const auto& b : a->bands) opt.bands.push_back(parse_band(b));
+
+    const LoadedSignal sig = load_signal(a->file, a->device, a->spacing, a->region);
+    const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing_mm, opt);
+
+    std::vector<PendingFile> files;
+    if (a->spectrum_csv) files.push_back({*a->spectrum_csv, csv_columns("frequency_cpm", "magnitude", r.spectrum.frequency_cpm, r.spectrum.magnitude)});
+    if (a->psd_csv) files.push_back({*a->psd_csv, csv_columns("frequency_cpm", "psd", r.psd.frequency_cpm, r.psd.density)});
+    if (a->output) {
+      plot_spectrum(make_spectrum_plot(a->file, sig, r, a->swipe_speed), *a->output);  // atomic on its own
+      try {
+        commit_files(files);
+      } catch (...) {
+        std::remove(a->output->c_str());
+        throw;
+      }
+    } else {
+      commit_files(files);
+    }
+    if (a->json) print_json(report_json(*a, sig, r));
+    else print_report(*a, sig, r);
+  });
+}
+
+}  // namespace texel::cli

@@ -1,0 +1,180 @@
+// Reference textures (docs: /spec/references.md): every texture the Texel
+// method was validated against, generated on the same device grid and
+// amplitude scale as Texel renderings, deterministic from a seed.
+//
+// Families (a registry of named generators, `reference_catalogue()`):
+//  - Friesen band-pass noise: `bandpass` and the nine named f_c × ζ pairs of
+//    the first study (`bandpass-f1-z0.05` … `bandpass-f20-z5`);
+//  - sums of sinusoids `2sin`, `3sin`, `4sin`;
+//  - colours of noise `white`, `pink`, `blue`;
+//  - band-limited waveforms `square`, `tri`, `saw`;
+//  - patch textures `patch-2.5`, `patch-4.6`, `patch-13.5` (and shuffles);
+//  - the mirrored coarse pulse pair `pulse-a`, `pulse-b`.
+// Every parameter is adjustable (ReferenceSpec::params); the spec's values
+// are the defaults.
+//
+// Method and trade-off. Every signal-defined reference (noise, sinusoids,
+// waveforms) is synthesised as a finite sum of sinusoids
+//     y(x) = Σ_k a_k · sin(2π(f_k·x + φ_k))
+// evaluated with detmath::sin_cycles, then mapped to amplitude by
+// a = 0.5 + 0.5·y / max|y| (references.md [choice]; max over the prepared
+// grid's samples). Noise is Gaussian noise specified in the frequency domain:
+// components sit at the harmonics k/P of the texture's length P (the bins of
+// a DFT over the whole texture), with Rayleigh magnitudes × the target
+// |H(f)| and uniform phases drawn from CounterRng(seed, Stream::reference)
+// at counters 2k (magnitude) and 2k+1 (phase). That is exactly what
+// "white noise filtered in the frequency domain" produces, but it needs no
+// FFT: the samples are a pure function of (parameters, seed, grid), bit for
+// bit on every build, independent of any FFT library, and free of aliasing
+// (no component at or above the grid's Nyquist frequency is ever
+// synthesised). The price is O(samples × components) work when preparing:
+// about 0.1 s for a full-band noise on the reference device.
+//
+// Patch and pulse textures are defined directly in amplitude (patches a = 1,
+// gaps a = 0; pulses 0.5 − 0.5·cos over one 5 mm period) and are not rescaled.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "texel/coarse.hpp"
+#include "texel/grid.hpp"
+#include "texel/texture.hpp"
+#include "texel/units.hpp"
+
+namespace texel {
+
+/// A parameter value: a number, a list of numbers, or a word from a choice.
+using ReferenceValue = std::variant<double, std::vector<double>, std::string>;
+
+enum class ReferenceParamKind {
+  number,   ///< a finite number in [min, max]
+  integer,  ///< a whole number in [min, max]
+  list,     ///< min_count … max_count numbers, each in [min, max]
+  choice,   ///< one of `choices`
+};
+
+/// One adjustable parameter of a generator: what `texel reference --list` prints.
+struct ReferenceParam {
+  std::string key;            ///< e.g. "frequencies_cpm" (units in the key, as in documents)
+  ReferenceParamKind kind = ReferenceParamKind::number;
+  std::string unit;           ///< "cpm", "mm", "deg" or "" (dimensionless)
+  ReferenceValue default_value;
+  double min = 0.0;           ///< number / integer / each list element
+  double max = 0.0;
+  std::size_t min_count = 0;  ///< list only
+  std::size_t max_count = 0;  ///< list only
+  std::vector<std::string> choices;  ///< choice only
+  std::string description;
+};
+
+/// A named generator with its parameters and their defaults.
+struct ReferenceInfo {
+  std::string name;         ///< e.g. "4sin"
+  std::string family;       ///< "band-pass noise", "sum of sinusoids", ...
+  std::string description;  ///< one line
+  bool uses_seed = false;   ///< false: the seed changes nothing
+  std::vector<ReferenceParam> params;
+};
+
+/// Everything that defines a reference texture: generator, overrides, seed.
+struct ReferenceSpec {
+  std::string name = "4sin";
+  /// Overrides of the generator's defaults, by key. Absent keys take defaults.
+  std::map<std::string, ReferenceValue> params;
+  std::uint64_t seed = 1;
+};
+
+/// Every named generator, in listing order (families together).
+const std::vector<ReferenceInfo>& reference_catalogue();
+/// The generator called `name`; throws InvalidArgument listing the names.
+const ReferenceInfo& reference_info(std::string_view name);
+/// The nine references of the second study, three families in three rows:
+/// 2sin 3sin 4sin / white pink blue / square tri saw.
+std::vector<std::string> second_study_names();
+
+/// Validates name, keys, kinds, ranges and cross-parameter rules; throws
+/// InvalidArgument naming the parameter, the value and what is allowed.
+void validate(const ReferenceSpec& spec);
+/// Parses a value written on a command line ("2.5,6,8.5", "random", "4")
+/// for `key` of generator `info`; throws InvalidArgument.
+ReferenceValue parse_reference_value(const ReferenceInfo& info, std::string_view key, std::string_view text);
+/// Applies "KEY=VALUE" (the CLI's --param) to `spec`; throws InvalidArgument.
+void set_reference_param(ReferenceSpec& spec, std::string_view assignment);
+/// The value in force for `key` (override or default).
+ReferenceValue reference_value(const ReferenceSpec& spec, std::string_view key);
+/// A value written back as text ("2.5,6", "zero", "4").
+std::string format_reference_value(const ReferenceValue& value);
+
+/// One sinusoidal component of a signal-defined reference (before scaling).
+struct ReferenceComponent {
+  double frequency_cpm;  ///< > 0, below the grid's Nyquist frequency
+  double amplitude;      ///< >= 0
+  double phase_cycles;   ///< in [0, 1)
+};
+
+/// One interval of an amplitude-defined reference (a patch or a pulse).
+struct ReferenceFeature {
+  double start_mm;
+  double length_mm;
+};
+
+/// A reference prepared for a grid: an immutable Texture.
+class ReferenceTexture final : public Texture {
+public:
+  /// Prepares `spec` over [0, length) for sampling on `grid` (positions in
+  /// the texture's own coordinates; only origin and spacing matter): the
+  /// grid's Nyquist frequency bounds the band, and the amplitude scale is
+  /// fixed from the grid's samples. Rendering on another grid evaluates the
+  /// same function of x with the same scale (values clamped to [0, 1]).
+  /// Validates; throws InvalidArgument. Allocates.
+  ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Grid& grid);
+
+  [[nodiscard]] Millimetres length() const override { return length_; }
+  void render(const Grid& grid, std::int64_t first, std::span<double> out) const override;
+  [[nodiscard]] std::string describe() const override;
+
+  [[nodiscard]] const ReferenceSpec& spec() const { return spec_; }
+  /// Sinusoidal components (signal-defined references); empty otherwise.
+  [[nodiscard]] const std::vector<ReferenceComponent>& components() const { return components_; }
+  /// Patches or pulses (amplitude-defined references); empty otherwise.
+  [[nodiscard]] const std::vector<ReferenceFeature>& features() const { return features_; }
+  /// The gaps between consecutive features (mm), in spatial order.
+  [[nodiscard]] std::vector<double> gaps_mm() const;
+  /// max|y| over the prepared grid's samples (1 for amplitude-defined references).
+  [[nodiscard]] double peak() const { return peak_; }
+  /// Slow, obviously-correct single-sample evaluation (tests).
+  [[nodiscard]] double amplitude_at(double x_mm) const;
+
+private:
+  enum class Shape { sum, patch, pulse };
+  void evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const;
+
+  ReferenceSpec spec_;
+  Millimetres length_;
+  Shape shape_ = Shape::sum;
+  std::vector<ReferenceComponent> components_;
+  std::vector<ReferenceFeature> features_;
+  double peak_ = 1.0;
+  double scale_ = 0.5;  // 0.5 / peak
+  // Samples on the prepared grid (global indices cache_first_ …), reused when
+  // the same grid renders again (the usual case: Surface::render).
+  Grid grid_;
+  std::int64_t cache_first_ = 0;
+  std::vector<double> cache_;
+};
+
+/// The reference's amplitudes on samples [0, grid.count) of `grid` (origin
+/// = the texture's left edge), over the grid's length.
+std::vector<double> render_reference(const ReferenceSpec& spec, const Grid& grid);
+
+/// A reference as a coarse profile (references.md, coarse-feature study):
+/// the reference prepared over `length` and sampled every `spacing_mm`.
+SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, double spacing_mm);
+
+}  // namespace texel

@@ -1,0 +1,408 @@
+// Reference generators: turning a ReferenceSpec into components (signal-
+// defined references) or features (patches, pulses), and evaluating them on
+// a grid. See include/texel/reference.hpp for the method and its trade-off.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "texel/detail/format.hpp"
+#include "texel/detmath.hpp"
+#include "texel/error.hpp"
+#include "texel/random.hpp"
+#include "texel/reference.hpp"
+
+namespace texel {
+namespace {
+
+using detail::num;
+
+// ------------------------------------------------------------ synthesis kernel
+//
+// acc[m] += a · sin(2π(φ + f·x_m)), x_m = origin + (base + m)·spacing, for one
+// component over a run of samples. Explicit lanes (GCC/clang vector
+// extensions), the same pattern and the same reasoning as the Texel renderer
+// (src/core/texture.cpp): every lane performs exactly the scalar operations
+// of detmath::sin_cycles in the same order in IEEE double, and x is computed
+// as Grid::position computes it, so lane width and -O level change speed,
+// never bits. Components are accumulated in a fixed order (ascending k).
+constexpr int lanes = 8;
+using vdouble = double __attribute__((vector_size(lanes * sizeof(double))));
+
+// Always inlined: called across target_clones, an out-of-line copy would be
+// compiled for the default target and receive wider vectors in another ABI.
+[[gnu::always_inline]] inline vdouble sin_cycles_lanes(vdouble u) {
+  constexpr double magic = 6755399441055744.0;  // detmath::round_even
+  vdouble r = u - ((u + magic) - magic);
+  const vdouble hi = 0.5 - r;
+  const vdouble lo = -0.5 - r;
+  r = r > 0.25 ? hi : r;
+  r = r < -0.25 ? lo : r;
+  const vdouble r2 = r * r;
+  vdouble p = -0.012031585942120619 * r2 + 0.10422916220813978;
+  p = p * r2 + -0.7181223017785001;
+  p = p * r2 + 3.8199525848482803;
+  p = p * r2 + -15.094642576822984;
+  p = p * r2 + 42.058693944897634;
+  p = p * r2 + -76.70585975306136;
+  p = p * r2 + 81.60524927607504;
+  p = p * r2 + -41.341702240399755;
+  p = p * r2 + 6.283185307179586;
+  return r * p;
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void accumulate_component(double base, double origin, double spacing, double f, double amplitude, double phase, double* acc,
+                          std::int32_t count) {
+  vdouble index;
+  for (int l = 0; l < lanes; ++l) index[l] = base + static_cast<double>(l);
+  std::int32_t m = 0;
+  for (; m < count; m += lanes) {
+    const vdouble x = origin + index * spacing;
+    const vdouble u = phase + f * x;
+    index += static_cast<double>(lanes);
+    vdouble a;
+    std::memcpy(&a, acc + m, sizeof a);  // acc is padded to a multiple of `lanes`
+    a = a + amplitude * sin_cycles_lanes(u);
+    std::memcpy(acc + m, &a, sizeof a);
+  }
+}
+
+/// Σ_k a_k·sin(2π(φ_k + f_k·x)) at grid samples [first, first + out.size()).
+void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, std::int64_t first, std::span<double> out) {
+  constexpr std::size_t chunk = 2048;  // accumulator stays in L1 across components
+  std::vector<double> acc(chunk + lanes);
+  for (std::size_t i = 0; i < out.size(); i += chunk) {
+    const std::size_t len = std::min(chunk, out.size() - i);
+    std::fill(acc.begin(), acc.end(), 0.0);
+    const double base = static_cast<double>(first + static_cast<std::int64_t>(i));
+    for (const auto& c : comps)
+      accumulate_component(base, grid.origin_mm, grid.spacing_mm, c.frequency_cpm, c.amplitude, c.phase_cycles, acc.data(),
+                           static_cast<std::int32_t>(len));
+    std::copy_n(acc.begin(), len, out.begin() + static_cast<std::ptrdiff_t>(i));
+  }
+}
+
+// ------------------------------------------------------------ parameters
+
+double number(const ReferenceSpec& s, const char* key) { return std::get<double>(reference_value(s, key)); }
+std::vector<double> numbers(const ReferenceSpec& s, const char* key) { return std::get<std::vector<double>>(reference_value(s, key)); }
+std::string word(const ReferenceSpec& s, const char* key) { return std::get<std::string>(reference_value(s, key)); }
+
+/// The band's upper edge: band_max (0 = Nyquist), never at or above Nyquist.
+double band_top(double band_max, double nyquist) { return band_max > 0.0 && band_max < nyquist ? band_max : nyquist; }
+
+/// Rayleigh magnitude (σ = 1) and uniform phase of noise component k.
+std::pair<double, double> noise_draw(const CounterRng& rng, std::uint64_t k) {
+  const double u = rng.uniform(2 * k);
+  return {std::sqrt(-2.0 * detmath::log(u)), rng.uniform(2 * k + 1)};
+}
+
+/// Harmonics k/P of the texture length P inside [lo, hi), hi exclusive.
+std::pair<std::uint64_t, std::uint64_t> harmonic_range(double lo, double hi, double period) {
+  const double kmin = std::max(1.0, std::ceil(lo * period - 1e-9));
+  double kmax = std::ceil(hi * period) - 1.0;  // k/P < hi
+  if (kmax / period >= hi) kmax -= 1.0;
+  return {static_cast<std::uint64_t>(kmin), kmax < kmin ? 0 : static_cast<std::uint64_t>(kmax)};
+}
+
+std::string field(const ReferenceSpec& s, const std::string& key) { return "reference '" + s.name + "' parameter " + key; }
+
+std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const std::string& family, double period, double nyquist) {
+  std::vector<ReferenceComponent> comps;
+  const CounterRng rng(s.seed, Stream::reference);
+  double lo = 0.0;
+  double hi = 0.0;
+  double fc = 0.0;
+  double q = 0.0;
+  double exponent = 0.0;
+  if (family == "band-pass noise") {
+    fc = number(s, "centre_cpm");
+    q = 1.0 / (2.0 * number(s, "zeta"));
+    lo = number(s, "band_min_cpm");
+    hi = band_top(number(s, "band_max_cpm"), nyquist);
+  } else {
+    lo = number(s, "band_min_cpm");
+    hi = band_top(number(s, "band_max_cpm"), nyquist);
+    exponent = number(s, "slope_db_per_decade") / 20.0;  // amplitude ∝ f^(slope/20)
+  }
+  const auto [k0, k1] = harmonic_range(lo, hi, period);
+  if (k1 < k0)
+    throw InvalidArgument("reference '" + s.name + "': the band " + num(lo) + " … " + num(hi) + " cpm holds no harmonic of the " +
+                          num(period) + " mm texture (spacing " + num(1.0 / period) + " cpm); widen the band or lengthen the texture");
+  comps.reserve(k1 - k0 + 1);
+  for (std::uint64_t k = k0; k <= k1; ++k) {
+    const double f = static_cast<double>(k) / period;
+    double gain = 1.0;
+    if (family == "band-pass noise") {
+      const double d = f / fc - fc / f;
+      gain = 1.0 / std::sqrt(1.0 + q * q * d * d);
+    } else if (exponent != 0.0) {
+      gain = detmath::exp(exponent * detmath::log(f));
+    }
+    const auto [mag, phase] = noise_draw(rng, k);
+    comps.push_back({f, gain * mag, phase});
+  }
+  return comps;
+}
+
+std::vector<ReferenceComponent> sine_components(const ReferenceSpec& s, double nyquist) {
+  const auto f = numbers(s, "frequencies_cpm");
+  auto w = numbers(s, "weights");
+  if (w.empty()) w.assign(f.size(), 1.0);
+  const bool random = word(s, "phase") == "random";
+  const CounterRng rng(s.seed, Stream::reference);
+  std::vector<ReferenceComponent> comps;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!(f[i] < nyquist))
+      throw InvalidArgument(field(s, "frequencies_cpm") + "[" + std::to_string(i) + "] is " + num(f[i]) +
+                            " cpm, at or above the grid's Nyquist frequency " + num(nyquist) + " cpm (it would alias)");
+    comps.push_back({f[i], w[i], random ? rng.uniform(i) : 0.0});
+  }
+  return comps;
+}
+
+std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, double nyquist) {
+  const double f0 = number(s, "fundamental_cpm");
+  const double hi = band_top(number(s, "band_max_cpm"), nyquist);
+  const double phase0 = number(s, "phase_deg") / 360.0;
+  if (!(f0 < hi))
+    throw InvalidArgument(field(s, "fundamental_cpm") + " is " + num(f0) + " cpm, not below the band's top " + num(hi) +
+                          " cpm (the grid's Nyquist frequency or band_max_cpm)");
+  std::vector<ReferenceComponent> comps;
+  for (std::uint64_t n = 1;; ++n) {
+    const double nd = static_cast<double>(n);
+    const double f = nd * f0;
+    if (!(f < hi)) break;
+    double a = 0.0;
+    double phase = nd * phase0;  // the whole waveform shifts with the fundamental
+    if (s.name == "square") {
+      if (n % 2 == 0) continue;
+      a = 1.0 / nd;
+    } else if (s.name == "tri") {
+      if (n % 2 == 0) continue;
+      a = 1.0 / (nd * nd);
+      if ((n / 2) % 2 == 1) phase += 0.5;  // (−1)^((n−1)/2)
+    } else {  // saw: Σ (−1)^(n+1) sin(nωx)/n
+      a = 1.0 / nd;
+      if (n % 2 == 0) phase += 0.5;
+    }
+    phase -= std::floor(phase);
+    comps.push_back({f, a, phase});
+  }
+  return comps;
+}
+
+/// Fisher–Yates shuffle number `shuffle` (>= 1) of `v`, from its own counters.
+void shuffle_gaps(std::vector<double>& v, std::uint64_t seed, std::uint64_t shuffle) {
+  const CounterRng rng(seed, Stream::reference);
+  const std::uint64_t base = (std::uint64_t{1} << 40) + (shuffle << 24);
+  for (std::size_t i = v.size(); i > 1; --i) {
+    const auto j = static_cast<std::size_t>(rng.below(base + i, i));
+    std::swap(v[i - 1], v[j]);
+  }
+}
+
+std::vector<ReferenceFeature> lay_out(double start, double feature, const std::vector<double>& gaps, double length,
+                                      std::size_t max_features) {
+  std::vector<ReferenceFeature> out;
+  double pos = start;
+  std::size_t i = 0;
+  while (pos + feature <= length + 1e-9 && out.size() < max_features) {
+    out.push_back({pos, feature});
+    if (gaps.empty()) break;
+    pos += feature + gaps[i % gaps.size()];
+    ++i;
+  }
+  return out;
+}
+
+std::vector<ReferenceFeature> patch_features(const ReferenceSpec& s, double length) {
+  const double patch = number(s, "patch_mm");
+  const double start = number(s, "start_mm");
+  std::vector<double> gaps = numbers(s, "gaps_mm");
+  const auto shuffle = static_cast<std::uint64_t>(number(s, "shuffle"));
+  const bool drawn = gaps.empty();
+  if (drawn) {
+    // Whole millimetres uniformly from {0 … round(2c)} [choice: for c = 4.6
+    // that is {0 … 9}, mean 4.5 mm; uniform integers cannot have mean 4.6].
+    const auto top = static_cast<std::uint64_t>(std::floor(2.0 * number(s, "spacing_mm") + 0.5));
+    const CounterRng rng(s.seed, Stream::reference);
+    const auto n = static_cast<std::size_t>(length / patch) + 1;  // enough for any layout
+    gaps.resize(n);
+    for (std::size_t i = 0; i < n; ++i) gaps[i] = static_cast<double>(rng.below(i, top + 1));
+  }
+  // Lay out in drawn order first: the shuffles permute exactly the gaps used,
+  // so their total (and the patch count) is unchanged.
+  std::vector<ReferenceFeature> f = lay_out(start, patch, gaps, length, std::size_t(-1));
+  if (f.size() < 2 || shuffle == 0) return f;
+  std::vector<double> used(f.size() - 1);
+  for (std::size_t i = 0; i + 1 < f.size(); ++i) used[i] = gaps[i % gaps.size()];
+  shuffle_gaps(used, s.seed, shuffle);
+  return lay_out(start, patch, used, length, f.size());
+}
+
+std::vector<ReferenceFeature> pulse_features(const ReferenceSpec& s, double length) {
+  std::vector<ReferenceFeature> f = lay_out(number(s, "start_mm"), number(s, "pulse_mm"), numbers(s, "gaps_mm"), length, std::size_t(-1));
+  if (word(s, "mirror") == "yes") {
+    for (auto& p : f) p.start_mm = length - p.start_mm - p.length_mm;
+    std::reverse(f.begin(), f.end());
+  }
+  return f;
+}
+
+}  // namespace
+
+ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Grid& grid)
+    : spec_(spec), length_(length), grid_(grid) {
+  validate(spec_);
+  if (!(std::isfinite(length.value()) && length.value() > 0.0))
+    throw InvalidArgument("reference length is " + num(length.value()) + " mm; it must be > 0");
+  if (!(std::isfinite(grid.spacing_mm) && grid.spacing_mm > 0.0 && std::isfinite(grid.origin_mm)))
+    throw InvalidArgument("reference grid spacing is " + num(grid.spacing_mm) + " mm; it must be > 0");
+  const ReferenceInfo& info = reference_info(spec_.name);
+  const double nyquist = grid.nyquist_cpm();
+  const double L = length.value();
+  if (info.family == "band-pass noise" || info.family == "colour of noise") {
+    components_ = noise_components(spec_, info.family, L, nyquist);
+  } else if (info.family == "sum of sinusoids") {
+    components_ = sine_components(spec_, nyquist);
+  } else if (info.family == "shaped waveform") {
+    components_ = waveform_components(spec_, nyquist);
+  } else if (info.family == "patch texture") {
+    shape_ = Shape::patch;
+    features_ = patch_features(spec_, L);
+  } else {
+    shape_ = Shape::pulse;
+    features_ = pulse_features(spec_, L);
+  }
+  if (shape_ != Shape::sum && features_.empty())
+    throw InvalidArgument("reference '" + spec_.name + "': no feature fits the " + num(L) + " mm texture; lower start_mm or the feature length");
+
+  // Samples of the prepared grid inside [0, L).
+  const double sp = grid.spacing_mm;
+  std::int64_t a = static_cast<std::int64_t>(std::ceil(-grid.origin_mm / sp)) - 1;
+  while (grid.position(a) < 0.0) ++a;
+  std::int64_t b = static_cast<std::int64_t>(std::floor((L - grid.origin_mm) / sp)) + 1;
+  while (b > a && !(grid.position(b - 1) < L)) --b;
+  while (grid.position(b) < L) ++b;
+  cache_first_ = a;
+  cache_.resize(static_cast<std::size_t>(b - a));
+  if (shape_ == Shape::sum) {
+    synthesize(components_, grid, a, cache_);
+    double peak = 0.0;
+    for (double y : cache_) peak = std::max(peak, std::abs(y));
+    peak_ = peak > 0.0 ? peak : 1.0;
+    scale_ = 0.5 / peak_;
+    for (double& y : cache_) {
+      const double v = 0.5 + scale_ * y;
+      y = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+    }
+  } else {
+    evaluate(grid, a, cache_);
+  }
+}
+
+void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const {
+  const double L = length_.value();
+  if (shape_ == Shape::sum) {
+    synthesize(components_, grid, first, out);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const double x = grid.position(first + static_cast<std::int64_t>(i));
+      const double v = 0.5 + scale_ * out[i];
+      out[i] = !(x >= 0.0 && x < L) ? 0.0 : (v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v));
+    }
+    return;
+  }
+  // Features are sorted and disjoint: walk them alongside the samples.
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double x = grid.position(first + static_cast<std::int64_t>(i));
+    out[i] = 0.0;
+    if (!(x >= 0.0 && x < L)) continue;
+    if (i == 0 || x < grid.position(first + static_cast<std::int64_t>(i) - 1)) {
+      j = static_cast<std::size_t>(std::upper_bound(features_.begin(), features_.end(), x,
+                                                    [](double v, const ReferenceFeature& f) { return v < f.start_mm; }) -
+                                   features_.begin());
+      j = j > 0 ? j - 1 : 0;
+    }
+    while (j + 1 < features_.size() && x >= features_[j + 1].start_mm) ++j;
+    const ReferenceFeature& f = features_[j];
+    const double t = x - f.start_mm;
+    if (!(t >= 0.0 && t < f.length_mm)) continue;
+    if (shape_ == Shape::patch) {
+      out[i] = 1.0;
+    } else {
+      const double v = 0.5 - 0.5 * detmath::cos_cycles(t / f.length_mm);
+      out[i] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+    }
+  }
+}
+
+void ReferenceTexture::render(const Grid& grid, std::int64_t first, std::span<double> out) const {
+  const auto n = static_cast<std::int64_t>(out.size());
+  const bool same_grid = grid.origin_mm == grid_.origin_mm && grid.spacing_mm == grid_.spacing_mm;
+  const std::int64_t cache_end = cache_first_ + static_cast<std::int64_t>(cache_.size());
+  if (same_grid && first >= cache_first_ && first + n <= cache_end) {
+    std::copy_n(cache_.begin() + (first - cache_first_), n, out.begin());
+    return;
+  }
+  evaluate(grid, first, out);
+}
+
+double ReferenceTexture::amplitude_at(double x_mm) const {
+  const double L = length_.value();
+  if (!(x_mm >= 0.0 && x_mm < L)) return 0.0;
+  if (shape_ == Shape::sum) {
+    double y = 0.0;
+    for (const auto& c : components_) y = y + c.amplitude * detmath::sin_cycles(c.phase_cycles + c.frequency_cpm * x_mm);
+    const double v = 0.5 + scale_ * y;
+    return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+  }
+  for (const auto& f : features_) {
+    const double t = x_mm - f.start_mm;
+    if (t >= 0.0 && t < f.length_mm) {
+      if (shape_ == Shape::patch) return 1.0;
+      const double v = 0.5 - 0.5 * detmath::cos_cycles(t / f.length_mm);
+      return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+    }
+  }
+  return 0.0;
+}
+
+std::vector<double> ReferenceTexture::gaps_mm() const {
+  std::vector<double> g;
+  for (std::size_t i = 1; i < features_.size(); ++i)
+    g.push_back(features_[i].start_mm - (features_[i - 1].start_mm + features_[i - 1].length_mm));
+  return g;
+}
+
+std::string ReferenceTexture::describe() const {
+  const ReferenceInfo& info = reference_info(spec_.name);
+  std::string s = "reference " + spec_.name;
+  for (const auto& [k, v] : spec_.params) s += " " + k + "=" + format_reference_value(v);
+  if (info.uses_seed) s += " seed=" + std::to_string(spec_.seed);
+  return s;
+}
+
+std::vector<double> render_reference(const ReferenceSpec& spec, const Grid& grid) {
+  if (grid.count <= 0) throw InvalidArgument("reference grid has " + std::to_string(grid.count) + " samples; it needs at least 1");
+  const ReferenceTexture t(spec, Millimetres(grid.length_mm()), Grid{0.0, grid.spacing_mm, grid.count});
+  std::vector<double> out(static_cast<std::size_t>(grid.count));
+  t.render(Grid{0.0, grid.spacing_mm, grid.count}, 0, out);
+  return out;
+}
+
+SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, double spacing_mm) {
+  if (!(std::isfinite(spacing_mm) && spacing_mm > 0.0))
+    throw InvalidArgument("reference profile spacing is " + num(spacing_mm) + " mm; it must be > 0");
+  const Grid grid{0.0, spacing_mm, 0};
+  const ReferenceTexture t(spec, length, grid);
+  const auto count = static_cast<std::int64_t>(std::ceil(length.value() / spacing_mm)) ;
+  SampledProfile p;
+  p.spacing_mm = spacing_mm;
+  p.values.resize(static_cast<std::size_t>(std::max<std::int64_t>(count, 1)));
+  t.render(grid, 0, p.values);
+  return p;
+}
+
+}  // namespace texel
