@@ -187,17 +187,106 @@ DeviceProfile with_grid(DeviceProfile p, std::optional<double> length_mm, std::o
   return p;
 }
 
-void encode_u16(std::span<const double> a, std::span<std::uint16_t> out) {
-  const std::size_t n = std::min(a.size(), out.size());
-  for (std::size_t i = 0; i < n; ++i) out[i] = to_u16(a[i]);
+namespace {
+
+// Encoders with explicit lanes (GCC/clang vector extensions): GCC will not
+// if-convert the clamp's selects under -ftrapping-math, so the plain loops ran
+// scalar. Each lane does exactly what to_u16 / the scalar clamp do — the same
+// comparisons, the same a·65535 + 0.5 in IEEE double, truncation to integer,
+// round-to-nearest double -> float — so the bytes do not depend on the lane
+// width, which is picked per instruction set at run time (as in texture.cpp).
+template <int W> struct Lanes;
+template <> struct Lanes<2> {
+  using d = double __attribute__((vector_size(16)));
+  using i32 = std::int32_t __attribute__((vector_size(8)));
+  using u16 = std::uint16_t __attribute__((vector_size(4)));
+  using f32 = float __attribute__((vector_size(8)));
+};
+template <> struct Lanes<4> {
+  using d = double __attribute__((vector_size(32)));
+  using i32 = std::int32_t __attribute__((vector_size(16)));
+  using u16 = std::uint16_t __attribute__((vector_size(8)));
+  using f32 = float __attribute__((vector_size(16)));
+};
+template <> struct Lanes<8> {
+  using d = double __attribute__((vector_size(64)));
+  using i32 = std::int32_t __attribute__((vector_size(32)));
+  using u16 = std::uint16_t __attribute__((vector_size(16)));
+  using f32 = float __attribute__((vector_size(32)));
+};
+
+template <int W>
+[[gnu::always_inline]] inline void encode_u16_lanes(const double* a, std::uint16_t* out, std::size_t n) {
+  using L = Lanes<W>;
+  const typename L::d zero{}, one = zero + 1.0;
+  std::size_t i = 0;
+  for (; i + W <= n; i += W) {
+    typename L::d v;
+    std::memcpy(&v, a + i, sizeof v);
+    v = v > zero ? (v < one ? v : one) : zero;
+    v = v * 65535.0 + 0.5;  // in [0.5, 65535.5]: truncates exactly through int32
+    const typename L::u16 q = __builtin_convertvector(__builtin_convertvector(v, typename L::i32), typename L::u16);
+    std::memcpy(out + i, &q, sizeof q);
+  }
+  for (; i < n; ++i) out[i] = to_u16(a[i]);
 }
 
-void encode_f32(std::span<const double> a, std::span<float> out) {
-  const std::size_t n = std::min(a.size(), out.size());
-  for (std::size_t i = 0; i < n; ++i) {
+template <int W>
+[[gnu::always_inline]] inline void encode_f32_lanes(const double* a, float* out, std::size_t n) {
+  using L = Lanes<W>;
+  const typename L::d zero{}, one = zero + 1.0;
+  std::size_t i = 0;
+  for (; i + W <= n; i += W) {
+    typename L::d v;
+    std::memcpy(&v, a + i, sizeof v);
+    v = v > zero ? (v < one ? v : one) : zero;
+    const typename L::f32 f = __builtin_convertvector(v, typename L::f32);
+    std::memcpy(out + i, &f, sizeof f);
+  }
+  for (; i < n; ++i) {
     const double v = a[i] > 0.0 ? (a[i] < 1.0 ? a[i] : 1.0) : 0.0;
     out[i] = static_cast<float>(v);
   }
+}
+
+template <class T>
+using EncodeKernel = void (*)(const double*, T*, std::size_t);
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void encode_u16_avx512(const double* a, std::uint16_t* o, std::size_t n) { encode_u16_lanes<8>(a, o, n); }
+__attribute__((target("avx2"))) void encode_u16_avx2(const double* a, std::uint16_t* o, std::size_t n) { encode_u16_lanes<4>(a, o, n); }
+__attribute__((target("avx512f"))) void encode_f32_avx512(const double* a, float* o, std::size_t n) { encode_f32_lanes<8>(a, o, n); }
+__attribute__((target("avx2"))) void encode_f32_avx2(const double* a, float* o, std::size_t n) { encode_f32_lanes<4>(a, o, n); }
+#endif
+void encode_u16_generic(const double* a, std::uint16_t* o, std::size_t n) { encode_u16_lanes<2>(a, o, n); }
+void encode_f32_generic(const double* a, float* o, std::size_t n) { encode_f32_lanes<2>(a, o, n); }
+
+/// The widest encoders this CPU runs (chosen once, at first use).
+EncodeKernel<std::uint16_t> pick_u16() {
+#if defined(__x86_64__) || defined(__i386__)
+  if (__builtin_cpu_supports("avx512f")) return &encode_u16_avx512;
+  if (__builtin_cpu_supports("avx2")) return &encode_u16_avx2;
+#endif
+  return &encode_u16_generic;
+}
+EncodeKernel<float> pick_f32() {
+#if defined(__x86_64__) || defined(__i386__)
+  if (__builtin_cpu_supports("avx512f")) return &encode_f32_avx512;
+  if (__builtin_cpu_supports("avx2")) return &encode_f32_avx2;
+#endif
+  return &encode_f32_generic;
+}
+
+}  // namespace
+
+void encode_u16(std::span<const double> a, std::span<std::uint16_t> out) {
+  static const EncodeKernel<std::uint16_t> kernel = pick_u16();
+  kernel(a.data(), out.data(), std::min(a.size(), out.size()));
+}
+
+void encode_f32(std::span<const double> a, std::span<float> out) {
+  static const EncodeKernel<float> kernel = pick_f32();
+  kernel(a.data(), out.data(), std::min(a.size(), out.size()));
 }
 
 void encode_samples(SampleFormat format, std::span<const double> a, std::span<std::byte> out) {
