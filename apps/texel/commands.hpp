@@ -10,6 +10,8 @@ void register_render(CLI::App& app);
 void register_info(CLI::App& app);
 void register_demo(CLI::App& app);
 void register_devices(CLI::App& app);
+void register_encode(CLI::App& app);
+void register_decode(CLI::App& app);
 void register_reference(CLI::App& app);
 void register_spectrum(CLI::App& app);
 void register_atlas(CLI::App& app);

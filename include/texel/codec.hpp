@@ -1,0 +1,132 @@
+// The Texel codec: any texture signal in, Texel parameters and a bitstream of
+// a few bytes out (encoder); bitstream in, a texture on any device out
+// (decoder).
+//
+// Encoder (docs/encoder.md has the model, its parameters and sources):
+//  1. Split. The amplitude envelope is what changes more slowly than the
+//     fine/coarse boundary (1 mm): running maximum and minimum over a window
+//     of about two fine periods, smoothed by a moving average one boundary
+//     long. A flat envelope is a fine-only texture; otherwise its values at
+//     the texel centres become the coarse profile c_k with strengths C and F
+//     (rendering.md §7: e_k = 1 − C(1 − c_k), trough/peak = 1 − F).
+//  2. Fine part by analysis-by-synthesis. A perceptual model maps a signal to
+//     a felt pitch (sensitivity-weighted, amplitude-weighted mean frequency)
+//     and a felt noisiness (the weighted spread of log-frequency), at the
+//     swipe speed that turns cycles/mm into Hz. Candidate Texel textures are
+//     rendered with the library and compared with the input under the model;
+//     Nelder–Mead over (Central Pitch, Irregularity) minimises the distance,
+//     starting from the input's spectral centroid and spread.
+// Trade-off: the fit matches what the model says is felt, not the waveform;
+// the texel length is a setting (default 0.25 mm), not an estimate.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "texel/bitstream.hpp"
+#include "texel/document.hpp"
+#include "texel/units.hpp"
+
+namespace texel::codec {
+
+// --- signals ----------------------------------------------------------------
+
+/// A texture signal on a uniform spatial grid (sample i at i·spacing mm).
+struct Signal {
+  std::vector<double> amplitude;  ///< nominally in [0, 1]
+  double spacing_mm = 0.0;        ///< > 0
+  std::string description;        ///< where it came from, for reports
+};
+
+struct LoadOptions {
+  std::optional<DeviceProfile> device;       ///< grid and format of .bin/.npy (default tpad)
+  std::optional<double> spacing_mm;          ///< overrides the device's spacing for .bin/.npy
+  std::optional<MmPerSecond> swipe_speed;    ///< needed for time recordings (.wav, time/value .csv)
+};
+
+/// Loads any texture signal: a device map (.bin), .npy, a position/amplitude
+/// or time/value .csv, a .wav recording, a texture document (.texel.json) or a
+/// bitstream (.texel). Time recordings become positions at the swipe speed and
+/// are scaled to the full amplitude range (a = 0.5 + 0.5·y/max|y|). Throws
+/// InvalidArgument / FormatError / IoError naming the file and the problem.
+Signal load_signal(const std::string& path, const LoadOptions& options);
+
+// --- the perceptual model ---------------------------------------------------
+
+struct PerceptualModel {
+  MmPerSecond swipe_speed{100.0};  ///< mm/s; turns cycles/mm into Hz (typical exploration 50 … 200 mm/s)
+  double pitch_jnd_db = 1.0;       ///< just-noticeable pitch change, dB (≈ 25 % frequency)
+  double noisiness_jnd_db = 1.0;   ///< just-noticeable change of spread, dB [modelling choice]
+  double tie_weight = 0.01;        ///< weight of the physical tie-break terms (see docs/encoder.md)
+};
+
+/// Relative vibrotactile threshold at temporal frequency f, dB above the most
+/// sensitive frequency (0 dB at 250 Hz): a straight-line Pacinian U
+/// (12 dB/octave either side of 250 Hz) capped by a flat non-Pacinian floor
+/// 30 dB up and a 60 dB ceiling. Weight = 10^(−threshold/20).
+double threshold_db(Hertz f);
+
+/// What the model extracts from a fine-texture signal.
+struct Percept {
+  double pitch_db = 0.0;       ///< felt pitch, dB re 1 cpm
+  double noisiness_db = 0.0;   ///< felt spread of log-frequency, dB
+  double mean_db = 0.0;        ///< physical: power-weighted mean frequency, dB re 1 cpm
+  double spread_db = 0.0;      ///< physical: power-weighted SD of 10·log10 f, dB
+};
+
+/// Percept of a zero-mean fine signal sampled every `spacing_mm`.
+Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model);
+/// Model distance in JND units (plus the small physical tie-break).
+double distance(const Percept& a, const Percept& b, const PerceptualModel& model);
+
+// --- encoder ----------------------------------------------------------------
+
+struct EncoderConfig {
+  PerceptualModel model;
+  Millimetres boundary{1.0};              ///< fine/coarse boundary, mm (> 0)
+  Millimetres texel_length{0.25};         ///< texel length of the encoding, mm
+  Parameterization parameterization = Parameterization::moments;
+  std::uint64_t seed = 1;                 ///< seed written to the bitstream
+  unsigned coarse_bits = 6;               ///< bits per coarse level (1 … 16)
+  std::optional<std::size_t> max_bytes;   ///< bitstream budget, bytes (coarse precision/stride adapt)
+  double flat_envelope = 0.08;            ///< relative envelope range below which the texture is fine only
+  int max_evaluations = 120;              ///< Nelder–Mead budget (each renders 2 candidates)
+};
+
+struct EncodeResult {
+  Bitstream bitstream;
+  std::vector<std::uint8_t> bytes;
+  TexelSpec spec;                  ///< what the bitstream decodes to
+  Percept input;                   ///< the input's fine part under the model
+  Percept decoded;                 ///< the decoded texture's, on the input's grid
+  double model_distance = 0.0;     ///< distance(input, decoded), JND units
+  bool coarse = false;             ///< a coarse profile was found
+  double coarse_correlation = 1.0; ///< envelope vs decoded envelope at texel centres
+  bool irregularity_identifiable = true;
+  double irregularity_bound_db = 0.0;  ///< when not identifiable: any value below this feels the same
+  int evaluations = 0;
+  double seconds = 0.0;
+  std::size_t samples = 0;
+  double spacing_mm = 0.0;
+};
+
+/// Encodes a signal. Throws InvalidArgument for unusable input (too short,
+/// constant, non-finite).
+EncodeResult encode(const Signal& signal, const EncoderConfig& config);
+
+// --- decoder ----------------------------------------------------------------
+
+/// The document a bitstream stands for on `device`: one region over the whole
+/// device. Rendering it gives the decoded map, byte for byte.
+Document decode_document(const Bitstream& b, const DeviceProfile& device);
+
+// --- compression report -----------------------------------------------------
+
+/// Size of `bytes` after zstd at its highest level (22, --ultra).
+std::size_t zstd_size(std::span<const std::byte> bytes);
+
+}  // namespace texel::codec

@@ -1,0 +1,673 @@
+// The encoder: coarse/fine split, the perceptual model and the
+// analysis-by-synthesis fit. docs/encoder.md explains every step and constant.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <deque>
+#include <numeric>
+
+#include "texel/codec.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel::codec {
+namespace {
+
+using detail::num;
+
+constexpr double ten_over_ln10 = 4.34294481903251827651;
+double db_of(double cpm) { return ten_over_ln10 * std::log(cpm); }
+double cpm_of(double db) { return std::pow(10.0, db / 10.0); }
+
+// --- spectra ------------------------------------------------------------------
+// Analysis only (never feeds rendered samples), so the C library's math and a
+// plain radix-2 FFT are fine here.
+
+void fft(std::vector<std::complex<double>>& a) {
+  const std::size_t n = a.size();
+  for (std::size_t i = 1, j = 0; i < n; ++i) {
+    std::size_t bit = n >> 1;
+    for (; j & bit; bit >>= 1) j ^= bit;
+    j ^= bit;
+    if (i < j) std::swap(a[i], a[j]);
+  }
+  // Twiddles once per size; products written out (std::complex's operator*
+  // calls __muldc3 for NaN handling, several times slower).
+  thread_local std::vector<double> tw_re, tw_im;
+  if (tw_re.size() != n / 2) {
+    tw_re.resize(n / 2);
+    tw_im.resize(n / 2);
+    for (std::size_t k = 0; k < n / 2; ++k) {
+      tw_re[k] = std::cos(-2.0 * M_PI * static_cast<double>(k) / static_cast<double>(n));
+      tw_im[k] = std::sin(-2.0 * M_PI * static_cast<double>(k) / static_cast<double>(n));
+    }
+  }
+  auto* d = reinterpret_cast<double*>(a.data());
+  for (std::size_t len = 2; len <= n; len <<= 1) {
+    const std::size_t half = len / 2;
+    const std::size_t step = n / len;
+    for (std::size_t i = 0; i < n; i += len) {
+      for (std::size_t k = 0; k < half; ++k) {
+        const double wr = tw_re[k * step], wi = tw_im[k * step];
+        double* u = d + 2 * (i + k);
+        double* v = d + 2 * (i + k + half);
+        const double vr = v[0] * wr - v[1] * wi;
+        const double vi = v[0] * wi + v[1] * wr;
+        v[0] = u[0] - vr;
+        v[1] = u[1] - vi;
+        u[0] += vr;
+        u[1] += vi;
+      }
+    }
+  }
+}
+
+std::size_t next_pow2(std::size_t n) {
+  std::size_t m = 1;
+  while (m < n) m <<= 1;
+  return m;
+}
+
+constexpr std::size_t max_segment = 1u << 15;
+/// Strengths this close to full scale are full scale (docs/encoder.md).
+constexpr double strength_snap = 0.02;
+/// How much more the envelope must vary than a fine-only texture's own (relative range).
+constexpr double coarse_margin = 0.1;
+/// Masking floor of the model, dB below the strongest spectral component.
+constexpr double masked_db = 50.0;
+
+/// One-sided power spectrum (arbitrary scale) of a zero-mean signal: a Hann
+/// periodogram zero-padded to a power of two, or Welch's average of
+/// half-overlapping 2^15-sample segments for long signals. Bin i is at
+/// i/(M·spacing) cpm; returns M through `m_out`.
+std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out) {
+  const std::size_t n = x.size();
+  const std::size_t seg = std::min(n, max_segment);
+  const std::size_t m = next_pow2(seg);
+  m_out = m;
+  std::vector<double> p(m / 2 + 1, 0.0);
+  std::vector<double> win(seg);
+  for (std::size_t i = 0; i < seg; ++i)
+    win[i] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (static_cast<double>(i) + 0.5) / static_cast<double>(seg));
+  std::vector<std::complex<double>> buf(m);
+  std::size_t count = 0;
+  const std::size_t hop = seg == n ? n : seg / 2;
+  for (std::size_t start = 0; start + seg <= n; start += hop) {
+    std::fill(buf.begin(), buf.end(), std::complex<double>(0.0));
+    for (std::size_t i = 0; i < seg; ++i) buf[i] = x[start + i] * win[i];
+    fft(buf);
+    for (std::size_t i = 0; i <= m / 2; ++i) p[i] += std::norm(buf[i]);
+    ++count;
+  }
+  for (double& v : p) v /= static_cast<double>(std::max<std::size_t>(count, 1));
+  return p;
+}
+
+std::vector<double> centred(std::span<const double> x) {
+  const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+  std::vector<double> y(x.begin(), x.end());
+  for (double& v : y) v -= mean;
+  return y;
+}
+
+// --- envelope tools ---------------------------------------------------------
+
+/// Running max (or min) over a centred window of w samples (monotonic deque, O(n)).
+std::vector<double> running_extreme(const std::vector<double>& x, std::size_t w, bool max) {
+  const std::size_t n = x.size();
+  const std::size_t half = w / 2;
+  std::vector<double> out(n);
+  std::deque<std::size_t> dq;
+  std::size_t next = 0;
+  auto better = [&](double a, double b) { return max ? a >= b : a <= b; };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t hi = std::min(n - 1, i + half);
+    for (; next <= hi; ++next) {
+      while (!dq.empty() && better(x[next], x[dq.back()])) dq.pop_back();
+      dq.push_back(next);
+    }
+    const std::size_t lo = i >= half ? i - half : 0;
+    while (dq.front() < lo) dq.pop_front();
+    out[i] = x[dq.front()];
+  }
+  return out;
+}
+
+/// Centred moving average of w samples, windows shortened at the ends.
+std::vector<double> moving_average(const std::vector<double>& x, std::size_t w) {
+  const std::size_t n = x.size();
+  const std::size_t half = w / 2;
+  std::vector<double> cum(n + 1, 0.0);
+  for (std::size_t i = 0; i < n; ++i) cum[i + 1] = cum[i] + x[i];
+  std::vector<double> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t lo = i >= half ? i - half : 0;
+    const std::size_t hi = std::min(n, i + half + 1);
+    out[i] = (cum[hi] - cum[lo]) / static_cast<double>(hi - lo);
+  }
+  return out;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto i = static_cast<std::size_t>(pos);
+  const double t = pos - static_cast<double>(i);
+  return i + 1 < v.size() ? v[i] + t * (v[i + 1] - v[i]) : v[i];
+}
+
+double correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  const std::size_t n = std::min(a.size(), b.size());
+  if (n < 2) return 1.0;
+  double ma = 0, mb = 0;
+  for (std::size_t i = 0; i < n; ++i) ma += a[i], mb += b[i];
+  ma /= static_cast<double>(n);
+  mb /= static_cast<double>(n);
+  double sab = 0, saa = 0, sbb = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 1.0;
+}
+
+// --- the coarse/fine split ----------------------------------------------------
+
+struct Split {
+  std::vector<double> fine;      // zero-mean fine signal (envelope divided out)
+  double range = 0.0;            // relative envelope range (p98 − p2) / p98 at texel centres
+  bool coarse = false;
+  double C = 0.0;
+  double F = 1.0;
+  std::vector<double> c;         // per-texel coarse profile (coarse only)
+};
+
+Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, bool fine_only = false) {
+  const std::size_t n = a.size();
+  const double B = cfg.boundary.value();
+  const double L = cfg.texel_length.value();
+
+  // Window for the envelope: about two periods of the fine texture, so that
+  // every window holds a peak and a trough. The fine frequency is the
+  // power-weighted mean above the boundary when that band carries the
+  // texture, else of the whole spectrum (a fine texture below the boundary).
+  std::size_t m = 0;
+  const std::vector<double> p = power_spectrum(centred(a), m);
+  const double df = 1.0 / (static_cast<double>(m) * dx);
+  double pw = 0, pf = 0, hw = 0, hf = 0;
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    const double f = static_cast<double>(i) * df;
+    pw += p[i];
+    pf += p[i] * f;
+    if (f >= 1.0 / B) hw += p[i], hf += p[i] * f;
+  }
+  Split s;
+  if (!(pw > 0.0)) throw InvalidArgument("the input is constant: it holds no texture to encode");
+  const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
+  const auto w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
+  const auto smooth = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
+  std::vector<double> up = moving_average(moving_average(running_extreme(a, w, true), smooth), smooth);
+  std::vector<double> lo = moving_average(moving_average(running_extreme(a, w, false), smooth), smooth);
+  for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
+
+  const std::size_t k_count = std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
+  std::vector<double> e(k_count), fk(k_count);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    const double x = (static_cast<double>(k) + 0.5) * L;
+    const auto i = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, std::round(x / dx))));
+    e[k] = up[i];
+    fk[k] = std::clamp(1.0 - lo[i] / up[i], 0.0, 1.0);
+  }
+  s.F = std::clamp(percentile(fk, 0.5), 0.0, 1.0);
+  const double e_hi = percentile(e, 0.98);
+  const double e_lo = percentile(e, 0.02);
+  s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
+  std::vector<double> fine(n);
+  if (fine_only || s.range < cfg.flat_envelope) {
+    // A flat envelope: strengths from the mean and RMS, which sampling does
+    // not bias (the extremes of a sinusoid near the Nyquist frequency are
+    // rarely sampled): mean = e(1 − F/2), RMS = e·F/(2√2).
+    s.coarse = false;
+    fine = centred(a);
+    double ms = 0.0;
+    for (double v : fine) ms += v * v;
+    const double rms = std::sqrt(ms / static_cast<double>(n));
+    const double mean = std::accumulate(a.begin(), a.end(), 0.0) / static_cast<double>(n);
+    const double env = std::min(1.0, mean + std::sqrt(2.0) * rms);
+    s.F = env > 0 ? std::clamp(2.0 * std::sqrt(2.0) * rms / env, 0.0, 1.0) : 0.0;
+    s.C = 1.0 - env;
+    // Within 2 % of full scale counts as full scale (well inside the
+    // intensity JND), so a fine-only texture stays a 14-byte stream.
+    if (s.C < strength_snap) s.C = 0.0;
+    if (s.F > 1.0 - strength_snap) s.F = 1.0;
+  } else {
+    s.coarse = true;
+    const double e_min = *std::min_element(e.begin(), e.end());
+    s.C = std::clamp(1.0 - e_min, 0.0, 1.0);
+    s.c.resize(k_count);
+    for (std::size_t k = 0; k < k_count; ++k) s.c[k] = s.C > 0 ? std::clamp((e[k] - e_min) / s.C, 0.0, 1.0) : 1.0;
+    for (std::size_t i = 0; i < n; ++i) fine[i] = a[i] / up[i];
+    fine = centred(fine);
+  }
+  s.fine = std::move(fine);
+  return s;
+}
+
+// --- the coarse section -------------------------------------------------------
+
+CoarseFields coarse_fields(const std::vector<double>& c, double C, double F, unsigned bits, std::uint32_t stride,
+                           std::uint8_t predictor) {
+  CoarseFields f;
+  f.coarse_strength = static_cast<std::uint8_t>(std::lround(std::clamp(C, 0.0, 1.0) * 255.0));
+  f.fine_strength = static_cast<std::uint8_t>(std::lround(std::clamp(F, 0.0, 1.0) * 255.0));
+  f.bits = static_cast<std::uint8_t>(bits);
+  f.predictor = predictor;
+  f.stride = stride;
+  const double top = static_cast<double>((1u << bits) - 1u);
+  for (std::size_t k = 0; k < c.size(); k += stride) f.levels.push_back(static_cast<std::uint16_t>(std::lround(c[k] * top)));
+  return f;
+}
+
+/// RMS difference between c and the profile the fields decode to (linear
+/// interpolation between stored levels, held flat past the last).
+double coarse_error(const std::vector<double>& c, const CoarseFields& f) {
+  const double top = static_cast<double>((1u << f.bits) - 1u);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const std::size_t j = k / f.stride;
+    const double t = static_cast<double>(k % f.stride) / f.stride;
+    const double a = f.levels[std::min(j, f.levels.size() - 1)] / top;
+    const double b = f.levels[std::min(j + 1, f.levels.size() - 1)] / top;
+    const double v = j + 1 < f.levels.size() ? a + t * (b - a) : a;
+    sum += (v - c[k]) * (v - c[k]);
+  }
+  return std::sqrt(sum / static_cast<double>(std::max<std::size_t>(c.size(), 1)));
+}
+
+std::vector<double> decoded_profile(const CoarseFields& f, std::size_t count) {
+  std::vector<double> c(count);
+  const double top = static_cast<double>((1u << f.bits) - 1u);
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t j = k / f.stride;
+    const double t = static_cast<double>(k % f.stride) / f.stride;
+    const double a = f.levels[std::min(j, f.levels.size() - 1)] / top;
+    const double b = f.levels[std::min(j + 1, f.levels.size() - 1)] / top;
+    c[k] = j + 1 < f.levels.size() ? a + t * (b - a) : a;
+  }
+  return c;
+}
+
+// --- analysis-by-synthesis ----------------------------------------------------
+
+struct Fitter {
+  const EncoderConfig& cfg;
+  const Percept& target;
+  double dx;
+  std::size_t samples;
+  CyclesPerMm band_max;
+  int evaluations = 0;
+
+  Percept render_percept(double p_db, double i_db, std::uint64_t seed) const {
+    TexelSpec s;
+    s.central_pitch = Decibels(p_db);
+    s.irregularity = Decibels(i_db);
+    s.texel_length = cfg.texel_length;
+    s.parameterization = cfg.parameterization;
+    s.band_max = band_max;
+    s.seed = seed;
+    const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx), band_max);
+    std::vector<double> a(samples);
+    t.render(Grid{0.0, dx, static_cast<std::int64_t>(samples)}, 0, a);
+    return perceive(centred(a), dx, cfg.model);
+  }
+
+  /// Mean percept over two candidate draws (common random numbers: the same
+  /// two seeds for every candidate, so the objective is smooth in P and I).
+  double operator()(double p_db, double i_db) {
+    ++evaluations;
+    Percept sum;
+    constexpr std::array<std::uint64_t, 2> seeds{0x5EED0001, 0x5EED0002};
+    try {
+      for (auto seed : seeds) {
+        const Percept q = render_percept(p_db, i_db, seed);
+        sum.pitch_db += q.pitch_db / seeds.size();
+        sum.noisiness_db += q.noisiness_db / seeds.size();
+        sum.mean_db += q.mean_db / seeds.size();
+        sum.spread_db += q.spread_db / seeds.size();
+      }
+    } catch (const InvalidArgument&) {
+      return 1e6;  // not renderable (e.g. too little of the distribution in the band)
+    }
+    return distance(target, sum, cfg.model);
+  }
+};
+
+struct Box {
+  double p_lo, p_hi, i_lo, i_hi;
+  [[nodiscard]] bool inside(double p, double i) const { return p >= p_lo && p <= p_hi && i >= i_lo && i <= i_hi; }
+};
+
+/// Nelder–Mead in (P, I) dB; points outside the box cost 1e6 plus their distance to it.
+std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double i0, double step_p, double step_i, int budget) {
+  auto f = [&](double p, double i) {
+    if (!box.inside(p, i)) {
+      const double dp = std::max({box.p_lo - p, p - box.p_hi, 0.0});
+      const double di = std::max({box.i_lo - i, i - box.i_hi, 0.0});
+      return 1e6 + dp + di;
+    }
+    return fit(p, i);
+  };
+  struct V {
+    double p, i, v;
+  };
+  std::array<V, 3> s{V{p0, i0, f(p0, i0)}, V{p0 + step_p, i0, f(p0 + step_p, i0)}, V{p0, i0 + step_i, f(p0, i0 + step_i)}};
+  int used = 3;
+  while (used < budget) {
+    std::sort(s.begin(), s.end(), [](const V& a, const V& b) { return a.v < b.v; });
+    const double size = std::max(std::hypot(s[1].p - s[0].p, s[1].i - s[0].i), std::hypot(s[2].p - s[0].p, s[2].i - s[0].i));
+    if (size < 0.01) break;
+    const double cp = (s[0].p + s[1].p) / 2, ci = (s[0].i + s[1].i) / 2;
+    const V r{cp + (cp - s[2].p), ci + (ci - s[2].i), 0};
+    const double fr = f(r.p, r.i);
+    ++used;
+    if (fr < s[0].v) {
+      const V e{cp + 2 * (cp - s[2].p), ci + 2 * (ci - s[2].i), 0};
+      const double fe = f(e.p, e.i);
+      ++used;
+      s[2] = fe < fr ? V{e.p, e.i, fe} : V{r.p, r.i, fr};
+    } else if (fr < s[1].v) {
+      s[2] = V{r.p, r.i, fr};
+    } else {
+      const bool outside = fr < s[2].v;
+      const V c = outside ? V{cp + 0.5 * (r.p - cp), ci + 0.5 * (r.i - ci), 0} : V{cp + 0.5 * (s[2].p - cp), ci + 0.5 * (s[2].i - ci), 0};
+      const double fc = f(c.p, c.i);
+      ++used;
+      if (fc < std::min(fr, s[2].v)) {
+        s[2] = V{c.p, c.i, fc};
+      } else {
+        for (int k = 1; k < 3; ++k) {
+          s[k].p = s[0].p + 0.5 * (s[k].p - s[0].p);
+          s[k].i = s[0].i + 0.5 * (s[k].i - s[0].i);
+          s[k].v = f(s[k].p, s[k].i);
+          ++used;
+        }
+      }
+    }
+  }
+  std::sort(s.begin(), s.end(), [](const V& a, const V& b) { return a.v < b.v; });
+  return {s[0].p, s[0].i, s[0].v};
+}
+
+/// A fine-only Texel texture of the encoder's settings.
+TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, Millimetres length,
+                          std::uint64_t seed = 0x5EED0001) {
+  TexelSpec s;
+  s.central_pitch = Decibels(p_db);
+  s.irregularity = Decibels(i_db);
+  s.texel_length = cfg.texel_length;
+  s.parameterization = cfg.parameterization;
+  s.band_max = band_max;
+  s.seed = seed;
+  return TexelTexture(s, length, band_max);
+}
+
+struct FineFit {
+  double p_db = 10.0, i_db = -5.0, distance = 0.0;
+  Percept input;
+  bool identifiable = true;
+  double bound_db = 0.0;
+  int evaluations = 0;
+};
+
+FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg) {
+  FineFit out;
+  out.input = perceive(fine, dx, cfg.model);
+  Fitter fit{cfg, out.input, dx, cand, band_max};
+  Box box{-20.0 + 0.5, db_of(band_max.value()) - 0.01, -40.0, 10.0};
+  if (cfg.parameterization == Parameterization::log) box.i_lo = 0.0, box.i_hi = 15.0;
+  // Start from the physical centroid and spread of the fine spectrum, then
+  // the best of a coarse grid around it (wide distributions make the
+  // objective rough enough to trap a simplex far from the optimum).
+  double p0 = std::clamp(out.input.mean_db, box.p_lo, box.p_hi);
+  double i0 = cfg.parameterization == Parameterization::log
+                  ? std::clamp(out.input.spread_db, box.i_lo, box.i_hi)
+                  : std::clamp(db_of(cpm_of(p0) * out.input.spread_db / ten_over_ln10), box.i_lo, box.i_hi);
+  double best_v = fit(p0, i0);
+  const double gp = p0, gi = i0;
+  for (double dp : {-3.0, 0.0, 3.0})
+    for (double di : {-8.0, 0.0, 8.0}) {
+      const double p = gp + dp, i = gi + di;
+      if ((dp == 0.0 && di == 0.0) || !box.inside(p, i)) continue;
+      const double v = fit(p, i);
+      if (v < best_v) best_v = v, p0 = p, i0 = i;
+    }
+  auto best = nelder_mead(fit, box, p0, i0, 1.5, 4.0, cfg.max_evaluations / 2);
+  best = nelder_mead(fit, box, best[0], best[1], 0.5, 2.0, cfg.max_evaluations / 2);  // restart: NM can stall
+  out.p_db = best[0];
+  out.i_db = best[1];
+  out.distance = best[2];
+  // Identifiability: does a much narrower distribution feel different?
+  const double narrower = std::max(box.i_lo, out.i_db - 6.0);
+  if (fit(out.p_db, narrower) - best[2] < 0.5) {
+    out.identifiable = false;
+    double bound = out.i_db;
+    for (double i = out.i_db + 1.0; i <= box.i_hi; i += 1.0) {
+      if (fit(out.p_db, i) - best[2] >= 0.5) break;
+      bound = i;
+    }
+    out.bound_db = bound;
+  }
+  out.evaluations = fit.evaluations;
+  return out;
+}
+
+}  // namespace
+
+// --- the perceptual model -------------------------------------------------------
+
+double threshold_db(Hertz f) {
+  const double hz = std::max(f.value(), 1e-6);
+  const double pacinian = 12.0 * std::fabs(std::log2(hz / 250.0));
+  return std::min({pacinian, 30.0, 60.0});
+}
+
+Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model) {
+  std::size_t m = 0;
+  const std::vector<double> p = power_spectrum(fine, m);
+  const double v = model.swipe_speed.value();
+  // Per-bin frequency, dB and sensitivity depend only on (M, Δx, v): cache them.
+  struct Bins {
+    std::size_t m = 0;
+    double dx = 0, v = 0;
+    std::vector<double> f, d, gain;
+  };
+  thread_local Bins bins;
+  if (bins.m != m || bins.dx != spacing_mm || bins.v != v) {
+    bins.m = m, bins.dx = spacing_mm, bins.v = v;
+    const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
+    bins.f.assign(p.size(), 0.0);
+    bins.d.assign(p.size(), 0.0);
+    bins.gain.assign(p.size(), 0.0);
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      const double f = static_cast<double>(i) * df;
+      bins.f[i] = f;
+      bins.d[i] = db_of(f);
+      // Sensitivity at f·v over sqrt(f): amplitude per unit log-frequency.
+      bins.gain[i] = f < 0.01 ? 0.0 : std::pow(10.0, -threshold_db(Hertz(f * v)) / 20.0) / std::sqrt(f);
+    }
+  }
+  // Components more than `masked_db` below the strongest are not felt
+  // (and leakage and quantization noise stay out of the spread).
+  const double peak = *std::max_element(p.begin() + 1, p.end());
+  const double floor = peak * std::pow(10.0, -masked_db / 10.0);
+  double sw = 0, swf = 0, swd = 0, swdd = 0;   // perceptual weights
+  double sp = 0, spf = 0, spd = 0, spdd = 0;   // physical (power) weights
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
+    const double f = bins.f[i], d = bins.d[i];
+    const double w = std::sqrt(p[i]) * bins.gain[i];
+    sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
+    sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+  }
+  if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above 0.01 cycles/mm");
+  Percept q;
+  q.pitch_db = db_of(swf / sw);
+  const double md = swd / sw;
+  q.noisiness_db = std::sqrt(std::max(0.0, swdd / sw - md * md));
+  q.mean_db = db_of(spf / sp);
+  const double pd = spd / sp;
+  q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  return q;
+}
+
+double distance(const Percept& a, const Percept& b, const PerceptualModel& model) {
+  const double dp = (a.pitch_db - b.pitch_db) / model.pitch_jnd_db;
+  const double dn = (a.noisiness_db - b.noisiness_db) / model.noisiness_jnd_db;
+  const double dm = a.mean_db - b.mean_db;
+  const double ds = a.spread_db - b.spread_db;
+  return std::sqrt(dp * dp + dn * dn + model.tie_weight * (dm * dm + ds * ds));
+}
+
+// --- encode -------------------------------------------------------------------
+
+EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double dx = signal.spacing_mm;
+  const std::size_t n = signal.amplitude.size();
+  if (!(std::isfinite(dx) && dx > 0.0)) throw InvalidArgument("signal spacing is " + num(dx) + " mm; it must be > 0");
+  if (!(cfg.boundary.value() > 0.0 && std::isfinite(cfg.boundary.value())))
+    throw InvalidArgument("--boundary is " + num(cfg.boundary.value()) + " mm; it must be > 0");
+  if (!(cfg.texel_length.value() >= 0.001 && cfg.texel_length.value() <= 65.535))
+    throw InvalidArgument("--texel-length is " + num(cfg.texel_length.value()) + " mm; allowed: 0.001 … 65.535 mm");
+  if (!(cfg.model.swipe_speed.value() > 0.0 && std::isfinite(cfg.model.swipe_speed.value())))
+    throw InvalidArgument("--swipe-speed is " + num(cfg.model.swipe_speed.value()) + " mm/s; it must be > 0");
+  if (cfg.coarse_bits < 1 || cfg.coarse_bits > 16)
+    throw InvalidArgument("--coarse-bits is " + std::to_string(cfg.coarse_bits) + "; allowed: 1 … 16");
+  const double len = static_cast<double>(n) * dx;
+  if (n < 64 || len < 4.0 * cfg.texel_length.value())
+    throw InvalidArgument("the input has " + std::to_string(n) + " samples over " + num(len) +
+                          " mm; at least 64 samples and 4 texels are needed");
+  for (double v : signal.amplitude)
+    if (!std::isfinite(v)) throw InvalidArgument("the input holds a non-finite value");
+  std::vector<double> a = signal.amplitude;
+  for (double& v : a) v = std::clamp(v, 0.0, 1.0);
+
+  EncodeResult res;
+  res.samples = n;
+  res.spacing_mm = dx;
+  // The band the decoded texture draws from: the analysed grid's Nyquist
+  // frequency, rounded down to the stream's 0.01 dB steps (device independent).
+  Bitstream b;
+  FineFields& f = b.fine;
+  f.band_max_cdb = static_cast<std::int16_t>(std::floor(db_of(0.5 / dx) * 100.0));
+  const CyclesPerMm band_max = to_cpm(Decibels(f.band_max_cdb / 100.0));
+  f.texel_length_um = static_cast<std::uint16_t>(std::lround(cfg.texel_length.value() * 1000.0));
+  f.seed = cfg.seed;
+  f.parameterization = cfg.parameterization;
+  EncoderConfig fit_cfg = cfg;
+  fit_cfg.texel_length = Millimetres(f.texel_length_um / 1000.0);
+  const std::size_t cand = std::min<std::size_t>(n, std::size_t{1} << 16);
+
+  Split sp = split(a, dx, fit_cfg);
+  FineFit fit;
+  bool has_fine = sp.F >= 0.02;
+  if (sp.coarse && has_fine) {
+    // Analysis-by-synthesis for the split too: a fine-only texture with low
+    // or widely spread frequencies has an uneven envelope by itself. Keep the
+    // coarse profile only if the input's envelope varies clearly more than
+    // that of the best fine-only explanation.
+    Split flat = split(a, dx, fit_cfg, true);
+    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, fit_cfg);
+    std::vector<double> r(n);
+    fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
+        .render(Grid{0.0, dx, static_cast<std::int64_t>(n)}, 0, r);
+    const Split own = split(r, dx, fit_cfg);
+    if (sp.range <= own.range + coarse_margin) {
+      sp = std::move(flat);
+      fit = flat_fit;
+    } else {
+      fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg);
+      fit.evaluations += flat_fit.evaluations;
+    }
+  } else if (has_fine) {
+    fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg);
+  }
+  res.coarse = sp.coarse;
+  has_fine = sp.F >= 0.02;
+  double p_est = 10.0, i_est = cfg.parameterization == Parameterization::log ? 1.0 : -5.0;
+  if (has_fine) {
+    p_est = fit.p_db;
+    i_est = fit.i_db;
+    res.input = fit.input;
+    res.irregularity_identifiable = fit.identifiable;
+    res.irregularity_bound_db = fit.bound_db;
+    res.evaluations = fit.evaluations;
+  }
+  f.central_pitch_cdb = static_cast<std::int16_t>(std::lround(p_est * 100.0));
+  f.irregularity_cdb = static_cast<std::int16_t>(std::lround(i_est * 100.0));
+
+  // Coarse part and strengths.
+  const double F = has_fine ? sp.F : 0.0;
+  std::vector<double> decoded_c;
+  if (sp.coarse) {
+    std::vector<CoarseFields> options;
+    if (cfg.max_bytes) {
+      for (unsigned bits = 8; bits >= 2; --bits)
+        for (std::uint32_t stride : {1u, 2u, 3u, 4u, 6u, 8u, 12u, 16u, 24u, 32u, 48u, 64u})
+          for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}}) options.push_back(coarse_fields(sp.c, sp.C, F, bits, stride, pred));
+    } else {
+      for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}}) options.push_back(coarse_fields(sp.c, sp.C, F, cfg.coarse_bits, 1, pred));
+    }
+    const std::size_t fixed = write_bitstream(b).size();
+    const CoarseFields* chosen = nullptr;
+    double chosen_err = 0;
+    std::size_t chosen_size = 0;
+    for (const auto& o : options) {
+      const std::size_t size = fixed + coarse_section_bytes(o);
+      if (cfg.max_bytes && size > *cfg.max_bytes) continue;
+      const double err = coarse_error(sp.c, o);
+      if (!chosen || err < chosen_err - 1e-12 || (std::fabs(err - chosen_err) <= 1e-12 && size < chosen_size))
+        chosen = &o, chosen_err = err, chosen_size = size;
+    }
+    if (!chosen)
+      throw InvalidArgument("--max-bytes " + std::to_string(*cfg.max_bytes) + " is too small for this texture's coarse profile; it needs at least " +
+                            std::to_string(fixed + coarse_section_bytes(options.back())) + " bytes");
+    b.coarse = *chosen;
+    decoded_c = decoded_profile(*chosen, sp.c.size());
+    res.coarse_correlation = correlation(sp.c, decoded_c);
+  } else {
+    const auto c8 = static_cast<std::uint8_t>(std::lround(sp.C * 255.0));
+    const auto f8 = static_cast<std::uint8_t>(std::lround(F * 255.0));
+    if (c8 != 0 || f8 != 255) {
+      CoarseFields c;
+      c.coarse_strength = c8;
+      c.fine_strength = f8;
+      c.bits = 0;
+      b.coarse = c;
+    }
+  }
+  res.bytes = write_bitstream(b);
+  res.bitstream = parse_bitstream(res.bytes);  // what a decoder sees
+  res.spec = to_spec(res.bitstream);
+
+  // The decoded texture on the input's grid, under the model.
+  if (has_fine) {
+    const TexelTexture t(res.spec, Millimetres(len), band_max);
+    std::vector<double> d(n);
+    t.render(Grid{0.0, dx, static_cast<std::int64_t>(n)}, 0, d);
+    EncoderConfig c2 = fit_cfg;
+    const Split dsp = split(d, dx, c2);
+    res.decoded = perceive(dsp.fine, dx, cfg.model);
+    res.model_distance = distance(res.input, res.decoded, cfg.model);
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+Document decode_document(const Bitstream& b, const DeviceProfile& device) { return make_document(device, to_spec(b)); }
+
+}  // namespace texel::codec
