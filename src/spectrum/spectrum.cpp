@@ -188,10 +188,20 @@ std::vector<Peak> find_peaks(const Spectrum& s, const PeakOptions& options) {
     for (std::size_t j = lo; j <= hi && dominant; ++j)
       if (s.magnitude[j] > m) dominant = false;
     if (!dominant) continue;
-    const double a = db(k - 1), b = db(k), c = db(k + 1);
-    const double den = a - 2.0 * b + c;
-    const double p = den < 0.0 ? std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : 0.0;
-    const double level = b - 0.25 * (a - c) * p;
+    // Parabola through the three dB values. A neighbour at the float FFT's
+    // floor (or exactly 0) would put the vertex anywhere: interpolate only
+    // between bins inside one main lobe, and never move a peak by more than a
+    // rectangular window's worst scalloping loss (3.92 dB).
+    double p = 0.0;
+    double level = db(k);
+    if (s.magnitude[k - 1] > 1e-7 * m && s.magnitude[k + 1] > 1e-7 * m) {
+      const double a = db(k - 1), b = db(k), c = db(k + 1);
+      const double den = a - 2.0 * b + c;
+      if (den < 0.0) {
+        p = std::clamp(0.5 * (a - c) / den, -0.5, 0.5);
+        level = std::min(b - 0.25 * (a - c) * p, b + 3.92);
+      }
+    }
     cands.push_back({(static_cast<double>(k) + p) * s.bin_cpm, std::pow(10.0, level / 20.0)});
   }
   if (cands.empty()) return peaks;
