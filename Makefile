@@ -19,6 +19,7 @@ build: configure
 
 demo: build
 	$(BUILD)/bin/texel demo --out out/demo
+	$(BUILD)/bin/texel atlas --out out/demo/references
 
 # Every test: unit and CLI tests (release build), the same under
 # AddressSanitizer + UndefinedBehaviorSanitizer, and byte-identity of the demo
