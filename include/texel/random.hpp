@@ -65,7 +65,11 @@ public:
   }
   /// Uniform in the open interval (0, 1), 53-bit resolution.
   [[nodiscard]] constexpr double uniform(std::uint64_t counter) const {
-    return (static_cast<double>(bits(counter) >> 11) + 0.5) * 0x1.0p-53;
+    // k + 0.5 is exact only for k < 2^52; above that it rounds to even, and
+    // k = 2^53 − 1 would round up to 2^53, i.e. u = 1 (Φ⁻¹(1) = +inf). Map that
+    // one word to the largest double below 1; every other value is unchanged.
+    const double u = (static_cast<double>(bits(counter) >> 11) + 0.5) * 0x1.0p-53;
+    return u < 1.0 ? u : 0x1.fffffffffffffp-1;
   }
   /// Standard normal by inversion of the CDF (one uniform per normal).
   [[nodiscard]] double normal(std::uint64_t counter) const { return detmath::normal_quantile(uniform(counter)); }
