@@ -88,15 +88,19 @@ Spectrum magnitude_spectrum(std::span<const double> samples, double spacing_mm, 
   const std::size_t n = samples.size();
   const std::size_t nfft = detail::fast_fft_length(n * static_cast<std::size_t>(options.zero_pad));
   const std::vector<double> w = window_coefficients(options.window, n);
-  const double mean = options.remove_mean ? mean_of(samples) : 0.0;
-  std::vector<double> buf(nfft, 0.0);
+  // Remove the window-weighted mean, so the windowed signal has no DC at all
+  // and the window's main lobe around 0 cpm does not leak into the lowest bins.
   double sum_w = 0.0;
   double sum_w2 = 0.0;
+  double sum_wx = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    buf[i] = (samples[i] - mean) * w[i];
     sum_w += w[i];
     sum_w2 += w[i] * w[i];
+    sum_wx += w[i] * samples[i];
   }
+  const double mean = options.remove_mean ? sum_wx / sum_w : 0.0;
+  std::vector<double> buf(nfft, 0.0);
+  for (std::size_t i = 0; i < n; ++i) buf[i] = (samples[i] - mean) * w[i];
   std::vector<std::complex<double>> X(nfft / 2 + 1);
   detail::RealFft fft(nfft);
   fft.forward(buf, X);
