@@ -78,8 +78,9 @@ struct Percept {
   double spread_db = 0.0;      ///< physical: power-weighted SD of 10·log10 f, dB
 };
 
-/// Percept of a zero-mean fine signal sampled every `spacing_mm`.
-Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model);
+/// Percept of a zero-mean fine signal sampled every `spacing_mm`, from its
+/// content above `f_min_cpm` (and above 0.01 cpm).
+Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm = 0.0);
 /// Model distance in JND units (plus the small physical tie-break).
 double distance(const Percept& a, const Percept& b, const PerceptualModel& model);
 

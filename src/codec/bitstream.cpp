@@ -141,6 +141,11 @@ public:
     return v;
   }
   [[nodiscard]] std::size_t bytes_used() const { return (pos_ + 7) / 8; }
+  [[nodiscard]] bool padding_is_zero() const {
+    const std::size_t rem = pos_ & 7;
+    if (rem == 0) return true;
+    return (b_[pos_ >> 3] & ((1u << (8 - rem)) - 1u)) == 0;
+  }
 
 private:
   std::span<const std::uint8_t> b_;
@@ -280,15 +285,15 @@ std::vector<std::uint8_t> write_bitstream(const Bitstream& b) {
 }
 
 Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
-  if (bytes.empty()) throw FormatError("bitstream is empty; a .texel bitstream is at least 13 bytes");
+  if (bytes.empty()) throw FormatError("bitstream is empty; a .texel bitstream is at least 12 bytes");
   if (bytes[0] != bitstream_magic)
     throw FormatError("not a Texel bitstream: first byte is " + hex(bytes[0]) + ", expected " + hex(bitstream_magic) + " ('T')");
   if (bytes.size() < 2) throw FormatError("bitstream truncated: 1 byte, no version");
   if (bytes[1] != bitstream_version)
     throw FormatError("unsupported bitstream version " + std::to_string(bytes[1]) + "; this build reads version " +
                       std::to_string(bitstream_version));
-  if (bytes.size() < 13)
-    throw FormatError("bitstream truncated: " + std::to_string(bytes.size()) + " bytes; a version-1 bitstream has at least 13");
+  if (bytes.size() < 12)
+    throw FormatError("bitstream truncated: " + std::to_string(bytes.size()) + " bytes; a version-1 bitstream has at least 12");
   ByteReader r(bytes.first(bytes.size() - 1));  // the last byte is the CRC
   r.skip(2);
   Bitstream b;
@@ -341,6 +346,9 @@ Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
         std::uint32_t u;
         if (quotient == rice_escape) {
           u = br.bits(c.bits);
+          if ((u >> kk) < rice_escape)
+            throw FormatError("bitstream coarse level " + std::to_string(k) + " uses an escape for residual code " + std::to_string(u) +
+                              ", which has a short code; allowed: canonical Rice codes only");
         } else {
           u = (quotient << kk) | br.bits(kk);
           if (u >= (1u << c.bits))
@@ -350,6 +358,7 @@ Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
         c.levels[k] = apply_residual(u, predict(c.levels, k, c.predictor, c.bits), c.bits);
         rs.update(u);
       }
+      if (!br.padding_is_zero()) throw FormatError("bitstream coarse levels end with non-zero padding bits; allowed: 0");
       r.skip(br.bytes_used());
     }
     b.coarse = std::move(c);

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <complex>
 #include <deque>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
 
 #include "texel/codec.hpp"
@@ -75,6 +77,8 @@ constexpr std::size_t max_segment = 1u << 15;
 constexpr double strength_snap = 0.02;
 /// How much more the envelope must vary than a fine-only texture's own (relative range).
 constexpr double coarse_margin = 0.1;
+/// Largest band-spectrum difference a fine-only explanation may leave (dB).
+constexpr double max_shape_db = 3.0;
 /// Masking floor of the model, dB below the strongest spectral component.
 constexpr double masked_db = 50.0;
 
@@ -180,13 +184,19 @@ double correlation(const std::vector<double>& a, const std::vector<double>& b) {
 struct Split {
   std::vector<double> fine;      // zero-mean fine signal (envelope divided out)
   double range = 0.0;            // relative envelope range (p98 − p2) / p98 at texel centres
+  std::size_t window = 0;        // running-extreme window, samples
   bool coarse = false;
   double C = 0.0;
   double F = 1.0;
   std::vector<double> c;         // per-texel coarse profile (coarse only)
 };
 
-Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, bool fine_only = false) {
+enum class SplitMode { automatic, fine_only, two_scale };
+
+/// `window` > 0 fixes the running-extreme window (samples) instead of
+/// deriving it from the spectrum: candidates are analysed exactly like the input.
+Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode = SplitMode::automatic,
+            std::size_t window = 0) {
   const std::size_t n = a.size();
   const double B = cfg.boundary.value();
   const double L = cfg.texel_length.value();
@@ -195,39 +205,53 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, b
   // every window holds a peak and a trough. The fine frequency is the
   // power-weighted mean above the boundary when that band carries the
   // texture, else of the whole spectrum (a fine texture below the boundary).
-  std::size_t m = 0;
-  const std::vector<double> p = power_spectrum(centred(a), m);
-  const double df = 1.0 / (static_cast<double>(m) * dx);
-  double pw = 0, pf = 0, hw = 0, hf = 0;
-  for (std::size_t i = 1; i < p.size(); ++i) {
-    const double f = static_cast<double>(i) * df;
-    pw += p[i];
-    pf += p[i] * f;
-    if (f >= 1.0 / B) hw += p[i], hf += p[i] * f;
-  }
   Split s;
-  if (!(pw > 0.0)) throw InvalidArgument("the input is constant: it holds no texture to encode");
-  const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
-  const auto w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
-  const auto smooth = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
-  std::vector<double> up = moving_average(moving_average(running_extreme(a, w, true), smooth), smooth);
-  std::vector<double> lo = moving_average(moving_average(running_extreme(a, w, false), smooth), smooth);
+  std::size_t w = window;
+  if (w == 0) {
+    std::size_t m = 0;
+    const std::vector<double> p = power_spectrum(centred(a), m);
+    const double df = 1.0 / (static_cast<double>(m) * dx);
+    double pw = 0, pf = 0, hw = 0, hf = 0;
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      const double f = static_cast<double>(i) * df;
+      pw += p[i];
+      pf += p[i] * f;
+      if (f >= 1.0 / B) hw += p[i], hf += p[i] * f;
+    }
+    if (!(pw > 0.0)) throw InvalidArgument("the input is constant: it holds no texture to encode");
+    const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
+    w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
+  }
+  s.window = w;
+  // One moving average over half the boundary (at least the window) removes
+  // the running extremes' steps; it barely attenuates coarse features (a
+  // 5 mm period keeps 98 % of its amplitude).
+  const auto smooth = std::max(w, static_cast<std::size_t>(std::round(0.5 * B / dx)));
+  const std::vector<double> up_raw = running_extreme(a, w, true);
+  std::vector<double> up = moving_average(up_raw, smooth);
+  // The decision coarse-or-not looks at the envelope low-passed at the
+  // boundary proper (two passes of B): the envelope of a noise fluctuates
+  // at the rate of its bandwidth, which is fine texture, not coarse layout.
+  const auto b_samples = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
+  const std::vector<double> up_slow = moving_average(moving_average(up_raw, b_samples), b_samples);
+  std::vector<double> lo = moving_average(running_extreme(a, w, false), smooth);
   for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
 
   const std::size_t k_count = std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
-  std::vector<double> e(k_count), fk(k_count);
+  std::vector<double> e(k_count), fk(k_count), e_slow(k_count);
   for (std::size_t k = 0; k < k_count; ++k) {
     const double x = (static_cast<double>(k) + 0.5) * L;
     const auto i = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, std::round(x / dx))));
     e[k] = up[i];
+    e_slow[k] = std::clamp(up_slow[i], 1e-6, 1.0);
     fk[k] = std::clamp(1.0 - lo[i] / up[i], 0.0, 1.0);
   }
   s.F = std::clamp(percentile(fk, 0.5), 0.0, 1.0);
-  const double e_hi = percentile(e, 0.98);
-  const double e_lo = percentile(e, 0.02);
+  const double e_hi = percentile(e_slow, 0.98);
+  const double e_lo = percentile(e_slow, 0.02);
   s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
   std::vector<double> fine(n);
-  if (fine_only || s.range < cfg.flat_envelope) {
+  if (mode == SplitMode::fine_only || (mode == SplitMode::automatic && s.range < cfg.flat_envelope)) {
     // A flat envelope: strengths from the mean and RMS, which sampling does
     // not bias (the extremes of a sinusoid near the Nyquist frequency are
     // rarely sampled): mean = e(1 − F/2), RMS = e·F/(2√2).
@@ -309,6 +333,8 @@ struct Fitter {
   double dx;
   std::size_t samples;
   CyclesPerMm band_max;
+  double f_min = 0.0;  // analysis band bottom (the boundary, for the fine part of a two-scale texture)
+  const Split* two_scale = nullptr;  // the input's coarse estimate: candidates carry it and are split alike
   int evaluations = 0;
 
   Percept render_percept(double p_db, double i_db, std::uint64_t seed) const {
@@ -319,10 +345,16 @@ struct Fitter {
     s.parameterization = cfg.parameterization;
     s.band_max = band_max;
     s.seed = seed;
+    if (two_scale) {
+      s.coarse_strength = two_scale->C;
+      s.fine_strength = two_scale->F;
+      s.coarse = ValuesProfile{two_scale->c};
+    }
     const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx), band_max);
     std::vector<double> a(samples);
     t.render(Grid{0.0, dx, static_cast<std::int64_t>(samples)}, 0, a);
-    return perceive(centred(a), dx, cfg.model);
+    if (two_scale) return perceive(split(a, dx, cfg, SplitMode::two_scale, two_scale->window).fine, dx, cfg.model, f_min);
+    return perceive(centred(a), dx, cfg.model, f_min);
   }
 
   /// Mean percept over two candidate draws (common random numbers: the same
@@ -423,10 +455,11 @@ struct FineFit {
   int evaluations = 0;
 };
 
-FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg) {
+FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg,
+                 double f_min = 0.0, const Split* two_scale = nullptr) {
   FineFit out;
-  out.input = perceive(fine, dx, cfg.model);
-  Fitter fit{cfg, out.input, dx, cand, band_max};
+  out.input = perceive(fine, dx, cfg.model, f_min);
+  Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale};
   Box box{-20.0 + 0.5, db_of(band_max.value()) - 0.01, -40.0, 10.0};
   if (cfg.parameterization == Parameterization::log) box.i_lo = 0.0, box.i_hi = 15.0;
   // Start from the physical centroid and spread of the fine spectrum, then
@@ -465,6 +498,36 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
   return out;
 }
 
+/// How differently two signals of the same length distribute their power
+/// over half-octave bands (0.01 cpm … Nyquist): the power-weighted mean
+/// absolute level difference in dB, each spectrum normalised to unit power
+/// and floored 40 dB below it.
+double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx) {
+  std::size_t m = 0;
+  const std::vector<double> px = power_spectrum(centred(x), m);
+  const std::vector<double> py = power_spectrum(centred(y), m);
+  const double df = 1.0 / (static_cast<double>(m) * dx);
+  std::vector<double> bx, by;
+  for (std::size_t i = 1; i < px.size(); ++i) {
+    const double f = static_cast<double>(i) * df;
+    if (f < 0.01) continue;
+    const auto band = static_cast<std::size_t>(std::floor(2.0 * std::log2(f / 0.01)));
+    if (band >= bx.size()) bx.resize(band + 1, 0.0), by.resize(band + 1, 0.0);
+    bx[band] += px[i];
+    by[band] += py[i];
+  }
+  const double tx = std::accumulate(bx.begin(), bx.end(), 0.0), ty = std::accumulate(by.begin(), by.end(), 0.0);
+  if (!(tx > 0 && ty > 0)) return 0.0;
+  double num_ = 0.0, den = 0.0;
+  for (std::size_t b = 0; b < bx.size(); ++b) {
+    const double u = bx[b] / tx + 1e-4, v = by[b] / ty + 1e-4;
+    const double w = std::max(u, v);
+    num_ += w * std::fabs(10.0 * std::log10(u / v));
+    den += w;
+  }
+  return num_ / den;
+}
+
 }  // namespace
 
 // --- the perceptual model -------------------------------------------------------
@@ -475,19 +538,20 @@ double threshold_db(Hertz f) {
   return std::min({pacinian, 30.0, 60.0});
 }
 
-Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model) {
+Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
   std::size_t m = 0;
   const std::vector<double> p = power_spectrum(fine, m);
   const double v = model.swipe_speed.value();
   // Per-bin frequency, dB and sensitivity depend only on (M, Δx, v): cache them.
   struct Bins {
     std::size_t m = 0;
-    double dx = 0, v = 0;
+    double dx = 0, v = 0, f_min = 0;
     std::vector<double> f, d, gain;
   };
   thread_local Bins bins;
-  if (bins.m != m || bins.dx != spacing_mm || bins.v != v) {
-    bins.m = m, bins.dx = spacing_mm, bins.v = v;
+  const double f_lo = std::max(0.01, f_min_cpm);
+  if (bins.m != m || bins.dx != spacing_mm || bins.v != v || bins.f_min != f_lo) {
+    bins.m = m, bins.dx = spacing_mm, bins.v = v, bins.f_min = f_lo;
     const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
     bins.f.assign(p.size(), 0.0);
     bins.d.assign(p.size(), 0.0);
@@ -497,12 +561,14 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
       bins.f[i] = f;
       bins.d[i] = db_of(f);
       // Sensitivity at f·v over sqrt(f): amplitude per unit log-frequency.
-      bins.gain[i] = f < 0.01 ? 0.0 : std::pow(10.0, -threshold_db(Hertz(f * v)) / 20.0) / std::sqrt(f);
+      bins.gain[i] = f < f_lo ? 0.0 : std::pow(10.0, -threshold_db(Hertz(f * v)) / 20.0) / std::sqrt(f);
     }
   }
   // Components more than `masked_db` below the strongest are not felt
   // (and leakage and quantization noise stay out of the spread).
-  const double peak = *std::max_element(p.begin() + 1, p.end());
+  double peak = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i)
+    if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   double sw = 0, swf = 0, swd = 0, swdd = 0;   // perceptual weights
   double sp = 0, spf = 0, spd = 0, spdd = 0;   // physical (power) weights
@@ -513,7 +579,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
     sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
   }
-  if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above 0.01 cycles/mm");
+  if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
   Percept q;
   q.pitch_db = db_of(swf / sw);
   const double md = swd / sw;
@@ -580,17 +646,20 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     // or widely spread frequencies has an uneven envelope by itself. Keep the
     // coarse profile only if the input's envelope varies clearly more than
     // that of the best fine-only explanation.
-    Split flat = split(a, dx, fit_cfg, true);
-    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, fit_cfg);
+    Split flat = split(a, dx, fit_cfg, SplitMode::fine_only);
+    EncoderConfig quick = fit_cfg;  // the check needs the neighbourhood, not the last 0.1 dB
+    quick.max_evaluations = fit_cfg.max_evaluations / 3;
+    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, quick);
     std::vector<double> r(n);
     fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
         .render(Grid{0.0, dx, static_cast<std::int64_t>(n)}, 0, r);
     const Split own = split(r, dx, fit_cfg);
-    if (sp.range <= own.range + coarse_margin) {
+    const double shape = shape_distance_db(a, r, dx);
+    if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
       sp = std::move(flat);
       fit = flat_fit;
     } else {
-      fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg);
+      fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg, 1.0 / cfg.boundary.value(), &sp);
       fit.evaluations += flat_fit.evaluations;
     }
   } else if (has_fine) {
@@ -660,8 +729,8 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     std::vector<double> d(n);
     t.render(Grid{0.0, dx, static_cast<std::int64_t>(n)}, 0, d);
     EncoderConfig c2 = fit_cfg;
-    const Split dsp = split(d, dx, c2);
-    res.decoded = perceive(dsp.fine, dx, cfg.model);
+    const Split dsp = res.coarse ? split(d, dx, c2, SplitMode::two_scale, sp.window) : split(d, dx, c2, SplitMode::fine_only);
+    res.decoded = perceive(dsp.fine, dx, cfg.model, res.coarse ? 1.0 / cfg.boundary.value() : 0.0);
     res.model_distance = distance(res.input, res.decoded, cfg.model);
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
