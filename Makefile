@@ -41,6 +41,7 @@ test-determinism: build
 bench: build
 	$(BUILD)/bin/texel_bench --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	$(PY) bench/summarize.py $(BUILD)/bench.json
+	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -15,5 +15,8 @@ void register_decode(CLI::App& app);
 void register_reference(CLI::App& app);
 void register_spectrum(CLI::App& app);
 void register_atlas(CLI::App& app);
+void register_swipe(CLI::App& app);
+void register_play(CLI::App& app);
+void register_controller(CLI::App& app);
 
 }  // namespace texel::cli

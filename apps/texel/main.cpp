@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   texel::cli::register_reference(app);
   texel::cli::register_spectrum(app);
   texel::cli::register_atlas(app);
+  texel::cli::register_swipe(app);
+  texel::cli::register_play(app);
+  texel::cli::register_controller(app);
   try {
     app.parse(argc, argv);
     return 0;

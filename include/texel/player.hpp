@@ -31,10 +31,12 @@
 //
 // Output modes (PlayerConfig::mode):
 //   amplitude  a(x) in [0, 1], for friction displays (0 = at rest);
-//   vibration  2·(a(x) band-passed): a one-pole DC blocker (high-pass at
-//              highpass_hz) and a 2nd-order Butterworth low-pass (lowpass_hz,
-//              default 0.4·rate), so the output is zero-mean; a full-range
-//              fine texture gives ±1; clipped to [−1, 1];
+//   vibration  a(x) band-passed: a 2nd-order Butterworth low-pass
+//              (lowpass_hz, default 0.4·rate) then a one-pole DC blocker
+//              (high-pass at highpass_hz), so the output is zero-mean. Unit
+//              gain: a full-range fine texture gives ±0.5 (−6 dBFS), which
+//              leaves room for the DC blocker's settling after a touch-down
+//              without clipping; clipped to [−1, 1];
 //   carrier    a(x)·sin(2π·f_c·t) from a phase accumulator, for displays fed
 //              from a signal generator or amplifier.
 // Touch and lift fade the output in and out with a raised-cosine ramp of

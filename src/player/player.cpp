@@ -273,7 +273,7 @@ BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) no
         const double hp = lp - dc_x1_ + dc_r_ * dc_y1_;
         dc_x1_ = lp;
         dc_y1_ = hp;
-        y = 2.0 * hp;
+        y = hp;
         break;
       }
     }

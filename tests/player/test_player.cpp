@@ -105,10 +105,10 @@ TEST(Player, VibrationIsZeroMeanAndBounded) {
   const double mean = std::accumulate(out.begin() + 9600, out.end(), 0.0) / static_cast<double>(out.size() - 9600);
   EXPECT_LT(std::fabs(mean), 0.01);
   for (float y : out) ASSERT_LE(std::fabs(y), 1.0f);
-  // 2·(0.3 sin) → amplitude 0.6 in the pass band.
+  // Unit gain: 0.3 sin → amplitude 0.3 in the pass band.
   const auto spec = signal_spectrum(std::span(out).subspan(9600), c.rate_hz);
   const double peak = *std::max_element(spec.magnitude.begin(), spec.magnitude.end());
-  EXPECT_NEAR(peak, 0.6, 0.03);
+  EXPECT_NEAR(peak, 0.3, 0.015);
 }
 
 TEST(Player, CarrierIsAmplitudeModulatedSine) {
