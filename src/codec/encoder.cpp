@@ -218,7 +218,13 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
       pf += p[i] * f;
       if (f >= 1.0 / B) hw += p[i], hf += p[i] * f;
     }
-    if (!(pw > 0.0)) throw InvalidArgument("the input is constant: it holds no texture to encode");
+    if (!(pw > 0.0)) {
+      // A flat surface is a texture too: no fine part, a constant envelope.
+      s.F = 0.0;
+      s.C = 1.0 - std::clamp(a.empty() ? 1.0 : a[0], 0.0, 1.0);
+      s.fine.assign(n, 0.0);
+      return s;
+    }
     const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
     w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
   }

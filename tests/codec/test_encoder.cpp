@@ -136,8 +136,11 @@ TEST(EncoderTrends, BandPassPitchFollowsCentreAndIrregularityFollowsZeta) {
 }
 
 TEST(Encoder, RejectsUnusableInput) {
-  Signal flat{std::vector<double>(19200, 0.5), 0.0053, "flat"};
-  EXPECT_THROW((void)encode(flat, EncoderConfig{}), InvalidArgument);
+  // A flat surface is encodable: no fine part, e = 0.5 as a constant envelope.
+  const EncodeResult flat = encode(Signal{std::vector<double>(19200, 0.5), 0.0053, "flat"}, EncoderConfig{});
+  EXPECT_EQ(flat.spec.fine_strength, 0.0);
+  EXPECT_NEAR(flat.spec.coarse_strength, 0.5, 0.5 / 255);
+  EXPECT_EQ(flat.bytes.size(), 17u);
   Signal tiny{std::vector<double>(10, 0.5), 0.0053, "tiny"};
   EXPECT_THROW((void)encode(tiny, EncoderConfig{}), InvalidArgument);
   Signal nan = render_signal(TexelSpec{});
