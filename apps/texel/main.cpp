@@ -21,11 +21,11 @@ int main(int argc, char** argv) {
   texel::cli::register_info(app);
   texel::cli::register_demo(app);
   texel::cli::register_devices(app);
-  texel::cli::register_encode(app);
-  texel::cli::register_decode(app);
   texel::cli::register_reference(app);
   texel::cli::register_spectrum(app);
   texel::cli::register_atlas(app);
+  texel::cli::register_encode(app);
+  texel::cli::register_decode(app);
   texel::cli::register_swipe(app);
   texel::cli::register_play(app);
   texel::cli::register_controller(app);
