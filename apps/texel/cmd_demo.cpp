@@ -1,8 +1,5 @@
-// texel demo: renders the set that shows what the method does (issue #2):
-// fine texture from two seeds; the same with a 5 mm sinusoidal coarse
-// profile from two seeds; a 3 × 3 grid of coarse strength × fine strength.
-// All at Central Pitch 10 dB, Irregularity −5 dB, texel length 0.25 mm on the
-// reference device. Each texture is written as device file, document and plot.
+// texel demo: renders the demonstration set (include/texel/demo.hpp) on the
+// reference device; each texture as device file, document and plot.
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -11,50 +8,11 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "render_output.hpp"
+#include "texel/demo.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 
 namespace texel::cli {
-namespace {
-
-struct DemoTexture {
-  std::string name;
-  TexelSpec spec;
-};
-
-std::vector<DemoTexture> demo_set() {
-  TexelSpec base;
-  base.central_pitch = Decibels(10.0);
-  base.irregularity = Decibels(-5.0);
-  base.texel_length = Millimetres(0.25);
-  std::vector<DemoTexture> set;
-  for (std::uint64_t seed : {1, 2}) {
-    TexelSpec s = base;
-    s.seed = seed;
-    set.push_back({"fine-seed" + std::to_string(seed), s});
-  }
-  for (std::uint64_t seed : {1, 2}) {
-    TexelSpec s = base;
-    s.seed = seed;
-    s.coarse = SineProfile{Millimetres(5.0), 0.0};
-    s.coarse_strength = 1.0;
-    s.fine_strength = 1.0;
-    set.push_back({"coarse-sine5mm-seed" + std::to_string(seed), s});
-  }
-  for (double c : {0.0, 0.5, 1.0})
-    for (double f : {0.0, 0.5, 1.0}) {
-      TexelSpec s = base;
-      s.seed = 1;
-      s.coarse = SineProfile{Millimetres(5.0), 0.0};
-      s.coarse_strength = c;
-      s.fine_strength = f;
-      set.push_back({"grid-C" + detail::num(c) + "-F" + detail::num(f), s});
-    }
-  return set;
-}
-
-}  // namespace
-
 void register_demo(CLI::App& app) {
   struct Args {
     std::string out = "out/demo";

@@ -28,40 +28,39 @@ constexpr double floor_exact(double x) {
   return r > x ? r - 1.0 : r;
 }
 
-/// sin(2π·u) for any |u| < 2^50 cycles. Exact reduction to [-1/4, 1/4] cycle,
-/// then an odd Taylor polynomial of degree 19 (truncation error < 1e-15).
-/// Written branch-free so loops over it auto-vectorize.
-constexpr double sin_cycles(double u) {
-  double r = u - round_even(u);             // [-0.5, 0.5], exact
+/// sin(2π·u), generic over the value type: `double`, or a GCC/clang vector
+/// of doubles (`double __attribute__((vector_size(N)))`), where every lane
+/// performs exactly the scalar operations in the same order. The scalar
+/// sin_cycles and the SIMD render kernels share this one definition, which is
+/// what keeps their results bit-identical.
+///
+/// Exact reduction to [-1/4, 1/4] cycle, then an odd Taylor polynomial of
+/// degree 19 (truncation error < 1e-15). Branch-free. Valid for |u| < 2^50.
+template <class T>
+[[gnu::always_inline]] constexpr T sin_cycles_generic(T u) {
+  constexpr double magic = 6755399441055744.0;  // round_even's 1.5 * 2^52
+  T r = u - ((u + magic) - magic);              // [-0.5, 0.5], exact
   // Reflect into [-0.25, 0.25]: sin(2π(±0.5 - r)) = sin(2πr). Exact (Sterbenz).
-  double hi = 0.5 - r;
-  double lo = -0.5 - r;
+  const T hi = 0.5 - r;
+  const T lo = -0.5 - r;
   r = r > 0.25 ? hi : r;
   r = r < -0.25 ? lo : r;
-  const double r2 = r * r;
+  const T r2 = r * r;
   // Coefficients (2π)^(2n+1) / (2n+1)! with alternating signs.
-  constexpr double c1 = 6.283185307179586;
-  constexpr double c3 = -41.341702240399755;
-  constexpr double c5 = 81.60524927607504;
-  constexpr double c7 = -76.70585975306136;
-  constexpr double c9 = 42.058693944897634;
-  constexpr double c11 = -15.094642576822984;
-  constexpr double c13 = 3.8199525848482803;
-  constexpr double c15 = -0.7181223017785001;
-  constexpr double c17 = 0.10422916220813978;
-  constexpr double c19 = -0.012031585942120619;
-  double p = c19;
-  p = p * r2 + c17;
-  p = p * r2 + c15;
-  p = p * r2 + c13;
-  p = p * r2 + c11;
-  p = p * r2 + c9;
-  p = p * r2 + c7;
-  p = p * r2 + c5;
-  p = p * r2 + c3;
-  p = p * r2 + c1;
+  T p = -0.012031585942120619 * r2 + 0.10422916220813978;
+  p = p * r2 + -0.7181223017785001;
+  p = p * r2 + 3.8199525848482803;
+  p = p * r2 + -15.094642576822984;
+  p = p * r2 + 42.058693944897634;
+  p = p * r2 + -76.70585975306136;
+  p = p * r2 + 81.60524927607504;
+  p = p * r2 + -41.341702240399755;
+  p = p * r2 + 6.283185307179586;
   return r * p;
 }
+
+/// sin(2π·u) for any |u| < 2^50 cycles.
+constexpr double sin_cycles(double u) { return sin_cycles_generic(u); }
 
 /// cos(2π·u) = sin(2π(u + 1/4)).
 constexpr double cos_cycles(double u) { return sin_cycles(u + 0.25); }

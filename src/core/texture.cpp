@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <string_view>
 
 #include "texel/detail/format.hpp"
 #include "texel/detmath.hpp"
@@ -38,29 +40,6 @@ struct Run {
   double base, origin, spacing, start, frequency, phase, offset, gain;
 };
 
-/// detmath::sin_cycles, lane-wise and in place: the same operations in the
-/// same order. Keep the two in step (the exactness test fails if they drift).
-template <class V>
-[[gnu::always_inline]] inline void sin_cycles_lanes(V& u) {
-  constexpr double magic = 6755399441055744.0;  // detmath::round_even
-  V r = u - ((u + magic) - magic);
-  const V hi = 0.5 - r;
-  const V lo = -0.5 - r;
-  r = r > 0.25 ? hi : r;
-  r = r < -0.25 ? lo : r;
-  const V r2 = r * r;
-  V p = -0.012031585942120619 * r2 + 0.10422916220813978;
-  p = p * r2 + -0.7181223017785001;
-  p = p * r2 + 3.8199525848482803;
-  p = p * r2 + -15.094642576822984;
-  p = p * r2 + 42.058693944897634;
-  p = p * r2 + -76.70585975306136;
-  p = p * r2 + 81.60524927607504;
-  p = p * r2 + -41.341702240399755;
-  p = p * r2 + 6.283185307179586;
-  u = r * p;
-}
-
 // W doubles in one vector register. Spelled out per width: GCC drops
 // vector_size on a type that depends on a template parameter.
 template <int W> struct Lanes;
@@ -78,7 +57,7 @@ template <int W>
   auto block = [&](V& a) {
     const V x = run.origin + index * run.spacing;
     a = run.phase + run.frequency * (x - run.start);
-    sin_cycles_lanes(a);
+    a = detmath::sin_cycles_generic(a);
     a = run.offset + run.gain * a;
     index += static_cast<double>(W);
   };
@@ -102,12 +81,21 @@ __attribute__((target("avx2"))) void render_run_avx2(const Run& r, double* out, 
 #endif
 void render_run_generic(const Run& r, double* out, std::int32_t n) { render_lanes<2>(r, out, n); }
 
-/// The widest kernel this CPU runs; chosen once.
+/// The widest kernel this CPU runs; chosen once. The environment variable
+/// TEXEL_SIMD=avx512|avx2|sse2 caps the width (the determinism check uses it
+/// to compare every width on one machine); results never depend on it.
 RunKernel run_kernel() {
   static const RunKernel kernel = [] {
+    const char* cap_env = std::getenv("TEXEL_SIMD");
+    const std::string_view cap = cap_env ? cap_env : "auto";
+    const bool allow512 = cap == "auto" || cap == "avx512";
+    const bool allow256 = allow512 || cap == "avx2";
 #if defined(__x86_64__) || defined(__i386__)
-    if (__builtin_cpu_supports("avx512f")) return &render_run_avx512;
-    if (__builtin_cpu_supports("avx2")) return &render_run_avx2;
+    if (allow512 && __builtin_cpu_supports("avx512f")) return &render_run_avx512;
+    if (allow256 && __builtin_cpu_supports("avx2")) return &render_run_avx2;
+#else
+    (void)allow512;
+    (void)allow256;
 #endif
     return &render_run_generic;
   }();

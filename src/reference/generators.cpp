@@ -28,28 +28,6 @@ using detail::num;
 constexpr int lanes = 8;
 using vdouble = double __attribute__((vector_size(lanes * sizeof(double))));
 
-// Always inlined: called across target_clones, an out-of-line copy would be
-// compiled for the default target and receive wider vectors in another ABI.
-[[gnu::always_inline]] inline vdouble sin_cycles_lanes(vdouble u) {
-  constexpr double magic = 6755399441055744.0;  // detmath::round_even
-  vdouble r = u - ((u + magic) - magic);
-  const vdouble hi = 0.5 - r;
-  const vdouble lo = -0.5 - r;
-  r = r > 0.25 ? hi : r;
-  r = r < -0.25 ? lo : r;
-  const vdouble r2 = r * r;
-  vdouble p = -0.012031585942120619 * r2 + 0.10422916220813978;
-  p = p * r2 + -0.7181223017785001;
-  p = p * r2 + 3.8199525848482803;
-  p = p * r2 + -15.094642576822984;
-  p = p * r2 + 42.058693944897634;
-  p = p * r2 + -76.70585975306136;
-  p = p * r2 + 81.60524927607504;
-  p = p * r2 + -41.341702240399755;
-  p = p * r2 + 6.283185307179586;
-  return r * p;
-}
-
 __attribute__((target_clones("avx512f", "avx2", "default")))
 void accumulate_component(double base, double origin, double spacing, double f, double amplitude, double phase, double* acc,
                           std::int32_t count) {
@@ -62,7 +40,7 @@ void accumulate_component(double base, double origin, double spacing, double f, 
     index += static_cast<double>(lanes);
     vdouble a;
     std::memcpy(&a, acc + m, sizeof a);  // acc is padded to a multiple of `lanes`
-    a = a + amplitude * sin_cycles_lanes(u);
+    a = a + amplitude * detmath::sin_cycles_generic(u);
     std::memcpy(acc + m, &a, sizeof a);
   }
 }
