@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <string_view>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/lanes.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
@@ -40,16 +39,9 @@ struct Run {
   double base, origin, spacing, start, frequency, phase, offset, gain;
 };
 
-// W doubles in one vector register. Spelled out per width: GCC drops
-// vector_size on a type that depends on a template parameter.
-template <int W> struct Lanes;
-template <> struct Lanes<2> { using type = double __attribute__((vector_size(16))); };
-template <> struct Lanes<4> { using type = double __attribute__((vector_size(32))); };
-template <> struct Lanes<8> { using type = double __attribute__((vector_size(64))); };
-
 template <int W>
 [[gnu::always_inline]] inline void render_lanes(const Run& run, double* out, std::int32_t count) {
-  using V = typename Lanes<W>::type;
+  using V = typename detail::Lanes<W>::type;
   V index;
   for (int l = 0; l < W; ++l) index[l] = run.base + static_cast<double>(l);
   // One block of W samples into `a`; the index steps by W (integers below
@@ -81,21 +73,12 @@ __attribute__((target("avx2"))) void render_run_avx2(const Run& r, double* out, 
 #endif
 void render_run_generic(const Run& r, double* out, std::int32_t n) { render_lanes<2>(r, out, n); }
 
-/// The widest kernel this CPU runs; chosen once. The environment variable
-/// TEXEL_SIMD=avx512|avx2|sse2 caps the width (the determinism check uses it
-/// to compare every width on one machine); results never depend on it.
+/// The widest kernel this CPU runs (detail::simd_lanes), chosen once.
 RunKernel run_kernel() {
   static const RunKernel kernel = [] {
-    const char* cap_env = std::getenv("TEXEL_SIMD");
-    const std::string_view cap = cap_env ? cap_env : "auto";
-    const bool allow512 = cap == "auto" || cap == "avx512";
-    const bool allow256 = allow512 || cap == "avx2";
 #if defined(__x86_64__) || defined(__i386__)
-    if (allow512 && __builtin_cpu_supports("avx512f")) return &render_run_avx512;
-    if (allow256 && __builtin_cpu_supports("avx2")) return &render_run_avx2;
-#else
-    (void)allow512;
-    (void)allow256;
+    if (detail::simd_lanes() == 8) return &render_run_avx512;
+    if (detail::simd_lanes() == 4) return &render_run_avx2;
 #endif
     return &render_run_generic;
   }();

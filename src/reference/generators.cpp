@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/lanes.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
@@ -25,30 +26,57 @@ using detail::num;
 // of detmath::sin_cycles in the same order in IEEE double, and x is computed
 // as Grid::position computes it, so lane width and -O level change speed,
 // never bits. Components are accumulated in a fixed order (ascending k).
-constexpr int lanes = 8;
-using vdouble = double __attribute__((vector_size(lanes * sizeof(double))));
+constexpr int max_lanes = 8;
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void accumulate_component(double base, double origin, double spacing, double f, double amplitude, double phase, double* acc,
-                          std::int32_t count) {
-  vdouble index;
-  for (int l = 0; l < lanes; ++l) index[l] = base + static_cast<double>(l);
-  std::int32_t m = 0;
-  for (; m < count; m += lanes) {
-    const vdouble x = origin + index * spacing;
-    const vdouble u = phase + f * x;
-    index += static_cast<double>(lanes);
-    vdouble a;
-    std::memcpy(&a, acc + m, sizeof a);  // acc is padded to a multiple of `lanes`
+template <int W>
+[[gnu::always_inline]] inline void accumulate_lanes(double base, double origin, double spacing, double f, double amplitude,
+                                                    double phase, double* acc, std::int32_t count) {
+  using V = typename detail::Lanes<W>::type;
+  V index;
+  for (int l = 0; l < W; ++l) index[l] = base + static_cast<double>(l);
+  for (std::int32_t m = 0; m < count; m += W) {
+    const V x = origin + index * spacing;
+    const V u = phase + f * x;
+    index += static_cast<double>(W);
+    V a;
+    std::memcpy(&a, acc + m, sizeof a);  // acc is padded to a multiple of max_lanes
     a = a + amplitude * detmath::sin_cycles_generic(u);
     std::memcpy(acc + m, &a, sizeof a);
   }
 }
 
+using AccumulateKernel = void (*)(double, double, double, double, double, double, double*, std::int32_t);
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void accumulate_avx512(double b, double o, double s, double f, double a, double p, double* acc,
+                                                          std::int32_t n) {
+  accumulate_lanes<8>(b, o, s, f, a, p, acc, n);
+}
+__attribute__((target("avx2"))) void accumulate_avx2(double b, double o, double s, double f, double a, double p, double* acc,
+                                                    std::int32_t n) {
+  accumulate_lanes<4>(b, o, s, f, a, p, acc, n);
+}
+#endif
+void accumulate_generic(double b, double o, double s, double f, double a, double p, double* acc, std::int32_t n) {
+  accumulate_lanes<2>(b, o, s, f, a, p, acc, n);
+}
+
+AccumulateKernel accumulate_kernel() {
+  static const AccumulateKernel kernel = [] {
+#if defined(__x86_64__) || defined(__i386__)
+    if (detail::simd_lanes() == 8) return &accumulate_avx512;
+    if (detail::simd_lanes() == 4) return &accumulate_avx2;
+#endif
+    return &accumulate_generic;
+  }();
+  return kernel;
+}
+
 /// Σ_k a_k·sin(2π(φ_k + f_k·x)) at grid samples [first, first + out.size()).
 void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, std::int64_t first, std::span<double> out) {
   constexpr std::size_t chunk = 2048;  // accumulator stays in L1 across components
-  std::vector<double> acc(chunk + lanes);
+  std::vector<double> acc(chunk + max_lanes);
+  const AccumulateKernel accumulate_component = accumulate_kernel();
   for (std::size_t i = 0; i < out.size(); i += chunk) {
     const std::size_t len = std::min(chunk, out.size() - i);
     std::fill(acc.begin(), acc.end(), 0.0);
