@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "texel/coarse.hpp"
+#include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 
 using namespace texel;
@@ -18,21 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A fresh, empty directory under the system temp dir, removed afterwards.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("texel-coarse-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-    return (path / name).string();
-  }
-};
+using texel::test_support::TempDir;
 
 std::string format_error(const std::string& path) {
   try {

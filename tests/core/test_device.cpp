@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "texel/device.hpp"
+#include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 
 using namespace texel;
@@ -21,20 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("texel-device-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-    return (path / name).string();
-  }
-};
+using texel::test_support::TempDir;
 
 const char* const valid_profile = R"({
   "name": "bench-rig",
