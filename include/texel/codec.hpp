@@ -16,8 +16,13 @@
 //     rendered with the library and compared with the input under the model;
 //     Nelder–Mead over (Central Pitch, Irregularity) minimises the distance,
 //     starting from the input's spectral centroid and spread.
+//  3. Inputs that are themselves fine-only Texel renderings are recognised
+//     (phase-continuous sinusoid, constant frequency per texel) and their
+//     texel length, Central Pitch and Irregularity are recovered from the
+//     texels' frequencies (truncated-lognormal maximum likelihood).
 // Trade-off: the fit matches what the model says is felt, not the waveform;
-// the texel length is a setting (default 0.25 mm), not an estimate.
+// the texel length is a setting (default 0.25 mm) except for recognised
+// Texel renderings.
 #pragma once
 
 #include <cstddef>
@@ -96,6 +101,10 @@ struct EncoderConfig {
   std::optional<std::size_t> max_bytes;   ///< bitstream budget, bytes (coarse precision/stride adapt)
   double flat_envelope = 0.08;            ///< relative envelope range below which the texture is fine only
   int max_evaluations = 120;              ///< Nelder–Mead budget (each renders 2 candidates)
+  /// Recognise inputs that are fine-only Texel renderings and recover their
+  /// texel length, Central Pitch and Irregularity from the texels'
+  /// frequencies (kept when the model distance is below 1 JND; docs/encoder.md).
+  bool recover_texel = true;
 };
 
 struct EncodeResult {
@@ -107,6 +116,7 @@ struct EncodeResult {
   double model_distance = 0.0;     ///< distance(input, decoded), JND units
   bool coarse = false;             ///< a coarse profile was found
   double coarse_correlation = 1.0; ///< envelope vs decoded envelope at texel centres
+  bool texel_recovered = false;    ///< the input was recognised as a Texel rendering (texel length detected)
   bool irregularity_identifiable = true;
   double irregularity_bound_db = 0.0;  ///< when not identifiable: any value below this feels the same
   int evaluations = 0;

@@ -1,26 +1,22 @@
 // Round trip on Texel renderings (issue #4): a grid of Central Pitch
 // (−10 … 19 dB), Irregularity (−30 … 5 dB) and texel length (0.25, 0.5,
 // 1 mm), rendered on the reference device with seed 3 and encoded with the
-// rendering's texel length.
+// default settings (the encoder detects the texel length).
 //
-// Tolerances: Central Pitch within ±0.5 dB, Irregularity within ±1.5 dB,
-// asserted where this encoder meets them (measured; docs/encoder.md,
-// "Measured behaviour", lists every miss):
-//  - the distribution is not truncated: >= 95 % of its mass inside the band
-//    [0.01, 94.2] cpm;
-//  - Central Pitch >= 5 dB. Below, wide distributions (I >= 0 dB at P <= 0,
-//    and most of P = −5 dB) miss by 0.5 … 8 dB: many (P, I) render alike and
-//    the split mistakes low texels for coarse envelope. Not asserted: bound
-//    documented;
-//  - at L = 1 mm, Central Pitch only for I <= 0 dB (P 5, I 5 misses by 1 dB);
-//  - Irregularity for L <= 0.5 mm where the encoder reports it identifiable
-//    (a 6 dB narrower distribution differs by >= 0.5 JND) and I >= −20 dB
-//    (the map's frequency resolution). At L = 1 mm narrow distributions come
-//    back ~1.9 dB wide at I = −20 dB and one case (P 15, I −5) misses by
-//    14 dB: not asserted, reported.
-// Every case is printed.
+// Asserted for every case whose distribution is not truncated (>= 95 % of
+// its mass inside the band [0.01, 94.2] cpm): the input is recognised as a
+// Texel rendering, the texel length is detected, Central Pitch is within
+// ±0.5 dB and Irregularity within ±1.5 dB, including the very narrow
+// distributions the model says feel the same (`identifiable 0`: recovery
+// reads them off the texels' frequencies, not off the felt spread).
+// Truncated distributions (mass < 0.95: P −10 dB with I >= −5 dB, P −5 dB
+// with I >= 0 dB at every L) are not identifiable from the renderable part:
+// the band cuts the distribution and the truncated lognormal fit has a few
+// hundred texels to go on. Bound documented (measured): |ΔP| <= 3 dB,
+// |ΔI| <= 6 dB there; asserted as that bound. Every case is printed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -34,7 +30,8 @@ using namespace texel::codec;
 
 TEST(RoundTrip, CentralPitchAndIrregularityAcrossTheGrid) {
   const DeviceProfile d = load_device("tpad");
-  int asserted_p = 0, asserted_i = 0;
+  int asserted = 0, truncated = 0;
+  double max_dp = 0.0, max_di = 0.0, max_seconds = 0.0;
   for (double L : {0.25, 0.5, 1.0})
     for (double P : {-10.0, -5.0, 0.0, 5.0, 10.0, 15.0, 19.0})
       for (double I : {-30.0, -20.0, -10.0, -5.0, 0.0, 5.0}) {
@@ -49,24 +46,28 @@ TEST(RoundTrip, CentralPitchAndIrregularityAcrossTheGrid) {
         pc.band_max = CyclesPerMm(94.18);
         const double mass = PitchDistribution(pc).band_mass();
         const Signal sig{prepare_surface(make_document(d, s)).render(), d.spacing_mm, "grid"};
-        EncoderConfig cfg;
-        cfg.texel_length = s.texel_length;
-        const EncodeResult r = encode(sig, cfg);
+        const EncodeResult r = encode(sig, EncoderConfig{});
         const double dp = r.spec.central_pitch.value() - P;
         const double di = r.spec.irregularity.value() - I;
-        std::printf("L %.2f P %6.1f I %6.1f  mass %.3f  dP %+6.2f dI %+6.2f identifiable %d  %zu bytes  %.2f s\n", L, P, I, mass, dp, di,
-                    r.irregularity_identifiable, r.bytes.size(), r.seconds);
-        if (mass < 0.95 || P < 5.0) continue;
-        if (L < 1.0 || I <= 0.0) {
-          ++asserted_p;
-          EXPECT_NEAR(dp, 0.0, 0.5) << "L " << L << " P " << P << " I " << I;
+        std::printf("L %.2f P %6.1f I %6.1f  mass %.3f  dP %+6.2f dI %+6.2f identifiable %d  rec %d L %.2f  %zu bytes  %.2f s\n", L, P, I, mass, dp, di,
+                    r.irregularity_identifiable, r.texel_recovered, r.spec.texel_length.value(), r.bytes.size(), r.seconds);
+        max_seconds = std::max(max_seconds, r.seconds);
+        if (mass < 0.95) {
+          ++truncated;
+          EXPECT_LE(std::fabs(dp), 3.0) << "L " << L << " P " << P << " I " << I;
+          EXPECT_LE(std::fabs(di), 6.0) << "L " << L << " P " << P << " I " << I;
+          continue;
         }
-        if (L <= 0.5 && r.irregularity_identifiable && I >= -20.0) {
-          ++asserted_i;
-          EXPECT_NEAR(di, 0.0, 1.5) << "L " << L << " P " << P << " I " << I;
-        }
+        ++asserted;
+        max_dp = std::max(max_dp, std::fabs(dp));
+        max_di = std::max(max_di, std::fabs(di));
+        EXPECT_TRUE(r.texel_recovered) << "L " << L << " P " << P << " I " << I;
+        EXPECT_NEAR(r.spec.texel_length.value(), L, 1e-9) << "L " << L << " P " << P << " I " << I;
+        EXPECT_NEAR(dp, 0.0, 0.5) << "L " << L << " P " << P << " I " << I;
+        EXPECT_NEAR(di, 0.0, 1.5) << "L " << L << " P " << P << " I " << I;
       }
-  std::printf("asserted: %d pitch cases, %d irregularity cases\n", asserted_p, asserted_i);
+  std::printf("asserted: %d cases (P and I), max |dP| %.2f dB, max |dI| %.2f dB; %d truncated cases within the documented bound; slowest %.2f s\n",
+              asserted, max_dp, max_di, truncated, max_seconds);
 }
 
 }  // namespace
