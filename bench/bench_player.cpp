@@ -31,7 +31,9 @@ struct Result {
 
 Result summarize(std::string name, std::vector<double>& t_us, std::size_t frames) {
   std::sort(t_us.begin(), t_us.end());
-  const auto at = [&](double q) { return t_us[std::min(t_us.size() - 1, static_cast<std::size_t>(q * static_cast<double>(t_us.size())))]; };
+  const auto at = [&](double q) {
+    return t_us[std::min(t_us.size() - 1, static_cast<std::size_t>(q * static_cast<double>(t_us.size())))];
+  };
   return {std::move(name), at(0.5), at(0.999), t_us.back(), at(0.5) * 1000.0 / static_cast<double>(frames)};
 }
 
@@ -42,8 +44,10 @@ int main(int argc, char** argv) {
   std::string json;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--json" && i + 1 < argc) json = argv[++i];
-    else blocks = static_cast<std::size_t>(std::strtoull(argv[i], nullptr, 10));
+    if (a == "--json" && i + 1 < argc)
+      json = argv[++i];
+    else
+      blocks = static_cast<std::size_t>(std::strtoull(argv[i], nullptr, 10));
   }
   constexpr std::size_t frames = 64;
   constexpr double rate = 48000.0;
@@ -92,16 +96,16 @@ int main(int argc, char** argv) {
   }
 
   std::printf("texel_bench_player: %zu blocks of %zu frames at %.0f Hz (period %.1f µs)\n", blocks, frames, rate, period_us);
-  std::printf("%-22s %10s %10s %10s %12s %12s %12s %10s\n", "", "median µs", "p99.9 µs", "max µs", "median %", "p99.9 %",
-              "max %", "ns/sample");
+  std::printf("%-22s %10s %10s %10s %12s %12s %12s %10s\n", "", "median µs", "p99.9 µs", "max µs", "median %", "p99.9 %", "max %",
+              "ns/sample");
   for (const auto& r : results)
     std::printf("%-22s %10.3f %10.3f %10.1f %11.4f%% %11.4f%% %11.3f%% %10.2f\n", r.name.c_str(), r.median_us, r.p999_us,
                 r.max_us, 100 * r.median_us / period_us, 100 * r.p999_us / period_us, 100 * r.max_us / period_us,
                 r.ns_per_sample);
   if (!json.empty()) {
     if (std::FILE* f = std::fopen(json.c_str(), "w")) {
-      std::fprintf(f, "{\"blocks\": %zu, \"frames\": %zu, \"rate_hz\": %.0f, \"period_us\": %.4f, \"results\": [", blocks, frames, rate,
-                   period_us);
+      std::fprintf(f, "{\"blocks\": %zu, \"frames\": %zu, \"rate_hz\": %.0f, \"period_us\": %.4f, \"results\": [", blocks, frames,
+                   rate, period_us);
       for (std::size_t i = 0; i < results.size(); ++i)
         std::fprintf(f, "%s{\"name\": \"%s\", \"median_us\": %.4f, \"p999_us\": %.4f, \"max_us\": %.4f}", i ? ", " : "",
                      results[i].name.c_str(), results[i].median_us, results[i].p999_us, results[i].max_us);

@@ -37,7 +37,8 @@ struct ControllerArgs {
 
 void run(const ControllerArgs& a) {
   if (a.serial.has_value() == a.pty) throw InvalidArgument("controller: give exactly one of --serial PATH or --pty");
-  if (!(a.duration_s >= 0)) throw InvalidArgument("--duration is " + detail::num(a.duration_s) + "; it must be >= 0 s (0 = until Ctrl-C)");
+  if (!(a.duration_s >= 0))
+    throw InvalidArgument("--duration is " + detail::num(a.duration_s) + "; it must be >= 0 s (0 = until Ctrl-C)");
   const DeviceProfile d = load_device(a.device);
   int fd = -1;
   int keep_slave = -1;

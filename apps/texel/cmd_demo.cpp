@@ -31,7 +31,8 @@ void register_demo(CLI::App& app) {
     if (ec) throw IoError("cannot create '" + args->out + "': " + ec.message());
     const DeviceProfile device = load_device(args->device);
     std::cout << std::left << std::setw(28) << "texture" << std::right << std::setw(8) << "texels" << std::setw(18)
-              << "raw device bytes" << std::setw(16) << "document bytes" << "\n";
+              << "raw device bytes" << std::setw(16) << "document bytes"
+              << "\n";
     for (const auto& t : demo_set()) {
       Document doc = make_document(device, t.spec);
       doc.description = "Texel demo: " + t.name;

@@ -76,6 +76,7 @@ nlohmann::ordered_json result_json(const std::string& input, const codec::Signal
   e["irregularity_db"] = s.irregularity.value();
   e["irregularity_identifiable"] = r.irregularity_identifiable;
   if (!r.irregularity_identifiable) e["irregularity_feels_same_below_db"] = r.irregularity_bound_db;
+  e["texel_recovered"] = r.texel_recovered;  // the input was recognised as a Texel rendering
   e["texel_length_mm"] = s.texel_length.value();
   e["parameterization"] = std::string(to_string(s.parameterization));
   e["seed"] = s.seed;
@@ -108,10 +109,12 @@ nlohmann::ordered_json result_json(const std::string& input, const codec::Signal
 void print_summary(const std::string& input, const codec::EncodeResult& r, const std::optional<std::string>& out) {
   const TexelSpec& s = r.spec;
   std::cout << input << ": Central Pitch " << detail::fixed(s.central_pitch.value(), 2) << " dB, Irregularity "
-            << detail::fixed(s.irregularity.value(), 2) << " dB" << (r.irregularity_identifiable ? "" : " (not identifiable: narrower feels the same)")
-            << ", texel " << detail::num(s.texel_length.value()) << " mm";
+            << detail::fixed(s.irregularity.value(), 2) << " dB"
+            << (r.irregularity_identifiable ? "" : " (not identifiable: narrower feels the same)") << ", texel "
+            << detail::num(s.texel_length.value()) << " mm";
   if (r.coarse || s.coarse_strength > 0 || s.fine_strength < 1)
-    std::cout << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength " << detail::fixed(s.fine_strength, 3);
+    std::cout << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength "
+              << detail::fixed(s.fine_strength, 3);
   std::cout << "\n  " << r.samples << " samples (" << r.samples * 2 << " bytes as u16) -> " << r.bytes.size() << " bytes"
             << (out ? " in " + *out : std::string()) << "; model distance " << detail::fixed(r.model_distance, 2) << " JND\n";
 }
@@ -141,7 +144,8 @@ void run_report(const EncodeArgs& a) {
     std::vector<std::byte> raw(sig.amplitude.size() * bytes_per_sample(device.format));
     if (output_extension(path) == ".bin") {
       const std::string bytes = read_file(path);
-      raw.assign(reinterpret_cast<const std::byte*>(bytes.data()), reinterpret_cast<const std::byte*>(bytes.data()) + bytes.size());
+      raw.assign(reinterpret_cast<const std::byte*>(bytes.data()),
+                 reinterpret_cast<const std::byte*>(bytes.data()) + bytes.size());
     } else {
       encode_samples(device.format, sig.amplitude, raw);
     }
@@ -149,15 +153,22 @@ void run_report(const EncodeArgs& a) {
     row.zstd = codec::zstd_size(raw);
     row.texel = r.bytes.size();
     std::ostringstream p;
-    p << "P " << detail::fixed(r.spec.central_pitch.value(), 2) << " dB, I " << detail::fixed(r.spec.irregularity.value(), 2) << " dB";
-    if (r.bitstream.coarse) p << ", C " << detail::fixed(r.spec.coarse_strength, 2) << ", F " << detail::fixed(r.spec.fine_strength, 2);
+    p << "P " << detail::fixed(r.spec.central_pitch.value(), 2) << " dB, I " << detail::fixed(r.spec.irregularity.value(), 2)
+      << " dB";
+    if (r.bitstream.coarse)
+      p << ", C " << detail::fixed(r.spec.coarse_strength, 2) << ", F " << detail::fixed(r.spec.fine_strength, 2);
     row.params = p.str();
     rows.push_back(row);
   }
   if (a.json) {
     nlohmann::ordered_json j = nlohmann::ordered_json::array();
     for (const auto& r : rows)
-      j.push_back({{"input", r.name}, {"samples", r.samples}, {"raw_bytes", r.raw}, {"zstd_bytes", r.zstd}, {"texel_bytes", r.texel}, {"estimate", r.params}});
+      j.push_back({{"input", r.name},
+                   {"samples", r.samples},
+                   {"raw_bytes", r.raw},
+                   {"zstd_bytes", r.zstd},
+                   {"texel_bytes", r.texel},
+                   {"estimate", r.params}});
     print_json(j);
     return;
   }
@@ -175,22 +186,27 @@ void run_report(const EncodeArgs& a) {
 void register_encode(CLI::App& app) {
   auto a = std::make_shared<EncodeArgs>();
   auto* cmd = app.add_subcommand("encode", "Encode a texture signal into Texel parameters and a .texel bitstream");
-  cmd->add_option("input", a->inputs,
-                  "Texture signal: .bin (device map), .npy, .csv (position_mm,amplitude or time_s,value), .wav, .texel.json, .texel; "
-                  "several with --report")
+  cmd->add_option(
+         "input", a->inputs,
+         "Texture signal: .bin (device map), .npy, .csv (position_mm,amplitude or time_s,value), .wav, .texel.json, .texel; "
+         "several with --report")
       ->required();
   cmd->add_option("-o,--output", a->output, "Output bitstream (.texel); without it, only the estimates are printed");
   add_device_options(*cmd, a->device);
   const std::string g = "Encoder";
-  cmd->add_option("--swipe-speed", a->swipe_speed, "Finger speed, mm/s: turns time recordings into positions and sets the model's temporal frequencies [100]")->group(g);
+  cmd->add_option("--swipe-speed", a->swipe_speed,
+                  "Finger speed, mm/s: turns time recordings into positions and sets the model's temporal frequencies [100]")
+      ->group(g);
   cmd->add_option("--boundary", a->boundary_mm, "Fine/coarse boundary, mm [1]")->group(g);
   cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
   cmd->add_option("--coarse-bits", a->coarse_bits, "Bits per coarse level, 1 … 16 [6]")->group(g);
-  cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")->group(g);
+  cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")
+      ->group(g);
   cmd->add_flag("--json", a->json, "Print estimates, model distance and sizes as JSON");
-  cmd->add_flag("--report", a->report, "Compression report over the inputs: raw device bytes, zstd -22 --ultra, .texel bytes (Markdown table)");
+  cmd->add_flag("--report", a->report,
+                "Compression report over the inputs: raw device bytes, zstd -22 --ultra, .texel bytes (Markdown table)");
   cmd->callback([a] {
     if (a->report) {
       if (a->output) throw InvalidArgument("--report writes no bitstream; drop -o");
@@ -199,16 +215,17 @@ void register_encode(CLI::App& app) {
     }
     if (a->inputs.size() != 1) throw InvalidArgument("encode takes one input (several only with --report)");
     if (a->output) {
-      if (output_extension(*a->output) != ".texel")
-        throw InvalidArgument("output '" + *a->output + "' must end in .texel");
+      if (output_extension(*a->output) != ".texel") throw InvalidArgument("output '" + *a->output + "' must end in .texel");
       check_writable(*a->output);
     }
     const codec::EncoderConfig cfg = config_of(*a);
     const codec::Signal sig = codec::load_signal(a->inputs[0], load_options(*a));
     const codec::EncodeResult r = codec::encode(sig, cfg);
     if (a->output) write_file_atomic(*a->output, std::string_view(reinterpret_cast<const char*>(r.bytes.data()), r.bytes.size()));
-    if (a->json) print_json(result_json(a->inputs[0], sig, r, cfg, a->output));
-    else print_summary(a->inputs[0], r, a->output);
+    if (a->json)
+      print_json(result_json(a->inputs[0], sig, r, cfg, a->output));
+    else
+      print_summary(a->inputs[0], r, a->output);
   });
 }
 

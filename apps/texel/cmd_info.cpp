@@ -76,8 +76,10 @@ void print_text(const ordered& j, int indent = 0) {
       int i = 0;
       for (const auto& e : *it) {
         std::cout << pad << "  [" << i++ << "]\n";
-        if (e.is_object()) print_text(e, indent + 4);
-        else std::cout << pad << "    " << e.dump() << "\n";
+        if (e.is_object())
+          print_text(e, indent + 4);
+        else
+          std::cout << pad << "    " << e.dump() << "\n";
       }
     } else {
       std::cout << pad << it.key() << ": " << (it->is_string() ? it->get<std::string>() : it->dump()) << "\n";
@@ -129,8 +131,10 @@ void register_info(CLI::App& app) {
     } else {
       throw InvalidArgument("info: '" + args->file + "' has extension '" + ext + "'; allowed: .texel.json, .bin, .csv, .npy");
     }
-    if (args->json) print_json(j);
-    else print_text(j);
+    if (args->json)
+      print_json(j);
+    else
+      print_text(j);
   });
 }
 
@@ -145,9 +149,9 @@ void register_devices(CLI::App& app) {
       if (*json) {
         all.push_back(ordered::parse(device_profile_json(d)));
       } else {
-        std::cout << d.name << ": " << d.samples << " samples x " << num(d.spacing_mm) << " mm = " << num(d.length_mm()) << " mm, "
-                  << to_string(d.format) << ", " << num(d.refresh_hz) << " Hz, Nyquist " << detail::fixed(d.nyquist_cpm(), 2)
-                  << " cpm\n    " << d.description << "\n";
+        std::cout << d.name << ": " << d.samples << " samples x " << num(d.spacing_mm) << " mm = " << num(d.length_mm())
+                  << " mm, " << to_string(d.format) << ", " << num(d.refresh_hz) << " Hz, Nyquist "
+                  << detail::fixed(d.nyquist_cpm(), 2) << " cpm\n    " << d.description << "\n";
       }
     }
     if (*json) print_json(all);

@@ -76,12 +76,16 @@ void run(const PlayArgs& a) {
     SerialOptions o;
     o.path = a.backend.substr(7);
     o.baud = a.baud;
-    if (a.stream == "position") o.stream = SerialStream::position;
-    else if (a.stream == "drive") o.stream = SerialStream::drive;
-    else throw InvalidArgument("--stream is '" + a.stream + "'; allowed: position, drive");
+    if (a.stream == "position")
+      o.stream = SerialStream::position;
+    else if (a.stream == "drive")
+      o.stream = SerialStream::drive;
+    else
+      throw InvalidArgument("--stream is '" + a.stream + "'; allowed: position, drive");
     FingerOptions f = a.finger;
     if (!f.rate_hz) f.rate_hz = 1000.0;  // one frame per millisecond, like a position sensor
-    if (o.stream == SerialStream::drive && f.output == "vibration") f.output = "amplitude";  // a friction display takes amplitudes
+    if (o.stream == SerialStream::drive && f.output == "vibration")
+      f.output = "amplitude";  // a friction display takes amplitudes
     config = player_config(f, 1000.0);
     o.rate_hz = config.rate_hz;
     backend = make_serial_backend(o, *map);
@@ -131,7 +135,8 @@ void run(const PlayArgs& a) {
   if (!error.empty()) throw IoError("play: " + error);
 
   const BackendStats s = backend->stats();
-  const double block_s = a.backend.rfind("serial:", 0) == 0 ? 1.0 / config.rate_hz : static_cast<double>(a.block) / config.rate_hz;
+  const double block_s =
+      a.backend.rfind("serial:", 0) == 0 ? 1.0 / config.rate_hz : static_cast<double>(a.block) / config.rate_hz;
   nlohmann::ordered_json j;
   j["backend"] = backend->describe();
   j["played_s"] = player.time_s();
@@ -157,13 +162,15 @@ void run(const PlayArgs& a) {
 
 void register_play(CLI::App& app) {
   auto a = std::make_shared<PlayArgs>();
-  auto* cmd = app.add_subcommand("play", "Play a texture in real time: sound card, serial friction display, or null (no hardware)");
+  auto* cmd =
+      app.add_subcommand("play", "Play a texture in real time: sound card, serial friction display, or null (no hardware)");
   cmd->add_option("document", a->document, "Texture document (*.texel.json)");
   cmd->add_option("--backend", a->backend, "audio (PortAudio), null (no output device) or serial:PATH [null]");
   cmd->add_option("--block", a->block, "Frames per block (audio, null) [64]");
   cmd->add_option("--audio-device", a->audio_device, "PortAudio output: index or name substring [default output]");
   cmd->add_flag("--list-devices", a->list_devices, "List PortAudio output devices and exit");
-  cmd->add_option("--stream", a->stream, "Serial: stream finger positions (the display looks up its map) or drive values [position]");
+  cmd->add_option("--stream", a->stream,
+                  "Serial: stream finger positions (the display looks up its map) or drive values [position]");
   cmd->add_option("--baud", a->baud, "Serial baud rate [921600]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
   add_finger_options(*cmd, a->finger);

@@ -60,7 +60,8 @@ void print_list(bool json) {
       j["params"] = ordered::array();
       for (const auto& p : info.params) {
         ordered pj{{"key", p.key}, {"kind", kind_text(p)}, {"unit", p.unit}, {"default", value_json(p.default_value)}};
-        if (p.kind == ReferenceParamKind::choice) pj["choices"] = p.choices;
+        if (p.kind == ReferenceParamKind::choice)
+          pj["choices"] = p.choices;
         else {
           pj["min"] = p.min;
           pj["max"] = p.max;
@@ -105,7 +106,9 @@ void register_reference(CLI::App& app) {
     bool json = false;
   };
   auto a = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand("reference", "Generate a reference texture (band-pass noise, sums of sinusoids, noise colours, waveforms, patches, pulses)");
+  auto* cmd = app.add_subcommand(
+      "reference",
+      "Generate a reference texture (band-pass noise, sums of sinusoids, noise colours, waveforms, patches, pulses)");
   cmd->add_option("name", a->name, "Reference name (texel reference --list shows them all)");
   cmd->add_option("--param", a->params, "KEY=VALUE override of a generator parameter (repeatable; lists comma-separated)");
   cmd->add_option("--seed", a->seed, "Random seed, 0 … 2^64-1 [1]");
@@ -135,8 +138,12 @@ void register_reference(CLI::App& app) {
     const std::vector<double> map = render_map(surface);
     write_rendered(*a->output, doc, surface, map, {});
     if (a->json) {
-      ordered j{{"output", *a->output}, {"reference", spec.name}, {"texture", surface.regions()[0].texture->describe()},
-                {"device", doc.device.name}, {"samples", surface.grid().count}, {"spacing_mm", surface.grid().spacing_mm},
+      ordered j{{"output", *a->output},
+                {"reference", spec.name},
+                {"texture", surface.regions()[0].texture->describe()},
+                {"device", doc.device.name},
+                {"samples", surface.grid().count},
+                {"spacing_mm", surface.grid().spacing_mm},
                 {"device_bytes", doc.device.native_bytes()}};
       print_json(j);
     }
@@ -150,7 +157,8 @@ void register_atlas(CLI::App& app) {
     std::uint64_t seed = 1;
   };
   auto a = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand("atlas", "Write every reference, its spectrum plot and the second study's overview into a directory");
+  auto* cmd =
+      app.add_subcommand("atlas", "Write every reference, its spectrum plot and the second study's overview into a directory");
   cmd->add_option("--out", a->out, "Output directory [out/demo/references]");
   cmd->add_option("--device", a->device, "Device profile [tpad]");
   cmd->add_option("--seed", a->seed, "Seed of the seeded references [1]");
@@ -163,7 +171,8 @@ void register_atlas(CLI::App& app) {
     const std::vector<std::string> overview_names = second_study_names();
     std::vector<Figure> cells(overview_names.size());
     std::cout << std::left << std::setw(20) << "reference" << std::right << std::setw(10) << "bytes" << std::setw(14)
-              << "centroid cpm" << std::setw(16) << "log centroid dB" << "  peaks (cpm)\n";
+              << "centroid cpm" << std::setw(16) << "log centroid dB"
+              << "  peaks (cpm)\n";
     for (const auto& info : reference_catalogue()) {
       ReferenceSpec spec;
       spec.name = info.name;
@@ -191,7 +200,8 @@ void register_atlas(CLI::App& app) {
           cells[i] = spectrum_cell_figure(cell, 460, 400);
         }
       std::string peaks;
-      for (std::size_t i = 0; i < r.peaks.size() && i < 5; ++i) peaks += (i ? " " : "") + detail::fixed(r.peaks[i].frequency.value(), 2);
+      for (std::size_t i = 0; i < r.peaks.size() && i < 5; ++i)
+        peaks += (i ? " " : "") + detail::fixed(r.peaks[i].frequency.value(), 2);
       if (r.peaks.size() > 5) peaks += " …";
       std::cout << std::left << std::setw(20) << info.name << std::right << std::setw(10) << fs::file_size(stem + ".bin")
                 << std::setw(14) << detail::fixed(r.summary.centroid.value(), 3) << std::setw(16)

@@ -130,10 +130,7 @@ ordered report_json(const Args& a, const LoadedSignal& sig, const SpectralReport
     bj["fraction"] = b.fraction;
     j["bands"].push_back(bj);
   }
-  j["welch"] = {{"window", "hann"},
-                {"segment_samples", r.psd.segment},
-                {"segments", r.psd.segments},
-                {"bin_cpm", r.psd.bin_cpm}};
+  j["welch"] = {{"window", "hann"}, {"segment_samples", r.psd.segment}, {"segments", r.psd.segments}, {"bin_cpm", r.psd.bin_cpm}};
   return j;
 }
 
@@ -141,8 +138,8 @@ void print_report(const Args& a, const LoadedSignal& sig, const SpectralReport& 
   const std::optional<double> v = a.swipe_speed;
   std::cout << a.file << ": " << sig.samples.size() << " samples × " << num(sig.spacing_mm) << " mm ("
             << fixed(static_cast<double>(sig.samples.size()) * sig.spacing_mm, 2) << " mm), " << sig.source << "\n";
-  std::cout << "resolution " << num(r.spectrum.resolution_cpm) << " cpm, Nyquist " << fixed(0.5 / sig.spacing_mm, 2) << " cpm, window "
-            << to_string(r.spectrum.window) << "\n";
+  std::cout << "resolution " << num(r.spectrum.resolution_cpm) << " cpm, Nyquist " << fixed(0.5 / sig.spacing_mm, 2)
+            << " cpm, window " << to_string(r.spectrum.window) << "\n";
   std::cout << "peaks (within " << num(a.threshold_db) << " dB of the highest):\n";
   std::cout << "  frequency_cpm      dB re 1 cpm   amplitude   level_dB" << (v ? "   frequency_Hz" : "") << "\n";
   for (const auto& p : r.peaks) {
@@ -152,20 +149,21 @@ void print_report(const Args& a, const LoadedSignal& sig, const SpectralReport& 
     std::cout << "\n";
   }
   const auto& s = r.summary;
-  std::cout << "spectral centroid " << fixed(s.centroid.value(), 4) << " cpm" << (v ? " (" + fixed(s.centroid.value() * *v, 2) + " Hz)" : "")
-            << ", log-frequency centroid " << fixed(s.log_centroid.value(), 2) << " dB re 1 cpm ("
-            << fixed(std::pow(10.0, s.log_centroid.value() / 10.0), 4) << " cpm)\n";
+  std::cout << "spectral centroid " << fixed(s.centroid.value(), 4) << " cpm"
+            << (v ? " (" + fixed(s.centroid.value() * *v, 2) + " Hz)" : "") << ", log-frequency centroid "
+            << fixed(s.log_centroid.value(), 2) << " dB re 1 cpm (" << fixed(std::pow(10.0, s.log_centroid.value() / 10.0), 4)
+            << " cpm)\n";
   std::cout << "spectral spread " << fixed(s.spread.value(), 4) << " cpm, log spread " << fixed(s.log_spread_db, 2) << " dB\n";
   std::cout << "band energy (mean-square amplitude, share):\n";
   for (const auto& b : r.bands)
-    std::cout << "  " << std::setw(8) << num(b.lo_cpm) << " … " << std::setw(8) << fixed(b.hi_cpm, 4) << " cpm  "
-              << std::setw(12) << num(b.mean_square) << "  " << fixed(100.0 * b.fraction, 2) << " %\n";
+    std::cout << "  " << std::setw(8) << num(b.lo_cpm) << " … " << std::setw(8) << fixed(b.hi_cpm, 4) << " cpm  " << std::setw(12)
+              << num(b.mean_square) << "  " << fixed(100.0 * b.fraction, 2) << " %\n";
 }
 
 }  // namespace
 
-LoadedSignal load_signal(const std::string& path, const std::optional<std::string>& device, const std::optional<double>& spacing_mm,
-                         const std::optional<std::string>& region) {
+LoadedSignal load_signal(const std::string& path, const std::optional<std::string>& device,
+                         const std::optional<double>& spacing_mm, const std::optional<std::string>& region) {
   const std::string ext = output_extension(path);
   if (spacing_mm && !(std::isfinite(*spacing_mm) && *spacing_mm > 0.0))
     throw InvalidArgument("--spacing is " + num(*spacing_mm) + "; it must be a finite number of mm > 0");
@@ -177,8 +175,8 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
     const std::string bytes = read_file(path);
     const std::size_t width = bytes_per_sample(d.format);
     if (bytes.size() % width != 0)
-      throw FormatError(path + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of " + std::string(to_string(d.format)) +
-                        " samples for device " + d.name);
+      throw FormatError(path + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
+                        std::string(to_string(d.format)) + " samples for device " + d.name);
     sig.samples = decode_samples(d.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
     sig.spacing_mm = spacing_mm.value_or(d.spacing_mm);
     sig.source = "device " + d.name + " (" + std::string(to_string(d.format)) + ")";
@@ -190,9 +188,12 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
     sig.source = "csv";
   } else if (ext == ".npy") {
     sig.samples = parse_npy(read_file(path), path);
-    if (spacing_mm) sig.spacing_mm = *spacing_mm;
-    else if (device) sig.spacing_mm = load_device(*device).spacing_mm;
-    else throw InvalidArgument("'" + path + "' carries no sample spacing: give --device or --spacing");
+    if (spacing_mm)
+      sig.spacing_mm = *spacing_mm;
+    else if (device)
+      sig.spacing_mm = load_device(*device).spacing_mm;
+    else
+      throw InvalidArgument("'" + path + "' carries no sample spacing: give --device or --spacing");
     sig.source = "npy";
   } else if (ext == ".texel.json" || ext == ".json") {
     Document doc = load_document(path);
@@ -214,7 +215,8 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
         if (regions[i].name == *region || std::to_string(i) == *region) chosen = &regions[i];
       if (!chosen) {
         std::string names;
-        for (std::size_t i = 0; i < regions.size(); ++i) names += (names.empty() ? "" : ", ") + (regions[i].name.empty() ? std::to_string(i) : regions[i].name);
+        for (std::size_t i = 0; i < regions.size(); ++i)
+          names += (names.empty() ? "" : ", ") + (regions[i].name.empty() ? std::to_string(i) : regions[i].name);
         throw InvalidArgument("--region '" + *region + "' is not in " + path + "; its regions: " + names);
       }
       std::vector<double> part;
@@ -230,10 +232,12 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
     }
     sig.samples = std::move(map);
   } else {
-    throw InvalidArgument("spectrum: '" + path + "' has extension '" + ext + "'; allowed: .bin (with --device), .csv, .npy, .texel.json");
+    throw InvalidArgument("spectrum: '" + path + "' has extension '" + ext +
+                          "'; allowed: .bin (with --device), .csv, .npy, .texel.json");
   }
   if (sig.samples.size() < 16)
-    throw InvalidArgument("'" + path + "' holds " + std::to_string(sig.samples.size()) + " samples; a spectrum needs at least 16");
+    throw InvalidArgument("'" + path + "' holds " + std::to_string(sig.samples.size()) +
+                          " samples; a spectrum needs at least 16");
   return sig;
 }
 
@@ -267,11 +271,14 @@ void register_spectrum(CLI::App& app) {
   cmd->add_option("--spectrum-csv", a->spectrum_csv, "Also write frequency_cpm,magnitude rows");
   cmd->add_option("--psd-csv", a->psd_csv, "Also write frequency_cpm,psd rows (Welch, a²/(cycle/mm))");
   const std::string g = "Analysis";
-  cmd->add_option("--window", a->window, "Magnitude-spectrum window: blackman-harris | hann | flat-top | rectangular [blackman-harris]")->group(g);
+  cmd->add_option("--window", a->window,
+                  "Magnitude-spectrum window: blackman-harris | hann | flat-top | rectangular [blackman-harris]")
+      ->group(g);
   cmd->add_option("--zero-pad", a->zero_pad, "Zero padding factor 1 … 16 [4]")->group(g);
   cmd->add_option("--threshold", a->threshold_db, "Peak threshold, dB below the highest peak [-40]")->group(g);
   cmd->add_option("--max-peaks", a->max_peaks, "Most peaks to list [32]")->group(g);
-  cmd->add_option("--welch-segment", a->welch_segment, "Welch segment, samples (0 = auto, about a quarter of the map) [0]")->group(g);
+  cmd->add_option("--welch-segment", a->welch_segment, "Welch segment, samples (0 = auto, about a quarter of the map) [0]")
+      ->group(g);
   cmd->add_option("--welch-overlap", a->welch_overlap, "Welch overlap, 0 … 0.95 [0.5]")->group(g);
   cmd->add_option("--band", a->bands, "Band for band energy, LOW:HIGH in cycles/mm (repeatable) [decades]")->group(g);
   cmd->callback([a] {
@@ -288,13 +295,15 @@ void register_spectrum(CLI::App& app) {
       }
     if (a->swipe_speed && !(std::isfinite(*a->swipe_speed) && *a->swipe_speed > 0.0))
       throw InvalidArgument("--swipe-speed is " + num(*a->swipe_speed) + "; it must be a finite speed in mm/s > 0");
-    if (a->max_peaks < 1 || a->max_peaks > 100000) throw InvalidArgument("--max-peaks is " + std::to_string(a->max_peaks) + "; allowed: 1 … 100000");
+    if (a->max_peaks < 1 || a->max_peaks > 100000)
+      throw InvalidArgument("--max-peaks is " + std::to_string(a->max_peaks) + "; allowed: 1 … 100000");
     if (!(a->threshold_db <= 0.0 && a->threshold_db >= -300.0))
       throw InvalidArgument("--threshold is " + num(a->threshold_db) + " dB; allowed: -300 … 0");
     AnalysisOptions opt;
     opt.spectrum.window = parse_window(a->window, "--window");
     opt.spectrum.zero_pad = a->zero_pad;
-    if (a->zero_pad < 1 || a->zero_pad > 16) throw InvalidArgument("--zero-pad is " + std::to_string(a->zero_pad) + "; allowed: 1 … 16");
+    if (a->zero_pad < 1 || a->zero_pad > 16)
+      throw InvalidArgument("--zero-pad is " + std::to_string(a->zero_pad) + "; allowed: 1 … 16");
     opt.welch.segment = a->welch_segment;
     opt.welch.overlap = a->welch_overlap;
     if (!(a->welch_overlap >= 0.0 && a->welch_overlap <= 0.95))
@@ -307,7 +316,9 @@ void register_spectrum(CLI::App& app) {
     const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing_mm, opt);
 
     std::vector<PendingFile> files;
-    if (a->spectrum_csv) files.push_back({*a->spectrum_csv, csv_columns("frequency_cpm", "magnitude", r.spectrum.frequency_cpm, r.spectrum.magnitude)});
+    if (a->spectrum_csv)
+      files.push_back(
+          {*a->spectrum_csv, csv_columns("frequency_cpm", "magnitude", r.spectrum.frequency_cpm, r.spectrum.magnitude)});
     if (a->psd_csv) files.push_back({*a->psd_csv, csv_columns("frequency_cpm", "psd", r.psd.frequency_cpm, r.psd.density)});
     if (a->output) {
       plot_spectrum(make_spectrum_plot(a->file, sig, r, a->swipe_speed), *a->output);  // atomic on its own
@@ -320,8 +331,10 @@ void register_spectrum(CLI::App& app) {
     } else {
       commit_files(files);
     }
-    if (a->json) print_json(report_json(*a, sig, r));
-    else print_report(*a, sig, r);
+    if (a->json)
+      print_json(report_json(*a, sig, r));
+    else
+      print_report(*a, sig, r);
   });
 }
 

@@ -21,7 +21,8 @@ void add_texture_options(CLI::App& cmd, TextureOptions& o) {
   cmd.add_option("--seed", o.seed, "Random seed, 0 … 2^64-1 [1]")->group(g);
   cmd.add_option("--quantization", o.quantization_db, "Frequency quantization step, dB (0 = off) [0]")->group(g);
   cmd.add_option("--phase", o.phase, "continuous | reset [continuous]")->group(g);
-  cmd.add_option("--parameterization", o.parameterization, "moments (mean/SD in cpm) | log (median, SD of 10·log10 f) [moments]")->group(g);
+  cmd.add_option("--parameterization", o.parameterization, "moments (mean/SD in cpm) | log (median, SD of 10·log10 f) [moments]")
+      ->group(g);
   cmd.add_option("--out-of-band", o.out_of_band, "redraw | clamp draws outside the band [redraw]")->group(g);
   cmd.add_option("--fill", o.fill, "whole (whole texels only) | partial (render a final partial texel) [whole]")->group(g);
   cmd.add_option("--band-min", o.band_min_cpm, "Lowest texel frequency, cpm [0.01]")->group(g);
@@ -63,20 +64,27 @@ void apply(const TextureOptions& o, TexelSpec& s) {
   const auto check = [](bool given, double v, const char* flag, auto ok, const char* allowed) {
     if (given && !ok(v)) throw InvalidArgument(std::string(flag) + " is " + detail::num(v) + "; " + allowed);
   };
-  check(o.texel_length_mm.has_value(), o.texel_length_mm.value_or(0), "--texel-length",
-        [](double v) { return std::isfinite(v) && v > 0; }, "it must be a finite number of mm > 0");
-  check(o.central_pitch_db.has_value(), o.central_pitch_db.value_or(0), "--central-pitch",
-        [](double v) { return std::isfinite(v); }, "it must be a finite number of dB");
-  check(o.irregularity_db.has_value(), o.irregularity_db.value_or(0), "--irregularity",
-        [](double v) { return std::isfinite(v); }, "it must be a finite number of dB");
-  check(o.coarse_strength.has_value(), o.coarse_strength.value_or(0), "--coarse-strength",
-        [](double v) { return v >= 0 && v <= 1; }, "allowed: 0 … 1");
-  check(o.fine_strength.has_value(), o.fine_strength.value_or(0), "--fine-strength",
-        [](double v) { return v >= 0 && v <= 1; }, "allowed: 0 … 1");
-  check(o.quantization_db.has_value(), o.quantization_db.value_or(0), "--quantization",
-        [](double v) { return v >= 0 && v <= 20; }, "allowed: 0 (off) … 20 dB");
-  check(o.coarse_sine_mm.has_value(), o.coarse_sine_mm.value_or(0), "--coarse-sine",
-        [](double v) { return std::isfinite(v) && v > 0; }, "it must be a finite period in mm > 0");
+  check(
+      o.texel_length_mm.has_value(), o.texel_length_mm.value_or(0), "--texel-length",
+      [](double v) { return std::isfinite(v) && v > 0; }, "it must be a finite number of mm > 0");
+  check(
+      o.central_pitch_db.has_value(), o.central_pitch_db.value_or(0), "--central-pitch",
+      [](double v) { return std::isfinite(v); }, "it must be a finite number of dB");
+  check(
+      o.irregularity_db.has_value(), o.irregularity_db.value_or(0), "--irregularity", [](double v) { return std::isfinite(v); },
+      "it must be a finite number of dB");
+  check(
+      o.coarse_strength.has_value(), o.coarse_strength.value_or(0), "--coarse-strength",
+      [](double v) { return v >= 0 && v <= 1; }, "allowed: 0 … 1");
+  check(
+      o.fine_strength.has_value(), o.fine_strength.value_or(0), "--fine-strength", [](double v) { return v >= 0 && v <= 1; },
+      "allowed: 0 … 1");
+  check(
+      o.quantization_db.has_value(), o.quantization_db.value_or(0), "--quantization", [](double v) { return v >= 0 && v <= 20; },
+      "allowed: 0 (off) … 20 dB");
+  check(
+      o.coarse_sine_mm.has_value(), o.coarse_sine_mm.value_or(0), "--coarse-sine",
+      [](double v) { return std::isfinite(v) && v > 0; }, "it must be a finite period in mm > 0");
   validate(s);
 }
 

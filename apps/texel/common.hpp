@@ -68,13 +68,13 @@ void commit_files(const std::vector<PendingFile>& files);
 
 /// A one-line progress indicator on stderr, only when stderr is a terminal.
 class Progress {
-public:
+ public:
   explicit Progress(std::string label);
   ~Progress();
   void update(double fraction);
   void done();
 
-private:
+ private:
   std::string label_;
   bool active_ = false;
   int last_percent_ = -1;

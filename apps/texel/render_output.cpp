@@ -54,8 +54,9 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
     case OutputKind::png:
     case OutputKind::svg: {
       MapPlot plot;
-      plot.title = doc.device.name + ": " + (surface.regions().size() == 1 ? surface.regions()[0].texture->describe()
-                                                                            : std::to_string(surface.regions().size()) + " regions");
+      plot.title = doc.device.name + ": " +
+                   (surface.regions().size() == 1 ? surface.regions()[0].texture->describe()
+                                                  : std::to_string(surface.regions().size()) + " regions");
       plot.positions_mm.resize(map.size());
       for (std::size_t i = 0; i < map.size(); ++i) plot.positions_mm[i] = g.position(static_cast<std::int64_t>(i));
       plot.amplitudes = map;

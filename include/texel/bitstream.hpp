@@ -46,13 +46,13 @@ inline constexpr std::uint32_t max_coarse_levels = 1u << 24;
 
 /// The fine texture's fields, as stored.
 struct FineFields {
-  std::int16_t central_pitch_cdb = 1000;    ///< Central Pitch, 0.01 dB units (10 dB)
-  std::int16_t irregularity_cdb = -500;     ///< Irregularity, 0.01 dB units (-5 dB)
-  std::uint16_t texel_length_um = 250;      ///< texel length, µm, >= 1 (0.25 mm)
-  std::uint8_t quantization_ddb = 0;        ///< frequency quantization, 0.1 dB units, <= 200 (0 = off)
-  bool band_max_device = false;             ///< true: band top = the device's Nyquist (device dependent)
-  std::int16_t band_max_cdb = 1974;         ///< band top, 0.01 dB (when !band_max_device)
-  std::optional<std::int16_t> band_min_cdb; ///< band bottom, 0.01 dB; none = 0.01 cpm (the default)
+  std::int16_t central_pitch_cdb = 1000;     ///< Central Pitch, 0.01 dB units (10 dB)
+  std::int16_t irregularity_cdb = -500;      ///< Irregularity, 0.01 dB units (-5 dB)
+  std::uint16_t texel_length_um = 250;       ///< texel length, µm, >= 1 (0.25 mm)
+  std::uint8_t quantization_ddb = 0;         ///< frequency quantization, 0.1 dB units, <= 200 (0 = off)
+  bool band_max_device = false;              ///< true: band top = the device's Nyquist (device dependent)
+  std::int16_t band_max_cdb = 1974;          ///< band top, 0.01 dB (when !band_max_device)
+  std::optional<std::int16_t> band_min_cdb;  ///< band bottom, 0.01 dB; none = 0.01 cpm (the default)
   std::uint64_t seed = 1;
   Parameterization parameterization = Parameterization::moments;
   OutOfBand out_of_band = OutOfBand::redraw;

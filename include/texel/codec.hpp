@@ -48,9 +48,9 @@ struct Signal {
 };
 
 struct LoadOptions {
-  std::optional<DeviceProfile> device;       ///< grid and format of .bin/.npy (default tpad)
-  std::optional<double> spacing_mm;          ///< overrides the device's spacing for .bin/.npy
-  std::optional<MmPerSecond> swipe_speed;    ///< needed for time recordings (.wav, time/value .csv)
+  std::optional<DeviceProfile> device;     ///< grid and format of .bin/.npy (default tpad)
+  std::optional<double> spacing_mm;        ///< overrides the device's spacing for .bin/.npy
+  std::optional<MmPerSecond> swipe_speed;  ///< needed for time recordings (.wav, time/value .csv)
 };
 
 /// Loads any texture signal: a device map (.bin), .npy, a position/amplitude
@@ -77,10 +77,10 @@ double threshold_db(Hertz f);
 
 /// What the model extracts from a fine-texture signal.
 struct Percept {
-  double pitch_db = 0.0;       ///< felt pitch, dB re 1 cpm
-  double noisiness_db = 0.0;   ///< felt spread of log-frequency, dB
-  double mean_db = 0.0;        ///< physical: power-weighted mean frequency, dB re 1 cpm
-  double spread_db = 0.0;      ///< physical: power-weighted SD of 10·log10 f, dB
+  double pitch_db = 0.0;      ///< felt pitch, dB re 1 cpm
+  double noisiness_db = 0.0;  ///< felt spread of log-frequency, dB
+  double mean_db = 0.0;       ///< physical: power-weighted mean frequency, dB re 1 cpm
+  double spread_db = 0.0;     ///< physical: power-weighted SD of 10·log10 f, dB
 };
 
 /// Percept of a zero-mean fine signal sampled every `spacing_mm`, from its
@@ -93,14 +93,14 @@ double distance(const Percept& a, const Percept& b, const PerceptualModel& model
 
 struct EncoderConfig {
   PerceptualModel model;
-  Millimetres boundary{1.0};              ///< fine/coarse boundary, mm (> 0)
-  Millimetres texel_length{0.25};         ///< texel length of the encoding, mm
+  Millimetres boundary{1.0};       ///< fine/coarse boundary, mm (> 0)
+  Millimetres texel_length{0.25};  ///< texel length of the encoding, mm
   Parameterization parameterization = Parameterization::moments;
-  std::uint64_t seed = 1;                 ///< seed written to the bitstream
-  unsigned coarse_bits = 6;               ///< bits per coarse level (1 … 16)
-  std::optional<std::size_t> max_bytes;   ///< bitstream budget, bytes (coarse precision/stride adapt)
-  double flat_envelope = 0.08;            ///< relative envelope range below which the texture is fine only
-  int max_evaluations = 120;              ///< Nelder–Mead budget (each renders 2 candidates)
+  std::uint64_t seed = 1;                ///< seed written to the bitstream
+  unsigned coarse_bits = 6;              ///< bits per coarse level (1 … 16)
+  std::optional<std::size_t> max_bytes;  ///< bitstream budget, bytes (coarse precision/stride adapt)
+  double flat_envelope = 0.08;           ///< relative envelope range below which the texture is fine only
+  int max_evaluations = 120;             ///< Nelder–Mead budget (each renders 2 candidates)
   /// Recognise inputs that are fine-only Texel renderings and recover their
   /// texel length, Central Pitch and Irregularity from the texels'
   /// frequencies (kept when the model distance is below 1 JND; docs/encoder.md).
@@ -110,13 +110,13 @@ struct EncoderConfig {
 struct EncodeResult {
   Bitstream bitstream;
   std::vector<std::uint8_t> bytes;
-  TexelSpec spec;                  ///< what the bitstream decodes to
-  Percept input;                   ///< the input's fine part under the model
-  Percept decoded;                 ///< the decoded texture's, on the input's grid
-  double model_distance = 0.0;     ///< distance(input, decoded), JND units
-  bool coarse = false;             ///< a coarse profile was found
-  double coarse_correlation = 1.0; ///< envelope vs decoded envelope at texel centres
-  bool texel_recovered = false;    ///< the input was recognised as a Texel rendering (texel length detected)
+  TexelSpec spec;                   ///< what the bitstream decodes to
+  Percept input;                    ///< the input's fine part under the model
+  Percept decoded;                  ///< the decoded texture's, on the input's grid
+  double model_distance = 0.0;      ///< distance(input, decoded), JND units
+  bool coarse = false;              ///< a coarse profile was found
+  double coarse_correlation = 1.0;  ///< envelope vs decoded envelope at texel centres
+  bool texel_recovered = false;     ///< the input was recognised as a Texel rendering (texel length detected)
   bool irregularity_identifiable = true;
   double irregularity_bound_db = 0.0;  ///< when not identifiable: any value below this feels the same
   int evaluations = 0;

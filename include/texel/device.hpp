@@ -35,15 +35,15 @@ struct RegionLayout {
 };
 
 struct DeviceProfile {
-  std::string name;                 ///< e.g. "tpad"
+  std::string name;  ///< e.g. "tpad"
   std::string description;
-  std::int64_t samples = 0;         ///< samples along the active length, >= 1
-  double spacing_mm = 0.0;          ///< Δx, > 0
+  std::int64_t samples = 0;  ///< samples along the active length, >= 1
+  double spacing_mm = 0.0;   ///< Δx, > 0
   SampleFormat format = SampleFormat::u16le;
-  double refresh_hz = 0.0;          ///< output update rate while playing, > 0
-  double band_min_cpm = 0.01;       ///< lowest renderable frequency
-  double band_max_cpm = 0.0;        ///< 0 = Nyquist of the grid
-  std::vector<RegionLayout> layout; ///< named regions; empty = whole surface
+  double refresh_hz = 0.0;           ///< output update rate while playing, > 0
+  double band_min_cpm = 0.01;        ///< lowest renderable frequency
+  double band_max_cpm = 0.0;         ///< 0 = Nyquist of the grid
+  std::vector<RegionLayout> layout;  ///< named regions; empty = whole surface
 
   [[nodiscard]] Grid grid() const { return Grid{0.0, spacing_mm, samples}; }
   [[nodiscard]] double length_mm() const { return static_cast<double>(samples) * spacing_mm; }

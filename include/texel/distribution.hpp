@@ -30,18 +30,18 @@ Parameterization parse_parameterization(std::string_view text, std::string_view 
 OutOfBand parse_out_of_band(std::string_view text, std::string_view field = "out_of_band");
 
 struct PitchDistributionConfig {
-  Decibels central_pitch{10.0};                 ///< dB re 1 cpm; -20 … 19.7 dB on the reference device
-  Decibels irregularity{-5.0};                  ///< dB re 1 cpm (moments) or dB of log-spread (log, >= 0)
+  Decibels central_pitch{10.0};  ///< dB re 1 cpm; -20 … 19.7 dB on the reference device
+  Decibels irregularity{-5.0};   ///< dB re 1 cpm (moments) or dB of log-spread (log, >= 0)
   Parameterization parameterization = Parameterization::moments;
   OutOfBand out_of_band = OutOfBand::redraw;
-  CyclesPerMm band_min{0.01};                   ///< lowest renderable frequency (cpm), > 0
-  CyclesPerMm band_max{94.33962264150944};      ///< highest (cpm): the grid's Nyquist frequency
-  double quantization_db = 0.0;                 ///< 0 = off; else grid spacing in dB, > 0
+  CyclesPerMm band_min{0.01};               ///< lowest renderable frequency (cpm), > 0
+  CyclesPerMm band_max{94.33962264150944};  ///< highest (cpm): the grid's Nyquist frequency
+  double quantization_db = 0.0;             ///< 0 = off; else grid spacing in dB, > 0
 };
 
 /// A validated, prepared distribution. Value type; draw() is pure.
 class PitchDistribution {
-public:
+ public:
   /// Validates the config; throws InvalidArgument if a value is out of range
   /// or the band [band_min, band_max] holds less than `min_band_mass` of the
   /// distribution (a drawing loop would then almost never terminate).
@@ -65,7 +65,7 @@ public:
   /// band mass >= 1e-3 the chance of reaching it is below 1e-40.
   static constexpr std::uint64_t max_attempts = 1u << 17;
 
-private:
+ private:
   PitchDistributionConfig config_;
   double mu_ = 0.0;
   double sigma_ = 0.0;

@@ -25,10 +25,10 @@ namespace texel {
 /// version 2, a reference texture ("kind": "reference"); a Texel texture's
 /// coarse profile may also be a reference (the coarse-study test texture).
 struct RegionSpec {
-  std::string name;                   ///< optional label, e.g. "left"
+  std::string name;  ///< optional label, e.g. "left"
   double start_mm = 0.0;
-  std::optional<double> length_mm;    ///< none = to the end of the device
-  TexelSpec texel;                    ///< used when `reference` is empty
+  std::optional<double> length_mm;  ///< none = to the end of the device
+  TexelSpec texel;                  ///< used when `reference` is empty
   /// Set: the region holds this reference instead of a Texel rendering.
   std::optional<ReferenceSpec> reference;
   /// Set (Texel regions only): the coarse profile is this reference, prepared
@@ -41,10 +41,10 @@ struct Document {
   /// version 1, so older readers keep reading them.
   static constexpr int current_version = 2;
   int version = current_version;
-  DeviceProfile device;               ///< resolved profile (by name or inline)
-  bool device_inline = false;         ///< written inline rather than by name
-  std::vector<RegionSpec> regions;    ///< at least one
-  std::string description;            ///< free text
+  DeviceProfile device;             ///< resolved profile (by name or inline)
+  bool device_inline = false;       ///< written inline rather than by name
+  std::vector<RegionSpec> regions;  ///< at least one
+  std::string description;          ///< free text
 };
 
 /// Parses and validates a document. `origin` names the source in errors.

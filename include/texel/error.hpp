@@ -10,25 +10,25 @@ namespace texel {
 
 /// Base of every exception Texel throws on purpose.
 class Error : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 
 /// A parameter outside its allowed range or set (library or CLI input).
 class InvalidArgument : public Error {
-public:
+ public:
   using Error::Error;
 };
 
 /// A file or byte string that does not parse or validate.
 class FormatError : public Error {
-public:
+ public:
   using Error::Error;
 };
 
 /// An operating-system level failure: unreadable input, unwritable output.
 class IoError : public Error {
-public:
+ public:
   using Error::Error;
 };
 

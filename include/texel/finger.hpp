@@ -38,14 +38,14 @@ struct SwipeConfig {
   /// Travel before the finger lifts (constant) or turns (back-and-forth), mm;
   /// 0 = from start_mm to the end of `surface_mm`.
   double extent_mm = 0.0;
-  double surface_mm = 0.0;    ///< surface length used when extent_mm is 0 (mm)
+  double surface_mm = 0.0;  ///< surface length used when extent_mm is 0 (mm)
   /// Back-and-forth: time to decelerate to rest and accelerate back at a
   /// turn (s), >= 0. Speed follows a half cosine through each turn, so
   /// acceleration stays finite (peak π·v/turn_s: 3.1 m/s² at 100 mm/s, 0.1 s).
   double turn_s = 0.1;
-  double duration_s = 1.0;    ///< length of the trace (s), > 0
-  double rate_hz = 1000.0;    ///< trace sample rate (s⁻¹), > 0; 1 kHz ≈ a position sensor
-  double lead_in_s = 0.0;     ///< lifted time before the finger lands (s), >= 0
+  double duration_s = 1.0;  ///< length of the trace (s), > 0
+  double rate_hz = 1000.0;  ///< trace sample rate (s⁻¹), > 0; 1 kHz ≈ a position sensor
+  double lead_in_s = 0.0;   ///< lifted time before the finger lands (s), >= 0
 };
 
 /// Validates the config (InvalidArgument naming the field) and samples it.
@@ -62,15 +62,15 @@ std::string trace_csv(std::span<const FingerSample> trace);
 /// Swipe behaviour of a trace (experiments.md "Measures"). Speeds are taken
 /// between consecutive samples that both touch: v_i = Δx/Δt.
 struct SwipeMeasures {
-  std::size_t intervals = 0;          ///< touched intervals used
-  double mean_speed_mm_s = 0.0;       ///< mean of |v_i|
-  double sd_speed_mm_s = 0.0;         ///< sample standard deviation of |v_i| (n−1)
+  std::size_t intervals = 0;     ///< touched intervals used
+  double mean_speed_mm_s = 0.0;  ///< mean of |v_i|
+  double sd_speed_mm_s = 0.0;    ///< sample standard deviation of |v_i| (n−1)
   /// (intervals moving right − intervals moving left) / all intervals, in [−1, 1].
   double directional_proportion = 0.0;
   std::size_t moving_right = 0;
   std::size_t moving_left = 0;
-  double touched_s = 0.0;             ///< total touched time (s)
-  double distance_mm = 0.0;           ///< total path length (mm)
+  double touched_s = 0.0;    ///< total touched time (s)
+  double distance_mm = 0.0;  ///< total path length (mm)
 };
 /// `still_below_mm_s`: intervals slower than this count as neither right nor
 /// left (sensor noise); they still count in "all intervals" and in the speed.

@@ -9,13 +9,11 @@
 namespace texel {
 
 struct Grid {
-  double origin_mm = 0.0;    ///< position of sample 0 (mm)
-  double spacing_mm = 0.0;   ///< distance between samples (mm), > 0
-  std::int64_t count = 0;    ///< number of samples
+  double origin_mm = 0.0;   ///< position of sample 0 (mm)
+  double spacing_mm = 0.0;  ///< distance between samples (mm), > 0
+  std::int64_t count = 0;   ///< number of samples
 
-  [[nodiscard]] constexpr double position(std::int64_t i) const {
-    return origin_mm + static_cast<double>(i) * spacing_mm;
-  }
+  [[nodiscard]] constexpr double position(std::int64_t i) const { return origin_mm + static_cast<double>(i) * spacing_mm; }
   [[nodiscard]] constexpr double length_mm() const { return static_cast<double>(count) * spacing_mm; }
   /// Spatial Nyquist frequency 1/(2·Δx) in cycles/mm: the highest renderable frequency.
   [[nodiscard]] constexpr double nyquist_cpm() const { return 0.5 / spacing_mm; }

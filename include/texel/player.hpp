@@ -62,7 +62,7 @@ class Texture;
 
 /// An immutable amplitude map on a uniform grid, in device coordinates (mm).
 class PlayerMap {
-public:
+ public:
   /// `values` holds one amplitude in [0, 1] per grid sample; grid.count must
   /// equal values.size() and be >= 1. Throws InvalidArgument otherwise.
   PlayerMap(Grid grid, std::vector<float> values);
@@ -80,7 +80,7 @@ public:
   /// True if x lies on the surface: [origin, origin + count·spacing).
   [[nodiscard]] bool on_surface(double x_mm) const noexcept;
 
-private:
+ private:
   Grid grid_;
   std::vector<float> values_;
   double inv_spacing_ = 0.0;
@@ -91,17 +91,17 @@ std::string_view to_string(OutputMode m);
 OutputMode parse_output_mode(std::string_view text, std::string_view field = "output");
 
 struct PlayerConfig {
-  double rate_hz = 48000.0;        ///< output rate (s⁻¹), 100 … 384000; tpad: 8333
+  double rate_hz = 48000.0;  ///< output rate (s⁻¹), 100 … 384000; tpad: 8333
   OutputMode mode = OutputMode::amplitude;
-  double gain = 1.0;               ///< output gain, 0 … 1 (changes are ramped over one block)
-  double carrier_hz = 250.0;       ///< carrier mode: carrier frequency (Hz), 0 … rate/2
-  double prediction_s = 0.0;       ///< latency compensation: look-ahead (s), 0 … 0.1 (TPaD tablet: 0.02)
-  double extrapolate_s = 0.03;     ///< longest extrapolation past the newest sample (s), >= prediction_s
+  double gain = 1.0;                   ///< output gain, 0 … 1 (changes are ramped over one block)
+  double carrier_hz = 250.0;           ///< carrier mode: carrier frequency (Hz), 0 … rate/2
+  double prediction_s = 0.0;           ///< latency compensation: look-ahead (s), 0 … 0.1 (TPaD tablet: 0.02)
+  double extrapolate_s = 0.03;         ///< longest extrapolation past the newest sample (s), >= prediction_s
   double velocity_smoothing_s = 0.01;  ///< time constant of the velocity estimate (s), > 0
-  double touch_ramp_s = 0.005;     ///< fade in on touch / out on lift (s), 0.0005 … 1
-  double crossfade_s = 0.02;       ///< crossfade when a new map is swapped in (s), 0.0005 … 1
-  double highpass_hz = 20.0;       ///< vibration: DC-blocker corner (Hz), 0.1 … rate/4
-  double lowpass_hz = 0.0;         ///< vibration: low-pass corner (Hz); 0 = 0.4·rate; at most 0.45·rate
+  double touch_ramp_s = 0.005;         ///< fade in on touch / out on lift (s), 0.0005 … 1
+  double crossfade_s = 0.02;           ///< crossfade when a new map is swapped in (s), 0.0005 … 1
+  double highpass_hz = 20.0;           ///< vibration: DC-blocker corner (Hz), 0.1 … rate/4
+  double lowpass_hz = 0.0;             ///< vibration: low-pass corner (Hz); 0 = 0.4·rate; at most 0.45·rate
 };
 /// Throws InvalidArgument naming the field, the value and the allowed range.
 void validate(const PlayerConfig& config);
@@ -116,14 +116,14 @@ struct PlayerEvent {
 
 /// What process() reports for one block.
 struct BlockInfo {
-  float peak = 0.0f;        ///< largest |output| in the block
-  double position_mm = 0.0; ///< finger position at the block's end (after prediction)
-  bool touching = false;    ///< finger down at the block's end
+  float peak = 0.0f;         ///< largest |output| in the block
+  double position_mm = 0.0;  ///< finger position at the block's end (after prediction)
+  bool touching = false;     ///< finger down at the block's end
   bool crossfading = false;
 };
 
 class Player {
-public:
+ public:
   static constexpr std::size_t event_capacity = 4096;
   static constexpr std::size_t retire_capacity = 16;
 
@@ -166,7 +166,7 @@ public:
   [[nodiscard]] std::uint64_t samples() const { return samples_done_.load(std::memory_order_relaxed); }
   [[nodiscard]] double time_s() const { return static_cast<double>(samples()) / config_.rate_hz; }
 
-private:
+ private:
   struct Biquad {
     double b0 = 1, b1 = 0, b2 = 0, a1 = 0, a2 = 0;
     double z1 = 0, z2 = 0;
@@ -189,19 +189,19 @@ private:
 
   // Real-time state (touched only by process()).
   const PlayerMap* current_ = nullptr;
-  const PlayerMap* fading_ = nullptr;         // the map being faded out (null: from silence)
-  const PlayerMap* retire_waiting_ = nullptr; // retired while the retire queue was full
+  const PlayerMap* fading_ = nullptr;          // the map being faded out (null: from silence)
+  const PlayerMap* retire_waiting_ = nullptr;  // retired while the retire queue was full
   bool crossfading_ = false;
-  double fade_pos_ = 1.0;              // 0 → 1 over crossfade_s
+  double fade_pos_ = 1.0;  // 0 → 1 over crossfade_s
   double fade_step_ = 0.0;
-  FingerSample last_{};                // newest consumed sample
+  FingerSample last_{};  // newest consumed sample
   bool have_last_ = false;
-  double velocity_ = 0.0;              // smoothed mm/s
-  double touch_level_ = 0.0;           // 0 … 1 before shaping
+  double velocity_ = 0.0;     // smoothed mm/s
+  double touch_level_ = 0.0;  // 0 … 1 before shaping
   double touch_step_ = 0.0;
   double gain_ = 1.0, gain_target_ = 1.0;
   double carrier_inc_ = 0.0, carrier_inc_target_ = 0.0;  // cycles per sample
-  double carrier_phase_ = 0.0;                            // cycles [0, 1)
+  double carrier_phase_ = 0.0;                           // cycles [0, 1)
   double dc_x1_ = 0.0, dc_y1_ = 0.0, dc_r_ = 0.0;
   Biquad lowpass_{};
   std::uint64_t n_ = 0;

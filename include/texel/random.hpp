@@ -54,9 +54,8 @@ enum class Stream : std::uint64_t {
 
 /// A counter-based generator: value type, no state beyond its key.
 class CounterRng {
-public:
-  constexpr CounterRng(std::uint64_t seed, std::uint64_t stream)
-      : key_(mix64(seed ^ mix64(stream + 0x9E3779B97F4A7C15ULL))) {}
+ public:
+  constexpr CounterRng(std::uint64_t seed, std::uint64_t stream) : key_(mix64(seed ^ mix64(stream + 0x9E3779B97F4A7C15ULL))) {}
   constexpr CounterRng(std::uint64_t seed, Stream stream) : CounterRng(seed, static_cast<std::uint64_t>(stream)) {}
 
   /// 64 random bits for this counter.
@@ -74,11 +73,9 @@ public:
   /// Standard normal by inversion of the CDF (one uniform per normal).
   [[nodiscard]] double normal(std::uint64_t counter) const { return detmath::normal_quantile(uniform(counter)); }
   /// Uniform integer in [0, n), n > 0 (Lemire's multiply-shift; the bias is < n/2^64).
-  [[nodiscard]] constexpr std::uint64_t below(std::uint64_t counter, std::uint64_t n) const {
-    return mul_high(bits(counter), n);
-  }
+  [[nodiscard]] constexpr std::uint64_t below(std::uint64_t counter, std::uint64_t n) const { return mul_high(bits(counter), n); }
 
-private:
+ private:
   std::uint64_t key_;
 };
 
@@ -86,7 +83,7 @@ private:
 /// in order (reference noise, shuffles). Same numbers as CounterRng at
 /// counters 0, 1, 2, ...
 class SequentialRng {
-public:
+ public:
   SequentialRng(std::uint64_t seed, std::uint64_t stream) : rng_(seed, stream) {}
   SequentialRng(std::uint64_t seed, Stream stream) : rng_(seed, stream) {}
   std::uint64_t bits() { return rng_.bits(counter_++); }
@@ -95,7 +92,7 @@ public:
   std::uint64_t below(std::uint64_t n) { return rng_.below(counter_++, n); }
   [[nodiscard]] std::uint64_t position() const { return counter_; }
 
-private:
+ private:
   CounterRng rng_;
   std::uint64_t counter_ = 0;
 };

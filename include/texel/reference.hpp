@@ -61,14 +61,14 @@ enum class ReferenceParamKind {
 
 /// One adjustable parameter of a generator: what `texel reference --list` prints.
 struct ReferenceParam {
-  std::string key;            ///< e.g. "frequencies_cpm" (units in the key, as in documents)
+  std::string key;  ///< e.g. "frequencies_cpm" (units in the key, as in documents)
   ReferenceParamKind kind = ReferenceParamKind::number;
-  std::string unit;           ///< "cpm", "mm", "deg" or "" (dimensionless)
+  std::string unit;  ///< "cpm", "mm", "deg" or "" (dimensionless)
   ReferenceValue default_value;
-  double min = 0.0;           ///< number / integer / each list element
+  double min = 0.0;  ///< number / integer / each list element
   double max = 0.0;
-  std::size_t min_count = 0;  ///< list only
-  std::size_t max_count = 0;  ///< list only
+  std::size_t min_count = 0;         ///< list only
+  std::size_t max_count = 0;         ///< list only
   std::vector<std::string> choices;  ///< choice only
   std::string description;
 };
@@ -126,7 +126,7 @@ struct ReferenceFeature {
 
 /// A reference prepared for a grid: an immutable Texture.
 class ReferenceTexture final : public Texture {
-public:
+ public:
   /// Prepares `spec` over [0, length) for sampling on `grid` (positions in
   /// the texture's own coordinates; only origin and spacing matter): the
   /// grid's Nyquist frequency bounds the band, and the amplitude scale is
@@ -151,7 +151,7 @@ public:
   /// Slow, obviously-correct single-sample evaluation (tests).
   [[nodiscard]] double amplitude_at(double x_mm) const;
 
-private:
+ private:
   enum class Shape { sum, patch, pulse };
   void evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const;
 

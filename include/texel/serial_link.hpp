@@ -21,7 +21,7 @@ class PlayerMap;
 
 /// The display refused a request (NACK).
 class SerialError : public IoError {
-public:
+ public:
   SerialError(const std::string& what, serial::ErrorCode error_code, std::uint32_t error_detail)
       : IoError(what), code(error_code), detail(error_detail) {}
   serial::ErrorCode code;
@@ -38,8 +38,8 @@ struct DisplayInfo {
 };
 
 struct DisplayStatus {
-  int selected = -1;            ///< -1: none
-  int mode = 0;                 ///< 0 idle, 1 position, 2 drive
+  int selected = -1;  ///< -1: none
+  int mode = 0;       ///< 0 idle, 1 position, 2 drive
   std::uint16_t amplitude = 0;
   double x_mm = 0.0;
   bool touch = false;
@@ -51,7 +51,7 @@ struct DisplayStatus {
 };
 
 class SerialLink {
-public:
+ public:
   /// Opens `path` (a tty or pty), raw 8N1 at `baud`. Throws IoError.
   explicit SerialLink(const std::string& path, int baud = 921600);
   /// Adopts an open descriptor (closed by the destructor); `name` is used in messages.
@@ -81,11 +81,10 @@ public:
 
   [[nodiscard]] const std::string& name() const { return name_; }
 
-private:
+ private:
   std::uint8_t send(serial::Type type, const std::uint8_t* payload, std::size_t n);
   /// Sends a request and waits for its reply; returns the reply's payload.
-  std::string request(serial::Type type, const std::uint8_t* payload, std::size_t n, serial::Type expect,
-                      const char* what);
+  std::string request(serial::Type type, const std::uint8_t* payload, std::size_t n, serial::Type expect, const char* what);
   void write_all(const std::uint8_t* p, std::size_t n);
 
   int fd_ = -1;

@@ -24,7 +24,7 @@ namespace texel::serial {
 inline constexpr std::uint8_t sync0 = 0xA5;
 inline constexpr std::uint8_t sync1 = 0x5A;
 inline constexpr std::uint8_t protocol_version = 1;
-inline constexpr std::size_t header_size = 6;   ///< sync0 sync1 type seq len(2)
+inline constexpr std::size_t header_size = 6;  ///< sync0 sync1 type seq len(2)
 inline constexpr std::size_t crc_size = 2;
 inline constexpr std::size_t max_payload = 1024;
 inline constexpr std::size_t max_frame = header_size + max_payload + crc_size;
@@ -49,7 +49,7 @@ enum class Type : std::uint8_t {
 
 enum class ErrorCode : std::uint8_t {
   none = 0,
-  bad_checksum = 1,        ///< frame CRC failed (counted; cannot be answered reliably)
+  bad_checksum = 1,  ///< frame CRC failed (counted; cannot be answered reliably)
   unknown_type = 2,
   bad_length = 3,          ///< payload length wrong for the type
   oversize_map = 4,        ///< detail: the display's max samples
@@ -86,8 +86,7 @@ inline const char* describe(ErrorCode e) {
 constexpr std::uint16_t crc16(const std::uint8_t* p, std::size_t n, std::uint16_t crc = 0xFFFF) {
   for (std::size_t i = 0; i < n; ++i) {
     crc = static_cast<std::uint16_t>(crc ^ (p[i] << 8));
-    for (int b = 0; b < 8; ++b)
-      crc = static_cast<std::uint16_t>((crc & 0x8000) ? (crc << 1) ^ 0x1021 : crc << 1);
+    for (int b = 0; b < 8; ++b) crc = static_cast<std::uint16_t>((crc & 0x8000) ? (crc << 1) ^ 0x1021 : crc << 1);
   }
   return crc;
 }
@@ -115,8 +114,8 @@ inline void put_u32(std::uint8_t* p, std::uint32_t v) {
 inline void put_i32(std::uint8_t* p, std::int32_t v) { put_u32(p, static_cast<std::uint32_t>(v)); }
 inline std::uint16_t get_u16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
 inline std::uint32_t get_u32(const std::uint8_t* p) {
-  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) | (static_cast<std::uint32_t>(p[2]) << 16) |
+         (static_cast<std::uint32_t>(p[3]) << 24);
 }
 inline std::int32_t get_i32(const std::uint8_t* p) { return static_cast<std::int32_t>(get_u32(p)); }
 
@@ -124,8 +123,7 @@ inline std::int32_t get_i32(const std::uint8_t* p) { return static_cast<std::int
 
 /// Writes a frame into `out` (room for length + 8 bytes); returns its size,
 /// or 0 if length > max_payload.
-inline std::size_t encode_frame(Type type, std::uint8_t seq, const std::uint8_t* payload, std::size_t length,
-                                std::uint8_t* out) {
+inline std::size_t encode_frame(Type type, std::uint8_t seq, const std::uint8_t* payload, std::size_t length, std::uint8_t* out) {
   if (length > max_payload) return 0;
   out[0] = sync0;
   out[1] = sync1;
@@ -151,7 +149,7 @@ struct Frame {
 /// each rejected one (bad_checksum, bad_length). Garbage between frames is
 /// skipped silently (counted in skipped()).
 class Decoder {
-public:
+ public:
   template <class OnFrame, class OnError>
   void feed(const std::uint8_t* data, std::size_t n, OnFrame&& on_frame, OnError&& on_error) {
     while (n > 0) {
@@ -181,7 +179,7 @@ public:
   [[nodiscard]] std::size_t buffered() const { return end_ - start_; }
   [[nodiscard]] std::uint32_t skipped() const { return skipped_; }
 
-private:
+ private:
   void compact() {
     std::memmove(buf_, buf_ + start_, end_ - start_);
     end_ -= start_;

@@ -44,7 +44,7 @@ struct BackendStats {
 };
 
 class Backend {
-public:
+ public:
   virtual ~Backend() = default;
   /// Starts calling player.process() on the backend's real-time thread.
   virtual void start(Player& player) = 0;
@@ -58,12 +58,12 @@ public:
   /// Snapshot of the statistics; resets the peak.
   BackendStats stats();
 
-protected:
+ protected:
   /// Called by implementations after each block (relaxed atomics only).
   void record(const BlockInfo& info, double seconds) noexcept;
   void record_underrun() noexcept { underruns_.fetch_add(1, std::memory_order_relaxed); }
 
-private:
+ private:
   std::atomic<std::uint64_t> blocks_{0};
   std::atomic<std::uint64_t> worst_ns_{0};
   std::atomic<std::uint64_t> total_ns_{0};
@@ -78,10 +78,10 @@ private:
 std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames);
 
 struct AudioOptions {
-  std::string device;            ///< PortAudio device index or name substring; empty = default output
+  std::string device;  ///< PortAudio device index or name substring; empty = default output
   double rate_hz = 48000.0;
-  std::size_t block_frames = 64; ///< frames per buffer
-  double latency_s = 0.0;        ///< suggested latency; 0 = the device's low default
+  std::size_t block_frames = 64;  ///< frames per buffer
+  double latency_s = 0.0;         ///< suggested latency; 0 = the device's low default
 };
 /// A sound-card output through PortAudio. Throws IoError if PortAudio or the
 /// device cannot be opened (naming the device and listing the outputs).

@@ -50,14 +50,14 @@ struct SpectrumOptions {
 
 /// One-sided spectrum on bins k·bin_cpm, k = 0 … nfft/2.
 struct Spectrum {
-  double bin_cpm = 0.0;                ///< bin spacing, cycles/mm
-  double resolution_cpm = 0.0;         ///< 1 / signal length: the unpadded bin spacing
-  std::size_t samples = 0;             ///< signal length (samples)
-  std::size_t nfft = 0;                ///< transform length
+  double bin_cpm = 0.0;         ///< bin spacing, cycles/mm
+  double resolution_cpm = 0.0;  ///< 1 / signal length: the unpadded bin spacing
+  std::size_t samples = 0;      ///< signal length (samples)
+  std::size_t nfft = 0;         ///< transform length
   Window window = Window::blackman_harris;
-  std::vector<double> frequency_cpm;   ///< k·bin_cpm
-  std::vector<double> magnitude;       ///< amplitude-calibrated |X_k|
-  std::vector<double> power;           ///< mean-square amplitude per bin (sums to the variance)
+  std::vector<double> frequency_cpm;  ///< k·bin_cpm
+  std::vector<double> magnitude;      ///< amplitude-calibrated |X_k|
+  std::vector<double> power;          ///< mean-square amplitude per bin (sums to the variance)
 };
 
 /// Throws InvalidArgument for fewer than 4 samples, non-finite values or a
@@ -75,10 +75,10 @@ struct WelchOptions {
 
 struct Psd {
   double bin_cpm = 0.0;
-  std::size_t segment = 0;             ///< segment length used (samples)
-  std::size_t segments = 0;            ///< number averaged
-  std::vector<double> frequency_cpm;   ///< k·bin_cpm, k = 0 … segment/2
-  std::vector<double> density;         ///< a²/(cycle/mm), one-sided
+  std::size_t segment = 0;            ///< segment length used (samples)
+  std::size_t segments = 0;           ///< number averaged
+  std::vector<double> frequency_cpm;  ///< k·bin_cpm, k = 0 … segment/2
+  std::vector<double> density;        ///< a²/(cycle/mm), one-sided
 };
 
 Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOptions& options = {});
@@ -90,8 +90,8 @@ struct Peak {
 };
 
 struct PeakOptions {
-  double threshold_db = -40.0;  ///< keep peaks within this many dB of the highest
-  std::size_t max_peaks = 32;   ///< strongest first, then reported by frequency
+  double threshold_db = -40.0;     ///< keep peaks within this many dB of the highest
+  std::size_t max_peaks = 32;      ///< strongest first, then reported by frequency
   double min_frequency_cpm = 0.0;  ///< ignore bins below (DC is always ignored)
   double max_frequency_cpm = std::numeric_limits<double>::infinity();
 };
@@ -109,8 +109,7 @@ struct SpectralSummary {
   double log_spread_db = 0.0;  ///< the same in dB of log-frequency
   double total_power = 0.0;    ///< Σ P: mean-square amplitude in the band (a²)
 };
-SpectralSummary summarize(const Spectrum& spectrum, double lo_cpm = 0.0,
-                          double hi_cpm = std::numeric_limits<double>::infinity());
+SpectralSummary summarize(const Spectrum& spectrum, double lo_cpm = 0.0, double hi_cpm = std::numeric_limits<double>::infinity());
 
 /// Mean-square amplitude (a²) in [lo, hi) cycles/mm.
 double band_energy(const Spectrum& spectrum, double lo_cpm, double hi_cpm);
@@ -147,10 +146,10 @@ struct SpectralReport {
   Spectrum spectrum;
   Psd psd;
   std::vector<Peak> peaks;
-  SpectralSummary summary;       ///< over the whole band (DC excluded)
+  SpectralSummary summary;  ///< over the whole band (DC excluded)
   std::vector<BandEnergy> bands;
-  double mean = 0.0;             ///< mean amplitude (removed before analysis)
-  double rms = 0.0;              ///< RMS about the mean
+  double mean = 0.0;  ///< mean amplitude (removed before analysis)
+  double rms = 0.0;   ///< RMS about the mean
 };
 
 /// Magnitude spectrum, Welch PSD, peaks, summary and band energies of one

@@ -15,16 +15,16 @@
 namespace texel {
 
 struct SpectrumPlot {
-  std::string title;                   ///< figure title; empty = "Spectrum"
-  std::vector<double> positions_mm;    ///< x of each map sample (mm), ascending
-  std::vector<double> amplitudes;      ///< a of each map sample
-  double excerpt_mm = 6.0;             ///< excerpt length from the first sample (mm); 0 = no excerpt panel
-  Spectrum spectrum;                   ///< from magnitude_spectrum()
-  std::vector<Peak> peaks;             ///< marked as stems (may be empty)
+  std::string title;                       ///< figure title; empty = "Spectrum"
+  std::vector<double> positions_mm;        ///< x of each map sample (mm), ascending
+  std::vector<double> amplitudes;          ///< a of each map sample
+  double excerpt_mm = 6.0;                 ///< excerpt length from the first sample (mm); 0 = no excerpt panel
+  Spectrum spectrum;                       ///< from magnitude_spectrum()
+  std::vector<Peak> peaks;                 ///< marked as stems (may be empty)
   std::optional<double> swipe_speed_mm_s;  ///< > 0: add the temporal-frequency panel
-  double range_db = 80.0;              ///< magnitude axis spans the top range_db dB (10 … 200)
+  double range_db = 80.0;                  ///< magnitude axis spans the top range_db dB (10 … 200)
   int width_px = 1000;
-  int height_px = 0;                   ///< 0 = 280 per panel
+  int height_px = 0;  ///< 0 = 280 per panel
 };
 
 /// Throws InvalidArgument for an empty spectrum or mismatched map columns.

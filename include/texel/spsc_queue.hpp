@@ -32,7 +32,7 @@ class SpscQueue {
   static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0, "SpscQueue capacity must be a power of two");
   static_assert(std::is_trivially_copyable_v<T>, "SpscQueue holds trivially copyable values only");
 
-public:
+ public:
   static constexpr std::size_t capacity = Capacity;
 
   /// Producer: appends `v`; false (and nothing changes) if the queue is full.
@@ -76,11 +76,11 @@ public:
     return tail_.load(std::memory_order_acquire) - head_.load(std::memory_order_acquire);
   }
 
-private:
+ private:
   alignas(64) std::atomic<std::size_t> head_{0};  // written by the consumer
-  std::size_t tail_cache_ = 0;                     // consumer's copy of tail_
+  std::size_t tail_cache_ = 0;                    // consumer's copy of tail_
   alignas(64) std::atomic<std::size_t> tail_{0};  // written by the producer
-  std::size_t head_cache_ = 0;                     // producer's copy of head_
+  std::size_t head_cache_ = 0;                    // producer's copy of head_
   alignas(64) std::array<T, Capacity> slots_{};
 };
 

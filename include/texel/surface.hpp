@@ -24,7 +24,7 @@ struct Region {
 };
 
 class Surface {
-public:
+ public:
   /// Regions must lie inside the grid and not overlap; throws InvalidArgument.
   Surface(Grid grid, std::vector<Region> regions);
 
@@ -39,7 +39,7 @@ public:
   /// Device-native bytes of the whole map, rendered in cache-sized chunks.
   [[nodiscard]] std::vector<std::byte> render_native(SampleFormat format) const;
 
-private:
+ private:
   Grid grid_;
   std::vector<Region> regions_;
 };

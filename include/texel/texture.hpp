@@ -31,7 +31,7 @@ namespace texel {
 /// A prepared texture. Implementations are immutable and safe to share
 /// between threads.
 class Texture {
-public:
+ public:
   virtual ~Texture() = default;
   /// Length of the textured span (mm); positions beyond it are at rest.
   [[nodiscard]] virtual Millimetres length() const = 0;
@@ -52,19 +52,19 @@ Fill parse_fill(std::string_view text, std::string_view field = "fill");
 
 /// Everything that defines a Texel texture. Defaults are the studies' values.
 struct TexelSpec {
-  Decibels central_pitch{10.0};        ///< dB re 1 cpm
-  Decibels irregularity{-5.0};         ///< dB (see Parameterization)
-  Millimetres texel_length{0.25};      ///< mm, > 0; keep below ~1 mm for fine texture
-  std::uint64_t seed = 1;              ///< the random draw
+  Decibels central_pitch{10.0};    ///< dB re 1 cpm
+  Decibels irregularity{-5.0};     ///< dB (see Parameterization)
+  Millimetres texel_length{0.25};  ///< mm, > 0; keep below ~1 mm for fine texture
+  std::uint64_t seed = 1;          ///< the random draw
   Parameterization parameterization = Parameterization::moments;
   OutOfBand out_of_band = OutOfBand::redraw;
-  CyclesPerMm band_min{0.01};          ///< cpm; the source's hardware floor
-  CyclesPerMm band_max{0.0};           ///< cpm; 0 = the rendering grid's Nyquist frequency
-  double quantization_db = 0.0;        ///< 0 = off, else > 0 dB
+  CyclesPerMm band_min{0.01};    ///< cpm; the source's hardware floor
+  CyclesPerMm band_max{0.0};     ///< cpm; 0 = the rendering grid's Nyquist frequency
+  double quantization_db = 0.0;  ///< 0 = off, else > 0 dB
   PhaseMode phase = PhaseMode::continuous;
   Fill fill = Fill::whole_texels;
-  double coarse_strength = 0.0;        ///< C in [0, 1]
-  double fine_strength = 1.0;          ///< F in [0, 1]
+  double coarse_strength = 0.0;  ///< C in [0, 1]
+  double fine_strength = 1.0;    ///< F in [0, 1]
   CoarseProfile coarse = ConstantProfile{};
 };
 
@@ -73,14 +73,14 @@ void validate(const TexelSpec& spec);
 
 /// One texel of a prepared texture.
 struct Texel {
-  double start_mm;        ///< left edge, k·L
-  double frequency_cpm;   ///< f_k after truncation and quantization
-  double phase_cycles;    ///< oscillation phase at start_mm, in cycles [0, 1)
-  double envelope;        ///< e_k = 1 − C·(1 − c_k)
+  double start_mm;       ///< left edge, k·L
+  double frequency_cpm;  ///< f_k after truncation and quantization
+  double phase_cycles;   ///< oscillation phase at start_mm, in cycles [0, 1)
+  double envelope;       ///< e_k = 1 − C·(1 − c_k)
 };
 
 class TexelTexture final : public Texture {
-public:
+ public:
   /// Prepares `spec` over `length`. `nyquist` is the rendering grid's Nyquist
   /// frequency, used as band_max when spec.band_max is 0. Allocates.
   TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerMm nyquist);
@@ -104,7 +104,7 @@ public:
   /// that k·L computed in floating point lands in texel k (1 picometre).
   static constexpr double boundary_tolerance_mm = 1e-9;
 
-private:
+ private:
   TexelSpec spec_;
   Millimetres length_;
   PitchDistribution distribution_;

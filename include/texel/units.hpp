@@ -14,7 +14,7 @@ namespace texel {
 
 template <class Tag>
 class Quantity {
-public:
+ public:
   constexpr Quantity() = default;
   constexpr explicit Quantity(double value) : value_(value) {}
   [[nodiscard]] constexpr double value() const { return value_; }
@@ -25,16 +25,24 @@ public:
   constexpr Quantity operator*(double k) const { return Quantity(value_ * k); }
   constexpr Quantity operator/(double k) const { return Quantity(value_ / k); }
   constexpr double operator/(Quantity o) const { return value_ / o.value_; }
-  constexpr Quantity& operator+=(Quantity o) { value_ += o.value_; return *this; }
-  constexpr Quantity& operator-=(Quantity o) { value_ -= o.value_; return *this; }
+  constexpr Quantity& operator+=(Quantity o) {
+    value_ += o.value_;
+    return *this;
+  }
+  constexpr Quantity& operator-=(Quantity o) {
+    value_ -= o.value_;
+    return *this;
+  }
   constexpr auto operator<=>(const Quantity&) const = default;
 
-private:
+ private:
   double value_ = 0.0;
 };
 
 template <class Tag>
-constexpr Quantity<Tag> operator*(double k, Quantity<Tag> q) { return q * k; }
+constexpr Quantity<Tag> operator*(double k, Quantity<Tag> q) {
+  return q * k;
+}
 
 struct MillimetreTag {};
 struct CyclesPerMmTag {};

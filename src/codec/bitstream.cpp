@@ -25,8 +25,8 @@ constexpr std::uint8_t flag_coarse = 1u << 6;
 constexpr std::uint8_t flag_reserved = 1u << 7;
 
 // Rice coding of the coarse residuals (JPEG-LS style adaptive parameter).
-constexpr unsigned rice_escape = 24;   // unary quotients this long switch to raw bits
-constexpr std::uint32_t rice_a0 = 2;   // initial sum of |residual|
+constexpr unsigned rice_escape = 24;  // unary quotients this long switch to raw bits
+constexpr std::uint32_t rice_a0 = 2;  // initial sum of |residual|
 constexpr std::uint32_t rice_reset = 32;
 
 std::string hex(std::uint8_t b) {
@@ -77,7 +77,7 @@ struct BitWriter {
 // --- readers (bounds-checked; every failure names the field) ----------------
 
 class ByteReader {
-public:
+ public:
   explicit ByteReader(std::span<const std::uint8_t> b) : b_(b) {}
   [[nodiscard]] std::size_t offset() const { return pos_; }
   [[nodiscard]] std::size_t remaining() const { return b_.size() - pos_; }
@@ -113,7 +113,7 @@ public:
   std::span<const std::uint8_t> rest() const { return b_.subspan(pos_); }
   void skip(std::size_t n) { pos_ += n; }
 
-private:
+ private:
   void need(std::size_t n, const char* field) const {
     if (remaining() < n)
       throw FormatError(std::string("bitstream truncated: field '") + field + "' needs " + std::to_string(n) +
@@ -125,7 +125,7 @@ private:
 };
 
 class BitReader {
-public:
+ public:
   explicit BitReader(std::span<const std::uint8_t> b) : b_(b) {}
   unsigned bit() {
     if (pos_ >= b_.size() * 8)
@@ -147,7 +147,7 @@ public:
     return (b_[pos_ >> 3] & ((1u << (8 - rem)) - 1u)) == 0;
   }
 
-private:
+ private:
   std::span<const std::uint8_t> b_;
   std::size_t pos_ = 0;
 };
@@ -183,7 +183,7 @@ std::int64_t predict(const std::vector<std::uint16_t>& q, std::size_t k, unsigne
 std::uint32_t residual_code(std::int64_t value, std::int64_t prediction, unsigned bits) {
   const std::int64_t m = std::int64_t{1} << bits;
   std::int64_t e = (value - prediction) & (m - 1);  // mod 2^bits
-  if (e >= m / 2) e -= m;                            // [-2^(b-1), 2^(b-1))
+  if (e >= m / 2) e -= m;                           // [-2^(b-1), 2^(b-1))
   return static_cast<std::uint32_t>(e >= 0 ? 2 * e : -2 * e - 1);
 }
 
@@ -328,7 +328,8 @@ Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
     if (c.bits > 0) {
       const std::uint64_t stride = r.varint("coarse_stride");
       if (stride == 0 || stride > max_coarse_levels)
-        throw FormatError("bitstream coarse_stride is " + std::to_string(stride) + "; allowed: 1 … " + std::to_string(max_coarse_levels));
+        throw FormatError("bitstream coarse_stride is " + std::to_string(stride) + "; allowed: 1 … " +
+                          std::to_string(max_coarse_levels));
       c.stride = static_cast<std::uint32_t>(stride);
       const std::uint64_t count = r.varint("coarse_count");
       // Every level costs at least one bit, so the bytes present bound the count.
@@ -347,8 +348,8 @@ Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
         if (quotient == rice_escape) {
           u = br.bits(c.bits);
           if ((u >> kk) < rice_escape)
-            throw FormatError("bitstream coarse level " + std::to_string(k) + " uses an escape for residual code " + std::to_string(u) +
-                              ", which has a short code; allowed: canonical Rice codes only");
+            throw FormatError("bitstream coarse level " + std::to_string(k) + " uses an escape for residual code " +
+                              std::to_string(u) + ", which has a short code; allowed: canonical Rice codes only");
         } else {
           u = (quotient << kk) | br.bits(kk);
           if (u >= (1u << c.bits))
@@ -368,7 +369,8 @@ Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
                       std::to_string(r.offset()) + " before the CRC");
   const std::uint8_t want = crc8(bytes.first(bytes.size() - 1));
   if (bytes.back() != want)
-    throw FormatError("bitstream CRC mismatch: stored " + hex(bytes.back()) + ", computed " + hex(want) + " (corrupted or truncated)");
+    throw FormatError("bitstream CRC mismatch: stored " + hex(bytes.back()) + ", computed " + hex(want) +
+                      " (corrupted or truncated)");
 
   // The texture must be renderable: validate the spec and its distribution.
   try {
@@ -470,7 +472,8 @@ Bitstream from_spec(const TexelSpec& spec, Millimetres length, unsigned bits) {
   } else {
     c.coarse_strength = static_cast<std::uint8_t>(std::lround(C * 255.0));
     const std::size_t n = std::max<std::size_t>(1, texel_count(length, spec.texel_length, spec.fill));
-    if (n > max_coarse_levels) throw InvalidArgument("coarse profile of " + std::to_string(n) + " texels exceeds the bitstream's limit");
+    if (n > max_coarse_levels)
+      throw InvalidArgument("coarse profile of " + std::to_string(n) + " texels exceeds the bitstream's limit");
     const std::vector<double> v = sample_at_texel_centres(spec.coarse, spec.texel_length, n);
     const double top = static_cast<double>((1u << bits) - 1u);
     c.bits = static_cast<std::uint8_t>(bits);

@@ -5,12 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
-#include <deque>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <memory>
-#include <numeric>
 #include <numbers>
+#include <numeric>
 #include <utility>
 
 #include "../spectrum/fft.hpp"
@@ -27,8 +27,8 @@ using detail::num;
 constexpr double ten_over_ln10 = 4.34294481903251827651;
 // Texel-rendering recovery (docs/encoder.md, "Texel renderings").
 constexpr std::array<double, 3> recovery_texel_lengths_mm{0.25, 0.5, 1.0};  // tried besides --texel-length
-constexpr double recovery_rms = 0.02;      // residual RMS (re amplitude) below which the input is a rendering
-constexpr double recovery_floor = 1e-4;    // residual RMS any rendering's quantization may add (16-bit: ~1e-5)
+constexpr double recovery_rms = 0.02;    // residual RMS (re amplitude) below which the input is a rendering
+constexpr double recovery_floor = 1e-4;  // residual RMS any rendering's quantization may add (16-bit: ~1e-5)
 double db_of(double cpm) { return ten_over_ln10 * std::log(cpm); }
 double cpm_of(double db) { return std::pow(10.0, db / 10.0); }
 
@@ -166,13 +166,13 @@ double correlation(const std::vector<double>& a, const std::vector<double>& b) {
 // --- the coarse/fine split ----------------------------------------------------
 
 struct Split {
-  std::vector<double> fine;      // zero-mean fine signal (envelope divided out)
-  double range = 0.0;            // relative envelope range (p98 − p2) / p98 at texel centres
-  std::size_t window = 0;        // running-extreme window, samples
+  std::vector<double> fine;  // zero-mean fine signal (envelope divided out)
+  double range = 0.0;        // relative envelope range (p98 − p2) / p98 at texel centres
+  std::size_t window = 0;    // running-extreme window, samples
   bool coarse = false;
   double C = 0.0;
   double F = 1.0;
-  std::vector<double> c;         // per-texel coarse profile (coarse only)
+  std::vector<double> c;  // per-texel coarse profile (coarse only)
 };
 
 enum class SplitMode { automatic, fine_only, two_scale };
@@ -227,7 +227,8 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
   std::vector<double> lo = moving_average(running_extreme(a, w, false), smooth);
   for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
 
-  const std::size_t k_count = std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
+  const std::size_t k_count =
+      std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
   std::vector<double> e(k_count), fk(k_count), e_slow(k_count);
   for (std::size_t k = 0; k < k_count; ++k) {
     const double x = (static_cast<double>(k) + 0.5) * L;
@@ -323,7 +324,7 @@ struct Fitter {
   double dx;
   std::size_t samples;
   CyclesPerMm band_max;
-  double f_min = 0.0;  // analysis band bottom (the boundary, for the fine part of a two-scale texture)
+  double f_min = 0.0;                // analysis band bottom (the boundary, for the fine part of a two-scale texture)
   const Split* two_scale = nullptr;  // the input's coarse estimate: candidates carry it and are split alike
   int evaluations = 0;
 
@@ -405,7 +406,8 @@ std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double
       s[2] = V{r.p, r.i, fr};
     } else {
       const bool outside = fr < s[2].v;
-      const V c = outside ? V{cp + 0.5 * (r.p - cp), ci + 0.5 * (r.i - ci), 0} : V{cp + 0.5 * (s[2].p - cp), ci + 0.5 * (s[2].i - ci), 0};
+      const V c =
+          outside ? V{cp + 0.5 * (r.p - cp), ci + 0.5 * (r.i - ci), 0} : V{cp + 0.5 * (s[2].p - cp), ci + 0.5 * (s[2].i - ci), 0};
       const double fc = f(c.p, c.i);
       ++used;
       if (fc < std::min(fr, s[2].v)) {
@@ -575,20 +577,20 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
     };
     double best = 1e300, bf = 0.0, bp = 0.0;
     auto search = [&](const std::vector<double>& starts) {
-    for (double ph : starts) {
-      std::vector<double> fs, cs;
-      for (double fq = 0.01; fq <= f_top + step; fq += step) fs.push_back(fq), cs.push_back(cost(b, e, x0, ph, fq));
-      std::vector<std::size_t> minima;
-      for (std::size_t j = 0; j < cs.size(); ++j)
-        if ((j == 0 || cs[j] <= cs[j - 1]) && (j + 1 == cs.size() || cs[j] <= cs[j + 1])) minima.push_back(j);
-      std::sort(minima.begin(), minima.end(), [&](std::size_t u, std::size_t v) { return cs[u] < cs[v]; });
-      if (minima.size() > 4) minima.resize(4);
-      for (std::size_t j : minima) {
-        double p1 = ph, f1 = fs[j], c1 = cs[j];
-        refine(p1, f1, c1);
-        if (c1 < best) best = c1, bf = f1, bp = p1;
+      for (double ph : starts) {
+        std::vector<double> fs, cs;
+        for (double fq = 0.01; fq <= f_top + step; fq += step) fs.push_back(fq), cs.push_back(cost(b, e, x0, ph, fq));
+        std::vector<std::size_t> minima;
+        for (std::size_t j = 0; j < cs.size(); ++j)
+          if ((j == 0 || cs[j] <= cs[j - 1]) && (j + 1 == cs.size() || cs[j] <= cs[j + 1])) minima.push_back(j);
+        std::sort(minima.begin(), minima.end(), [&](std::size_t u, std::size_t v) { return cs[u] < cs[v]; });
+        if (minima.size() > 4) minima.resize(4);
+        for (std::size_t j : minima) {
+          double p1 = ph, f1 = fs[j], c1 = cs[j];
+          refine(p1, f1, c1);
+          if (c1 < best) best = c1, bf = f1, bp = p1;
+        }
       }
-    }
     };
     search(phases);
     // The previous texel may have ended near a crest, where its end phase is
@@ -646,7 +648,8 @@ struct TexelRecovery {
   std::size_t texels = 0;
 };
 
-std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double dx, const EncoderConfig& cfg, CyclesPerMm band_max) {
+std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double dx, const EncoderConfig& cfg,
+                                           CyclesPerMm band_max) {
   const auto [lo_it, hi_it] = std::minmax_element(a.begin(), a.end());
   const double g = 0.5 * (*hi_it - *lo_it), c = 0.5 * (*hi_it + *lo_it);
   if (g < 0.01) return std::nullopt;
@@ -766,8 +769,8 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   for (std::size_t i = 1; i < p.size(); ++i)
     if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
-  double sw = 0, swf = 0, swd = 0, swdd = 0;   // perceptual weights
-  double sp = 0, spf = 0, spd = 0, spdd = 0;   // physical (power) weights
+  double sw = 0, swf = 0, swd = 0, swdd = 0;  // perceptual weights
+  double sp = 0, spf = 0, spd = 0, spdd = 0;  // physical (power) weights
   for (std::size_t i = 1; i < p.size(); ++i) {
     if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
     const double f = bins.f[i], d = bins.d[i];
@@ -907,9 +910,11 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     if (cfg.max_bytes) {
       for (unsigned bits = 8; bits >= 2; --bits)
         for (std::uint32_t stride : {1u, 2u, 3u, 4u, 6u, 8u, 12u, 16u, 24u, 32u, 48u, 64u})
-          for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}}) options.push_back(coarse_fields(sp.c, sp.C, F, bits, stride, pred));
+          for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}})
+            options.push_back(coarse_fields(sp.c, sp.C, F, bits, stride, pred));
     } else {
-      for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}}) options.push_back(coarse_fields(sp.c, sp.C, F, cfg.coarse_bits, 1, pred));
+      for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}})
+        options.push_back(coarse_fields(sp.c, sp.C, F, cfg.coarse_bits, 1, pred));
     }
     const std::size_t fixed = write_bitstream(b).size();
     const CoarseFields* chosen = nullptr;
@@ -923,7 +928,8 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
         chosen = &o, chosen_err = err, chosen_size = size;
     }
     if (!chosen)
-      throw InvalidArgument("--max-bytes " + std::to_string(*cfg.max_bytes) + " is too small for this texture's coarse profile; it needs at least " +
+      throw InvalidArgument("--max-bytes " + std::to_string(*cfg.max_bytes) +
+                            " is too small for this texture's coarse profile; it needs at least " +
                             std::to_string(fixed + coarse_section_bytes(options.back())) + " bytes");
     b.coarse = *chosen;
     decoded_c = decoded_profile(*chosen, sp.c.size());

@@ -31,7 +31,8 @@ void normalize_full_range(std::vector<double>& y, const std::string& path) {
 
 MmPerSecond need_speed(const LoadOptions& o, const std::string& path) {
   if (!o.swipe_speed)
-    throw InvalidArgument("'" + path + "' is a time recording; give the swipe speed that turns time into position (--swipe-speed MM_S)");
+    throw InvalidArgument("'" + path +
+                          "' is a time recording; give the swipe speed that turns time into position (--swipe-speed MM_S)");
   return *o.swipe_speed;
 }
 
@@ -43,8 +44,8 @@ double uniform_step(const std::vector<double>& axis, const std::string& path, co
     throw FormatError("'" + path + "': the " + std::string(what) + " column must increase");
   for (std::size_t i = 1; i < axis.size(); ++i)
     if (std::fabs(axis[i] - axis[i - 1] - step) > 0.01 * step)
-      throw FormatError("'" + path + "': the " + std::string(what) + " column is not uniformly sampled at row " + std::to_string(i + 1) +
-                        " (step " + num(axis[i] - axis[i - 1]) + ", expected " + num(step) + ")");
+      throw FormatError("'" + path + "': the " + std::string(what) + " column is not uniformly sampled at row " +
+                        std::to_string(i + 1) + " (step " + num(axis[i] - axis[i - 1]) + ", expected " + num(step) + ")");
   return step;
 }
 
@@ -111,7 +112,8 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
     const std::size_t bps = bytes_per_sample(device.format);
     if (bytes.empty() || bytes.size() % bps != 0)
       throw FormatError("'" + path + "' has " + std::to_string(bytes.size()) + " bytes, not a whole number of " +
-                        std::string(to_string(device.format)) + " samples of device '" + device.name + "' (choose it with --device)");
+                        std::string(to_string(device.format)) + " samples of device '" + device.name +
+                        "' (choose it with --device)");
     sig.amplitude = decode_samples(device.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
     sig.spacing_mm = device_spacing(o, device);
     sig.description = "device map (" + device.name + ", " + std::string(to_string(device.format)) + ")";

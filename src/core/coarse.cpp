@@ -52,7 +52,8 @@ struct Validator {
   }
   void operator()(const ValuesProfile& p) const {
     if (p.values.empty()) throw InvalidArgument("coarse.values is empty; give one value in 0 … 1 per texel");
-    for (std::size_t i = 0; i < p.values.size(); ++i) check_unit_interval(p.values[i], "coarse.values[" + std::to_string(i) + "]");
+    for (std::size_t i = 0; i < p.values.size(); ++i)
+      check_unit_interval(p.values[i], "coarse.values[" + std::to_string(i) + "]");
   }
   void operator()(const PointsProfile& p) const {
     if (p.points.empty()) throw InvalidArgument("coarse.points is empty; give at least one [position_mm, value] pair");
@@ -70,7 +71,8 @@ struct Validator {
     if (!(std::isfinite(p.spacing_mm) && p.spacing_mm > 0.0))
       throw InvalidArgument("coarse.spacing_mm is " + num(p.spacing_mm) + " mm; it must be a finite number > 0");
     if (p.values.empty()) throw InvalidArgument("coarse sampled profile has no values");
-    for (std::size_t i = 0; i < p.values.size(); ++i) check_unit_interval(p.values[i], "coarse.samples[" + std::to_string(i) + "]");
+    for (std::size_t i = 0; i < p.values.size(); ++i)
+      check_unit_interval(p.values[i], "coarse.samples[" + std::to_string(i) + "]");
   }
 };
 

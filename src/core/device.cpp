@@ -71,7 +71,8 @@ void validate(const DeviceProfile& p) {
     throw InvalidArgument(at + "band_max_cpm " + num(p.band_max_cpm) + " cpm is above the grid's Nyquist frequency " +
                           num(p.nyquist_cpm()) + " cpm");
   if (p.band_min_cpm >= p.band_top_cpm())
-    throw InvalidArgument(at + "band_min_cpm " + num(p.band_min_cpm) + " cpm is not below the band's top " + num(p.band_top_cpm()) + " cpm");
+    throw InvalidArgument(at + "band_min_cpm " + num(p.band_min_cpm) + " cpm is not below the band's top " +
+                          num(p.band_top_cpm()) + " cpm");
   double prev_end = 0.0;
   for (const auto& r : p.layout) {
     if (!(r.start_mm >= prev_end - 1e-9 && r.length_mm > 0.0 && r.start_mm + r.length_mm <= p.length_mm() + 1e-3))
@@ -154,7 +155,8 @@ DeviceProfile load_device(std::string_view name_or_path) {
       if (dir.empty()) continue;
       const auto candidate = std::filesystem::path(dir) / (key + ".json");
       std::error_code ec;
-      if (std::filesystem::is_regular_file(candidate, ec)) return parse_device_profile(read_file(candidate.string()), candidate.string());
+      if (std::filesystem::is_regular_file(candidate, ec))
+        return parse_device_profile(read_file(candidate.string()), candidate.string());
     }
   }
   std::string known;
@@ -195,20 +197,24 @@ namespace {
 // comparisons, the same a·65535 + 0.5 in IEEE double, truncation to integer,
 // round-to-nearest double -> float — so the bytes do not depend on the lane
 // width, which is picked per instruction set at run time (as in texture.cpp).
-template <int W> struct Lanes;
-template <> struct Lanes<2> {
+template <int W>
+struct Lanes;
+template <>
+struct Lanes<2> {
   using d = double __attribute__((vector_size(16)));
   using i32 = std::int32_t __attribute__((vector_size(8)));
   using u16 = std::uint16_t __attribute__((vector_size(4)));
   using f32 = float __attribute__((vector_size(8)));
 };
-template <> struct Lanes<4> {
+template <>
+struct Lanes<4> {
   using d = double __attribute__((vector_size(32)));
   using i32 = std::int32_t __attribute__((vector_size(16)));
   using u16 = std::uint16_t __attribute__((vector_size(8)));
   using f32 = float __attribute__((vector_size(16)));
 };
-template <> struct Lanes<8> {
+template <>
+struct Lanes<8> {
   using d = double __attribute__((vector_size(64)));
   using i32 = std::int32_t __attribute__((vector_size(32)));
   using u16 = std::uint16_t __attribute__((vector_size(16)));
@@ -253,9 +259,15 @@ template <class T>
 using EncodeKernel = void (*)(const double*, T*, std::size_t);
 
 #if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx512f"))) void encode_u16_avx512(const double* a, std::uint16_t* o, std::size_t n) { encode_u16_lanes<8>(a, o, n); }
-__attribute__((target("avx2"))) void encode_u16_avx2(const double* a, std::uint16_t* o, std::size_t n) { encode_u16_lanes<4>(a, o, n); }
-__attribute__((target("avx512f"))) void encode_f32_avx512(const double* a, float* o, std::size_t n) { encode_f32_lanes<8>(a, o, n); }
+__attribute__((target("avx512f"))) void encode_u16_avx512(const double* a, std::uint16_t* o, std::size_t n) {
+  encode_u16_lanes<8>(a, o, n);
+}
+__attribute__((target("avx2"))) void encode_u16_avx2(const double* a, std::uint16_t* o, std::size_t n) {
+  encode_u16_lanes<4>(a, o, n);
+}
+__attribute__((target("avx512f"))) void encode_f32_avx512(const double* a, float* o, std::size_t n) {
+  encode_f32_lanes<8>(a, o, n);
+}
 __attribute__((target("avx2"))) void encode_f32_avx2(const double* a, float* o, std::size_t n) { encode_f32_lanes<4>(a, o, n); }
 #endif
 void encode_u16_generic(const double* a, std::uint16_t* o, std::size_t n) { encode_u16_lanes<2>(a, o, n); }

@@ -61,9 +61,9 @@ PitchDistribution::PitchDistribution(const PitchDistributionConfig& config) : co
   const double lo_db = db_of(lo);
   const double hi_db = db_of(hi);
   if (p_db < lo_db - 1e-9 || p_db > hi_db + 1e-9)
-    throw InvalidArgument("central_pitch_db is " + num(p_db) + " dB (" + num(cpm_of(p_db)) + " cpm), outside the renderable band " +
-                          detail::fixed(lo_db, 2) + " … " + detail::fixed(hi_db, 2) + " dB (" + num(lo) + " … " + num(hi) +
-                          " cpm; the top is the grid's Nyquist frequency unless set)");
+    throw InvalidArgument("central_pitch_db is " + num(p_db) + " dB (" + num(cpm_of(p_db)) +
+                          " cpm), outside the renderable band " + detail::fixed(lo_db, 2) + " … " + detail::fixed(hi_db, 2) +
+                          " dB (" + num(lo) + " … " + num(hi) + " cpm; the top is the grid's Nyquist frequency unless set)");
 
   if (config.parameterization == Parameterization::moments) {
     const double m = cpm_of(p_db);
@@ -91,7 +91,8 @@ PitchDistribution::PitchDistribution(const PitchDistributionConfig& config) : co
   if (config.out_of_band == OutOfBand::redraw && band_mass_ < min_band_mass)
     throw InvalidArgument("the pitch distribution (central_pitch_db " + num(p_db) + " dB, irregularity_db " + num(i_db) +
                           " dB) has only " + num(band_mass_) + " of its mass inside the band " + num(lo) + " … " + num(hi) +
-                          " cpm; at least " + num(min_band_mass) + " is needed (narrow the irregularity or use out_of_band clamp)");
+                          " cpm; at least " + num(min_band_mass) +
+                          " is needed (narrow the irregularity or use out_of_band clamp)");
 }
 
 double PitchDistribution::quantize(double f) const {

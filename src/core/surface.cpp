@@ -42,7 +42,8 @@ void Surface::render(std::int64_t first, std::span<double> out) const {
       const double x = grid_.position(i);
       return x >= r.start_mm && x < end_mm;
     };
-    std::int64_t a = std::max<std::int64_t>(first, static_cast<std::int64_t>(std::floor((r.start_mm - grid_.origin_mm) / grid_.spacing_mm)) - 1);
+    std::int64_t a = std::max<std::int64_t>(
+        first, static_cast<std::int64_t>(std::floor((r.start_mm - grid_.origin_mm) / grid_.spacing_mm)) - 1);
     while (a < first + n && !inside(a)) ++a;
     if (a >= first + n) continue;
     std::int64_t b = a;

@@ -68,7 +68,9 @@ template <int W>
 using RunKernel = void (*)(const Run&, double*, std::int32_t);
 
 #if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx512f"))) void render_run_avx512(const Run& r, double* out, std::int32_t n) { render_lanes<8>(r, out, n); }
+__attribute__((target("avx512f"))) void render_run_avx512(const Run& r, double* out, std::int32_t n) {
+  render_lanes<8>(r, out, n);
+}
 __attribute__((target("avx2"))) void render_run_avx2(const Run& r, double* out, std::int32_t n) { render_lanes<4>(r, out, n); }
 #endif
 void render_run_generic(const Run& r, double* out, std::int32_t n) { render_lanes<2>(r, out, n); }
@@ -110,7 +112,8 @@ void validate(const TexelSpec& spec) {
   check_fraction(spec.coarse_strength, "coarse_strength");
   check_fraction(spec.fine_strength, "fine_strength");
   if (!std::isfinite(spec.band_max.value()) || spec.band_max.value() < 0.0)
-    throw InvalidArgument("band_max_cpm is " + num(spec.band_max.value()) + " cpm; allowed: 0 (the grid's Nyquist) or > band_min_cpm");
+    throw InvalidArgument("band_max_cpm is " + num(spec.band_max.value()) +
+                          " cpm; allowed: 0 (the grid's Nyquist) or > band_min_cpm");
   validate(spec.coarse);
 }
 
@@ -125,9 +128,7 @@ std::size_t texel_count(Millimetres length, Millimetres texel_length, Fill fill)
 }
 
 TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerMm nyquist)
-    : spec_(spec),
-      length_(length),
-      distribution_([&] {
+    : spec_(spec), length_(length), distribution_([&] {
         validate(spec);
         if (!(std::isfinite(length.value()) && length.value() > 0.0))
           throw InvalidArgument("texture length is " + num(length.value()) + " mm; it must be a finite number > 0");
@@ -225,8 +226,14 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
     const Texel& t = texels_[ik];
     for (std::int64_t a = j; a < end;) {
       const std::int64_t len = std::min<std::int64_t>(end - a, 1 << 30);
-      const Run run{static_cast<double>(first + a), grid.origin_mm, grid.spacing_mm, t.start_mm, t.frequency_cpm,
-                    t.phase_cycles, offset_[ik], gain_[ik]};
+      const Run run{static_cast<double>(first + a),
+                    grid.origin_mm,
+                    grid.spacing_mm,
+                    t.start_mm,
+                    t.frequency_cpm,
+                    t.phase_cycles,
+                    offset_[ik],
+                    gain_[ik]};
       kernel(run, out.data() + a, static_cast<std::int32_t>(len));
       a += len;
     }

@@ -82,9 +82,12 @@ ordered reference_json(const ReferenceSpec& spec) {
   j["seed"] = spec.seed;
   ordered params = ordered::object();
   for (const auto& [key, value] : spec.params) {
-    if (const auto* d = std::get_if<double>(&value)) params[key] = *d;
-    else if (const auto* l = std::get_if<std::vector<double>>(&value)) params[key] = *l;
-    else params[key] = std::get<std::string>(value);
+    if (const auto* d = std::get_if<double>(&value))
+      params[key] = *d;
+    else if (const auto* l = std::get_if<std::vector<double>>(&value))
+      params[key] = *l;
+    else
+      params[key] = std::get<std::string>(value);
   }
   j["params"] = std::move(params);
   return j;
@@ -112,12 +115,14 @@ CoarseProfile parse_coarse(const json& j, const std::string& path) {
     profile = std::move(v);
   } else if (kind == "points") {
     const auto& arr = o.raw("points");
-    if (!arr.is_array() || arr.empty()) throw FormatError(o.field("points") + " must be a non-empty array of [position_mm, value] pairs");
+    if (!arr.is_array() || arr.empty())
+      throw FormatError(o.field("points") + " must be a non-empty array of [position_mm, value] pairs");
     PointsProfile p;
     for (std::size_t i = 0; i < arr.size(); ++i) {
       const auto& pt = arr[i];
       if (!pt.is_array() || pt.size() != 2 || !pt[0].is_number() || !pt[1].is_number())
-        throw FormatError(o.field("points") + "[" + std::to_string(i) + "] must be a pair [position_mm, value], got " + pt.dump());
+        throw FormatError(o.field("points") + "[" + std::to_string(i) + "] must be a pair [position_mm, value], got " +
+                          pt.dump());
       p.points.emplace_back(pt[0].get<double>(), pt[1].get<double>());
     }
     profile = std::move(p);
@@ -150,7 +155,8 @@ ordered coarse_json(const CoarseProfile& profile) {
     // A sampled profile is written as points, which the parser reads back.
     j["kind"] = "points";
     j["points"] = ordered::array();
-    for (std::size_t i = 0; i < sp->values.size(); ++i) j["points"].push_back({static_cast<double>(i) * sp->spacing_mm, sp->values[i]});
+    for (std::size_t i = 0; i < sp->values.size(); ++i)
+      j["points"].push_back({static_cast<double>(i) * sp->spacing_mm, sp->values[i]});
   }
   return j;
 }
@@ -327,8 +333,8 @@ std::string document_json(const Document& doc) {
   } else {
     j["device"] = doc.device.name;
   }
-  const bool whole = doc.regions.size() == 1 && doc.regions[0].start_mm == 0.0 && !doc.regions[0].length_mm &&
-                     doc.regions[0].name.empty();
+  const bool whole =
+      doc.regions.size() == 1 && doc.regions[0].start_mm == 0.0 && !doc.regions[0].length_mm && doc.regions[0].name.empty();
   const auto texture_json = [](const RegionSpec& r) {
     return r.reference ? reference_json(*r.reference) : texel_json(r.texel, r.coarse_reference);
   };

@@ -37,7 +37,8 @@ void check_writable(const std::string& path) {
   if (fs::is_directory(p, ec)) throw IoError("cannot write '" + path + "': it is a directory");
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw IoError("cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0) throw IoError("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw IoError("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
 }
 
 void write_file_atomic(const std::string& path, std::string_view data) {
@@ -107,7 +108,8 @@ std::string npy_bytes(std::span<const double> values) {
 
 std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
   const std::string where(origin);
-  if (b.size() < 10 || b.substr(0, 6) != std::string_view("\x93NUMPY", 6)) throw FormatError(where + ": not a .npy file (bad magic)");
+  if (b.size() < 10 || b.substr(0, 6) != std::string_view("\x93NUMPY", 6))
+    throw FormatError(where + ": not a .npy file (bad magic)");
   const auto major = static_cast<unsigned char>(b[6]);
   std::size_t header_len = 0;
   std::size_t offset = 0;
@@ -162,21 +164,38 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
   }
   if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
   std::size_t width = 0;
-  if (descr == "<f8") width = 8;
-  else if (descr == "<f4") width = 4;
-  else if (descr == "<u2" || descr == "<i2") width = 2;
-  else if (descr == "|u1" || descr == "<u1") width = 1;
-  else throw FormatError(where + ": .npy dtype '" + descr + "' is not supported (use float64, float32, int16, uint16 or uint8)");
+  if (descr == "<f8")
+    width = 8;
+  else if (descr == "<f4")
+    width = 4;
+  else if (descr == "<u2" || descr == "<i2")
+    width = 2;
+  else if (descr == "|u1" || descr == "<u1")
+    width = 1;
+  else
+    throw FormatError(where + ": .npy dtype '" + descr + "' is not supported (use float64, float32, int16, uint16 or uint8)");
   if (b.size() - data_at != n * width)
-    throw FormatError(where + ": .npy data holds " + std::to_string(b.size() - data_at) + " bytes, shape needs " + std::to_string(n * width));
+    throw FormatError(where + ": .npy data holds " + std::to_string(b.size() - data_at) + " bytes, shape needs " +
+                      std::to_string(n * width));
   std::vector<double> out(n);
   const char* p = b.data() + data_at;
   for (std::size_t i = 0; i < n; ++i, p += width) {
-    if (descr == "<f8") std::memcpy(&out[i], p, 8);
-    else if (descr == "<f4") { float f; std::memcpy(&f, p, 4); out[i] = f; }
-    else if (descr == "<u2") { std::uint16_t u; std::memcpy(&u, p, 2); out[i] = u / 65535.0; }
-    else if (descr == "<i2") { std::int16_t s; std::memcpy(&s, p, 2); out[i] = s / 32768.0; }
-    else out[i] = static_cast<unsigned char>(*p) / 255.0;
+    if (descr == "<f8")
+      std::memcpy(&out[i], p, 8);
+    else if (descr == "<f4") {
+      float f;
+      std::memcpy(&f, p, 4);
+      out[i] = f;
+    } else if (descr == "<u2") {
+      std::uint16_t u;
+      std::memcpy(&u, p, 2);
+      out[i] = u / 65535.0;
+    } else if (descr == "<i2") {
+      std::int16_t s;
+      std::memcpy(&s, p, 2);
+      out[i] = s / 32768.0;
+    } else
+      out[i] = static_cast<unsigned char>(*p) / 255.0;
   }
   return out;
 }
@@ -220,7 +239,8 @@ std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::strin
     const bool ok = comma != std::string_view::npos && parse(line.substr(0, comma), x) && parse(line.substr(comma + 1), y);
     if (!ok) {
       if (a.empty() && line_no == 1) continue;  // header
-      throw FormatError(std::string(origin) + ":" + std::to_string(line_no) + ": expected two numbers, got '" + std::string(line) + "'");
+      throw FormatError(std::string(origin) + ":" + std::to_string(line_no) + ": expected two numbers, got '" +
+                        std::string(line) + "'");
     }
     a.push_back(x);
     b.push_back(y);

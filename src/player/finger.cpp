@@ -14,9 +14,7 @@ namespace texel {
 
 using detail::num;
 
-std::string_view to_string(SwipePattern p) {
-  return p == SwipePattern::constant ? "constant" : "back-and-forth";
-}
+std::string_view to_string(SwipePattern p) { return p == SwipePattern::constant ? "constant" : "back-and-forth"; }
 
 SwipePattern parse_swipe_pattern(std::string_view text, std::string_view field) {
   if (text == "constant") return SwipePattern::constant;
@@ -139,7 +137,8 @@ std::vector<FingerSample> parse_trace_csv(std::string_view text, std::string_vie
     while (true) {
       const std::size_t comma = line.find(',', pos);
       const std::string_view cell = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
-      if (n >= 3) throw FormatError(where + ":" + std::to_string(line_no) + ": more than 3 columns; expected time_s,position_mm[,touch]");
+      if (n >= 3)
+        throw FormatError(where + ":" + std::to_string(line_no) + ": more than 3 columns; expected time_s,position_mm[,touch]");
       if (!parse_double(cell, cols[n])) numeric = false;
       ++n;
       if (comma == std::string_view::npos) break;

@@ -307,8 +307,7 @@ std::vector<float> render_trace(const PlayerMap& map, const PlayerConfig& config
   for (std::size_t done = 0; done < frames;) {
     while (next < trace.size() && player.push(trace[next])) ++next;
     const std::size_t n = std::min(block, frames - done);
-    player.process(std::span(out).subspan(done, n),
-                   positions ? std::span(*positions).subspan(done, n) : std::span<float>{});
+    player.process(std::span(out).subspan(done, n), positions ? std::span(*positions).subspan(done, n) : std::span<float>{});
     done += n;
   }
   return out;

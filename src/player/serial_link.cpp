@@ -20,8 +20,7 @@ namespace texel {
 using serial::ErrorCode;
 using serial::Type;
 
-SerialLink::SerialLink(const std::string& path, int baud)
-    : fd_(controller::open_serial_port(path, baud)), name_(path) {}
+SerialLink::SerialLink(const std::string& path, int baud) : fd_(controller::open_serial_port(path, baud)), name_(path) {}
 
 SerialLink::SerialLink(int fd, std::string name) : fd_(fd), name_(std::move(name)) {
   const int flags = fcntl(fd_, F_GETFL);
@@ -48,8 +47,8 @@ void SerialLink::write_all(const std::uint8_t* p, std::size_t n) {
       ::poll(&pf, 1, 5);
       continue;
     }
-    throw IoError("serial link " + name_ + ": the display is disconnected (write: " +
-                  std::string(w < 0 ? std::strerror(errno) : "nothing written") + ")");
+    throw IoError("serial link " + name_ +
+                  ": the display is disconnected (write: " + std::string(w < 0 ? std::strerror(errno) : "nothing written") + ")");
   }
 }
 
@@ -71,7 +70,8 @@ std::string SerialLink::request(Type type, const std::uint8_t* payload, std::siz
     std::string reply;
     Type reply_type{};
     while (!got) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
       if (left <= 0) break;
       pollfd pf{fd_, POLLIN, 0};
       const int r = ::poll(&pf, 1, static_cast<int>(left));
@@ -100,8 +100,8 @@ std::string SerialLink::request(Type type, const std::uint8_t* payload, std::siz
       const auto* p = reinterpret_cast<const std::uint8_t*>(reply.data());
       const auto code = reply.size() >= 2 ? static_cast<ErrorCode>(p[1]) : ErrorCode::none;
       const std::uint32_t detail = reply.size() >= 6 ? serial::get_u32(p + 2) : 0;
-      throw SerialError("serial link " + name_ + ": the display refused " + what + ": " + serial::describe(code) +
-                            " (code " + std::to_string(static_cast<int>(code)) + ", detail " + std::to_string(detail) + ")",
+      throw SerialError("serial link " + name_ + ": the display refused " + what + ": " + serial::describe(code) + " (code " +
+                            std::to_string(static_cast<int>(code)) + ", detail " + std::to_string(detail) + ")",
                         code, detail);
     }
     return reply;
@@ -113,7 +113,8 @@ std::string SerialLink::request(Type type, const std::uint8_t* payload, std::siz
 DisplayInfo SerialLink::hello() {
   const std::uint8_t p[1] = {serial::protocol_version};
   const std::string r = request(Type::hello, p, 1, Type::hello_reply, "HELLO");
-  if (r.size() < 12) throw IoError("serial link " + name_ + ": HELLO_REPLY has " + std::to_string(r.size()) + " bytes; expected >= 12");
+  if (r.size() < 12)
+    throw IoError("serial link " + name_ + ": HELLO_REPLY has " + std::to_string(r.size()) + " bytes; expected >= 12");
   const auto* b = reinterpret_cast<const std::uint8_t*>(r.data());
   DisplayInfo info;
   info.version = b[0];

@@ -2,8 +2,8 @@
 #include "texel/sinks.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -72,9 +72,9 @@ std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std:
   out.reserve(out.size() + output.size() * 32);
   char buf[96];
   for (std::size_t i = 0; i < output.size(); ++i) {
-    const int n = std::snprintf(buf, sizeof buf, "%.9g,%.7g,%.7g\n", static_cast<double>(i) / rate_hz,
-                                i < positions_mm.size() ? static_cast<double>(positions_mm[i]) : 0.0,
-                                static_cast<double>(output[i]));
+    const int n =
+        std::snprintf(buf, sizeof buf, "%.9g,%.7g,%.7g\n", static_cast<double>(i) / rate_hz,
+                      i < positions_mm.size() ? static_cast<double>(positions_mm[i]) : 0.0, static_cast<double>(output[i]));
     out.append(buf, static_cast<std::size_t>(n));
   }
   return out;
@@ -112,10 +112,12 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 // ------------------------------------------------------------------ null
 
 class NullBackend final : public Backend {
-public:
+ public:
   NullBackend(double rate, std::size_t block) : rate_(rate), buffer_(block) {
-    if (!(rate >= 100 && rate <= 384000)) throw InvalidArgument("null backend: rate is " + detail::num(rate) + " Hz; allowed 100 … 384000");
-    if (block < 1 || block > 65536) throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
+    if (!(rate >= 100 && rate <= 384000))
+      throw InvalidArgument("null backend: rate is " + detail::num(rate) + " Hz; allowed 100 … 384000");
+    if (block < 1 || block > 65536)
+      throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
   }
   ~NullBackend() override { stop(); }
   void start(Player& player) override {
@@ -131,7 +133,7 @@ public:
     return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
   }
 
-private:
+ private:
   void loop(Player& player) {
     const auto period = std::chrono::duration<double>(static_cast<double>(buffer_.size()) / rate_);
     const auto t0 = Clock::now();
@@ -157,7 +159,7 @@ void pa_check(PaError e, const std::string& what) {
 }
 
 class PaSession {
-public:
+ public:
   PaSession() {
     // PortAudio probes every host API on initialisation and some (ALSA, JACK)
     // print to stderr when no server or card exists; silence them.
@@ -185,14 +187,14 @@ std::vector<std::string> list_outputs() {
     const PaDeviceInfo* d = Pa_GetDeviceInfo(i);
     if (!d || d->maxOutputChannels < 1) continue;
     const PaHostApiInfo* h = Pa_GetHostApiInfo(d->hostApi);
-    out.push_back(std::to_string(i) + ": " + d->name + " (" + (h ? h->name : "?") + ", " +
-                  std::to_string(d->maxOutputChannels) + " ch, default " + detail::num(d->defaultSampleRate) + " Hz)");
+    out.push_back(std::to_string(i) + ": " + d->name + " (" + (h ? h->name : "?") + ", " + std::to_string(d->maxOutputChannels) +
+                  " ch, default " + detail::num(d->defaultSampleRate) + " Hz)");
   }
   return out;
 }
 
 class AudioBackend final : public Backend {
-public:
+ public:
   explicit AudioBackend(const AudioOptions& o) : options_(o) {
     PaDeviceIndex dev = paNoDevice;
     if (o.device.empty()) {
@@ -225,10 +227,10 @@ public:
     p.channelCount = 1;
     p.sampleFormat = paFloat32;
     p.suggestedLatency = o.latency_s > 0 ? o.latency_s : info->defaultLowOutputLatency;
-    pa_check(Pa_OpenStream(&stream_, nullptr, &p, o.rate_hz, static_cast<unsigned long>(o.block_frames), paClipOff,
-                           &AudioBackend::callback, this),
-             "cannot open '" + device_name_ + "' at " + detail::num(o.rate_hz) + " Hz, " + std::to_string(o.block_frames) +
-                 " frames");
+    pa_check(
+        Pa_OpenStream(&stream_, nullptr, &p, o.rate_hz, static_cast<unsigned long>(o.block_frames), paClipOff,
+                      &AudioBackend::callback, this),
+        "cannot open '" + device_name_ + "' at " + detail::num(o.rate_hz) + " Hz, " + std::to_string(o.block_frames) + " frames");
   }
   ~AudioBackend() override {
     stop();
@@ -246,7 +248,7 @@ public:
            " frames per block";
   }
 
-private:
+ private:
   // PortAudio's callback: calls only the real-time-safe process() and
   // relaxed atomics.
   static int callback(const void*, void* output, unsigned long frames, const PaStreamCallbackTimeInfo*,
@@ -268,7 +270,7 @@ private:
 // ---------------------------------------------------------------- serial
 
 class SerialBackend final : public Backend {
-public:
+ public:
   SerialBackend(const SerialOptions& o, const PlayerMap& map) : options_(o), link_(o.path, o.baud) {
     if (!(o.rate_hz >= 1 && o.rate_hz <= 20000))
       throw InvalidArgument("serial backend: rate is " + detail::num(o.rate_hz) + " Hz; allowed 1 … 20000");
@@ -291,14 +293,15 @@ public:
   [[nodiscard]] std::string describe() const override {
     return "serial " + options_.path + " → '" + info_.name + "' (protocol " + std::to_string(info_.version) + ", " +
            detail::num(info_.refresh_hz) + " Hz refresh), streaming " +
-           (options_.stream == SerialStream::position ? "positions" : "drive values") + " at " + detail::num(options_.rate_hz) + " Hz";
+           (options_.stream == SerialStream::position ? "positions" : "drive values") + " at " + detail::num(options_.rate_hz) +
+           " Hz";
   }
   [[nodiscard]] std::string error() const override {
     std::lock_guard lock(error_mutex_);
     return error_;
   }
 
-private:
+ private:
   // The streaming thread does I/O by nature; process() itself stays
   // real-time safe, and errors end the loop instead of escaping the thread.
   void loop(Player& player) {
@@ -312,8 +315,10 @@ private:
         const auto b0 = Clock::now();
         const BlockInfo info = player.process(out, pos);
         record(info, seconds_since(b0));
-        if (options_.stream == SerialStream::position) link_.stream_position(pos[0], info.touching);
-        else link_.stream_drive(out[0]);
+        if (options_.stream == SerialStream::position)
+          link_.stream_position(pos[0], info.touching);
+        else
+          link_.stream_drive(out[0]);
       }
     } catch (const std::exception& e) {
       std::lock_guard lock(error_mutex_);

@@ -52,8 +52,8 @@ Panel spectrum_panel(const SpectrumPlot& p, bool temporal) {
   panel.x.min = line.x.front();
   panel.x.max = line.x.back();
   panel.x.db_labels = !temporal;
-  panel.x.label = temporal ? "temporal frequency (Hz) at " + detail::num(*p.swipe_speed_mm_s) + " mm/s"
-                           : "spatial frequency (cycles/mm)";
+  panel.x.label =
+      temporal ? "temporal frequency (Hz) at " + detail::num(*p.swipe_speed_mm_s) + " mm/s" : "spatial frequency (cycles/mm)";
   panel.y.label = "magnitude (dB re a = 1)";
   line.label = "magnitude (" + std::string(to_string(s.window)) + ")";
   panel.lines.push_back(std::move(line));

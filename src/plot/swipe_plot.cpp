@@ -13,8 +13,7 @@ Figure swipe_figure(const SwipePlot& p) {
   if (p.output.empty() || p.positions_mm.size() != p.output.size())
     throw InvalidArgument("swipe plot: " + std::to_string(p.output.size()) + " output samples and " +
                           std::to_string(p.positions_mm.size()) + " positions; they must match and be non-empty");
-  if (p.frequency_hz.size() != p.magnitude.size())
-    throw InvalidArgument("swipe plot: spectrum columns differ in length");
+  if (p.frequency_hz.size() != p.magnitude.size()) throw InvalidArgument("swipe plot: spectrum columns differ in length");
   const double dt = 1.0 / p.rate_hz;
   Figure fig;
   fig.width_px = p.width_px;

@@ -82,9 +82,9 @@ ReferenceInfo colour(const std::string& name, double slope, const std::string& w
           what + " Gaussian noise over the band (second study)",
           true,
           {number("band_min_cpm", "cpm", 0.5, 1e-6, big, "lowest frequency of the band"),
-           number("band_max_cpm", "cpm", 0.0, 0.0, big, "highest frequency of the band; 0 (or above Nyquist) = the grid's Nyquist frequency"),
-           number("slope_db_per_decade", "dB/decade", slope, -60.0, 60.0,
-                  "PSD slope: 0 white, -10 pink (1/f), +10 blue (f)")}};
+           number("band_max_cpm", "cpm", 0.0, 0.0, big,
+                  "highest frequency of the band; 0 (or above Nyquist) = the grid's Nyquist frequency"),
+           number("slope_db_per_decade", "dB/decade", slope, -60.0, 60.0, "PSD slope: 0 white, -10 pink (1/f), +10 blue (f)")}};
 }
 
 ReferenceInfo waveform(const std::string& name, const std::string& what) {
@@ -93,19 +93,22 @@ ReferenceInfo waveform(const std::string& name, const std::string& what) {
           what + ", band-limited to the grid's Nyquist frequency (second study)",
           false,
           {number("fundamental_cpm", "cpm", 1.0, 1e-6, big, "fundamental frequency"),
-           number("band_max_cpm", "cpm", 0.0, 0.0, big, "highest harmonic frequency; 0 (or above Nyquist) = the grid's Nyquist frequency"),
+           number("band_max_cpm", "cpm", 0.0, 0.0, big,
+                  "highest harmonic frequency; 0 (or above Nyquist) = the grid's Nyquist frequency"),
            number("phase_deg", "deg", 0.0, -big, big, "phase of the fundamental")}};
 }
 
 ReferenceInfo bandpass(const std::string& name, double fc, double zeta, const std::string& what) {
-  return {name,
-          "band-pass noise",
-          what,
-          true,
-          {number("centre_cpm", "cpm", fc, 1e-6, big, "centre frequency f_c of the second-order band-pass"),
-           number("zeta", "", zeta, 1e-4, 1e3, "irregularity ζ = 1/(2Q); -3 dB width 2ζ·f_c"),
-           number("band_min_cpm", "cpm", 0.0, 0.0, big, "lowest synthesised frequency; 0 = the texture's lowest harmonic 1/length"),
-           number("band_max_cpm", "cpm", 0.0, 0.0, big, "highest synthesised frequency; 0 (or above Nyquist) = the grid's Nyquist frequency")}};
+  return {
+      name,
+      "band-pass noise",
+      what,
+      true,
+      {number("centre_cpm", "cpm", fc, 1e-6, big, "centre frequency f_c of the second-order band-pass"),
+       number("zeta", "", zeta, 1e-4, 1e3, "irregularity ζ = 1/(2Q); -3 dB width 2ζ·f_c"),
+       number("band_min_cpm", "cpm", 0.0, 0.0, big, "lowest synthesised frequency; 0 = the texture's lowest harmonic 1/length"),
+       number("band_max_cpm", "cpm", 0.0, 0.0, big,
+              "highest synthesised frequency; 0 (or above Nyquist) = the grid's Nyquist frequency")}};
 }
 
 ReferenceInfo patch(const std::string& name, double spacing) {
@@ -115,9 +118,9 @@ ReferenceInfo patch(const std::string& name, double spacing) {
               " mm (working-memory study)",
           true,
           {number("patch_mm", "mm", 2.6, 1e-3, 1e4, "length of each patch"),
-           number("spacing_mm", "mm", spacing, 0.0, 1e4,
-                  "average gap c: gaps are whole mm drawn from {0 … round(2c)}"),
-           list("gaps_mm", "mm", {}, 0.0, 1e4, 0, 1000000, "explicit gaps in order (cycled if the texture is longer); empty = draw from the seed"),
+           number("spacing_mm", "mm", spacing, 0.0, 1e4, "average gap c: gaps are whole mm drawn from {0 … round(2c)}"),
+           list("gaps_mm", "mm", {}, 0.0, 1e4, 0, 1000000,
+                "explicit gaps in order (cycled if the texture is longer); empty = draw from the seed"),
            integer("shuffle", 0, 0, 2147483647, "0 = gaps in drawn order; n >= 1 = the n-th shuffle of the same gaps"),
            number("start_mm", "mm", 0.0, 0.0, 1e6, "position of the first patch")}};
 }
@@ -241,7 +244,9 @@ const ReferenceInfo& reference_info(std::string_view name) {
   throw InvalidArgument("unknown reference '" + std::string(name) + "'; known: " + names);
 }
 
-std::vector<std::string> second_study_names() { return {"2sin", "3sin", "4sin", "white", "pink", "blue", "square", "tri", "saw"}; }
+std::vector<std::string> second_study_names() {
+  return {"2sin", "3sin", "4sin", "white", "pink", "blue", "square", "tri", "saw"};
+}
 
 void validate(const ReferenceSpec& spec) {
   const ReferenceInfo& info = reference_info(spec.name);
@@ -257,7 +262,8 @@ void validate(const ReferenceSpec& spec) {
     const auto w = std::get<std::vector<double>>(reference_value(spec, "weights"));
     if (!w.empty() && w.size() != f.size())
       throw InvalidArgument("reference '" + info.name + "' parameter weights has " + std::to_string(w.size()) +
-                            " values but frequencies_cpm has " + std::to_string(f.size()) + "; give one weight per frequency or none");
+                            " values but frequencies_cpm has " + std::to_string(f.size()) +
+                            "; give one weight per frequency or none");
   }
 }
 
@@ -273,8 +279,8 @@ ReferenceValue reference_value(const ReferenceSpec& spec, std::string_view key) 
 ReferenceValue parse_reference_value(const ReferenceInfo& info, std::string_view key, std::string_view text) {
   const ReferenceParam* p = find_param(info, key);
   if (!p)
-    throw InvalidArgument("reference '" + info.name + "' has no parameter '" + std::string(key) + "'; its parameters: " +
-                          known_keys(info));
+    throw InvalidArgument("reference '" + info.name + "' has no parameter '" + std::string(key) +
+                          "'; its parameters: " + known_keys(info));
   const std::string field = "reference '" + info.name + "' parameter " + p->key;
   ReferenceValue v;
   switch (p->kind) {
@@ -304,7 +310,8 @@ ReferenceValue parse_reference_value(const ReferenceInfo& info, std::string_view
 void set_reference_param(ReferenceSpec& spec, std::string_view assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string_view::npos || eq == 0)
-    throw InvalidArgument("--param '" + std::string(assignment) + "' must be KEY=VALUE (lists comma-separated, e.g. frequencies_cpm=2.5,6)");
+    throw InvalidArgument("--param '" + std::string(assignment) +
+                          "' must be KEY=VALUE (lists comma-separated, e.g. frequencies_cpm=2.5,6)");
   const std::string key(assignment.substr(0, eq));
   spec.params[key] = parse_reference_value(reference_info(spec.name), key, assignment.substr(eq + 1));
 }

@@ -53,7 +53,7 @@ __attribute__((target("avx512f"))) void accumulate_avx512(double b, double o, do
   accumulate_lanes<8>(b, o, s, f, a, p, acc, n);
 }
 __attribute__((target("avx2"))) void accumulate_avx2(double b, double o, double s, double f, double a, double p, double* acc,
-                                                    std::int32_t n) {
+                                                     std::int32_t n) {
   accumulate_lanes<4>(b, o, s, f, a, p, acc, n);
 }
 #endif
@@ -91,7 +91,9 @@ void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, 
 // ------------------------------------------------------------ parameters
 
 double number(const ReferenceSpec& s, const char* key) { return std::get<double>(reference_value(s, key)); }
-std::vector<double> numbers(const ReferenceSpec& s, const char* key) { return std::get<std::vector<double>>(reference_value(s, key)); }
+std::vector<double> numbers(const ReferenceSpec& s, const char* key) {
+  return std::get<std::vector<double>>(reference_value(s, key));
+}
 std::string word(const ReferenceSpec& s, const char* key) { return std::get<std::string>(reference_value(s, key)); }
 
 /// The band's upper edge: band_max (0 = Nyquist), never at or above Nyquist.
@@ -113,7 +115,8 @@ std::pair<std::uint64_t, std::uint64_t> harmonic_range(double lo, double hi, dou
 
 std::string field(const ReferenceSpec& s, const std::string& key) { return "reference '" + s.name + "' parameter " + key; }
 
-std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const std::string& family, double period, double nyquist) {
+std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const std::string& family, double period,
+                                                 double nyquist) {
   std::vector<ReferenceComponent> comps;
   const CounterRng rng(s.seed, Stream::reference);
   double lo = 0.0;
@@ -134,7 +137,8 @@ std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const s
   const auto [k0, k1] = harmonic_range(lo, hi, period);
   if (k1 < k0)
     throw InvalidArgument("reference '" + s.name + "': the band " + num(lo) + " … " + num(hi) + " cpm holds no harmonic of the " +
-                          num(period) + " mm texture (spacing " + num(1.0 / period) + " cpm); widen the band or lengthen the texture");
+                          num(period) + " mm texture (spacing " + num(1.0 / period) +
+                          " cpm); widen the band or lengthen the texture");
   comps.reserve(k1 - k0 + 1);
   for (std::uint64_t k = k0; k <= k1; ++k) {
     const double f = static_cast<double>(k) / period;
@@ -188,7 +192,7 @@ std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, doub
       if (n % 2 == 0) continue;
       a = 1.0 / (nd * nd);
       if ((n / 2) % 2 == 1) phase += 0.5;  // (−1)^((n−1)/2)
-    } else {  // saw: Σ (−1)^(n+1) sin(nωx)/n
+    } else {                               // saw: Σ (−1)^(n+1) sin(nωx)/n
       a = 1.0 / nd;
       if (n % 2 == 0) phase += 0.5;
     }
@@ -248,7 +252,8 @@ std::vector<ReferenceFeature> patch_features(const ReferenceSpec& s, double leng
 }
 
 std::vector<ReferenceFeature> pulse_features(const ReferenceSpec& s, double length) {
-  std::vector<ReferenceFeature> f = lay_out(number(s, "start_mm"), number(s, "pulse_mm"), numbers(s, "gaps_mm"), length, std::size_t(-1));
+  std::vector<ReferenceFeature> f =
+      lay_out(number(s, "start_mm"), number(s, "pulse_mm"), numbers(s, "gaps_mm"), length, std::size_t(-1));
   if (word(s, "mirror") == "yes") {
     for (auto& p : f) p.start_mm = length - p.start_mm - p.length_mm;
     std::reverse(f.begin(), f.end());
@@ -282,7 +287,8 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     features_ = pulse_features(spec_, L);
   }
   if (shape_ != Shape::sum && features_.empty())
-    throw InvalidArgument("reference '" + spec_.name + "': no feature fits the " + num(L) + " mm texture; lower start_mm or the feature length");
+    throw InvalidArgument("reference '" + spec_.name + "': no feature fits the " + num(L) +
+                          " mm texture; lower start_mm or the feature length");
 
   // Samples of the prepared grid inside [0, L).
   const double sp = grid.spacing_mm;
@@ -391,7 +397,8 @@ std::string ReferenceTexture::describe() const {
 }
 
 std::vector<double> render_reference(const ReferenceSpec& spec, const Grid& grid) {
-  if (grid.count <= 0) throw InvalidArgument("reference grid has " + std::to_string(grid.count) + " samples; it needs at least 1");
+  if (grid.count <= 0)
+    throw InvalidArgument("reference grid has " + std::to_string(grid.count) + " samples; it needs at least 1");
   const ReferenceTexture t(spec, Millimetres(grid.length_mm()), Grid{0.0, grid.spacing_mm, grid.count});
   std::vector<double> out(static_cast<std::size_t>(grid.count));
   t.render(Grid{0.0, grid.spacing_mm, grid.count}, 0, out);
@@ -403,7 +410,7 @@ SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, 
     throw InvalidArgument("reference profile spacing is " + num(spacing_mm) + " mm; it must be > 0");
   const Grid grid{0.0, spacing_mm, 0};
   const ReferenceTexture t(spec, length, grid);
-  const auto count = static_cast<std::int64_t>(std::ceil(length.value() / spacing_mm)) ;
+  const auto count = static_cast<std::int64_t>(std::ceil(length.value() / spacing_mm));
   SampledProfile p;
   p.spacing_mm = spacing_mm;
   p.values.resize(static_cast<std::size_t>(std::max<std::int64_t>(count, 1)));

@@ -14,7 +14,7 @@ namespace texel::detail {
 /// plan depends only on n, so results are deterministic for a build.
 /// Not thread-safe per object (it owns scratch buffers).
 class RealFft {
-public:
+ public:
   explicit RealFft(std::size_t n);
   ~RealFft();
   RealFft(const RealFft&) = delete;
@@ -24,7 +24,7 @@ public:
   /// in.size() == size(); out.size() == size()/2 + 1.
   void forward(std::span<const double> in, std::span<std::complex<double>> out);
 
-private:
+ private:
   struct Impl;
   std::size_t n_;
   std::unique_ptr<Impl> impl_;

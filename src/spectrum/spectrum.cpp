@@ -22,7 +22,8 @@ void check_signal(std::span<const double> x, double spacing_mm, std::size_t min_
     throw InvalidArgument("the signal has " + std::to_string(x.size()) + " samples; spectral analysis needs at least " +
                           std::to_string(min_samples));
   for (std::size_t i = 0; i < x.size(); ++i)
-    if (!std::isfinite(x[i])) throw InvalidArgument("sample " + std::to_string(i) + " is " + num(x[i]) + "; samples must be finite");
+    if (!std::isfinite(x[i]))
+      throw InvalidArgument("sample " + std::to_string(i) + " is " + num(x[i]) + "; samples must be finite");
 }
 
 /// Main-lobe half-width in (unpadded) bins: beyond it, a sinusoid's
@@ -37,9 +38,7 @@ double main_lobe_half_width(Window w) {
   return 4.0;
 }
 
-double mean_of(std::span<const double> x) {
-  return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
-}
+double mean_of(std::span<const double> x) { return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size()); }
 
 }  // namespace
 
@@ -56,7 +55,8 @@ std::string_view to_string(Window w) {
 Window parse_window(std::string_view text, std::string_view field) {
   for (Window w : {Window::rectangular, Window::hann, Window::blackman_harris, Window::flat_top})
     if (text == to_string(w)) return w;
-  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: rectangular, hann, blackman-harris, flat-top");
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) +
+                        "'; allowed: rectangular, hann, blackman-harris, flat-top");
 }
 
 std::vector<double> window_coefficients(Window w, std::size_t n) {
@@ -142,7 +142,8 @@ Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOpt
                           " (the signal's length)");
   }
   seg -= seg % 2;
-  const auto step = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(static_cast<double>(seg) * (1.0 - options.overlap))));
+  const auto step =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(static_cast<double>(seg) * (1.0 - options.overlap))));
   const std::vector<double> w = window_coefficients(options.window, seg);
   const double sum_w2 = std::inner_product(w.begin(), w.end(), w.begin(), 0.0);
   detail::RealFft fft(seg);

@@ -73,12 +73,12 @@ Result run_texel(const std::vector<std::string>& args, const fs::path& cwd) {
 }
 
 class Cli : public ::testing::Test {
-protected:
+ protected:
   fs::path dir;
 
   void SetUp() override {
-    dir = fs::temp_directory_path() / ("texel-cli-" + std::to_string(::getpid()) + "-" +
-                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir = fs::temp_directory_path() /
+          ("texel-cli-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir);
     fs::create_directories(dir);
   }
@@ -133,8 +133,8 @@ std::vector<std::string> read_lines(const fs::path& p) {
 // ---------------------------------------------------------------- acceptance
 
 TEST_F(Cli, AcceptanceTpadFileIsDeterministicAndSeedDependent) {
-  const std::vector<std::string> base = {"render", "--central-pitch", "10", "--irregularity", "-5", "--texel-length", "0.25",
-                                         "--device", "tpad"};
+  const std::vector<std::string> base = {"render", "--central-pitch", "10",  "--irregularity", "-5", "--texel-length",
+                                         "0.25",   "--device",        "tpad"};
   auto with = [&](std::vector<std::string> extra) {
     auto a = base;
     a.insert(a.end(), extra.begin(), extra.end());
@@ -220,7 +220,9 @@ TEST_F(Cli, AcceptanceGenericTexelStatisticsAndSignalFrequencies) {
 
 // ------------------------------------------------------- bad input, by class
 
-TEST_F(Cli, RejectsUnknownDevice) { expect_rejected({"render", "--device", "nosuch", "-o", "out.bin"}, "unknown device 'nosuch'"); }
+TEST_F(Cli, RejectsUnknownDevice) {
+  expect_rejected({"render", "--device", "nosuch", "-o", "out.bin"}, "unknown device 'nosuch'");
+}
 
 TEST_F(Cli, RejectsNegativeTexelLength) {
   expect_rejected({"render", "--texel-length=-0.25", "-o", "out.bin"}, "--texel-length");
@@ -228,7 +230,8 @@ TEST_F(Cli, RejectsNegativeTexelLength) {
 }
 
 TEST_F(Cli, RejectsNonFinitePitch) {
-  for (const char* v : {"nan", "inf", "-inf", "NaN"}) expect_rejected({"render", std::string("--central-pitch=") + v, "-o", "out.bin"}, "--central-pitch");
+  for (const char* v : {"nan", "inf", "-inf", "NaN"})
+    expect_rejected({"render", std::string("--central-pitch=") + v, "-o", "out.bin"}, "--central-pitch");
   expect_rejected({"render", "--irregularity=nan", "-o", "out.bin"}, "--irregularity");
 }
 

@@ -73,7 +73,7 @@ RC_GTEST_PROP(Bitstream, EveryFineFieldRoundTrips, ()) {
   f.parameterization = *rc::gen::element(Parameterization::moments, Parameterization::log);
   f.central_pitch_cdb = static_cast<std::int16_t>(*rc::gen::inRange(-1000, 1900));
   f.irregularity_cdb = static_cast<std::int16_t>(f.parameterization == Parameterization::log ? *rc::gen::inRange(0, 800)
-                                                                                            : *rc::gen::inRange(-3000, 500));
+                                                                                             : *rc::gen::inRange(-3000, 500));
   f.texel_length_um = static_cast<std::uint16_t>(*rc::gen::inRange(1, 65536));
   f.quantization_ddb = static_cast<std::uint8_t>(*rc::gen::inRange(0, 201));
   f.band_max_device = *rc::gen::arbitrary<bool>();

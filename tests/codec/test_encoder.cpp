@@ -152,10 +152,10 @@ TEST(Encoder, RejectsUnusableInput) {
 }
 
 TEST(Encoder, PerceptualModelShape) {
-  EXPECT_EQ(threshold_db(Hertz(250.0)), 0.0);                 // most sensitive
-  EXPECT_NEAR(threshold_db(Hertz(125.0)), 12.0, 1e-9);         // 12 dB/octave below
-  EXPECT_NEAR(threshold_db(Hertz(500.0)), 12.0, 1e-9);         // and above
-  EXPECT_EQ(threshold_db(Hertz(10.0)), 30.0);                  // non-Pacinian floor
+  EXPECT_EQ(threshold_db(Hertz(250.0)), 0.0);           // most sensitive
+  EXPECT_NEAR(threshold_db(Hertz(125.0)), 12.0, 1e-9);  // 12 dB/octave below
+  EXPECT_NEAR(threshold_db(Hertz(500.0)), 12.0, 1e-9);  // and above
+  EXPECT_EQ(threshold_db(Hertz(10.0)), 30.0);           // non-Pacinian floor
 }
 
 }  // namespace

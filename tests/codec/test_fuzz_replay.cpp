@@ -71,10 +71,16 @@ TEST(FuzzReplay, MutatedValidStreams) {
       const int ops = 1 + static_cast<int>(rng.below(3));
       for (int o = 0; o < ops; ++o) {
         switch (rng.below(5)) {
-          case 0: if (!v.empty()) v[rng.below(v.size())] ^= static_cast<std::uint8_t>(1u << rng.below(8)); break;
-          case 1: if (!v.empty()) v[rng.below(v.size())] = static_cast<std::uint8_t>(rng.bits()); break;
+          case 0:
+            if (!v.empty()) v[rng.below(v.size())] ^= static_cast<std::uint8_t>(1u << rng.below(8));
+            break;
+          case 1:
+            if (!v.empty()) v[rng.below(v.size())] = static_cast<std::uint8_t>(rng.bits());
+            break;
           case 2: v.resize(rng.below(v.size() + 1)); break;
-          case 3: v.insert(v.begin() + static_cast<std::ptrdiff_t>(rng.below(v.size() + 1)), static_cast<std::uint8_t>(rng.bits())); break;
+          case 3:
+            v.insert(v.begin() + static_cast<std::ptrdiff_t>(rng.below(v.size() + 1)), static_cast<std::uint8_t>(rng.bits()));
+            break;
           default: v.push_back(static_cast<std::uint8_t>(rng.bits())); break;
         }
       }

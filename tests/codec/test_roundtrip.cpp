@@ -49,8 +49,9 @@ TEST(RoundTrip, CentralPitchAndIrregularityAcrossTheGrid) {
         const EncodeResult r = encode(sig, EncoderConfig{});
         const double dp = r.spec.central_pitch.value() - P;
         const double di = r.spec.irregularity.value() - I;
-        std::printf("L %.2f P %6.1f I %6.1f  mass %.3f  dP %+6.2f dI %+6.2f identifiable %d  rec %d L %.2f  %zu bytes  %.2f s\n", L, P, I, mass, dp, di,
-                    r.irregularity_identifiable, r.texel_recovered, r.spec.texel_length.value(), r.bytes.size(), r.seconds);
+        std::printf("L %.2f P %6.1f I %6.1f  mass %.3f  dP %+6.2f dI %+6.2f identifiable %d  rec %d L %.2f  %zu bytes  %.2f s\n",
+                    L, P, I, mass, dp, di, r.irregularity_identifiable, r.texel_recovered, r.spec.texel_length.value(),
+                    r.bytes.size(), r.seconds);
         max_seconds = std::max(max_seconds, r.seconds);
         if (mass < 0.95) {
           ++truncated;
@@ -66,8 +67,10 @@ TEST(RoundTrip, CentralPitchAndIrregularityAcrossTheGrid) {
         EXPECT_NEAR(dp, 0.0, 0.5) << "L " << L << " P " << P << " I " << I;
         EXPECT_NEAR(di, 0.0, 1.5) << "L " << L << " P " << P << " I " << I;
       }
-  std::printf("asserted: %d cases (P and I), max |dP| %.2f dB, max |dI| %.2f dB; %d truncated cases within the documented bound; slowest %.2f s\n",
-              asserted, max_dp, max_di, truncated, max_seconds);
+  std::printf(
+      "asserted: %d cases (P and I), max |dP| %.2f dB, max |dI| %.2f dB; %d truncated cases within the documented bound; slowest "
+      "%.2f s\n",
+      asserted, max_dp, max_di, truncated, max_seconds);
 }
 
 }  // namespace

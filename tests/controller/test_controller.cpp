@@ -50,12 +50,12 @@ TEST(Protocol, DecoderResynchronisesAfterGarbageAndCorruption) {
   std::uint8_t good[ser::max_frame];
   const std::uint8_t p[] = {9, 8, 7};
   const std::size_t n = ser::encode_frame(ser::Type::select, 3, p, 3, good);
-  std::vector<std::uint8_t> stream{0x00, 0xA5, 0xA5, 0x13};          // garbage, false syncs
+  std::vector<std::uint8_t> stream{0x00, 0xA5, 0xA5, 0x13};  // garbage, false syncs
   std::vector<std::uint8_t> bad(good, good + n);
-  bad[7] ^= 0x40;                                                      // payload bit flip
+  bad[7] ^= 0x40;  // payload bit flip
   stream.insert(stream.end(), bad.begin(), bad.end());
-  stream.insert(stream.end(), good, good + 5);                         // truncated frame…
-  stream.insert(stream.end(), good, good + n);                         // …then a whole one
+  stream.insert(stream.end(), good, good + 5);                        // truncated frame…
+  stream.insert(stream.end(), good, good + n);                        // …then a whole one
   stream.insert(stream.end(), {0xA5, 0x5A, 0x01, 0x00, 0xFF, 0xFF});  // length 65535
   stream.insert(stream.end(), good, good + n);
   ser::Decoder d;
@@ -87,10 +87,13 @@ TEST(Protocol, DecoderSurvivesRandomBytes) {
   std::vector<std::uint8_t> junk(200000);
   for (auto& b : junk) b = static_cast<std::uint8_t>(rng() % 4 == 0 ? 0xA5 : rng());
   int frames = 0;
-  d.feed(junk.data(), junk.size(), [&](const ser::Frame& f) { frames += f.length <= ser::max_payload; }, [](ser::ErrorCode) {});
+  d.feed(
+      junk.data(), junk.size(), [&](const ser::Frame& f) { frames += f.length <= ser::max_payload; }, [](ser::ErrorCode) {});
   std::uint8_t good[ser::max_frame];
   const std::size_t n = ser::encode_frame(ser::Type::hello, 1, nullptr, 0, good);
-  for (int i = 0; i < 3; ++i) d.feed(good, n, [&](const ser::Frame&) { ++frames; }, [](ser::ErrorCode) {});
+  for (int i = 0; i < 3; ++i)
+    d.feed(
+        good, n, [&](const ser::Frame&) { ++frames; }, [](ser::ErrorCode) {});
   EXPECT_GE(frames, 1);
 }
 
@@ -120,7 +123,10 @@ struct Rig {
     ctl = std::make_unique<SmallController>(*hal, controller::Info{});
     thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
   }
-  ~Rig() { halt(); if (slave >= 0) ::close(slave); }
+  ~Rig() {
+    halt();
+    if (slave >= 0) ::close(slave);
+  }
   void halt() {
     stop = true;
     if (thread.joinable()) thread.join();
@@ -162,7 +168,8 @@ TEST(HostController, HelloUploadSelectStream) {
   for (double x : {1.0, 25.3, 50.88, 101.7}) {
     link.stream_position(x, true);
     const auto expect = u16(map[static_cast<std::size_t>(std::lround(x / 0.0053))]);
-    EXPECT_TRUE(wait_for([&] { return rig.hal->amplitude.load() == expect; })) << "x=" << x << " got " << rig.hal->amplitude.load();
+    EXPECT_TRUE(wait_for([&] { return rig.hal->amplitude.load() == expect; }))
+        << "x=" << x << " got " << rig.hal->amplitude.load();
   }
   link.stream_position(30, false);  // lifted: at rest
   EXPECT_TRUE(wait_for([&] { return rig.hal->amplitude.load() == 0; }));
@@ -221,7 +228,7 @@ TEST(HostController, RefusesBadRequestsAndKeepsTheLastGoodMap) {
   f[n - 1] ^= 0xFF;  // wrong checksum: must NOT take effect
   link.send_raw({f, n});
   link.send_raw(std::vector<std::uint8_t>{0xA5, 0x5A, 0x05, 0x01, 0x01});  // partial header
-  link.send_raw(std::vector<std::uint8_t>{0x00, 0x11, 0xA5, 0x22});          // noise
+  link.send_raw(std::vector<std::uint8_t>{0x00, 0x11, 0xA5, 0x22});        // noise
   std::uint8_t unknown[ser::max_frame];
   n = ser::encode_frame(static_cast<ser::Type>(0x42), 1, nullptr, 0, unknown);
   link.send_raw({unknown, n});

@@ -10,8 +10,8 @@
 
 #include <unistd.h>
 
-#include "texel/coarse.hpp"
 #include "../support/temp_dir.hpp"
+#include "texel/coarse.hpp"
 #include "texel/error.hpp"
 
 using namespace texel;

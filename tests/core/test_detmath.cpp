@@ -142,9 +142,8 @@ RC_GTEST_PROP(Detmath, SinCyclesReductionIsExactOverWholeCycles, ()) {
 }
 
 RC_GTEST_PROP(Detmath, SinCyclesStaysInUnitInterval, ()) {
-  const double u = *rc::gen::map(rc::gen::arbitrary<std::int64_t>(), [](std::int64_t v) {
-    return static_cast<double>(v % (std::int64_t{1} << 53)) * 0x1.0p-20;
-  });
+  const double u = *rc::gen::map(rc::gen::arbitrary<std::int64_t>(),
+                                 [](std::int64_t v) { return static_cast<double>(v % (std::int64_t{1} << 53)) * 0x1.0p-20; });
   const double y = dm::sin_cycles(u);
   RC_ASSERT(y >= -1.0);
   RC_ASSERT(y <= 1.0);

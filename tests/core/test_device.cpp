@@ -13,8 +13,8 @@
 
 #include <unistd.h>
 
-#include "texel/device.hpp"
 #include "../support/temp_dir.hpp"
+#include "texel/device.hpp"
 #include "texel/error.hpp"
 
 using namespace texel;
@@ -206,8 +206,10 @@ RC_GTEST_PROP(Encode, DecodeInvertsEncodeWithinHalfAStep, ()) {
   encode_samples(format, a, std::span<std::byte>(bytes.data() + 1, bytes.size() - 1));
   const auto back = decode_samples(format, std::span<const std::byte>(bytes.data() + 1, bytes.size() - 1));
   RC_ASSERT(back.size() == n);
-  const double tol = format == SampleFormat::u16le ? 0.5 / 65535 : format == SampleFormat::u8 ? 0.5 / 255 :
-                     format == SampleFormat::f32le ? 1e-7 : 0.0;
+  const double tol = format == SampleFormat::u16le   ? 0.5 / 65535
+                     : format == SampleFormat::u8    ? 0.5 / 255
+                     : format == SampleFormat::f32le ? 1e-7
+                                                     : 0.0;
   for (std::size_t i = 0; i < n; ++i) RC_ASSERT(std::fabs(back[i] - a[i]) <= tol + 1e-15);
 }
 

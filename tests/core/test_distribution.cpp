@@ -144,8 +144,8 @@ TEST_P(LogDraws, MedianAndDecibelSdMatch) {
   const double median_db = y[n_draws / 2];
   EXPECT_NEAR(median_db, p_db, 5.0 * std::sqrt(std::numbers::pi / 2.0) * i_db / std::sqrt(n_draws));
   std::nth_element(f.begin(), f.begin() + n_draws / 2, f.end());
-  EXPECT_NEAR(std::log(f[n_draws / 2] / std::pow(10.0, p_db / 10.0)),
-              0.0, 5.0 * std::sqrt(std::numbers::pi / 2.0) * d.sigma() / std::sqrt(n_draws));
+  EXPECT_NEAR(std::log(f[n_draws / 2] / std::pow(10.0, p_db / 10.0)), 0.0,
+              5.0 * std::sqrt(std::numbers::pi / 2.0) * d.sigma() / std::sqrt(n_draws));
 }
 
 INSTANTIATE_TEST_SUITE_P(Configurations, LogDraws,

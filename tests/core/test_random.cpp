@@ -57,7 +57,8 @@ TEST(CounterRng, FirstValuesArePinned) {
   };
   for (const auto& c : cases) {
     const CounterRng rng(c.seed, c.stream);
-    for (std::uint64_t i = 0; i < 4; ++i) EXPECT_EQ(rng.bits(i), c.bits[i]) << "seed " << c.seed << " stream " << c.stream << " counter " << i;
+    for (std::uint64_t i = 0; i < 4; ++i)
+      EXPECT_EQ(rng.bits(i), c.bits[i]) << "seed " << c.seed << " stream " << c.stream << " counter " << i;
   }
   // The frequency stream of seed 1 (texel 0's first draw) as a uniform.
   EXPECT_EQ(CounterRng(1, Stream::frequency).uniform(0), 0.13143070512329408);

@@ -106,10 +106,24 @@ TEST(RenderExact, EveryWindowMatchesAmplitudeAt) {
 }
 
 TEST(RenderExact, EncodersMatchPerSampleRules) {
-  std::vector<double> a = {0.0, -0.0, 1.0, 0.5, -1e-300, 1e-300, 0.999999, 1.0000001, 2.0, -3.0,
-                           0.5 / 65535.0, 1.5 / 65535.0, 0.49999999 / 65535.0, 65534.5 / 65535.0,
-                           std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
-                           -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::denorm_min()};
+  std::vector<double> a = {0.0,
+                           -0.0,
+                           1.0,
+                           0.5,
+                           -1e-300,
+                           1e-300,
+                           0.999999,
+                           1.0000001,
+                           2.0,
+                           -3.0,
+                           0.5 / 65535.0,
+                           1.5 / 65535.0,
+                           0.49999999 / 65535.0,
+                           65534.5 / 65535.0,
+                           std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::denorm_min()};
   for (int i = 0; i < 1000; ++i) a.push_back(std::fmod(i * 0.6180339887498949, 1.3) - 0.1);
   for (std::size_t n = 0; n <= a.size(); n += (n < 40 ? 1 : 97)) {  // every tail length
     const std::span<const double> in(a.data(), n);

@@ -50,7 +50,7 @@ double ref_sine_profile(const SineProfile& p, double L, std::size_t k) {
 
 struct BoundaryJumps {
   int boundaries = 0;
-  int over_bound = 0;     // steps across a boundary larger than slope × spacing
+  int over_bound = 0;      // steps across a boundary larger than slope × spacing
   double worst_ratio = 0;  // largest step / bound
 };
 

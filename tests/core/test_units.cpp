@@ -18,7 +18,9 @@ static_assert(!std::is_constructible_v<CyclesPerMm, Decibels>);
 static_assert(!std::is_convertible_v<double, Millimetres>);
 static_assert(!std::is_convertible_v<Hertz, CyclesPerMm>);
 template <class A, class B>
-concept Addable = requires(A a, B b) { a + b; };
+concept Addable = requires(A a, B b) {
+  a + b;
+};
 static_assert(Addable<Millimetres, Millimetres>);
 static_assert(!Addable<Millimetres, Decibels>);
 static_assert(!Addable<CyclesPerMm, Hertz>);

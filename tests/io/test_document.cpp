@@ -217,13 +217,16 @@ TEST(Document, ErrorsNameTheJsonPath) {
       // wrong types
       {"\"seed\": 2", "\"seed\": \"two\"", "regions[1].texture.seed must be a whole number"},
       {"\"seed\": 1", "\"seed\": -1", "regions[0].texture.seed must be a whole number"},
-      {"\"central_pitch_db\": 12", "\"central_pitch_db\": \"12\"", "regions[1].texture.central_pitch_db must be a number, got the string"},
+      {"\"central_pitch_db\": 12", "\"central_pitch_db\": \"12\"",
+       "regions[1].texture.central_pitch_db must be a number, got the string"},
       // bad values
-      {"\"texel_length_mm\": 0.25, \"seed\": 2", "\"texel_length_mm\": -1, \"seed\": 2", "regions[1].texture.texel_length_mm is -1"},
+      {"\"texel_length_mm\": 0.25, \"seed\": 2", "\"texel_length_mm\": -1, \"seed\": 2",
+       "regions[1].texture.texel_length_mm is -1"},
       {"\"coarse_strength\": 0.5", "\"coarse_strength\": 1.5", "regions[1].texture.coarse_strength is 1.5; allowed: 0 … 1"},
       {"\"period_mm\": 5", "\"period_mm\": 0", "regions[1].texture.coarse.period_mm is 0"},
       {"\"kind\": \"sine\"", "\"kind\": \"wavy\"", "regions[1].texture.coarse.kind is 'wavy'"},
-      {"\"kind\": \"texel\", \"central_pitch_db\": 10", "\"kind\": \"noise\", \"central_pitch_db\": 10", "regions[0].texture.kind is 'noise'"},
+      {"\"kind\": \"texel\", \"central_pitch_db\": 10", "\"kind\": \"noise\", \"central_pitch_db\": 10",
+       "regions[0].texture.kind is 'noise'"},
       {"\"seed\": 2,", "\"seed\": 2, \"phase\": \"sideways\",", "regions[1].texture.phase is 'sideways'"},
       {"\"central_pitch_db\": 12", "\"central_pitch_db\": 25", "outside the renderable band"},
       {"\"device\": \"tpad\"", "\"device\": \"nosuch\"", "unknown device 'nosuch'"},
@@ -243,7 +246,8 @@ TEST(Document, ErrorsNameTheJsonPath) {
     const std::string msg = load_error(edit(c.from, c.to));
     EXPECT_NE(msg.find(c.expect), std::string::npos) << "edit '" << c.to << "': " << msg;
   }
-  EXPECT_NE(load_error(R"({"format": "texel-document", "version": 1, "device": "tpad"})").find("exactly one of"), std::string::npos);
+  EXPECT_NE(load_error(R"({"format": "texel-document", "version": 1, "device": "tpad"})").find("exactly one of"),
+            std::string::npos);
   EXPECT_NE(load_error(R"({"format": "texel-document", "device": "tpad", "texture": {}})").find("version is missing"),
             std::string::npos);
 }

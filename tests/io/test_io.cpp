@@ -77,11 +77,14 @@ RC_GTEST_PROP(Npy, RoundTripIsBitExact, ()) {
 }
 
 TEST(Npy, ReadsOtherDtypesAndColumnShapes) {
-  auto f4 = parse_npy(npy_with("{'descr': '<f4', 'fortran_order': False, 'shape': (3,), }", raw_bytes<float>({0.5f, 1.0f, -2.0f})), "a");
+  auto f4 = parse_npy(
+      npy_with("{'descr': '<f4', 'fortran_order': False, 'shape': (3,), }", raw_bytes<float>({0.5f, 1.0f, -2.0f})), "a");
   EXPECT_EQ(f4, (std::vector<double>{0.5, 1.0, -2.0}));
-  auto u2 = parse_npy(npy_with("{'descr': '<u2', 'fortran_order': False, 'shape': (2, 1), }", raw_bytes<std::uint16_t>({0, 65535})), "b");
+  auto u2 = parse_npy(
+      npy_with("{'descr': '<u2', 'fortran_order': False, 'shape': (2, 1), }", raw_bytes<std::uint16_t>({0, 65535})), "b");
   EXPECT_EQ(u2, (std::vector<double>{0.0, 1.0}));
-  auto i2 = parse_npy(npy_with("{'descr': '<i2', 'fortran_order': False, 'shape': (1, 2), }", raw_bytes<std::int16_t>({-32768, 16384})), "c");
+  auto i2 = parse_npy(
+      npy_with("{'descr': '<i2', 'fortran_order': False, 'shape': (1, 2), }", raw_bytes<std::int16_t>({-32768, 16384})), "c");
   EXPECT_EQ(i2, (std::vector<double>{-1.0, 0.5}));
 }
 

@@ -39,7 +39,8 @@ std::vector<FingerSample> line(double t0, double t1, double x0, double v, double
 
 float max_step(std::span<const float> y, std::size_t from = 0, std::size_t to = SIZE_MAX) {
   float m = 0;
-  for (std::size_t i = std::max<std::size_t>(from, 1); i < std::min(to, y.size()); ++i) m = std::max(m, std::fabs(y[i] - y[i - 1]));
+  for (std::size_t i = std::max<std::size_t>(from, 1); i < std::min(to, y.size()); ++i)
+    m = std::max(m, std::fabs(y[i] - y[i - 1]));
   return m;
 }
 
@@ -65,8 +66,10 @@ TEST(SpscQueue, TwoThreadsKeepOrder) {
   constexpr std::uint64_t n = 50000;
   std::thread producer([&] {
     for (std::uint64_t i = 0; i < n;) {
-      if (q.try_push(i)) ++i;
-      else std::this_thread::yield();  // 2 shared cores: do not starve the consumer
+      if (q.try_push(i))
+        ++i;
+      else
+        std::this_thread::yield();  // 2 shared cores: do not starve the consumer
     }
   });
   std::uint64_t expect = 0, v = 0;
@@ -184,9 +187,9 @@ TEST(Player, TouchAndLiftRampWithoutClicks) {
   // Raised-cosine ramp of N samples: largest step π/(2N) of the full scale.
   const float bound = static_cast<float>(pi / (2 * c.touch_ramp_s * c.rate_hz)) * 1.01f;
   EXPECT_LE(max_step(out), bound);
-  EXPECT_EQ(out[4799], 0.0f);                 // before touch
+  EXPECT_EQ(out[4799], 0.0f);                     // before touch
   EXPECT_NEAR(out[4800 + 240 + 10], 1.0f, 1e-6);  // fully on after the ramp
-  EXPECT_EQ(out.back(), 0.0f);                // at rest after lift
+  EXPECT_EQ(out.back(), 0.0f);                    // at rest after lift
   // Vibration mode over a textured map: lift and touch stay within the same bound plus the texture's own slope.
   auto tex = make_map(100, 0.005, [](double x) { return 0.5 + 0.5 * std::sin(2 * pi * 2 * x); });
   c.mode = OutputMode::vibration;

@@ -4,12 +4,12 @@
 // input exits 2 with one line and writes nothing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
-#include <algorithm>
 
 #include "texel/player.hpp"
 #include "texel/sinks.hpp"
@@ -36,7 +36,7 @@ CliRun run(const std::string& args) {
 }
 
 class Cli : public ::testing::Test {
-protected:
+ protected:
   void SetUp() override {
     dir = fs::temp_directory_path() / ("texel-player-cli-" + std::to_string(::getpid()) + "-" +
                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -68,7 +68,7 @@ TEST_F(Cli, SwipeWavPeaksAtCentralPitchTimesSpeed) {
 TEST_F(Cli, SwipeCsvAndPlot) {
   const std::string csv = (dir / "s.csv").string(), png = (dir / "s.png").string();
   const CliRun r = run("swipe " + doc + " --pattern back-and-forth --duration 0.5 --rate 8333 --output amplitude -o " + csv +
-                    " --plot " + png);
+                       " --plot " + png);
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(fs::exists(png));
   EXPECT_GT(fs::file_size(csv), 4000u * 10);
@@ -83,14 +83,12 @@ TEST_F(Cli, PlayNullReportsBlocksAndWorstTime) {
 
 TEST_F(Cli, BadInputExitsTwoAndWritesNothing) {
   const std::string wav = (dir / "bad.wav").string();
-  for (const std::string& args : std::vector<std::string>{"swipe " + doc + " -o " + (dir / "x.mp3").string(),
-                                 "swipe " + doc + " --speed -3 -o " + wav,
-                                 "swipe " + doc + " --output loud -o " + wav,
-                                 "swipe " + doc + " --trace " + (dir / "none.csv").string() + " -o " + wav,
-                                 "swipe " + doc + " -o " + wav + " --plot " + (dir / "p.gif").string(),
-                                 "play " + doc + " --backend floppy",
-                                 "play " + doc + " --backend serial:" + (dir / "no-such-tty").string(),
-                                 "controller --serial " + (dir / "no-such-tty").string()}) {
+  for (const std::string& args : std::vector<std::string>{
+           "swipe " + doc + " -o " + (dir / "x.mp3").string(), "swipe " + doc + " --speed -3 -o " + wav,
+           "swipe " + doc + " --output loud -o " + wav, "swipe " + doc + " --trace " + (dir / "none.csv").string() + " -o " + wav,
+           "swipe " + doc + " -o " + wav + " --plot " + (dir / "p.gif").string(), "play " + doc + " --backend floppy",
+           "play " + doc + " --backend serial:" + (dir / "no-such-tty").string(),
+           "controller --serial " + (dir / "no-such-tty").string()}) {
     const CliRun r = run(args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;

@@ -37,7 +37,7 @@ TEST(ReferenceParams, ValidatesKeysRangesAndKinds) {
   ReferenceSpec s = spec("4sin");
   EXPECT_NO_THROW(set_reference_param(s, "frequencies_cpm=1,2,3"));
   EXPECT_EQ(std::get<std::vector<double>>(s.params.at("frequencies_cpm")).size(), 3u);
-  EXPECT_THROW(set_reference_param(s, "frequency=1"), InvalidArgument);         // unknown key
+  EXPECT_THROW(set_reference_param(s, "frequency=1"), InvalidArgument);          // unknown key
   EXPECT_THROW(set_reference_param(s, "frequencies_cpm=1,x"), InvalidArgument);  // not a number
   EXPECT_THROW(set_reference_param(s, "frequencies_cpm=-1"), InvalidArgument);   // out of range
   EXPECT_THROW(set_reference_param(s, "phase=sometimes"), InvalidArgument);      // not a choice
@@ -209,5 +209,6 @@ TEST(ReferenceDocument, TexelOnlyDocumentsStayVersion1AndBadReferencesAreNamed) 
     EXPECT_NE(std::string(e.what()).find("frequencies_cpm[1]"), std::string::npos) << e.what();
   }
   EXPECT_THROW(parse_document(R"({"format": "texel-document", "version": 2, "device": "tpad",
-    "texture": {"kind": "reference", "name": "4sin", "extra": 1}})"), FormatError);
+    "texture": {"kind": "reference", "name": "4sin", "extra": 1}})"),
+               FormatError);
 }

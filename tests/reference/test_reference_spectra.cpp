@@ -60,7 +60,8 @@ Psd mean_psd(const std::string& name, int seeds) {
   for (int seed = 1; seed <= seeds; ++seed) {
     const auto a = render_reference(spec(name, static_cast<std::uint64_t>(seed)), g);
     Psd p = welch_psd(a, g.spacing_mm, {.segment = 2000});
-    if (seed == 1) mean = p;
+    if (seed == 1)
+      mean = p;
     else
       for (std::size_t k = 0; k < p.density.size(); ++k) mean.density[k] += p.density[k];
   }
@@ -156,7 +157,9 @@ TEST(BandpassNoise, CentreAndMinus3dBWidth) {
     for (double zeta : {0.05, 0.5, 5.0}) {
       if (fc == 20.0 && zeta == 5.0) continue;
       const std::string name = "bandpass-f" + std::to_string(static_cast<int>(fc)) + "-z" +
-                               (zeta == 0.05 ? "0.05" : zeta == 0.5 ? "0.5" : "5");
+                               (zeta == 0.05  ? "0.05"
+                                : zeta == 0.5 ? "0.5"
+                                              : "5");
       const double f1 = fc * (std::sqrt(1 + zeta * zeta) - zeta);
       const double f2 = fc * (std::sqrt(1 + zeta * zeta) + zeta);
       std::vector<double> power, freq;

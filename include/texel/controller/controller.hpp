@@ -28,7 +28,7 @@ namespace texel::controller {
 
 /// The hardware abstraction: everything the controller touches.
 class Hal {
-public:
+ public:
   /// Monotonic microseconds (wraps at 2³²; the controller handles the wrap).
   virtual std::uint32_t micros() = 0;
   /// Non-blocking read of up to `max` bytes: the count read (0 = none),
@@ -44,7 +44,7 @@ public:
   /// Idles until about `t_us` (or returns early when bytes arrive).
   virtual void idle_until(std::uint32_t t_us) = 0;
 
-protected:
+ protected:
   ~Hal() = default;
 };
 
@@ -64,7 +64,7 @@ struct Status {
   std::int32_t x_nm = 0;
   bool touch = false;
   std::uint32_t frames_ok = 0;
-  std::uint32_t frames_bad = 0;   ///< CRC and length errors
+  std::uint32_t frames_bad = 0;  ///< CRC and length errors
   std::uint32_t nacks = 0;
   std::uint32_t link_errors = 0;  ///< times the link was found down
   std::uint32_t ticks = 0;        ///< output updates
@@ -75,7 +75,7 @@ template <std::size_t MaxSamples = 32768, std::size_t Slots = 2>
 class Controller {
   static_assert(Slots >= 1 && Slots < serial::no_map, "1 … 254 map slots");
 
-public:
+ public:
   static constexpr std::size_t max_samples = MaxSamples;
   static constexpr std::size_t slots = Slots;
 
@@ -121,7 +121,7 @@ public:
     return id < Slots && i < maps_[id].samples ? maps_[id].data[i] : 0;
   }
 
-private:
+ private:
   struct Map {
     std::uint32_t samples = 0;  // 0 = empty
     std::uint32_t spacing_nm = 0;
@@ -280,8 +280,7 @@ private:
       }
       case Type::select: {
         if (f.length != 1) return nack(f, ErrorCode::bad_length);
-        if (p[0] != serial::no_map && (p[0] >= Slots || maps_[p[0]].samples == 0))
-          return nack(f, ErrorCode::unknown_map);
+        if (p[0] != serial::no_map && (p[0] >= Slots || maps_[p[0]].samples == 0)) return nack(f, ErrorCode::unknown_map);
         status_.selected = p[0];
         status_.mode = Mode::position;
         return ack(f);

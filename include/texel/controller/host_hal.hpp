@@ -14,7 +14,7 @@
 namespace texel::controller {
 
 class HostHal final : public Hal {
-public:
+ public:
   /// Takes ownership of `fd` (set non-blocking here).
   explicit HostHal(int fd);
   ~HostHal();
@@ -36,7 +36,7 @@ public:
   /// Closes the descriptor (simulates unplugging the display).
   void close_link();
 
-private:
+ private:
   int fd_ = -1;
   bool down_ = false;
 };

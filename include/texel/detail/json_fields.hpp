@@ -21,7 +21,7 @@
 namespace texel::detail {
 
 class JsonObject {
-public:
+ public:
   JsonObject(const nlohmann::json& j, std::string path) : j_(j), path_(std::move(path)) {
     if (!j_.is_object()) throw FormatError(where() + " must be a JSON object, got " + type_of(j_));
   }
@@ -43,8 +43,7 @@ public:
     const auto& v = raw(key);
     if (!v.is_number()) throw FormatError(field(key) + " must be a number, got " + type_of(v));
     const double d = v.get<double>();
-    if (!(d >= lo && d <= hi))
-      throw FormatError(field(key) + " is " + num(d) + "; allowed: " + num(lo) + " … " + num(hi));
+    if (!(d >= lo && d <= hi)) throw FormatError(field(key) + " is " + num(d) + "; allowed: " + num(lo) + " … " + num(hi));
     return d;
   }
   double number_or(std::string_view key, double fallback, double lo = -std::numeric_limits<double>::infinity(),
@@ -82,7 +81,8 @@ public:
     if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(hi))
       throw FormatError(field(key) + " is " + v.dump() + "; allowed: " + std::to_string(lo) + " … " + std::to_string(hi));
     if (i < lo || i > hi)
-      throw FormatError(field(key) + " is " + std::to_string(i) + "; allowed: " + std::to_string(lo) + " … " + std::to_string(hi));
+      throw FormatError(field(key) + " is " + std::to_string(i) + "; allowed: " + std::to_string(lo) + " … " +
+                        std::to_string(hi));
     return i;
   }
   std::string string(std::string_view key) {
@@ -127,7 +127,7 @@ public:
     return std::string("a ") + v.type_name();
   }
 
-private:
+ private:
   const nlohmann::json& j_;
   std::string path_;
   std::set<std::string> seen_;

@@ -10,10 +10,20 @@ namespace texel::detail {
 
 // W doubles in one vector register. Spelled out per width: GCC drops
 // vector_size on a type that depends on a template parameter.
-template <int W> struct Lanes;
-template <> struct Lanes<2> { using type = double __attribute__((vector_size(16))); };
-template <> struct Lanes<4> { using type = double __attribute__((vector_size(32))); };
-template <> struct Lanes<8> { using type = double __attribute__((vector_size(64))); };
+template <int W>
+struct Lanes;
+template <>
+struct Lanes<2> {
+  using type = double __attribute__((vector_size(16)));
+};
+template <>
+struct Lanes<4> {
+  using type = double __attribute__((vector_size(32)));
+};
+template <>
+struct Lanes<8> {
+  using type = double __attribute__((vector_size(64)));
+};
 
 /// The widest lane count (8, 4 or 2) this CPU runs, chosen once. The
 /// environment variable TEXEL_SIMD=avx512|avx2|sse2 caps it (the determinism
