@@ -537,7 +537,10 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
   };
   const double step = 0.1 / L;  // at most 0.05 cycles of phase off at the texel's end
   for (std::size_t k = 0; k < texels; ++k) {
-    const auto [b, e] = range(k);
+    // Not a structured binding: clang 14 cannot capture one in the lambdas below.
+    const auto bounds = range(k);
+    const std::size_t b = bounds.first;
+    const std::size_t e = bounds.second;
     if (e <= b + 2) return r;
     const double x0 = static_cast<double>(k) * L;
     std::vector<double> phases;
