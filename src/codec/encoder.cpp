@@ -318,6 +318,18 @@ std::vector<double> decoded_profile(const CoarseFields& f, std::size_t count) {
 
 // --- analysis-by-synthesis ----------------------------------------------------
 
+/// The fine-only TexelSpec of a candidate under the encoder's settings.
+TexelSpec fine_spec(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, std::uint64_t seed) {
+  TexelSpec s;
+  s.central_pitch = Decibels(p_db);
+  s.irregularity = Decibels(i_db);
+  s.texel_length = cfg.texel_length;
+  s.parameterization = cfg.parameterization;
+  s.band_max = band_max;
+  s.seed = seed;
+  return s;
+}
+
 struct Fitter {
   const EncoderConfig& cfg;
   const Percept& target;
@@ -329,13 +341,7 @@ struct Fitter {
   int evaluations = 0;
 
   Percept render_percept(double p_db, double i_db, std::uint64_t seed) const {
-    TexelSpec s;
-    s.central_pitch = Decibels(p_db);
-    s.irregularity = Decibels(i_db);
-    s.texel_length = cfg.texel_length;
-    s.parameterization = cfg.parameterization;
-    s.band_max = band_max;
-    s.seed = seed;
+    TexelSpec s = fine_spec(p_db, i_db, cfg, band_max, seed);
     if (two_scale) {
       s.coarse_strength = two_scale->C;
       s.fine_strength = two_scale->F;
@@ -429,14 +435,7 @@ std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double
 /// A fine-only Texel texture of the encoder's settings.
 TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, Millimetres length,
                           std::uint64_t seed = 0x5EED0001) {
-  TexelSpec s;
-  s.central_pitch = Decibels(p_db);
-  s.irregularity = Decibels(i_db);
-  s.texel_length = cfg.texel_length;
-  s.parameterization = cfg.parameterization;
-  s.band_max = band_max;
-  s.seed = seed;
-  return TexelTexture(s, length, band_max);
+  return TexelTexture(fine_spec(p_db, i_db, cfg, band_max, seed), length, band_max);
 }
 
 struct FineFit {

@@ -9,6 +9,7 @@
 
 #include "texel/detail/format.hpp"
 #include "texel/detail/json_fields.hpp"
+#include "texel/detail/lanes.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -197,37 +198,15 @@ namespace {
 // comparisons, the same a·65535 + 0.5 in IEEE double, truncation to integer,
 // round-to-nearest double -> float — so the bytes do not depend on the lane
 // width, which is picked per instruction set at run time (as in texture.cpp).
-template <int W>
-struct Lanes;
-template <>
-struct Lanes<2> {
-  using d = double __attribute__((vector_size(16)));
-  using i32 = std::int32_t __attribute__((vector_size(8)));
-  using u16 = std::uint16_t __attribute__((vector_size(4)));
-  using f32 = float __attribute__((vector_size(8)));
-};
-template <>
-struct Lanes<4> {
-  using d = double __attribute__((vector_size(32)));
-  using i32 = std::int32_t __attribute__((vector_size(16)));
-  using u16 = std::uint16_t __attribute__((vector_size(8)));
-  using f32 = float __attribute__((vector_size(16)));
-};
-template <>
-struct Lanes<8> {
-  using d = double __attribute__((vector_size(64)));
-  using i32 = std::int32_t __attribute__((vector_size(32)));
-  using u16 = std::uint16_t __attribute__((vector_size(16)));
-  using f32 = float __attribute__((vector_size(32)));
-};
+using detail::Lanes;
 
 template <int W>
 [[gnu::always_inline]] inline void encode_u16_lanes(const double* a, std::uint16_t* out, std::size_t n) {
   using L = Lanes<W>;
-  const typename L::d zero{}, one = zero + 1.0;
+  const typename L::type zero{}, one = zero + 1.0;
   std::size_t i = 0;
   for (; i + W <= n; i += W) {
-    typename L::d v;
+    typename L::type v;
     std::memcpy(&v, a + i, sizeof v);
     v = v > zero ? (v < one ? v : one) : zero;
     v = v * 65535.0 + 0.5;  // in [0.5, 65535.5]: truncates exactly through int32
@@ -240,10 +219,10 @@ template <int W>
 template <int W>
 [[gnu::always_inline]] inline void encode_f32_lanes(const double* a, float* out, std::size_t n) {
   using L = Lanes<W>;
-  const typename L::d zero{}, one = zero + 1.0;
+  const typename L::type zero{}, one = zero + 1.0;
   std::size_t i = 0;
   for (; i + W <= n; i += W) {
-    typename L::d v;
+    typename L::type v;
     std::memcpy(&v, a + i, sizeof v);
     v = v > zero ? (v < one ? v : one) : zero;
     const typename L::f32 f = __builtin_convertvector(v, typename L::f32);
@@ -276,15 +255,15 @@ void encode_f32_generic(const double* a, float* o, std::size_t n) { encode_f32_l
 /// The widest encoders this CPU runs (chosen once, at first use).
 EncodeKernel<std::uint16_t> pick_u16() {
 #if defined(__x86_64__) || defined(__i386__)
-  if (__builtin_cpu_supports("avx512f")) return &encode_u16_avx512;
-  if (__builtin_cpu_supports("avx2")) return &encode_u16_avx2;
+  if (detail::simd_lanes() == 8) return &encode_u16_avx512;
+  if (detail::simd_lanes() == 4) return &encode_u16_avx2;
 #endif
   return &encode_u16_generic;
 }
 EncodeKernel<float> pick_f32() {
 #if defined(__x86_64__) || defined(__i386__)
-  if (__builtin_cpu_supports("avx512f")) return &encode_f32_avx512;
-  if (__builtin_cpu_supports("avx2")) return &encode_f32_avx2;
+  if (detail::simd_lanes() == 8) return &encode_f32_avx512;
+  if (detail::simd_lanes() == 4) return &encode_f32_avx2;
 #endif
   return &encode_f32_generic;
 }
