@@ -43,6 +43,7 @@ bench: build
 	$(BUILD)/bin/texel_bench --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
+	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

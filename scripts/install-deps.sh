@@ -11,7 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev
   libcairo2-dev libkissfft-dev libzstd-dev zstd
   libsndfile1-dev portaudio19-dev libsqlite3-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest
+  libboost-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy
 )
 
 missing=()

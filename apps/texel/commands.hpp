@@ -18,5 +18,8 @@ void register_decode(CLI::App& app);
 void register_swipe(CLI::App& app);
 void register_play(CLI::App& app);
 void register_controller(CLI::App& app);
+void register_staircase(CLI::App& app);
+void register_stats(CLI::App& app);
+void register_experiment(CLI::App& app);
 
 }  // namespace texel::cli

@@ -29,6 +29,9 @@ int main(int argc, char** argv) {
   texel::cli::register_swipe(app);
   texel::cli::register_play(app);
   texel::cli::register_controller(app);
+  texel::cli::register_experiment(app);
+  texel::cli::register_staircase(app);
+  texel::cli::register_stats(app);
   try {
     app.parse(argc, argv);
     return 0;

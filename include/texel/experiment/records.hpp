@@ -1,0 +1,93 @@
+// The long-format trial record: one row per answered trial, the contract
+// between the session store (which writes them), `texel experiment export`
+// (which prints them as CSV), and the analysis (which reads them back from the
+// store or from that CSV). R, pandas and MATLAB read the CSV directly:
+// a header row, comma separated, RFC 4180 quoting, empty cell = missing (NA).
+//
+// Every field that a task does not use is missing (NaN or empty). Column
+// names and units are documented in docs/experiments.md ("Export").
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace texel::experiment {
+
+inline constexpr double missing = std::numeric_limits<double>::quiet_NaN();
+
+struct TrialRow {
+  // -- who and where
+  std::string participant;  ///< pseudonymous code, e.g. "S01"
+  std::int64_t session_id = 0;
+  std::string protocol;  ///< protocol name, e.g. "texel-length"
+  std::string study;     ///< one of: working-memory, texel-length, parameter-mapping,
+                         ///< free-exploration, quantization, guided-exploration, coarse-features
+  std::string block;     ///< block name, e.g. "narrow", "fine-50"
+  int block_index = 0;   ///< 0-based position of the block in the protocol
+  int trial = 0;         ///< 0-based trial index within the session (all blocks)
+  int trial_in_block = 0;
+  bool practice = false;
+  std::string task;       ///< oddity, two-alternative, match, rating, guided, same-different
+  std::string condition;  ///< task-specific condition label ("wide-distractor", "q3", ...); may be empty
+  std::string reference;  ///< reference name (matching, rating, guided, coarse); may be empty
+
+  // -- adaptive procedure (staircase tasks)
+  std::string variable;            ///< adaptive variable, e.g. "texel_length_mm", "coarse_strength"
+  double intensity = missing;      ///< value presented on this trial (variable's unit)
+  bool reversal = false;           ///< this trial was a reversal
+  double next_intensity = missing; ///< value computed after this answer (last row: the convergent value)
+  bool procedure_finished = false; ///< the procedure finished with this answer
+
+  // -- response
+  std::string response;       ///< raw response: "2", "A", "B", "unsure", "same", "different", a rating, ...
+  std::string correct_answer; ///< what would have been correct, where there is one (never shown to participants)
+  double correct = missing;   ///< 1 correct, 0 wrong, missing where the task has no right answer
+  double rating = missing;    ///< similarity rating on the protocol's scale
+  double confidence = missing;///< confidence rating (1 … 5)
+  double rt_ms = missing;     ///< reaction time: first presentation → answer (ms)
+
+  // -- matching (sliders, guided)
+  double slider_p = missing;  ///< pitch slider position (protocol's slider units)
+  double slider_i = missing;  ///< irregularity slider position
+  double pitch_db = missing;  ///< matched / presented Central Pitch (dB re 1 cpm)
+  double irregularity_db = missing;
+  double pitch_a_db = missing, irregularity_a_db = missing;  ///< guided: point A
+  double pitch_b_db = missing, irregularity_b_db = missing;  ///< guided: point B
+  int iteration = -1;  ///< guided: optimizer iteration (0-based), -1 otherwise
+
+  // -- stimulus parameters shown on this trial
+  double texel_length_mm = missing;
+  double coarse_strength = missing;
+  double fine_strength = missing;
+  double quantization_db = missing;
+
+  // -- working memory
+  double digit_cell = missing;      ///< matrix cell asked (0 … 15, row-major), or missing
+  double digit_response = missing;  ///< digit answered
+  double digit_correct = missing;   ///< 1 / 0
+
+  // -- swipe behaviour (experiments.md "Measures"), when a finger trace exists
+  double swipe_mean_speed_mm_s = missing;
+  double swipe_sd_speed_mm_s = missing;
+  double directional_proportion = missing;
+
+  // -- time stamps (UTC, ISO 8601 with milliseconds)
+  std::string shown_at;
+  std::string answered_at;
+};
+
+/// Column names in CSV order (the export's header).
+const std::vector<std::string>& trial_columns();
+/// One CSV line (no newline) for `row`, in trial_columns() order.
+std::string csv_line(const TrialRow& row);
+/// The whole CSV: header + one line per row, '\n' line ends.
+std::string trials_csv(const std::vector<TrialRow>& rows);
+/// Reads a CSV written by trials_csv (columns may be in any order; unknown
+/// columns are ignored; missing columns stay missing). Throws FormatError
+/// naming the line and column.
+std::vector<TrialRow> parse_trials_csv(std::string_view text, std::string_view origin);
+
+}  // namespace texel::experiment
