@@ -57,6 +57,11 @@ struct TrialRow {
   double pitch_a_db = missing, irregularity_a_db = missing;  ///< guided: point A
   double pitch_b_db = missing, irregularity_b_db = missing;  ///< guided: point B
   int iteration = -1;  ///< guided: optimizer iteration (0-based), -1 otherwise
+  /// The reference's own position in (Central Pitch, Irregularity): the
+  /// encoder's perceptual estimate of the reference texture (dB), so matches
+  /// and references compare in one unit. Missing where there is no reference.
+  double reference_pitch_db = missing;
+  double reference_irregularity_db = missing;
 
   // -- stimulus parameters shown on this trial
   double texel_length_mm = missing;
