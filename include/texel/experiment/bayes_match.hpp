@@ -57,6 +57,7 @@ class BayesOptimizer final : public MatchOptimizer {
   /// Posterior SD per axis.
   [[nodiscard]] MatchPoint uncertainty() const override { return sd_; }
   [[nodiscard]] int comparisons() const override { return static_cast<int>(choices_.size()); }
+  [[nodiscard]] int budget() const override { return config_.comparisons; }
   [[nodiscard]] std::string state_json() const override;
   [[nodiscard]] std::string name() const override { return "bayesian"; }
 

@@ -55,6 +55,9 @@ class MatchOptimizer {
   [[nodiscard]] virtual MatchPoint uncertainty() const = 0;
   /// Answered comparisons.
   [[nodiscard]] virtual int comparisons() const = 0;
+  /// Planned comparisons: guided 4 × iterations (unsure = repeat adds up to
+  /// one per unsure answer), Bayesian its budget (sd_stop may end earlier).
+  [[nodiscard]] virtual int budget() const = 0;
   /// Compact JSON snapshot of the state, for the record.
   [[nodiscard]] virtual std::string state_json() const = 0;
   /// "guided" | "bayesian".
@@ -135,6 +138,7 @@ class GuidedOptimizer final : public MatchOptimizer {
   /// The box half-widths.
   [[nodiscard]] MatchPoint uncertainty() const override { return {box_.pitch_half_db, box_.irregularity_half_db}; }
   [[nodiscard]] int comparisons() const override { return static_cast<int>(choices_.size()); }
+  [[nodiscard]] int budget() const override { return 4 * config_.iterations; }
   [[nodiscard]] std::string state_json() const override;
   [[nodiscard]] std::string name() const override { return "guided"; }
 
