@@ -49,7 +49,8 @@ class BayesOptimizer final : public MatchOptimizer {
  public:
   explicit BayesOptimizer(BayesConfig config);
 
-  [[nodiscard]] MatchQuestion next() const override { return pending_; }
+  /// The pending comparison; throws texel::Error if finished().
+  [[nodiscard]] MatchQuestion next() const override;
   void answer(MatchChoice choice) override;
   [[nodiscard]] bool finished() const override;
   /// Posterior mean.
