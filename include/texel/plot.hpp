@@ -51,6 +51,11 @@ struct Axis {
   /// value in dB re 1 cycle/mm (10·log10 f), as a second line "(10 dB)" under
   /// x tick labels or "1 (0 dB)" on y. Ignored on linear axes.
   bool db_labels = false;
+  /// A category axis when non-empty: category i sits at data value i, major
+  /// ticks at 0 … n − 1 carry these texts (thinned if they would overlap),
+  /// and an unset range is −0.5 … n − 0.5. Linear scale only. A heatmap's
+  /// row/column labels are used when this is empty.
+  std::vector<std::string> categories{};
 };
 
 /// A polyline through (x[i], y[i]). x should be sorted ascending: sorted
@@ -63,9 +68,11 @@ struct LineSeries {
   std::optional<Rgb> colour;  ///< unset: the panel's next palette colour
   double width_px = 1.25;     ///< stroke width, px (0.1 … 20)
   std::string label;          ///< legend text; empty = not in the legend
+  bool dashed = false;        ///< dashed stroke (reference lines, e.g. y = x)
 };
 
-/// Markers at (x[i], y[i]), optionally on stems from `baseline` (peak lists).
+/// Markers at (x[i], y[i]), optionally on stems from `baseline` (peak lists);
+/// with stems = false, a scatter plot.
 struct StemSeries {
   std::vector<double> x;          ///< data units
   std::vector<double> y;          ///< same length as x
@@ -93,9 +100,73 @@ struct VerticalMarker {
   bool dashed = true;
 };
 
+/// Tukey's box-and-whisker summary of one sample (Tukey 1977): quartiles
+/// (Hyndman & Fan type 7, R's default), whiskers at the most extreme values
+/// within 1.5 IQR of the box, and the values beyond them as outliers.
+struct BoxStats {
+  std::size_t n = 0;  ///< finite values; 0 = every other field NaN, no outliers
+  double q1 = 0, median = 0, q3 = 0;
+  double whisker_low = 0, whisker_high = 0;
+  double mean = 0;
+  std::vector<double> outliers;  ///< ascending
+};
+/// The box summary of the finite values of `values`.
+BoxStats box_stats(std::span<const double> values);
+
+/// Box plots, one per group (categories on x): box q1 … q3 with the median,
+/// whiskers, outliers as open circles, the mean as a small cross.
+struct BoxSeries {
+  std::vector<std::vector<double>> groups;  ///< one sample per box (NaNs skipped; empty = no box)
+  std::vector<double> positions;            ///< x of each box, data units; empty = 0, 1, 2 … (a category axis)
+  double offset = 0.0;                      ///< added to every position, data units (boxes side by side)
+  double box_width = 0.5;                   ///< data units, > 0
+  std::optional<Rgb> colour;                ///< unset: the panel's next palette colour
+  bool show_mean = true;                    ///< mark the mean with a cross
+  bool show_points = false;                 ///< every value as a small dot over its box
+  std::string label;                        ///< legend text; empty = not in the legend
+};
+
+/// Points with symmetric error bars (mean ± SEM, mean ± CI half-width),
+/// optionally joined by a line in x order.
+struct ErrorBarSeries {
+  std::vector<double> x;          ///< data units
+  std::vector<double> y;          ///< same length as x
+  std::vector<double> error;      ///< half-length of each bar, >= 0 (NaN = no bar); same length as x
+  std::optional<Rgb> colour;      ///< unset: the panel's next palette colour
+  bool connect = false;           ///< join the points with a line
+  double marker_radius_px = 3.5;  ///< 0 … 20 px
+  double cap_px = 5.0;            ///< half-width of the bar caps, 0 … 40 px
+  std::string label;              ///< legend text; empty = not in the legend
+};
+
+/// A matrix drawn as coloured cells (e.g. a similarity matrix), the value
+/// printed in each cell and a colour bar at the right. Row 0 is drawn at the
+/// top; cell (r, c) is centred on x = c, y = rows − 1 − r, so the panel's
+/// axes become category axes labelled with the row and column labels.
+struct HeatmapSeries {
+  std::size_t rows = 0;
+  std::size_t cols = 0;
+  std::vector<double> values;              ///< rows × cols, row-major; NaN = blank cell
+  std::vector<std::string> row_labels;     ///< rows texts, or empty
+  std::vector<std::string> column_labels;  ///< cols texts, or empty
+  std::optional<double> min;               ///< colour-scale end; unset = data minimum
+  std::optional<double> max;               ///< colour-scale end; unset = data maximum
+  int decimals = 1;                        ///< digits of the printed values, 0 … 6; −1 = no text
+  std::string scale_label;                 ///< colour bar label, e.g. "mean rating (1–5)"
+};
+
+/// Text placed at a data point (a p value over a bar, a name by an ellipse).
+struct TextNote {
+  double x = 0.0;  ///< data units: where the text is centred
+  double y = 0.0;  ///< data units: the text's vertical middle
+  std::string text;
+  Rgb colour{0.1, 0.1, 0.1};
+};
+
 /// One plot area with its axes, series and legend. Draw order, back to
-/// front: grid, histograms, markers, lines, stems; palette colours are
-/// assigned in the order lines, stems, histograms.
+/// front: grid, heatmap, histograms, markers, boxes, lines, error bars,
+/// stems, notes; palette colours are assigned in the order lines, stems,
+/// histograms, boxes, error bars.
 struct Panel {
   std::string title;  ///< above the plot area; empty = none
   Axis x;
@@ -104,6 +175,10 @@ struct Panel {
   std::vector<StemSeries> stems;
   std::vector<Histogram> histograms;
   std::vector<VerticalMarker> markers;
+  std::vector<BoxSeries> boxes;
+  std::vector<ErrorBarSeries> error_bars;
+  std::optional<HeatmapSeries> heatmap;  ///< at most one matrix per panel
+  std::vector<TextNote> notes;
   bool legend = true;          ///< drawn (top right) when more than one series is labelled
   double height_weight = 1.0;  ///< relative height of this panel's row (> 0)
 };

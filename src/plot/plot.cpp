@@ -153,6 +153,9 @@ void check_axis(const Axis& a, const std::string& name) {
 void check_panel(const Panel& p, const std::string& name) {
   check_axis(p.x, name + ".x");
   check_axis(p.y, name + ".y");
+  for (const auto& [axis, an] : {std::pair{&p.x, ".x"}, std::pair{&p.y, ".y"}})
+    if (!axis->categories.empty() && axis->scale != AxisScale::linear)
+      throw InvalidArgument(name + an + " has categories on a log scale; category axes must be linear");
   if (!(p.height_weight > 0) || !std::isfinite(p.height_weight))
     throw InvalidArgument(name + ".height_weight is " + detail::num(p.height_weight) + "; must be > 0");
   for (std::size_t i = 0; i < p.lines.size(); ++i) {
@@ -171,6 +174,54 @@ void check_panel(const Panel& p, const std::string& name) {
     if (!(s.marker_radius_px >= 0 && s.marker_radius_px <= 20))
       throw InvalidArgument(where(name + ".stems", i) + ".marker_radius_px is " + detail::num(s.marker_radius_px) +
                             "; allowed 0 … 20");
+  }
+  for (std::size_t i = 0; i < p.boxes.size(); ++i) {
+    const auto& b = p.boxes[i];
+    if (!b.positions.empty() && b.positions.size() != b.groups.size())
+      throw InvalidArgument(where(name + ".boxes", i) + " has " + std::to_string(b.positions.size()) + " positions for " +
+                            std::to_string(b.groups.size()) + " groups; they must match (or positions be empty)");
+    if (!(b.box_width > 0) || !std::isfinite(b.box_width))
+      throw InvalidArgument(where(name + ".boxes", i) + ".box_width is " + detail::num(b.box_width) + "; must be > 0");
+    if (!std::isfinite(b.offset))
+      throw InvalidArgument(where(name + ".boxes", i) + ".offset is " + detail::num(b.offset) + "; must be finite");
+  }
+  for (std::size_t i = 0; i < p.error_bars.size(); ++i) {
+    const auto& e = p.error_bars[i];
+    if (e.x.size() != e.y.size() || e.x.size() != e.error.size())
+      throw InvalidArgument(where(name + ".error_bars", i) + " has " + std::to_string(e.x.size()) + " x, " +
+                            std::to_string(e.y.size()) + " y and " + std::to_string(e.error.size()) +
+                            " error values; they must match");
+    for (std::size_t k = 0; k < e.error.size(); ++k)
+      if (e.error[k] < 0 || std::isinf(e.error[k]))
+        throw InvalidArgument(where(name + ".error_bars", i) + ".error[" + std::to_string(k) + "] is " + detail::num(e.error[k]) +
+                              "; must be >= 0 (NaN = no bar)");
+    if (!(e.marker_radius_px >= 0 && e.marker_radius_px <= 20))
+      throw InvalidArgument(where(name + ".error_bars", i) + ".marker_radius_px is " + detail::num(e.marker_radius_px) +
+                            "; allowed 0 … 20");
+    if (!(e.cap_px >= 0 && e.cap_px <= 40))
+      throw InvalidArgument(where(name + ".error_bars", i) + ".cap_px is " + detail::num(e.cap_px) + "; allowed 0 … 40");
+  }
+  if (const auto& h = p.heatmap) {
+    const std::string hn = name + ".heatmap";
+    if (h->rows == 0 || h->cols == 0 || h->rows > 1000 || h->cols > 1000)
+      throw InvalidArgument(hn + " is " + std::to_string(h->rows) + "×" + std::to_string(h->cols) + "; allowed 1 … 1000 a side");
+    if (h->values.size() != h->rows * h->cols)
+      throw InvalidArgument(hn + " has " + std::to_string(h->values.size()) + " values for " + std::to_string(h->rows) + "×" +
+                            std::to_string(h->cols) + " cells; they must match");
+    if (!h->row_labels.empty() && h->row_labels.size() != h->rows)
+      throw InvalidArgument(hn + " has " + std::to_string(h->row_labels.size()) + " row labels for " + std::to_string(h->rows) +
+                            " rows; they must match (or be empty)");
+    if (!h->column_labels.empty() && h->column_labels.size() != h->cols)
+      throw InvalidArgument(hn + " has " + std::to_string(h->column_labels.size()) + " column labels for " +
+                            std::to_string(h->cols) + " columns; they must match (or be empty)");
+    if (h->decimals < -1 || h->decimals > 6)
+      throw InvalidArgument(hn + ".decimals is " + std::to_string(h->decimals) + "; allowed −1 (no text) … 6");
+    for (const auto& [end, v] : {std::pair{"min", h->min}, std::pair{"max", h->max}})
+      if (v && !std::isfinite(*v)) throw InvalidArgument(hn + "." + end + " is " + detail::num(*v) + "; must be finite");
+    if (h->min && h->max && !(*h->min < *h->max))
+      throw InvalidArgument(hn + " colour range is " + detail::num(*h->min) + " … " + detail::num(*h->max) +
+                            "; min must be < max");
+    if (p.x.scale != AxisScale::linear || p.y.scale != AxisScale::linear) throw InvalidArgument(hn + " needs linear axes");
   }
   for (std::size_t i = 0; i < p.histograms.size(); ++i) {
     const auto& h = p.histograms[i];
@@ -458,30 +509,108 @@ struct PanelPlan {
   Rect cell;  // the panel's share of the figure
   double xlo = 0, xhi = 1, ylo = 0, yhi = 1;
   std::vector<Tick> xticks, yticks;
-  std::vector<Rgb> line_colours, stem_colours, hist_colours;
+  std::vector<Rgb> line_colours, stem_colours, hist_colours, box_colours, error_colours;
+  std::vector<std::vector<BoxStats>> boxes;
+  std::vector<std::string> xcats, ycats;            // category labels in effect (axis or heatmap)
+  double heat_lo = 0, heat_hi = 1;                  // colour-scale range of the heatmap
+  double colour_bar = 0;                            // px reserved right of the plot for the heatmap's colour bar
   double left = 0, right = 0, top = 0, bottom = 0;  // margins, px
   Rect plot;
 };
+
+constexpr double colour_bar_px = 12.0;  // width of a heatmap's colour bar
+
+/// A heatmap value as printed in its cell and on the colour bar.
+std::string format_heat(double v, const HeatmapSeries& h) { return typographic(detail::fixed(v, std::max(0, h.decimals))); }
+
+/// ColorBrewer "Blues" (Brewer 2003; sequential, print- and colour-blind-safe)
+/// at t in [0, 1], interpolated linearly between its nine classes.
+Rgb blues(double t) {
+  static constexpr Rgb stops[] = {{0.969, 0.984, 1.000}, {0.871, 0.922, 0.969}, {0.776, 0.859, 0.937},
+                                  {0.620, 0.792, 0.882}, {0.420, 0.682, 0.839}, {0.259, 0.573, 0.776},
+                                  {0.129, 0.443, 0.710}, {0.031, 0.318, 0.612}, {0.031, 0.188, 0.420}};
+  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * 8.0;
+  const auto i = std::min<std::size_t>(7, static_cast<std::size_t>(t));
+  const double u = t - static_cast<double>(i);
+  const Rgb a = stops[i], b = stops[i + 1];
+  return {a.r + (b.r - a.r) * u, a.g + (b.g - a.g) * u, a.b + (b.b - a.b) * u};
+}
 
 struct Fonts {
   double base, title, tick, small;
   explicit Fonts(double b) : base(b), title(b * 1.12), tick(b * 0.88), small(b * 0.82) {}
 };
 
+/// x of box group `g` of series `b`.
+double box_x(const BoxSeries& b, std::size_t g) {
+  return (b.positions.empty() ? static_cast<double>(g) : b.positions[g]) + b.offset;
+}
+
+/// Category labels in effect for the panel's axes: the axis' own, else a
+/// heatmap's row/column labels (rows reversed: row 0 is drawn at the top).
+void plan_categories(PanelPlan& pp) {
+  const Panel& p = *pp.panel;
+  pp.xcats = p.x.categories;
+  pp.ycats = p.y.categories;
+  if (const auto& h = p.heatmap) {
+    if (pp.xcats.empty()) {
+      pp.xcats = h->column_labels;
+      if (pp.xcats.empty())
+        for (std::size_t c = 0; c < h->cols; ++c) pp.xcats.push_back(std::to_string(c + 1));
+    }
+    if (pp.ycats.empty()) {
+      pp.ycats.assign(h->row_labels.rbegin(), h->row_labels.rend());
+      if (pp.ycats.empty())
+        for (std::size_t r = h->rows; r > 0; --r) pp.ycats.push_back(std::to_string(r));
+    }
+    Range v;
+    for (const double x : h->values) v.add(x, false);
+    if (v.empty()) v = Range{0.0, 1.0};
+    pp.heat_lo = h->min.value_or(v.lo);
+    pp.heat_hi = h->max.value_or(v.hi);
+    if (!(pp.heat_lo < pp.heat_hi)) {
+      // One value: centre it on the scale.
+      if (h->min && !h->max)
+        pp.heat_hi = pp.heat_lo + 1;
+      else if (h->max && !h->min)
+        pp.heat_lo = pp.heat_hi - 1;
+      else
+        pp.heat_lo -= 0.5, pp.heat_hi += 0.5;
+    }
+  }
+}
+
 void plan_ranges(PanelPlan& pp) {
   const Panel& p = *pp.panel;
   const bool xlog = p.x.scale == AxisScale::log10;
   const bool ylog = p.y.scale == AxisScale::log10;
+  plan_categories(pp);
+  for (const auto& b : p.boxes) {
+    std::vector<BoxStats> st;
+    for (const auto& g : b.groups) st.push_back(box_stats(g));
+    pp.boxes.push_back(std::move(st));
+  }
   Range xr;
-  bool only_lines = p.stems.empty();
+  bool only_lines = p.stems.empty() && p.boxes.empty() && p.error_bars.empty();
   for (const auto& s : p.lines)
     for (const double v : s.x) xr.add(v, xlog);
   for (const auto& s : p.stems)
     for (const double v : s.x) xr.add(v, xlog);
   for (const auto& h : p.histograms)
     for (const double v : h.edges) xr.add(v, xlog);
+  for (const auto& b : p.boxes)
+    for (std::size_t g = 0; g < b.groups.size(); ++g) {
+      xr.add(box_x(b, g) - b.box_width / 2, xlog);
+      xr.add(box_x(b, g) + b.box_width / 2, xlog);
+    }
+  for (const auto& e : p.error_bars)
+    for (const double v : e.x) xr.add(v, xlog);
   const double xpad = only_lines ? 0.0 : 0.04;
   std::tie(pp.xlo, pp.xhi) = resolve_range(p.x, xr, xpad, xpad);
+  if (!pp.xcats.empty()) {
+    pp.xlo = p.x.min.value_or(-0.5);
+    pp.xhi = p.x.max.value_or(static_cast<double>(pp.xcats.size()) - 0.5);
+  }
 
   // y from the points inside the chosen x range, so an excerpt autoscales to itself.
   Range yr;
@@ -504,9 +633,32 @@ void plan_ranges(PanelPlan& pp) {
       if (yr.lo >= 0) yr.anchored_lo = true;
     }
   }
+  for (std::size_t i = 0; i < p.boxes.size(); ++i)
+    for (std::size_t g = 0; g < p.boxes[i].groups.size(); ++g) {
+      if (!visible(box_x(p.boxes[i], g))) continue;
+      const BoxStats& st = pp.boxes[i][g];
+      yr.add(st.whisker_low, ylog);
+      yr.add(st.whisker_high, ylog);
+      for (const double o : st.outliers) yr.add(o, ylog);
+    }
+  for (const auto& e : p.error_bars)
+    for (std::size_t k = 0; k < e.x.size(); ++k) {
+      if (!visible(e.x[k])) continue;
+      yr.add(e.y[k], ylog);
+      if (std::isfinite(e.error[k])) {
+        yr.add(e.y[k] - e.error[k], ylog);
+        yr.add(e.y[k] + e.error[k], ylog);
+      }
+    }
+  for (const auto& t : p.notes)
+    if (visible(t.x)) yr.add(t.y, ylog);
   // Headroom for marker labels, which sit at the top of the plot.
   const bool labelled_markers = std::any_of(p.markers.begin(), p.markers.end(), [](const auto& m) { return !m.label.empty(); });
   std::tie(pp.ylo, pp.yhi) = resolve_range(p.y, yr, 0.05, labelled_markers ? 0.14 : 0.05);
+  if (!pp.ycats.empty()) {
+    pp.ylo = p.y.min.value_or(-0.5);
+    pp.yhi = p.y.max.value_or(static_cast<double>(pp.ycats.size()) - 0.5);
+  }
 }
 
 void plan_colours(PanelPlan& pp) {
@@ -516,14 +668,23 @@ void plan_colours(PanelPlan& pp) {
   for (const auto& s : p.lines) pp.line_colours.push_back(pick(s.colour));
   for (const auto& s : p.stems) pp.stem_colours.push_back(pick(s.colour));
   for (const auto& h : p.histograms) pp.hist_colours.push_back(pick(h.colour));
+  for (const auto& b : p.boxes) pp.box_colours.push_back(pick(b.colour));
+  for (const auto& e : p.error_bars) pp.error_colours.push_back(pick(e.colour));
+}
+
+/// Ticks of a category axis: one labelled major tick per category.
+std::vector<Tick> category_ticks(const std::vector<std::string>& cats) {
+  std::vector<Tick> ticks;
+  for (std::size_t i = 0; i < cats.size(); ++i) ticks.push_back({static_cast<double>(i), cats[i], {}, true});
+  return ticks;
 }
 
 void plan_margins(PanelPlan& pp, const Painter& pa, const Fonts& f) {
   const Panel& p = *pp.panel;
   const int xtarget = std::clamp(static_cast<int>(pp.cell.w / (f.base * 7)), 2, 10);
   const int ytarget = std::clamp(static_cast<int>(pp.cell.h / (f.base * 3.2)), 2, 8);
-  pp.xticks = axis_ticks(pp.xlo, pp.xhi, p.x.scale, p.x.db_labels, xtarget);
-  pp.yticks = axis_ticks(pp.ylo, pp.yhi, p.y.scale, p.y.db_labels, ytarget);
+  pp.xticks = pp.xcats.empty() ? axis_ticks(pp.xlo, pp.xhi, p.x.scale, p.x.db_labels, xtarget) : category_ticks(pp.xcats);
+  pp.yticks = pp.ycats.empty() ? axis_ticks(pp.ylo, pp.yhi, p.y.scale, p.y.db_labels, ytarget) : category_ticks(pp.ycats);
   const double pad = f.base * 0.6;
   const double tick_len = 5.0;
 
@@ -544,6 +705,13 @@ void plan_margins(PanelPlan& pp, const Painter& pa, const Fonts& f) {
   pp.left = pad + (p.y.label.empty() ? 0 : lh + pad * 0.5) + ylabel_w + tick_len + 3;
   pp.bottom = tick_len + 3 + tick_lh * (x_secondary ? 2 : 1) + (p.x.label.empty() ? 0 : lh * 1.1) + pad * 0.5;
   pp.right = std::max(pad * 2, xlast_w / 2 + pad);
+  if (p.heatmap) {
+    // Colour bar: gap, bar, tick, value labels, the rotated scale label.
+    pa.font(f.tick);
+    const double vw = std::max(pa.width(format_heat(pp.heat_lo, *p.heatmap)), pa.width(format_heat(pp.heat_hi, *p.heatmap)));
+    pp.colour_bar = pad + colour_bar_px + 4 + vw + pad + (p.heatmap->scale_label.empty() ? 0 : lh + pad * 0.5);
+    pp.right = std::max(pp.right, pp.colour_bar + pad);
+  }
   pa.font(f.title, true);
   pp.top = p.title.empty() ? pad : pa.line_height() + pad;
 }
@@ -557,6 +725,10 @@ std::vector<Swatch> legend_entries(const PanelPlan& pp) {
     if (!p.stems[i].label.empty()) out.push_back({Swatch::stem, pp.stem_colours[i], p.stems[i].label});
   for (std::size_t i = 0; i < p.histograms.size(); ++i)
     if (!p.histograms[i].label.empty()) out.push_back({Swatch::bar, pp.hist_colours[i], p.histograms[i].label});
+  for (std::size_t i = 0; i < p.boxes.size(); ++i)
+    if (!p.boxes[i].label.empty()) out.push_back({Swatch::bar, pp.box_colours[i], p.boxes[i].label});
+  for (std::size_t i = 0; i < p.error_bars.size(); ++i)
+    if (!p.error_bars[i].label.empty()) out.push_back({Swatch::stem, pp.error_colours[i], p.error_bars[i].label});
   return out;
 }
 
@@ -679,6 +851,40 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
   pa.rect(r);
   cairo_clip(cr);
 
+  if (const auto& h = p.heatmap) {
+    pa.font(f.tick);
+    for (std::size_t row = 0; row < h->rows; ++row)
+      for (std::size_t col = 0; col < h->cols; ++col) {
+        const double v = h->values[row * h->cols + col];
+        if (!std::isfinite(v)) continue;
+        const double cx = static_cast<double>(col), cy = static_cast<double>(h->rows - 1 - row);
+        const double x0 = xs(cx - 0.5), x1 = xs(cx + 0.5), y0 = ys(cy + 0.5), y1 = ys(cy - 0.5);
+        const double t = (v - pp.heat_lo) / (pp.heat_hi - pp.heat_lo);
+        pa.colour(blues(t));
+        cairo_rectangle(cr, x0, y0, x1 - x0, y1 - y0);
+        cairo_fill(cr);
+        if (h->decimals >= 0) {
+          // Light text on the darker half of the scale keeps every value legible.
+          pa.colour(t > 0.55 ? Rgb{1, 1, 1} : text_colour);
+          pa.text(format_heat(v, *h), (x0 + x1) / 2, (y0 + y1) / 2, HAlign::centre, VAlign::middle);
+        }
+      }
+    // White cell borders read as a table without a grid behind it.
+    cairo_set_line_width(cr, 1.0);
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    for (std::size_t c = 1; c < h->cols; ++c) {
+      const double x = xs(static_cast<double>(c) - 0.5);
+      cairo_move_to(cr, x, r.y);
+      cairo_line_to(cr, x, r.bottom());
+    }
+    for (std::size_t k = 1; k < h->rows; ++k) {
+      const double y = ys(static_cast<double>(k) - 0.5);
+      cairo_move_to(cr, r.x, y);
+      cairo_line_to(cr, r.right(), y);
+    }
+    cairo_stroke(cr);
+  }
+
   const double y_base = ys.log ? r.bottom() : ys(std::clamp(0.0, pp.ylo, pp.yhi));
   for (std::size_t i = 0; i < p.histograms.size(); ++i) {
     const auto& h = p.histograms[i];
@@ -724,6 +930,68 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
     }
   }
 
+  for (std::size_t i = 0; i < p.boxes.size(); ++i) {
+    const auto& b = p.boxes[i];
+    const Rgb c = pp.box_colours[i];
+    cairo_set_line_width(cr, 1.2);
+    for (std::size_t g = 0; g < b.groups.size(); ++g) {
+      const BoxStats& st = pp.boxes[i][g];
+      if (st.n == 0) continue;
+      const double xc = box_x(b, g);
+      const double x0 = xs(xc - b.box_width / 2), x1 = xs(xc + b.box_width / 2), xm = xs(xc);
+      const double yq1 = ys(st.q1), yq3 = ys(st.q3), ymed = ys(st.median);
+      if (std::isnan(x0) || std::isnan(x1) || std::isnan(yq1) || std::isnan(yq3)) continue;
+      const double cap = (x1 - x0) * 0.25;
+      pa.colour(c);
+      // Whiskers and their caps.
+      for (const double w : {st.whisker_low, st.whisker_high}) {
+        const double yw = ys(w);
+        if (std::isnan(yw)) continue;
+        cairo_move_to(cr, xm, w < st.q1 ? yq1 : yq3);
+        cairo_line_to(cr, xm, yw);
+        cairo_move_to(cr, xm - cap, yw);
+        cairo_line_to(cr, xm + cap, yw);
+      }
+      cairo_stroke(cr);
+      cairo_rectangle(cr, x0, std::min(yq1, yq3), x1 - x0, std::abs(yq1 - yq3));
+      pa.colour(c, 0.3);
+      cairo_fill_preserve(cr);
+      pa.colour(c);
+      cairo_stroke(cr);
+      cairo_set_line_width(cr, 2.2);
+      cairo_move_to(cr, x0, ymed);
+      cairo_line_to(cr, x1, ymed);
+      cairo_stroke(cr);
+      cairo_set_line_width(cr, 1.2);
+      for (const double o : st.outliers) {
+        const double yo = ys(o);
+        if (std::isnan(yo)) continue;
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, xm, yo, 3.2, 0, 2 * std::numbers::pi);
+      }
+      cairo_stroke(cr);
+      if (b.show_points) {
+        pa.colour(c, 0.7);
+        for (const double v : b.groups[g]) {
+          const double yv = ys(v);
+          if (std::isnan(yv)) continue;
+          cairo_new_sub_path(cr);
+          cairo_arc(cr, xm, yv, 1.8, 0, 2 * std::numbers::pi);
+        }
+        cairo_fill(cr);
+      }
+      if (b.show_mean && std::isfinite(ys(st.mean))) {
+        const double ym = ys(st.mean), d = 3.5;
+        pa.colour(text_colour);
+        cairo_move_to(cr, xm - d, ym - d);
+        cairo_line_to(cr, xm + d, ym + d);
+        cairo_move_to(cr, xm - d, ym + d);
+        cairo_line_to(cr, xm + d, ym - d);
+        cairo_stroke(cr);
+      }
+    }
+  }
+
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   // Stroked in chunks: Cairo tessellates a path as a whole, and a dense
   // envelope crosses itself so often that one path costs seconds. Chunks
@@ -732,6 +1000,8 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
   for (std::size_t i = 0; i < p.lines.size(); ++i) {
     pa.colour(pp.line_colours[i]);
     cairo_set_line_width(cr, p.lines[i].width_px);
+    const double dash[] = {6.0, 4.0};
+    cairo_set_dash(cr, dash, p.lines[i].dashed ? 2 : 0, 0);
     bool pen_down = false;
     std::size_t in_path = 0;
     for (const auto& [x, y] : line_px[i]) {
@@ -752,6 +1022,55 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
       pen_down = true;
     }
     cairo_stroke(cr);
+  }
+  cairo_set_dash(cr, nullptr, 0, 0);
+
+  for (std::size_t i = 0; i < p.error_bars.size(); ++i) {
+    const auto& e = p.error_bars[i];
+    const Rgb c = pp.error_colours[i];
+    pa.colour(c);
+    if (e.connect) {
+      std::vector<std::size_t> order(e.x.size());
+      for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return e.x[a] < e.x[b]; });
+      cairo_set_line_width(cr, 1.5);
+      bool pen_down = false;
+      for (const std::size_t k : order) {
+        const double x = xs(e.x[k]), y = ys(e.y[k]);
+        if (std::isnan(x) || std::isnan(y)) {
+          pen_down = false;
+          continue;
+        }
+        pen_down ? cairo_line_to(cr, x, y) : cairo_move_to(cr, x, y);
+        pen_down = true;
+      }
+      cairo_stroke(cr);
+    }
+    cairo_set_line_width(cr, 1.3);
+    for (std::size_t k = 0; k < e.x.size(); ++k) {
+      const double x = xs(e.x[k]), y = ys(e.y[k]);
+      if (std::isnan(x) || std::isnan(y)) continue;
+      if (std::isfinite(e.error[k]) && e.error[k] > 0) {
+        const double lo = ys(e.y[k] - e.error[k]), hi = ys(e.y[k] + e.error[k]);
+        const double ylo = std::isnan(lo) ? r.bottom() : lo;  // log axis: a bar below 0 runs off the plot
+        if (!std::isnan(hi)) {
+          cairo_move_to(cr, x, ylo);
+          cairo_line_to(cr, x, hi);
+          cairo_move_to(cr, x - e.cap_px, hi);
+          cairo_line_to(cr, x + e.cap_px, hi);
+          if (!std::isnan(lo)) {
+            cairo_move_to(cr, x - e.cap_px, lo);
+            cairo_line_to(cr, x + e.cap_px, lo);
+          }
+          cairo_stroke(cr);
+        }
+      }
+      if (e.marker_radius_px > 0) {
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, x, y, e.marker_radius_px, 0, 2 * std::numbers::pi);
+        cairo_fill(cr);
+      }
+    }
   }
 
   for (std::size_t i = 0; i < p.stems.size(); ++i) {
@@ -779,7 +1098,49 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
       }
     }
   }
+
+  if (!p.notes.empty()) {
+    pa.font(f.small);
+    for (const auto& t : p.notes) {
+      const double x = xs(t.x), y = ys(t.y);
+      if (std::isnan(x) || std::isnan(y)) continue;
+      pa.colour(t.colour);
+      pa.text(t.text, x, y, HAlign::centre, VAlign::middle);
+    }
+  }
   cairo_restore(cr);
+}
+
+/// The heatmap's colour scale: a vertical bar right of the plot, its two
+/// ends labelled, the scale label rotated beside it.
+void draw_colour_bar(const PanelPlan& pp, const Painter& pa, const Fonts& f) {
+  const auto& h = pp.panel->heatmap;
+  if (!h) return;
+  cairo_t* cr = pa.cr();
+  const Rect& r = pp.plot;
+  const double pad = f.base * 0.6;
+  const Rect bar{r.right() + pad, r.y, colour_bar_px, r.h};
+  constexpr int steps = 64;
+  for (int k = 0; k < steps; ++k) {
+    const double t0 = static_cast<double>(k) / steps;
+    pa.colour(blues(t0 + 0.5 / steps));
+    // Slight overlap so antialiased seams do not show.
+    cairo_rectangle(cr, bar.x, bar.bottom() - bar.h * (t0 + 1.0 / steps) - 0.5, bar.w, bar.h / steps + 1.0);
+    cairo_fill(cr);
+  }
+  cairo_set_line_width(cr, 1.0);
+  pa.colour(frame_colour);
+  pa.rect(bar);
+  cairo_stroke(cr);
+  pa.font(f.tick);
+  pa.colour(text_colour);
+  pa.text(format_heat(pp.heat_hi, *h), bar.right() + 4, bar.y, HAlign::left, VAlign::top);
+  pa.text(format_heat(pp.heat_lo, *h), bar.right() + 4, bar.bottom(), HAlign::left, VAlign::bottom);
+  if (!h->scale_label.empty()) {
+    pa.font(f.base);
+    const double x = r.right() + pp.colour_bar - pa.line_height();
+    pa.text(h->scale_label, x, r.y + r.h / 2, HAlign::centre, VAlign::top, -std::numbers::pi / 2);
+  }
 }
 
 /// The legend goes in the plot corner that hides the fewest drawn points
@@ -930,6 +1291,7 @@ void draw_figure(const Painter& pa, const Figure& fig, const Rect& area) {
     std::vector<Vertices> line_px;
     for (const auto& s : pp.panel->lines) line_px.push_back(line_vertices(s, xs, ys));
     draw_series(pp, pa, f, xs, ys, line_px);
+    draw_colour_bar(pp, pa, f);
     draw_legend(pp, pa, f, xs, ys, line_px);
   }
   cairo_restore(cr);
@@ -1009,6 +1371,44 @@ Rgb palette_colour(std::size_t i) {
                                       {0.580, 0.404, 0.741}, {0.549, 0.337, 0.294}, {0.890, 0.467, 0.761}, {0.498, 0.498, 0.498},
                                       {0.737, 0.741, 0.133}, {0.090, 0.745, 0.812}};
   return tableau10[i % std::size(tableau10)];
+}
+
+BoxStats box_stats(std::span<const double> values) {
+  std::vector<double> v;
+  v.reserve(values.size());
+  for (const double x : values)
+    if (std::isfinite(x)) v.push_back(x);
+  BoxStats st;
+  st.n = v.size();
+  if (v.empty()) {
+    st.q1 = st.median = st.q3 = st.whisker_low = st.whisker_high = st.mean = nan;
+    return st;
+  }
+  std::sort(v.begin(), v.end());
+  // Hyndman & Fan type 7: h = (n − 1)p, linear between order statistics.
+  const auto q = [&](double prob) {
+    const double h = static_cast<double>(v.size() - 1) * prob;
+    const auto lo = static_cast<std::size_t>(std::floor(h));
+    const std::size_t hi = std::min(lo + 1, v.size() - 1);
+    return v[lo] + (h - static_cast<double>(lo)) * (v[hi] - v[lo]);
+  };
+  st.q1 = q(0.25);
+  st.median = q(0.5);
+  st.q3 = q(0.75);
+  const double iqr = st.q3 - st.q1;
+  const double fence_lo = st.q1 - 1.5 * iqr, fence_hi = st.q3 + 1.5 * iqr;
+  st.whisker_low = st.q1;
+  st.whisker_high = st.q3;
+  double sum = 0;
+  for (const double x : v) {
+    sum += x;
+    if (x < fence_lo || x > fence_hi)
+      st.outliers.push_back(x);
+    else
+      st.whisker_low = std::min(st.whisker_low, x), st.whisker_high = std::max(st.whisker_high, x);
+  }
+  st.mean = sum / static_cast<double>(v.size());
+  return st;
 }
 
 std::vector<Tick> axis_ticks(double min, double max, AxisScale scale, bool db_labels, int target) {
