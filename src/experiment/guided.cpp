@@ -185,7 +185,13 @@ void GuidedOptimizer::finish_iteration() {
   const double max_shift_p = config_.shrink_rate * len_p / 2, max_shift_i = config_.shrink_rate * len_i / 2;
   double k_p = max_shift_p / (1.5 * box_.pitch_half_db);
   double k_i = max_shift_i / (1.5 * box_.irregularity_half_db);
-  if (config_.bound == BoundMode::joint) k_p = k_i = std::min(k_p, k_i);
+  if (config_.bound == BoundMode::joint) {
+    // The longest possible Σ: all four pairs on one side, (3hP/2, hI/2) or
+    // (hP/2, 3hI/2) up to signs. Its length maps to the smaller half-shrink.
+    const double hp = box_.pitch_half_db, hi = box_.irregularity_half_db;
+    const double longest = std::max(std::hypot(3 * hp, hi), std::hypot(hp, 3 * hi)) / 2;
+    k_p = k_i = std::min(max_shift_p, max_shift_i) / longest;
+  }
   nb.center = {box_.center.pitch_db + k_p * sum_.pitch_db, box_.center.irregularity_db + k_i * sum_.irregularity_db};
   // Enforce containment exactly (it holds mathematically; this absorbs rounding).
   const double room_p = std::max(0.0, box_.pitch_half_db - nb.pitch_half_db);

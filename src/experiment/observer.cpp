@@ -71,7 +71,8 @@ double PsychometricObserver::p_correct(double x) const {
 double PsychometricObserver::inverse(double p) const {
   const auto& c = config_;
   if (!(p > c.guess && p < 1.0 - c.lapse))
-    throw InvalidArgument("p: " + num(p) + " (allowed: between guess " + num(c.guess) + " and 1 − lapse " + num(1 - c.lapse) + ")");
+    throw InvalidArgument("p: " + num(p) + " (allowed: between guess " + num(c.guess) + " and 1 − lapse " + num(1 - c.lapse) +
+                          ")");
   const double f = (p - c.guess) / (1.0 - c.guess - c.lapse);
   if (c.shape == PsychometricShape::weibull) return c.threshold * std::pow(-std::log(1.0 - f), 1.0 / c.slope);
   const double logit = std::log(f / (1.0 - f)) / c.slope;
@@ -117,9 +118,10 @@ MatchChoice Matcher::choose(const MatchQuestion& q, std::uint64_t trial) const {
 
 MatchPoint Matcher::adjust(std::uint64_t trial) const {
   const CounterRng rng(config_.seed, stream_adjust);
-  return {std::clamp(config_.target.pitch_db + config_.noise_db * rng.normal(2 * trial), config_.pitch_min_db, config_.pitch_max_db),
-          std::clamp(config_.target.irregularity_db + config_.noise_db * rng.normal(2 * trial + 1), config_.irregularity_min_db,
-                     config_.irregularity_max_db)};
+  return {
+      std::clamp(config_.target.pitch_db + config_.noise_db * rng.normal(2 * trial), config_.pitch_min_db, config_.pitch_max_db),
+      std::clamp(config_.target.irregularity_db + config_.noise_db * rng.normal(2 * trial + 1), config_.irregularity_min_db,
+                 config_.irregularity_max_db)};
 }
 
 int Matcher::confidence(std::uint64_t trial) const {
@@ -160,7 +162,8 @@ void validate(const RaterConfig& c) {
 Rater::Rater(RaterConfig config) : config_(config) { validate(config_); }
 
 double Rater::expected(double distance_db) const {
-  return config_.scale_min + (config_.scale_max - config_.scale_min) * std::exp(-std::abs(distance_db) / config_.distance_scale_db);
+  return config_.scale_min +
+         (config_.scale_max - config_.scale_min) * std::exp(-std::abs(distance_db) / config_.distance_scale_db);
 }
 
 int Rater::rate(double distance_db, std::uint64_t trial) const {

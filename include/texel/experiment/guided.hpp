@@ -88,9 +88,15 @@ std::string_view to_string(UnsureMode m);
 
 /// How the pursuit gain k is bounded so the new box lies in the old one.
 ///   per_axis  one gain per axis: the largest possible shift on each axis is
-///             half that axis' shrink per iteration ([choice], default)
-///   joint     one scalar gain, the smaller of the two, so the pursuit
-///             direction is kept (moves less on the freer axis)
+///             half that axis' shrink per iteration ([choice], default; the
+///             spec's rule). With both axes shrinking by the same fraction of
+///             their initial lengths the two gains are equal, so the pursuit
+///             direction is kept; a diagonal answer pattern moves up to √2
+///             further than an axis-aligned one.
+///   joint     one gain bounding the Euclidean length of the longest possible
+///             pursuit vector by the smaller axis' half-shrink: isotropic
+///             moves (no diagonal advantage) but shorter ones (about 0.6 of
+///             per_axis for the device box).
 enum class BoundMode { per_axis, joint };
 BoundMode parse_bound_mode(std::string_view text, std::string_view field = "bound");
 std::string_view to_string(BoundMode m);
