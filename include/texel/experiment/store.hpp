@@ -1,0 +1,133 @@
+// The durable session store (SQLite; docs/session-store.md).
+//
+// One file holds participants (pseudonymous codes only), sessions (with a
+// copy of the protocol and the seed), and per answered trial: the question
+// as shown (stimulus documents and seeds), the hidden truth, the response,
+// the adaptive state after it, the long-format row, and the presentation and
+// selection events with time stamps.
+//
+// Durability. The database runs in WAL mode with synchronous=FULL: "WAL mode
+// is always consistent with synchronous=NORMAL, but WAL mode does lose
+// durability. [...] With synchronous=FULL in WAL mode, an additional sync
+// operation of the WAL file happens after each transaction commit", so a
+// committed transaction survives a power cut (sqlite.org/pragma.html#
+// pragma_synchronous, sqlite.org/wal.html). Each trial is one transaction,
+// committed before append_trial() returns, i.e. before the front end shows
+// the next question: a crash loses at most the trial in progress. Trial
+// indices are append-only (primary key session, trial): a duplicate or a gap
+// is refused and nothing is written.
+//
+// One writer per session. acquire_writer() records the writing process (pid,
+// its start time from /proc so a recycled pid is not mistaken for it, host)
+// in a `writers` row inside an IMMEDIATE transaction; a second live writer
+// is refused with a message naming it; a row left by a dead process (a
+// SIGKILLed run) is taken over, so --resume after a crash just works. The
+// rule holds on one machine (pids are per host).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "texel/experiment/records.hpp"
+
+namespace texel::experiment {
+
+struct TrialEvent {
+  double t_s = 0.0;    ///< seconds since the trial was first shown
+  std::string kind;    ///< "show", "select", "slider", "matrix", "timeout", "answer", …
+  std::string detail;  ///< e.g. the stimulus label
+  std::string at;      ///< ISO 8601 UTC with ms (may be empty for simulated events)
+};
+
+struct StoredTrial {
+  int trial = 0;              ///< 0-based index in the session; append-only
+  std::string question_json;  ///< what was shown (+ the hidden truth), as the engine describes it
+  std::string response_json;  ///< the answer as given
+  std::string state_json;     ///< adaptive procedure state after the answer
+  TrialRow row;               ///< the long-format row
+  std::vector<TrialEvent> events;
+};
+
+struct SessionInfo {
+  std::int64_t id = 0;
+  std::string participant, protocol, study, protocol_json;
+  std::uint64_t seed = 0;
+  std::string simulate;  ///< simulation spec, or empty for a person
+  std::string status;    ///< "running" | "finished"
+  std::string created_at, updated_at;
+  int trials_done = 0;
+  int trials_planned = -1;  ///< -1 = adaptive (open-ended)
+};
+
+enum class StoreMode { read_only, read_write };
+
+class Store;
+namespace detail {
+struct StoreImpl;  // the connection (store.cpp); shared by the Store and its locks
+}
+
+/// Proof of being the session's only writer; releases on destruction. It
+/// shares the Store's connection, so it stays valid if the Store is moved
+/// (or destroyed first).
+class WriterLock {
+ public:
+  WriterLock(WriterLock&&) noexcept;
+  WriterLock& operator=(WriterLock&&) noexcept;
+  ~WriterLock();
+  [[nodiscard]] std::int64_t session_id() const { return session_id_; }
+
+ private:
+  friend class Store;
+  WriterLock(std::shared_ptr<detail::StoreImpl> impl, std::int64_t session_id);
+  std::shared_ptr<detail::StoreImpl> impl_;
+  std::int64_t session_id_ = 0;
+};
+
+class Store {
+ public:
+  static constexpr int current_schema_version = 1;
+
+  /// read_write creates the file if missing (and migrates older schemas);
+  /// read_only never creates or writes. Throws IoError (missing, unreadable,
+  /// read-only, locked) / FormatError (not a Texel database, or a schema
+  /// newer than this build) naming the path; nothing stored is touched.
+  static Store open(const std::string& path, StoreMode mode);
+  ~Store();
+  Store(Store&&) noexcept;
+  Store& operator=(Store&&) noexcept;
+
+  [[nodiscard]] int schema_version() const;
+  [[nodiscard]] const std::string& path() const;
+
+  /// Creates the participant if new (code: 1–32 of A–Z a–z 0–9 _ . -).
+  std::int64_t create_session(const std::string& participant, const std::string& protocol, const std::string& study,
+                              const std::string& protocol_json, std::uint64_t seed, const std::string& simulate,
+                              int trials_planned);
+  /// The participant's newest running session of `protocol`, if any.
+  [[nodiscard]] std::optional<SessionInfo> unfinished_session(const std::string& participant, const std::string& protocol) const;
+  /// Throws InvalidArgument if there is no such session.
+  [[nodiscard]] SessionInfo session(std::int64_t id) const;
+  [[nodiscard]] std::vector<SessionInfo> sessions() const;
+  [[nodiscard]] std::vector<std::string> participants() const;
+
+  /// Throws Error naming the other writer if a live process holds the session.
+  WriterLock acquire_writer(std::int64_t session_id);
+  /// One transaction, durable before return. Refuses (without writing) a
+  /// trial index other than the number already stored, or a lock for
+  /// another session.
+  void append_trial(const WriterLock& lock, const StoredTrial& t);
+  void finish_session(const WriterLock& lock);
+
+  [[nodiscard]] std::vector<StoredTrial> trials(std::int64_t session_id) const;
+  /// Rows of every session (or one), in (session, trial) order.
+  [[nodiscard]] std::vector<TrialRow> rows(std::optional<std::int64_t> session_id = std::nullopt) const;
+
+ private:
+  explicit Store(std::shared_ptr<detail::StoreImpl> impl);
+  std::shared_ptr<detail::StoreImpl> impl_;
+};
+
+}  // namespace texel::experiment
