@@ -1,1 +1,583 @@
-// placeholder: being written
+// The analysis figures (analysis.hpp): each mirrors a figure of the thesis
+// for its study, so a researcher can set them side by side — staircase
+// tracks, box plots of convergent values with 95 % CIs, matched parameters
+// against the references, confidence ellipses of the mean match, similarity
+// matrices, rating changes under quantization, working-memory performance.
+// docs/analysis.md says which question of the source each one answers.
+//
+// Figures are built from the study's summary (so a figure never disagrees
+// with the numbers reported next to it) plus the rows where a figure shows
+// every trial (tracks). Every file is written through save_figure, i.e.
+// atomically (temporary + rename).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/experiment/analysis.hpp"
+#include "texel/experiment/stats.hpp"
+#include "texel/plot.hpp"
+
+namespace texel::experiment::analysis_figures {
+namespace {
+
+using json = nlohmann::ordered_json;
+using Rows = std::vector<const TrialRow*>;
+
+double d(const json& j) { return j.is_number() ? j.get<double>() : missing; }
+
+const std::string pitch_label = "Central Pitch (dB re 1 cycle/mm)";
+const std::string irregularity_label = "Irregularity (dB)";
+
+struct Writer {
+  const std::string& study;
+  const AnalysisOptions& o;
+  std::vector<std::string> paths;
+  void save(const Figure& f, const std::string& name) {
+    const std::string path = (std::filesystem::path(o.out_dir) / (study + "-" + name + "." + o.format)).string();
+    save_figure(f, path);
+    paths.push_back(path);
+  }
+};
+
+Figure figure(std::string title, int width, int height, int columns = 1) {
+  Figure f;
+  f.title = std::move(title);
+  f.width_px = width;
+  f.height_px = height;
+  f.columns = columns;
+  return f;
+}
+
+double mean_of(const std::vector<double>& v) {
+  double s = 0;
+  std::size_t n = 0;
+  for (const double x : v)
+    if (std::isfinite(x)) s += x, ++n;
+  return n ? s / static_cast<double>(n) : missing;
+}
+
+std::string percent(double v) { return texel::detail::fixed(v * 100, 0) + " %"; }
+
+// --------------------------------------------------------------- staircases
+
+std::string variable_label(const std::string& study) {
+  return study == "texel-length" ? "texel length (mm)" : "coarse strength (0 … 1)";
+}
+
+/// Intensity against trial, one line per block, reversals marked; one panel
+/// per participant (and session).
+Figure staircase_tracks(const std::string& study, const Rows& rows) {
+  std::map<std::pair<std::string, std::int64_t>, std::map<std::string, Rows>> runs;
+  std::vector<std::string> blocks;
+  std::map<std::string, std::set<std::int64_t>> sessions;
+  for (const TrialRow* r : rows) {
+    runs[{r->participant, r->session_id}][r->block].push_back(r);
+    sessions[r->participant].insert(r->session_id);
+    if (std::find(blocks.begin(), blocks.end(), r->block) == blocks.end()) blocks.push_back(r->block);
+  }
+  const int cols = static_cast<int>(std::min<std::size_t>(3, runs.size()));
+  const int nrows = static_cast<int>((runs.size() + 2) / 3);
+  Figure f = figure(study == "texel-length" ? "Texel length staircases" : "Coarse strength staircases", 420 * cols + 40,
+                    std::min(16000, 60 + 300 * nrows), cols);
+  for (const auto& [key, by_block] : runs) {
+    Panel p;
+    p.title = key.first + (sessions[key.first].size() > 1 ? " (session " + std::to_string(key.second) + ")" : "");
+    p.x.label = "trial in block";
+    p.y.label = variable_label(study);
+    for (const auto& [block, rs] : by_block) {
+      const auto colour =
+          palette_colour(static_cast<std::size_t>(std::find(blocks.begin(), blocks.end(), block) - blocks.begin()));
+      LineSeries line;
+      StemSeries rev;
+      rev.stems = false;
+      rev.colour = line.colour = colour;
+      rev.marker_radius_px = 4.0;
+      for (const TrialRow* r : rs) {
+        line.x.push_back(r->trial_in_block + 1);
+        line.y.push_back(r->intensity);
+        if (r->reversal) rev.x.push_back(r->trial_in_block + 1), rev.y.push_back(r->intensity);
+      }
+      // The convergent value (computed after the last answer) as the line's end.
+      if (!rs.empty() && std::isfinite(rs.back()->next_intensity)) {
+        line.x.push_back(rs.back()->trial_in_block + 2);
+        line.y.push_back(rs.back()->next_intensity);
+      }
+      line.width_px = 1.6;
+      line.label = block;
+      p.lines.push_back(std::move(line));
+      p.stems.push_back(std::move(rev));
+    }
+    if (p.stems.size() > 0 && !p.stems.front().x.empty()) p.stems.front().label = "reversal";
+    f.panels.push_back(std::move(p));
+  }
+  return f;
+}
+
+/// Box plots of the per-participant convergent values per block, with the
+/// group mean ± 95 % CI beside each box.
+Figure convergent_boxes(const std::string& study, const json& s) {
+  const bool coarse = study == "coarse-features";
+  std::vector<std::string> cats;
+  std::map<std::string, std::map<std::string, std::vector<double>>> per;  // block → participant → values
+  for (const auto& r : s["runs"])
+    per[r["block"].get<std::string>()][r["participant"].get<std::string>()].push_back(d(r["convergent"]));
+  BoxSeries box;
+  box.colour = palette_colour(0);
+  box.label = "participants";
+  box.offset = -0.12;
+  box.box_width = 0.4;
+  box.show_points = true;
+  ErrorBarSeries ci;
+  ci.colour = palette_colour(3);
+  ci.label = "mean ± 95 % CI";
+  std::size_t i = 0;
+  for (const auto& b : s["blocks"]) {
+    const std::string name = b["block"].get<std::string>();
+    cats.push_back(coarse ? "fine " + percent(d(b["fine_strength"])) : name);
+    std::vector<double> v;
+    for (const auto& [p, x] : per[name]) v.push_back(mean_of(x));
+    box.groups.push_back(v);
+    const auto& c = b["convergent"];
+    ci.x.push_back(static_cast<double>(i++) + 0.25);
+    ci.y.push_back(d(c["mean"]));
+    ci.error.push_back((d(c["ci95_high"]) - d(c["ci95_low"])) / 2);
+  }
+  Figure f =
+      figure(coarse ? "Convergent coarse strength per fine strength" : "Convergent texel length per distribution", 640, 480);
+  Panel p;
+  p.x = Axis{coarse ? "fine-texture strength" : "frequency distribution (Irregularity)",
+             AxisScale::linear,
+             std::nullopt,
+             std::nullopt,
+             false,
+             cats};
+  p.y.label = "convergent " + variable_label(study);
+  p.boxes.push_back(std::move(box));
+  p.error_bars.push_back(std::move(ci));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+/// Swiping behaviour against the result: directional proportion of each run
+/// against its convergent texel length, one colour per distribution.
+std::optional<Figure> directional_scatter(const json& s) {
+  std::map<std::string, StemSeries> series;
+  std::vector<std::string> order;
+  for (const auto& r : s["runs"]) {
+    const double x = d(r["convergent"]), y = d(r["directional_proportion"]);
+    if (!std::isfinite(x) || !std::isfinite(y)) continue;
+    const std::string b = r["block"].get<std::string>();
+    if (!series.count(b)) order.push_back(b);
+    auto& st = series[b];
+    st.stems = false;
+    st.marker_radius_px = 4.5;
+    st.label = b;
+    st.x.push_back(x);
+    st.y.push_back(y);
+  }
+  if (order.empty()) return std::nullopt;
+  Figure f = figure("Directional proportion against convergent texel length", 640, 480);
+  Panel p;
+  p.x.label = "convergent texel length (mm)";
+  p.y = Axis{"directional proportion (right − left) / all", AxisScale::linear, -1.05, 1.05, false};
+  for (const auto& b : order) p.stems.push_back(series[b]);
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+// ---------------------------------------------------------------- matching
+
+struct Match {
+  std::string reference;
+  double pitch, irr, ref_pitch, ref_irr, distance, confidence;
+};
+
+std::vector<Match> matches_of(const json& s) {
+  std::vector<Match> out;
+  if (!s.contains("matches")) return out;
+  for (const auto& m : s["matches"])
+    out.push_back({m["reference"].get<std::string>(), d(m["pitch_db"]), d(m["irregularity_db"]), d(m["reference_pitch_db"]),
+                   d(m["reference_irregularity_db"]), d(m["distance_db"]),
+                   m.contains("confidence") ? d(m["confidence"]) : missing});
+  return out;
+}
+
+std::vector<std::string> reference_names(const json& s) {
+  std::vector<std::string> names;
+  for (const auto& r : s["references"]) names.push_back(r["reference"].get<std::string>());
+  return names;
+}
+
+/// Matched against reference value, per parameter, with the identity line.
+Figure matched_vs_reference(const std::string& title, const json& s) {
+  const auto ms = matches_of(s);
+  Figure f = figure(title + ": matched against reference parameters", 1000, 480, 2);
+  for (int k = 0; k < 2; ++k) {
+    Panel p;
+    const std::string what = k == 0 ? "Central Pitch (dB)" : "Irregularity (dB)";
+    p.title = k == 0 ? "Central Pitch" : "Irregularity";
+    p.x.label = "reference " + what;
+    p.y.label = "matched " + what;
+    StemSeries pts;
+    pts.stems = false;
+    pts.marker_radius_px = 4.0;
+    pts.label = "matches";
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& m : ms) {
+      const double x = k == 0 ? m.ref_pitch : m.ref_irr, y = k == 0 ? m.pitch : m.irr;
+      if (!std::isfinite(x) || !std::isfinite(y)) continue;
+      pts.x.push_back(x);
+      pts.y.push_back(y);
+      lo = std::min({lo, x, y});
+      hi = std::max({hi, x, y});
+    }
+    if (lo < hi) p.lines.push_back(LineSeries{{lo, hi}, {lo, hi}, Rgb{0.45, 0.45, 0.45}, 1.2, "matched = reference", true});
+    p.stems.push_back(std::move(pts));
+    f.panels.push_back(std::move(p));
+  }
+  return f;
+}
+
+/// Box plots of matched parameters per reference, reference values marked.
+Figure matched_boxes(const std::string& title, const json& s) {
+  const auto names = reference_names(s);
+  const auto ms = matches_of(s);
+  Figure f = figure(title + ": matched parameters per reference", std::max(700, 90 * static_cast<int>(names.size()) + 200), 760);
+  for (int k = 0; k < 2; ++k) {
+    Panel p;
+    p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
+    p.y.label = "matched " + (k == 0 ? pitch_label : irregularity_label);
+    BoxSeries box;
+    box.colour = palette_colour(static_cast<std::size_t>(k));
+    box.show_points = true;
+    box.label = "matches";
+    StemSeries ref;
+    ref.stems = false;
+    ref.colour = Rgb{0.1, 0.1, 0.1};
+    ref.marker_radius_px = 4.5;
+    ref.label = "reference";
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      std::vector<double> v;
+      for (const auto& m : ms)
+        if (m.reference == names[i]) v.push_back(k == 0 ? m.pitch : m.irr);
+      box.groups.push_back(std::move(v));
+      const double rv = d(s["references"][i][k == 0 ? "reference_pitch_db" : "reference_irregularity_db"]);
+      if (std::isfinite(rv)) ref.x.push_back(static_cast<double>(i) + 0.32), ref.y.push_back(rv);
+    }
+    p.boxes.push_back(std::move(box));
+    if (!ref.x.empty()) p.stems.push_back(std::move(ref));
+    f.panels.push_back(std::move(p));
+  }
+  return f;
+}
+
+/// The 2-D matches per reference and the confidence ellipse of their mean.
+Figure match_ellipses(const std::string& title, const json& s, double level) {
+  const auto names = reference_names(s);
+  const auto ms = matches_of(s);
+  Figure f =
+      figure(title + ": matches and " + texel::detail::fixed(level * 100, 0) + " % confidence ellipses of the mean", 820, 680);
+  Panel p;
+  p.x.label = pitch_label;
+  p.y.label = irregularity_label;
+  StemSeries refs;
+  refs.stems = false;
+  refs.colour = Rgb{0.1, 0.1, 0.1};
+  refs.marker_radius_px = 2.5;
+  refs.label = "reference position";
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const Rgb c = palette_colour(i);
+    std::vector<double> x, y;
+    for (const auto& m : ms)
+      if (m.reference == names[i] && std::isfinite(m.pitch) && std::isfinite(m.irr)) x.push_back(m.pitch), y.push_back(m.irr);
+    StemSeries pts;
+    pts.stems = false;
+    pts.colour = c;
+    pts.marker_radius_px = 3.5;
+    pts.label = names[i];
+    pts.x = x;
+    pts.y = y;
+    p.stems.push_back(std::move(pts));
+    try {
+      const auto e = stats::mean_confidence_ellipse(x, y, level);
+      LineSeries outline;
+      for (const auto& pt : e.outline(96)) outline.x.push_back(pt[0]), outline.y.push_back(pt[1]);
+      outline.x.push_back(outline.x.front());
+      outline.y.push_back(outline.y.front());
+      outline.colour = c;
+      outline.width_px = 1.6;
+      p.lines.push_back(std::move(outline));
+    } catch (const InvalidArgument&) {
+      // Fewer than three matches (or collinear ones): points only, as the summary says.
+    }
+    const double rx = d(s["references"][i]["reference_pitch_db"]), ry = d(s["references"][i]["reference_irregularity_db"]);
+    if (std::isfinite(rx) && std::isfinite(ry)) refs.x.push_back(rx), refs.y.push_back(ry);
+    if (!x.empty()) p.notes.push_back(TextNote{mean_of(x), mean_of(y), names[i], c});
+  }
+  if (!refs.x.empty()) p.stems.push_back(std::move(refs));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+/// Confidence rating against the distance of the match from that
+/// reference's mean match.
+std::optional<Figure> confidence_vs_distance(const std::string& title, const json& s) {
+  StemSeries pts;
+  pts.stems = false;
+  pts.marker_radius_px = 4.0;
+  for (const auto& m : matches_of(s))
+    if (std::isfinite(m.confidence) && std::isfinite(m.distance)) pts.x.push_back(m.distance), pts.y.push_back(m.confidence);
+  if (pts.x.empty()) return std::nullopt;
+  std::string sub;
+  if (s.contains("confidence_vs_distance") && s["confidence_vs_distance"].contains("pearson_r"))
+    sub = " (r = " + texel::detail::fixed(d(s["confidence_vs_distance"]["pearson_r"]), 2) + ")";
+  Figure f = figure(title + ": confidence against distance from the mean match" + sub, 700, 480);
+  Panel p;
+  p.x.label = "distance from the reference's mean match (dB)";
+  p.y = Axis{"confidence (1 … 5)", AxisScale::linear, 0.5, 5.5, false};
+  p.stems.push_back(std::move(pts));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+/// Rating per reference (box plots of per-participant ratings).
+Figure rating_boxes(const std::string& title, const Rows& rows, const std::string& scale) {
+  std::vector<std::string> names;
+  std::map<std::string, std::map<std::string, std::vector<double>>> v;
+  for (const TrialRow* r : rows) {
+    if (r->task != "rating") continue;
+    if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
+    v[r->reference][r->participant].push_back(r->rating);
+  }
+  Figure f = figure(title + ": similarity of match and reference", std::max(640, 90 * static_cast<int>(names.size()) + 200), 460);
+  Panel p;
+  p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
+  p.y.label = "similarity rating (" + scale + ")";
+  BoxSeries box;
+  box.show_points = true;
+  for (const auto& n : names) {
+    std::vector<double> g;
+    for (const auto& [pp, x] : v[n]) g.push_back(mean_of(x));
+    box.groups.push_back(std::move(g));
+  }
+  p.boxes.push_back(std::move(box));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+// ------------------------------------------------------------ quantization
+
+std::string p_text(const json& t) {
+  if (!t.contains("p") || t["p"].is_null()) return "n/a";
+  const double p = d(t["p"]);
+  return p < 0.001 ? "p < 0.001" : "p = " + texel::detail::fixed(p, 3);
+}
+
+Figure quantization_figure(const json& s, const Rows& rows) {
+  std::vector<std::string> cats;
+  ErrorBarSeries eb;
+  eb.colour = palette_colour(0);
+  eb.label = "mean change ± 95 % CI";
+  double lo = 0, hi = 0;
+  for (const auto& c : s["changes"]) {
+    const double m = d(c["change"]["mean"]);
+    const double half = c["t_test"].contains("ci_high") ? (d(c["t_test"]["ci_high"]) - d(c["t_test"]["ci_low"])) / 2 : missing;
+    cats.push_back(texel::detail::num(d(c["quantization_db"])) + " dB");
+    eb.x.push_back(static_cast<double>(eb.x.size()));
+    eb.y.push_back(m);
+    eb.error.push_back(half);
+    if (std::isfinite(m))
+      lo = std::min(lo, m - (std::isfinite(half) ? half : 0)), hi = std::max(hi, m + (std::isfinite(half) ? half : 0));
+  }
+  Figure f = figure("Quantization: similarity rating change against unquantized", 1100, 480, 2);
+  Panel a;
+  a.title = "Change per quantization step";
+  a.x = Axis{"quantization step", AxisScale::linear, std::nullopt, std::nullopt, false, cats};
+  a.y.label = "rating change (rating points, 1 … 5 scale)";
+  const double n = static_cast<double>(cats.size());
+  a.lines.push_back(LineSeries{{-0.5, n - 0.5}, {0, 0}, Rgb{0.45, 0.45, 0.45}, 1.0, {}, true});
+  const double room = std::max(0.1, (hi - lo) * 0.08);
+  for (std::size_t i = 0; i < eb.x.size(); ++i) {
+    const double top = eb.y[i] + (std::isfinite(eb.error[i]) ? eb.error[i] : 0);
+    if (std::isfinite(top)) a.notes.push_back(TextNote{eb.x[i], top + room, p_text(s["changes"][i]["t_test"])});
+  }
+  a.error_bars.push_back(std::move(eb));
+  f.panels.push_back(std::move(a));
+
+  // Ratings per condition (per-participant means over references).
+  std::vector<std::string> conds;
+  std::map<std::string, std::map<std::string, std::vector<double>>> v;
+  for (const auto& c : s["conditions"]) conds.push_back(c["condition"].get<std::string>());
+  for (const TrialRow* r : rows)
+    if (r->task == "rating") v[r->condition][r->participant].push_back(r->rating);
+  Panel b;
+  b.title = "Ratings per condition";
+  b.x = Axis{"rendering", AxisScale::linear, std::nullopt, std::nullopt, false, conds};
+  b.y = Axis{"similarity rating (1 … 5)", AxisScale::linear, 0.8, 5.2, false};
+  BoxSeries box;
+  box.show_points = true;
+  for (const auto& c : conds) {
+    std::vector<double> g;
+    for (const auto& [pp, x] : v[c]) g.push_back(mean_of(x));
+    box.groups.push_back(std::move(g));
+  }
+  b.boxes.push_back(std::move(box));
+  f.panels.push_back(std::move(b));
+  return f;
+}
+
+// ------------------------------------------------------ guided exploration
+
+Figure similarity_heatmap(const json& sim) {
+  const auto refs = sim["references"].get<std::vector<std::string>>();
+  const auto rend = sim["renderings"].get<std::vector<std::string>>();
+  HeatmapSeries h;
+  h.rows = refs.size();
+  h.cols = rend.size();
+  for (const auto& row : sim["mean_rating"])
+    for (const auto& v : row) h.values.push_back(d(v));
+  h.row_labels = refs;
+  h.column_labels = rend;
+  h.min = 1.0;
+  h.max = 5.0;
+  h.decimals = 2;
+  h.scale_label = "mean similarity rating (1 … 5)";
+  Figure f = figure("Guided exploration: similarity of references and optimized renderings", 760, 600);
+  Panel p;
+  p.x.label = "optimized rendering of";
+  p.y.label = "reference felt";
+  p.heatmap = std::move(h);
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+/// The optimizer's estimate after each comparison, per reference, one line
+/// per participant, the reference's own position dashed.
+Figure guided_convergence(const Rows& rows) {
+  std::vector<std::string> names;
+  std::map<std::string, std::map<std::string, Rows>> runs;  // reference → participant/session → rows
+  for (const TrialRow* r : rows) {
+    if (r->task != "guided") continue;
+    if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
+    runs[r->reference][r->participant + "#" + std::to_string(r->session_id)].push_back(r);
+  }
+  const int cols = static_cast<int>(std::max<std::size_t>(1, names.size()));
+  Figure f = figure("Guided exploration: optimizer estimate per comparison", std::min(16000, 360 * cols + 40), 640, cols);
+  for (int k = 0; k < 2; ++k)
+    for (const auto& n : names) {
+      Panel p;
+      p.title = k == 0 ? n : std::string();
+      p.x.label = "comparison";
+      p.y.label = k == 0 ? "estimate: Central Pitch (dB)" : "estimate: Irregularity (dB)";
+      double ref = missing, last_x = 1;
+      std::size_t i = 0;
+      for (const auto& [who, rs] : runs[n]) {
+        LineSeries l;
+        l.colour = palette_colour(i++);
+        for (std::size_t t = 0; t < rs.size(); ++t) {
+          l.x.push_back(static_cast<double>(t + 1));
+          l.y.push_back(k == 0 ? rs[t]->pitch_db : rs[t]->irregularity_db);
+          ref = k == 0 ? rs[t]->reference_pitch_db : rs[t]->reference_irregularity_db;
+        }
+        last_x = std::max(last_x, static_cast<double>(rs.size()));
+        p.lines.push_back(std::move(l));
+      }
+      if (std::isfinite(ref)) p.lines.push_back(LineSeries{{1, last_x}, {ref, ref}, Rgb{0.2, 0.2, 0.2}, 1.2, "reference", true});
+      p.legend = false;
+      f.panels.push_back(std::move(p));
+    }
+  return f;
+}
+
+// ----------------------------------------------------------- working memory
+
+Figure memory_figure(const json& s) {
+  std::vector<std::string> spacings, kinds;
+  for (const auto& c : s["conditions"]) {
+    const auto sp = c["spacing"].get<std::string>(), kd = c["distractor"].get<std::string>();
+    if (std::find(spacings.begin(), spacings.end(), sp) == spacings.end()) spacings.push_back(sp);
+    if (std::find(kinds.begin(), kinds.end(), kd) == kinds.end()) kinds.push_back(kd);
+  }
+  Figure f = figure("Working memory: same/different accuracy (" + std::to_string(s["included"].get<std::size_t>()) +
+                        " participants after exclusions)",
+                    1100, 480, 2);
+  Panel a;
+  a.title = "Mean ± SEM per condition";
+  a.x = Axis{"texel spacing", AxisScale::linear, std::nullopt, std::nullopt, false, spacings};
+  a.y = Axis{"proportion correct", AxisScale::linear, 0.0, 1.05, false};
+  for (std::size_t k = 0; k < kinds.size(); ++k) {
+    ErrorBarSeries e;
+    e.connect = true;
+    e.label = kinds[k];
+    e.colour = palette_colour(k);
+    for (const auto& c : s["conditions"]) {
+      if (c["distractor"] != kinds[k]) continue;
+      const auto it = std::find(spacings.begin(), spacings.end(), c["spacing"].get<std::string>());
+      e.x.push_back(static_cast<double>(it - spacings.begin()) + (static_cast<double>(k) - 0.5) * 0.08);
+      e.y.push_back(d(c["accuracy"]["mean"]));
+      e.error.push_back(d(c["accuracy"]["sem"]));
+    }
+    a.error_bars.push_back(std::move(e));
+  }
+  a.lines.push_back(
+      LineSeries{{-0.5, static_cast<double>(spacings.size()) - 0.5}, {0.5, 0.5}, Rgb{0.5, 0.5, 0.5}, 1.0, "chance", true});
+  f.panels.push_back(std::move(a));
+
+  Panel b;
+  b.title = "Participants (excluded ones left out)";
+  std::vector<std::string> conds;
+  BoxSeries box;
+  box.show_points = true;
+  for (const auto& c : s["conditions"]) {
+    conds.push_back(c["condition"].get<std::string>());
+    std::vector<double> g;
+    for (const auto& p : s["participants"])
+      if (p["excluded"] == false) g.push_back(d(p["conditions"][conds.back()]));
+    box.groups.push_back(std::move(g));
+  }
+  b.x = Axis{"condition", AxisScale::linear, std::nullopt, std::nullopt, false, conds};
+  b.y = Axis{"proportion correct", AxisScale::linear, 0.0, 1.05, false};
+  b.boxes.push_back(std::move(box));
+  f.panels.push_back(std::move(b));
+  return f;
+}
+
+}  // namespace
+
+std::vector<std::string> study_figures(const std::string& study, const nlohmann::ordered_json& summary, const Rows& rows,
+                                       const AnalysisOptions& options) {
+  Writer w{study, options, {}};
+  if (study == "texel-length" || study == "coarse-features") {
+    w.save(staircase_tracks(study, rows), "tracks");
+    w.save(convergent_boxes(study, summary), "convergent");
+    if (study == "texel-length")
+      if (auto f = directional_scatter(summary)) w.save(*f, "directional");
+  } else if (study == "parameter-mapping" || study == "free-exploration" || study == "guided-exploration") {
+    const std::string title = study == "parameter-mapping"  ? "Parameter mapping"
+                              : study == "free-exploration" ? "Free exploration"
+                                                            : "Guided exploration";
+    if (!summary["matches"].empty()) {
+      w.save(matched_vs_reference(title, summary), "matched-vs-reference");
+      w.save(matched_boxes(title, summary), "matched-boxes");
+      w.save(match_ellipses(title, summary, options.level), "ellipses");
+    }
+    if (auto f = confidence_vs_distance(title, summary)) w.save(*f, "confidence");
+    if (study == "parameter-mapping" && summary.contains("ratings")) w.save(rating_boxes(title, rows, "0 … 10"), "ratings");
+    if (study == "guided-exploration") {
+      w.save(guided_convergence(rows), "convergence");
+      if (summary.contains("similarity")) w.save(similarity_heatmap(summary["similarity"]), "similarity");
+    }
+  } else if (study == "quantization") {
+    w.save(quantization_figure(summary, rows), "rating-change");
+  } else if (study == "working-memory") {
+    w.save(memory_figure(summary), "performance");
+  }
+  return w.paths;
+}
+
+}  // namespace texel::experiment::analysis_figures

@@ -68,12 +68,4 @@ struct AnalysisReport {
 /// IoError if a figure cannot be written.
 AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions& options);
 
-namespace detail {
-/// Figures of one study from its summary (as analyze() builds it) and its
-/// non-practice rows; writes into options.out_dir and returns the paths.
-/// Implemented in analysis_figures.cpp.
-std::vector<std::string> study_figures(const std::string& study, const nlohmann::ordered_json& summary,
-                                       const std::vector<const TrialRow*>& rows, const AnalysisOptions& options);
-}  // namespace detail
-
 }  // namespace texel::experiment
