@@ -22,14 +22,14 @@ namespace texel_stats_test {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct ProcessResult {
   int status = -1;
   std::string out;
 };
 
 // Runs a shell command; stdout (and stderr when merge) captured.
-inline Run run_command(const std::string& cmd, bool merge = true) {
-  Run r;
+inline ProcessResult run_command(const std::string& cmd, bool merge = true) {
+  ProcessResult r;
   FILE* p = ::popen((cmd + (merge ? " 2>&1" : "")).c_str(), "r");
   if (!p) return r;
   std::array<char, 4096> buf{};
@@ -46,7 +46,7 @@ inline const char* python = "/usr/bin/python3";
 // Runs the oracle; a missing SciPy is a FAILURE (exit 3 from oracle.py), never a skip.
 inline nlohmann::json oracle(const std::string& args) {
   const std::string script = std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/stats/oracle.py";
-  const Run r = run_command(std::string(python) + " " + script + " " + args, false);
+  const ProcessResult r = run_command(std::string(python) + " " + script + " " + args, false);
   if (r.status != 0) {
     ADD_FAILURE() << "oracle failed (status " << r.status << "): " << python << " " << script << " " << args << "\n"
                   << r.out << "\nIs python3-scipy installed? (scripts/install-deps.sh)";

@@ -14,11 +14,11 @@ using namespace texel_stats_test;
 
 namespace {
 
-Run texel_stats(const std::string& args, bool merge = true) {
+ProcessResult texel_stats(const std::string& args, bool merge = true) {
   return run_command(std::string(TEXEL_CLI) + " stats " + args, merge);
 }
 
-nlohmann::json json_of(const Run& r) {
+nlohmann::json json_of(const ProcessResult& r) {
   EXPECT_EQ(r.status, 0) << r.out;
   if (r.status != 0) return nlohmann::json::object();
   return nlohmann::json::parse(r.out);
@@ -71,7 +71,7 @@ TEST_F(StatsCli, AnovaTwoFactorsWithReplicatesMatchesOracle) {
 TEST_F(StatsCli, AnovaReadableTable) {
   const LongData d = make_rm_data({"width", "q"}, {{"narrow", "wide"}, {"q1", "q2", "q3"}}, 5, 1, 3);
   write_file(path("a.csv"), d.csv());
-  const Run r = texel_stats("anova " + path("a.csv") + " --subject participant --within width,q --dv rt_ms");
+  const ProcessResult r = texel_stats("anova " + path("a.csv") + " --subject participant --within width,q --dv rt_ms");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("effect"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("width:q"), std::string::npos) << r.out;
@@ -97,7 +97,7 @@ TEST_F(StatsCli, TTestsMatchOracle) {
   EXPECT_NEAR(pr["t"].get<double>(), -4.0621, 5e-5);  // R's documented sleep example
   EXPECT_EQ(pr["n"], 10);
 
-  const Run readable = texel_stats("ttest " + path("t.csv") + " --column drug1 --paired drug2");
+  const ProcessResult readable = texel_stats("ttest " + path("t.csv") + " --column drug1 --paired drug2");
   ASSERT_EQ(readable.status, 0) << readable.out;
   EXPECT_NE(readable.out.find("Paired t-test of drug1 - drug2"), std::string::npos) << readable.out;
   EXPECT_NE(readable.out.find("-4.0621"), std::string::npos) << readable.out;
@@ -132,7 +132,7 @@ TEST_F(StatsCli, EllipsePerGroupMatchesOracle) {
          {"n", "mean_x", "mean_y", "cov_xx", "cov_xy", "cov_yy", "t2_critical", "semi_major", "semi_minor", "angle_deg"})
       expect_close(e[k].get<double>(), o[k], std::string("group ") + std::to_string(g) + " " + k);
   }
-  const Run readable = texel_stats("ellipse " + path("e.csv") + " --x pitch_db --y irregularity_db");
+  const ProcessResult readable = texel_stats("ellipse " + path("e.csv") + " --x pitch_db --y irregularity_db");
   ASSERT_EQ(readable.status, 0) << readable.out;
   EXPECT_EQ(count_lines(readable.out), 3u) << readable.out;
 }
@@ -154,6 +154,7 @@ TEST_F(StatsCli, BadInputExitsTwoWithOneLine) {
   write_file(path("ragged.csv"), "a,b\n1,2\n3\n");
   write_file(path("words.csv"), "a,b\n1,x\n2,3\n");
   write_file(path("const.csv"), "a\n2\n2\n2\n");
+  write_file(path("two.csv"), "a,b\n1,2\n2,4\n");
   const std::string anova = "anova " + path("ok.csv") + " --subject participant --dv rt_ms ";
   const std::vector<std::pair<std::string, std::string>> cases{
       {"anova " + path("unbalanced.csv") + " --subject participant --within width,q --dv rt_ms",
@@ -166,12 +167,12 @@ TEST_F(StatsCli, BadInputExitsTwoWithOneLine) {
       {"ttest " + path("const.csv") + " --column a", "--column a"},
       {"ttest " + path("words.csv") + " --column a --level 2", "--level 2"},
       {"ttest " + path("missing.csv") + " --column a", "missing.csv"},
-      {"ellipse " + path("const.csv") + " --x a --y a", "at least 3"},
+      {"ellipse " + path("two.csv") + " --x a --y b", "at least 3"},
       {"ellipse " + path("ok.csv") + " --x rt_ms --y rt_ms --by nope", "column 'nope'"},
       {"ttest " + path("ok.csv"), "--column"},
   };
   for (const auto& [args, needle] : cases) {
-    const Run r = texel_stats(args);
+    const ProcessResult r = texel_stats(args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.out;
     EXPECT_EQ(count_lines(r.out), 1u) << args << "\n" << r.out;
     EXPECT_NE(r.out.find(needle), std::string::npos) << args << "\n" << r.out;
