@@ -1,5 +1,628 @@
-// placeholder: being written
+// texel experiment run|list|status|export|analyze — the terminal front door
+// to the experiment engine (docs/experiments.md). It parses, drives the
+// library's Session one question at a time, stores every answer before the
+// next question, and formats; the studies' logic lives in libtexel_experiment.
+#include <poll.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <thread>
+
 #include "commands.hpp"
+#include "common.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/experiment/analysis.hpp"
+#include "texel/experiment/presenter.hpp"
+#include "texel/experiment/protocol.hpp"
+#include "texel/experiment/records.hpp"
+#include "texel/experiment/session.hpp"
+#include "texel/experiment/simulate.hpp"
+#include "texel/experiment/store.hpp"
+#include "texel/io.hpp"
+
 namespace texel::cli {
-void register_experiment(CLI::App&) {}
+namespace {
+
+namespace ex = texel::experiment;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+std::atomic<bool> interrupted{false};
+extern "C" void on_signal(int) { interrupted = true; }
+
+std::string iso_now() {
+  const auto t = std::chrono::system_clock::now();
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count();
+  const std::time_t s = static_cast<std::time_t>(ms / 1000);
+  std::tm tm{};
+  gmtime_r(&s, &tm);
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
+                tm.tm_min, tm.tm_sec, static_cast<int>(ms % 1000));
+  return buf;
+}
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Waits `seconds` while keeping the presenter fed; returns early on Ctrl-C.
+void wait_pumping(ex::Presenter* presenter, double seconds) {
+  const auto t0 = Clock::now();
+  while (!interrupted && seconds_since(t0) < seconds) {
+    if (presenter) presenter->pump();
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::min(10, std::max(1, static_cast<int>(seconds * 1000)))));
+  }
+  if (presenter) presenter->pump();
+}
+
+// Reads one line from stdin, pumping the presenter meanwhile. nullopt on
+// end of input, Ctrl-C or timeout (timeout_s <= 0: none).
+std::optional<std::string> read_line(ex::Presenter* presenter, double timeout_s, bool* timed_out = nullptr) {
+  static std::string buffer;
+  const auto t0 = Clock::now();
+  if (timed_out) *timed_out = false;
+  for (;;) {
+    if (const auto nl = buffer.find('\n'); nl != std::string::npos) {
+      std::string line = buffer.substr(0, nl);
+      buffer.erase(0, nl + 1);
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      return line;
+    }
+    if (interrupted) return std::nullopt;
+    if (timeout_s > 0 && seconds_since(t0) >= timeout_s) {
+      if (timed_out) *timed_out = true;
+      return std::nullopt;
+    }
+    if (presenter) presenter->pump();
+    pollfd p{STDIN_FILENO, POLLIN, 0};
+    const int r = ::poll(&p, 1, 20);
+    if (r > 0) {
+      char chunk[512];
+      const ssize_t n = ::read(STDIN_FILENO, chunk, sizeof chunk);
+      if (n <= 0) {
+        if (!buffer.empty()) {
+          std::string line;
+          line.swap(buffer);
+          return line;
+        }
+        return std::nullopt;  // end of input
+      }
+      buffer.append(chunk, static_cast<std::size_t>(n));
+      if (buffer.size() > 4096) buffer.clear();  // a pasted novel is not an answer
+    }
+  }
+}
+
+std::string trim(std::string s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
+  std::size_t i = 0;
+  while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+  return s.substr(i);
+}
+
+// ------------------------------------------------------------- terminal UI
+
+// Presents one question on the terminal and collects a valid answer.
+// Returns nullopt when the participant quits (q, end of input, Ctrl-C).
+std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Presenter* presenter) {
+  const ex::Question& q = session.question();
+  ex::Response r;
+  r.shown_at = iso_now();
+  const auto t0 = Clock::now();
+  auto event = [&](const std::string& kind, const std::string& detail) {
+    r.events.push_back({seconds_since(t0), kind, detail, iso_now()});
+  };
+  auto feel = [&](int i) {
+    if (presenter) presenter->show(q.stimuli[static_cast<std::size_t>(i)].document_json);
+    event("select", q.stimuli[static_cast<std::size_t>(i)].label);
+  };
+  std::cout << "\n" << q.prompt << "\n";
+  event("show", "trial " + std::to_string(q.trial));
+
+  // Working memory: the timed sequence first.
+  for (const auto& ph : q.phases) {
+    if (ph.kind == "stimulus") {
+      feel(ph.stimulus);
+      std::cout << "  feeling " << q.stimuli[static_cast<std::size_t>(ph.stimulus)].label << " for " << detail::num(ph.duration_s)
+                << " s ...\n";
+      std::cout.flush();
+    } else {
+      if (presenter) presenter->blank();
+      event("matrix", "");
+      std::cout << "  remember this matrix (" << detail::num(ph.duration_s) << " s):\n";
+      for (int row = 0; row < 4; ++row) {
+        std::cout << "      ";
+        for (int col = 0; col < 4; ++col) {
+          const int d = (*q.matrix)[static_cast<std::size_t>(row * 4 + col)];
+          std::cout << (d ? std::to_string(d) : std::string(".")) << "  ";
+        }
+        std::cout << "\n";
+      }
+      std::cout.flush();
+    }
+    wait_pumping(presenter, ph.duration_s);
+    if (ph.kind == "matrix" && ::isatty(STDOUT_FILENO)) std::cout << "\033[6A\033[J";  // hide the matrix again
+    if (interrupted) return std::nullopt;
+  }
+  if (!q.phases.empty() && presenter) presenter->blank();
+
+  std::string labels;
+  for (std::size_t i = 0; i < q.stimuli.size(); ++i) labels += "  [f " + std::to_string(i + 1) + "] " + q.stimuli[i].label;
+  if (q.phases.empty() && !q.stimuli.empty()) {
+    std::cout << "  feel:" << labels << "\n";
+    feel(0);
+  }
+  double slider_p = q.sliders.empty() ? 0 : q.sliders[0].start, slider_i = q.sliders.empty() ? 0 : q.sliders[1].start;
+  if (!q.sliders.empty())
+    std::cout << "  sliders: 'p VALUE' (" << q.sliders[0].label << ", " << detail::num(q.sliders[0].min) << " … "
+              << detail::num(q.sliders[0].max) << "), 'i VALUE' (" << q.sliders[1].label << ", " << detail::num(q.sliders[1].min)
+              << " … " << detail::num(q.sliders[1].max) << "), 'a' to accept\n";
+  if (!q.choices.empty()) {
+    std::string c;
+    for (const auto& x : q.choices) c += (c.empty() ? "" : " | ") + x;
+    std::cout << "  answer: 'a CHOICE' with CHOICE one of " << c << "\n";
+  }
+  if (q.rating_scale)
+    std::cout << "  answer: 'a N' with N from " << (*q.rating_scale)[0] << " to " << (*q.rating_scale)[1] << "\n";
+  if (q.time_limit_s > 0) std::cout << "  (" << detail::num(q.time_limit_s) << " s to explore)\n";
+  std::cout << "  ('q' saves and quits; the session resumes with --resume)\n";
+
+  bool time_up = false;
+  for (;;) {
+    std::cout << "> " << std::flush;
+    const double remaining = q.time_limit_s > 0 && !time_up ? q.time_limit_s - seconds_since(t0) : 0.0;
+    bool timed_out = false;
+    const auto line = read_line(presenter, remaining > 0 ? remaining : (q.time_limit_s > 0 && !time_up ? 1e-3 : 0.0), &timed_out);
+    if (timed_out) {
+      time_up = true;
+      if (presenter) presenter->blank();
+      event("timeout", "");
+      std::cout << "\n  time is up: answer now\n";
+      continue;
+    }
+    if (!line) return std::nullopt;
+    const std::string cmd = trim(*line);
+    if (cmd == "q" || cmd == "quit") return std::nullopt;
+    std::istringstream in(cmd);
+    std::string verb, arg;
+    in >> verb >> arg;
+    if (verb == "f" && !time_up) {
+      int i = 0;
+      try {
+        i = std::stoi(arg);
+      } catch (...) {
+        i = 0;
+      }
+      if (i >= 1 && i <= static_cast<int>(q.stimuli.size()) && q.phases.empty())
+        feel(i - 1);
+      else
+        std::cout << "  feel which? 1 … " << q.stimuli.size() << "\n";
+    } else if ((verb == "p" || verb == "i") && !q.sliders.empty()) {
+      try {
+        (verb == "p" ? slider_p : slider_i) = std::stod(arg);
+      } catch (...) {
+        std::cout << "  '" << verb << "' needs a number\n";
+        continue;
+      }
+      event("slider", verb + "=" + arg);
+      if (presenter) presenter->show(session.preview_document(slider_p, slider_i));
+    } else if (verb == "a") {
+      r.choice.clear();
+      if (!q.choices.empty()) r.choice = arg;
+      if (q.rating_scale) {
+        try {
+          r.rating = std::stod(arg);
+        } catch (...) {
+          r.rating.reset();
+        }
+      }
+      if (!q.sliders.empty()) {
+        r.slider_p = slider_p;
+        r.slider_i = slider_i;
+      }
+      const double rt = seconds_since(t0) * 1000.0;
+      if (q.confidence) {
+        std::cout << "  how confident are you in this match? 1 (not at all) … 5 (very)\n> " << std::flush;
+        const auto c = read_line(presenter, 0);
+        if (!c) return std::nullopt;
+        try {
+          r.confidence = std::stod(trim(*c));
+        } catch (...) {
+          r.confidence.reset();
+        }
+      }
+      if (q.recall_cell != -2) {
+        if (q.recall_cell >= 0)
+          std::cout << "  which digit was in row " << q.recall_cell / 4 + 1 << ", column " << q.recall_cell % 4 + 1
+                    << "? (1 … 9)\n> ";
+        else
+          std::cout << "  which digit was in the cells? (1 … 9)\n> ";
+        std::cout << std::flush;
+        const auto d = read_line(presenter, 0);
+        if (!d) return std::nullopt;
+        try {
+          r.digit = std::stoi(trim(*d));
+        } catch (...) {
+          r.digit.reset();
+        }
+      }
+      r.rt_ms = std::round(rt);
+      r.answered_at = iso_now();
+      event("answer", arg);
+      return r;
+    } else if (!cmd.empty()) {
+      std::cout << "  commands: 'f N' feel stimulus N, 'a ANSWER', " << (q.sliders.empty() ? "" : "'p V', 'i V', ")
+                << "'q' quit\n";
+    }
+  }
+}
+
+// --------------------------------------------------------------------- run
+
+struct RunArgs {
+  std::string protocol;
+  std::string participant;
+  std::string db;
+  std::optional<std::string> simulate;
+  double pace = 0.0;
+  bool resume = false;
+  std::string backend = "null";
+  std::string audio_device;
+  bool json = false;
+  bool quiet = false;
+};
+
+// Matches of the participant's finished sessions, for renderings that use
+// them ("from_protocol" in a rating block).
+std::map<std::string, std::map<std::string, ex::MatchResult>> prior_matches(const ex::Store& store, const ex::Protocol& p,
+                                                                            const std::string& participant) {
+  std::map<std::string, std::map<std::string, ex::MatchResult>> out;
+  std::set<std::string> wanted;
+  for (const auto& b : p.blocks)
+    for (const auto& pair : b.pairs)
+      if (!pair.rendering.from_protocol.empty()) wanted.insert(pair.rendering.from_protocol);
+  if (wanted.empty()) return out;
+  for (const auto& s : store.sessions()) {
+    if (s.participant != participant || s.status != "finished" || !wanted.count(s.protocol)) continue;
+    for (const auto& row : store.rows(s.id)) {
+      const bool match_row = row.task == "match" || (row.task == "guided" && row.procedure_finished);
+      if (match_row && !row.practice && std::isfinite(row.pitch_db))
+        out[s.protocol][row.reference] = ex::MatchResult{row.pitch_db, row.irregularity_db};
+    }
+  }
+  return out;
+}
+
+void run(const RunArgs& a) {
+  if (!(a.pace >= 0 && a.pace <= 3600)) throw InvalidArgument("--pace is " + detail::num(a.pace) + "; allowed: 0 … 3600 s");
+  ex::Protocol file_protocol = ex::load_protocol(a.protocol);
+  ex::Store store = ex::Store::open(a.db, ex::StoreMode::read_write);
+
+  ex::SessionInfo info;
+  const auto existing = store.unfinished_session(a.participant, file_protocol.name);
+  if (a.resume) {
+    if (!existing)
+      throw InvalidArgument("--resume: participant '" + a.participant + "' has no unfinished '" + file_protocol.name +
+                            "' session in " + a.db + " (run without --resume to start one)");
+    info = *existing;
+  } else if (existing) {
+    throw InvalidArgument("participant '" + a.participant + "' has an unfinished '" + file_protocol.name + "' session (id " +
+                          std::to_string(existing->id) + ", " + std::to_string(existing->trials_done) + " trials stored) in " +
+                          a.db + "; add --resume to continue it");
+  }
+  // The stored copy of the protocol is what a resumed session runs, so an
+  // edited file cannot change a session half-way.
+  const ex::Protocol protocol = a.resume ? ex::parse_protocol(info.protocol_json, a.db + ": stored protocol") : file_protocol;
+  std::string simulate = a.simulate.value_or(a.resume ? info.simulate : std::string());
+  std::optional<json> observer;
+  if (!simulate.empty()) observer = ex::simulation_observer(protocol.observer, simulate);  // validates before anything is stored
+
+  if (!a.resume) {
+    const std::uint64_t seed = ex::session_seed(protocol.seed, a.participant);
+    const auto id = store.create_session(a.participant, protocol.name, protocol.study, protocol.json, seed, simulate,
+                                         protocol.planned_trials());
+    info = store.session(id);
+  }
+  ex::WriterLock lock = store.acquire_writer(info.id);
+
+  ex::SessionContext ctx;
+  ctx.participant = a.participant;
+  ctx.session_id = info.id;
+  ctx.seed = info.seed;
+  ctx.prior_matches = prior_matches(store, protocol, a.participant);
+  ex::Session session(protocol, ctx);
+  const auto stored = store.trials(info.id);
+  for (const auto& t : stored) session.replay(t);
+  std::optional<ex::SimulatedParticipant> sim;
+  if (observer) sim.emplace(*observer, session);
+
+  ex::PresenterOptions po;
+  po.backend = a.backend;
+  po.audio_device = a.audio_device;
+  ex::Presenter presenter(po);
+
+  interrupted = false;
+  auto old_int = std::signal(SIGINT, on_signal);
+  auto old_term = std::signal(SIGTERM, on_signal);
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  if (!a.quiet)
+    std::cerr << (a.resume ? "resuming" : "starting") << " session " << info.id << ": " << protocol.name << " for "
+              << a.participant
+              << (sim ? " (simulated: " + (simulate.empty() ? std::string("default") : simulate) + ")" : std::string()) << ", "
+              << session.trials_done() << " trials stored, backend " << presenter.describe() << "\n";
+
+  const int planned = session.trials_planned();
+  bool quit = false;
+  while (!session.finished() && !interrupted) {
+    const ex::Question& q = session.question();
+    ex::Response r;
+    if (sim) {
+      // Present as a participant would: each stimulus in turn (the pace
+      // shared among them), then answer.
+      for (const auto& s : q.stimuli) {
+        presenter.show(s.document_json);
+        wait_pumping(&presenter, a.pace / static_cast<double>(std::max<std::size_t>(1, q.stimuli.size())));
+      }
+      if (q.stimuli.empty()) wait_pumping(&presenter, a.pace);
+      if (interrupted) break;
+      r = sim->respond(session);
+      r.shown_at = r.answered_at = iso_now();
+    } else {
+      auto answer = ask_terminal(session, &presenter);
+      if (!answer) {
+        quit = true;
+        break;
+      }
+      r = std::move(*answer);
+    }
+    ex::StoredTrial t;
+    try {
+      t = session.answer(r);
+    } catch (const InvalidArgument& e) {
+      if (sim) throw;
+      std::cout << "  not a valid answer: " << e.what() << "\n";
+      continue;
+    }
+    presenter.blank();
+    store.append_trial(lock, t);  // committed (fsync) before the next question appears
+    if (tty && !a.quiet)
+      std::fprintf(
+          stderr, "\rtrial %d%s  block %s  %s   ", session.trials_done(),
+          planned > 0 ? ("/" + std::to_string(planned)).c_str() : "", t.row.block.c_str(),
+          std::isfinite(t.row.next_intensity) ? (t.row.variable + " → " + detail::num(t.row.next_intensity)).c_str() : "");
+  }
+  if (tty && !a.quiet) std::fprintf(stderr, "\n");
+  std::signal(SIGINT, old_int);
+  std::signal(SIGTERM, old_term);
+  presenter.stop();
+  const bool finished = session.finished();
+  if (finished) store.finish_session(lock);
+
+  const BackendStats s = presenter.stats();
+  ordered_json j;
+  j["session"] = info.id;
+  j["participant"] = a.participant;
+  j["protocol"] = protocol.name;
+  j["study"] = protocol.study;
+  j["finished"] = finished;
+  j["trials"] = session.trials_done();
+  j["backend"] = presenter.describe();
+  j["blocks_processed"] = s.blocks;
+  j["worst_block_ms"] = s.worst_block_s * 1e3;
+  j["worst_block_fraction"] = presenter.block_period_s() > 0 ? s.worst_block_s / presenter.block_period_s() : 0.0;
+  j["late_blocks"] = s.underruns;
+  j["stimuli_shown"] = presenter.shown();
+  if (a.json) {
+    print_json(j);
+  } else if (!a.quiet) {
+    std::cout << (finished ? "finished" : "stopped") << " session " << info.id << " (" << protocol.name << ", " << a.participant
+              << "): " << session.trials_done() << " trials stored in " << a.db << "\n"
+              << "backend " << presenter.describe() << ": " << s.blocks << " blocks, worst "
+              << detail::fixed(s.worst_block_s * 1e3, 3) << " ms, late blocks " << s.underruns << "\n";
+    if (!finished)
+      std::cout << "resume with: texel experiment run " << a.protocol << " --participant " << a.participant << " --db " << a.db
+                << " --resume\n";
+  }
+  if (!presenter.error().empty()) throw IoError("experiment run: " + presenter.error());
+  (void)quit;
+}
+
+// ------------------------------------------------------- list / status / export / analyze
+
+ordered_json session_json(const ex::SessionInfo& s) {
+  ordered_json j;
+  j["id"] = s.id;
+  j["participant"] = s.participant;
+  j["protocol"] = s.protocol;
+  j["study"] = s.study;
+  j["status"] = s.status;
+  j["trials_done"] = s.trials_done;
+  j["trials_planned"] = s.trials_planned;
+  j["seed"] = s.seed;
+  j["simulate"] = s.simulate;
+  j["created_at"] = s.created_at;
+  j["updated_at"] = s.updated_at;
+  return j;
+}
+
+void list_sessions(const std::string& db, bool as_json, const std::optional<std::string>& participant) {
+  const ex::Store store = ex::Store::open(db, ex::StoreMode::read_only);
+  const auto sessions = store.sessions();
+  ordered_json arr = ordered_json::array();
+  for (const auto& s : sessions)
+    if (!participant || s.participant == *participant) arr.push_back(session_json(s));
+  if (as_json) {
+    print_json(arr);
+    return;
+  }
+  std::printf("%-4s %-12s %-20s %-10s %-12s %s\n", "id", "participant", "protocol", "status", "trials", "updated");
+  for (const auto& s : arr) {
+    const int planned = s["trials_planned"].get<int>();
+    const std::string trials = std::to_string(s["trials_done"].get<int>()) + (planned > 0 ? "/" + std::to_string(planned) : "");
+    std::printf("%-4lld %-12s %-20s %-10s %-12s %s\n", static_cast<long long>(s["id"].get<std::int64_t>()),
+                s["participant"].get<std::string>().c_str(), s["protocol"].get<std::string>().c_str(),
+                s["status"].get<std::string>().c_str(), trials.c_str(), s["updated_at"].get<std::string>().c_str());
+  }
+}
+
+void status(const std::string& db, bool as_json, const std::optional<std::string>& participant) {
+  const ex::Store store = ex::Store::open(db, ex::StoreMode::read_only);
+  ordered_json out;
+  out["database"] = db;
+  out["schema_version"] = store.schema_version();
+  out["participants"] = store.participants();
+  ordered_json sessions = ordered_json::array();
+  for (const auto& s : store.sessions()) {
+    if (participant && s.participant != *participant) continue;
+    ordered_json j = session_json(s);
+    // Where each block stands, from the stored rows.
+    ordered_json blocks = ordered_json::object();
+    for (const auto& row : store.rows(s.id)) {
+      auto& b = blocks[row.block];
+      b["trials"] = b.value("trials", 0) + 1;
+      if (std::isfinite(row.next_intensity) && !row.variable.empty()) {
+        b["variable"] = row.variable;
+        b["current_value"] = row.next_intensity;
+        b["reversals"] = b.value("reversals", 0) + (row.reversal ? 1 : 0);
+        b["finished"] = row.procedure_finished;
+      }
+    }
+    j["blocks"] = blocks;
+    sessions.push_back(j);
+  }
+  out["sessions"] = sessions;
+  if (as_json) {
+    print_json(out);
+    return;
+  }
+  std::cout << db << ": schema " << store.schema_version() << ", " << out["participants"].size() << " participants, "
+            << sessions.size() << " sessions\n";
+  for (const auto& s : sessions) {
+    std::cout << "  session " << s["id"] << " " << s["participant"].get<std::string>() << " " << s["protocol"].get<std::string>()
+              << " [" << s["status"].get<std::string>() << "] " << s["trials_done"] << " trials\n";
+    for (auto it = s["blocks"].begin(); it != s["blocks"].end(); ++it) {
+      std::cout << "    " << it.key() << ": " << it.value()["trials"] << " trials";
+      if (it.value().contains("current_value"))
+        std::cout << ", " << it.value()["variable"].get<std::string>() << " = "
+                  << detail::num(it.value()["current_value"].get<double>()) << ", " << it.value()["reversals"] << " reversals"
+                  << (it.value()["finished"].get<bool>() ? " (finished)" : "");
+      std::cout << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+void register_experiment(CLI::App& app) {
+  auto* cmd = app.add_subcommand("experiment", "Run the perceptual studies: protocols, sessions, export, analysis");
+  cmd->require_subcommand(1);
+
+  auto a = std::make_shared<RunArgs>();
+  auto* run_cmd = cmd->add_subcommand("run", "Run a protocol for a participant (terminal or --simulate), storing every answer");
+  run_cmd->add_option("protocol", a->protocol, "Protocol file (.json; examples/protocols/)")->required();
+  run_cmd->add_option("--participant", a->participant, "Pseudonymous participant code (1–32 of A–Z a–z 0–9 _ . -)")->required();
+  run_cmd->add_option("--db", a->db, "Session database (SQLite; created if missing)")->required();
+  run_cmd->add_option("--simulate", a->simulate,
+                      "Answer with a simulated observer: 'default' or key=value pairs, e.g. threshold=6mm, target=4sin, "
+                      "target=8dB/-3dB, noise=1dB, seed=3");
+  run_cmd->add_option("--pace", a->pace, "Simulated: seconds spent on each trial (demos, kill tests) [0]");
+  run_cmd->add_flag("--resume", a->resume, "Continue the participant's unfinished session of this protocol");
+  run_cmd->add_option("--backend", a->backend, "Stimulus output: null (no hardware), audio (PortAudio) or serial:PATH [null]");
+  run_cmd->add_option("--audio-device", a->audio_device, "PortAudio output: index or name substring [default output]");
+  run_cmd->add_flag("--json", a->json, "Print the run summary as JSON");
+  run_cmd->add_flag("--quiet", a->quiet, "No progress or summary text");
+  run_cmd->callback([a] { run(*a); });
+
+  struct DbArgs {
+    std::string db;
+    bool json = false;
+    std::optional<std::string> participant;
+  };
+  auto l = std::make_shared<DbArgs>();
+  auto* list_cmd = cmd->add_subcommand("list", "List the sessions in a database");
+  list_cmd->add_option("--db", l->db, "Session database")->required();
+  list_cmd->add_option("--participant", l->participant, "Only this participant");
+  list_cmd->add_flag("--json", l->json, "JSON output");
+  list_cmd->callback([l] { list_sessions(l->db, l->json, l->participant); });
+
+  auto st = std::make_shared<DbArgs>();
+  auto* status_cmd = cmd->add_subcommand("status", "Progress of every session: trials, blocks, staircase values");
+  status_cmd->add_option("--db", st->db, "Session database")->required();
+  status_cmd->add_option("--participant", st->participant, "Only this participant");
+  status_cmd->add_flag("--json", st->json, "JSON output");
+  status_cmd->callback([st] { status(st->db, st->json, st->participant); });
+
+  struct ExportArgs {
+    std::string db;
+    std::string output;
+    std::optional<std::int64_t> session;
+  };
+  auto e = std::make_shared<ExportArgs>();
+  auto* export_cmd =
+      cmd->add_subcommand("export", "Export every trial as long-format CSV (one row per trial; docs/experiments.md)");
+  export_cmd->add_option("--db", e->db, "Session database")->required();
+  export_cmd->add_option("-o,--output", e->output, "Output .csv")->required();
+  export_cmd->add_option("--session", e->session, "Only this session id");
+  export_cmd->callback([e] {
+    if (output_extension(e->output) != ".csv") throw InvalidArgument("--output is '" + e->output + "'; allowed: a .csv file");
+    check_writable(e->output);
+    const ex::Store store = ex::Store::open(e->db, ex::StoreMode::read_only);
+    if (e->session) (void)store.session(*e->session);
+    const auto rows = store.rows(e->session);
+    write_file_atomic(e->output, ex::trials_csv(rows));
+    std::cerr << "wrote " << rows.size() << " trials to " << e->output << "\n";
+  });
+
+  struct AnalyzeArgs {
+    std::optional<std::string> db;
+    std::optional<std::string> csv;
+    std::optional<std::string> out_dir;
+    std::string format = "png";
+    std::size_t reversals = 6;
+    bool json = false;
+  };
+  auto an = std::make_shared<AnalyzeArgs>();
+  auto* analyze_cmd = cmd->add_subcommand("analyze", "Per-study summaries and figures (staircases, matches, ratings, ANOVA)");
+  analyze_cmd->add_option("--db", an->db, "Session database");
+  analyze_cmd->add_option("--csv", an->csv, "…or a CSV written by 'texel experiment export'");
+  analyze_cmd->add_option("-o,--out", an->out_dir, "Folder for the figures (created if missing)");
+  analyze_cmd->add_option("--format", an->format, "Figure format: png or svg [png]");
+  analyze_cmd->add_option("--reversals", an->reversals, "Threshold = mean of the last K reversals [6]");
+  analyze_cmd->add_flag("--json", an->json, "Print the summary as JSON");
+  analyze_cmd->callback([an] {
+    if (an->db.has_value() == an->csv.has_value()) throw InvalidArgument("analyze: give exactly one of --db FILE or --csv FILE");
+    if (an->format != "png" && an->format != "svg") throw InvalidArgument("--format is '" + an->format + "'; allowed: png, svg");
+    if (an->reversals < 1 || an->reversals > 1000)
+      throw InvalidArgument("--reversals is " + std::to_string(an->reversals) + "; allowed: 1 … 1000");
+    std::vector<ex::TrialRow> rows;
+    if (an->db)
+      rows = ex::Store::open(*an->db, ex::StoreMode::read_only).rows();
+    else
+      rows = ex::parse_trials_csv(read_file(*an->csv), *an->csv);
+    ex::AnalysisOptions o;
+    if (an->out_dir) {
+      std::error_code ec;
+      std::filesystem::create_directories(*an->out_dir, ec);
+      if (ec) throw IoError("--out " + *an->out_dir + ": cannot create the folder (" + ec.message() + ")");
+      o.out_dir = *an->out_dir;
+    }
+    o.format = an->format;
+    o.reversals_k = an->reversals;
+    const ex::AnalysisReport report = ex::analyze(rows, o);
+    if (an->json)
+      print_json(report.summary);
+    else
+      std::cout << report.text;
+    for (const auto& f : report.figures) std::cerr << "wrote " << f << "\n";
+  });
+}
+
 }  // namespace texel::cli

@@ -1,1 +1,102 @@
-// placeholder: being written
+// Stimulus presentation through the player backends (presenter.hpp).
+#include "texel/experiment/presenter.hpp"
+
+#include <cmath>
+
+#include "texel/document.hpp"
+#include "texel/error.hpp"
+#include "texel/player.hpp"
+
+namespace texel::experiment {
+namespace {
+
+// The simulated finger: to and fro over [a, b] at constant speed (a triangle
+// wave), touching throughout. Turns are sharp; the player's interpolation
+// and the vibration filters smooth them.
+double finger_x(double t, double speed, double a, double b) {
+  const double span = b - a;
+  const double period = 2.0 * span / speed;
+  const double phase = std::fmod(t, period);
+  return phase < period / 2 ? a + speed * phase : b - speed * (phase - period / 2);
+}
+
+constexpr double finger_rate_hz = 1000.0;  // like a position sensor
+constexpr double finger_lead_s = 0.05;     // samples queued ahead of the player
+
+}  // namespace
+
+Presenter::Presenter(const PresenterOptions& options) : options_(options) {
+  if (!(options_.swipe_speed_mm_s > 0 && options_.swipe_speed_mm_s <= 10000))
+    throw InvalidArgument("swipe speed is " + std::to_string(options_.swipe_speed_mm_s) + "; allowed: 0 … 10000 mm/s");
+  PlayerConfig config;
+  const std::string& b = options_.backend;
+  if (b == "null" || b == "audio") {
+    config.rate_hz = options_.rate_hz;
+    config.mode = OutputMode::vibration;
+    period_s_ = static_cast<double>(options_.block_frames) / config.rate_hz;
+    player_ = std::make_unique<Player>(config);
+    if (b == "null") {
+      backend_ = make_null_backend(config.rate_hz, options_.block_frames);
+    } else {
+      AudioOptions ao;
+      ao.device = options_.audio_device;
+      ao.rate_hz = config.rate_hz;
+      ao.block_frames = options_.block_frames;
+      backend_ = make_audio_backend(ao);
+    }
+  } else if (b.rfind("serial:", 0) == 0 && b.size() > 7) {
+    // A friction display takes amplitudes; the player's output is streamed
+    // as drive values, so switching stimuli needs no map upload.
+    config.rate_hz = 1000.0;
+    config.mode = OutputMode::amplitude;
+    period_s_ = 1.0 / config.rate_hz;
+    player_ = std::make_unique<Player>(config);
+    SerialOptions so;
+    so.path = b.substr(7);
+    so.rate_hz = config.rate_hz;
+    so.stream = SerialStream::drive;
+    const PlayerMap blank_map(Grid{0.0, 1.0, 1}, std::vector<float>{0.0f});
+    backend_ = make_serial_backend(so, blank_map);
+  } else {
+    throw InvalidArgument("backend is '" + b + "'; allowed: null, audio, serial:PATH");
+  }
+  pump();
+  backend_->start(*player_);
+  running_ = true;
+}
+
+Presenter::~Presenter() { stop(); }
+
+void Presenter::stop() {
+  if (running_) backend_->stop();
+  running_ = false;
+  if (player_) player_->collect();
+}
+
+void Presenter::show(const std::string& document_json) {
+  const Surface surface = prepare_surface(parse_document(document_json, "stimulus"));
+  player_->set_map(PlayerMap::from_surface(surface));
+  ++shown_;
+}
+
+void Presenter::blank() {
+  // A one-sample map at rest: the finger is off it, so the player fades out.
+  player_->set_map(std::make_unique<const PlayerMap>(Grid{0.0, 1.0, 1}, std::vector<float>{0.0f}));
+}
+
+void Presenter::pump() {
+  const double horizon = player_->time_s() + finger_lead_s;
+  while (next_finger_s_ <= horizon) {
+    const FingerSample s{next_finger_s_, finger_x(next_finger_s_, options_.swipe_speed_mm_s, 10.0, 90.0), true};
+    if (!player_->push(s)) break;
+    next_finger_s_ += 1.0 / finger_rate_hz;
+  }
+  player_->collect();
+}
+
+BackendStats Presenter::stats() { return backend_->stats(); }
+std::string Presenter::describe() const { return backend_->describe(); }
+double Presenter::block_period_s() const { return period_s_; }
+std::string Presenter::error() const { return backend_->error(); }
+
+}  // namespace texel::experiment

@@ -1,1 +1,262 @@
-// placeholder: being written
+// Simulated participants (simulate.hpp).
+#include "texel/experiment/simulate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+#include "texel/experiment/observer.hpp"
+#include "texel/finger.hpp"
+#include "texel/random.hpp"
+#include "texel/reference.hpp"
+
+namespace texel::experiment {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::uint64_t stream_behaviour = static_cast<std::uint64_t>(Stream::user) + 50;
+
+double number_with_unit(const std::string& key, const std::string& text, std::initializer_list<const char*> units) {
+  std::string v = text;
+  double scale = 1.0;
+  for (const char* u : units) {
+    const std::string unit = u;
+    if (v.size() > unit.size() && v.compare(v.size() - unit.size(), unit.size(), unit) == 0) {
+      v.resize(v.size() - unit.size());
+      if (unit == "%") scale = 0.01;
+      break;
+    }
+  }
+  std::size_t used = 0;
+  double d = 0.0;
+  try {
+    d = std::stod(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != v.size() || v.empty() || !std::isfinite(d)) {
+    std::string allowed;
+    for (const char* u : units) allowed += (allowed.empty() ? "" : ", ") + std::string(u);
+    throw InvalidArgument("--simulate " + key + "=" + text + ": not a number" +
+                          (allowed.empty() ? std::string() : " (units allowed: " + allowed + ")"));
+  }
+  return d * scale;
+}
+
+double get(const json& o, const char* key, double fallback) {
+  return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : fallback;
+}
+
+}  // namespace
+
+json simulation_observer(const json& protocol_observer, const std::string& spec) {
+  json o = protocol_observer.is_object() ? protocol_observer : json::object();
+  for (const char* section : {"psychometric", "matcher", "rater", "memory", "explorer"})
+    if (!o.contains(section)) o[section] = json::object();
+  if (spec.empty() || spec == "default") return o;
+  std::size_t pos = 0;
+  while (pos <= spec.size()) {
+    const std::size_t comma = spec.find(',', pos);
+    const std::string item = spec.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    pos = comma == std::string::npos ? spec.size() + 1 : comma + 1;
+    if (item.empty() || item == "default") continue;
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InvalidArgument("--simulate: '" + item + "' is not key=value (e.g. threshold=6mm, target=4sin, noise=1dB, seed=3)");
+    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    if (key == "threshold") {
+      o["psychometric"]["threshold"] = number_with_unit(key, value, {"mm", "dB", "%"});
+    } else if (key == "slope") {
+      o["psychometric"]["slope"] = number_with_unit(key, value, {});
+    } else if (key == "guess") {
+      o["psychometric"]["guess"] = number_with_unit(key, value, {"%"});
+    } else if (key == "lapse") {
+      o["psychometric"]["lapse"] = number_with_unit(key, value, {"%"});
+    } else if (key == "shape") {
+      (void)parse_psychometric_shape(value, "--simulate shape");
+      o["psychometric"]["shape"] = value;
+    } else if (key == "target") {
+      const auto slash = value.find('/');
+      if (slash != std::string::npos) {
+        o["matcher"]["target"] = {number_with_unit(key, value.substr(0, slash), {"dB"}),
+                                  number_with_unit(key, value.substr(slash + 1), {"dB"})};
+      } else {
+        try {
+          (void)reference_info(value);
+        } catch (const Error&) {
+          throw InvalidArgument("--simulate target=" + value +
+                                ": allowed: a reference name (texel reference --list) or PITCHdB/IRREGULARITYdB, e.g. 8dB/-3dB");
+        }
+        o["matcher"]["target"] = value;
+      }
+    } else if (key == "noise") {
+      o["matcher"]["noise_db"] = number_with_unit(key, value, {"dB"});
+    } else if (key == "unsure") {
+      o["matcher"]["unsure_db"] = number_with_unit(key, value, {"dB"});
+    } else if (key == "p") {
+      o["memory"]["p_correct"] = number_with_unit(key, value, {"%"});
+    } else if (key == "digit") {
+      o["memory"]["p_digit"] = number_with_unit(key, value, {"%"});
+    } else if (key == "rating-noise") {
+      o["rater"]["noise"] = number_with_unit(key, value, {});
+    } else if (key == "speed") {
+      o["explorer"]["speed_mm_s"] = number_with_unit(key, value, {"mm/s"});
+    } else if (key == "seed") {
+      const double s = number_with_unit(key, value, {});
+      if (s < 0 || s != std::floor(s) || s > 9007199254740992.0)
+        throw InvalidArgument("--simulate seed=" + value + ": allowed: a whole number 0 … 2^53");
+      o["seed"] = static_cast<std::uint64_t>(s);
+    } else {
+      throw InvalidArgument("--simulate: unknown key '" + key +
+                            "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, rating-noise, "
+                            "speed, seed, default");
+    }
+  }
+  return o;
+}
+
+SimulatedParticipant::SimulatedParticipant(json observer, const Session& session) : observer_(std::move(observer)) {
+  seed_ = observer_.contains("seed") && observer_["seed"].is_number_unsigned() ? observer_["seed"].get<std::uint64_t>()
+                                                                               : mix64(session.context().seed ^ 0x51u);
+  // Validate the parts a protocol will need, up front, with the spec's names.
+  const json& p = observer_["psychometric"];
+  const double lapse = get(p, "lapse", 0.02);
+  const double guess = get(p, "guess", 0.0);
+  if (!(lapse >= 0 && lapse < 0.5))
+    throw InvalidArgument("observer lapse is " + texel::detail::num(lapse) + "; allowed: 0 … 0.5");
+  if (!(guess >= 0 && guess < 1)) throw InvalidArgument("observer guess is " + texel::detail::num(guess) + "; allowed: 0 … 1");
+  if (p.contains("threshold") && !(get(p, "threshold", 1) > 0)) throw InvalidArgument("observer threshold must be > 0");
+  const json& m = observer_["memory"];
+  if (m.contains("p_correct") && m["p_correct"].is_number()) {
+    const double pc = m["p_correct"].get<double>();
+    if (!(pc >= 0 && pc <= 1)) throw InvalidArgument("observer p is " + texel::detail::num(pc) + "; allowed: 0 … 1");
+  }
+}
+
+Response SimulatedParticipant::respond(const Session& session) const {
+  const Question& q = session.question();
+  const TrialTruth& t = session.truth();
+  const auto trial = static_cast<std::uint64_t>(q.trial);
+  const CounterRng rng(seed_, stream_behaviour);
+  Response r;
+
+  auto wrong_choice = [&](const std::string& correct) {
+    std::vector<std::string> others;
+    for (const auto& c : q.choices)
+      if (c != correct && c != "unsure") others.push_back(c);
+    return others[static_cast<std::size_t>(rng.below(trial * 8 + 1, others.size()))];
+  };
+  auto matcher = [&](std::optional<MatchResult> fallback_target) {
+    const json& mj = observer_["matcher"];
+    MatcherConfig mc;
+    mc.noise_db = get(mj, "noise_db", 1.5);
+    mc.unsure_band_db = get(mj, "unsure_db", 0.5);
+    mc.irregularity_weight = get(mj, "irregularity_weight", 1.0);
+    mc.seed = seed_;
+    MatchResult target = fallback_target.value_or(MatchResult{});
+    if (mj.contains("target") && mj["target"].is_array() && mj["target"].size() == 2) {
+      target = {mj["target"][0].get<double>(), mj["target"][1].get<double>()};
+    } else if (mj.contains("target") && mj["target"].is_string() && mj["target"].get<std::string>() != "reference") {
+      target = session.reference_position(mj["target"].get<std::string>());
+    }
+    mc.target = MatchPoint{target.pitch_db, target.irregularity_db};
+    return Matcher(mc);
+  };
+
+  switch (q.task) {
+    case TaskKind::oddity:
+    case TaskKind::two_alternative: {
+      const json& pj = observer_["psychometric"];
+      PsychometricConfig pc;
+      pc.shape = parse_psychometric_shape(pj.value("shape", std::string("weibull")), "observer shape");
+      pc.threshold = get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
+      pc.slope = get(pj, "slope", 3.5);
+      pc.guess = get(pj, "guess", q.task == TaskKind::oddity ? guess_oddity3 : guess_2afc);
+      pc.lapse = get(pj, "lapse", 0.02);
+      pc.seed = seed_;
+      const PsychometricObserver obs(pc);
+      r.choice = obs.respond(t.intensity, trial) ? t.correct_answer : wrong_choice(t.correct_answer);
+      break;
+    }
+    case TaskKind::match: {
+      const Matcher m = matcher(session.reference_position(t.reference));
+      const MatchPoint p = m.adjust(trial);
+      const auto& sp = q.sliders[0];
+      const auto& si = q.sliders[1];
+      double xp = p.pitch_db, xi = p.irregularity_db;
+      if (session.protocol().blocks[static_cast<std::size_t>(q.block_index)].sliders == SliderMapping::lognormal) {
+        // Study 2's sliders: invert m = 0.75·1.04^P and s = 3·I/10.
+        xp = std::log(std::pow(10.0, p.pitch_db / 10.0) / 0.75) / std::log(1.04);
+        xi = std::pow(10.0, p.irregularity_db / 10.0) * 10.0 / 3.0;
+      }
+      r.slider_p = std::clamp(xp, sp.min, sp.max);
+      r.slider_i = std::clamp(xi, si.min, si.max);
+      if (q.confidence) r.confidence = m.confidence(trial);
+      break;
+    }
+    case TaskKind::rating: {
+      const json& rj = observer_["rater"];
+      RaterConfig rc;
+      rc.scale_min = (*q.rating_scale)[0];
+      rc.scale_max = (*q.rating_scale)[1];
+      rc.distance_scale_db = get(rj, "distance_scale_db", 10.0);
+      rc.noise = get(rj, "noise", 0.5);
+      rc.seed = seed_;
+      const MatchResult ref = session.reference_position(t.reference);
+      const MatchResult ren = t.rendering.value_or(ref);
+      // Assumption of the simulated rater (not a perceptual claim): a
+      // quantization step of q dB adds q/2 dB of felt difference.
+      const double d =
+          std::hypot(ren.pitch_db - ref.pitch_db, ren.irregularity_db - ref.irregularity_db) + 0.5 * t.quantization_db;
+      r.rating = Rater(rc).rate(d, trial);
+      break;
+    }
+    case TaskKind::guided: {
+      const Matcher m = matcher(session.reference_position(t.reference));
+      const MatchChoice c = m.choose(*t.pair, trial);
+      r.choice = c == MatchChoice::a ? "A" : c == MatchChoice::b ? "B" : "unsure";
+      break;
+    }
+    case TaskKind::same_different: {
+      const json& mj = observer_["memory"];
+      double p = 0.85;
+      if (mj.contains("p_correct") && mj["p_correct"].is_number()) p = mj["p_correct"].get<double>();
+      if (mj.contains("p_correct") && mj["p_correct"].is_object()) p = get(mj["p_correct"], t.condition.c_str(), p);
+      const bool ok = rng.uniform(trial * 8 + 2) < p;
+      r.choice = ok ? t.correct_answer : wrong_choice(t.correct_answer);
+      if (q.recall_cell != -2) {
+        const int expected = q.recall_cell >= 0 ? (*q.matrix)[static_cast<std::size_t>(q.recall_cell)] : 1;
+        const bool recall = rng.uniform(trial * 8 + 3) < get(mj, "p_digit", 0.8);
+        r.digit =
+            recall ? expected : 1 + static_cast<int>((static_cast<std::uint64_t>(expected) + rng.below(trial * 8 + 4, 8)) % 9);
+      }
+      break;
+    }
+  }
+
+  // Exploration: a reaction time (lognormal around rt_s), the stimuli visited
+  // in turn, and a back-and-forth swipe at a drawn speed over that time.
+  const json& ej = observer_["explorer"];
+  const double rt_s = get(ej, "rt_s", 4.0) * std::exp(0.3 * rng.normal(trial * 8 + 5));
+  r.rt_ms = std::round(rt_s * 1000.0);
+  r.events.push_back({0.0, "show", "trial " + std::to_string(q.trial), ""});
+  for (std::size_t i = 0; i < q.stimuli.size(); ++i)
+    r.events.push_back({rt_s * static_cast<double>(i) / static_cast<double>(q.stimuli.size()), "select", q.stimuli[i].label, ""});
+  r.events.push_back({rt_s, "answer", r.choice, ""});
+  SwipeConfig sc;
+  sc.pattern = SwipePattern::back_and_forth;
+  sc.speed_mm_s = std::max(10.0, get(ej, "speed_mm_s", 100.0) + get(ej, "speed_sd_mm_s", 15.0) * rng.normal(trial * 8 + 6));
+  sc.surface_mm = 100.0;
+  sc.extent_mm = 60.0 + 20.0 * rng.uniform(trial * 8 + 7);
+  sc.duration_s = std::min(rt_s, 30.0);
+  sc.rate_hz = 250.0;
+  const SwipeMeasures sm = swipe_measures(simulate_swipe(sc));
+  r.swipe_mean_speed_mm_s = sm.mean_speed_mm_s;
+  r.swipe_sd_speed_mm_s = sm.sd_speed_mm_s;
+  r.directional_proportion = sm.directional_proportion;
+  return r;
+}
+
+}  // namespace texel::experiment

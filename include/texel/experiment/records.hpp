@@ -95,4 +95,9 @@ std::string trials_csv(const std::vector<TrialRow>& rows);
 /// naming the line and column.
 std::vector<TrialRow> parse_trials_csv(std::string_view text, std::string_view origin);
 
+/// The row as a JSON object of column name → cell text (the store's form;
+/// same cells as the CSV), and back. Unknown keys are ignored.
+std::string row_json(const TrialRow& row);
+TrialRow row_from_json(std::string_view json_text, std::string_view origin);
+
 }  // namespace texel::experiment

@@ -1,0 +1,139 @@
+// Protocol files: an experiment is data, not code (experiments.md; format in
+// docs/experiments.md, schema in docs/schema/texel-protocol.schema.json).
+//
+// A protocol names its study, a device, a randomization seed, the simulated
+// observer that `--simulate default` uses, and an ordered list of blocks.
+// Each block runs one task — oddity, two-alternative, match, rating, guided,
+// same-different — with its stimuli, timings, response type and (for the
+// threshold tasks) a staircase. Validation names the field by its JSON path,
+// the value and what is allowed; unknown keys are errors, so a misspelt key
+// never falls back to a default.
+//
+// Trade-off: one flat Block type with per-task fields (validated per task)
+// rather than a class per task, so a front end can show any block's settings
+// and the stored protocol copy stays plain JSON.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "texel/experiment/guided.hpp"
+#include "texel/experiment/staircase.hpp"
+
+namespace texel::experiment {
+
+enum class TaskKind { oddity, two_alternative, match, rating, guided, same_different };
+std::string_view to_string(TaskKind t);
+TaskKind parse_task_kind(std::string_view text, std::string_view field = "task");
+
+/// The seven studies of experiments.md.
+inline constexpr std::string_view study_names[] = {"working-memory",   "texel-length", "parameter-mapping",
+                                                   "free-exploration", "quantization", "guided-exploration",
+                                                   "coarse-features"};
+
+/// Slider mappings of the matching studies.
+enum class SliderMapping {
+  lognormal,  ///< study 2: P 0…100 → m = 0.75·1.04^P cpm, I 0…100 → s = 3·I/10 cpm (moments)
+  device_db,  ///< study 3: sliders in dB over the device ranges (−20…19.7, −30…5)
+};
+
+/// A rendering shown on the right in a rating trial.
+struct RenderingSource {
+  nlohmann::json texture;        ///< explicit texel texture (document "texture" object); may be empty
+  std::string match_of;          ///< use the match of this reference …
+  std::string from_block;        ///< … made in this block of the same session
+  std::string from_protocol;     ///< … or in the participant's finished session of this protocol
+  double quantization_db = 0.0;  ///< applied to the rendering (0 = unquantized)
+};
+
+struct RatingPair {
+  std::string reference;  ///< reference felt on the left
+  RenderingSource rendering;
+  std::string condition;  ///< label for the analysis ("unquantized", "q3", "rendering:4sin", …)
+};
+
+/// Working memory: one condition (spacing × distractor).
+struct MemoryCondition {
+  std::string name;      ///< e.g. "wide-distractor"
+  std::string stimulus;  ///< key into Block::memory_stimuli
+  bool distractor = true;
+};
+struct MemoryStimulus {
+  std::string name;
+  nlohmann::json texture;    ///< texture 1 (document "texture" object)
+  nlohmann::json different;  ///< texture 2 on "different" trials
+};
+
+struct Block {
+  std::string name;
+  TaskKind task = TaskKind::oddity;
+  bool practice = false;
+  std::string condition;  ///< label copied to every row ("narrow", "fine-50", …)
+  std::string prompt;     ///< participant-facing instruction (empty: the task's default)
+
+  // Stimulus layout.
+  double display_mm = 0.0;    ///< oddity / two-alternative: textured length from 0 (0 = the whole device)
+  double time_limit_s = 0.0;  ///< 0 = none (oddity: 30 s)
+  bool show_maps = false;     ///< visual practice: the front end draws the friction maps
+  nlohmann::json texture;     ///< base texel texture (document "texture" object, seed optional)
+
+  // Adaptive (oddity, two-alternative).
+  std::optional<StaircaseConfig> staircase;
+  std::string variable;      ///< texture key the staircase sets, e.g. "texel_length_mm"
+  int trials = 0;            ///< fixed trial count when there is no staircase (practice)
+  double fixed_value = 0.0;  ///< value of `variable` without a staircase
+
+  // References (two-alternative: the pair A/B; match, guided: the list).
+  std::vector<std::string> references;
+  bool shuffle = true;  ///< randomize the order of references / pairs / trials
+
+  // Match.
+  SliderMapping sliders = SliderMapping::device_db;
+  bool confidence = false;  ///< ask a 1…5 confidence rating after each match
+
+  // Rating.
+  double scale_min = 1.0, scale_max = 5.0;
+  std::vector<RatingPair> pairs;
+  int repeats = 1;
+
+  // Guided.
+  std::string optimizer = "guided";  ///< "guided" | "bayesian"
+  nlohmann::json optimizer_params = nlohmann::json::object();
+
+  // Same-different.
+  std::vector<MemoryCondition> conditions;
+  std::vector<MemoryStimulus> memory_stimuli;
+  int trials_per_condition = 8;
+  double texture_s = 10.0, matrix_s = 10.0;
+  int matrix_cells = 5;
+  bool recall_question = true;
+};
+
+struct Protocol {
+  static constexpr int current_version = 1;
+  int version = current_version;
+  std::string name;
+  std::string study;
+  std::string title;
+  std::string description;
+  std::string device = "tpad";
+  std::uint64_t seed = 1;
+  nlohmann::json observer = nlohmann::json::object();  ///< simulated observer for `--simulate default`
+  std::vector<Block> blocks;
+  std::string json;  ///< the validated source (stored with every session)
+
+  [[nodiscard]] const Block* block(std::string_view name) const;
+  /// Trials the protocol will run, or -1 when a staircase makes it open-ended.
+  [[nodiscard]] int planned_trials() const;
+};
+
+/// Parses and validates; `origin` names the source in errors.
+Protocol parse_protocol(std::string_view json_text, std::string_view origin = "protocol");
+Protocol load_protocol(const std::string& path);
+
+}  // namespace texel::experiment

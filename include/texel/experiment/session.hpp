@@ -1,0 +1,178 @@
+// The experiment engine: a protocol in, one question at a time out, answers
+// in, records to store out. No terminal, network or file I/O inside: the
+// terminal runner (`texel experiment run`), the studio and the Python
+// bindings all drive this same object (style.md: "a procedure is a state
+// machine you step").
+//
+//   Session s(protocol, context);
+//   while (!s.finished()) {
+//     const Question& q = s.question();     // what to show (never the answer)
+//     ... present q.stimuli, collect a Response ...
+//     StoredTrial t = s.answer(response);   // validated; the engine advances
+//     store.append_trial(lock, t);          // commit before the next question
+//   }
+//
+// Determinism and resume. Every random draw of a trial (seeds of the
+// stimuli, the odd interval, orders, matrix digits) comes from
+// CounterRng(session seed, stream) at a counter derived from the trial index
+// or block index, and every adaptive procedure is rebuilt by replaying its
+// answers. So resume is replay: a Session built from the same protocol and
+// seed, fed the stored responses with `replay()`, is in exactly the state an
+// uninterrupted run would be in (and `replay` checks that the stored question
+// is the one it would have asked).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "texel/experiment/guided.hpp"
+#include "texel/experiment/protocol.hpp"
+#include "texel/experiment/records.hpp"
+#include "texel/experiment/staircase.hpp"
+#include "texel/experiment/store.hpp"
+
+namespace texel::experiment {
+
+/// Something the participant can select and feel.
+struct Stimulus {
+  std::string label;          ///< button text: "1", "Reference", "A", "Test", "Texture 1", …
+  std::string document_json;  ///< the full texture document (device, regions)
+};
+
+/// One timed phase of a trial (working memory): show a stimulus, the digit
+/// matrix, or nothing, for a fixed time.
+struct Phase {
+  std::string kind;   ///< "stimulus" | "matrix"
+  int stimulus = -1;  ///< index into Question::stimuli for "stimulus"
+  double duration_s = 0.0;
+};
+
+struct SliderSpec {
+  std::string name;   ///< "pitch" | "irregularity"
+  std::string label;  ///< participant-facing
+  double min = 0.0, max = 100.0, start = 50.0;
+};
+
+/// What a front end shows for the current trial. Holds nothing that would
+/// reveal the answer.
+struct Question {
+  int trial = 0;  ///< 0-based index in the session
+  int block_index = 0;
+  std::string block;
+  int trial_in_block = 0;
+  int block_trials = -1;  ///< planned trials in this block, -1 = adaptive
+  bool practice = false;
+  TaskKind task = TaskKind::oddity;
+  std::string prompt;
+  std::vector<Stimulus> stimuli;
+  std::vector<std::string> choices;                   ///< allowed Response::choice values (empty: none asked)
+  std::optional<std::array<double, 2>> rating_scale;  ///< [min, max], whole steps
+  std::vector<SliderSpec> sliders;
+  bool confidence = false;                    ///< ask a 1 … 5 confidence rating
+  double time_limit_s = 0.0;                  ///< 0 = none
+  bool show_maps = false;                     ///< visual practice: draw the stimuli's friction maps
+  std::vector<Phase> phases;                  ///< timed sequence before the questions (working memory)
+  std::optional<std::array<int, 16>> matrix;  ///< working memory: 4 × 4 digits, 0 = empty cell
+  int recall_cell = -2;  ///< working memory: cell asked (0 … 15), -1 = "all cells", -2 = no recall question
+
+  [[nodiscard]] nlohmann::ordered_json to_json() const;  ///< participant-safe view (studio messages)
+};
+
+/// A participant's answer. Only the fields the question asks for are read.
+struct Response {
+  std::string choice;                        ///< one of Question::choices
+  std::optional<double> rating;              ///< on Question::rating_scale
+  std::optional<double> confidence;          ///< 1 … 5
+  std::optional<double> slider_p, slider_i;  ///< final slider positions
+  std::optional<int> digit;                  ///< recall answer 1 … 9
+  double rt_ms = missing;                    ///< first presentation → answer
+  std::vector<TrialEvent> events;            ///< presentation / selection events
+  std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
+  std::string shown_at, answered_at;  ///< ISO 8601 UTC
+
+  [[nodiscard]] nlohmann::ordered_json to_json() const;
+  static Response from_json(const nlohmann::json& j);  ///< throws FormatError
+};
+
+/// A finished match (slider or guided), by reference.
+struct MatchResult {
+  double pitch_db = 0.0;
+  double irregularity_db = 0.0;
+};
+
+struct SessionContext {
+  std::string participant;
+  std::int64_t session_id = 0;
+  std::uint64_t seed = 0;  ///< randomization seed (protocol seed mixed with the participant code by default)
+  /// Matches from the participant's earlier finished sessions, by protocol
+  /// then reference (for rating renderings "from_protocol"). Resolved when
+  /// the session is created and stored with it, so resume sees the same.
+  std::map<std::string, std::map<std::string, MatchResult>> prior_matches;
+};
+
+/// The seed a participant's session uses by default: the protocol's seed
+/// mixed with the participant code, so participants get different draws and
+/// a re-run of the same participant the same ones.
+std::uint64_t session_seed(std::uint64_t protocol_seed, const std::string& participant);
+
+/// The hidden side of the current trial (for simulated observers, stored
+/// with the trial, never shown to participants).
+struct TrialTruth {
+  std::string correct_answer;            ///< "" where there is none
+  double intensity = missing;            ///< staircase / fixed value of the block's variable
+  std::string reference;                 ///< reference felt
+  std::optional<MatchResult> rendering;  ///< parameters of the compared rendering (rating)
+  double quantization_db = 0.0;
+  std::optional<MatchQuestion> pair;  ///< guided: the two points
+  std::string condition;
+};
+
+class Session {
+ public:
+  /// Prepares the first question. Throws FormatError/InvalidArgument for a
+  /// protocol the engine cannot run.
+  Session(Protocol protocol, SessionContext context);
+  ~Session();
+  Session(Session&&) noexcept;
+  Session& operator=(Session&&) noexcept;
+
+  [[nodiscard]] bool finished() const;
+  /// The current question; throws texel::Error when finished.
+  [[nodiscard]] const Question& question() const;
+  [[nodiscard]] const TrialTruth& truth() const;
+  /// For match questions: the document to feel at these slider positions.
+  [[nodiscard]] std::string preview_document(double slider_p, double slider_i) const;
+  /// Validates `r` against the question (InvalidArgument naming the field),
+  /// advances, and returns the record to store.
+  StoredTrial answer(const Response& r);
+  /// Re-applies a stored trial (resume): checks that it answers the question
+  /// this session would ask now, then answers it. Throws FormatError if the
+  /// stored data do not fit (another protocol, seed or engine version).
+  void replay(const StoredTrial& t);
+
+  [[nodiscard]] int trials_done() const;
+  [[nodiscard]] int trials_planned() const;  ///< -1 when adaptive
+  [[nodiscard]] const Protocol& protocol() const;
+  [[nodiscard]] const SessionContext& context() const;
+  /// Matches finished so far in a block, by reference.
+  [[nodiscard]] std::map<std::string, MatchResult> matches(const std::string& block) const;
+  /// The encoder's perceptual position of a reference on the protocol's device (cached).
+  [[nodiscard]] MatchResult reference_position(const std::string& reference) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Slider mappings (experiments.md studies 2 and 3): slider positions to
+/// (Central Pitch dB, Irregularity dB) under the moments parameterization.
+MatchResult slider_to_parameters(SliderMapping mapping, double slider_p, double slider_i);
+
+}  // namespace texel::experiment
