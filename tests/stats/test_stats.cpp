@@ -73,11 +73,13 @@ TEST(Textbook, SleepOneSampleT) {
 }
 
 // Winer (1971), Statistical Principles in Experimental Design, 2nd ed.: four
-// drugs × five subjects, reaction time; the example of NCSS's "Repeated
-// Measures Analysis of Variance" chapter (214), which reports F = 24.76 on
-// (3, 12) df. The sums of squares follow from the printed table by hand:
-// drug means 26.4, 25.6, 15.6, 32.0 around 24.9 give SS_drugs = 5·139.64 = 698.2,
-// and F·SS_drugs/3 fixes SS_residual = 112.8.
+// drugs × five subjects, reaction time — the worked example of NCSS's
+// "Repeated Measures Analysis of Variance" chapter (214). Expected values are
+// worked by hand from the printed table, not by any code: grand mean 24.9;
+// drug means 26.4, 25.6, 15.6, 32.0 → SS_drugs = 5·139.64 = 698.2; subject
+// means 27, 16, 23, 34, 24.5 → SS_subjects = 4·170.2 = 680.8; Σy² = 13892 →
+// SS_total = 13892 − 20·24.9² = 1491.8; SS_residual = 1491.8 − 698.2 − 680.8 =
+// 112.8; F(3, 12) = (698.2/3)/(112.8/12) = 24.7589.
 TEST(Textbook, WinerDrugsOneFactor) {
   const double y[5][4] = {{30, 28, 16, 34}, {14, 18, 10, 22}, {24, 20, 18, 30}, {38, 34, 20, 44}, {26, 28, 14, 30}};
   std::vector<st::Observation> obs;
@@ -92,7 +94,7 @@ TEST(Textbook, WinerDrugsOneFactor) {
   EXPECT_EQ(e.df, 3.0);
   EXPECT_NEAR(e.ss_error, 112.8, 1e-9);
   EXPECT_EQ(e.df_error, 12.0);
-  EXPECT_NEAR(e.f, 24.76, 5e-3);
+  EXPECT_NEAR(e.f, 24.7589, 5e-5);
   EXPECT_TRUE(e.sphericity_applies);
   EXPECT_GE(e.gg_epsilon, 1.0 / 3.0);
   EXPECT_LE(e.gg_epsilon, 1.0);
