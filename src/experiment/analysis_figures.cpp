@@ -112,7 +112,11 @@ Figure staircase_tracks(const std::string& study, const Rows& rows) {
       p.lines.push_back(std::move(line));
       p.stems.push_back(std::move(rev));
     }
-    if (p.stems.size() > 0 && !p.stems.front().x.empty()) p.stems.front().label = "reversal";
+    for (auto& st : p.stems)
+      if (!st.x.empty()) {
+        st.label = "reversal";
+        break;
+      }
     f.panels.push_back(std::move(p));
   }
   return f;

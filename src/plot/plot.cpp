@@ -1178,6 +1178,19 @@ void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
     for (const auto& s : pp.panel->stems)
       for (std::size_t k = 0; k < s.x.size(); ++k) n += in(xs(s.x[k]), ys(s.y[k])) ? 10 : 0;
     for (const auto& [x0, x1] : marker_spans) n += x1 >= b.x - 2 && x0 <= b.right() + 2 ? 50 : 0;
+    for (const auto& e : pp.panel->error_bars)
+      for (std::size_t k = 0; k < e.x.size(); ++k)
+        for (const double dy : {0.0, e.error[k], -e.error[k]})
+          if (std::isfinite(dy)) n += in(xs(e.x[k]), ys(e.y[k] + dy)) ? 10 : 0;
+    for (std::size_t i = 0; i < pp.panel->boxes.size(); ++i)
+      for (std::size_t g = 0; g < pp.boxes[i].size(); ++g) {
+        const BoxStats& st = pp.boxes[i][g];
+        const double x = box_x(pp.panel->boxes[i], g), hw = pp.panel->boxes[i].box_width / 2;
+        for (const double y : {st.whisker_low, st.q1, st.median, st.q3, st.whisker_high})
+          for (const double dx : {-hw, 0.0, hw}) n += in(xs(x + dx), ys(y)) ? 10 : 0;
+        for (const double o : st.outliers) n += in(xs(x), ys(o)) ? 10 : 0;
+      }
+    if (pp.panel->heatmap) n += 1000;  // never over the matrix if avoidable (it fills the plot)
     return n;
   };
   Rect box = corners[0];
