@@ -658,6 +658,16 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
     else
       s = memory_summary(rs, options, report.text);
     json head{{"participants", participants.size()}, {"rows", rs.size()}};
+    // Reaction times: each participant's median (robust to a trial left
+    // open), described over participants.
+    std::map<std::string, std::vector<double>> rts;
+    for (const TrialRow* r : rs)
+      if (std::isfinite(r->rt_ms)) rts[r->participant].push_back(r->rt_ms);
+    if (!rts.empty()) {
+      std::vector<double> medians;
+      for (const auto& [p, v] : rts) medians.push_back(stats::quantile(v, 0.5));
+      head["rt_ms_median"] = describe_json(medians);
+    }
     head.update(s);
     report.summary[study] = std::move(head);
     if (!options.out_dir.empty()) {

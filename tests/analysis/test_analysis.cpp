@@ -474,6 +474,33 @@ TEST(Analysis, EveryStudyWritesItsFiguresAsPng) {
                                  std::filesystem::copy_options::overwrite_existing);
 }
 
+TEST(Analysis, SingleParticipantReportsSkippedTestsAndStillDraws) {
+  test_support::TempDir dir("texel-analysis");
+  std::vector<TrialRow> one;
+  for (const auto& r : all_rows())
+    if (r.participant == "S01") one.push_back(r);
+  AnalysisOptions o;
+  o.out_dir = dir.at("one");
+  AnalysisReport r;
+  ASSERT_NO_THROW(r = analyze(one, o));
+  EXPECT_EQ(r.summary.size(), 7u);
+  EXPECT_TRUE(r.summary["texel-length"]["paired_t_test"].contains("skipped"));
+  EXPECT_TRUE(r.summary["coarse-features"]["rm_anova"].contains("skipped"));
+  EXPECT_TRUE(r.summary["working-memory"]["rm_anova"].contains("skipped"));
+  EXPECT_TRUE(r.summary["guided-exploration"]["references"][0]["ellipse"].contains("skipped"));
+  EXPECT_TRUE(r.summary["guided-exploration"]["similarity"]["own_vs_other_t_test"].contains("skipped"));
+  EXPECT_EQ(r.figures.size(), 20u);
+}
+
+TEST(Analysis, ReactionTimesAreParticipantMedians) {
+  std::vector<TrialRow> rows = quantization_rows();
+  for (auto& r : rows) r.rt_ms = r.participant == "S01" ? (r.condition == "q5" ? 5000 : 1000) : 2000;
+  const json s = analyze(rows, {}).summary["quantization"];
+  EXPECT_EQ(s["rt_ms_median"]["n"], 3);
+  EXPECT_DOUBLE_EQ(s["rt_ms_median"]["min"].get<double>(), 1000);  // S01's median ignores its slow q5 trials
+  EXPECT_DOUBLE_EQ(s["rt_ms_median"]["max"].get<double>(), 2000);
+}
+
 TEST(Analysis, SvgFiguresOnRequest) {
   test_support::TempDir dir("texel-analysis");
   AnalysisOptions o;
