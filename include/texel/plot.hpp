@@ -161,6 +161,7 @@ struct TextNote {
   double y = 0.0;  ///< data units: the text's vertical middle
   std::string text;
   Rgb colour{0.1, 0.1, 0.1};
+  double dy_px = 0.0;  ///< shift after placing, px (negative = up), e.g. to sit just above a point
 };
 
 /// One plot area with its axes, series and legend. Draw order, back to

@@ -321,7 +321,8 @@ Figure match_ellipses(const std::string& title, const json& s, double level) {
     }
     const double rx = d(s["references"][i]["reference_pitch_db"]), ry = d(s["references"][i]["reference_irregularity_db"]);
     if (std::isfinite(rx) && std::isfinite(ry)) refs.x.push_back(rx), refs.y.push_back(ry);
-    if (!x.empty()) p.notes.push_back(TextNote{mean_of(x), mean_of(y), names[i], c});
+    // The name just above the reference's highest match, clear of the points.
+    if (!x.empty()) p.notes.push_back(TextNote{mean_of(x), *std::max_element(y.begin(), y.end()), names[i], c, -14.0});
   }
   if (!refs.x.empty()) p.stems.push_back(std::move(refs));
   f.panels.push_back(std::move(p));
@@ -405,11 +406,13 @@ Figure quantization_figure(const json& s, const Rows& rows) {
   a.y.label = "rating change (rating points, 1 … 5 scale)";
   const double n = static_cast<double>(cats.size());
   a.lines.push_back(LineSeries{{-0.5, n - 0.5}, {0, 0}, Rgb{0.45, 0.45, 0.45}, 1.0, {}, true});
-  const double room = std::max(0.1, (hi - lo) * 0.08);
   for (std::size_t i = 0; i < eb.x.size(); ++i) {
     const double top = eb.y[i] + (std::isfinite(eb.error[i]) ? eb.error[i] : 0);
-    if (std::isfinite(top)) a.notes.push_back(TextNote{eb.x[i], top + room, p_text(s["changes"][i]["t_test"])});
+    if (std::isfinite(top))
+      a.notes.push_back(TextNote{eb.x[i], top, p_text(s["changes"][i]["t_test"]), Rgb{0.1, 0.1, 0.1}, -12.0});
   }
+  // Room above the highest bar for its p value.
+  if (hi > lo) a.y.max = hi + (hi - lo) * 0.15;
   a.error_bars.push_back(std::move(eb));
   f.panels.push_back(std::move(a));
 

@@ -1105,7 +1105,7 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
       const double x = xs(t.x), y = ys(t.y);
       if (std::isnan(x) || std::isnan(y)) continue;
       pa.colour(t.colour);
-      pa.text(t.text, x, y, HAlign::centre, VAlign::middle);
+      pa.text(t.text, x, y + t.dy_px, HAlign::centre, VAlign::middle);
     }
   }
   cairo_restore(cr);

@@ -132,6 +132,10 @@ TEST(PlotStat, ErrorBarsRenderAndBarLengthMatters) {
   p.notes.push_back(TextNote{1, 0.9, "p = 0.03"});
   const std::string a = render_figure(one_panel(p), PlotFormat::png);
   EXPECT_GT(count_colour(a, {0.1, 0.6, 0.1}, 10), 30u);
+  p.notes[0].dy_px = -12;  // the note moves up
+  EXPECT_NE(render_figure(one_panel(p), PlotFormat::png), a);
+  p.notes[0].dy_px = 0;
+  EXPECT_EQ(render_figure(one_panel(p), PlotFormat::png), a);
   p.error_bars[0].error = {0.05, 0.2};
   EXPECT_NE(render_figure(one_panel(p), PlotFormat::png), a);
   EXPECT_FALSE(render_figure(one_panel(p), PlotFormat::svg).empty());
