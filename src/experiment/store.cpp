@@ -181,18 +181,16 @@ bool valid_code(const std::string& code) {
 // ---------------------------------------------------------------------------
 // The connection and its wrappers.
 
-namespace detail {
-
-struct StoreImpl {
+struct StoreConnection {
   sqlite3* db = nullptr;
   std::string path;
   bool writable = false;
   int version = 0;
 
-  StoreImpl() = default;
-  StoreImpl(const StoreImpl&) = delete;
-  StoreImpl& operator=(const StoreImpl&) = delete;
-  ~StoreImpl() {
+  StoreConnection() = default;
+  StoreConnection(const StoreConnection&) = delete;
+  StoreConnection& operator=(const StoreConnection&) = delete;
+  ~StoreConnection() {
     if (db) sqlite3_close_v2(db);
   }
 
@@ -215,11 +213,9 @@ struct StoreImpl {
   }
 };
 
-}  // namespace detail
-
 namespace {
 
-using detail::StoreImpl;
+using StoreImpl = StoreConnection;
 
 class Stmt {
  public:
@@ -359,14 +355,14 @@ std::string session_label(const SessionInfo& s) {
 // ---------------------------------------------------------------------------
 // Store
 
-Store::Store(std::shared_ptr<detail::StoreImpl> impl) : impl_(std::move(impl)) {}
+Store::Store(std::shared_ptr<StoreConnection> impl) : impl_(std::move(impl)) {}
 Store::~Store() = default;
 Store::Store(Store&&) noexcept = default;
 Store& Store::operator=(Store&&) noexcept = default;
 
 Store Store::open(const std::string& path, StoreMode mode) {
   namespace fs = std::filesystem;
-  auto s = std::make_shared<detail::StoreImpl>();
+  auto s = std::make_shared<StoreConnection>();
   s->path = path;
   std::error_code ec;
   const bool exists = fs::exists(path, ec);
@@ -672,7 +668,7 @@ std::vector<TrialRow> Store::rows(std::optional<std::int64_t> session_id) const 
 // ---------------------------------------------------------------------------
 // WriterLock
 
-WriterLock::WriterLock(std::shared_ptr<detail::StoreImpl> impl, std::int64_t session_id)
+WriterLock::WriterLock(std::shared_ptr<StoreConnection> impl, std::int64_t session_id)
     : impl_(std::move(impl)), session_id_(session_id) {}
 WriterLock::WriterLock(WriterLock&& o) noexcept : impl_(std::move(o.impl_)), session_id_(o.session_id_) {}
 WriterLock& WriterLock::operator=(WriterLock&& o) noexcept {

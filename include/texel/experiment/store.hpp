@@ -65,9 +65,10 @@ struct SessionInfo {
 enum class StoreMode { read_only, read_write };
 
 class Store;
-namespace detail {
-struct StoreImpl;  // the connection (store.cpp); shared by the Store and its locks
-}
+// The connection (store.cpp), shared by a Store and its locks. Declared here,
+// not in a texel::experiment::detail namespace, which would hide texel::detail
+// from code in texel::experiment.
+struct StoreConnection;
 
 /// Proof of being the session's only writer; releases on destruction. It
 /// shares the Store's connection, so it stays valid if the Store is moved
@@ -81,8 +82,8 @@ class WriterLock {
 
  private:
   friend class Store;
-  WriterLock(std::shared_ptr<detail::StoreImpl> impl, std::int64_t session_id);
-  std::shared_ptr<detail::StoreImpl> impl_;
+  WriterLock(std::shared_ptr<StoreConnection> impl, std::int64_t session_id);
+  std::shared_ptr<StoreConnection> impl_;
   std::int64_t session_id_ = 0;
 };
 
@@ -126,8 +127,8 @@ class Store {
   [[nodiscard]] std::vector<TrialRow> rows(std::optional<std::int64_t> session_id = std::nullopt) const;
 
  private:
-  explicit Store(std::shared_ptr<detail::StoreImpl> impl);
-  std::shared_ptr<detail::StoreImpl> impl_;
+  explicit Store(std::shared_ptr<StoreConnection> impl);
+  std::shared_ptr<StoreConnection> impl_;
 };
 
 }  // namespace texel::experiment
