@@ -376,7 +376,10 @@ json ratings_by_reference(const Rows& ratings) {
 
 json match_study(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
   Rows matches, ratings;
-  for (const TrialRow* r : rows) (r->task == "match" ? matches : r->task == "rating" ? ratings : matches).push_back(r);
+  for (const TrialRow* r : rows) {
+    if (r->task == "match") matches.push_back(r);
+    if (r->task == "rating") ratings.push_back(r);
+  }
   json out = json::object();
   matching_summary(matches, o, out, text, study);
   if (!ratings.empty()) out["ratings"] = ratings_by_reference(ratings);

@@ -501,6 +501,39 @@ TEST(Analysis, ReactionTimesAreParticipantMedians) {
   EXPECT_DOUBLE_EQ(s["rt_ms_median"]["max"].get<double>(), 2000);
 }
 
+namespace {
+/// Same structure, strings and booleans; numbers within 1e-9 relative.
+void expect_same(const json& a, const json& b, const std::string& at) {
+  if (a.is_number() && b.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    EXPECT_NEAR(x, y, 1e-9 * std::max(1.0, std::abs(x))) << at;
+    return;
+  }
+  ASSERT_EQ(a.type(), b.type()) << at;
+  if (a.is_object()) {
+    ASSERT_EQ(a.size(), b.size()) << at;
+    for (const auto& [k, v] : a.items()) {
+      ASSERT_TRUE(b.contains(k)) << at << "/" << k;
+      expect_same(v, b[k], at + "/" + k);
+    }
+  } else if (a.is_array()) {
+    ASSERT_EQ(a.size(), b.size()) << at;
+    for (std::size_t i = 0; i < a.size(); ++i) expect_same(a[i], b[i], at + "/" + std::to_string(i));
+  } else {
+    EXPECT_EQ(a, b) << at;
+  }
+}
+}  // namespace
+
+// The summary is a function of the rows alone: analysing the exported CSV
+// read back gives the same numbers as analysing the rows themselves.
+TEST(Analysis, ExportedCsvGivesTheSameSummary) {
+  const std::vector<TrialRow> rows = all_rows();
+  const std::vector<TrialRow> back = parse_trials_csv(trials_csv(rows), "export.csv");
+  ASSERT_EQ(back.size(), rows.size());
+  expect_same(analyze(rows, {}).summary, analyze(back, {}).summary, "");
+}
+
 TEST(Analysis, SvgFiguresOnRequest) {
   test_support::TempDir dir("texel-analysis");
   AnalysisOptions o;
