@@ -153,8 +153,15 @@ ProcStat proc_stat(std::int64_t pid) {
   return s;
 }
 
+// Our own start time; recomputed after a fork(), where the child inherits
+// the parent's cached value.
 std::int64_t own_start() {
-  static const std::int64_t start = proc_stat(::getpid()).start;
+  static pid_t cached_pid = 0;
+  static std::int64_t start = 0;
+  if (cached_pid != ::getpid()) {
+    cached_pid = ::getpid();
+    start = proc_stat(cached_pid).start;
+  }
   return start;
 }
 
