@@ -104,7 +104,9 @@ TEST(Guided, EveryBoxLiesInThePreviousOneAndEndsAsAPoint) {
       ASSERT_TRUE(boxes[i - 1].contains(boxes[i], 1e-9)) << "seed " << seed << " box " << i;
     EXPECT_EQ(g.box().pitch_half_db, 0.0);
     EXPECT_EQ(g.box().irregularity_half_db, 0.0);
-    if (c.unsure == UnsureMode::ignore) EXPECT_EQ(g.comparisons(), 20);
+    if (c.unsure == UnsureMode::ignore) {
+      EXPECT_EQ(g.comparisons(), 20);
+    }
     EXPECT_GE(g.comparisons(), 20);
   }
 }
