@@ -22,10 +22,10 @@ inline constexpr std::size_t max_csv_bytes = std::size_t{256} << 20;  ///< 256 M
 inline constexpr std::size_t max_csv_cells = 10'000'000;
 
 struct Table {
-  std::string origin;  ///< file name or label used in error messages
   std::vector<std::string> columns;
   std::vector<std::vector<std::string>> cells;  ///< cells[row][column], rows exclude the header
-  std::vector<std::size_t> lines;               ///< 1-based line where each row starts
+  std::string origin;                           ///< file name or label used in error messages (may be empty)
+  std::vector<std::size_t> lines;               ///< 1-based line where each row starts (may be empty)
 
   /// Index of a column; throws InvalidArgument naming it and the available ones.
   std::size_t column(std::string_view name) const;
