@@ -174,13 +174,39 @@ TEST(Store, WriteProtectedFileOpenedForWritingIsRefused) {
   }
   const auto before = file_bytes(path);
   ::chmod(path.c_str(), 0444);
+  const std::string want = path + " is read-only (no write permission); nothing was stored";
   if (::access(path.c_str(), W_OK) == 0) {
+    // Root ignores the mode bits: check from a child that drops to nobody.
+    if (::geteuid() != 0) {
+      ::chmod(path.c_str(), 0644);
+      GTEST_SKIP() << "this user can write a 0444 file (CAP_DAC_OVERRIDE) and is not root, so cannot drop to nobody; "
+                      "read-only semantics are covered by ReadOnlyModeNeverWrites";
+    }
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      int code = 0;
+      if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
+      try {
+        (void)ex::Store::open(path, ex::StoreMode::read_write);
+        code = 1;
+      } catch (const texel::IoError& e) {
+        code = e.what() == want ? 0 : 2;
+      } catch (...) {
+        code = 2;
+      }
+      ::_exit(code);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "1: opened for writing, 2: wrong error, 3: could not drop to nobody";
+    EXPECT_EQ(file_bytes(path), before);
     ::chmod(path.c_str(), 0644);
-    GTEST_SKIP() << "running as root (or with CAP_DAC_OVERRIDE): chmod 0444 does not stop writes here; "
-                    "read-only semantics are covered by ReadOnlyModeNeverWrites";
+    return;
   }
   const auto msg = message_of<texel::IoError>([&] { (void)ex::Store::open(path, ex::StoreMode::read_write); });
-  EXPECT_EQ(msg, path + " is read-only (no write permission); nothing was stored");
+  EXPECT_EQ(msg, want);
   {
     const auto s = ex::Store::open(path, ex::StoreMode::read_only);  // reading still works
     EXPECT_EQ(s.sessions().size(), 1u);
