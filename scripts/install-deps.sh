@@ -12,7 +12,7 @@ packages=(
   libcairo2-dev libkissfft-dev libzstd-dev zstd
   libsndfile1-dev portaudio19-dev libsqlite3-dev
   libboost-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema
 )
 
 missing=()

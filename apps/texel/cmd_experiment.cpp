@@ -23,6 +23,7 @@
 #include "texel/experiment/presenter.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/records.hpp"
+#include "texel/experiment/runner.hpp"
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
@@ -37,7 +38,7 @@ using nlohmann::json;
 using nlohmann::ordered_json;
 
 std::atomic<bool> interrupted{false};
-extern "C" void on_signal(int) { interrupted = true; }
+extern "C" void on_experiment_signal(int) { interrupted = true; }
 
 std::string iso_now() {
   const auto t = std::chrono::system_clock::now();
@@ -280,69 +281,21 @@ struct RunArgs {
   bool quiet = false;
 };
 
-// Matches of the participant's finished sessions, for renderings that use
-// them ("from_protocol" in a rating block).
-std::map<std::string, std::map<std::string, ex::MatchResult>> prior_matches(const ex::Store& store, const ex::Protocol& p,
-                                                                            const std::string& participant) {
-  std::map<std::string, std::map<std::string, ex::MatchResult>> out;
-  std::set<std::string> wanted;
-  for (const auto& b : p.blocks)
-    for (const auto& pair : b.pairs)
-      if (!pair.rendering.from_protocol.empty()) wanted.insert(pair.rendering.from_protocol);
-  if (wanted.empty()) return out;
-  for (const auto& s : store.sessions()) {
-    if (s.participant != participant || s.status != "finished" || !wanted.count(s.protocol)) continue;
-    for (const auto& row : store.rows(s.id)) {
-      const bool match_row = row.task == "match" || (row.task == "guided" && row.procedure_finished);
-      if (match_row && !row.practice && std::isfinite(row.pitch_db))
-        out[s.protocol][row.reference] = ex::MatchResult{row.pitch_db, row.irregularity_db};
-    }
-  }
-  return out;
-}
-
 void run(const RunArgs& a) {
   if (!(a.pace >= 0 && a.pace <= 3600)) throw InvalidArgument("--pace is " + detail::num(a.pace) + "; allowed: 0 … 3600 s");
-  ex::Protocol file_protocol = ex::load_protocol(a.protocol);
+  const ex::Protocol protocol_file = ex::load_protocol(a.protocol);
   ex::Store store = ex::Store::open(a.db, ex::StoreMode::read_write);
-
-  ex::SessionInfo info;
-  const auto existing = store.unfinished_session(a.participant, file_protocol.name);
-  if (a.resume) {
-    if (!existing)
-      throw InvalidArgument("--resume: participant '" + a.participant + "' has no unfinished '" + file_protocol.name +
-                            "' session in " + a.db + " (run without --resume to start one)");
-    info = *existing;
-  } else if (existing) {
-    throw InvalidArgument("participant '" + a.participant + "' has an unfinished '" + file_protocol.name + "' session (id " +
-                          std::to_string(existing->id) + ", " + std::to_string(existing->trials_done) + " trials stored) in " +
-                          a.db + "; add --resume to continue it");
-  }
-  // The stored copy of the protocol is what a resumed session runs, so an
-  // edited file cannot change a session half-way.
-  const ex::Protocol protocol = a.resume ? ex::parse_protocol(info.protocol_json, a.db + ": stored protocol") : file_protocol;
-  std::string simulate = a.simulate.value_or(a.resume ? info.simulate : std::string());
-  std::optional<json> observer;
-  if (!simulate.empty()) observer = ex::simulation_observer(protocol.observer, simulate);  // validates before anything is stored
-
-  if (!a.resume) {
-    const std::uint64_t seed = ex::session_seed(protocol.seed, a.participant);
-    const auto id = store.create_session(a.participant, protocol.name, protocol.study, protocol.json, seed, simulate,
-                                         protocol.planned_trials());
-    info = store.session(id);
-  }
-  ex::WriterLock lock = store.acquire_writer(info.id);
-
-  ex::SessionContext ctx;
-  ctx.participant = a.participant;
-  ctx.session_id = info.id;
-  ctx.seed = info.seed;
-  ctx.prior_matches = prior_matches(store, protocol, a.participant);
-  ex::Session session(protocol, ctx);
-  const auto stored = store.trials(info.id);
-  for (const auto& t : stored) session.replay(t);
+  ex::OpenOptions oo;
+  oo.participant = a.participant;
+  oo.resume = a.resume;
+  oo.simulate = a.simulate;
+  ex::ActiveSession active = ex::open_session(store, protocol_file, oo);
+  const ex::Session& session = active.session;
+  const ex::Protocol& protocol = session.protocol();
+  const ex::SessionInfo& info = active.info;
+  const std::string& simulate = active.simulate;
   std::optional<ex::SimulatedParticipant> sim;
-  if (observer) sim.emplace(*observer, session);
+  if (!simulate.empty()) sim.emplace(ex::simulated_participant(active));
 
   ex::PresenterOptions po;
   po.backend = a.backend;
@@ -350,8 +303,8 @@ void run(const RunArgs& a) {
   ex::Presenter presenter(po);
 
   interrupted = false;
-  auto old_int = std::signal(SIGINT, on_signal);
-  auto old_term = std::signal(SIGTERM, on_signal);
+  auto old_int = std::signal(SIGINT, on_experiment_signal);
+  auto old_term = std::signal(SIGTERM, on_experiment_signal);
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   if (!a.quiet)
     std::cerr << (a.resume ? "resuming" : "starting") << " session " << info.id << ": " << protocol.name << " for "
@@ -385,14 +338,13 @@ void run(const RunArgs& a) {
     }
     ex::StoredTrial t;
     try {
-      t = session.answer(r);
+      t = ex::record(store, active, r);  // committed (fsync) before the next question appears
     } catch (const InvalidArgument& e) {
       if (sim) throw;
       std::cout << "  not a valid answer: " << e.what() << "\n";
       continue;
     }
     presenter.blank();
-    store.append_trial(lock, t);  // committed (fsync) before the next question appears
     if (tty && !a.quiet)
       std::fprintf(
           stderr, "\rtrial %d%s  block %s  %s   ", session.trials_done(),
@@ -404,7 +356,6 @@ void run(const RunArgs& a) {
   std::signal(SIGTERM, old_term);
   presenter.stop();
   const bool finished = session.finished();
-  if (finished) store.finish_session(lock);
 
   const BackendStats s = presenter.stats();
   ordered_json j;
@@ -487,6 +438,7 @@ void status(const std::string& db, bool as_json, const std::optional<std::string
     ordered_json blocks = ordered_json::object();
     for (const auto& row : store.rows(s.id)) {
       auto& b = blocks[row.block];
+      if (b.is_null()) b = ordered_json::object();
       b["trials"] = b.value("trials", 0) + 1;
       if (std::isfinite(row.next_intensity) && !row.variable.empty()) {
         b["variable"] = row.variable;
@@ -540,6 +492,38 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_flag("--json", a->json, "Print the run summary as JSON");
   run_cmd->add_flag("--quiet", a->quiet, "No progress or summary text");
   run_cmd->callback([a] { run(*a); });
+
+  struct CohortArgs {
+    std::vector<std::string> protocols;
+    std::string db;
+    int participants = 8;
+    std::string prefix = "P";
+    std::string simulate = "default";
+  };
+  auto co = std::make_shared<CohortArgs>();
+  auto* cohort_cmd = cmd->add_subcommand("cohort", "Run simulated participants through protocols (demos, planning sample sizes)");
+  cohort_cmd->add_option("protocols", co->protocols, "Protocol files")->required();
+  cohort_cmd->add_option("--db", co->db, "Session database (created if missing)")->required();
+  cohort_cmd->add_option("--participants", co->participants, "Number of simulated participants, 1 … 1000 [8]");
+  cohort_cmd->add_option("--prefix", co->prefix, "Participant codes PREFIX01, PREFIX02, … [P]");
+  cohort_cmd->add_option("--simulate", co->simulate, "Observer spec, as for run --simulate [default]");
+  cohort_cmd->callback([co] {
+    if (co->participants < 1 || co->participants > 1000)
+      throw InvalidArgument("--participants is " + std::to_string(co->participants) + "; allowed: 1 … 1000");
+    std::vector<ex::Protocol> protocols;
+    for (const auto& p : co->protocols) protocols.push_back(ex::load_protocol(p));  // all valid before anything is stored
+    std::vector<std::string> codes;
+    for (int i = 1; i <= co->participants; ++i) {
+      char code[48];
+      std::snprintf(code, sizeof code, "%s%02d", co->prefix.c_str(), i);
+      codes.emplace_back(code);
+    }
+    ex::Store store = ex::Store::open(co->db, ex::StoreMode::read_write);
+    for (const auto& p : protocols) {
+      const auto ids = ex::simulate_cohort(store, p, codes, co->simulate);
+      std::cerr << p.name << ": " << ids.size() << " simulated sessions in " << co->db << "\n";
+    }
+  });
 
   struct DbArgs {
     std::string db;

@@ -1,0 +1,280 @@
+// The acceptance checks of issue #8 on the built CLI: simulated runs,
+// export (one row per trial), analyze (convergent value + staircase figure),
+// a paced run SIGKILLed at random moments and resumed (nothing lost, nothing
+// duplicated, the same data as an uninterrupted run), a second writer, bad
+// input (exit 2, one line, nothing stored touched), and the audio backend
+// through a real PortAudio stream on an ALSA null PCM.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../support/temp_dir.hpp"
+#include "texel/experiment/records.hpp"
+#include "texel/io.hpp"
+
+namespace ex = texel::experiment;
+namespace fs = std::filesystem;
+using texel::test_support::TempDir;
+
+namespace {
+
+const std::string protocols = std::string(TEXEL_TEST_SOURCE_DIR) + "/examples/protocols/";
+
+struct CliRun {
+  int status;
+  std::string out;
+};
+
+CliRun run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + std::string(TEXEL_CLI) + " " + args + " 2>&1 </dev/null";
+  CliRun r{-1, {}};
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int s = ::pclose(p);
+  r.status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
+  return r;
+}
+
+// The export without its wall-clock columns: what must be equal between an
+// interrupted and an uninterrupted run.
+std::vector<std::string> stable_rows(const std::string& csv_path) {
+  auto rows = ex::parse_trials_csv(texel::read_file(csv_path), csv_path);
+  std::vector<std::string> out;
+  for (auto& r : rows) {
+    r.shown_at.clear();
+    r.answered_at.clear();
+    r.session_id = 0;
+    out.push_back(ex::csv_line(r));
+  }
+  return out;
+}
+
+std::size_t lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
+
+}  // namespace
+
+TEST(ExperimentCli, TexelLengthSimulatedExportAnalyze) {
+  TempDir d("texel-exp-cli");
+  const std::string db = d.at("s.db");
+  const CliRun r =
+      run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db + " --simulate threshold=6mm --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto summary = nlohmann::json::parse(r.out.substr(r.out.find('{')));
+  EXPECT_TRUE(summary["finished"].get<bool>());
+  const int trials = summary["trials"].get<int>();
+  EXPECT_GT(trials, 10);
+
+  const CliRun e = run("experiment export --db " + db + " -o " + d.at("results.csv"));
+  ASSERT_EQ(e.status, 0) << e.out;
+  const std::string csv = texel::read_file(d.at("results.csv"));
+  EXPECT_EQ(lines(csv), static_cast<std::size_t>(trials) + 1);  // header + one row per trial
+  EXPECT_EQ(csv.rfind("participant,session_id,protocol", 0), 0u);
+
+  const CliRun a = run("experiment analyze --db " + db + " --json -o " + d.at("fig"));
+  ASSERT_EQ(a.status, 0) << a.out;
+  EXPECT_NE(a.out.find("convergent"), std::string::npos) << a.out;
+  bool staircase_figure = false;
+  for (const auto& f : fs::directory_iterator(d.at("fig")))
+    staircase_figure |= f.path().filename().string().find("staircase") != std::string::npos;
+  EXPECT_TRUE(staircase_figure);
+
+  // The same analysis from the exported CSV.
+  EXPECT_EQ(run("experiment analyze --csv " + d.at("results.csv") + " --json").status, 0);
+  const CliRun l = run("experiment list --db " + db);
+  EXPECT_EQ(l.status, 0);
+  EXPECT_NE(l.out.find("finished"), std::string::npos);
+  EXPECT_EQ(run("experiment status --db " + db + " --json").status, 0);
+}
+
+TEST(ExperimentCli, GuidedExplorationStoresTwentyComparisonsPerReference) {
+  TempDir d("texel-exp-cli");
+  const std::string db = d.at("s.db");
+  const CliRun r = run("experiment run " + protocols + "guided-exploration.json --participant S02 --db " + db +
+                       " --simulate target=4sin --quiet");
+  ASSERT_EQ(r.status, 0) << r.out;
+  ASSERT_EQ(run("experiment export --db " + db + " -o " + d.at("g.csv")).status, 0);
+  const auto rows = ex::parse_trials_csv(texel::read_file(d.at("g.csv")), "g.csv");
+  std::map<std::string, int> per_ref;
+  int finished = 0;
+  for (const auto& row : rows) {
+    if (row.task != "guided") continue;
+    ++per_ref[row.reference];
+    if (row.procedure_finished) {
+      ++finished;
+      EXPECT_TRUE(std::isfinite(row.pitch_db));
+      EXPECT_TRUE(std::isfinite(row.irregularity_db));
+    }
+  }
+  ASSERT_EQ(per_ref.size(), 3u);
+  for (const auto& [ref, n] : per_ref) EXPECT_EQ(n, 20) << ref;
+  EXPECT_EQ(finished, 3);
+}
+
+TEST(ExperimentCli, KilledAtRandomMomentsAndResumedEqualsUninterrupted) {
+  TempDir d("texel-exp-kill");
+  const std::string proto = protocols + "texel-length.json";
+  // Reference: the uninterrupted run.
+  ASSERT_EQ(
+      run("experiment run " + proto + " --participant K1 --db " + d.at("ref.db") + " --simulate threshold=6mm --quiet").status,
+      0);
+  ASSERT_EQ(run("experiment export --db " + d.at("ref.db") + " -o " + d.at("ref.csv")).status, 0);
+  const auto expected = stable_rows(d.at("ref.csv"));
+
+  const std::string db = d.at("kill.db");
+  std::mt19937 rng(12345);
+  std::uniform_int_distribution<int> delay_ms(40, 400);
+  int kills = 0;
+  for (int attempt = 0; attempt < 60; ++attempt) {
+    const bool first = attempt == 0;
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const int devnull = ::open("/dev/null", O_RDWR);
+      ::dup2(devnull, 0);
+      ::dup2(devnull, 1);
+      ::dup2(devnull, 2);
+      std::vector<std::string> args = {TEXEL_CLI, "experiment", "run",           proto,    "--participant", "K1",     "--db",
+                                       db,        "--simulate", "threshold=6mm", "--pace", "0.01",          "--quiet"};
+      if (!first) args.push_back("--resume");
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      ::execv(TEXEL_CLI, argv.data());
+      ::_exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) {
+      ASSERT_TRUE(WIFEXITED(status));
+      ASSERT_EQ(WEXITSTATUS(status), 0) << "run finished with an error at attempt " << attempt;
+      break;  // it completed before the kill
+    }
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    ++kills;
+  }
+  EXPECT_GE(kills, 3);
+  // Finish whatever is left.
+  const auto status = run("experiment status --db " + db + " --json");
+  if (status.out.find("\"running\"") != std::string::npos)
+    ASSERT_EQ(
+        run("experiment run " + proto + " --participant K1 --db " + db + " --simulate threshold=6mm --resume --quiet").status, 0);
+  ASSERT_EQ(run("experiment export --db " + db + " -o " + d.at("kill.csv")).status, 0);
+  const auto got = stable_rows(d.at("kill.csv"));
+  ASSERT_EQ(got.size(), expected.size()) << "kills: " << kills;
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "trial " << i;
+}
+
+TEST(ExperimentCli, ResumeContinuesAtTheNextTrialAndSecondWriterIsRefused) {
+  TempDir d("texel-exp-writer");
+  const std::string proto = protocols + "working-memory.json";
+  const std::string db = d.at("w.db");
+  // A paced run in the background; while it runs, a second writer is refused.
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int devnull = ::open("/dev/null", O_RDWR);
+    ::dup2(devnull, 0);
+    ::dup2(devnull, 1);
+    ::dup2(devnull, 2);
+    ::execl(TEXEL_CLI, TEXEL_CLI, "experiment", "run", proto.c_str(), "--participant", "W1", "--db", db.c_str(), "--simulate",
+            "default", "--pace", "0.05", "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Wait for a few stored trials.
+  int done = 0;
+  for (int i = 0; i < 200 && done < 3; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto s = run("experiment status --db " + db + " --json");
+    if (s.status == 0) {
+      const auto j = nlohmann::json::parse(s.out.substr(s.out.find('{')));
+      if (!j["sessions"].empty()) done = j["sessions"][0]["trials_done"].get<int>();
+    }
+  }
+  ASSERT_GE(done, 3);
+  const CliRun second = run("experiment run " + proto + " --participant W1 --db " + db + " --simulate default --resume");
+  EXPECT_EQ(second.status, 2) << second.out;
+  EXPECT_NE(second.out.find("is being written by process"), std::string::npos) << second.out;
+  EXPECT_EQ(lines(second.out), 1u) << second.out;
+  ::kill(pid, SIGKILL);
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  const auto before = nlohmann::json::parse(run("experiment status --db " + db + " --json").out);
+  const int stored = before["sessions"][0]["trials_done"].get<int>();
+  const CliRun resumed = run("experiment run " + proto + " --participant W1 --db " + db + " --simulate default --resume --json");
+  ASSERT_EQ(resumed.status, 0) << resumed.out;
+  const auto after = nlohmann::json::parse(run("experiment status --db " + db + " --json").out);
+  EXPECT_EQ(after["sessions"][0]["trials_done"].get<int>(), 40);
+  EXPECT_EQ(after["sessions"][0]["status"], "finished");
+  EXPECT_GT(40, stored);
+  // Starting again without --resume: the finished session stays, a new one starts.
+  EXPECT_EQ(run("experiment list --db " + db + " --json").status, 0);
+}
+
+TEST(ExperimentCli, BadInputIsOneLineExitTwoAndTouchesNothing) {
+  TempDir d("texel-exp-bad");
+  const std::string db = d.at("s.db");
+  auto one_line_2 = [](const CliRun& r) {
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << r.out;
+  };
+  const std::string bad =
+      d.write("bad.json", R"({"format": "texel-protocol", "version": 1, "name": "x", "study": "nosuch", "blocks": []})");
+  one_line_2(run("experiment run " + bad + " --participant S01 --db " + db + " --simulate default"));
+  EXPECT_FALSE(fs::exists(db));
+  one_line_2(
+      run("experiment run " + protocols + "texel-length.json --participant 'John Smith' --db " + db + " --simulate default"));
+  one_line_2(run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db + " --simulate colour=red"));
+  one_line_2(
+      run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db + " --resume --simulate default"));
+  one_line_2(run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db +
+                 " --backend laser --simulate default"));
+  one_line_2(run("experiment export --db " + d.at("missing.db") + " -o " + d.at("x.csv")));
+  EXPECT_FALSE(fs::exists(d.at("x.csv")));
+  // A corrupt database is refused and left byte-identical.
+  const std::string corrupt = d.write("corrupt.db", std::string(4096, 'x'));
+  one_line_2(run("experiment run " + protocols + "texel-length.json --participant S01 --db " + corrupt + " --simulate default"));
+  one_line_2(run("experiment list --db " + corrupt));
+  EXPECT_EQ(texel::read_file(corrupt), std::string(4096, 'x'));
+  // An unfinished session is not silently restarted.
+  ASSERT_EQ(
+      run("experiment run " + protocols + "coarse-features.json --participant S01 --db " + db + " --simulate default --quiet")
+          .status,
+      0);
+  one_line_2(run("experiment analyze --db " + db + " --csv x.csv"));
+}
+
+TEST(ExperimentCli, AudioBackendThroughPortAudioOnAnAlsaNullPcm) {
+  // A real PortAudio stream with no sound card: ALSA's default device is a
+  // `null` PCM defined by this test's own configuration file.
+  TempDir d("texel-exp-audio");
+  const std::string conf = d.write("asound.conf", "pcm.!default { type null }\nctl.!default { type hw card 0 }\n");
+  const std::string env = "ALSA_CONFIG_PATH=" + conf;
+  const CliRun r = run("experiment run " + protocols + "coarse-features.json --participant A1 --db " + d.at("a.db") +
+                           " --simulate default --pace 0.01 --backend audio --json",
+                       env);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out.substr(r.out.find('{')));
+  EXPECT_TRUE(j["finished"].get<bool>());
+  EXPECT_GT(j["blocks_processed"].get<double>(), 10);
+  EXPECT_GT(j["stimuli_shown"].get<double>(), 10);
+  std::cout << "audio backend: " << j["backend"] << ", blocks " << j["blocks_processed"] << ", worst block "
+            << j["worst_block_ms"] << " ms (" << j["worst_block_fraction"] << " of the period), late blocks " << j["late_blocks"]
+            << "\n";
+}

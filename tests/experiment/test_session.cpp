@@ -1,0 +1,205 @@
+// The engine end to end in-process: every shipped protocol runs to its end
+// with a simulated participant; a session rebuilt by replaying any prefix of
+// its stored trials continues exactly as the uninterrupted one (resume is
+// replay); responses are validated; questions never reveal the answer.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "texel/error.hpp"
+#include "texel/experiment/protocol.hpp"
+#include "texel/experiment/session.hpp"
+#include "texel/experiment/simulate.hpp"
+
+namespace ex = texel::experiment;
+namespace fs = std::filesystem;
+
+namespace {
+const fs::path protocols = fs::path(TEXEL_TEST_SOURCE_DIR) / "examples" / "protocols";
+
+ex::Session make(const std::string& name, const std::string& participant = "S01") {
+  ex::Protocol p = ex::load_protocol((protocols / (name + ".json")).string());
+  ex::SessionContext c;
+  c.participant = participant;
+  c.session_id = 1;
+  c.seed = ex::session_seed(p.seed, participant);
+  return ex::Session(std::move(p), std::move(c));
+}
+
+std::vector<ex::StoredTrial> simulate(ex::Session& s, const std::string& spec, std::size_t limit = 100000) {
+  const ex::SimulatedParticipant sim(ex::simulation_observer(s.protocol().observer, spec), s);
+  std::vector<ex::StoredTrial> out;
+  while (!s.finished() && out.size() < limit) out.push_back(s.answer(sim.respond(s)));
+  return out;
+}
+
+void expect_same(const std::vector<ex::StoredTrial>& a, const std::vector<ex::StoredTrial>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].trial, b[i].trial);
+    EXPECT_EQ(a[i].question_json, b[i].question_json) << "trial " << i;
+    EXPECT_EQ(a[i].response_json, b[i].response_json) << "trial " << i;
+    EXPECT_EQ(a[i].state_json, b[i].state_json) << "trial " << i;
+  }
+}
+}  // namespace
+
+TEST(Session, TexelLengthStaircaseRunsToTenReversals) {
+  auto s = make("texel-length");
+  const auto trials = simulate(s, "threshold=6mm");
+  ASSERT_TRUE(s.finished());
+  int reversals = 0;
+  for (const auto& t : trials) {
+    reversals += t.row.reversal ? 1 : 0;
+    EXPECT_EQ(t.row.task, "oddity");
+    EXPECT_EQ(t.row.variable, "texel_length_mm");
+    EXPECT_TRUE(t.row.correct == 0.0 || t.row.correct == 1.0);
+    EXPECT_TRUE(std::isfinite(t.row.directional_proportion));
+  }
+  EXPECT_GE(reversals, 10);
+  EXPECT_TRUE(trials.back().row.procedure_finished);
+  EXPECT_EQ(trials[0].row.intensity, 26.0);
+  // The convergent value lands in the region of the simulated threshold.
+  EXPECT_GT(trials.back().row.next_intensity, 1.0);
+  EXPECT_LT(trials.back().row.next_intensity, 20.0);
+}
+
+TEST(Session, ResumeIsReplayAtEveryPrefix) {
+  for (const std::string name : {"texel-length", "working-memory", "coarse-features"}) {
+    auto full = make(name);
+    const auto all = simulate(full, "default");
+    for (std::size_t k : {std::size_t{0}, std::size_t{1}, all.size() / 3, all.size() - 1}) {
+      auto resumed = make(name);
+      for (std::size_t i = 0; i < k; ++i) resumed.replay(all[i]);
+      auto rest = simulate(resumed, "default");
+      std::vector<ex::StoredTrial> joined(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k));
+      joined.insert(joined.end(), rest.begin(), rest.end());
+      expect_same(all, joined);
+    }
+  }
+}
+
+TEST(Session, ReplayRefusesAnotherSessionsData) {
+  auto a = make("texel-length", "S01");
+  const auto trials = simulate(a, "default", 3);
+  auto b = make("texel-length", "S02");  // another participant: other seeds
+  EXPECT_THROW(b.replay(trials[0]), texel::FormatError);
+}
+
+TEST(Session, QuestionsNeverRevealTheAnswer) {
+  auto s = make("texel-length");
+  const ex::Question& q = s.question();
+  const std::string j = q.to_json().dump();
+  EXPECT_EQ(j.find("correct"), std::string::npos);
+  EXPECT_EQ(q.stimuli.size(), 3u);
+  // Two stimuli are identical documents, one differs (the odd one).
+  const bool ab = q.stimuli[0].document_json == q.stimuli[1].document_json;
+  const bool ac = q.stimuli[0].document_json == q.stimuli[2].document_json;
+  const bool bc = q.stimuli[1].document_json == q.stimuli[2].document_json;
+  EXPECT_EQ(int(ab) + int(ac) + int(bc), 1);
+  const std::string odd = ab ? "3" : ac ? "2" : "1";
+  EXPECT_EQ(s.truth().correct_answer, odd);
+}
+
+TEST(Session, ResponsesAreValidated) {
+  auto s = make("texel-length");
+  ex::Response r;
+  r.choice = "4";
+  EXPECT_THROW((void)s.answer(r), texel::InvalidArgument);
+  EXPECT_EQ(s.trials_done(), 0);
+  r.choice = "2";
+  r.rt_ms = -5;
+  EXPECT_THROW((void)s.answer(r), texel::InvalidArgument);
+  r.rt_ms = 1200;
+  EXPECT_NO_THROW((void)s.answer(r));
+  EXPECT_EQ(s.trials_done(), 1);
+}
+
+TEST(Session, WorkingMemoryTrialsAreBalancedWithTheSpecMatrix) {
+  auto s = make("working-memory");
+  std::map<std::string, int> same, total;
+  int practice = 0;
+  const ex::SimulatedParticipant sim(ex::simulation_observer(s.protocol().observer, "default"), s);
+  while (!s.finished()) {
+    const ex::Question& q = s.question();
+    ASSERT_TRUE(q.matrix);
+    int filled = 0, ones = 0;
+    for (int d : *q.matrix) {
+      filled += d != 0;
+      ones += d == 1;
+    }
+    const std::string cond = s.truth().condition;
+    if (cond.find("control") != std::string::npos) {
+      EXPECT_EQ(ones, 16);
+      EXPECT_EQ(q.recall_cell, -1);
+    } else {
+      EXPECT_EQ(filled, 5);
+      EXPECT_GE(q.recall_cell, 0);
+      EXPECT_NE((*q.matrix)[static_cast<std::size_t>(q.recall_cell)], 0);
+    }
+    ASSERT_EQ(q.phases.size(), 3u);
+    EXPECT_EQ(q.phases[1].kind, "matrix");
+    EXPECT_EQ(q.phases[1].duration_s, 10);
+    practice += q.practice;
+    if (!q.practice) {
+      ++total[cond];
+      same[cond] += s.truth().correct_answer == "same";
+    }
+    (void)s.answer(sim.respond(s));
+  }
+  EXPECT_EQ(practice, 8);
+  ASSERT_EQ(total.size(), 4u);
+  for (const auto& [cond, n] : total) {
+    EXPECT_EQ(n, 8) << cond;
+    EXPECT_EQ(same[cond], 4) << cond;
+  }
+}
+
+TEST(Session, GuidedExplorationAsksTwentyComparisonsPerReferenceThenRates) {
+  auto s = make("guided-exploration");
+  const auto trials = simulate(s, "target=4sin");
+  ASSERT_TRUE(s.finished());
+  std::map<std::string, int> comparisons;
+  int ratings = 0;
+  for (const auto& t : trials) {
+    if (t.row.task == "guided") ++comparisons[t.row.reference];
+    if (t.row.task == "rating") ++ratings;
+  }
+  ASSERT_EQ(comparisons.size(), 3u);
+  for (const auto& [ref, n] : comparisons) EXPECT_EQ(n, 20) << ref;
+  EXPECT_EQ(ratings, 9);
+  const auto matches = s.matches("guided");
+  EXPECT_EQ(matches.size(), 3u);
+  // Every reference was matched against the same hidden target (4sin).
+  const auto target = s.reference_position("4sin");
+  for (const auto& [ref, m] : matches)
+    EXPECT_LT(std::hypot(m.pitch_db - target.pitch_db, m.irregularity_db - target.irregularity_db), 8.0) << ref;
+}
+
+TEST(Session, MatchingStudiesRunAndMapSliders) {
+  // Study 2's mapping: P = 0 → m = 0.75 cpm; I = 10 → s = 3 cpm.
+  const auto m = ex::slider_to_parameters(ex::SliderMapping::lognormal, 0, 10);
+  EXPECT_NEAR(m.pitch_db, 10 * std::log10(0.75), 1e-12);
+  EXPECT_NEAR(m.irregularity_db, 10 * std::log10(3.0), 1e-12);
+  auto s = make("parameter-mapping");
+  const auto trials = simulate(s, "default");
+  int matches = 0, ratings = 0;
+  for (const auto& t : trials) {
+    matches += t.row.task == "match";
+    ratings += t.row.task == "rating";
+    if (t.row.task == "match") {
+      EXPECT_GE(t.row.slider_p, 0);
+      EXPECT_LE(t.row.slider_p, 100);
+      EXPECT_TRUE(std::isfinite(t.row.reference_pitch_db));
+    }
+    if (t.row.task == "rating") {
+      EXPECT_GE(t.row.rating, 0);
+      EXPECT_LE(t.row.rating, 10);
+    }
+  }
+  EXPECT_EQ(matches, 9);
+  EXPECT_EQ(ratings, 9);
+}
