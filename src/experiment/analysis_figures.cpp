@@ -61,6 +61,31 @@ double mean_of(const std::vector<double>& v) {
   return n ? s / static_cast<double>(n) : missing;
 }
 
+std::string p_text(const json& t) {
+  if (!t.contains("p") || t["p"].is_null()) return "n/a";
+  const double p = d(t["p"]);
+  return p < 0.001 ? "p < 0.001" : "p = " + texel::detail::fixed(p, 3);
+}
+
+/// "spacing 0.012, distractor < 0.001, interaction 0.2": the p value of
+/// each effect of an ANOVA summary (short enough for a panel title); empty
+/// if the ANOVA was skipped.
+std::string anova_text(const json& a) {
+  if (!a.contains("effects")) return {};
+  std::string out;
+  for (const auto& e : a["effects"]) {
+    if (!out.empty()) out += ", ";
+    std::string name = e["effect"].get<std::string>();
+    if (name.find(':') != std::string::npos) name = "interaction";
+    const double p = d(e["p"]);
+    out += name + " " +
+           (!std::isfinite(p) ? std::string("n/a")
+            : p < 0.001       ? std::string("< 0.001")
+                              : texel::detail::fixed(p, 3));
+  }
+  return out;
+}
+
 std::string percent(double v) { return texel::detail::fixed(v * 100, 0) + " %"; }
 
 // --------------------------------------------------------------- staircases
@@ -154,6 +179,10 @@ Figure convergent_boxes(const std::string& study, const json& s) {
   Figure f =
       figure(coarse ? "Convergent coarse strength per fine strength" : "Convergent texel length per distribution", 640, 480);
   Panel p;
+  // The group test beside the boxes it is about.
+  if (s.contains("paired_t_test") && s["paired_t_test"].contains("p"))
+    p.title = "paired t-test " + s["paired_t_test"]["comparison"].get<std::string>() + ": " + p_text(s["paired_t_test"]);
+  if (s.contains("rm_anova") && s["rm_anova"].contains("effects")) p.title = "RM-ANOVA p: " + anova_text(s["rm_anova"]);
   p.x = Axis{coarse ? "fine-texture strength" : "frequency distribution (Irregularity)",
              AxisScale::linear,
              std::nullopt,
@@ -377,12 +406,6 @@ Figure rating_boxes(const std::string& title, const Rows& rows, const std::strin
 
 // ------------------------------------------------------------ quantization
 
-std::string p_text(const json& t) {
-  if (!t.contains("p") || t["p"].is_null()) return "n/a";
-  const double p = d(t["p"]);
-  return p < 0.001 ? "p < 0.001" : "p = " + texel::detail::fixed(p, 3);
-}
-
 Figure quantization_figure(const json& s, const Rows& rows) {
   std::vector<std::string> cats;
   ErrorBarSeries eb;
@@ -512,11 +535,12 @@ Figure memory_figure(const json& s) {
   }
   Figure f = figure("Working memory: same/different accuracy (" + std::to_string(s["included"].get<std::size_t>()) +
                         " participants after exclusions)",
-                    1100, 480, 2);
+                    1280, 480, 2);
   Panel a;
-  a.title = "Mean ± SEM per condition";
+  const std::string anova = anova_text(s["rm_anova"]);
+  a.title = anova.empty() ? "Mean ± SEM per condition" : "RM-ANOVA p: " + anova;
   a.x = Axis{"texel spacing", AxisScale::linear, std::nullopt, std::nullopt, false, spacings};
-  a.y = Axis{"proportion correct", AxisScale::linear, 0.0, 1.05, false};
+  a.y = Axis{"proportion correct (mean ± SEM)", AxisScale::linear, 0.0, 1.05, false};
   for (std::size_t k = 0; k < kinds.size(); ++k) {
     ErrorBarSeries e;
     e.connect = true;
