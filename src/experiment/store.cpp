@@ -378,7 +378,7 @@ Store Store::open(const std::string& path, StoreMode mode) {
 
   // An existing file is never created anew (no SQLITE_OPEN_CREATE), so a
   // path that vanishes between the check and the open is not recreated.
-  int flags = SQLITE_OPEN_FULLMUTEX | SQLITE_OPEN_NOFOLLOW;
+  int flags = SQLITE_OPEN_FULLMUTEX;
   if (mode == StoreMode::read_only)
     flags |= SQLITE_OPEN_READONLY;
   else

@@ -2,6 +2,7 @@
 // trials_csv / parse_trials_csv, RFC 4180 quoting, missing = empty cell,
 // columns in any order, and bad cells name their record and column.
 #include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
 
 #include <cmath>
 #include <limits>
@@ -141,4 +142,42 @@ TEST(TrialCsv, BadInputNamesRecordAndColumn) {
   EXPECT_EQ(msg("participant\n\"S1\n"), "r.csv: line 2: unterminated quoted field");
   EXPECT_EQ(msg(""), "r.csv is empty; expected a header row (participant, …)");
   EXPECT_EQ(msg("a,b\n1,2\n"), "r.csv: the header names none of the trial columns (participant, trial, …)");
+}
+
+// Property: any strings (commas, quotes, CR, LF, NUL, UTF-8) and any doubles
+// (NaN = missing, ±0, ±Inf, subnormals) survive trials_csv → parse_trials_csv.
+RC_GTEST_PROP(TrialCsvProperty, AnyRowRoundTrips,
+              (const std::string& text, const std::string& other, double x, double y, int i, bool b)) {
+  ex::TrialRow r;
+  r.participant = text;
+  r.block = other;
+  r.response = text + "," + other;
+  r.shown_at = "\"" + other + "\r\n";
+  r.session_id = static_cast<std::int64_t>(i) * 3000000000LL;
+  r.trial = i;
+  r.iteration = i < 0 ? -1 : i;
+  r.practice = b;
+  r.intensity = x;
+  r.rt_ms = y;
+  r.rating = std::nextafter(x, y);
+  const auto back = ex::parse_trials_csv(ex::trials_csv({r, ex::TrialRow{}, r}), "prop.csv");
+  RC_ASSERT(back.size() == 3u);
+  const auto same = [](double a, double c) {
+    return (std::isnan(a) && std::isnan(c)) || (a == c && std::signbit(a) == std::signbit(c));
+  };
+  for (std::size_t k : {std::size_t{0}, std::size_t{2}}) {
+    RC_ASSERT(back[k].participant == r.participant);
+    RC_ASSERT(back[k].block == r.block);
+    RC_ASSERT(back[k].response == r.response);
+    RC_ASSERT(back[k].shown_at == r.shown_at);
+    RC_ASSERT(back[k].session_id == r.session_id);
+    RC_ASSERT(back[k].trial == r.trial);
+    RC_ASSERT(back[k].iteration == r.iteration);
+    RC_ASSERT(back[k].practice == r.practice);
+    RC_ASSERT(same(back[k].intensity, r.intensity));
+    RC_ASSERT(same(back[k].rt_ms, r.rt_ms));
+    RC_ASSERT(same(back[k].rating, r.rating));
+  }
+  RC_ASSERT(back[1].participant.empty());
+  RC_ASSERT(std::isnan(back[1].rt_ms));
 }
