@@ -2,6 +2,7 @@
 // values: SciPy/NumPy through tests/stats/oracle.py (within 1e-6), and
 // published textbook examples (at the precision they were published).
 #include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
 
 #include <cmath>
 #include <limits>
@@ -411,4 +412,76 @@ TEST(Table, SizeBounds) {
   for (std::size_t i = 0; i < texel::experiment::max_csv_cells; ++i) big += "1\n";
   const std::string m = message_of([&] { parse_csv_table(big, "big.csv"); });
   EXPECT_NE(m.find("more than 10000000 cells"), std::string::npos) << m;
+}
+
+// ---------------------------------------------------------------- properties
+
+namespace {
+
+std::string csv_field(const std::string& v, bool force_quotes) {
+  // Quote when RFC 4180 requires it, when forced, and always for an empty
+  // field (a line of one empty unquoted field is a blank line, which is skipped).
+  if (!force_quotes && !v.empty() && v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string q = "\"";
+  for (char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+// Any table written by an RFC 4180 writer (quotes, commas, CR/LF inside fields,
+// LF or CRLF line ends, with or without a final line end) reads back cell for cell.
+RC_GTEST_PROP(TableProperty, WrittenTablesReadBack, ()) {
+  const int ncol = *rc::gen::inRange(1, 6);
+  const int nrow = *rc::gen::inRange(0, 12);
+  const auto cell = rc::gen::container<std::string>(rc::gen::element('a', 'Z', '7', ' ', ',', '"', '\n', '\r', '.'));
+  std::vector<std::string> cols;
+  for (int c = 0; c < ncol; ++c) cols.push_back("c" + std::to_string(c) + *cell);
+  std::vector<std::vector<std::string>> rows;
+  for (int r = 0; r < nrow; ++r) {
+    std::vector<std::string> row;
+    for (int c = 0; c < ncol; ++c) row.push_back(*cell);
+    rows.push_back(row);
+  }
+  const std::string eol = *rc::gen::element(std::string("\n"), std::string("\r\n"));
+  const bool final_eol = *rc::gen::arbitrary<bool>();
+  const bool force = *rc::gen::arbitrary<bool>();
+  std::string text;
+  const auto write_row = [&](const std::vector<std::string>& row, bool last) {
+    for (std::size_t i = 0; i < row.size(); ++i) text += (i ? "," : "") + csv_field(row[i], force);
+    if (!last || final_eol) text += eol;
+  };
+  write_row(cols, rows.empty());
+  for (std::size_t r = 0; r < rows.size(); ++r) write_row(rows[r], r + 1 == rows.size());
+  const auto t = parse_csv_table(text, "prop.csv");
+  RC_ASSERT(t.columns == cols);
+  RC_ASSERT(t.cells == rows);
+}
+
+// Arbitrary bytes either parse into a rectangular table or fail with a texel::Error.
+RC_GTEST_PROP(TableProperty, ArbitraryTextNeverCrashes, ()) {
+  const auto text =
+      *rc::gen::container<std::string>(rc::gen::element('a', '1', ',', '"', '\n', '\r', ' ', '\xEF', '\xBB', '\xBF'));
+  try {
+    const auto t = parse_csv_table(text, "fuzz.csv");
+    for (const auto& row : t.cells) RC_ASSERT(row.size() == t.columns.size());
+    RC_ASSERT(t.lines.size() == t.rows());
+  } catch (const texel::Error&) {
+  }
+}
+
+// Within-subject effects ignore each subject's overall level: adding a
+// per-subject constant changes no effect's SS, error SS, F or ε.
+RC_GTEST_PROP(AnovaProperty, SubjectOffsetsDoNotChangeWithinEffects, ()) {
+  const unsigned seed = *rc::gen::inRange(1u, 100000u);
+  const LongData d = make_rm_data({"a", "b"}, {{"x", "y", "z"}, {"p", "q"}}, 5, 1, seed);
+  std::vector<st::Observation> obs = observations(d), shifted = obs;
+  for (auto& o : shifted) o.value += 100.0 * static_cast<double>(o.subject.back() - '0');
+  const auto t1 = st::rm_anova(obs, {"a", "b"});
+  const auto t2 = st::rm_anova(shifted, {"a", "b"});
+  for (std::size_t i = 0; i < t1.effects.size(); ++i) {
+    RC_ASSERT(std::abs(t1.effects[i].ss - t2.effects[i].ss) <= 1e-7 * (1 + t1.effects[i].ss));
+    RC_ASSERT(std::abs(t1.effects[i].ss_error - t2.effects[i].ss_error) <= 1e-7 * (1 + t1.effects[i].ss_error));
+    RC_ASSERT(std::abs(t1.effects[i].gg_epsilon - t2.effects[i].gg_epsilon) <= 1e-9);
+  }
 }
