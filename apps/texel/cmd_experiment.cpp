@@ -369,6 +369,7 @@ void run(const RunArgs& a) {
   j["blocks_processed"] = s.blocks;
   j["worst_block_ms"] = s.worst_block_s * 1e3;
   j["worst_block_fraction"] = presenter.block_period_s() > 0 ? s.worst_block_s / presenter.block_period_s() : 0.0;
+  j["mean_block_ms"] = s.blocks ? s.total_block_s / static_cast<double>(s.blocks) * 1e3 : 0.0;
   j["late_blocks"] = s.underruns;
   j["stimuli_shown"] = presenter.shown();
   if (a.json) {

@@ -1,6 +1,7 @@
 // Stimulus presentation through the player backends (presenter.hpp).
 #include "texel/experiment/presenter.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "texel/document.hpp"
@@ -74,8 +75,21 @@ void Presenter::stop() {
 }
 
 void Presenter::show(const std::string& document_json) {
-  const Surface surface = prepare_surface(parse_document(document_json, "stimulus"));
-  player_->set_map(PlayerMap::from_surface(surface));
+  // Participants switch back and forth among a trial's few stimuli, and a
+  // reference recurs over many trials: keep the last few rendered maps (a
+  // noise reference takes ~0.1 s to synthesise; copying its map, 0.1 ms).
+  auto it = std::find_if(cache_.begin(), cache_.end(), [&](const auto& e) { return e.first == document_json; });
+  if (it == cache_.end()) {
+    const Surface surface = prepare_surface(parse_document(document_json, "stimulus"));
+    cache_.emplace_front(document_json, PlayerMap::from_surface(surface));
+    if (cache_.size() > cache_size) cache_.pop_back();
+    it = cache_.begin();
+  } else {
+    cache_.splice(cache_.begin(), cache_, it);
+    it = cache_.begin();
+  }
+  const PlayerMap& m = *it->second;
+  player_->set_map(std::make_unique<const PlayerMap>(m.grid(), std::vector<float>(m.values().begin(), m.values().end())));
   ++shown_;
 }
 

@@ -17,8 +17,10 @@
 #pragma once
 
 #include <cstddef>
+#include <list>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "texel/sinks.hpp"
 
@@ -59,6 +61,8 @@ class Presenter {
   [[nodiscard]] std::string error() const;
 
  private:
+  static constexpr std::size_t cache_size = 8;
+  std::list<std::pair<std::string, std::unique_ptr<const PlayerMap>>> cache_;  // most recent first
   PresenterOptions options_;
   std::unique_ptr<Player> player_;
   std::unique_ptr<Backend> backend_;
