@@ -59,15 +59,28 @@ void check_level(double level) {
   if (!(level > 0.0 && level < 1.0)) throw InvalidArgument("--level " + fmt(level) + " is outside the allowed range (0, 1)");
 }
 
-// Library messages name library parameters; say which flag and column they came from.
+// Library messages start "function: field ..." with the library's parameter
+// names; the user typed flags and column names. Strip the function name,
+// rename the leading field (e.g. "x" -> "column 'rt' (--column)") and keep the
+// rest, which already carries the value and what is allowed.
 template <class F>
-auto with_context(const std::string& context, F&& f) {
+auto translated(const std::string& function, const std::vector<std::pair<std::string, std::string>>& fields,
+                const std::string& suffix, F&& f) {
   try {
     return f();
   } catch (const InvalidArgument& e) {
-    throw InvalidArgument(context + ": " + e.what());
+    std::string m = e.what();
+    if (m.rfind(function + ": ", 0) == 0) m.erase(0, function.size() + 2);
+    for (const auto& [from, to] : fields)
+      if (m.rfind(from + " ", 0) == 0) {
+        m = to + m.substr(from.size());
+        break;
+      }
+    throw InvalidArgument(m + suffix);
   }
 }
+
+std::string col(const std::string& name, const std::string& flag) { return "column '" + name + "' (" + flag + ")"; }
 
 std::vector<std::string> split_commas(const std::string& s) {
   std::vector<std::string> r;
@@ -111,7 +124,8 @@ void register_anova(CLI::App& stats) {
       o.value = dv[r];
       obs.push_back(std::move(o));
     }
-    const st::AnovaTable res = with_context("--dv " + a->dv, [&] { return st::rm_anova(obs, factors); });
+    const st::AnovaTable res = translated("rm_anova", {{"subject", col(a->subject, "--subject")}}, " [--dv " + a->dv + "]",
+                                          [&] { return st::rm_anova(obs, factors); });
     if (a->json) {
       nlohmann::ordered_json j;
       j["test"] = "rm_anova";
@@ -179,10 +193,12 @@ void register_ttest(CLI::App& stats) {
     if (a->paired) {
       const std::vector<double> y = t.numbers(*a->paired);
       label = a->column + " - " + *a->paired;
-      r = with_context("--column " + a->column + " --paired " + *a->paired, [&] { return st::t_test_paired(x, y, a->level); });
+      r = translated("t_test_paired", {{"a - b", col(a->column, "--column") + " - " + col(*a->paired, "--paired")}}, "",
+                     [&] { return st::t_test_paired(x, y, a->level); });
     } else {
       label = a->column;
-      r = with_context("--column " + a->column, [&] { return st::t_test_one_sample(x, a->mu, a->level); });
+      r = translated("t_test_one_sample", {{"x", col(a->column, "--column")}}, "",
+                     [&] { return st::t_test_one_sample(x, a->mu, a->level); });
     }
     if (a->json) {
       nlohmann::ordered_json j;
@@ -246,8 +262,9 @@ void register_ellipse(CLI::App& stats) {
     if (groups.empty()) throw InvalidArgument("'" + a->csv + "' has no data rows; an ellipse needs at least 3");
     std::vector<st::Ellipse> res;
     for (const auto& g : groups) {
-      const std::string ctx = "--x " + a->x + " --y " + a->y + (a->by ? " (--by " + *a->by + " = '" + g + "')" : "");
-      res.push_back(with_context(ctx, [&] { return st::mean_confidence_ellipse(data[g].first, data[g].second, a->level); }));
+      const std::string where = a->by ? " [group " + *a->by + " = '" + g + "']" : "";
+      res.push_back(translated("mean_confidence_ellipse", {{"x, y", col(a->x, "--x") + ", " + col(a->y, "--y")}}, where,
+                               [&] { return st::mean_confidence_ellipse(data[g].first, data[g].second, a->level); }));
     }
     if (a->json) {
       nlohmann::ordered_json j;

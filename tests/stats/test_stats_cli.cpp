@@ -164,10 +164,10 @@ TEST_F(StatsCli, BadInputExitsTwoWithOneLine) {
       {"anova " + path("ok.csv") + " --subject participant --within width --dv q", "column 'q' has 'q1'"},
       {"ttest " + path("ragged.csv") + " --column a", "ragged.csv':3: row has 1 field(s)"},
       {"ttest " + path("words.csv") + " --column b", "column 'b' has 'x'"},
-      {"ttest " + path("const.csv") + " --column a", "--column a"},
+      {"ttest " + path("const.csv") + " --column a", "column 'a' (--column) is constant"},
       {"ttest " + path("words.csv") + " --column a --level 2", "--level 2"},
       {"ttest " + path("missing.csv") + " --column a", "missing.csv"},
-      {"ellipse " + path("two.csv") + " --x a --y b", "at least 3"},
+      {"ellipse " + path("two.csv") + " --x a --y b", "column 'a' (--x), column 'b' (--y) have 2 complete pair(s)"},
       {"ellipse " + path("ok.csv") + " --x rt_ms --y rt_ms --by nope", "column 'nope'"},
       {"ttest " + path("ok.csv"), "--column"},
   };
