@@ -83,7 +83,8 @@ struct AnovaTable {
 };
 /// Repeated-measures ANOVA with one or two within-subject factors (type III
 /// sums of squares on the balanced cell means). Several rows for one
-/// subject × cell are averaged; NaN values are skipped; every subject must
+/// subject × cell are averaged; NaN values are skipped (a subject or level
+/// with no finite value at all is left out entirely); every subject must
 /// have every cell (the error names the first missing subject × cell).
 /// Levels are ordered by first appearance. Needs ≥ 2 subjects and ≥ 2 levels
 /// per factor.
