@@ -129,10 +129,7 @@ void register_staircase(CLI::App& app) {
     const std::vector<bool> answers = parse_responses(a->responses);
     std::optional<experiment::Staircase> s;
     try {
-      // vector<bool> has no contiguous storage: copy to a span-able array.
-      const std::unique_ptr<bool[]> buf(new bool[answers.size() + 1]);
-      for (std::size_t i = 0; i < answers.size(); ++i) buf[i] = answers[i];
-      s.emplace(experiment::Staircase::replay(c, std::span<const bool>(buf.get(), answers.size())));
+      s.emplace(experiment::Staircase::replay(c, answers));
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(flag_message(e.what()));
     }

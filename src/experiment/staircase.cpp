@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <sstream>
 
@@ -163,6 +164,12 @@ std::string Staircase::state_json() const {
   j["last_was_reversal"] = last_was_reversal_;
   j["finished"] = finished();
   return j.dump();
+}
+
+Staircase Staircase::replay(const StaircaseConfig& config, const std::vector<bool>& answers) {
+  const std::unique_ptr<bool[]> copy(new bool[answers.size() + 1]);
+  for (std::size_t i = 0; i < answers.size(); ++i) copy[i] = answers[i];
+  return replay(config, std::span<const bool>(copy.get(), answers.size()));
 }
 
 Staircase Staircase::replay(const StaircaseConfig& config, std::span<const bool> answers) {

@@ -226,10 +226,7 @@ TEST(Staircase, ReplayRebuildsTheSameState) {
     const bool a = (t * 7 + 3) % 5 != 0;
     answers.push_back(a);
     live.answer(a);
-    const auto prefix = to_bools(answers);
-    std::unique_ptr<bool[]> buf(new bool[prefix.size()]);
-    for (std::size_t i = 0; i < prefix.size(); ++i) buf[i] = prefix[i];
-    const Staircase again = Staircase::replay(c, std::span<const bool>(buf.get(), prefix.size()));
+    const Staircase again = Staircase::replay(c, to_bools(answers));  // the std::vector<bool> overload
     EXPECT_EQ(again.state_json(), live.state_json());
   }
   // One answer more than it took: alternating answers reverse every trial.

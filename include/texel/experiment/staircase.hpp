@@ -87,6 +87,8 @@ class Staircase {
   /// Rebuilds a staircase from its answers. Throws InvalidArgument
   /// ("answers") if an answer comes after the staircase finished.
   static Staircase replay(const StaircaseConfig& config, std::span<const bool> answers);
+  /// The same for a std::vector<bool> (which has no contiguous storage), e.g. responses().
+  static Staircase replay(const StaircaseConfig& config, const std::vector<bool>& answers);
 
   [[nodiscard]] const StaircaseConfig& config() const { return config_; }
 
