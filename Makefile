@@ -17,9 +17,20 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# The studies (issue #8): a simulated cohort of 8 participants through every
+# shipped protocol (free exploration before the quantization test that uses
+# its matches), then each study's summaries and figures.
+PROTOCOLS := $(addprefix examples/protocols/,free-exploration.json quantization.json parameter-mapping.json \
+  guided-exploration.json coarse-features.json texel-length.json texel-length-wide.json working-memory.json)
+
 demo: build
 	$(BUILD)/bin/texel demo --out out/demo
 	$(BUILD)/bin/texel atlas --out out/demo/references
+	rm -rf out/demo/experiments && mkdir -p out/demo/experiments
+	$(BUILD)/bin/texel experiment cohort $(PROTOCOLS) --participants 8 --db out/demo/experiments/cohort.db
+	$(BUILD)/bin/texel experiment export --db out/demo/experiments/cohort.db -o out/demo/experiments/trials.csv
+	$(BUILD)/bin/texel experiment analyze --db out/demo/experiments/cohort.db -o out/demo/experiments > out/demo/experiments/summary.txt
+	@cat out/demo/experiments/summary.txt
 
 # Every test: unit and CLI tests (release build), the same under
 # AddressSanitizer + UndefinedBehaviorSanitizer, and byte-identity of the demo

@@ -103,6 +103,8 @@ json simulation_observer(const json& protocol_observer, const std::string& spec)
       o["rater"]["noise"] = number_with_unit(key, value, {});
     } else if (key == "speed") {
       o["explorer"]["speed_mm_s"] = number_with_unit(key, value, {"mm/s"});
+    } else if (key == "spread") {
+      o["participant_sd"] = number_with_unit(key, value, {});
     } else if (key == "seed") {
       const double s = number_with_unit(key, value, {});
       if (s < 0 || s != std::floor(s) || s > 9007199254740992.0)
@@ -111,7 +113,7 @@ json simulation_observer(const json& protocol_observer, const std::string& spec)
     } else {
       throw InvalidArgument("--simulate: unknown key '" + key +
                             "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, rating-noise, "
-                            "speed, seed, default");
+                            "speed, spread, seed, default");
     }
   }
   return o;
@@ -128,6 +130,17 @@ SimulatedParticipant::SimulatedParticipant(json observer, const Session& session
     throw InvalidArgument("observer lapse is " + texel::detail::num(lapse) + "; allowed: 0 … 0.5");
   if (!(guess >= 0 && guess < 1)) throw InvalidArgument("observer guess is " + texel::detail::num(guess) + "; allowed: 0 … 1");
   if (p.contains("threshold") && !(get(p, "threshold", 1) > 0)) throw InvalidArgument("observer threshold must be > 0");
+  // Between-participant variability (participant_sd, 0 = identical
+  // observers): this participant's threshold is scaled by exp(sd·n₀), the
+  // matcher's target shifted by 3·sd·(n₁, n₂) dB, and memory accuracy
+  // shifted by 0.3·sd·n₃, with n drawn once from the observer seed.
+  const double sd = get(observer_, "participant_sd", 0.0);
+  if (!(sd >= 0 && sd <= 3)) throw InvalidArgument("observer participant_sd is " + texel::detail::num(sd) + "; allowed: 0 … 3");
+  const CounterRng person(seed_, stream_behaviour + 1);
+  threshold_scale_ = std::exp(sd * person.normal(0));
+  bias_pitch_db_ = 3.0 * sd * person.normal(1);
+  bias_irregularity_db_ = 3.0 * sd * person.normal(2);
+  memory_shift_ = 0.3 * sd * person.normal(3);
   const json& m = observer_["memory"];
   if (m.contains("p_correct") && m["p_correct"].is_number()) {
     const double pc = m["p_correct"].get<double>();
@@ -161,7 +174,7 @@ Response SimulatedParticipant::respond(const Session& session) const {
     } else if (mj.contains("target") && mj["target"].is_string() && mj["target"].get<std::string>() != "reference") {
       target = session.reference_position(mj["target"].get<std::string>());
     }
-    mc.target = MatchPoint{target.pitch_db, target.irregularity_db};
+    mc.target = MatchPoint{target.pitch_db + bias_pitch_db_, target.irregularity_db + bias_irregularity_db_};
     return Matcher(mc);
   };
 
@@ -171,7 +184,7 @@ Response SimulatedParticipant::respond(const Session& session) const {
       const json& pj = observer_["psychometric"];
       PsychometricConfig pc;
       pc.shape = parse_psychometric_shape(pj.value("shape", std::string("weibull")), "observer shape");
-      pc.threshold = get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
+      pc.threshold = threshold_scale_ * get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
       pc.slope = get(pj, "slope", 3.5);
       pc.guess = get(pj, "guess", q.task == TaskKind::oddity ? guess_oddity3 : guess_2afc);
       pc.lapse = get(pj, "lapse", 0.02);
@@ -224,7 +237,7 @@ Response SimulatedParticipant::respond(const Session& session) const {
       double p = 0.85;
       if (mj.contains("p_correct") && mj["p_correct"].is_number()) p = mj["p_correct"].get<double>();
       if (mj.contains("p_correct") && mj["p_correct"].is_object()) p = get(mj["p_correct"], t.condition.c_str(), p);
-      const bool ok = rng.uniform(trial * 8 + 2) < p;
+      const bool ok = rng.uniform(trial * 8 + 2) < std::clamp(p + memory_shift_, 0.0, 1.0);
       r.choice = ok ? t.correct_answer : wrong_choice(t.correct_answer);
       if (q.recall_cell != -2) {
         const int expected = q.recall_cell >= 0 ? (*q.matrix)[static_cast<std::size_t>(q.recall_cell)] : 1;

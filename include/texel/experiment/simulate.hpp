@@ -16,6 +16,9 @@
 //   noise=1.5dB     matcher noise; unsure=0.5dB (unsure band)
 //   p=0.85          working memory: P(correct) for every condition; digit=0.8
 //   rating-noise=0.5, speed=100 (mm/s swipe speed), seed=7
+//   spread=0.25     between-participant variability (participant_sd): each
+//                   participant's threshold, matcher target and memory
+//                   accuracy deviate from the group by a draw from the seed
 //
 // Trade-off: the observers are stand-ins with textbook shapes (observer.hpp),
 // good for testing procedures and planning sample sizes, not a model of a
@@ -47,6 +50,9 @@ class SimulatedParticipant {
  private:
   nlohmann::json observer_;
   std::uint64_t seed_ = 1;
+  double threshold_scale_ = 1.0;  // this participant's deviations from the group
+  double bias_pitch_db_ = 0.0, bias_irregularity_db_ = 0.0;
+  double memory_shift_ = 0.0;
 };
 
 }  // namespace texel::experiment
