@@ -128,8 +128,8 @@ struct Ordered {
 
 std::string fmt(double v, int digits = 2) { return std::isfinite(v) ? texel::detail::fixed(v, digits) : std::string("NA"); }
 std::string fmt_p(double p) {
-  if (!std::isfinite(p)) return "NA";
-  return p < 0.001 ? std::string("< 0.001") : texel::detail::fixed(p, 3);
+  if (!std::isfinite(p)) return "p = NA";
+  return p < 0.001 ? std::string("p < 0.001") : "p = " + texel::detail::fixed(p, 3);
 }
 
 // --------------------------------------------------------------- staircases
@@ -238,7 +238,7 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     t["comparison"] = a + " − " + b;
     out["paired_t_test"] = t;
     if (t.contains("p"))
-      text += "  paired t-test " + a + " − " + b + ": p = " + fmt_p(t["p"].is_null() ? missing : t["p"].get<double>()) + "\n";
+      text += "  paired t-test " + a + " − " + b + ": " + fmt_p(t["p"].is_null() ? missing : t["p"].get<double>()) + "\n";
   } else if (blocks.names.size() > 2) {
     // Only participants with every block enter the ANOVA.
     std::vector<stats::Observation> complete;
@@ -352,7 +352,7 @@ void matching_summary(const Rows& matches, const AnalysisOptions& o, json& out, 
       } else {
         c["p"] = 0.0;
       }
-      text += "  confidence vs distance: r = " + fmt(r) + ", p = " + fmt_p(c["p"].get<double>()) + "\n";
+      text += "  confidence vs distance: r = " + fmt(r) + ", " + fmt_p(c["p"].get<double>()) + "\n";
     }
     out["confidence_vs_distance"] = c;
   }
@@ -440,8 +440,8 @@ json quantization_summary(const Rows& rows, const AnalysisOptions& o, std::strin
     e["t_test"] = guarded([&] { return ttest_json(stats::t_test_one_sample(changes, 0.0, o.level)); });
     std::string line = "  " + c + " vs unquantized: change " + fmt(mean_of(changes));
     if (e["t_test"].contains("p") && !e["t_test"]["p"].is_null())
-      line += ", t(" + fmt(e["t_test"]["df"].get<double>(), 0) + ") = " + fmt(e["t_test"]["t"].get<double>()) +
-              ", p = " + fmt_p(e["t_test"]["p"].get<double>());
+      line += ", t(" + fmt(e["t_test"]["df"].get<double>(), 0) + ") = " + fmt(e["t_test"]["t"].get<double>()) + ", " +
+              fmt_p(e["t_test"]["p"].get<double>());
     text += line + "\n";
     ch.push_back(std::move(e));
   }
@@ -526,7 +526,7 @@ json guided_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   sim["own_vs_other_t_test"] = t;
   out["similarity"] = sim;
   text += "  similarity: own rendering " + fmt(mean_of(diag)) + " vs others " + fmt(mean_of(off));
-  if (t.contains("p") && !t["p"].is_null()) text += ", paired p = " + fmt_p(t["p"].get<double>());
+  if (t.contains("p") && !t["p"].is_null()) text += ", paired " + fmt_p(t["p"].get<double>());
   text += "\n";
   return out;
 }
@@ -613,8 +613,8 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
     for (const auto& e : out["rm_anova"]["effects"])
       text += "  " + e["effect"].get<std::string>() + ": F(" + fmt(e["df"].is_null() ? missing : e["df"].get<double>(), 0) +
               ", " + fmt(e["df_error"].is_null() ? missing : e["df_error"].get<double>(), 0) +
-              ") = " + fmt(e["f"].is_null() ? missing : e["f"].get<double>()) +
-              ", p = " + fmt_p(e["p"].is_null() ? missing : e["p"].get<double>()) + "\n";
+              ") = " + fmt(e["f"].is_null() ? missing : e["f"].get<double>()) + ", " +
+              fmt_p(e["p"].is_null() ? missing : e["p"].get<double>()) + "\n";
   return out;
 }
 

@@ -86,6 +86,16 @@ std::string anova_text(const json& a) {
   return out;
 }
 
+/// A figure width that leaves every category label of `names` room to be
+/// printed (tick labels that would overlap are thinned otherwise): about
+/// 7.5 px per character at the tick font, at least `min_px`.
+int category_width(const std::vector<std::string>& names, int min_px) {
+  std::size_t longest = 0;
+  for (const auto& n : names) longest = std::max(longest, n.size());
+  const double per = std::max(90.0, 7.5 * static_cast<double>(longest) + 20.0);
+  return std::clamp(static_cast<int>(per * static_cast<double>(names.size())) + 200, min_px, 16000);
+}
+
 std::string percent(double v) { return texel::detail::fixed(v * 100, 0) + " %"; }
 
 // --------------------------------------------------------------- staircases
@@ -280,7 +290,7 @@ Figure matched_vs_reference(const std::string& title, const json& s) {
 Figure matched_boxes(const std::string& title, const json& s) {
   const auto names = reference_names(s);
   const auto ms = matches_of(s);
-  Figure f = figure(title + ": matched parameters per reference", std::max(700, 90 * static_cast<int>(names.size()) + 200), 760);
+  Figure f = figure(title + ": matched parameters per reference", category_width(names, 700), 760);
   for (int k = 0; k < 2; ++k) {
     Panel p;
     p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
@@ -388,7 +398,7 @@ Figure rating_boxes(const std::string& title, const Rows& rows, const std::strin
     if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
     v[r->reference][r->participant].push_back(r->rating);
   }
-  Figure f = figure(title + ": similarity of match and reference", std::max(640, 90 * static_cast<int>(names.size()) + 200), 460);
+  Figure f = figure(title + ": similarity of match and reference", category_width(names, 640), 460);
   Panel p;
   p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
   p.y.label = "similarity rating (" + scale + ")";
