@@ -359,7 +359,11 @@ Figure match_ellipses(const std::string& title, const json& s, double level) {
       // Fewer than three matches (or collinear ones): points only, as the summary says.
     }
     const double rx = d(s["references"][i]["reference_pitch_db"]), ry = d(s["references"][i]["reference_irregularity_db"]);
-    if (std::isfinite(rx) && std::isfinite(ry)) refs.x.push_back(rx), refs.y.push_back(ry);
+    if (std::isfinite(rx) && std::isfinite(ry)) {
+      refs.x.push_back(rx), refs.y.push_back(ry);
+      // Which reference position is whose: a dashed line to its mean match.
+      if (!x.empty()) p.lines.push_back(LineSeries{{rx, mean_of(x)}, {ry, mean_of(y)}, c, 1.0, {}, true});
+    }
     // The name just above the reference's highest match, clear of the points.
     if (!x.empty()) p.notes.push_back(TextNote{mean_of(x), *std::max_element(y.begin(), y.end()), names[i], c, -14.0});
   }
