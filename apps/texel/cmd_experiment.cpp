@@ -10,6 +10,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -39,18 +40,6 @@ using nlohmann::ordered_json;
 
 std::atomic<bool> interrupted{false};
 extern "C" void on_experiment_signal(int) { interrupted = true; }
-
-std::string iso_now() {
-  const auto t = std::chrono::system_clock::now();
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count();
-  const std::time_t s = static_cast<std::time_t>(ms / 1000);
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
-                tm.tm_min, tm.tm_sec, static_cast<int>(ms % 1000));
-  return buf;
-}
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -116,10 +105,10 @@ std::string trim(std::string s) {
 std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Presenter* presenter) {
   const ex::Question& q = session.question();
   ex::Response r;
-  r.shown_at = iso_now();
+  r.shown_at = ex::utc_timestamp();
   const auto t0 = Clock::now();
   auto event = [&](const std::string& kind, const std::string& detail) {
-    r.events.push_back({seconds_since(t0), kind, detail, iso_now()});
+    r.events.push_back({seconds_since(t0), kind, detail, ex::utc_timestamp()});
   };
   auto feel = [&](int i) {
     if (presenter) presenter->show(q.stimuli[static_cast<std::size_t>(i)].document_json);
@@ -256,7 +245,7 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
         }
       }
       r.rt_ms = std::round(rt);
-      r.answered_at = iso_now();
+      r.answered_at = ex::utc_timestamp();
       event("answer", arg);
       return r;
     } else if (!cmd.empty()) {
@@ -283,24 +272,39 @@ struct RunArgs {
 
 void run(const RunArgs& a) {
   if (!(a.pace >= 0 && a.pace <= 3600)) throw InvalidArgument("--pace is " + detail::num(a.pace) + "; allowed: 0 … 3600 s");
+  // Everything that can be checked is checked before the database is
+  // touched; a database this command created is removed again if the
+  // session cannot start, so a failed command leaves nothing behind.
   const ex::Protocol protocol_file = ex::load_protocol(a.protocol);
-  ex::Store store = ex::Store::open(a.db, ex::StoreMode::read_write);
-  ex::OpenOptions oo;
-  oo.participant = a.participant;
-  oo.resume = a.resume;
-  oo.simulate = a.simulate;
-  ex::ActiveSession active = ex::open_session(store, protocol_file, oo);
+  if (a.simulate) (void)ex::simulation_observer(protocol_file.observer, *a.simulate);
+  ex::PresenterOptions po;
+  po.backend = a.backend;
+  po.audio_device = a.audio_device;
+  ex::Presenter presenter(po);
+  const bool existed = std::filesystem::exists(a.db);
+  std::optional<ex::Store> opened;
+  std::optional<ex::ActiveSession> started;
+  try {
+    opened.emplace(ex::Store::open(a.db, ex::StoreMode::read_write));
+    ex::OpenOptions oo;
+    oo.participant = a.participant;
+    oo.resume = a.resume;
+    oo.simulate = a.simulate;
+    started.emplace(ex::open_session(*opened, protocol_file, oo));
+  } catch (const Error&) {
+    opened.reset();
+    if (!existed)
+      for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(a.db + suffix);
+    throw;
+  }
+  ex::Store& store = *opened;
+  ex::ActiveSession& active = *started;
   const ex::Session& session = active.session;
   const ex::Protocol& protocol = session.protocol();
   const ex::SessionInfo& info = active.info;
   const std::string& simulate = active.simulate;
   std::optional<ex::SimulatedParticipant> sim;
   if (!simulate.empty()) sim.emplace(ex::simulated_participant(active));
-
-  ex::PresenterOptions po;
-  po.backend = a.backend;
-  po.audio_device = a.audio_device;
-  ex::Presenter presenter(po);
 
   interrupted = false;
   auto old_int = std::signal(SIGINT, on_experiment_signal);
@@ -327,7 +331,7 @@ void run(const RunArgs& a) {
       if (q.stimuli.empty()) wait_pumping(&presenter, a.pace);
       if (interrupted) break;
       r = sim->respond(session);
-      r.shown_at = r.answered_at = iso_now();
+      r.shown_at = r.answered_at = ex::utc_timestamp();
     } else {
       auto answer = ask_terminal(session, &presenter);
       if (!answer) {
@@ -572,6 +576,9 @@ void register_experiment(CLI::App& app) {
     std::optional<std::string> out_dir;
     std::string format = "png";
     std::size_t reversals = 6;
+    double level = 0.95;
+    double recall_chance = 1.0 / 9.0;
+    double accuracy_sd = 2.5;
     bool json = false;
   };
   auto an = std::make_shared<AnalyzeArgs>();
@@ -581,6 +588,11 @@ void register_experiment(CLI::App& app) {
   analyze_cmd->add_option("-o,--out", an->out_dir, "Folder for the figures (created if missing)");
   analyze_cmd->add_option("--format", an->format, "Figure format: png or svg [png]");
   analyze_cmd->add_option("--reversals", an->reversals, "Threshold = mean of the last K reversals [6]");
+  analyze_cmd->add_option("--level", an->level, "Confidence level of t-test intervals and ellipses, 0 … 1 [0.95]");
+  analyze_cmd->add_option("--memory-recall-chance", an->recall_chance,
+                          "Working memory: exclude participants whose digit recall is at or below this; negative = off [1/9]");
+  analyze_cmd->add_option("--memory-accuracy-sd", an->accuracy_sd,
+                          "Working memory: exclude participants this many SD from the group's accuracy; 0 = off [2.5]");
   analyze_cmd->add_flag("--json", an->json, "Print the summary as JSON");
   analyze_cmd->callback([an] {
     if (an->db.has_value() == an->csv.has_value()) throw InvalidArgument("analyze: give exactly one of --db FILE or --csv FILE");
@@ -601,6 +613,11 @@ void register_experiment(CLI::App& app) {
     }
     o.format = an->format;
     o.reversals_k = an->reversals;
+    if (!(an->level > 0 && an->level < 1))
+      throw InvalidArgument("--level is " + detail::num(an->level) + "; allowed: 0 … 1 (exclusive)");
+    o.level = an->level;
+    o.memory_recall_chance = an->recall_chance;
+    o.memory_accuracy_sd = an->accuracy_sd;
     const ex::AnalysisReport report = ex::analyze(rows, o);
     if (an->json)
       print_json(report.summary);

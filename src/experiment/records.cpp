@@ -3,7 +3,10 @@
 #include "texel/experiment/records.hpp"
 
 #include <charconv>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <map>
@@ -185,6 +188,18 @@ std::vector<std::vector<std::string>> parse_csv(std::string_view text, std::stri
 }
 
 }  // namespace
+
+std::string utc_timestamp() {
+  const auto now = std::chrono::system_clock::now();
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count();
+  const std::time_t secs = static_cast<std::time_t>(ms / 1000);
+  std::tm tm{};
+  gmtime_r(&secs, &tm);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
+                tm.tm_min, tm.tm_sec, static_cast<int>(ms % 1000));
+  return buf;
+}
 
 const std::vector<std::string>& trial_columns() {
   static const std::vector<std::string> names = [] {

@@ -38,20 +38,6 @@ void shuffle(std::vector<T>& v, const CounterRng& rng, std::uint64_t block) {
   }
 }
 
-std::string now_iso() {
-  // Stored times come from the front end (Response::shown_at/answered_at);
-  // this is only the fallback when a front end gives none.
-  const auto t = std::chrono::system_clock::now();
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count();
-  const std::time_t s = static_cast<std::time_t>(ms / 1000);
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
-                tm.tm_min, tm.tm_sec, static_cast<int>(ms % 1000));
-  return buf;
-}
-
 json region(const std::string& name, double start_mm, std::optional<double> length_mm, const json& texture) {
   json r = {{"name", name}, {"start_mm", start_mm}, {"texture", texture}};
   if (length_mm) r["length_mm"] = *length_mm;
@@ -507,8 +493,8 @@ struct Session::Impl {
     row.reference = truth.reference;
     row.correct_answer = truth.correct_answer;
     row.rt_ms = r.rt_ms;
-    row.shown_at = r.shown_at.empty() ? now_iso() : r.shown_at;
-    row.answered_at = r.answered_at.empty() ? now_iso() : r.answered_at;
+    row.shown_at = r.shown_at.empty() ? utc_timestamp() : r.shown_at;
+    row.answered_at = r.answered_at.empty() ? utc_timestamp() : r.answered_at;
     if (r.swipe_mean_speed_mm_s) row.swipe_mean_speed_mm_s = *r.swipe_mean_speed_mm_s;
     if (r.swipe_sd_speed_mm_s) row.swipe_sd_speed_mm_s = *r.swipe_sd_speed_mm_s;
     if (r.directional_proportion) row.directional_proportion = *r.directional_proportion;

@@ -106,18 +106,6 @@ CREATE TABLE writers (
 };
 static_assert(migrations.size() == Store::current_schema_version);
 
-std::string now_iso() {
-  const auto now = std::chrono::system_clock::now();
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count();
-  const std::time_t secs = static_cast<std::time_t>(ms / 1000);
-  std::tm tm{};
-  gmtime_r(&secs, &tm);
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
-                tm.tm_min, tm.tm_sec, static_cast<int>(ms % 1000));
-  return buf;
-}
-
 std::string host_name() {
   char buf[256] = {};
   if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
@@ -442,7 +430,7 @@ std::int64_t Store::create_session(const std::string& participant, const std::st
   if (trials_planned < -1) throw InvalidArgument("trials_planned " + std::to_string(trials_planned) + " is below -1 (adaptive)");
   const std::string op = "creating a session for " + participant;
   Transaction tx(*impl_, op);
-  const std::string now = now_iso();
+  const std::string now = utc_timestamp();
   Stmt(*impl_, "INSERT OR IGNORE INTO participants(code, created_at) VALUES (?, ?)", op).bind(1, participant).bind(2, now).run();
   Stmt(*impl_,
        "INSERT INTO sessions(participant, protocol, study, protocol_json, seed, simulate, status, trials_planned, created_at, "
@@ -530,7 +518,7 @@ WriterLock Store::acquire_writer(std::int64_t session_id) {
       .bind(2, static_cast<std::int64_t>(::getpid()))
       .bind(3, own_start())
       .bind(4, host)
-      .bind(5, now_iso())
+      .bind(5, utc_timestamp())
       .run();
   tx.commit();
   return WriterLock(impl_, session_id);
@@ -574,7 +562,7 @@ void Store::append_trial(const WriterLock& lock, const StoredTrial& t) {
   row.protocol = info.protocol;
   row.study = info.study;
   row.trial = t.trial;
-  const std::string now = now_iso();
+  const std::string now = utc_timestamp();
   Stmt(*impl_,
        "INSERT INTO trials(session_id, trial, question_json, response_json, state_json, row_json, stored_at) "
        "VALUES (?, ?, ?, ?, ?, ?, ?)",
@@ -609,7 +597,10 @@ void Store::finish_session(const WriterLock& lock) {
   const std::string op = "finishing session " + std::to_string(sid);
   Transaction tx(*impl_, op);
   check_lock(*impl_, impl_, lock, lock.impl_, op);
-  Stmt(*impl_, "UPDATE sessions SET status = 'finished', updated_at = ? WHERE id = ?", op).bind(1, now_iso()).bind(2, sid).run();
+  Stmt(*impl_, "UPDATE sessions SET status = 'finished', updated_at = ? WHERE id = ?", op)
+      .bind(1, utc_timestamp())
+      .bind(2, sid)
+      .run();
   tx.commit();
 }
 

@@ -5,7 +5,7 @@
 // a header row, comma separated, RFC 4180 quoting, empty cell = missing (NA).
 //
 // Every field that a task does not use is missing (NaN or empty). Column
-// names and units are documented in docs/experiments.md ("Export").
+// names and units are documented in docs/session-store.md ("The export CSV").
 #pragma once
 
 #include <cstdint>
@@ -35,19 +35,19 @@ struct TrialRow {
   std::string reference;  ///< reference name (matching, rating, guided, coarse); may be empty
 
   // -- adaptive procedure (staircase tasks)
-  std::string variable;            ///< adaptive variable, e.g. "texel_length_mm", "coarse_strength"
-  double intensity = missing;      ///< value presented on this trial (variable's unit)
-  bool reversal = false;           ///< this trial was a reversal
-  double next_intensity = missing; ///< value computed after this answer (last row: the convergent value)
-  bool procedure_finished = false; ///< the procedure finished with this answer
+  std::string variable;             ///< adaptive variable, e.g. "texel_length_mm", "coarse_strength"
+  double intensity = missing;       ///< value presented on this trial (variable's unit)
+  bool reversal = false;            ///< this trial was a reversal
+  double next_intensity = missing;  ///< value computed after this answer (last row: the convergent value)
+  bool procedure_finished = false;  ///< the procedure finished with this answer
 
   // -- response
-  std::string response;       ///< raw response: "2", "A", "B", "unsure", "same", "different", a rating, ...
-  std::string correct_answer; ///< what would have been correct, where there is one (never shown to participants)
-  double correct = missing;   ///< 1 correct, 0 wrong, missing where the task has no right answer
-  double rating = missing;    ///< similarity rating on the protocol's scale
-  double confidence = missing;///< confidence rating (1 … 5)
-  double rt_ms = missing;     ///< reaction time: first presentation → answer (ms)
+  std::string response;         ///< raw response: "2", "A", "B", "unsure", "same", "different", a rating, ...
+  std::string correct_answer;   ///< what would have been correct, where there is one (never shown to participants)
+  double correct = missing;     ///< 1 correct, 0 wrong, missing where the task has no right answer
+  double rating = missing;      ///< similarity rating on the protocol's scale
+  double confidence = missing;  ///< confidence rating (1 … 5)
+  double rt_ms = missing;       ///< reaction time: first presentation → answer (ms)
 
   // -- matching (sliders, guided)
   double slider_p = missing;  ///< pitch slider position (protocol's slider units)
@@ -56,7 +56,7 @@ struct TrialRow {
   double irregularity_db = missing;
   double pitch_a_db = missing, irregularity_a_db = missing;  ///< guided: point A
   double pitch_b_db = missing, irregularity_b_db = missing;  ///< guided: point B
-  int iteration = -1;  ///< guided: optimizer iteration (0-based), -1 otherwise
+  int iteration = -1;                                        ///< guided: optimizer iteration (0-based), -1 otherwise
   /// The reference's own position in (Central Pitch, Irregularity): the
   /// encoder's perceptual estimate of the reference texture (dB), so matches
   /// and references compare in one unit. Missing where there is no reference.
@@ -83,6 +83,10 @@ struct TrialRow {
   std::string shown_at;
   std::string answered_at;
 };
+
+/// The current time, UTC, ISO 8601 with milliseconds ("2026-11-23T14:02:08.123Z"):
+/// the form of every time stamp in rows, events and the store.
+std::string utc_timestamp();
 
 /// Column names in CSV order (the export's header).
 const std::vector<std::string>& trial_columns();
