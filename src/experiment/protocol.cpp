@@ -8,6 +8,7 @@
 #include "texel/detail/json_fields.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/simulate.hpp"
 #include "texel/io.hpp"
 #include "texel/reference.hpp"
 
@@ -49,7 +50,8 @@ std::string variable_names() {
 void check_texture(const json& texture, const std::string& device, const std::string& path) {
   if (!texture.is_object()) throw FormatError(path + " must be a texture object ({\"kind\": \"texel\", …})");
   json t = texture;
-  if (t.value("kind", std::string("texel")) == "texel" && !t.contains("seed")) t["seed"] = 1;
+  const bool texel_kind = !t.contains("kind") || (t["kind"].is_string() && t["kind"].get<std::string>() == "texel");
+  if (texel_kind && !t.contains("seed")) t["seed"] = 1;
   json doc = {{"format", "texel-document"}, {"version", 2}, {"device", device}, {"texture", t}};
   try {
     (void)parse_document(doc.dump(), path);
@@ -387,7 +389,7 @@ Protocol parse_protocol(std::string_view json_text, std::string_view origin) {
   p.seed = o.uint64_or("seed", 1);
   if (o.has("observer")) {
     p.observer = o.raw("observer");
-    if (!p.observer.is_object()) throw FormatError("observer must be an object");
+    validate_observer(p.observer);
   } else {
     o.skip("observer");
   }

@@ -398,7 +398,12 @@ struct Session::Impl {
         } else {
           right = texel_texture(src.texture, seed_draw(0));
         }
-        if (!params) params = MatchResult{right.value("central_pitch_db", 0.0), right.value("irregularity_db", 0.0)};
+        if (!params) {
+          auto number = [&](const char* key) {
+            return right.contains(key) && right[key].is_number() ? right[key].get<double>() : missing;
+          };
+          params = MatchResult{number("central_pitch_db"), number("irregularity_db")};
+        }
         if (src.quantization_db > 0) right["quantization_db"] = src.quantization_db;
         t.rendering = params;
         q.stimuli.push_back({"Reference | Rendering", halves(reference_texture(pair.reference, 1), right)});

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/json_fields.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/observer.hpp"
 #include "texel/finger.hpp"
@@ -51,8 +53,82 @@ double get(const json& o, const char* key, double fallback) {
 
 }  // namespace
 
+void validate_observer(const json& o) {
+  using texel::detail::JsonObject;
+  const double inf = std::numeric_limits<double>::infinity();
+  JsonObject top(o, "observer");
+  if (top.has("seed"))
+    (void)top.uint64("seed");
+  else
+    top.skip("seed");
+  (void)top.number_or("participant_sd", 0.0, 0.0, 3.0);
+  auto section = [&](const char* key, auto&& check) {
+    if (!top.has(key)) {
+      top.skip(key);
+      return;
+    }
+    JsonObject s(top.raw(key), top.field(key));
+    check(s);
+    s.finish();
+  };
+  section("psychometric", [&](JsonObject& s) {
+    (void)parse_psychometric_shape(s.string_or("shape", "weibull"), s.field("shape"));
+    if (s.has("threshold") && !(s.number("threshold", -inf, inf) > 0)) throw FormatError(s.field("threshold") + " must be > 0");
+    s.skip("threshold");
+    if (s.has("slope") && !(s.number("slope", -inf, inf) > 0)) throw FormatError(s.field("slope") + " must be > 0");
+    s.skip("slope");
+    (void)s.number_or("guess", 0.0, 0.0, 0.999);
+    (void)s.number_or("lapse", 0.0, 0.0, 0.5);
+  });
+  section("matcher", [&](JsonObject& s) {
+    if (s.has("target")) {
+      const auto& t = s.raw("target");
+      const bool pair = t.is_array() && t.size() == 2 && t[0].is_number() && t[1].is_number();
+      if (!pair && !t.is_string())
+        throw FormatError(s.field("target") + " must be \"reference\", a reference name, or [pitch_db, irregularity_db]");
+      if (t.is_string() && t.get<std::string>() != "reference") {
+        try {
+          (void)reference_info(t.get<std::string>());
+        } catch (const Error&) {
+          throw FormatError(s.field("target") + " is '" + t.get<std::string>() + "'; allowed: \"reference\" or a reference name");
+        }
+      }
+    } else {
+      s.skip("target");
+    }
+    (void)s.number_or("noise_db", 0.0, 0.0, 100.0);
+    (void)s.number_or("unsure_db", 0.0, 0.0, 100.0);
+    (void)s.number_or("irregularity_weight", 1.0, 1e-6, 1e6);
+  });
+  section("rater", [&](JsonObject& s) {
+    (void)s.number_or("distance_scale_db", 10.0, 1e-6, 1e6);
+    (void)s.number_or("noise", 0.5, 0.0, 100.0);
+  });
+  section("memory", [&](JsonObject& s) {
+    if (s.has("p_correct")) {
+      const auto& p = s.raw("p_correct");
+      bool ok = p.is_number() && p.get<double>() >= 0 && p.get<double>() <= 1;
+      if (p.is_object()) {
+        ok = true;
+        for (const auto& v : p) ok = ok && v.is_number() && v.get<double>() >= 0 && v.get<double>() <= 1;
+      }
+      if (!ok) throw FormatError(s.field("p_correct") + " must be a probability 0 … 1, or an object of them by condition");
+    } else {
+      s.skip("p_correct");
+    }
+    (void)s.number_or("p_digit", 0.8, 0.0, 1.0);
+  });
+  section("explorer", [&](JsonObject& s) {
+    (void)s.number_or("speed_mm_s", 100.0, 1.0, 10000.0);
+    (void)s.number_or("speed_sd_mm_s", 15.0, 0.0, 10000.0);
+    (void)s.number_or("rt_s", 4.0, 0.01, 3600.0);
+  });
+  top.finish();
+}
+
 json simulation_observer(const json& protocol_observer, const std::string& spec) {
   json o = protocol_observer.is_object() ? protocol_observer : json::object();
+  validate_observer(o);
   for (const char* section : {"psychometric", "matcher", "rater", "memory", "explorer"})
     if (!o.contains(section)) o[section] = json::object();
   if (spec.empty() || spec == "default") return o;
@@ -115,6 +191,11 @@ json simulation_observer(const json& protocol_observer, const std::string& spec)
                             "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, rating-noise, "
                             "speed, spread, seed, default");
     }
+  }
+  try {
+    validate_observer(o);
+  } catch (const FormatError& e) {
+    throw InvalidArgument(std::string("--simulate: ") + e.what());
   }
   return o;
 }
@@ -184,7 +265,8 @@ Response SimulatedParticipant::respond(const Session& session) const {
       const json& pj = observer_["psychometric"];
       PsychometricConfig pc;
       pc.shape = parse_psychometric_shape(pj.value("shape", std::string("weibull")), "observer shape");
-      pc.threshold = threshold_scale_ * get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
+      pc.threshold =
+          threshold_scale_ * get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
       pc.slope = get(pj, "slope", 3.5);
       pc.guess = get(pj, "guess", q.task == TaskKind::oddity ? guess_oddity3 : guess_2afc);
       pc.lapse = get(pj, "lapse", 0.02);

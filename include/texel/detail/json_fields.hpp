@@ -137,10 +137,12 @@ class JsonObject {
 inline nlohmann::json parse_json(std::string_view text, std::string_view origin) {
   try {
     return nlohmann::json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number too large for a double ("1e999").
     std::string msg = e.what();
     // "[json.exception.parse_error.101] parse error at line 1, column 5: ..." -> keep the useful part
-    const auto pos = msg.find("parse error");
+    auto pos = msg.find("parse error");
+    if (pos == std::string::npos && (pos = msg.find("] ")) != std::string::npos) pos += 2;
     throw FormatError(std::string(origin) + ": malformed JSON: " + (pos == std::string::npos ? msg : msg.substr(pos)));
   }
 }

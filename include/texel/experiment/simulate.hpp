@@ -34,6 +34,10 @@
 
 namespace texel::experiment {
 
+/// Validates an "observer" object (its sections, keys, types and ranges);
+/// throws FormatError naming the field ("observer.psychometric.slope …").
+void validate_observer(const nlohmann::json& observer);
+
 /// The observer description a SPEC produces over the protocol's observer
 /// (throws InvalidArgument naming the key, the value and what is allowed).
 nlohmann::json simulation_observer(const nlohmann::json& protocol_observer, const std::string& spec);
