@@ -44,6 +44,12 @@ std::string show_number(double d) {
 // and values outside T are not.
 template <class T>
 T parse_whole(const std::string& s) {
+  // Plain integers exactly (session ids may exceed 2^53); other spellings
+  // of a whole number ("3.0", "1e3", from spreadsheets) through double.
+  T exact{};
+  const auto res = std::from_chars(s.data(), s.data() + s.size(), exact);
+  if (res.ec == std::errc() && res.ptr == s.data() + s.size()) return exact;
+  if (res.ec == std::errc::result_out_of_range) throw std::invalid_argument("out of range");
   const double d = parse_number(s);
   if (!std::isfinite(d) || d != std::floor(d)) throw std::invalid_argument("not a whole number");
   // Exactly representable bounds: -2^63 / -2^31 and 2^63 / 2^31.
