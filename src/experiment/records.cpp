@@ -15,6 +15,7 @@
 
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/table.hpp"
 
 namespace texel::experiment {
 namespace {
@@ -142,57 +143,6 @@ std::string quote(const std::string& s) {
   return q + "\"";
 }
 
-// RFC 4180 records; fields may hold quoted commas, quotes and line breaks.
-std::vector<std::vector<std::string>> parse_csv(std::string_view text, std::string_view origin) {
-  std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> row;
-  std::string field;
-  bool quoted = false, field_started = false;
-  std::size_t line = 1, quote_line = 1;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (quoted) {
-      if (c == '"') {
-        if (i + 1 < text.size() && text[i + 1] == '"') {
-          field += '"';
-          ++i;
-        } else {
-          quoted = false;
-        }
-      } else {
-        if (c == '\n') ++line;
-        field += c;
-      }
-      continue;
-    }
-    if (c == '"' && !field_started) {
-      quoted = field_started = true;
-      quote_line = line;
-    } else if (c == ',') {
-      row.push_back(std::move(field));
-      field.clear();
-      field_started = false;
-    } else if (c == '\n' || c == '\r') {
-      if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
-      row.push_back(std::move(field));
-      field.clear();
-      field_started = false;
-      if (!(row.size() == 1 && row[0].empty())) rows.push_back(std::move(row));
-      row.clear();
-      ++line;
-    } else {
-      field += c;
-      field_started = true;
-    }
-  }
-  if (quoted) throw FormatError(std::string(origin) + ": line " + std::to_string(quote_line) + ": unterminated quoted field");
-  if (field_started || !row.empty()) {
-    row.push_back(std::move(field));
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
-
 }  // namespace
 
 std::string utc_timestamp() {
@@ -241,39 +191,34 @@ std::string trials_csv(const std::vector<TrialRow>& rows) {
 }
 
 std::vector<TrialRow> parse_trials_csv(std::string_view text, std::string_view origin) {
-  if (text.size() > (512u << 20)) throw FormatError(std::string(origin) + " is larger than 512 MiB; not a trial export");
-  const auto records = parse_csv(text, origin);
-  if (records.empty())
-    throw FormatError(std::string(origin) + " is empty; expected a header row (" + trial_columns()[0] + ", …)");
-  const auto& header = records[0];
-  std::vector<const Field*> map(header.size(), nullptr);
-  std::map<std::string, const Field*> by_name;
+  // One RFC 4180 reader for every CSV the experiments read (table.hpp): it
+  // bounds sizes, handles quotes, CRLF and a byte-order mark, and rejects
+  // ragged rows naming the line.
+  const Table table = parse_csv_table(text, origin);
+  std::vector<const Field*> map(table.columns.size(), nullptr);
+  std::map<std::string, const Field*, std::less<>> by_name;
   for (const auto& f : fields()) by_name[f.name] = &f;
   bool any = false;
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    std::string name = header[c];
-    if (c == 0 && name.rfind("\xEF\xBB\xBF", 0) == 0) name.erase(0, 3);  // a UTF-8 BOM from spreadsheet software
-    if (auto it = by_name.find(name); it != by_name.end()) {
+  for (std::size_t c = 0; c < table.columns.size(); ++c) {
+    if (auto it = by_name.find(table.columns[c]); it != by_name.end()) {
       map[c] = it->second;
       any = true;
     }
   }
   if (!any) throw FormatError(std::string(origin) + ": the header names none of the trial columns (participant, trial, …)");
   std::vector<TrialRow> rows;
-  rows.reserve(records.size() - 1);
-  for (std::size_t i = 1; i < records.size(); ++i) {
-    const auto& rec = records[i];
-    if (rec.size() != header.size())
-      throw FormatError(std::string(origin) + ": record " + std::to_string(i + 1) + " has " + std::to_string(rec.size()) +
-                        " fields; the header has " + std::to_string(header.size()));
+  rows.reserve(table.rows());
+  for (std::size_t i = 0; i < table.rows(); ++i) {
+    const auto& rec = table.cells[i];
+    const std::string line = i < table.lines.size() ? std::to_string(table.lines[i]) : std::to_string(i + 2);
     TrialRow r;
     for (std::size_t c = 0; c < rec.size(); ++c) {
       if (!map[c]) continue;
       try {
         map[c]->set(r, rec[c]);
       } catch (const std::invalid_argument& e) {
-        throw FormatError(std::string(origin) + ": record " + std::to_string(i + 1) + ", column " + map[c]->name + ": '" +
-                          rec[c] + "' is " + e.what());
+        throw FormatError(std::string(origin) + ": line " + line + ", column " + map[c]->name + ": '" + rec[c] + "' is " +
+                          e.what());
       }
     }
     rows.push_back(std::move(r));

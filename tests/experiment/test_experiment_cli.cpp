@@ -6,9 +6,11 @@
 // through a real PortAudio stream on an ALSA null PCM.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "../support/cli_run.hpp"
 
 #include <array>
 #include <chrono>
@@ -35,21 +37,9 @@ namespace {
 
 const std::string protocols = std::string(TEXEL_TEST_SOURCE_DIR) + "/examples/protocols/";
 
-struct CliRun {
-  int status;
-  std::string out;
-};
-
+using texel::test_support::CliRun;
 CliRun run(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + " " + std::string(TEXEL_CLI) + " " + args + " 2>&1 </dev/null";
-  CliRun r{-1, {}};
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int s = ::pclose(p);
-  r.status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  return r;
+  return texel::test_support::run_cli(TEXEL_CLI, args, true, env);
 }
 
 // The export without its wall-clock columns: what must be equal between an

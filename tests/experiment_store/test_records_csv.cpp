@@ -125,7 +125,7 @@ TEST(TrialCsv, ColumnsInAnyOrderUnknownIgnoredMissingStayMissing) {
   EXPECT_TRUE(std::isnan(rows[1].correct));
 }
 
-TEST(TrialCsv, BadInputNamesRecordAndColumn) {
+TEST(TrialCsv, BadInputNamesLineAndColumn) {
   const auto msg = [](const std::string& text) {
     try {
       (void)ex::parse_trials_csv(text, "r.csv");
@@ -134,13 +134,13 @@ TEST(TrialCsv, BadInputNamesRecordAndColumn) {
     }
     return std::string("no FormatError");
   };
-  EXPECT_EQ(msg("participant,rt_ms\nS1,12\nS2,fast\n"), "r.csv: record 3, column rt_ms: 'fast' is not a number");
-  EXPECT_EQ(msg("participant,trial\nS1,1.5\n"), "r.csv: record 2, column trial: '1.5' is not a whole number");
-  EXPECT_EQ(msg("participant,trial\nS1,99999999999\n"), "r.csv: record 2, column trial: '99999999999' is out of range");
-  EXPECT_EQ(msg("participant,practice\nS1,yes\n"), "r.csv: record 2, column practice: 'yes' is not 0 or 1");
-  EXPECT_EQ(msg("participant,trial\nS1\n"), "r.csv: record 2 has 1 fields; the header has 2");
-  EXPECT_EQ(msg("participant\n\"S1\n"), "r.csv: line 2: unterminated quoted field");
-  EXPECT_EQ(msg(""), "r.csv is empty; expected a header row (participant, …)");
+  EXPECT_EQ(msg("participant,rt_ms\nS1,12\nS2,fast\n"), "r.csv: line 3, column rt_ms: 'fast' is not a number");
+  EXPECT_EQ(msg("participant,trial\nS1,1.5\n"), "r.csv: line 2, column trial: '1.5' is not a whole number");
+  EXPECT_EQ(msg("participant,trial\nS1,99999999999\n"), "r.csv: line 2, column trial: '99999999999' is out of range");
+  EXPECT_EQ(msg("participant,practice\nS1,yes\n"), "r.csv: line 2, column practice: 'yes' is not 0 or 1");
+  EXPECT_EQ(msg("participant,trial\nS1\n"), "r.csv:2: row has 1 field(s) but the header has 2");
+  EXPECT_EQ(msg("participant\n\"S1\n"), "r.csv:2: a quoted field starting on this line is never closed");
+  EXPECT_EQ(msg(""), "r.csv: empty; a CSV table needs a header row");
   EXPECT_EQ(msg("a,b\n1,2\n"), "r.csv: the header names none of the trial columns (participant, trial, …)");
 }
 

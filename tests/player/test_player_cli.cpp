@@ -4,6 +4,8 @@
 // input exits 2 with one line and writes nothing.
 #include <gtest/gtest.h>
 
+#include "../support/cli_run.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -18,22 +20,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-  int status;
-  std::string out;
-};
-
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string(TEXEL_CLI) + " " + args + " 2>&1";
-  CliRun r{-1, {}};
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int s = ::pclose(p);
-  r.status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  return r;
-}
+using texel::test_support::CliRun;
+CliRun run(const std::string& args) { return texel::test_support::run_cli(TEXEL_CLI, args); }
 
 class Cli : public ::testing::Test {
  protected:

@@ -3,6 +3,8 @@
 // naming the flag (answers after the staircase finished are an error).
 #include <gtest/gtest.h>
 
+#include "../support/cli_run.hpp"
+
 #include <sys/wait.h>
 #include <array>
 #include <cmath>
@@ -14,21 +16,9 @@
 
 namespace {
 
-struct CliRun {
-  int status;
-  std::string out;
-};
-
+using texel::test_support::CliRun;
 CliRun run(const std::string& args, bool merge_stderr = true) {
-  const std::string cmd = std::string(TEXEL_CLI) + " " + args + (merge_stderr ? " 2>&1" : " 2>/dev/null");
-  CliRun r{-1, {}};
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int s = ::pclose(p);
-  r.status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  return r;
+  return texel::test_support::run_cli(TEXEL_CLI, args, merge_stderr);
 }
 
 const std::string published =
