@@ -52,13 +52,8 @@ const std::vector<std::string>& study_order() {
 /// A number for JSON: non-finite values become null (JSON has no NaN).
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-double mean_of(const std::vector<double>& v) {
-  double s = 0;
-  std::size_t n = 0;
-  for (const double x : v)
-    if (std::isfinite(x)) s += x, ++n;
-  return n ? s / static_cast<double>(n) : missing;
-}
+/// Mean of the finite values (NaN when there are none).
+double mean_of(const std::vector<double>& v) { return stats::describe(v).mean; }
 
 json describe_json(const std::vector<double>& v) {
   const stats::Descriptive d = stats::describe(v);

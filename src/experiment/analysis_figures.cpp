@@ -53,13 +53,8 @@ Figure figure(std::string title, int width, int height, int columns = 1) {
   return f;
 }
 
-double mean_of(const std::vector<double>& v) {
-  double s = 0;
-  std::size_t n = 0;
-  for (const double x : v)
-    if (std::isfinite(x)) s += x, ++n;
-  return n ? s / static_cast<double>(n) : missing;
-}
+/// Mean of the finite values (NaN when there are none).
+double mean_of(const std::vector<double>& v) { return stats::describe(v).mean; }
 
 std::string p_text(const json& t) {
   if (!t.contains("p") || t["p"].is_null()) return "n/a";

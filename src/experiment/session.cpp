@@ -419,10 +419,12 @@ struct Session::Impl {
         t.reference = ref;
         const MatchQuestion mq = optimizer->next();
         t.pair = mq;
-        const std::uint64_t seed =
-            trial_rng.bits(
-                counter(static_cast<std::uint64_t>(block_index) << 20 | static_cast<std::uint64_t>(guided_reference), 0xFFFF)) >>
-            11;
+        // A and B of one reference share a texture seed (they differ only in
+        // their parameters): one draw per reference from the block-level
+        // stream, at minors above any shuffle's (<= 4096 items).
+        const std::uint64_t seed = order_rng.bits(counter(static_cast<std::uint64_t>(block_index),
+                                                          0x8000 + static_cast<std::uint64_t>(guided_reference))) >>
+                                   11;
         q.stimuli.push_back({"Reference", single(reference_texture(ref, 1))});
         q.stimuli.push_back({"A", single(texel_texture(b.texture, seed, MatchResult{mq.a.pitch_db, mq.a.irregularity_db}))});
         q.stimuli.push_back({"B", single(texel_texture(b.texture, seed, MatchResult{mq.b.pitch_db, mq.b.irregularity_db}))});
