@@ -114,7 +114,9 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
     if (presenter) presenter->show(q.stimuli[static_cast<std::size_t>(i)].document_json);
     event("select", q.stimuli[static_cast<std::size_t>(i)].label);
   };
-  std::cout << "\n" << q.prompt << "\n";
+  std::cout << "\n── trial " << q.trial + 1 << (q.practice ? " (practice)" : "") << " · " << q.block << " "
+            << q.trial_in_block + 1 << (q.block_trials > 0 ? " of " + std::to_string(q.block_trials) : std::string()) << " ──\n"
+            << q.prompt << "\n";
   event("show", "trial " + std::to_string(q.trial));
 
   // Working memory: the timed sequence first.

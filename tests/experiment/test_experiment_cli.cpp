@@ -220,6 +220,29 @@ TEST(ExperimentCli, ResumeContinuesAtTheNextTrialAndSecondWriterIsRefused) {
   EXPECT_EQ(run("experiment list --db " + db + " --json").status, 0);
 }
 
+TEST(ExperimentCli, TerminalRunnerTakesKeyAnswersAndSavesOnEndOfInput) {
+  TempDir d("texel-exp-terminal");
+  const std::string db = d.at("t.db");
+  // A participant feels stimuli 1 and 3, answers "3", makes a typo, answers
+  // "2" twice, then the input ends: three trials stored, session resumable.
+  const std::string answers = d.write("answers.txt", "f 1\nf 3\na 3\nhello\na 7\na 2\nf 2\na 2\n");
+  const std::string cmd = std::string(TEXEL_CLI) + " experiment run " + protocols + "texel-length.json --participant T1 --db " +
+                          db + " < " + answers + " > " + d.at("out.txt") + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << texel::read_file(d.at("out.txt"));
+  const std::string out = texel::read_file(d.at("out.txt"));
+  EXPECT_NE(out.find("not a valid answer"), std::string::npos) << out;  // "a 7"
+  EXPECT_NE(out.find("--resume"), std::string::npos) << out;
+  ASSERT_EQ(run("experiment export --db " + db + " -o " + d.at("t.csv")).status, 0);
+  const auto rows = ex::parse_trials_csv(texel::read_file(d.at("t.csv")), "t.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].response, "3");
+  EXPECT_EQ(rows[1].response, "2");
+  EXPECT_TRUE(std::isfinite(rows[0].rt_ms));
+  EXPECT_EQ(rows[0].intensity, 26.0);
+  const auto status = nlohmann::json::parse(run("experiment status --db " + db + " --json").out);
+  EXPECT_EQ(status["sessions"][0]["status"], "running");
+}
+
 TEST(ExperimentCli, BadInputIsOneLineExitTwoAndTouchesNothing) {
   TempDir d("texel-exp-bad");
   const std::string db = d.at("s.db");
