@@ -276,6 +276,45 @@ TEST(ExperimentCli, BadInputIsOneLineExitTwoAndTouchesNothing) {
   one_line_2(run("experiment analyze --db " + db + " --csv x.csv"));
 }
 
+TEST(ExperimentCli, SerialFrictionDisplayThroughTheReferenceController) {
+  // The reference display controller on a pseudo-terminal stands in for a
+  // friction display; the study streams drive values to it.
+  TempDir d("texel-exp-serial");
+  int out[2];
+  ASSERT_EQ(::pipe(out), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::dup2(out[1], 1);
+    ::dup2(out[1], 2);
+    ::close(out[0]);
+    ::execl(TEXEL_CLI, TEXEL_CLI, "controller", "--pty", "--duration", "120", "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(out[1]);
+  FILE* ctl = ::fdopen(out[0], "r");
+  ASSERT_NE(ctl, nullptr);
+  std::array<char, 512> line{};
+  ASSERT_NE(std::fgets(line.data(), static_cast<int>(line.size()), ctl), nullptr);
+  std::string pty = line.data();
+  while (!pty.empty() && (pty.back() == '\n' || pty.back() == '\r')) pty.pop_back();
+  const CliRun r = run("experiment run " + protocols + "coarse-features.json --participant D1 --db " + d.at("d.db") +
+                       " --simulate default --pace 0.005 --backend serial:" + pty + " --json");
+  ::kill(pid, SIGTERM);  // the controller stops cleanly and reports its counters
+  std::string rest;
+  while (std::fgets(line.data(), static_cast<int>(line.size()), ctl)) rest += line.data();
+  std::fclose(ctl);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out.substr(r.out.find('{')));
+  EXPECT_TRUE(j["finished"].get<bool>());
+  EXPECT_GT(j["blocks_processed"].get<double>(), 50);
+  EXPECT_EQ(j["late_blocks"].get<double>(), 0);
+  // The controller took every frame the study sent: none bad, no link error.
+  EXPECT_NE(rest.find("bad 0, nacks 0, link errors 0"), std::string::npos) << rest;
+}
+
 TEST(ExperimentCli, AudioBackendThroughPortAudioOnAnAlsaNullPcm) {
   // A real PortAudio stream with no sound card: ALSA's default device is a
   // `null` PCM defined by this test's own configuration file.
