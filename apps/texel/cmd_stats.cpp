@@ -23,12 +23,6 @@ namespace {
 
 namespace st = texel::experiment::stats;
 
-// JSON has no NaN or infinity: they are written as null.
-nlohmann::ordered_json jnum(double v) {
-  if (!std::isfinite(v)) return nullptr;
-  return v;
-}
-
 std::string fmt(double v, int digits = 6) {
   if (std::isnan(v)) return "NA";
   char buf[64];
@@ -132,28 +126,7 @@ void register_anova(CLI::App& stats) {
       j["csv"] = a->csv;
       j["dv"] = a->dv;
       j["subject"] = a->subject;
-      j["factors"] = res.factors;
-      j["subjects"] = res.subjects;
-      j["effects"] = nlohmann::ordered_json::array();
-      for (const auto& e : res.effects) {
-        nlohmann::ordered_json x;
-        x["effect"] = e.effect;
-        x["ss"] = jnum(e.ss);
-        x["df"] = jnum(e.df);
-        x["ms"] = jnum(e.ms);
-        x["ss_error"] = jnum(e.ss_error);
-        x["df_error"] = jnum(e.df_error);
-        x["ms_error"] = jnum(e.ms_error);
-        x["f"] = jnum(e.f);
-        x["p"] = jnum(e.p);
-        x["partial_eta2"] = jnum(e.partial_eta2);
-        x["sphericity_applies"] = e.sphericity_applies;
-        x["gg_epsilon"] = jnum(e.gg_epsilon);
-        x["df_gg"] = jnum(e.df_gg);
-        x["df_error_gg"] = jnum(e.df_error_gg);
-        x["p_gg"] = jnum(e.p_gg);
-        j["effects"].push_back(std::move(x));
-      }
+      j.update(st::to_json(res));
       print_json(j);
       return;
     }
@@ -206,18 +179,7 @@ void register_ttest(CLI::App& stats) {
       j["csv"] = a->csv;
       j["column"] = a->column;
       if (a->paired) j["paired"] = *a->paired;
-      j["n"] = r.n;
-      j["mean"] = jnum(r.mean);
-      j["sd"] = jnum(r.sd);
-      j["se"] = jnum(r.se);
-      j["mu"] = jnum(r.mu);
-      j["t"] = jnum(r.t);
-      j["df"] = jnum(r.df);
-      j["p"] = jnum(r.p);
-      j["level"] = r.level;
-      j["ci_low"] = jnum(r.ci_low);
-      j["ci_high"] = jnum(r.ci_high);
-      j["cohen_d"] = jnum(r.cohen_d);
+      j.update(st::to_json(r));
       print_json(j);
       return;
     }
@@ -279,16 +241,7 @@ void register_ellipse(CLI::App& stats) {
         const st::Ellipse& e = res[i];
         nlohmann::ordered_json x;
         if (a->by) x["group"] = groups[i];
-        x["n"] = e.n;
-        x["mean_x"] = jnum(e.mean_x);
-        x["mean_y"] = jnum(e.mean_y);
-        x["cov_xx"] = jnum(e.cov_xx);
-        x["cov_xy"] = jnum(e.cov_xy);
-        x["cov_yy"] = jnum(e.cov_yy);
-        x["t2_critical"] = jnum(e.t2_critical);
-        x["semi_major"] = jnum(e.semi_major);
-        x["semi_minor"] = jnum(e.semi_minor);
-        x["angle_deg"] = jnum(e.angle_deg);
+        x.update(st::to_json(e));
         if (a->outline > 0) {
           nlohmann::ordered_json pts = nlohmann::ordered_json::array();
           for (const auto& p : e.outline(a->outline)) pts.push_back({p[0], p[1]});

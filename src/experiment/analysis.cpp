@@ -55,26 +55,8 @@ json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 /// Mean of the finite values (NaN when there are none).
 double mean_of(const std::vector<double>& v) { return stats::describe(v).mean; }
 
-json describe_json(const std::vector<double>& v) {
-  const stats::Descriptive d = stats::describe(v);
-  return json{{"n", d.n},
-              {"mean", num(d.mean)},
-              {"sd", num(d.sd)},
-              {"sem", num(d.sem)},
-              {"min", num(d.min)},
-              {"q1", num(d.q1)},
-              {"median", num(d.median)},
-              {"q3", num(d.q3)},
-              {"max", num(d.max)},
-              {"ci95_low", num(d.ci95_low)},
-              {"ci95_high", num(d.ci95_high)}};
-}
-
-json ttest_json(const stats::TTest& t) {
-  return json{{"n", t.n},         {"mean", num(t.mean)},     {"sd", num(t.sd)},           {"se", num(t.se)},
-              {"mu", num(t.mu)},  {"t", num(t.t)},           {"df", num(t.df)},           {"p", num(t.p)},
-              {"level", t.level}, {"ci_low", num(t.ci_low)}, {"ci_high", num(t.ci_high)}, {"cohen_d", num(t.cohen_d)}};
-}
+json describe_json(const std::vector<double>& v) { return stats::to_json(stats::describe(v)); }
+json ttest_json(const stats::TTest& t) { return stats::to_json(t); }
 
 json skipped(const std::string& why) { return json{{"skipped", why}}; }
 
@@ -89,26 +71,7 @@ json guarded(F&& f) {
   }
 }
 
-json anova_json(const stats::AnovaTable& a) {
-  json effects = json::array();
-  for (const auto& e : a.effects)
-    effects.push_back(json{{"effect", e.effect},
-                           {"ss", num(e.ss)},
-                           {"df", num(e.df)},
-                           {"ms", num(e.ms)},
-                           {"ss_error", num(e.ss_error)},
-                           {"df_error", num(e.df_error)},
-                           {"ms_error", num(e.ms_error)},
-                           {"f", num(e.f)},
-                           {"p", num(e.p)},
-                           {"partial_eta2", num(e.partial_eta2)},
-                           {"sphericity_applies", e.sphericity_applies},
-                           {"gg_epsilon", num(e.gg_epsilon)},
-                           {"p_gg", num(e.p_gg)},
-                           {"df_gg", num(e.df_gg)},
-                           {"df_error_gg", num(e.df_error_gg)}});
-  return json{{"factors", a.factors}, {"subjects", a.subjects}, {"effects", effects}};
-}
+json anova_json(const stats::AnovaTable& a) { return stats::to_json(a); }
 
 /// Names in order of first appearance.
 struct Ordered {

@@ -368,4 +368,62 @@ Ellipse mean_confidence_ellipse(std::span<const double> x, std::span<const doubl
   return e;
 }
 
+namespace {
+nlohmann::ordered_json jnum(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
+}  // namespace
+
+nlohmann::ordered_json to_json(const Descriptive& d) {
+  return {{"n", d.n},
+          {"mean", jnum(d.mean)},
+          {"sd", jnum(d.sd)},
+          {"sem", jnum(d.sem)},
+          {"min", jnum(d.min)},
+          {"q1", jnum(d.q1)},
+          {"median", jnum(d.median)},
+          {"q3", jnum(d.q3)},
+          {"max", jnum(d.max)},
+          {"ci95_low", jnum(d.ci95_low)},
+          {"ci95_high", jnum(d.ci95_high)}};
+}
+
+nlohmann::ordered_json to_json(const TTest& t) {
+  return {{"n", t.n},         {"mean", jnum(t.mean)},     {"sd", jnum(t.sd)},           {"se", jnum(t.se)},
+          {"mu", jnum(t.mu)}, {"t", jnum(t.t)},           {"df", jnum(t.df)},           {"p", jnum(t.p)},
+          {"level", t.level}, {"ci_low", jnum(t.ci_low)}, {"ci_high", jnum(t.ci_high)}, {"cohen_d", jnum(t.cohen_d)}};
+}
+
+nlohmann::ordered_json to_json(const AnovaTable& a) {
+  nlohmann::ordered_json effects = nlohmann::ordered_json::array();
+  for (const auto& e : a.effects)
+    effects.push_back({{"effect", e.effect},
+                       {"ss", jnum(e.ss)},
+                       {"df", jnum(e.df)},
+                       {"ms", jnum(e.ms)},
+                       {"ss_error", jnum(e.ss_error)},
+                       {"df_error", jnum(e.df_error)},
+                       {"ms_error", jnum(e.ms_error)},
+                       {"f", jnum(e.f)},
+                       {"p", jnum(e.p)},
+                       {"partial_eta2", jnum(e.partial_eta2)},
+                       {"sphericity_applies", e.sphericity_applies},
+                       {"gg_epsilon", jnum(e.gg_epsilon)},
+                       {"df_gg", jnum(e.df_gg)},
+                       {"df_error_gg", jnum(e.df_error_gg)},
+                       {"p_gg", jnum(e.p_gg)}});
+  return {{"factors", a.factors}, {"subjects", a.subjects}, {"effects", effects}};
+}
+
+nlohmann::ordered_json to_json(const Ellipse& e) {
+  return {{"n", e.n},
+          {"mean_x", jnum(e.mean_x)},
+          {"mean_y", jnum(e.mean_y)},
+          {"cov_xx", jnum(e.cov_xx)},
+          {"cov_xy", jnum(e.cov_xy)},
+          {"cov_yy", jnum(e.cov_yy)},
+          {"t2_critical", jnum(e.t2_critical)},
+          {"semi_major", jnum(e.semi_major)},
+          {"semi_minor", jnum(e.semi_minor)},
+          {"angle_deg", jnum(e.angle_deg)}};
+}
+
 }  // namespace texel::experiment::stats

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace texel::experiment::stats {
 
 /// Summary of a sample. NaNs are skipped (n counts the finite values only).
@@ -108,5 +110,13 @@ struct Ellipse {
 /// x, y: paired coordinates (same length; pairs with a NaN dropped; ≥ 3 pairs);
 /// level in (0, 1).
 Ellipse mean_confidence_ellipse(std::span<const double> x, std::span<const double> y, double level = 0.95);
+
+/// JSON views under the fields' names (what `texel stats --json` prints and
+/// the analysis summaries embed); non-finite numbers become null, since JSON
+/// has no NaN.
+nlohmann::ordered_json to_json(const Descriptive& d);
+nlohmann::ordered_json to_json(const TTest& t);
+nlohmann::ordered_json to_json(const AnovaTable& a);  ///< factors, subjects, effects
+nlohmann::ordered_json to_json(const Ellipse& e);     ///< without the outline
 
 }  // namespace texel::experiment::stats
