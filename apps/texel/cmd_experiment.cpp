@@ -319,7 +319,6 @@ void run(const RunArgs& a) {
               << session.trials_done() << " trials stored, backend " << presenter.describe() << "\n";
 
   const int planned = session.trials_planned();
-  bool quit = false;
   while (!session.finished() && !interrupted) {
     const ex::Question& q = session.question();
     ex::Response r;
@@ -336,10 +335,7 @@ void run(const RunArgs& a) {
       r.shown_at = r.answered_at = ex::utc_timestamp();
     } else {
       auto answer = ask_terminal(session, &presenter);
-      if (!answer) {
-        quit = true;
-        break;
-      }
+      if (!answer) break;  // 'q', end of input or Ctrl-C: everything answered is stored
       r = std::move(*answer);
     }
     ex::StoredTrial t;
@@ -390,7 +386,6 @@ void run(const RunArgs& a) {
                 << " --resume\n";
   }
   if (!presenter.error().empty()) throw IoError("experiment run: " + presenter.error());
-  (void)quit;
 }
 
 // ------------------------------------------------------- list / status / export / analyze

@@ -148,7 +148,7 @@ RenderingSource parse_rendering(JsonObject o, const std::string& device) {
   return r;
 }
 
-Block parse_block(JsonObject o, const std::string& device, std::size_t index) {
+Block parse_block(JsonObject o, const std::string& device) {
   Block b;
   b.name = o.string("name");
   if (b.name.empty() || b.name.size() > 64) throw FormatError(o.field("name") + " must be 1 … 64 characters");
@@ -157,7 +157,6 @@ Block parse_block(JsonObject o, const std::string& device, std::size_t index) {
   b.condition = o.string_or("condition", "");
   b.prompt = o.string_or("prompt", "");
   b.shuffle = o.boolean_or("shuffle", true);
-  (void)index;
 
   auto need_texture = [&] {
     b.texture = o.raw("texture");
@@ -398,7 +397,7 @@ Protocol parse_protocol(std::string_view json_text, std::string_view origin) {
     throw FormatError("blocks must be an array of 1 … " + std::to_string(max_blocks) + " blocks");
   std::set<std::string> names;
   for (std::size_t i = 0; i < blocks.size(); ++i) {
-    Block b = parse_block(JsonObject(blocks[i], "blocks[" + std::to_string(i) + "]"), p.device, i);
+    Block b = parse_block(JsonObject(blocks[i], "blocks[" + std::to_string(i) + "]"), p.device);
     if (!names.insert(b.name).second)
       throw FormatError("blocks[" + std::to_string(i) + "].name '" + b.name + "' is used twice; block names must be unique");
     // References to earlier blocks must exist and come earlier.
