@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD := build
 PY := /usr/bin/python3
 
-.PHONY: all deps configure build demo test test-unit test-asan test-determinism bench format clean
+.PHONY: all deps configure build web demo test test-unit test-browser test-asan test-determinism bench format clean
 
 all: build
 
@@ -17,13 +17,28 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# Texel Studio's front end (web/, TypeScript + Vite + uPlot), built once into
+# build/web and rebuilt only when its sources or lockfile change. `npm ci`
+# installs exactly the committed lockfile from the npm registry; nothing else
+# is downloaded (the browser tests drive Debian's chromium).
+WEB_OUT := $(BUILD)/web
+WEB_SRC := $(shell find web -path web/node_modules -prune -o -path web/tests -prune -o -type f -print 2>/dev/null)
+
+web: $(WEB_OUT)/index.html
+
+web/node_modules/.package-lock.json: web/package-lock.json | deps
+	cd web && npm ci --no-audit --no-fund --loglevel=error
+
+$(WEB_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC)
+	cd web && TEXEL_WEB_OUT=$(CURDIR)/$(WEB_OUT) npm run --silent build
+
 # The studies (issue #8): a simulated cohort of 8 participants through every
 # shipped protocol (free exploration before the quantization test that uses
 # its matches), then each study's summaries and figures.
 PROTOCOLS := $(addprefix examples/protocols/,free-exploration.json quantization.json parameter-mapping.json \
   guided-exploration.json coarse-features.json texel-length.json texel-length-wide.json working-memory.json)
 
-demo: build
+demo: build web
 	$(BUILD)/bin/texel demo --out out/demo
 	$(BUILD)/bin/texel atlas --out out/demo/references
 	rm -rf out/demo/experiments && mkdir -p out/demo/experiments
@@ -31,14 +46,24 @@ demo: build
 	$(BUILD)/bin/texel experiment export --db out/demo/experiments/cohort.db -o out/demo/experiments/trials.csv
 	$(BUILD)/bin/texel experiment analyze --db out/demo/experiments/cohort.db -o out/demo/experiments > out/demo/experiments/summary.txt
 	@cat out/demo/experiments/summary.txt
+	@echo "Texel Studio is built: $(BUILD)/bin/texel studio --port 8080  (then open http://127.0.0.1:8080/)"
 
 # Every test: unit and CLI tests (release build), the same under
 # AddressSanitizer + UndefinedBehaviorSanitizer, and byte-identity of the demo
 # set across GCC/clang, -O0/-O3 and SIMD widths.
-test: test-unit test-asan test-determinism
+test: test-unit test-browser test-asan test-determinism
 
 test-unit: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+
+# End-to-end browser tests of Texel Studio: headless Debian chromium driven by
+# playwright-core against `texel studio` on loopback. Screenshots and the
+# measured latencies land in build/browser-artifacts/.
+BROWSER_ENV = TEXEL_BIN=$(CURDIR)/$(BUILD)/bin/texel TEXEL_WEB=$(CURDIR)/$(WEB_OUT) \
+  TEXEL_ARTIFACTS=$(CURDIR)/$(BUILD)/browser-artifacts TEXEL_PROTOCOLS=$(CURDIR)/examples/protocols
+
+test-browser: build web
+	cd web && $(BROWSER_ENV) npm test --silent
 
 test-asan: deps
 	@cmake --preset asan >/dev/null

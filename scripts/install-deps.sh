@@ -13,7 +13,15 @@ packages=(
   libsndfile1-dev portaudio19-dev libsqlite3-dev
   libboost-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema
+  chromium
 )
+
+# Texel Studio's front end builds with the machine's Node.js (>= 20) and npm
+# from the npm registry; Debian 12's own nodejs (18) is too old for Vite.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null || ! node -e 'process.exit(Number(process.versions.node.split(".")[0]) < 20 ? 1 : 0)'; then
+  echo "install-deps: Node.js >= 20 with npm is needed to build Texel Studio's front end (found: $(node --version 2>/dev/null || echo none))" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do
