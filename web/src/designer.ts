@@ -1,0 +1,594 @@
+// Designer page (#/designer): the texture's parameters as controls, the
+// document they make (docs/format.md), and live plots of the engine's answer
+// to `design` on every input event (the service coalesces: latest wins).
+
+import { studio, StudioError } from './ws';
+import { h, decodeF32, download, base64ToBytes, bytesToBase64, fmt, stats, checksum } from './util';
+import { MapPlot, HistogramPlot, SpectrumPlot } from './plots';
+import { FeelStrip } from './feel';
+import { hearIt } from './audio';
+import type {
+  CoarseProfile,
+  DesignReply,
+  DeviceProfile,
+  FileReply,
+  HelloReply,
+  ImportReply,
+  MatchReply,
+  RegionDoc,
+  Spectrum,
+  TexelTexture,
+  TextureDocument,
+} from './protocol';
+
+interface TexelParams {
+  central_pitch_db: number;
+  irregularity_db: number;
+  texel_length_mm: number;
+  seed: number;
+  parameterization: 'moments' | 'log';
+  quantization_db: number;
+  coarse: 'constant' | 'sine' | 'points';
+  coarse_value: number;
+  sine_period_mm: number;
+  sine_phase_deg: number;
+  points: [number, number][];
+  coarse_strength: number;
+  fine_strength: number;
+}
+
+interface DesignerState {
+  device: string | DeviceProfile;
+  split: boolean;
+  reference: string;
+  reference_seed: number;
+  texel: TexelParams;
+  /** Keys of an imported texel texture the controls do not show (kept as they are). */
+  extra: Record<string, unknown>;
+}
+
+const defaults = (): TexelParams => ({
+  central_pitch_db: 10,
+  irregularity_db: -5,
+  texel_length_mm: 0.25,
+  seed: 1,
+  parameterization: 'moments',
+  quantization_db: 0,
+  coarse: 'constant',
+  coarse_value: 1,
+  sine_period_mm: 5,
+  sine_phase_deg: 0,
+  points: [],
+  coarse_strength: 0,
+  fine_strength: 1,
+});
+
+let hello: HelloReply | null = null;
+
+export async function getHello(): Promise<HelloReply> {
+  if (!hello) hello = await studio().call<HelloReply>('hello', {}, 15000);
+  return hello;
+}
+
+function deviceProfile(dev: string | DeviceProfile): DeviceProfile | undefined {
+  if (typeof dev === 'object') return dev;
+  return hello?.devices.find((d) => d.name === dev);
+}
+
+function deviceLength(dev: string | DeviceProfile): number {
+  const p = deviceProfile(dev);
+  return p ? p.samples * p.spacing_mm : 101.76;
+}
+
+function halves(dev: string | DeviceProfile): { left: [number, number]; right: [number, number] } {
+  const p = deviceProfile(dev);
+  const l = p?.layout?.find((r) => r.name === 'left');
+  const r = p?.layout?.find((r) => r.name === 'right');
+  if (l && r) return { left: [l.start_mm, l.length_mm], right: [r.start_mm, r.length_mm] };
+  const len = deviceLength(dev);
+  // Half of the samples each, on the grid (a region must end inside the device).
+  const half = p ? Math.floor(p.samples / 2) * p.spacing_mm : len / 2;
+  return { left: [0, half], right: [half, half] };
+}
+
+function texelTexture(t: TexelParams, extra: Record<string, unknown>): TexelTexture {
+  const tex: TexelTexture = {
+    ...(extra as object),
+    kind: 'texel',
+    central_pitch_db: round(t.central_pitch_db, 2),
+    irregularity_db: round(t.irregularity_db, 2),
+    texel_length_mm: round(t.texel_length_mm, 3),
+    seed: t.seed,
+    parameterization: t.parameterization,
+    quantization_db: t.quantization_db,
+    coarse_strength: t.coarse_strength,
+    fine_strength: t.fine_strength,
+  };
+  let coarse: CoarseProfile;
+  if (t.coarse === 'sine') coarse = { kind: 'sine', period_mm: t.sine_period_mm, phase_deg: t.sine_phase_deg };
+  else if (t.coarse === 'points' && t.points.length) coarse = { kind: 'points', points: t.points };
+  else coarse = { kind: 'constant', value: t.coarse_value };
+  tex.coarse = coarse;
+  return tex;
+}
+
+function round(x: number, d: number): number {
+  const f = 10 ** d;
+  return Math.round(x * f) / f;
+}
+
+export function buildDocument(s: DesignerState): TextureDocument {
+  if (!s.split) return { format: 'texel-document', version: 1, device: s.device, texture: texelTexture(s.texel, s.extra) };
+  const hv = halves(s.device);
+  return {
+    format: 'texel-document',
+    version: 2,
+    description: 'reference left, rendering right',
+    device: s.device,
+    regions: [
+      { name: 'left', start_mm: hv.left[0], length_mm: hv.left[1], texture: { kind: 'reference', name: s.reference, seed: s.reference_seed } },
+      { name: 'right', start_mm: hv.right[0], length_mm: hv.right[1], texture: texelTexture(s.texel, s.extra) },
+    ],
+  };
+}
+
+/** Reads a document back into the designer's state (what the controls cannot show is kept in `extra`). */
+function stateFromDocument(doc: TextureDocument, prev: DesignerState): DesignerState {
+  const s: DesignerState = { ...prev, texel: { ...prev.texel }, extra: {}, device: doc.device ?? prev.device };
+  let texel: TexelTexture | undefined;
+  if (doc.texture) {
+    s.split = false;
+    if (doc.texture.kind === 'texel') texel = doc.texture;
+  } else if (doc.regions) {
+    const ref = doc.regions.find((r) => r.texture.kind === 'reference');
+    const tex = [...doc.regions].reverse().find((r) => r.texture.kind === 'texel');
+    s.split = !!ref && doc.regions.length > 1;
+    if (ref && ref.texture.kind === 'reference') {
+      s.reference = ref.texture.name;
+      s.reference_seed = ref.texture.seed ?? 1;
+    }
+    if (tex) texel = tex.texture as TexelTexture;
+  }
+  if (texel) applyTexel(s, texel);
+  return s;
+}
+
+function applyTexel(s: DesignerState, t: TexelTexture): void {
+  const known = new Set([
+    'kind', 'central_pitch_db', 'irregularity_db', 'texel_length_mm', 'seed', 'parameterization',
+    'quantization_db', 'coarse', 'coarse_strength', 'fine_strength',
+  ]);
+  s.extra = {};
+  for (const [k, v] of Object.entries(t)) if (!known.has(k)) s.extra[k] = v;
+  const p = s.texel;
+  p.central_pitch_db = t.central_pitch_db;
+  p.irregularity_db = t.irregularity_db;
+  p.texel_length_mm = t.texel_length_mm;
+  p.seed = Number(t.seed ?? 1);
+  p.parameterization = t.parameterization ?? 'moments';
+  p.quantization_db = t.quantization_db ?? 0;
+  p.coarse_strength = t.coarse_strength ?? 0;
+  p.fine_strength = t.fine_strength ?? 1;
+  const c = t.coarse;
+  p.coarse = 'constant';
+  p.coarse_value = 1;
+  if (c?.kind === 'constant') p.coarse_value = c.value ?? 1;
+  else if (c?.kind === 'sine') {
+    p.coarse = 'sine';
+    p.sine_period_mm = c.period_mm;
+    p.sine_phase_deg = c.phase_deg ?? 0;
+  } else if (c?.kind === 'points') {
+    p.coarse = 'points';
+    p.points = c.points;
+  } else if (c) s.extra.coarse = c; // values / reference profiles: kept, not editable here
+}
+
+// ---------------------------------------------------------------- controls
+
+interface SliderCtl {
+  row: HTMLElement;
+  input: HTMLInputElement;
+  set(v: number): void;
+}
+
+function slider(
+  id: string,
+  label: string,
+  min: number,
+  max: number,
+  step: number,
+  value: number,
+  unit: string,
+  onInput: (v: number) => void,
+  extra?: HTMLElement,
+): SliderCtl {
+  const input = h('input', { type: 'range', id, min, max, step, value, 'data-testid': id }) as HTMLInputElement;
+  const num = h('input', { type: 'number', min, max, step, value, 'aria-label': `${label} (${unit})`, class: 'num' }) as HTMLInputElement;
+  input.addEventListener('input', () => {
+    num.value = input.value;
+    onInput(Number(input.value));
+  });
+  num.addEventListener('change', () => {
+    const v = Math.min(max, Math.max(min, Number(num.value)));
+    if (!Number.isFinite(v)) return;
+    input.value = String(v);
+    num.value = String(v);
+    onInput(v);
+  });
+  const row = h('div', { class: 'ctl' }, h('label', { for: id }, label, ' ', h('span', { class: 'unit' }, `(${unit})`)), h('div', { class: 'ctl-row' }, input, num), extra ?? null);
+  return {
+    row,
+    input,
+    set(v: number) {
+      input.value = String(v);
+      num.value = String(v);
+    },
+  };
+}
+
+function select(id: string, label: string, options: [string, string][], value: string, onChange: (v: string) => void): { row: HTMLElement; el: HTMLSelectElement } {
+  const el = h('select', { id, 'data-testid': id }) as HTMLSelectElement;
+  for (const [v, t] of options) el.append(h('option', { value: v }, t));
+  el.value = value;
+  el.addEventListener('change', () => onChange(el.value));
+  return { row: h('div', { class: 'ctl' }, h('label', { for: id }, label), el), el };
+}
+
+// ---------------------------------------------------------------- page
+
+export function mountDesigner(root: HTMLElement): void {
+  const s: DesignerState = { device: 'tpad', split: false, reference: '4sin', reference_seed: 1, texel: defaults(), extra: {} };
+  const client = studio();
+
+  const mapPlot = new MapPlot();
+  const hist = new HistogramPlot();
+  const spec = new SpectrumPlot();
+  let overlays: { target?: Spectrum; match?: Spectrum } = {};
+  let lastSpectrum: Spectrum | null = null;
+  let lastSelectedKey = '';
+  let stripActiveUntil = 0;
+
+  const status = h('div', { class: 'status', role: 'status', 'aria-live': 'polite', 'data-testid': 'designer-status' });
+  const bytesEl = h('span', { class: 'bytes', 'data-testid': 'encoded-bytes', id: 'encoded-bytes' }, '–');
+  const hexEl = h('code', { class: 'hex', 'data-testid': 'encoded-hex' });
+  const pitchCpm = h('span', { class: 'cpm', 'data-testid': 'pitch-cpm' });
+  const irrCpm = h('span', { class: 'cpm', 'data-testid': 'irregularity-cpm' });
+  const texelsEl = h('span', { 'data-testid': 'texels' });
+  const elapsedEl = h('span', { 'data-testid': 'elapsed' });
+
+  // --- design requests and redraw timing
+  let gen = 0;
+  let drawnGen = 0;
+  const t0s: { g: number; t0: number }[] = [];
+  const strip = new FeelStrip({ length_mm: 101.76, onEnter: () => {
+    stripActiveUntil = performance.now() + 30000;
+    void selectForFeel();
+  } });
+
+  async function selectForFeel(): Promise<void> {
+    const doc = buildDocument(s);
+    const key = JSON.stringify(doc);
+    if (key === lastSelectedKey) return;
+    lastSelectedKey = key;
+    try {
+      await client.request('feel.select', { document: doc }, { lane: 'feel.select', timeoutMs: 30000 });
+    } catch (e) {
+      lastSelectedKey = '';
+      showError(e);
+    }
+  }
+
+  function showError(e: unknown): void {
+    status.textContent = e instanceof Error ? e.message : String(e);
+    status.classList.add('error');
+  }
+
+  async function design(): Promise<void> {
+    const g = ++gen;
+    const t0 = performance.now();
+    t0s.push({ g, t0 });
+    if (t0s.length > 500) t0s.splice(0, t0s.length - 500);
+    stats.designsSent++;
+    let reply: DesignReply | null;
+    try {
+      reply = await client.request<DesignReply>('design', { document: buildDocument(s) }, { lane: 'design', timeoutMs: 60000 });
+    } catch (e) {
+      if (e instanceof StudioError && e.code === 'superseded') return;
+      if (g >= drawnGen) showError(e);
+      return;
+    }
+    if (!reply || g < drawnGen) return; // superseded or stale
+    drawnGen = g;
+    draw(reply);
+    await Promise.resolve(); // uPlot commits its redraw in a microtask queued by setData
+    const t1 = performance.now();
+    for (let i = t0s.length - 1; i >= 0; i--)
+      if (t0s[i].g <= g) {
+        stats.sliderToRedrawMs.push(t1 - t0s[i].t0);
+        t0s.splice(i, 1);
+      }
+    if (stats.sliderToRedrawMs.length > 5000) stats.sliderToRedrawMs.splice(0, 1000);
+    stats.designsDrawn++;
+    if (performance.now() < stripActiveUntil) void selectForFeel();
+  }
+
+  function draw(r: DesignReply): void {
+    status.textContent = '';
+    status.classList.remove('error');
+    const values = decodeF32(r.map_f32);
+    const analysed = [...r.regions].reverse().find((x) => x.kind === 'texel') ?? r.regions[r.regions.length - 1];
+    mapPlot.setMap(r.grid.origin_mm, r.grid.spacing_mm, values, r.regions, analysed ? analysed.start_mm + Math.min(3, analysed.length_mm / 2) : undefined);
+    stats.lastMapChecksum = checksum(values);
+    hearIt.setMap(values, r.grid.origin_mm, r.grid.spacing_mm);
+    if (r.histogram) {
+      hist.set(r.histogram.edges_cpm, r.histogram.counts, r.histogram.pdf);
+      stats.lastHistChecksum = checksum(r.histogram.counts.concat(r.histogram.edges_cpm));
+    }
+    if (r.spectrum) {
+      lastSpectrum = r.spectrum;
+      spec.set(r.spectrum, overlays.target, overlays.match);
+    }
+    if (r.encoded) {
+      bytesEl.textContent = `${r.encoded.bytes} bytes`;
+      bytesEl.dataset.bytes = String(r.encoded.bytes);
+      hexEl.textContent = r.encoded.hex;
+      stats.lastEncodedBytes = r.encoded.bytes;
+    }
+    pitchCpm.textContent = r.central_pitch_cpm !== undefined ? `= ${fmt(r.central_pitch_cpm, 3)} cycles/mm` : '';
+    irrCpm.textContent = r.irregularity_cpm !== undefined ? `= ${fmt(r.irregularity_cpm, 3)} cycles/mm` : '';
+    texelsEl.textContent = r.texels !== undefined ? `${r.texels} texels` : '';
+    elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
+    strip.setLength(r.grid.count * r.grid.spacing_mm);
+    root.dataset.designs = String(stats.designsDrawn + 1);
+  }
+
+  const changed = () => void design();
+
+  // --- controls
+  const t = s.texel;
+  const pitch = slider('central-pitch', 'Central Pitch', -10, 19.5, 0.1, t.central_pitch_db, 'dB re 1 cycle/mm', (v) => ((t.central_pitch_db = v), changed()), pitchCpm);
+  const irr = slider('irregularity', 'Irregularity', -30, 20, 0.1, t.irregularity_db, 'dB', (v) => ((t.irregularity_db = v), changed()), irrCpm);
+  const length = slider('texel-length', 'Texel length', 0.05, 10, 0.01, t.texel_length_mm, 'mm', (v) => ((t.texel_length_mm = v), changed()));
+  const seedIn = h('input', { type: 'number', id: 'seed', min: 0, step: 1, value: t.seed, 'data-testid': 'seed', class: 'num' }) as HTMLInputElement;
+  seedIn.addEventListener('change', () => {
+    t.seed = Math.max(0, Math.floor(Number(seedIn.value) || 0));
+    changed();
+  });
+  const newDraw = h('button', { type: 'button', 'data-testid': 'new-draw', onclick: () => {
+    t.seed = Math.floor(Math.random() * 2 ** 31);
+    seedIn.value = String(t.seed);
+    changed();
+  } }, 'New draw');
+  const param = select('parameterization', 'Parameterization', [['moments', 'moments (mean, SD)'], ['log', 'log (lognormal μ, σ)']], t.parameterization, (v) => {
+    t.parameterization = v as 'moments' | 'log';
+    if (v === 'log' && t.irregularity_db < 0) {
+      t.irregularity_db = 0;
+      irr.set(0);
+    }
+    changed();
+  });
+  const quant = slider('quantization', 'Quantization', 0, 20, 0.5, t.quantization_db, 'dB, 0 = off', (v) => ((t.quantization_db = v), changed()));
+  const cStrength = slider('coarse-strength', 'Coarse strength C', 0, 1, 0.01, t.coarse_strength, '0…1', (v) => ((t.coarse_strength = v), changed()));
+  const fStrength = slider('fine-strength', 'Fine strength F', 0, 1, 0.01, t.fine_strength, '0…1', (v) => ((t.fine_strength = v), changed()));
+
+  const constVal = slider('coarse-value', 'Constant value', 0, 1, 0.01, t.coarse_value, '0…1', (v) => ((t.coarse_value = v), changed()));
+  const sinePeriod = slider('sine-period', 'Sine period', 0.5, 50, 0.1, t.sine_period_mm, 'mm', (v) => ((t.sine_period_mm = v), changed()));
+  const sinePhase = slider('sine-phase', 'Sine phase', 0, 360, 1, t.sine_phase_deg, 'degrees', (v) => ((t.sine_phase_deg = v), changed()));
+  const pointsInfo = h('p', { class: 'hint', 'data-testid': 'points-info' });
+  const drawBtn = h('button', { type: 'button', 'aria-pressed': 'false', 'data-testid': 'draw-coarse' }, 'Draw on the map') as HTMLButtonElement;
+  const coarseSel = select('coarse-kind', 'Coarse profile', [['constant', 'constant'], ['sine', 'sine'], ['points', 'drawn on the map']], t.coarse, (v) => {
+    t.coarse = v as TexelParams['coarse'];
+    setDrawMode(v === 'points' && !t.points.length);
+    showCoarse();
+    changed();
+  });
+  const coarseParams = h('div', { class: 'coarse-params' });
+  function showCoarse(): void {
+    coarseParams.replaceChildren();
+    if (t.coarse === 'constant') coarseParams.append(constVal.row);
+    else if (t.coarse === 'sine') coarseParams.append(sinePeriod.row, sinePhase.row);
+    else {
+      pointsInfo.textContent = t.points.length ? `${t.points.length} drawn points` : 'Press "Draw on the map" and drag over the map.';
+      coarseParams.append(pointsInfo);
+    }
+  }
+  function setDrawMode(on: boolean): void {
+    mapPlot.drawMode = on;
+    drawBtn.setAttribute('aria-pressed', String(on));
+    drawBtn.textContent = on ? 'Drawing: drag over the map (click to stop)' : 'Draw on the map';
+    mapPlot.el.classList.toggle('drawing', on);
+  }
+  drawBtn.addEventListener('click', () => setDrawMode(!mapPlot.drawMode));
+  mapPlot.onDrawn = (pts) => {
+    const hv = halves(s.device);
+    const start = s.split ? hv.right[0] : 0;
+    const len = s.split ? hv.right[1] : deviceLength(s.device);
+    const local = pts
+      .map(([x, v]) => [x - start, v] as [number, number])
+      .filter(([x]) => x >= 0 && x <= len)
+      .sort((a, b) => a[0] - b[0]);
+    const out: [number, number][] = [];
+    for (const [x, v] of local) if (!out.length || x > out[out.length - 1][0] + 1e-3) out.push([round(x, 3), round(v, 3)]);
+    if (!out.length) {
+      showError('Draw over the rendering (the texel region) to set its coarse profile.');
+      return;
+    }
+    t.points = out;
+    t.coarse = 'points';
+    coarseSel.el.value = 'points';
+    if (t.coarse_strength === 0) {
+      // C = 0 would hide the profile: show it at full strength.
+      t.coarse_strength = 1;
+      cStrength.set(1);
+    }
+    showCoarse();
+    setDrawMode(false);
+    changed();
+  };
+
+  // device, regions, reference
+  const deviceSel = select('device', 'Device', [['tpad', 'tpad']], 'tpad', (v) => {
+    s.device = v;
+    changed();
+  });
+  const splitSel = select('regions', 'Regions', [['single', 'single texture'], ['split', 'reference left, rendering right']], 'single', (v) => {
+    s.split = v === 'split';
+    matchBtn.disabled = !s.split;
+    refRow.hidden = !s.split;
+    overlays = {};
+    changed();
+  });
+  const refSel = select('reference', 'Reference', [['4sin', '4sin']], s.reference, (v) => {
+    s.reference = v;
+    overlays = {};
+    changed();
+  });
+  const refRow = refSel.row;
+  refRow.hidden = true;
+
+  const matchBtn = h('button', { type: 'button', 'data-testid': 'match', disabled: true }, 'Match a reference') as HTMLButtonElement;
+  const matchInfo = h('span', { class: 'hint', 'data-testid': 'match-info' });
+  matchBtn.addEventListener('click', async () => {
+    matchBtn.disabled = true;
+    matchInfo.textContent = 'encoding…';
+    try {
+      const r = await client.call<MatchReply>('match', { document: buildDocument(s), region: 'left' }, 120000);
+      const reg = r.region as RegionDoc;
+      if (reg?.texture?.kind === 'texel') applyTexel(s, reg.texture);
+      syncControls();
+      overlays = { target: r.target_spectrum, match: r.match_spectrum };
+      if (lastSpectrum) spec.set(lastSpectrum, overlays.target, overlays.match);
+      matchInfo.textContent = `matched in ${r.bytes} bytes${r.model_distance !== undefined ? `, model distance ${fmt(r.model_distance, 2)}` : ''}`;
+      changed();
+    } catch (e) {
+      matchInfo.textContent = '';
+      showError(e);
+    } finally {
+      matchBtn.disabled = !s.split;
+    }
+  });
+
+  function syncControls(): void {
+    pitch.set(t.central_pitch_db);
+    irr.set(t.irregularity_db);
+    length.set(t.texel_length_mm);
+    seedIn.value = String(t.seed);
+    param.el.value = t.parameterization;
+    quant.set(t.quantization_db);
+    cStrength.set(t.coarse_strength);
+    fStrength.set(t.fine_strength);
+    constVal.set(t.coarse_value);
+    sinePeriod.set(t.sine_period_mm);
+    sinePhase.set(t.sine_phase_deg);
+    coarseSel.el.value = t.coarse;
+    splitSel.el.value = s.split ? 'split' : 'single';
+    refRow.hidden = !s.split;
+    matchBtn.disabled = !s.split;
+    if (typeof s.device === 'string') {
+      if (![...deviceSel.el.options].some((o) => o.value === s.device)) deviceSel.el.append(h('option', { value: s.device as string }, s.device as string));
+      deviceSel.el.value = s.device;
+    }
+    refSel.el.value = s.reference;
+    showCoarse();
+  }
+
+  // --- import / export, drag and drop
+  const fileIn = h('input', { type: 'file', id: 'import-file', 'data-testid': 'import-file', accept: '.json,.texel,.bin,.npy,.csv,.wav', class: 'visually-hidden' }) as HTMLInputElement;
+  fileIn.addEventListener('change', () => {
+    if (fileIn.files?.[0]) void importFile(fileIn.files[0]);
+    fileIn.value = '';
+  });
+  async function importFile(f: File): Promise<void> {
+    status.textContent = `importing ${f.name}…`;
+    try {
+      const bytes = new Uint8Array(await f.arrayBuffer());
+      const dev = typeof s.device === 'string' ? s.device : s.device.name;
+      const r = await client.call<ImportReply>('import', { name: f.name, data_base64: bytesToBase64(bytes), device: dev }, 120000);
+      Object.assign(s, stateFromDocument(r.document, s));
+      syncControls();
+      status.textContent = `imported ${f.name}`;
+      status.dataset.imported = f.name;
+      changed();
+    } catch (e) {
+      showError(e);
+    }
+  }
+  async function exportAs(as: string): Promise<void> {
+    try {
+      const r = await client.call<FileReply>('export', { document: buildDocument(s), as }, 60000);
+      download(r.name, r.mime, base64ToBytes(r.data_base64));
+    } catch (e) {
+      showError(e);
+    }
+  }
+  const dropHint = h('div', { class: 'drop-hint', 'aria-hidden': 'true' }, 'Drop a .texel.json, .texel or device file to import it');
+  root.addEventListener('dragover', (e) => {
+    e.preventDefault();
+    root.classList.add('dragging');
+  });
+  root.addEventListener('dragleave', (e) => {
+    if (e.target === root) root.classList.remove('dragging');
+  });
+  root.addEventListener('drop', (e) => {
+    e.preventDefault();
+    root.classList.remove('dragging');
+    const f = e.dataTransfer?.files?.[0];
+    if (f) void importFile(f);
+  });
+
+  const hear = h('input', { type: 'checkbox', id: 'hear-it', 'data-testid': 'hear-it' }) as HTMLInputElement;
+  hear.addEventListener('change', async () => {
+    try {
+      if (hear.checked) await hearIt.enable();
+      else await hearIt.disable();
+    } catch (e) {
+      hear.checked = false;
+      showError(e);
+    }
+  });
+
+  const controls = h(
+    'form',
+    { class: 'controls', 'aria-label': 'Texture parameters', onsubmit: (e: Event) => e.preventDefault() },
+    h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row,
+      h('div', { class: 'ctl' }, h('label', { for: 'seed' }, 'Seed'), h('div', { class: 'ctl-row' }, seedIn, newDraw)),
+      param.row, quant.row, fStrength.row),
+    h('fieldset', {}, h('legend', {}, 'Coarse profile'), coarseSel.row, coarseParams, drawBtn, cStrength.row),
+    h('fieldset', {}, h('legend', {}, 'Device and regions'), deviceSel.row, splitSel.row, refRow, h('div', { class: 'ctl-row' }, matchBtn, matchInfo)),
+    h('fieldset', {}, h('legend', {}, 'Files'),
+      h('div', { class: 'btn-row' },
+        h('button', { type: 'button', onclick: () => fileIn.click(), 'data-testid': 'import' }, 'Import…'),
+        fileIn,
+        h('button', { type: 'button', onclick: () => void exportAs('document'), 'data-testid': 'export-document' }, 'Export .texel.json'),
+        h('button', { type: 'button', onclick: () => void exportAs('bitstream'), 'data-testid': 'export-bitstream' }, 'Export .texel'),
+        h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin')),
+      h('p', { class: 'hint' }, 'Or drop a file anywhere on the page.')),
+  );
+
+  const summary = h('div', { class: 'summary' }, h('div', { class: 'size' }, h('span', { class: 'label' }, 'Encoded size'), bytesEl), h('div', { class: 'meta' }, texelsEl, ' · ', elapsedEl), hexEl);
+  const plots = h(
+    'div',
+    { class: 'plots' },
+    summary,
+    h('h2', {}, 'Friction map'),
+    h('p', { class: 'hint' }, 'Drag to zoom, double-click to reset.'),
+    mapPlot.el,
+    h('h2', {}, 'Feel it'),
+    strip.el,
+    h('label', { class: 'inline' }, hear, ' Hear it (browser audio, when no display is attached)'),
+    h('div', { class: 'two' }, h('div', {}, h('h2', {}, 'Texel frequencies'), hist.el), h('div', {}, h('h2', {}, 'Spectrum'), spec.el)),
+  );
+  root.replaceChildren(h('div', { class: 'designer' }, controls, plots), status, dropHint);
+  showCoarse();
+
+  void getHello()
+    .then((hi) => {
+      deviceSel.el.replaceChildren(...hi.devices.map((d) => h('option', { value: d.name, title: d.description ?? '' }, d.name)));
+      deviceSel.el.value = typeof s.device === 'string' ? s.device : s.device.name;
+      refSel.el.replaceChildren(...hi.references.map((r) => h('option', { value: r.name, title: r.description ?? '' }, r.name)));
+      refSel.el.value = s.reference;
+      root.dataset.ready = 'true';
+      changed();
+    })
+    .catch(showError);
+}

@@ -1,0 +1,138 @@
+// Experimenter view (#/experimenter): shipped protocols and stored sessions
+// (`experiment.list`), start or resume a protocol for a participant code
+// (optionally simulated), suspend it, follow its progress, and open the
+// participant screen.
+
+import { studio } from './ws';
+import { h } from './util';
+import type { ListReply, SessionInfo } from './protocol';
+
+export function mountExperimenter(root: HTMLElement): void {
+  const client = studio();
+  const status = h('div', { class: 'status', role: 'status', 'aria-live': 'polite', 'data-testid': 'experimenter-status' });
+  const protoSel = h('select', { id: 'protocol', 'data-testid': 'protocol' }) as HTMLSelectElement;
+  const participant = h('input', { id: 'participant', 'data-testid': 'participant', placeholder: 'S01', pattern: '[A-Za-z0-9._-]{1,64}', required: true, autocomplete: 'off' }) as HTMLInputElement;
+  const simulate = h('input', { id: 'simulate', 'data-testid': 'simulate', placeholder: 'e.g. default, or target=4sin (blank: a person answers)', autocomplete: 'off' }) as HTMLInputElement;
+  const resume = h('input', { type: 'checkbox', id: 'resume', 'data-testid': 'resume' }) as HTMLInputElement;
+  const active = h('div', { class: 'active', 'data-testid': 'active-session', 'aria-live': 'polite' });
+  const sessionsBody = h('tbody', {});
+  const openLink = h('a', { href: '#/participant', target: '_blank', rel: 'noopener', class: 'button', 'data-testid': 'open-participant' }, 'Open the participant screen');
+
+  async function start(protocol: string, code: string, resumeIt: boolean, sim: string): Promise<void> {
+    status.classList.remove('error');
+    status.textContent = `starting ${protocol} for ${code}…`;
+    try {
+      const body: Record<string, unknown> = { protocol, participant: code };
+      if (resumeIt) body.resume = true;
+      if (sim) body.simulate = sim;
+      await client.call('experiment.start', body, 120000);
+      status.textContent = `${protocol} running for ${code}`;
+    } catch (e) {
+      status.textContent = e instanceof Error ? e.message : String(e);
+      status.classList.add('error');
+    }
+    await refresh();
+  }
+
+  const form = h(
+    'form',
+    { class: 'controls', 'aria-label': 'Start a session' },
+    h('div', { class: 'ctl' }, h('label', { for: 'protocol' }, 'Protocol'), protoSel),
+    h('div', { class: 'ctl' }, h('label', { for: 'participant' }, 'Participant code'), participant),
+    h('div', { class: 'ctl' }, h('label', { for: 'simulate' }, 'Simulate (optional)'), simulate),
+    h('label', { class: 'inline' }, resume, ' Resume an unfinished session'),
+    h('div', { class: 'btn-row' }, h('button', { type: 'submit', class: 'primary', 'data-testid': 'start' }, 'Start')),
+  );
+  form.addEventListener('submit', (e) => {
+    e.preventDefault();
+    if (!participant.value.trim()) {
+      participant.focus();
+      return;
+    }
+    void start(protoSel.value, participant.value.trim(), resume.checked, simulate.value.trim());
+  });
+
+  const stopBtn = h('button', { type: 'button', 'data-testid': 'stop', onclick: async () => {
+    try {
+      await client.call('experiment.stop', {}, 30000);
+      status.textContent = 'session suspended (resumable)';
+    } catch (e) {
+      status.textContent = e instanceof Error ? e.message : String(e);
+    }
+    await refresh();
+  } }, 'Stop (suspend)');
+
+  function row(s: SessionInfo): HTMLElement {
+    const resumeBtn = s.finished
+      ? h('span', {}, '')
+      : h('button', { type: 'button', 'aria-label': `Resume session ${s.id} (${s.participant}, ${s.protocol})`, onclick: () => void start(s.protocol, s.participant, true, '') }, 'Resume');
+    return h(
+      'tr',
+      { 'data-session': s.id, 'data-finished': String(s.finished) },
+      h('td', {}, String(s.id)),
+      h('td', {}, s.participant),
+      h('td', {}, s.protocol),
+      h('td', { class: 'progress-cell' }, `${s.trials_done} / ${s.trials_planned}`),
+      h('td', { 'data-testid': 'session-state' }, s.finished ? 'finished' : 'unfinished'),
+      h('td', {}, resumeBtn),
+    );
+  }
+
+  async function refresh(): Promise<void> {
+    let l: ListReply;
+    try {
+      l = await client.call<ListReply>('experiment.list', {}, 15000);
+    } catch (e) {
+      status.textContent = e instanceof Error ? e.message : String(e);
+      return;
+    }
+    const keep = protoSel.value;
+    protoSel.replaceChildren(...l.protocols.map((p) => h('option', { value: p.name }, p.study ? `${p.name} (${p.study})` : p.name)));
+    if (keep) protoSel.value = keep;
+    sessionsBody.replaceChildren(...l.sessions.map(row));
+    if (l.active) {
+      let progress = '';
+      try {
+        const cur = await client.call<{ type: string; progress?: { done: number; planned: number } }>('experiment.current', {}, 15000);
+        if (cur.progress) progress = `${cur.progress.done} / ${cur.progress.planned} trials`;
+        active.dataset.state = cur.type;
+      } catch {
+        /* list is enough */
+      }
+      active.replaceChildren(
+        h('strong', {}, `Session ${l.active.id}: ${l.active.participant}, ${l.active.protocol}`),
+        ' ',
+        h('span', { 'data-testid': 'active-progress' }, progress),
+        ' ',
+        stopBtn,
+        ' ',
+        openLink,
+      );
+    } else {
+      active.dataset.state = 'idle';
+      active.replaceChildren(h('span', {}, 'No session is running.'), ' ', openLink);
+    }
+    root.dataset.ready = 'true';
+  }
+
+  root.replaceChildren(
+    h(
+      'div',
+      { class: 'experimenter' },
+      h('section', { 'aria-label': 'Start a protocol' }, h('h2', {}, 'Start a protocol'), form),
+      h('section', { 'aria-label': 'Active session' }, h('h2', {}, 'Active session'), active),
+      h(
+        'section',
+        { 'aria-label': 'Sessions' },
+        h('h2', {}, 'Sessions'),
+        h('table', { class: 'sessions', 'data-testid': 'sessions' }, h('thead', {}, h('tr', {}, ...['#', 'Participant', 'Protocol', 'Trials', 'State', ''].map((c) => h('th', { scope: 'col' }, c)))), sessionsBody),
+      ),
+      status,
+    ),
+  );
+  void refresh();
+  const timer = setInterval(() => {
+    if (!document.body.contains(root) || !root.querySelector('.experimenter')) clearInterval(timer);
+    else void refresh();
+  }, 2000);
+}

@@ -1,0 +1,196 @@
+// The "Feel it" strip: the display on the page. Pointer Events (mouse, pen,
+// touch; `touch-action: none`) and the arrow keys stream finger samples to the
+// engine's player as `feel.move {seq, x_mm, touch}`; the player's own report
+// (`feel.state`, polled at 10 Hz) is shown as #player-position.
+//
+// Touch semantics [choice]: a finger or pen touches while in contact
+// (pointerdown … pointerup/cancel). A mouse touches while its button is held;
+// with "Mouse hover touches" on (the default on the designer: a mouse has no
+// contact sense, and sweeping it is the quickest way to feel), hovering over
+// the strip counts as touch too. Leaving the strip always lifts the finger.
+
+import { studio } from './ws';
+import { h, stats, fmt } from './util';
+import { hearIt } from './audio';
+import type { FeelState } from './protocol';
+
+const sentAt = new Map<number, number>();
+let seq = 0;
+let ackInstalled = false;
+
+function installAck(): void {
+  if (ackInstalled) return;
+  ackInstalled = true;
+  studio().on('feel.ack', (m) => {
+    const s = Number((m as { seq?: number }).seq);
+    const t0 = sentAt.get(s);
+    stats.feelAcks++;
+    if (t0 !== undefined) {
+      sentAt.delete(s);
+      stats.pointerToAckMs.push(performance.now() - t0);
+      if (stats.pointerToAckMs.length > 5000) stats.pointerToAckMs.splice(0, 1000);
+    }
+  });
+}
+
+export function sendMove(x_mm: number, touch: boolean): void {
+  installAck();
+  const s = ++seq;
+  if (sentAt.size > 2000) sentAt.clear();
+  sentAt.set(s, performance.now());
+  if (studio().send('feel.move', { seq: s, x_mm, touch })) stats.feelMovesSent++;
+  hearIt.pointer(x_mm, touch);
+}
+
+export interface StripOptions {
+  length_mm: number;
+  hoverTouches?: boolean;
+  onEnter?: () => void;
+  label?: string;
+}
+
+export class FeelStrip {
+  readonly el: HTMLElement;
+  private strip: HTMLElement;
+  private finger: HTMLElement;
+  private playerMark: HTMLElement;
+  private posText: HTMLElement;
+  private pressed = false;
+  private lastX = 0;
+  private pollTimer: ReturnType<typeof setInterval> | null = null;
+  length_mm: number;
+  hoverTouches: boolean;
+
+  constructor(private opts: StripOptions) {
+    this.length_mm = opts.length_mm;
+    this.hoverTouches = opts.hoverTouches ?? true;
+    this.finger = h('div', { class: 'finger', 'aria-hidden': 'true' });
+    this.playerMark = h('div', { class: 'player-mark', 'aria-hidden': 'true' });
+    this.strip = h(
+      'div',
+      {
+        class: 'strip',
+        tabindex: 0,
+        role: 'slider',
+        'aria-label': opts.label ?? 'Feel it: the display. Move the pointer or a finger over it, or use the arrow keys',
+        'aria-valuemin': 0,
+        'aria-valuemax': Math.round(this.length_mm),
+        'aria-valuenow': 0,
+        'data-testid': 'feel-strip',
+      },
+      this.finger,
+      this.playerMark,
+    );
+    this.posText = h('span', { id: 'player-position', 'data-testid': 'player-position', 'data-mm': '', 'aria-live': 'off' }, '–');
+    const hover = h('input', { type: 'checkbox', id: 'hover-touches', checked: this.hoverTouches }) as HTMLInputElement;
+    hover.addEventListener('change', () => (this.hoverTouches = hover.checked));
+    this.el = h(
+      'section',
+      { class: 'feel', 'aria-label': 'Feel it' },
+      this.strip,
+      h(
+        'div',
+        { class: 'feel-status' },
+        h('span', {}, 'Player: '),
+        this.posText,
+        h('label', { class: 'inline' }, hover, ' Mouse hover touches'),
+      ),
+    );
+    this.bind();
+    this.startPolling();
+  }
+
+  private xOf(e: PointerEvent): number {
+    const r = this.strip.getBoundingClientRect();
+    const f = Math.min(1, Math.max(0, (e.clientX - r.left) / r.width));
+    return f * this.length_mm;
+  }
+
+  private move(x: number, touch: boolean): void {
+    this.lastX = x;
+    this.finger.style.left = `${(100 * x) / this.length_mm}%`;
+    this.finger.classList.toggle('touching', touch);
+    this.strip.setAttribute('aria-valuenow', x.toFixed(1));
+    sendMove(x, touch);
+  }
+
+  private bind(): void {
+    const s = this.strip;
+    s.addEventListener('pointerenter', () => this.opts.onEnter?.());
+    s.addEventListener('pointerdown', (e) => {
+      this.pressed = true;
+      s.setPointerCapture(e.pointerId);
+      e.preventDefault();
+      s.focus({ preventScroll: true });
+      this.move(this.xOf(e), true);
+    });
+    s.addEventListener('pointermove', (e) => {
+      const touch = this.pressed || (e.pointerType === 'mouse' && this.hoverTouches);
+      if (!touch && e.pointerType !== 'mouse') return;
+      this.move(this.xOf(e), touch);
+    });
+    const lift = (e: PointerEvent) => {
+      this.pressed = false;
+      const stillHover = e.type === 'pointerup' && e.pointerType === 'mouse' && this.hoverTouches;
+      this.move(this.xOf(e), stillHover);
+    };
+    s.addEventListener('pointerup', lift);
+    s.addEventListener('pointercancel', lift);
+    s.addEventListener('pointerleave', (e) => {
+      if (this.pressed) return; // captured: leave comes with pointerup
+      this.move(this.xOf(e), false);
+    });
+    s.addEventListener('keydown', (e) => {
+      const step = e.shiftKey ? 10 : 1;
+      let x = this.lastX;
+      if (e.key === 'ArrowRight') x += step;
+      else if (e.key === 'ArrowLeft') x -= step;
+      else if (e.key === 'Home') x = 0;
+      else if (e.key === 'End') x = this.length_mm;
+      else return;
+      e.preventDefault();
+      this.opts.onEnter?.();
+      this.move(Math.min(this.length_mm, Math.max(0, x)), true);
+    });
+    s.addEventListener('keyup', (e) => {
+      if (e.key.startsWith('Arrow') || e.key === 'Home' || e.key === 'End') this.move(this.lastX, false);
+    });
+    s.addEventListener('blur', () => this.move(this.lastX, false));
+  }
+
+  setLength(length_mm: number): void {
+    this.length_mm = length_mm;
+    this.strip.setAttribute('aria-valuemax', String(Math.round(length_mm)));
+  }
+
+  private startPolling(): void {
+    this.pollTimer = setInterval(async () => {
+      if (!document.body.contains(this.el)) {
+        if (this.pollTimer) clearInterval(this.pollTimer);
+        return;
+      }
+      if (studio().state !== 'open') return;
+      try {
+        const st = await studio().request<FeelState>('feel.state', {}, { lane: 'feel.state', timeoutMs: 2000 });
+        if (!st) return;
+        this.showState(st);
+      } catch {
+        /* transient: next poll */
+      }
+    }, 100);
+  }
+
+  private showState(st: FeelState): void {
+    const p = st.position_mm;
+    if (p === null || p === undefined || !Number.isFinite(p)) {
+      this.posText.textContent = '–';
+      this.posText.dataset.mm = '';
+    } else {
+      this.posText.textContent = `${fmt(p, 2)} mm${st.touching ? ' (touching)' : ''}`;
+      this.posText.dataset.mm = String(p);
+      this.playerMark.style.left = `${(100 * p) / this.length_mm}%`;
+    }
+    this.posText.dataset.touching = String(!!st.touching);
+    this.playerMark.classList.toggle('touching', !!st.touching);
+  }
+}

@@ -1,0 +1,361 @@
+// Participant screens (#/participant), driven entirely by the engine's
+// `experiment.current` / `experiment.question` replies: whatever the question
+// asks (stimuli, choices, rating scale, sliders, confidence, timed phases,
+// digit recall) is shown, and nothing else — the question never carries the
+// answer, and this page shows no maps unless the question says `show_maps`.
+//
+// Timing: rt_ms runs from the moment the question is first shown on this
+// page to the press of Submit (performance.now(), monotonic); events carry
+// t_s on the same clock plus the wall time (ISO UTC). After a reload the
+// clock restarts with the re-shown question.
+
+import { studio, StudioError } from './ws';
+import { h, isoNow, decodeF32 } from './util';
+import { FeelStrip } from './feel';
+import { getHello } from './designer';
+import type { CurrentReply, DesignReply, Question, QuestionReply, ResponseJson, TrialEvent } from './protocol';
+
+const niceChoice: Record<string, string> = { unsure: 'Unsure', same: 'Same', different: 'Different' };
+
+function radioGroup(label: string, options: { value: string; text: string }[], onPick: (v: string) => void, testid: string): { el: HTMLElement; value: () => string | null } {
+  let picked: string | null = null;
+  const buttons = options.map((o) =>
+    h('button', { type: 'button', role: 'radio', 'aria-checked': 'false', class: 'big choice', 'data-value': o.value, 'aria-label': `${label}: ${o.text}` }, o.text),
+  );
+  const el = h('div', { role: 'radiogroup', 'aria-label': label, class: 'choices', 'data-testid': testid }, ...buttons);
+  buttons.forEach((b, i) => {
+    b.tabIndex = i === 0 ? 0 : -1;
+    b.addEventListener('click', () => {
+      picked = options[i].value;
+      buttons.forEach((x) => x.setAttribute('aria-checked', String(x === b)));
+      onPick(picked);
+    });
+    b.addEventListener('keydown', (e) => {
+      const d = e.key === 'ArrowRight' || e.key === 'ArrowDown' ? 1 : e.key === 'ArrowLeft' || e.key === 'ArrowUp' ? -1 : 0;
+      if (!d) return;
+      e.preventDefault();
+      const n = buttons[(i + d + buttons.length) % buttons.length];
+      buttons.forEach((x) => (x.tabIndex = x === n ? 0 : -1));
+      n.focus();
+    });
+  });
+  return { el, value: () => picked };
+}
+
+function drawMiniMap(canvas: HTMLCanvasElement, values: Float32Array): void {
+  const ctx = canvas.getContext('2d')!;
+  const w = canvas.width;
+  const hgt = canvas.height;
+  ctx.clearRect(0, 0, w, hgt);
+  ctx.strokeStyle = '#2a6fdb';
+  ctx.beginPath();
+  for (let px = 0; px < w; px++) {
+    const i0 = Math.floor((px * values.length) / w);
+    const i1 = Math.max(i0 + 1, Math.floor(((px + 1) * values.length) / w));
+    let lo = 1;
+    let hi = 0;
+    for (let i = i0; i < i1; i++) {
+      lo = Math.min(lo, values[i]);
+      hi = Math.max(hi, values[i]);
+    }
+    ctx.moveTo(px + 0.5, (1 - hi) * hgt);
+    ctx.lineTo(px + 0.5, (1 - lo) * hgt + 1);
+  }
+  ctx.stroke();
+}
+
+export function mountParticipant(root: HTMLElement): void {
+  const client = studio();
+  let idleTimer: ReturnType<typeof setTimeout> | null = null;
+  const alive = () => document.body.contains(root) && !!root.querySelector('.participant');
+
+  const screen = h('div', { class: 'participant-screen' });
+  const strip = new FeelStrip({ length_mm: 101.76, label: 'Feel the selected texture here: move a finger or the pointer along the strip' });
+  root.replaceChildren(h('div', { class: 'participant' }, screen));
+
+  async function load(): Promise<void> {
+    if (idleTimer) clearTimeout(idleTimer);
+    try {
+      const cur = await client.call<CurrentReply>('experiment.current', {}, 60000);
+      show(cur);
+    } catch (e) {
+      screen.replaceChildren(h('p', { class: 'status error', role: 'alert' }, e instanceof Error ? e.message : String(e)));
+      idleTimer = setTimeout(() => alive() && void load(), 2000);
+    }
+  }
+
+  function show(cur: CurrentReply): void {
+    root.dataset.state = cur.type;
+    if (cur.type === 'experiment.question') void renderQuestion(cur);
+    else if (cur.type === 'experiment.finished') {
+      screen.replaceChildren(h('div', { class: 'thanks', 'data-testid': 'thank-you', role: 'status' }, h('h1', {}, 'Thank you'), h('p', {}, 'The session is complete.')));
+    } else {
+      screen.replaceChildren(h('div', { class: 'waiting', 'data-testid': 'waiting', role: 'status' }, h('h1', {}, 'Please wait'), h('p', {}, 'The experimenter will start the session shortly.')));
+      idleTimer = setTimeout(() => alive() && void load(), 1500);
+    }
+  }
+
+  async function renderQuestion(reply: QuestionReply): Promise<void> {
+    const q: Question = reply.question;
+    const shownPerf = performance.now();
+    const shownAt = isoNow();
+    const events: TrialEvent[] = [];
+    const ev = (kind: string, detail: string) => events.push({ t_s: (performance.now() - shownPerf) / 1000, kind, detail, at: isoNow() });
+    ev('show', `trial ${q.trial}`);
+    let timedOut = false;
+    const timers: ReturnType<typeof setTimeout>[] = [];
+    const clearTimers = () => timers.forEach((t) => clearTimeout(t));
+
+    try {
+      const hi = await getHello();
+      const dev = q.stimuli[0]?.document.device;
+      const p = typeof dev === 'object' ? dev : hi.devices.find((d) => d.name === dev);
+      if (p) strip.setLength(p.samples * p.spacing_mm);
+    } catch {
+      /* keep the default length */
+    }
+
+    // ---- answer state
+    const answer: { choice?: string; rating?: number; confidence?: number; digit?: number; slider_p?: number; slider_i?: number } = {};
+    const submit = h('button', { type: 'button', class: 'big primary submit', 'data-testid': 'submit', disabled: true }, 'Submit') as HTMLButtonElement;
+    const needs = {
+      choice: q.choices.length > 0,
+      rating: !!q.rating_scale,
+      confidence: q.confidence,
+      digit: q.recall_cell >= 0,
+      sliders: q.sliders.length >= 2,
+    };
+    let inputsReady = q.phases.length === 0;
+    const update = () => {
+      submit.disabled =
+        !inputsReady ||
+        (needs.choice && answer.choice === undefined) ||
+        (needs.rating && answer.rating === undefined) ||
+        (needs.confidence && answer.confidence === undefined) ||
+        (needs.digit && answer.digit === undefined);
+    };
+
+    // ---- stimuli
+    const stimulusButtons = q.stimuli.map((s, i) => {
+      const b = h('button', { type: 'button', class: 'big stimulus', 'aria-pressed': 'false', 'data-stimulus': i, 'aria-label': `Feel ${s.label}` }, s.label) as HTMLButtonElement;
+      b.addEventListener('click', () => void selectStimulus(i));
+      return b;
+    });
+    async function selectStimulus(i: number): Promise<void> {
+      if (timedOut) return;
+      stimulusButtons.forEach((b, k) => b.setAttribute('aria-pressed', String(k === i)));
+      ev('select', q.stimuli[i]?.label ?? String(i));
+      try {
+        await client.call('experiment.select', { trial: q.trial, stimulus: i }, 30000);
+      } catch (e) {
+        msg.textContent = e instanceof Error ? e.message : String(e);
+      }
+    }
+    const msg = h('p', { class: 'status', role: 'status', 'aria-live': 'polite', 'data-testid': 'participant-status' });
+
+    const parts: (HTMLElement | null)[] = [];
+    const progress = reply.progress ? `${Math.min(reply.progress.done + 1, reply.progress.planned)} of ${reply.progress.planned}` : '';
+    parts.push(
+      h('header', { class: 'q-head' },
+        h('span', { class: 'trial', 'data-testid': 'trial-number', 'data-trial': q.trial }, `Trial ${q.trial + 1}`),
+        progress ? h('span', { class: 'progress', 'data-testid': 'progress' }, progress) : null,
+        q.practice ? h('span', { class: 'badge' }, 'practice') : null),
+    );
+    if (q.prompt) parts.push(h('p', { class: 'prompt', id: 'prompt' }, q.prompt));
+
+    const countdown = h('div', { class: 'countdown', 'data-testid': 'countdown', 'aria-live': 'off' });
+    if (q.time_limit_s > 0 && q.phases.length === 0) {
+      parts.push(countdown);
+      const end = shownPerf + q.time_limit_s * 1000;
+      const tick = () => {
+        if (!alive()) return;
+        const left = Math.max(0, (end - performance.now()) / 1000);
+        countdown.textContent = `${Math.ceil(left)} s left to feel`;
+        if (left <= 0) {
+          timedOut = true;
+          ev('timeout', `${q.time_limit_s} s`);
+          stimulusButtons.forEach((b) => (b.disabled = true));
+          countdown.textContent = 'Time is up: please answer.';
+          return;
+        }
+        timers.push(setTimeout(tick, 250));
+      };
+      tick();
+    }
+
+    const phaseArea = h('div', { class: 'phase', 'data-testid': 'phase', 'aria-live': 'polite' });
+    const answerArea = h('div', { class: 'answers' });
+    if (q.phases.length === 0) {
+      if (stimulusButtons.length) parts.push(h('div', { class: 'stimuli', role: 'group', 'aria-label': 'Textures to feel' }, ...stimulusButtons));
+      if (q.show_maps) {
+        const maps = h('div', { class: 'maps' });
+        parts.push(maps);
+        q.stimuli.forEach(async (s) => {
+          const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
+          maps.append(h('div', {}, h('span', {}, s.label), c));
+          try {
+            const r = await client.call<DesignReply>('design', { document: s.document }, 60000);
+            drawMiniMap(c, decodeF32(r.map_f32));
+          } catch {
+            /* maps are an aid only */
+          }
+        });
+      }
+    } else {
+      parts.push(phaseArea);
+    }
+    parts.push(strip.el);
+    parts.push(answerArea);
+
+    // ---- answer inputs
+    if (needs.sliders) {
+      const vals = q.sliders.map((s) => s.start);
+      answer.slider_p = vals[0];
+      answer.slider_i = vals[1];
+      let inFlight = false;
+      let again = false;
+      const preview = async () => {
+        if (inFlight) {
+          again = true;
+          return;
+        }
+        inFlight = true;
+        try {
+          await client.call('experiment.preview', { trial: q.trial, slider_p: vals[0], slider_i: vals[1] }, 30000);
+        } catch (e) {
+          msg.textContent = e instanceof Error ? e.message : String(e);
+        }
+        inFlight = false;
+        if (again) {
+          again = false;
+          void preview();
+        }
+      };
+      q.sliders.slice(0, 2).forEach((s, k) => {
+        const id = `slider-${s.name}`;
+        const input = h('input', { type: 'range', id, min: s.min, max: s.max, step: (s.max - s.min) / 200, value: s.start, class: 'big-slider', 'data-testid': id }) as HTMLInputElement;
+        input.addEventListener('input', () => {
+          vals[k] = Number(input.value);
+          if (k === 0) answer.slider_p = vals[0];
+          else answer.slider_i = vals[1];
+          void preview();
+        });
+        input.addEventListener('change', () => ev('slider', `${s.name}=${input.value}`));
+        answerArea.append(h('div', { class: 'ctl' }, h('label', { for: id }, s.label || s.name), input));
+      });
+    }
+    if (needs.choice) {
+      const g = radioGroup('Your answer', q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? c })), (v) => {
+        answer.choice = v;
+        ev('choice', v);
+        update();
+      }, 'choices');
+      answerArea.append(g.el);
+    }
+    if (q.rating_scale) {
+      const [lo, hi] = q.rating_scale;
+      const opts = [];
+      for (let v = lo; v <= hi; v++) opts.push({ value: String(v), text: String(v) });
+      const g = radioGroup(`Similarity from ${lo} (different) to ${hi} (the same)`, opts, (v) => {
+        answer.rating = Number(v);
+        ev('rating', v);
+        update();
+      }, 'rating');
+      answerArea.append(h('p', { class: 'scale-label' }, `${lo} = very different … ${hi} = identical`), g.el);
+    }
+    if (needs.digit) {
+      const r = Math.floor(q.recall_cell / 4) + 1;
+      const c = (q.recall_cell % 4) + 1;
+      const opts = [];
+      for (let v = 1; v <= 9; v++) opts.push({ value: String(v), text: String(v) });
+      const g = radioGroup(`Digit in row ${r}, column ${c}`, opts, (v) => {
+        answer.digit = Number(v);
+        update();
+      }, 'digit');
+      answerArea.append(h('p', { class: 'prompt' }, `Which digit was in row ${r}, column ${c} of the matrix?`), g.el);
+    }
+    if (q.confidence) {
+      const opts = [1, 2, 3, 4, 5].map((v) => ({ value: String(v), text: String(v) }));
+      const g = radioGroup('Confidence from 1 (guess) to 5 (certain)', opts, (v) => {
+        answer.confidence = Number(v);
+        update();
+      }, 'confidence');
+      answerArea.append(h('p', { class: 'scale-label' }, 'How confident are you? 1 = guess … 5 = certain'), g.el);
+    }
+    answerArea.append(submit, msg);
+
+    submit.addEventListener('click', async () => {
+      if (submit.disabled) return;
+      submit.disabled = true;
+      submit.textContent = 'Saving…';
+      const answeredPerf = performance.now();
+      ev('answer', answer.choice ?? (answer.rating !== undefined ? String(answer.rating) : 'sliders'));
+      const response: ResponseJson = {
+        ...answer,
+        rt_ms: Math.round((answeredPerf - shownPerf) * 10) / 10,
+        shown_at: shownAt,
+        answered_at: isoNow(),
+        events,
+      };
+      try {
+        const next = await client.call<CurrentReply>('experiment.answer', { trial: q.trial, response }, 60000);
+        clearTimers();
+        show(next);
+      } catch (e) {
+        submit.textContent = 'Submit';
+        msg.textContent = e instanceof Error ? e.message : String(e);
+        msg.classList.add('error');
+        if (e instanceof StudioError && (e.code === 'invalid' || e.code === 'not_found' || e.code === 'disconnected')) {
+          // A stale trial or a lost connection: show what the engine holds now.
+          setTimeout(() => alive() && void load(), 500);
+        } else {
+          update();
+        }
+      }
+    });
+
+    screen.replaceChildren(h('div', { class: 'question', 'data-task': q.task, 'data-trial': q.trial, 'aria-describedby': q.prompt ? 'prompt' : undefined }, ...parts.filter((p): p is HTMLElement => !!p)));
+    update();
+
+    // ---- timed phases (working memory): stimulus, matrix, stimulus, then the questions
+    if (q.phases.length) {
+      answerArea.hidden = true;
+      const runPhase = (k: number) => {
+        if (!alive()) return;
+        if (k >= q.phases.length) {
+          phaseArea.replaceChildren(h('p', {}, 'Now answer the questions.'));
+          answerArea.hidden = false;
+          inputsReady = true;
+          update();
+          return;
+        }
+        const ph = q.phases[k];
+        const end = performance.now() + ph.duration_s * 1000;
+        const left = h('span', { class: 'countdown' });
+        if (ph.kind === 'stimulus') {
+          const label = q.stimuli[ph.stimulus]?.label ?? `texture ${ph.stimulus + 1}`;
+          phaseArea.replaceChildren(h('p', { class: 'prompt' }, `Feel ${label} on the strip.`), left);
+          void selectStimulus(ph.stimulus);
+        } else if (ph.kind === 'matrix') {
+          ev('matrix', 'shown');
+          const cells = (q.matrix ?? []).map((d, i) => h('div', { class: 'cell', role: 'gridcell', 'aria-label': `row ${Math.floor(i / 4) + 1}, column ${(i % 4) + 1}: ${d || 'empty'}` }, d ? String(d) : ''));
+          const rows = [0, 1, 2, 3].map((r) => h('div', { role: 'row', class: 'mrow' }, ...cells.slice(r * 4, r * 4 + 4)));
+          phaseArea.replaceChildren(h('p', { class: 'prompt' }, 'Remember the digits.'), h('div', { class: 'matrix', role: 'grid', 'aria-label': 'Digit matrix', 'data-testid': 'matrix' }, ...rows), left);
+        } else {
+          phaseArea.replaceChildren(h('p', {}, 'Please wait.'), left);
+        }
+        const tick = () => {
+          if (!alive()) return;
+          const s = Math.max(0, (end - performance.now()) / 1000);
+          left.textContent = `${Math.ceil(s)} s`;
+          if (s <= 0) runPhase(k + 1);
+          else timers.push(setTimeout(tick, 200));
+        };
+        tick();
+      };
+      runPhase(0);
+    }
+  }
+
+  void load();
+}
