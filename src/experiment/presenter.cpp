@@ -29,6 +29,8 @@ constexpr double finger_lead_s = 0.05;     // samples queued ahead of the player
 Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   if (!(options_.swipe_speed_mm_s > 0 && options_.swipe_speed_mm_s <= 10000))
     throw InvalidArgument("swipe speed is " + std::to_string(options_.swipe_speed_mm_s) + "; allowed: 0 … 10000 mm/s");
+  if (!(options_.finger_lead_s >= 0 && options_.finger_lead_s <= 0.1))
+    throw InvalidArgument("finger lead is " + std::to_string(options_.finger_lead_s) + " s; allowed: 0 … 0.1 s");
   PlayerConfig config;
   const std::string& b = options_.backend;
   if (b == "null" || b == "audio") {
@@ -99,6 +101,10 @@ void Presenter::blank() {
 }
 
 void Presenter::pump() {
+  if (options_.finger == FingerSource::external) {
+    player_->collect();
+    return;
+  }
   const double horizon = player_->time_s() + finger_lead_s;
   while (next_finger_s_ <= horizon) {
     const FingerSample s{next_finger_s_, finger_x(next_finger_s_, options_.swipe_speed_mm_s, 10.0, 90.0), true};
@@ -106,6 +112,17 @@ void Presenter::pump() {
     next_finger_s_ += 1.0 / finger_rate_hz;
   }
   player_->collect();
+}
+
+std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
+  if (options_.finger != FingerSource::external) return std::nullopt;
+  // The player consumes samples in time order: a burst arriving within one
+  // clock tick still gets strictly increasing stamps.
+  const double t = std::max(player_->time_s() + options_.finger_lead_s, next_finger_s_ + 1e-6);
+  const FingerSample s{t, x_mm, touching};
+  if (!player_->push(s)) return std::nullopt;
+  next_finger_s_ = t;
+  return s;
 }
 
 BackendStats Presenter::stats() { return backend_->stats(); }

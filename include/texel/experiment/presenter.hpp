@@ -12,6 +12,12 @@
 // felt or heard. pump() feeds that finger and frees retired maps: call it
 // often (every ≤ 20 ms) from the control thread.
 //
+// External finger (FingerSource::external, the studio's "Feel it" strip): the
+// positions come from outside (a browser's pointer) through push_finger(),
+// which stamps each sample with the player's clock on arrival plus a small
+// lead, so the player interpolates towards it instead of extrapolating; pump()
+// then feeds nothing and only frees retired maps.
+//
 // Trade-off: one control thread, no callback into the engine; the real-time
 // side is the player's (no allocation, locks or I/O).
 #pragma once
@@ -19,6 +25,7 @@
 #include <cstddef>
 #include <list>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -26,12 +33,19 @@
 
 namespace texel::experiment {
 
+/// Where finger positions come from (see the banner).
+enum class FingerSource { simulated, external };
+
 struct PresenterOptions {
   std::string backend = "null";  ///< "null", "audio", "serial:PATH"
   std::string audio_device;      ///< PortAudio device (index or name substring); empty = default
   double rate_hz = 48000.0;      ///< audio / null output rate (Hz)
   std::size_t block_frames = 64;
   double swipe_speed_mm_s = 100.0;  ///< simulated finger speed (mm/s), > 0
+  FingerSource finger = FingerSource::simulated;
+  /// External finger: a sample is due this long after it arrives (s), 0 … 0.1.
+  /// Longer hides network jitter, shorter feels more direct.
+  double finger_lead_s = 0.005;
 };
 
 class Presenter {
@@ -46,8 +60,14 @@ class Presenter {
   void show(const std::string& document_json);
   /// Silence (between trials, during the working-memory matrix).
   void blank();
-  /// Feeds the simulated finger ahead of the player and frees retired maps.
+  /// Feeds the simulated finger ahead of the player (simulated mode) and
+  /// frees retired maps.
   void pump();
+  /// External finger mode: queues one sample (position in device mm, finger
+  /// down or lifted), due finger_lead_s after now on the player's clock.
+  /// Returns the sample as queued, or nothing if the player's queue is full
+  /// (or the presenter simulates its finger). Control thread only.
+  std::optional<FingerSample> push_finger(double x_mm, bool touching);
   /// Stops the backend; statistics stay readable. Safe to call twice.
   void stop();
 
@@ -66,7 +86,7 @@ class Presenter {
   PresenterOptions options_;
   std::unique_ptr<Player> player_;
   std::unique_ptr<Backend> backend_;
-  double next_finger_s_ = 0.0;
+  double next_finger_s_ = 0.0;  // simulated: next sample's time; external: newest sample's time
   double period_s_ = 0.0;
   std::size_t shown_ = 0;
   bool running_ = false;

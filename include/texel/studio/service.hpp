@@ -35,6 +35,9 @@ struct ServiceOptions {
   std::string protocols_dir;                ///< shipped protocols offered in the experimenter view ("" = none)
   std::size_t max_message_bytes = 4u << 20;  ///< larger messages are refused
   double max_messages_per_s = 2000.0;       ///< per client, token bucket (burst = one second's worth)
+  /// Largest device map (samples) and texel count a client's document may
+  /// ask to render; tpad is 19,200 samples. Bounds memory and time per message.
+  std::size_t max_map_samples = std::size_t{1} << 21;
 };
 
 class Service final : public MessageHandler {
