@@ -328,14 +328,18 @@ export function mountDesigner(root: HTMLElement): void {
       lastSpectrum = r.spectrum;
       spec.set(r.spectrum, overlays.target, overlays.match);
     }
-    if (r.encoded) {
+    if (r.encoded && r.encoded.bytes !== null) {
       bytesEl.textContent = `${r.encoded.bytes} bytes`;
       bytesEl.dataset.bytes = String(r.encoded.bytes);
-      hexEl.textContent = r.encoded.hex;
+      hexEl.textContent = r.encoded.hex ?? '';
       stats.lastEncodedBytes = r.encoded.bytes;
+    } else {
+      bytesEl.textContent = r.encoded?.error ? 'not encodable' : '–';
+      bytesEl.dataset.bytes = '';
+      hexEl.textContent = r.encoded?.error ?? '';
     }
-    pitchCpm.textContent = r.central_pitch_cpm !== undefined ? `= ${fmt(r.central_pitch_cpm, 3)} cycles/mm` : '';
-    irrCpm.textContent = r.irregularity_cpm !== undefined ? `= ${fmt(r.irregularity_cpm, 3)} cycles/mm` : '';
+    pitchCpm.textContent = typeof r.central_pitch_cpm === 'number' ? `= ${fmt(r.central_pitch_cpm, 3)} cycles/mm` : '';
+    irrCpm.textContent = typeof r.irregularity_cpm === 'number' ? `= ${fmt(r.irregularity_cpm, 3)} cycles/mm` : '';
     texelsEl.textContent = r.texels !== undefined ? `${r.texels} texels` : '';
     elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
     strip.setLength(r.grid.count * r.grid.spacing_mm);
@@ -452,13 +456,14 @@ export function mountDesigner(root: HTMLElement): void {
     matchBtn.disabled = true;
     matchInfo.textContent = 'encoding…';
     try {
-      const r = await client.call<MatchReply>('match', { document: buildDocument(s), region: 'left' }, 120000);
+      // Region 0 is the reference on the left; the service puts the match into the last Texel region.
+      const r = await client.call<MatchReply>('match', { document: buildDocument(s), region: 0 }, 120000);
       const reg = r.region as RegionDoc;
       if (reg?.texture?.kind === 'texel') applyTexel(s, reg.texture);
       syncControls();
       overlays = { target: r.target_spectrum, match: r.match_spectrum };
       if (lastSpectrum) spec.set(lastSpectrum, overlays.target, overlays.match);
-      matchInfo.textContent = `matched in ${r.bytes} bytes${r.model_distance !== undefined ? `, model distance ${fmt(r.model_distance, 2)}` : ''}`;
+      matchInfo.textContent = `matched in ${r.encoded?.bytes} bytes${r.model_distance !== undefined ? `, model distance ${fmt(r.model_distance, 2)}` : ''}`;
       changed();
     } catch (e) {
       matchInfo.textContent = '';

@@ -108,7 +108,7 @@ export function mountParticipant(root: HTMLElement): void {
 
     try {
       const hi = await getHello();
-      const dev = q.stimuli[0]?.document.device;
+      const dev = q.stimuli.find((x) => x.document)?.document?.device ?? 'tpad';
       const p = typeof dev === 'object' ? dev : hi.devices.find((d) => d.name === dev);
       if (p) strip.setLength(p.samples * p.spacing_mm);
     } catch {
@@ -190,16 +190,20 @@ export function mountParticipant(root: HTMLElement): void {
       if (q.show_maps) {
         const maps = h('div', { class: 'maps' });
         parts.push(maps);
-        q.stimuli.forEach(async (s) => {
-          const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
-          maps.append(h('div', {}, h('span', {}, s.label), c));
-          try {
-            const r = await client.call<DesignReply>('design', { document: s.document }, 60000);
-            drawMiniMap(c, decodeF32(r.map_f32));
-          } catch {
-            /* maps are an aid only */
+        // One at a time: the service keeps only the newest queued design per client.
+        void (async () => {
+          for (const s of q.stimuli) {
+            const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
+            maps.append(h('div', {}, h('span', {}, s.label), c));
+            if (!s.document) continue;
+            try {
+              const r = await client.call<DesignReply>('design', { document: s.document }, 60000);
+              drawMiniMap(c, decodeF32(r.map_f32));
+            } catch {
+              /* maps are an aid only */
+            }
           }
-        });
+        })();
       }
     } else {
       parts.push(phaseArea);
@@ -305,7 +309,7 @@ export function mountParticipant(root: HTMLElement): void {
         submit.textContent = 'Submit';
         msg.textContent = e instanceof Error ? e.message : String(e);
         msg.classList.add('error');
-        if (e instanceof StudioError && (e.code === 'invalid' || e.code === 'not_found' || e.code === 'disconnected')) {
+        if (e instanceof StudioError && (e.code === 'conflict' || e.code === 'not_found' || e.code === 'disconnected')) {
           // A stale trial or a lost connection: show what the engine holds now.
           setTimeout(() => alive() && void load(), 500);
         } else {

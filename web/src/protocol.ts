@@ -56,19 +56,26 @@ export interface DesignReply {
   grid: { origin_mm: number; spacing_mm: number; count: number };
   map_f32: string;
   regions: { name: string; kind: string; start_mm: number; length_mm: number }[];
-  histogram?: { edges_cpm: number[]; counts: number[]; pdf: number[] };
+  /** Index of the analysed region (service.cpp; default the last Texel region). */
+  region?: number;
+  /** null when the analysed region is a reference. */
+  histogram?: { edges_cpm: number[]; counts: number[]; pdf: number[] } | null;
   spectrum?: Spectrum;
-  encoded?: { bytes: number; hex: string };
-  central_pitch_cpm?: number;
-  irregularity_cpm?: number;
+  /** {bytes: null, error} when the region cannot be encoded; null for a reference region. */
+  encoded?: { bytes: number | null; hex?: string; error?: string } | null;
+  central_pitch_cpm?: number | null;
+  irregularity_cpm?: number | null;
   texels?: number;
   elapsed_ms?: number;
 }
 
+/** service.cpp: `match {document, region: index, into?: index}`. */
 export interface MatchReply {
   type: 'match';
+  into: number;
   region: RegionDoc;
-  bytes: number;
+  document: TextureDocument;
+  encoded: { bytes: number; hex: string; model_distance: number; [k: string]: Json };
   model_distance?: number;
   target_spectrum?: Spectrum;
   match_spectrum?: Spectrum;
@@ -149,7 +156,7 @@ export interface TextureDocument {
 // ---- experiments
 export interface StimulusQ {
   label: string;
-  document: TextureDocument;
+  document?: TextureDocument;
 }
 
 export interface Question {
@@ -161,6 +168,7 @@ export interface Question {
   practice: boolean;
   task: string;
   prompt: string;
+  /** Documents are withheld unless show_maps (they would give the answer away). */
   stimuli: StimulusQ[];
   choices: string[];
   rating_scale?: [number, number];
@@ -203,6 +211,7 @@ export interface SessionInfo {
   participant: string;
   protocol: string;
   finished: boolean;
+  status?: string;
   trials_done: number;
   trials_planned: number;
 }
