@@ -8,6 +8,7 @@ import { withStudio, openDesigner, screenshot } from './studio.mjs';
 const TPAD_MM = 19200 * 0.0053;
 
 async function stripBox(page) {
+  await page.locator('[data-testid=feel-strip]').scrollIntoViewIfNeeded();
   const b = await page.locator('[data-testid=feel-strip]').boundingBox();
   assert.ok(b && b.width > 100, 'the strip is visible');
   return b;
