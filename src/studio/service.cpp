@@ -453,7 +453,8 @@ struct Service::Impl {
       }
       if (c->slots.size() + c->fifo_jobs >= max_queued_jobs) throw busy();
       if (c->slots.empty()) design_turns.push_back(c->id);
-      c->slots.emplace(job.type, std::make_pair(next_order++, std::move(job)));
+      std::string kind = job.type;  // not job.type itself: the job is moved from in the same call
+      c->slots.emplace(std::move(kind), std::make_pair(next_order++, std::move(job)));
     }
     wake.notify_all();
   }
@@ -517,9 +518,12 @@ struct Service::Impl {
   // -------------------------------------------------------------- design
 
   // A client's document: built-in devices only (a device name may be a path
-  // to any file), and a map and texel count the service will render.
+  // to any file), and a map and texel count the service will render. The
+  // caps are checked on the JSON before parse_document, which prepares every
+  // texture to validate it (a 1 nm texel length would mean 10^8 texels).
   Document document_of(const json& j, const std::string& where) const {
     if (!j.is_object()) throw Reject{"bad_message", where + " must be a document object, got " + type_name(j)};
+    std::optional<DeviceProfile> device;
     if (j.contains("device") && j["device"].is_string()) {
       const auto names = builtin_device_names();
       const auto& name = j["device"].get_ref<const std::string&>();
@@ -528,21 +532,37 @@ struct Service::Impl {
         for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
         throw Reject{"invalid", where + ".device is " + clipped(name) + "; allowed: " + list + " or an inline profile"};
       }
+      device = load_device(name);
+    } else if (j.contains("device") && j["device"].is_object()) {
+      device = parse_device_profile(j["device"].dump(), where + ".device");
     }
-    Document doc = parse_document(j.dump(), where);
-    const auto cap = static_cast<double>(options.max_map_samples);
-    if (static_cast<double>(doc.device.samples) > cap)
-      throw Reject{"too_large", where + ".device has " + std::to_string(doc.device.samples) + " samples; allowed: at most " +
-                                    std::to_string(options.max_map_samples)};
-    for (std::size_t i = 0; i < doc.regions.size(); ++i) {
-      const RegionSpec& r = doc.regions[i];
-      if (r.reference) continue;
-      const double length = r.length_mm ? *r.length_mm : doc.device.length_mm() - r.start_mm;
-      if (length / r.texel.texel_length.value() > cap)
-        throw Reject{"too_large", where + ".regions[" + std::to_string(i) + "] holds more than " +
-                                      std::to_string(options.max_map_samples) + " texels; use a longer texel_length_mm"};
+    if (device && j.contains("device_grid") && j["device_grid"].is_object()) {
+      const json& g = j["device_grid"];
+      auto opt = [&](const char* k) { return g.contains(k) && g[k].is_number() ? std::optional(g[k].get<double>()) : std::nullopt; };
+      device = with_grid(*device, opt("length_mm"), opt("spacing_mm"));
     }
-    return doc;
+    if (device) check_cost(j, *device, where);
+    return parse_document(j.dump(), where);
+  }
+
+  void check_cost(const json& j, const DeviceProfile& device, const std::string& where) const {
+    const auto cap = options.max_map_samples;
+    if (static_cast<double>(device.samples) > static_cast<double>(cap))
+      throw Reject{"too_large", where + ".device has " + std::to_string(device.samples) + " samples; allowed: at most " +
+                                    std::to_string(cap)};
+    std::vector<const json*> textures;
+    if (j.contains("texture")) textures.push_back(&j["texture"]);
+    if (j.contains("regions") && j["regions"].is_array())
+      for (const auto& r : j["regions"])
+        if (r.is_object() && r.contains("texture")) textures.push_back(&r["texture"]);
+    for (const json* t : textures) {
+      if (!t->is_object() || !t->contains("texel_length_mm") || !(*t)["texel_length_mm"].is_number()) continue;
+      const double length = (*t)["texel_length_mm"].get<double>();
+      if (length > 0 && device.length_mm() / length > static_cast<double>(cap))
+        throw Reject{"too_large", where + ": texel_length_mm " + json(length).dump() + " makes more than " +
+                                      std::to_string(cap) + " texels; allowed: at least " +
+                                      json(device.length_mm() / static_cast<double>(cap)).dump() + " mm on this device"};
+    }
   }
 
   static std::optional<std::size_t> region_field(const Fields& f, const char* key) {
@@ -855,15 +875,23 @@ struct Service::Impl {
                                      ") is running; stop it first (experiment.stop)"};
     } else {
       active.reset();
+      ex::Store& st = the_store();
+      const bool unfinished = st.unfinished_session(o.participant, protocol->name).has_value();
+      if (unfinished && !o.resume)
+        throw Reject{"conflict", "experiment.start: participant " + clipped(o.participant) + " has an unfinished " +
+                                     protocol->name + " session; resume it (resume: true)"};
+      if (!unfinished && o.resume)
+        throw Reject{"not_found", "experiment.start: participant " + clipped(o.participant) + " has no unfinished " +
+                                      protocol->name + " session to resume"};
       try {
-        active.emplace(ex::open_session(the_store(), *protocol, o));
-      } catch (const InvalidArgument& e) {
-        throw Reject{"conflict", std::string("experiment.start: ") + e.what()};
+        active.emplace(ex::open_session(st, *protocol, o));
+      } catch (const InvalidArgument&) {
+        throw;
       } catch (const FormatError&) {
         throw;
       } catch (const IoError&) {
         throw;
-      } catch (const Error& e) {
+      } catch (const Error& e) {  // another process is writing this session
         throw Reject{"conflict", std::string("experiment.start: ") + e.what()};
       }
       new_trial();
