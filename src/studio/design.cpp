@@ -4,11 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <unistd.h>
 
 #include "texel/bitstream.hpp"
 #include "texel/detail/format.hpp"
@@ -97,7 +96,7 @@ HistogramView histogram_of(const TexelTexture& t, std::size_t bins) {
   return v;
 }
 
-// The region's spec as a bitstream; "" or the reason it cannot be one.
+// The region's spec as a bitstream (InvalidArgument when a field is not representable).
 std::vector<std::uint8_t> region_bitstream(const TexelTexture& t, const Region& r) {
   return codec::write_bitstream(codec::from_spec(t.spec(), Millimetres(r.length_mm)));
 }

@@ -8,8 +8,8 @@
 // being run. Clients are numbered by the server; each message is one JSON
 // object with a "type" (docs/studio.md lists them all, with limits).
 //
-// Threads. handle() may be called from any thread. Cheap messages (finger
-// positions, slider previews) are answered before handle() returns; slow
+// Threads. handle() may be called from any thread. Cheap messages (hello,
+// finger positions, backend state) are answered before handle() returns; slow
 // ones (designing a map, encoding, experiment steps) run on the service's
 // own worker threads and answer through the client's Sink later. Design
 // requests coalesce: while one is being computed, newer ones from the same
