@@ -509,7 +509,10 @@ export function mountDesigner(root: HTMLElement): void {
       const bytes = new Uint8Array(await f.arrayBuffer());
       const dev = typeof s.device === 'string' ? s.device : s.device.name;
       const r = await client.call<ImportReply>('import', { name: f.name, data_base64: bytesToBase64(bytes), device: dev }, 120000);
-      Object.assign(s, stateFromDocument(r.document, s));
+      // The controls hold on to s.texel: update it in place.
+      const ns = stateFromDocument(r.document, s);
+      Object.assign(s.texel, ns.texel);
+      Object.assign(s, ns, { texel: s.texel });
       syncControls();
       status.textContent = `imported ${f.name}`;
       status.dataset.imported = f.name;

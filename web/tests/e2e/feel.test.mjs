@@ -1,11 +1,18 @@
 // Feel it: a mouse sweep and a touch sweep over the strip reach the engine's
 // player (null backend), whose reported position (#player-position, polled
 // from feel.state) follows the pointer.
+//
+// The sweeps move at a hand's pace (~1 mm per 10 ms). The player extrapolates
+// up to 30 ms past its newest sample at the finger's last velocity
+// (PlayerConfig::extrapolate_s) and holds there once samples stop, so the
+// reported position may lead the last pointer sample by ~velocity × 30 ms:
+// the tolerance (3 mm) allows for it.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { withStudio, openDesigner, screenshot } from './studio.mjs';
 
 const TPAD_MM = 19200 * 0.0053;
+const TOL_MM = 3;
 
 async function stripBox(page) {
   await page.locator('[data-testid=feel-strip]').scrollIntoViewIfNeeded();
@@ -14,17 +21,26 @@ async function stripBox(page) {
   return b;
 }
 
-async function waitPlayerAt(page, mm, tol = 1.0) {
+async function waitPlayerAt(page, mm) {
   await page.waitForFunction(
     ([want, tol]) => {
       const el = document.querySelector('#player-position');
-      const v = Number(el?.dataset.mm);
-      return el?.dataset.mm !== '' && Math.abs(v - want) <= tol;
+      return el?.dataset.mm !== '' && Math.abs(Number(el.dataset.mm) - want) <= tol;
     },
-    [mm, tol],
+    [mm, TOL_MM],
     { timeout: 10_000 },
   );
   return Number(await page.getAttribute('#player-position', 'data-mm'));
+}
+
+/** Moves from fraction f0 to f1 of the strip in ~1 mm steps; `move(x)` sends one sample at client x. */
+async function sweep(page, b, f0, f1, move) {
+  const steps = Math.max(1, Math.round(Math.abs(f1 - f0) * TPAD_MM));
+  for (let k = 1; k <= steps; k++) {
+    await move(b.x + 2 + (f0 + ((f1 - f0) * k) / steps) * (b.width - 4));
+    await page.waitForTimeout(10);
+  }
+  return ((2 + f1 * (b.width - 4)) / b.width) * TPAD_MM;
 }
 
 test('feel: a mouse sweep reaches the player', { timeout: 120_000 }, async () => {
@@ -32,12 +48,13 @@ test('feel: a mouse sweep reaches the player', { timeout: 120_000 }, async () =>
     await openDesigner(page, studio.url);
     const b = await stripBox(page);
     const y = b.y + b.height / 2;
-    const seen = [];
     // Hovering counts as touch for a mouse (feel.ts); the sweep goes left to right.
-    for (const f of [0.1, 0.3, 0.5, 0.7, 0.9]) {
-      const x = b.x + 2 + f * (b.width - 4);
-      await page.mouse.move(x, y, { steps: 4 });
-      const want = ((x - b.x) / b.width) * TPAD_MM;
+    await page.mouse.move(b.x + 2 + 0.1 * (b.width - 4), y);
+    const seen = [];
+    let f = 0.1;
+    for (const g of [0.3, 0.5, 0.7, 0.9]) {
+      const want = await sweep(page, b, f, g, (x) => page.mouse.move(x, y));
+      f = g;
       seen.push(await waitPlayerAt(page, want));
     }
     for (let i = 1; i < seen.length; i++) assert.ok(seen[i] > seen[i - 1], `positions increase: ${seen.join(', ')}`);
@@ -59,23 +76,22 @@ test('feel: a touch sweep reaches the player', { timeout: 120_000 }, async () =>
       const b = await stripBox(page);
       const y = Math.round(b.y + b.height / 2);
       const cdp = await context.newCDPSession(page);
-      const at = (f) => Math.round(b.x + 2 + f * (b.width - 4));
-      await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: [{ x: at(0.8), y }] });
-      const seen = [await waitPlayerAt(page, ((at(0.8) - b.x) / b.width) * TPAD_MM)];
-      for (const f of [0.6, 0.4, 0.2]) {
-        for (let k = 1; k <= 5; k++) {
-          const g = f + 0.2 * (1 - k / 5);
-          await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: [{ x: at(g), y }] });
-        }
-        seen.push(await waitPlayerAt(page, ((at(f) - b.x) / b.width) * TPAD_MM));
+      const touch = (type, x) => cdp.send('Input.dispatchTouchEvent', { type, touchPoints: x === undefined ? [] : [{ x: Math.round(x), y }] });
+      await touch('touchStart', b.x + 2 + 0.8 * (b.width - 4));
+      const seen = [await waitPlayerAt(page, ((2 + 0.8 * (b.width - 4)) / b.width) * TPAD_MM)];
+      let f = 0.8;
+      for (const g of [0.6, 0.4, 0.2]) {
+        const want = await sweep(page, b, f, g, (x) => touch('touchMove', x));
+        f = g;
+        seen.push(await waitPlayerAt(page, want));
       }
       await page.waitForFunction(() => document.querySelector('#player-position').dataset.touching === 'true');
       await screenshot(page, 'feel-touch');
-      await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+      await touch('touchEnd');
       await page.waitForFunction(() => document.querySelector('#player-position').dataset.touching === 'false', null, { timeout: 10_000 });
       for (let i = 1; i < seen.length; i++) assert.ok(seen[i] < seen[i - 1], `positions decrease: ${seen.join(', ')}`);
       assert.deepEqual(errors, []);
     },
-    { contextOptions: { hasTouch: true, isMobile: false, viewport: { width: 1024, height: 1366 } } },
+    { contextOptions: { hasTouch: true, viewport: { width: 1024, height: 1366 } } },
   );
 });
