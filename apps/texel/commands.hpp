@@ -21,5 +21,6 @@ void register_controller(CLI::App& app);
 void register_staircase(CLI::App& app);
 void register_stats(CLI::App& app);
 void register_experiment(CLI::App& app);
+void register_studio(CLI::App& app);
 
 }  // namespace texel::cli

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   texel::cli::register_experiment(app);
   texel::cli::register_staircase(app);
   texel::cli::register_stats(app);
+  texel::cli::register_studio(app);
   try {
     app.parse(argc, argv);
     return 0;

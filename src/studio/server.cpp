@@ -560,7 +560,7 @@ void Server::Impl::begin_stop() {
   const auto connections = live();
   if (connections.empty()) return;
   for (const auto& c : connections) c->shutdown();
-  grace.expires_after(options.limits.ws_handshake_timeout);
+  grace.expires_after(options.limits.stop_grace);
   grace.async_wait([this](beast::error_code e) {
     if (e) return;
     for (const auto& c : live()) c->abort();

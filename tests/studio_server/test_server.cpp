@@ -681,7 +681,7 @@ TEST(StudioServerWs, StopCutsAPeerThatIgnoresTheClosingHandshake) {
   Site site;
   FakeHandler h;
   ServerOptions o = options_for(site);
-  o.limits.ws_handshake_timeout = 300ms;
+  o.limits.stop_grace = 300ms;
   Server server(h, o);
   const std::uint16_t port = server.start();
   std::thread runner([&] { server.run(); });

@@ -31,7 +31,8 @@
 //   whole within `http_timeout` (slowloris); a WebSocket that receives
 //   nothing for half of `ws_idle_timeout` is pinged and closed if still
 //   silent at `ws_idle_timeout`. Opening and closing handshakes are bounded
-//   by `ws_handshake_timeout`. A trade-off: a peer trickling one valid byte
+//   by `ws_handshake_timeout`; on stop(), peers get `stop_grace` to answer
+//   the close ("going away") before they are cut. A trade-off: a peer trickling one valid byte
 //   at a time keeps its connection; `max_connections` bounds the cost.
 #pragma once
 
@@ -54,6 +55,7 @@ struct ServerLimits {
   std::chrono::milliseconds http_timeout{10'000};         ///< to receive one whole HTTP request, and to write a response
   std::chrono::milliseconds ws_handshake_timeout{5'000};  ///< WebSocket opening / closing handshake
   std::chrono::milliseconds ws_idle_timeout{30'000};      ///< silence before a WebSocket is dropped (pinged at half)
+  std::chrono::milliseconds stop_grace{1'000};            ///< stop() waits this long for closing handshakes, then cuts
 };
 
 struct ServerOptions {
@@ -79,8 +81,8 @@ class Server {
   /// Checks the web root and binds the address; returns the bound port.
   /// Throws IoError naming the path or address (missing front end, port in use).
   std::uint16_t start();
-  /// Serves until stop(); returns once every connection has closed (bounded
-  /// by ws_handshake_timeout, then the rest are cut).
+  /// Serves until stop(); returns once every connection has closed (within
+  /// stop_grace; the rest are cut).
   void run();
   /// Thread-safe, idempotent; may be called before, during or after run().
   void stop();
