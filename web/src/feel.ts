@@ -14,9 +14,65 @@ import { h, stats, fmt } from './util';
 import { hearIt } from './audio';
 import type { FeelState } from './protocol';
 
-const sentAt = new Map<number, number>();
+// Finger samples travel on their own WebSocket, owned by a small worker:
+// the worker sends each sample the moment it is posted and time-stamps the
+// feel.ack as it arrives, whatever the page's main thread is doing (after a
+// pointer event Chromium renders a frame first, which would otherwise add up
+// to a frame to every measured ack). Times are absolute (timeOrigin + now),
+// so the page's and the worker's clocks agree.
+const FEEL_WORKER = `
+let ws = null, url = '', sent = new Map();
+function connect() {
+  ws = new WebSocket(url);
+  ws.onmessage = (e) => {
+    const t = performance.timeOrigin + performance.now();
+    let m; try { m = JSON.parse(e.data); } catch { return; }
+    if (m.type === 'feel.ack') {
+      const t0 = sent.get(m.seq); sent.delete(m.seq);
+      postMessage({ ack: m.seq, ms: t0 === undefined ? null : t - t0 });
+    } else if (m.type === 'error') postMessage({ error: m.message });
+  };
+  ws.onclose = () => { ws = null; setTimeout(connect, 500); };
+}
+onmessage = (e) => {
+  const m = e.data;
+  if (m.url) { url = m.url; connect(); return; }
+  if (!ws || ws.readyState !== 1) { postMessage({ dropped: m.seq }); return; }
+  if (sent.size > 4096) sent.clear();
+  sent.set(m.seq, m.t0);
+  ws.send(JSON.stringify({ type: 'feel.move', seq: m.seq, x_mm: m.x_mm, touch: m.touch }));
+};
+`;
+
 let seq = 0;
+let worker: Worker | null | undefined;
+const sentAt = new Map<number, number>(); // fallback path (no Worker): main-thread times
 let ackInstalled = false;
+
+function feelWorker(): Worker | null {
+  if (worker !== undefined) return worker;
+  try {
+    const w = new Worker(URL.createObjectURL(new Blob([FEEL_WORKER], { type: 'text/javascript' })));
+    const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
+    w.postMessage({ url: `${proto}//${location.host}/ws` });
+    w.onmessage = (e: MessageEvent) => {
+      const m = e.data as { ack?: number; ms?: number | null; dropped?: number };
+      if (m.ack !== undefined) {
+        stats.feelAcks++;
+        if (typeof m.ms === 'number') pushAck(m.ms);
+      } else if (m.dropped !== undefined) stats.feelMovesSent--;
+    };
+    worker = w;
+  } catch {
+    worker = null;
+  }
+  return worker;
+}
+
+function pushAck(ms: number): void {
+  stats.pointerToAckMs.push(ms);
+  if (stats.pointerToAckMs.length > 5000) stats.pointerToAckMs.splice(0, 1000);
+}
 
 function installAck(): void {
   if (ackInstalled) return;
@@ -27,18 +83,23 @@ function installAck(): void {
     stats.feelAcks++;
     if (t0 !== undefined) {
       sentAt.delete(s);
-      stats.pointerToAckMs.push(performance.now() - t0);
-      if (stats.pointerToAckMs.length > 5000) stats.pointerToAckMs.splice(0, 1000);
+      pushAck(performance.now() - t0);
     }
   });
 }
 
 export function sendMove(x_mm: number, touch: boolean): void {
-  installAck();
   const s = ++seq;
-  if (sentAt.size > 2000) sentAt.clear();
-  sentAt.set(s, performance.now());
-  if (studio().send('feel.move', { seq: s, x_mm, touch })) stats.feelMovesSent++;
+  const w = feelWorker();
+  if (w) {
+    w.postMessage({ seq: s, x_mm, touch, t0: performance.timeOrigin + performance.now() });
+    stats.feelMovesSent++;
+  } else {
+    installAck();
+    if (sentAt.size > 2000) sentAt.clear();
+    sentAt.set(s, performance.now());
+    if (studio().send('feel.move', { seq: s, x_mm, touch })) stats.feelMovesSent++;
+  }
   hearIt.pointer(x_mm, touch);
 }
 
@@ -108,7 +169,10 @@ export class FeelStrip {
 
   private move(x: number, touch: boolean): void {
     this.lastX = x;
-    this.finger.style.left = `${(100 * x) / this.length_mm}%`;
+    // A transform, not `left`: the marker moves on the compositor without a
+    // layout or paint, so the frame after a pointer event is cheap and the
+    // main thread is free for the next message (feel.ack) sooner.
+    this.finger.style.transform = `translateX(${(100 * x) / this.length_mm}%)`;
     this.finger.classList.toggle('touching', touch);
     this.strip.setAttribute('aria-valuenow', x.toFixed(1));
     sendMove(x, touch);
@@ -188,7 +252,7 @@ export class FeelStrip {
     } else {
       this.posText.textContent = `${fmt(p, 2)} mm${st.touching ? ' (touching)' : ''}`;
       this.posText.dataset.mm = String(p);
-      this.playerMark.style.left = `${(100 * p) / this.length_mm}%`;
+      this.playerMark.style.transform = `translateX(${(100 * p) / this.length_mm}%)`;
     }
     this.posText.dataset.touching = String(!!st.touching);
     this.playerMark.classList.toggle('touching', !!st.touching);
