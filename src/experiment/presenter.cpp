@@ -95,6 +95,11 @@ void Presenter::show(const std::string& document_json) {
   ++shown_;
 }
 
+void Presenter::show(std::unique_ptr<const PlayerMap> map) {
+  player_->set_map(std::move(map));
+  ++shown_;
+}
+
 void Presenter::blank() {
   // A one-sample map at rest: the finger is off it, so the player fades out.
   player_->set_map(std::make_unique<const PlayerMap>(Grid{0.0, 1.0, 1}, std::vector<float>{0.0f}));

@@ -40,6 +40,7 @@
 #include "texel/experiment/presenter.hpp"
 #include "texel/experiment/runner.hpp"
 #include "texel/finger.hpp"
+#include "texel/player.hpp"
 #include "texel/reference.hpp"
 #include "texel/studio/design.hpp"
 
@@ -500,7 +501,8 @@ struct Service::Impl {
     while (true) {
       wake.wait(lock, [&] { return stopping || !fifo.empty(); });
       if (stopping) return;
-      auto [c, job] = std::move(fifo.front());
+      const std::shared_ptr<Client> c = std::move(fifo.front().first);
+      const Job job = std::move(fifo.front().second);
       fifo.pop_front();
       --c->fifo_jobs;
       lock.unlock();
@@ -683,10 +685,11 @@ struct Service::Impl {
 
   void feel_select(Client& c, const Job& job) {
     const Fields f(job.msg, job.type, {"document"});
-    const Document doc = document_of(f.object("document"), "document");
+    // Rendered here, outside feel_mutex: finger samples keep flowing meanwhile.
+    auto map = PlayerMap::from_surface(prepare_surface(document_of(f.object("document"), "document")));
     {
       std::lock_guard lock(feel_mutex);
-      presenter->show(document_json(doc));
+      presenter->show(std::move(map));
     }
     send(c, reply("feel.selected", job.id));
   }

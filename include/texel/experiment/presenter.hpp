@@ -58,6 +58,9 @@ class Presenter {
 
   /// Plays the texture document (a Texel document as JSON text).
   void show(const std::string& document_json);
+  /// Plays a map prepared by the caller (PlayerMap::from_surface), so a
+  /// front end shared by several threads can render outside its lock.
+  void show(std::unique_ptr<const PlayerMap> map);
   /// Silence (between trials, during the working-memory matrix).
   void blank();
   /// Feeds the simulated finger ahead of the player (simulated mode) and
