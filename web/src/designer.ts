@@ -473,18 +473,22 @@ export function mountDesigner(root: HTMLElement): void {
     }
   });
 
+  function shown(v: number): number {
+    return Math.round(v * 1e4) / 1e4;
+  }
+
   function syncControls(): void {
-    pitch.set(t.central_pitch_db);
-    irr.set(t.irregularity_db);
-    length.set(t.texel_length_mm);
+    pitch.set(shown(t.central_pitch_db));
+    irr.set(shown(t.irregularity_db));
+    length.set(shown(t.texel_length_mm));
     seedIn.value = String(t.seed);
     param.el.value = t.parameterization;
-    quant.set(t.quantization_db);
-    cStrength.set(t.coarse_strength);
-    fStrength.set(t.fine_strength);
-    constVal.set(t.coarse_value);
-    sinePeriod.set(t.sine_period_mm);
-    sinePhase.set(t.sine_phase_deg);
+    quant.set(shown(t.quantization_db));
+    cStrength.set(shown(t.coarse_strength));
+    fStrength.set(shown(t.fine_strength));
+    constVal.set(shown(t.coarse_value));
+    sinePeriod.set(shown(t.sine_period_mm));
+    sinePhase.set(shown(t.sine_phase_deg));
     coarseSel.el.value = t.coarse;
     splitSel.el.value = s.split ? 'split' : 'single';
     refRow.hidden = !s.split;

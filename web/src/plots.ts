@@ -178,7 +178,9 @@ export class MapPlot {
     this.y = values;
     this.regions = regions;
     const data: uPlot.AlignedData = [this.x, this.y];
+    // setData(…, false) keeps the zoom but does not repaint (uPlot 1.6): redraw explicitly.
     this.main.setData(data, gridChanged);
+    if (!gridChanged) this.main.redraw(true, false);
     this.detail.setData(data, false);
     if (gridChanged || !Number.isFinite(this.detailCentre)) this.setDetail(focus_mm ?? origin_mm + (values.length * spacing_mm) / 2);
     else this.setDetail(this.detailCentre);

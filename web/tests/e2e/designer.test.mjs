@@ -3,7 +3,7 @@
 // re-imported restores the sliders.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { withStudio, openDesigner, nextDraw, stats, screenshot, artifact, setRange } from './studio.mjs';
+import { withStudio, openDesigner, nextDraw, stats, screenshot, artifact, setRange, canvasHash } from './studio.mjs';
 
 test('designer: slider, drawn coarse profile, export and re-import', { timeout: 180_000 }, async () => {
   await withStudio(async ({ studio, page, errors }) => {
@@ -11,6 +11,7 @@ test('designer: slider, drawn coarse profile, export and re-import', { timeout: 
     await page.waitForSelector('[data-testid=encoded-bytes][data-bytes]');
     const s0 = await stats(page);
     const hex0 = await page.textContent('[data-testid=encoded-hex]');
+    const px0 = { map: await canvasHash(page, 'map-plot'), hist: await canvasHash(page, 'histogram-plot') };
     await screenshot(page, 'designer-initial');
 
     // Move the Central Pitch slider with the keyboard (each key press is an input event).
@@ -25,6 +26,8 @@ test('designer: slider, drawn coarse profile, export and re-import', { timeout: 
     s1 = await stats(page);
     assert.notEqual(s1.lastMapChecksum, s0.lastMapChecksum, 'the map changed');
     assert.notEqual(s1.lastHistChecksum, s0.lastHistChecksum, 'the histogram changed');
+    assert.notEqual(await canvasHash(page, 'map-plot'), px0.map, 'the map was redrawn');
+    assert.notEqual(await canvasHash(page, 'histogram-plot'), px0.hist, 'the histogram was redrawn');
     const hex1 = await page.textContent('[data-testid=encoded-hex]');
     assert.notEqual(hex1, hex0, 'the encoded bitstream changed');
     assert.match(await page.textContent('[data-testid=pitch-cpm]'), /cycles\/mm/);
@@ -38,6 +41,7 @@ test('designer: slider, drawn coarse profile, export and re-import', { timeout: 
     await screenshot(page, 'designer-after-slider');
 
     // Draw a coarse profile with the pointer on the map.
+    const px2 = await canvasHash(page, 'map-plot');
     await page.click('[data-testid=draw-coarse]');
     const over = await page.locator('[data-testid=map-plot] .u-over').boundingBox();
     await page.mouse.move(over.x + over.width * 0.05, over.y + over.height * 0.9);
@@ -48,6 +52,8 @@ test('designer: slider, drawn coarse profile, export and re-import', { timeout: 
     }
     await page.mouse.up();
     const s3 = await nextDraw(page, s2.designsDrawn);
+    await page.waitForTimeout(100);
+    assert.notEqual(await canvasHash(page, 'map-plot'), px2, 'the map was redrawn with the profile');
     assert.notEqual(s3.lastMapChecksum, s2.lastMapChecksum, 'the drawn profile changed the map');
     assert.match(await page.textContent('[data-testid=points-info]'), /\d+ drawn points/);
     assert.ok(s3.lastEncodedBytes > s2.lastEncodedBytes, 'the coarse section adds bytes');

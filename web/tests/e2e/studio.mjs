@@ -178,3 +178,13 @@ export function setRange(page, selector, value) {
     value,
   );
 }
+
+/** A hash of a plot's drawn pixels (its uPlot canvas), to see that it was redrawn. */
+export function canvasHash(page, testid) {
+  return page.$eval(`[data-testid=${testid}] canvas`, (c) => {
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let h = 0;
+    for (let i = 0; i < d.length; i += 4) h = (h * 31 + d[i] + 7 * d[i + 1] + 13 * d[i + 2]) >>> 0;
+    return h;
+  });
+}
