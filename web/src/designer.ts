@@ -331,7 +331,9 @@ export function mountDesigner(root: HTMLElement): void {
     if (r.encoded && r.encoded.bytes !== null) {
       bytesEl.textContent = `${r.encoded.bytes} bytes`;
       bytesEl.dataset.bytes = String(r.encoded.bytes);
-      hexEl.textContent = r.encoded.hex ?? '';
+      const hex = r.encoded.hex ?? '';
+      hexEl.textContent = hex.length > 72 ? `${hex.slice(0, 72)}…` : hex;
+      hexEl.title = hex;
       stats.lastEncodedBytes = r.encoded.bytes;
     } else {
       bytesEl.textContent = r.encoded?.error ? 'not encodable' : '–';

@@ -21,9 +21,16 @@ import type { FeelState } from './protocol';
 // to a frame to every measured ack). Times are absolute (timeOrigin + now),
 // so the page's and the worker's clocks agree.
 const FEEL_WORKER = `
-let ws = null, url = '', sent = new Map();
+let ws = null, url = '', sent = new Map(), waiting = null;
+function send(m) {
+  if (sent.size > 4096) sent.clear();
+  sent.set(m.seq, m.t0);
+  ws.send(JSON.stringify({ type: 'feel.move', seq: m.seq, x_mm: m.x_mm, touch: m.touch }));
+}
 function connect() {
   ws = new WebSocket(url);
+  // While connecting, only the newest sample is kept (it is where the finger is now).
+  ws.onopen = () => { if (waiting) { const m = waiting; waiting = null; send(m); } };
   ws.onmessage = (e) => {
     const t = performance.timeOrigin + performance.now();
     let m; try { m = JSON.parse(e.data); } catch { return; }
@@ -37,10 +44,12 @@ function connect() {
 onmessage = (e) => {
   const m = e.data;
   if (m.url) { url = m.url; connect(); return; }
-  if (!ws || ws.readyState !== 1) { postMessage({ dropped: m.seq }); return; }
-  if (sent.size > 4096) sent.clear();
-  sent.set(m.seq, m.t0);
-  ws.send(JSON.stringify({ type: 'feel.move', seq: m.seq, x_mm: m.x_mm, touch: m.touch }));
+  if (!ws || ws.readyState !== 1) {
+    if (waiting) postMessage({ dropped: waiting.seq });
+    waiting = m;
+    return;
+  }
+  send(m);
 };
 `;
 
@@ -49,7 +58,7 @@ let worker: Worker | null | undefined;
 const sentAt = new Map<number, number>(); // fallback path (no Worker): main-thread times
 let ackInstalled = false;
 
-function feelWorker(): Worker | null {
+export function feelWorker(): Worker | null {
   if (worker !== undefined) return worker;
   try {
     const w = new Worker(URL.createObjectURL(new Blob([FEEL_WORKER], { type: 'text/javascript' })));
@@ -159,6 +168,7 @@ export class FeelStrip {
     );
     this.bind();
     this.startPolling();
+    feelWorker(); // connect before the first touch
   }
 
   private xOf(e: PointerEvent): number {

@@ -188,3 +188,9 @@ export function canvasHash(page, testid) {
     return h;
   });
 }
+
+/** Waits until the designer's plotted map (data checksum) differs from `prev`; returns the stats. */
+export async function mapChanged(page, prev) {
+  await page.waitForFunction((p) => window.__texelStats.lastMapChecksum !== p, prev, { timeout: 30_000 });
+  return stats(page);
+}
