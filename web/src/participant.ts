@@ -122,7 +122,7 @@ export function mountParticipant(root: HTMLElement): void {
       choice: q.choices.length > 0,
       rating: !!q.rating_scale,
       confidence: q.confidence,
-      digit: q.recall_cell >= 0,
+      digit: q.recall_cell >= -1, // -1: the recall question indicates all cells (control matrix); -2: none
       sliders: q.sliders.length >= 2,
     };
     let inputsReady = q.phases.length === 0;
@@ -268,15 +268,15 @@ export function mountParticipant(root: HTMLElement): void {
       answerArea.append(h('p', { class: 'scale-label' }, `${lo} = very different … ${hi} = identical`), g.el);
     }
     if (needs.digit) {
-      const r = Math.floor(q.recall_cell / 4) + 1;
-      const c = (q.recall_cell % 4) + 1;
+      const where =
+        q.recall_cell >= 0 ? `in row ${Math.floor(q.recall_cell / 4) + 1}, column ${(q.recall_cell % 4) + 1}` : 'in the cells';
       const opts = [];
       for (let v = 1; v <= 9; v++) opts.push({ value: String(v), text: String(v) });
-      const g = radioGroup(`Digit in row ${r}, column ${c}`, opts, (v) => {
+      const g = radioGroup(`Digit ${where}`, opts, (v) => {
         answer.digit = Number(v);
         update();
       }, 'digit');
-      answerArea.append(h('p', { class: 'prompt' }, `Which digit was in row ${r}, column ${c} of the matrix?`), g.el);
+      answerArea.append(h('p', { class: 'prompt' }, `Which digit was ${where} of the matrix?`), g.el);
     }
     if (q.confidence) {
       const opts = [1, 2, 3, 4, 5].map((v) => ({ value: String(v), text: String(v) }));
