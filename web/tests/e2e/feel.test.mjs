@@ -46,6 +46,8 @@ async function sweep(page, b, f0, f1, move) {
 test('feel: a mouse sweep reaches the player', { timeout: 120_000 }, async () => {
   await withStudio(async ({ studio, page, errors }) => {
     await openDesigner(page, studio.url);
+    // Browser audio on (AudioWorklet; headless Chromium plays to a null sink).
+    await page.check('#hear-it');
     const b = await stripBox(page);
     const y = b.y + b.height / 2;
     // Hovering counts as touch for a mouse (feel.ts); the sweep goes left to right.
@@ -60,6 +62,8 @@ test('feel: a mouse sweep reaches the player', { timeout: 120_000 }, async () =>
     for (let i = 1; i < seen.length; i++) assert.ok(seen[i] > seen[i - 1], `positions increase: ${seen.join(', ')}`);
     await page.waitForFunction(() => document.querySelector('#player-position').dataset.touching === 'true');
     await screenshot(page, 'feel-mouse');
+    assert.ok(await page.isChecked('#hear-it'), 'Hear it stayed on (the worklet started)');
+    assert.equal(await page.textContent('[data-testid=designer-status]'), '');
     // Leaving the strip lifts the finger.
     await page.mouse.move(b.x + b.width / 2, b.y - 200);
     await page.waitForFunction(() => document.querySelector('#player-position').dataset.touching === 'false', null, { timeout: 10_000 });
