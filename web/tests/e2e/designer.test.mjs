@@ -3,6 +3,7 @@
 // re-imported restores the sliders.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
 import { withStudio, openDesigner, nextDraw, stats, screenshot, artifact, setRange, canvasHash, mapChanged } from './studio.mjs';
 
 test('designer: slider, drawn coarse profile, export and re-import', { timeout: 180_000 }, async () => {
@@ -78,6 +79,23 @@ test('designer: slider, drawn coarse profile, export and re-import', { timeout: 
     assert.equal(await page.inputValue('#texel-length'), exported.length, 'texel length restored');
     assert.equal(await page.inputValue('#coarse-kind'), 'points', 'drawn profile restored');
     await screenshot(page, 'designer-reimported');
+
+    // A bitstream (.texel) dropped on the page imports too (decoded on the device).
+    const [bits] = await Promise.all([page.waitForEvent('download'), page.click('[data-testid=export-bitstream]')]);
+    assert.match(bits.suggestedFilename(), /\.texel$/);
+    const bitsFile = artifact('exported.texel');
+    await bits.saveAs(bitsFile);
+    const bytes = [...readFileSync(bitsFile)];
+    assert.equal(bytes[0], 0x54, 'bitstream magic');
+    await setRange(page, '#central-pitch', 0);
+    const dt = await page.evaluateHandle((b) => {
+      const d = new DataTransfer();
+      d.items.add(new File([new Uint8Array(b)], 'dropped.texel', { type: 'application/octet-stream' }));
+      return d;
+    }, bytes);
+    await page.dispatchEvent('.page-designer', 'drop', { dataTransfer: dt });
+    await page.waitForFunction(() => document.querySelector('[data-testid=designer-status]').dataset.imported === 'dropped.texel');
+    assert.equal(await pitch.inputValue(), exported.pitch, 'Central Pitch restored from the dropped bitstream');
     assert.deepEqual(errors, []);
   });
 });
