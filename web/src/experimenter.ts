@@ -62,6 +62,28 @@ export function mountExperimenter(root: HTMLElement): void {
     await refresh();
   } }, 'Stop (suspend)');
 
+  // Sessions started with a simulate spec can be answered by the engine's
+  // simulated participant (experiment.answer {trial, simulated: true}).
+  let simulating = false;
+  const simulateBtn = h('button', { type: 'button', 'data-testid': 'simulate-run' }, 'Run the simulated participant') as HTMLButtonElement;
+  simulateBtn.addEventListener('click', async () => {
+    simulating = !simulating;
+    simulateBtn.textContent = simulating ? 'Pause the simulation' : 'Run the simulated participant';
+    while (simulating && document.body.contains(root)) {
+      try {
+        const cur = await client.call<{ type: string; question?: { trial: number } }>('experiment.current', {}, 30000);
+        if (cur.type !== 'experiment.question' || !cur.question) break;
+        await client.call('experiment.answer', { trial: cur.question.trial, simulated: true }, 60000);
+      } catch (e) {
+        status.textContent = e instanceof Error ? e.message : String(e);
+        break;
+      }
+    }
+    simulating = false;
+    simulateBtn.textContent = 'Run the simulated participant';
+    await refresh();
+  });
+
   function row(s: SessionInfo): HTMLElement {
     const resumeBtn = s.finished
       ? h('span', {}, '')
@@ -72,7 +94,7 @@ export function mountExperimenter(root: HTMLElement): void {
       h('td', {}, String(s.id)),
       h('td', {}, s.participant),
       h('td', {}, s.protocol),
-      h('td', { class: 'progress-cell' }, `${s.trials_done} / ${s.trials_planned}`),
+      h('td', { class: 'progress-cell' }, s.trials_planned > 0 ? `${s.trials_done} / ${s.trials_planned}` : `${s.trials_done} (adaptive)`),
       h('td', { 'data-testid': 'session-state' }, s.finished ? 'finished' : 'unfinished'),
       h('td', {}, resumeBtn),
     );
@@ -94,7 +116,9 @@ export function mountExperimenter(root: HTMLElement): void {
       let progress = '';
       try {
         const cur = await client.call<{ type: string; progress?: { done: number; planned: number } }>('experiment.current', {}, 15000);
-        if (cur.progress) progress = `${cur.progress.done} / ${cur.progress.planned} trials`;
+        if (cur.progress)
+          progress = cur.progress.planned > 0 ? `${cur.progress.done} / ${cur.progress.planned} trials` : `${cur.progress.done} trials (adaptive)`;
+        if (cur.type === 'experiment.finished') progress += ', finished';
         active.dataset.state = cur.type;
       } catch {
         /* list is enough */
@@ -107,6 +131,7 @@ export function mountExperimenter(root: HTMLElement): void {
         stopBtn,
         ' ',
         openLink,
+        (l.active as { simulated?: boolean }).simulated ? simulateBtn : '',
       );
     } else {
       active.dataset.state = 'idle';

@@ -154,7 +154,9 @@ export function mountParticipant(root: HTMLElement): void {
     const msg = h('p', { class: 'status', role: 'status', 'aria-live': 'polite', 'data-testid': 'participant-status' });
 
     const parts: (HTMLElement | null)[] = [];
-    const progress = reply.progress ? `${Math.min(reply.progress.done + 1, reply.progress.planned)} of ${reply.progress.planned}` : '';
+    // planned is -1 for adaptive protocols (a staircase decides when to stop).
+    const progress =
+      reply.progress && reply.progress.planned > 0 ? `${Math.min(reply.progress.done + 1, reply.progress.planned)} of ${reply.progress.planned}` : '';
     parts.push(
       h('header', { class: 'q-head' },
         h('span', { class: 'trial', 'data-testid': 'trial-number', 'data-trial': q.trial }, `Trial ${q.trial + 1}`),

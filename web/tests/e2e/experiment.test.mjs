@@ -99,3 +99,22 @@ test('experiment: guided-exploration through the participant screen, with a relo
     assert.deepEqual(errors, []);
   });
 });
+
+test('experiment: a simulated session run from the experimenter view', { timeout: 300_000 }, async () => {
+  await withStudio(async ({ studio, page, errors }) => {
+    await page.goto(`${studio.url}#/experimenter`);
+    await page.waitForSelector('#protocol option[value="texel-length"]', { state: 'attached' });
+    await page.selectOption('#protocol', 'texel-length');
+    await page.fill('#participant', 'SIM1');
+    await page.fill('#simulate', 'threshold=6mm');
+    await page.click('[data-testid=start]');
+    await page.click('[data-testid=simulate-run]', { timeout: 30_000 });
+    await page.waitForFunction(
+      () => [...document.querySelectorAll('[data-testid=sessions] tbody tr')].some((r) => /SIM1/.test(r.textContent) && r.dataset.finished === 'true'),
+      null,
+      { timeout: 240_000 },
+    );
+    await screenshot(page, 'experimenter-simulated');
+    assert.deepEqual(errors, []);
+  });
+});
