@@ -1,7 +1,9 @@
 // Latency, measured in the browser with performance.now() (web/src: the
 // designer and the strip record each sample in window.__texelStats):
 //   slider change → map and histogram redrawn (tpad), one change at a time;
-//   pointer move  → feel.ack received (the sample is queued on the player).
+//   pointer move  → feel.ack received (the sample is queued on the player),
+//                   from the pointer handler's post to the finger worker to
+//                   the ack's arrival in that worker.
 // Written to $TEXEL_ARTIFACTS/latency.json and printed. Only generous sanity
 // bounds are asserted here; the goals (p95 < 50 ms, < 10 ms) are reported by
 // `make bench`.
@@ -53,7 +55,9 @@ test('latency: slider → redraw and pointer → player', { timeout: 300_000 }, 
       device: 'tpad',
       browser: `chromium ${browser.version()}`,
       measured_at: new Date().toISOString(),
-      note: 'browser performance.now(); slider: input event → design reply drawn by uPlot (map, detail, histogram, spectrum); pointer: feel.move sent → feel.ack received',
+      note:
+        'browser clocks (performance.timeOrigin + now). slider: input event → the design reply drawn by uPlot (map, detail, histogram, spectrum), one change at a time; ' +
+        'pointer: pointer event handled → feel.ack received by the finger worker that sends feel.move (web/src/feel.ts)',
     };
     writeFileSync(artifact('latency.json'), JSON.stringify(result, null, 2) + '\n');
     console.log(`slider → redraw  p50 ${result.slider_to_redraw_ms.p50} ms  p95 ${result.slider_to_redraw_ms.p95} ms  (n ${slider.length}; goal p95 < 50 ms)`);
