@@ -278,6 +278,9 @@ class WsSession final : public Connection, public std::enable_shared_from_this<W
 
   void run(http::request<http::string_body> req) {
     id_ = server_.add(shared_from_this());
+    // Upgraded while the server stops: stop()'s round of shutdowns may have
+    // missed this session, so it closes itself once the handshake is done.
+    closing_ = server_.stopping;
     const auto& limits = server_.options.limits;
     beast::get_lowest_layer(ws_).expires_never();  // the WebSocket's own timeouts take over
     websocket::stream_base::timeout timeouts{};
@@ -296,8 +299,8 @@ class WsSession final : public Connection, public std::enable_shared_from_this<W
     net::post(executor_, [self = shared_from_this()] {
       if (self->finished_ || self->closing_) return;
       self->closing_ = true;
-      if (!self->client_) return self->cut();  // still handshaking
-      if (!self->writing_) self->close();      // else once the current write is done
+      // Still handshaking: on_accept closes. Writing: on_write closes.
+      if (self->client_ && !self->writing_) self->close();
     });
   }
 
@@ -329,7 +332,8 @@ class WsSession final : public Connection, public std::enable_shared_from_this<W
   }
 
   void on_accept(beast::error_code ec) {
-    if (ec || closing_) return cut();
+    if (ec) return cut();
+    if (closing_) return close();  // stopped during the handshake: the handler never hears of it
     client_ = server_.handler.connect(make_sink());
     read();
   }
@@ -456,6 +460,8 @@ class HttpSession final : public Connection, public std::enable_shared_from_this
       if (target.substr(0, target.find('?')) != "/ws") return reply(http::status::not_found, "not found", version, false, false);
       if (!origin_allowed(req, server_.options.allowed_origins))
         return reply(http::status::forbidden, "origin not allowed", version, false, false);
+      // The connection now counts as the WebSocket's, before the 101 goes out.
+      server_.remove(std::exchange(id_, 0));
       std::make_shared<WsSession>(server_, stream_.release_socket())->run(std::move(req));
       return;
     }

@@ -424,7 +424,7 @@ TEST(StudioServerWs, UpgradesElsewhereThanWsAreNotFound) {
   }
   WsClient query;
   EXPECT_TRUE(query.connect(r.port, "/ws?session=1")) << query.error();
-  EXPECT_EQ(h.connects(), 1u);
+  EXPECT_TRUE(eventually([&] { return h.connects() == 1; }));
 }
 
 TEST(StudioServerWs, BrowserOriginsMustBeThisServer) {
@@ -550,7 +550,7 @@ TEST(StudioServerWs, ConnectionsBeyondTheLimitAreRefusedWith503) {
   std::vector<std::unique_ptr<WsClient>> clients;
   for (int i = 0; i < 4; ++i) {
     clients.push_back(std::make_unique<WsClient>());
-    ASSERT_TRUE(clients.back()->connect(r.port)) << i;
+    ASSERT_TRUE(clients.back()->connect(r.port)) << i << ": " << clients.back()->status() << " " << clients.back()->error();
   }
   WsClient extra;
   EXPECT_FALSE(extra.connect(r.port));
@@ -628,7 +628,9 @@ TEST(StudioServerWs, AReaderThatNeverReadsIsDroppedAndMemoryStaysBounded) {
   ASSERT_TRUE(slow.send_text("big 65536 4000"));
   ASSERT_TRUE(h.wait_disconnects(1));
   const long after = rss_kib();
+#if !defined(__SANITIZE_ADDRESS__)  // AddressSanitizer's quarantine keeps the freed replies resident
   EXPECT_LT(after - before, 64 * 1024) << "RSS grew by " << (after - before) << " KiB";
+#endif
   std::printf("slow reader dropped; server RSS %ld KiB before, %ld KiB after (+%ld KiB for 250 MiB of replies asked)\n",
               before, after, after - before);
   WsClient other;
@@ -661,7 +663,8 @@ TEST(StudioServerWs, StopSaysGoingAwayAndRunReturns) {
   WsClient a, b;
   ASSERT_TRUE(a.connect(port));
   ASSERT_TRUE(b.connect(port));
-  const int idle = texel::test_support::tcp_connect(port);  // an HTTP connection that never asks
+  ASSERT_TRUE(eventually([&] { return h.connects() == 2; }));  // the client may see 101 first
+  const int idle = texel::test_support::tcp_connect(port);       // an HTTP connection that never asks
   const auto t0 = Clock::now();
   server.stop();
   for (WsClient* c : {&a, &b}) {
