@@ -113,6 +113,40 @@ ordered_json Response::to_json() const {
   return j;
 }
 
+// The presentation / selection log a front end kept for the trial (stored
+// beside the trial, one row per event). Bounded: a trial is minutes long.
+static std::vector<TrialEvent> events_from_json(const json& list) {
+  constexpr std::size_t max_events = 10000, max_text = 256;
+  if (!list.is_array()) throw FormatError("response.events must be an array of events, got " + list.dump().substr(0, 80));
+  if (list.size() > max_events)
+    throw FormatError("response.events has " + std::to_string(list.size()) + " events; at most " + std::to_string(max_events));
+  std::vector<TrialEvent> events;
+  events.reserve(list.size());
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const json& e = list[k];
+    const std::string where = "response.events[" + std::to_string(k) + "]";
+    if (!e.is_object()) throw FormatError(where + " must be an object {t_s, kind, detail?, at?}");
+    TrialEvent ev;
+    for (auto it = e.begin(); it != e.end(); ++it) {
+      const std::string& key = it.key();
+      if (key == "t_s") {
+        if (!it->is_number() || !std::isfinite(it->get<double>()) || it->get<double>() < 0)
+          throw FormatError(where + ".t_s must be a number of seconds >= 0, got " + it->dump());
+        ev.t_s = it->get<double>();
+      } else if (key == "kind" || key == "detail" || key == "at") {
+        if (!it->is_string() || it->get_ref<const std::string&>().size() > max_text)
+          throw FormatError(where + "." + key + " must be a string of at most " + std::to_string(max_text) + " characters");
+        (key == "kind" ? ev.kind : key == "detail" ? ev.detail : ev.at) = it->get<std::string>();
+      } else {
+        throw FormatError(where + " has unknown key '" + key + "'; allowed: t_s, kind, detail, at");
+      }
+    }
+    if (ev.kind.empty()) throw FormatError(where + ".kind is missing (e.g. \"show\", \"select\", \"answer\")");
+    events.push_back(std::move(ev));
+  }
+  return events;
+}
+
 Response Response::from_json(const json& j) {
   if (!j.is_object()) throw FormatError("a response must be a JSON object");
   Response r;
@@ -154,6 +188,7 @@ Response Response::from_json(const json& j) {
   r.directional_proportion = opt("directional_proportion");
   if (j.contains("shown_at") && j["shown_at"].is_string()) r.shown_at = j["shown_at"].get<std::string>();
   if (j.contains("answered_at") && j["answered_at"].is_string()) r.answered_at = j["answered_at"].get<std::string>();
+  if (j.contains("events") && !j["events"].is_null()) r.events = events_from_json(j["events"]);
   return r;
 }
 

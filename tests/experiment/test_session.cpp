@@ -118,6 +118,25 @@ TEST(Session, ResponsesAreValidated) {
   EXPECT_EQ(s.trials_done(), 1);
 }
 
+TEST(Session, ResponseEventsFromAFrontEndAreKeptWithTheTrial) {
+  const auto r = ex::Response::from_json(nlohmann::json::parse(
+      R"({"choice":"2","rt_ms":900,"events":[{"t_s":0,"kind":"show","detail":"","at":"2026-11-23T10:00:00.000Z"},)"
+      R"({"t_s":0.4,"kind":"select","detail":"2"},{"t_s":0.9,"kind":"answer","detail":"2"}]})"));
+  ASSERT_EQ(r.events.size(), 3u);
+  EXPECT_EQ(r.events[1].kind, "select");
+  EXPECT_EQ(r.events[1].detail, "2");
+  EXPECT_DOUBLE_EQ(r.events[2].t_s, 0.9);
+  EXPECT_EQ(r.events[0].at, "2026-11-23T10:00:00.000Z");
+  auto s = make("texel-length");
+  const ex::StoredTrial t = s.answer(r);
+  ASSERT_EQ(t.events.size(), 3u);
+  EXPECT_EQ(t.events[2].kind, "answer");
+  for (const char* bad : {R"({"events":{}})", R"({"events":[1]})", R"({"events":[{"kind":"show","t_s":-1}]})",
+                          R"({"events":[{"t_s":0}]})", R"({"events":[{"t_s":0,"kind":"show","extra":1}]})",
+                          R"({"events":[{"t_s":0,"kind":7}]})"})
+    EXPECT_THROW((void)ex::Response::from_json(nlohmann::json::parse(bad)), texel::FormatError) << bad;
+}
+
 TEST(Session, WorkingMemoryTrialsAreBalancedWithTheSpecMatrix) {
   auto s = make("working-memory");
   std::map<std::string, int> same, total;
