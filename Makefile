@@ -75,11 +75,13 @@ test-asan: deps
 test-determinism: build
 	bash tests/determinism/cross_build.sh
 
-bench: build
+bench: build web
 	$(BUILD)/bin/texel_bench --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
+	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null
+	$(PY) bench/studio_latency.py $(BUILD)/browser-artifacts/latency.json
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

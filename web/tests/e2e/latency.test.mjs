@@ -49,9 +49,29 @@ test('latency: slider → redraw and pointer → player', { timeout: 300_000 }, 
     await page.waitForFunction((k) => window.__texelStats.pointerToAckMs.length >= k, moves, { timeout: 20_000 });
     const pointer = (await stats(page)).pointerToAckMs;
 
+    // Baseline in the same run: a bare WebSocket round trip through the
+    // server and the service (feel.state is answered inline, no work), one
+    // request at a time from the page. Ratios to it compare across machines.
+    const baseline = await page.evaluate(async () => {
+      const ws = new WebSocket(`ws://${location.host}/ws`);
+      await new Promise((ok, fail) => ((ws.onopen = ok), (ws.onerror = fail)));
+      const rtt = [];
+      for (let k = 0; k < 250; k++) {
+        const t0 = performance.now();
+        await new Promise((ok) => {
+          ws.onmessage = ok;
+          ws.send(JSON.stringify({ type: 'feel.state', id: k }));
+        });
+        rtt.push(performance.now() - t0);
+      }
+      ws.close();
+      return rtt;
+    });
+
     const result = {
       slider_to_redraw_ms: summary(slider),
       pointer_to_player_ms: summary(pointer),
+      baseline_ws_round_trip_ms: summary(baseline),
       device: 'tpad',
       browser: `chromium ${browser.version()}`,
       measured_at: new Date().toISOString(),
@@ -62,6 +82,7 @@ test('latency: slider → redraw and pointer → player', { timeout: 300_000 }, 
     writeFileSync(artifact('latency.json'), JSON.stringify(result, null, 2) + '\n');
     console.log(`slider → redraw  p50 ${result.slider_to_redraw_ms.p50} ms  p95 ${result.slider_to_redraw_ms.p95} ms  (n ${slider.length}; goal p95 < 50 ms)`);
     console.log(`pointer → player p50 ${result.pointer_to_player_ms.p50} ms  p95 ${result.pointer_to_player_ms.p95} ms  (n ${pointer.length}; goal p95 < 10 ms)`);
+    console.log(`baseline: WebSocket round trip p50 ${result.baseline_ws_round_trip_ms.p50} ms  p95 ${result.baseline_ws_round_trip_ms.p95} ms`);
     assert.ok(slider.length >= 50, `slider samples ${slider.length}`);
     assert.ok(pointer.length >= 200, `pointer samples ${pointer.length}`);
     assert.ok(result.slider_to_redraw_ms.p95 < 500, 'slider p95 sanity bound');
