@@ -107,7 +107,8 @@ void register_studio(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "null, audio or serial:PATH")->capture_default_str();
   cmd->add_option("--audio-device", args->audio_device, "PortAudio output device for --backend audio (index or name)");
   cmd->add_option("--web", args->web, "the built front end (default: <texel dir>/../web, built by make demo)");
-  cmd->add_option("--protocols", args->protocols, "directory of shipped protocols (default: the source tree's examples/protocols)");
+  cmd->add_option("--protocols", args->protocols,
+                  "directory of shipped protocols (default: the source tree's examples/protocols)");
   cmd->add_flag("--open", args->open, "open the page with xdg-open");
   cmd->callback([args] { run(*args); });
 }

@@ -206,7 +206,7 @@ struct Server::Impl {
   net::strand<net::io_context::executor_type> strand{net::make_strand(ioc)};  // acceptor, timers, signals
   tcp::acceptor acceptor{strand};
   net::signal_set signals{strand};
-  net::steady_timer grace{strand};        // cuts connections that outlive a stop
+  net::steady_timer grace{strand};         // cuts connections that outlive a stop
   net::steady_timer accept_pause{strand};  // after an accept error (e.g. out of descriptors)
 
   std::uint64_t add(const std::shared_ptr<Connection>& c) {
@@ -288,8 +288,8 @@ class WsSession final : public Connection, public std::enable_shared_from_this<W
     timeouts.idle_timeout = limits.ws_idle_timeout;
     timeouts.keep_alive_pings = true;
     ws_.set_option(timeouts);
-    ws_.set_option(websocket::stream_base::decorator(
-        [](websocket::response_type& res) { res.set(http::field::server, server_name); }));
+    ws_.set_option(
+        websocket::stream_base::decorator([](websocket::response_type& res) { res.set(http::field::server, server_name); }));
     ws_.read_message_max(limits.max_message_bytes);
     ws_.auto_fragment(false);
     ws_.async_accept(req, beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
@@ -443,10 +443,11 @@ class HttpSession final : public Connection, public std::enable_shared_from_this
   }
 
   void on_read(beast::error_code ec, std::size_t) {
-    if (ec == http::error::header_limit) return reply(http::status::request_header_fields_too_large, "request header too large", 11, false, false);
+    if (ec == http::error::header_limit)
+      return reply(http::status::request_header_fields_too_large, "request header too large", 11, false, false);
     if (ec == http::error::body_limit) return reply(http::status::payload_too_large, "request body too large", 11, false, false);
-    if (ec && ec.category() == beast::error_code(http::error::bad_target).category() &&
-        ec != http::error::end_of_stream && ec != http::error::partial_message)
+    if (ec && ec.category() == beast::error_code(http::error::bad_target).category() && ec != http::error::end_of_stream &&
+        ec != http::error::partial_message)
       return reply(http::status::bad_request, "malformed request", 11, false, false);
     if (ec) return;  // closed, reset, timed out: nothing to answer
     handle(parser_->release());
@@ -466,10 +467,12 @@ class HttpSession final : public Connection, public std::enable_shared_from_this
       return;
     }
     const bool head = req.method() == http::verb::head;
-    if (req.method() != http::verb::get && !head) return reply(http::status::method_not_allowed, "method not allowed", version, keep_alive, head);
+    if (req.method() != http::verb::get && !head)
+      return reply(http::status::method_not_allowed, "method not allowed", version, keep_alive, head);
     const Lookup found = lookup(server_.root, target);
     if (found.status != http::status::ok)
-      return reply(found.status, found.status == http::status::not_found ? "not found" : "bad request", version, keep_alive, head);
+      return reply(found.status, found.status == http::status::not_found ? "not found" : "bad request", version, keep_alive,
+                   head);
 
     beast::error_code ec;
     http::file_body::value_type body;
@@ -537,9 +540,7 @@ class HttpSession final : public Connection, public std::enable_shared_from_this
 
 // ------------------------------------------------------------ server internals
 
-void Server::Impl::accept() {
-  acceptor.async_accept(net::make_strand(ioc), beast::bind_front_handler(&Impl::on_accept, this));
-}
+void Server::Impl::accept() { acceptor.async_accept(net::make_strand(ioc), beast::bind_front_handler(&Impl::on_accept, this)); }
 
 void Server::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
   if (stopping || !acceptor.is_open()) return;

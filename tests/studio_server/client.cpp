@@ -79,7 +79,8 @@ void reset_close(int fd) {
 
 std::string HttpReply::header(const std::string& name) const {
   std::string folded = headers;
-  std::transform(folded.begin(), folded.end(), folded.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(folded.begin(), folded.end(), folded.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   const std::string key = "\r\n" + name + ":";
   const auto at = folded.find(key);
   if (at == std::string::npos) return "";
@@ -104,8 +105,8 @@ HttpReply http_raw(std::uint16_t port, const std::string& request) {
 }
 
 HttpReply http_request(std::uint16_t port, const std::string& method, const std::string& target) {
-  return http_raw(port, method + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-                            "\r\nConnection: close\r\n\r\n");
+  return http_raw(
+      port, method + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\nConnection: close\r\n\r\n");
 }
 
 std::string ws_frame_header(std::uint64_t payload_length, int opcode) {
@@ -168,8 +169,8 @@ bool WsClient::connect(std::uint16_t port, const std::string& target, const std:
     return false;
   }
   if (!origin.empty())
-    impl_->ws.set_option(websocket::stream_base::decorator(
-        [origin](websocket::request_type& req) { req.set(http::field::origin, origin); }));
+    impl_->ws.set_option(
+        websocket::stream_base::decorator([origin](websocket::request_type& req) { req.set(http::field::origin, origin); }));
   const std::string h = host.empty() ? "127.0.0.1:" + std::to_string(port) : host;
   ec = impl_->run(5s, [&](auto handler) { impl_->ws.async_handshake(impl_->response, h, target, handler); });
   impl_->open = !ec;

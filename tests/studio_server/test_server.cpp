@@ -297,8 +297,8 @@ TEST(StudioServerHttp, OversizedHeadersAndBodiesAreRefused) {
   ServerOptions o = options_for(site);
   o.limits.max_request_bytes = 4096;
   Running r(h, o);
-  const HttpReply big_header = texel::test_support::http_raw(
-      r.port, "GET / HTTP/1.1\r\nHost: x\r\nX-Junk: " + std::string(8000, 'a') + "\r\n\r\n");
+  const HttpReply big_header =
+      texel::test_support::http_raw(r.port, "GET / HTTP/1.1\r\nHost: x\r\nX-Junk: " + std::string(8000, 'a') + "\r\n\r\n");
   EXPECT_EQ(big_header.status, 431);
   const HttpReply big_body = texel::test_support::http_raw(
       r.port, "GET / HTTP/1.1\r\nHost: x\r\nContent-Length: 100000\r\n\r\n" + std::string(100000, 'b'));
@@ -439,16 +439,16 @@ TEST(StudioServerWs, BrowserOriginsMustBeThisServer) {
     int status;
   };
   const Case cases[] = {
-      {"", "", 101},                                                      // not a browser
-      {"http://127.0.0.1:" + port, "", 101},                              // our own page
-      {"http://localhost:" + port, "localhost:" + port, 101},             // addressed by name
-      {"http://[::1]:" + port, "[::1]:" + port, 101},                     // IPv6 literal
-      {"http://localhost:5173", "", 101},                                 // listed (a dev server)
-      {"http://evil.example", "", 403},                                   // another site
-      {"http://127.0.0.1:1", "", 403},                                    // another local server
-      {"null", "", 403},                                                  // file:// or sandboxed
-      {"http://evil.example:" + port, "evil.example:" + port, 403},       // DNS rebinding
-      {"https://127.0.0.1:" + port, "", 403},                             // wrong scheme
+      {"", "", 101},                                                 // not a browser
+      {"http://127.0.0.1:" + port, "", 101},                         // our own page
+      {"http://localhost:" + port, "localhost:" + port, 101},        // addressed by name
+      {"http://[::1]:" + port, "[::1]:" + port, 101},                // IPv6 literal
+      {"http://localhost:5173", "", 101},                            // listed (a dev server)
+      {"http://evil.example", "", 403},                              // another site
+      {"http://127.0.0.1:1", "", 403},                               // another local server
+      {"null", "", 403},                                             // file:// or sandboxed
+      {"http://evil.example:" + port, "evil.example:" + port, 403},  // DNS rebinding
+      {"https://127.0.0.1:" + port, "", 403},                        // wrong scheme
   };
   for (const auto& c : cases) {
     WsClient client;
@@ -525,7 +525,8 @@ TEST(StudioServerWs, AFloodOfTenThousandMessagesIsAnsweredInOrder) {
   constexpr int n = 10000;
   const auto t0 = Clock::now();
   std::thread writer([&] {
-    for (int i = 0; i < n; ++i) flooder.send_raw(texel::test_support::ws_frame_header(std::to_string(i).size()) + std::to_string(i));
+    for (int i = 0; i < n; ++i)
+      flooder.send_raw(texel::test_support::ws_frame_header(std::to_string(i).size()) + std::to_string(i));
   });
   // Another client is served meanwhile.
   WsClient other;
@@ -631,8 +632,8 @@ TEST(StudioServerWs, AReaderThatNeverReadsIsDroppedAndMemoryStaysBounded) {
 #if !defined(__SANITIZE_ADDRESS__)  // AddressSanitizer's quarantine keeps the freed replies resident
   EXPECT_LT(after - before, 64 * 1024) << "RSS grew by " << (after - before) << " KiB";
 #endif
-  std::printf("slow reader dropped; server RSS %ld KiB before, %ld KiB after (+%ld KiB for 250 MiB of replies asked)\n",
-              before, after, after - before);
+  std::printf("slow reader dropped; server RSS %ld KiB before, %ld KiB after (+%ld KiB for 250 MiB of replies asked)\n", before,
+              after, after - before);
   WsClient other;
   ASSERT_TRUE(other.connect(r.port));
   ASSERT_TRUE(other.send_text("fine"));
@@ -664,7 +665,7 @@ TEST(StudioServerWs, StopSaysGoingAwayAndRunReturns) {
   ASSERT_TRUE(a.connect(port));
   ASSERT_TRUE(b.connect(port));
   ASSERT_TRUE(eventually([&] { return h.connects() == 2; }));  // the client may see 101 first
-  const int idle = texel::test_support::tcp_connect(port);       // an HTTP connection that never asks
+  const int idle = texel::test_support::tcp_connect(port);     // an HTTP connection that never asks
   const auto t0 = Clock::now();
   server.stop();
   for (WsClient* c : {&a, &b}) {

@@ -168,8 +168,8 @@ TEST(StudioCli, BadFlagsAddressesAndMissingFrontEndsExitWithTwo) {
   // A port in use.
   Studio first({"--port", "0", "--web", web, "--db", dir.at("a.db")});
   ASSERT_NE(first.port, 0);
-  const auto busy = texel::test_support::run_cli(cli, "studio --port " + std::to_string(first.port) + " --web " + web +
-                                                          " --db " + dir.at("b.db"));
+  const auto busy = texel::test_support::run_cli(
+      cli, "studio --port " + std::to_string(first.port) + " --web " + web + " --db " + dir.at("b.db"));
   EXPECT_EQ(busy.status, 2) << busy.out;
   EXPECT_NE(busy.out.find("cannot listen on 127.0.0.1:" + std::to_string(first.port)), std::string::npos) << busy.out;
   EXPECT_EQ(first.terminate(), 0);
@@ -246,7 +246,8 @@ TEST(StudioCli, AbuseDuringASessionLeavesTheStoredTrialsIntact) {
 
     int trial = started["progress"]["done"].get<int>();
     for (int i = 0; i < answered; ++i) {
-      ASSERT_TRUE(experimenter.send_text(R"({"type":"experiment.answer","simulated":true,"trial":)" + std::to_string(trial) + "}"));
+      ASSERT_TRUE(
+          experimenter.send_text(R"({"type":"experiment.answer","simulated":true,"trial":)" + std::to_string(trial) + "}"));
       const json next = read_json(experimenter);
       ASSERT_EQ(next.value("type", ""), "experiment.question") << next.dump().substr(0, 300);
       EXPECT_EQ(next["progress"]["done"].get<int>(), i + 1);
@@ -277,8 +278,8 @@ TEST(StudioCli, AbuseDuringASessionLeavesTheStoredTrialsIntact) {
   ASSERT_NE(again.port, 0);
   WsClient experimenter;
   ASSERT_TRUE(experimenter.connect(again.port));
-  ASSERT_TRUE(experimenter.send_text(
-      R"({"type":"experiment.start","protocol":"texel-length","participant":"P01","resume":true})"));
+  ASSERT_TRUE(
+      experimenter.send_text(R"({"type":"experiment.start","protocol":"texel-length","participant":"P01","resume":true})"));
   const json resumed = read_json(experimenter);
   ASSERT_EQ(resumed.value("type", ""), "experiment.started") << resumed.dump();
   EXPECT_EQ(resumed["progress"]["done"].get<int>(), answered);

@@ -48,24 +48,24 @@
 namespace texel::studio {
 
 struct ServerLimits {
-  std::size_t max_message_bytes = 4u << 20;   ///< largest WebSocket message accepted (bigger: closed, code 1009)
-  std::size_t max_connections = 32;           ///< TCP connections at once (HTTP + WebSocket); beyond: 503 and close
-  std::size_t max_queued_bytes = 16u << 20;   ///< per-connection replies not yet written; beyond: the client is dropped
-  std::size_t max_request_bytes = 16u << 10;  ///< HTTP request header and body limit, each (431/413 beyond)
-  std::chrono::milliseconds http_timeout{10'000};         ///< to receive one whole HTTP request, and to write a response
+  std::size_t max_message_bytes = 4u << 20;        ///< largest WebSocket message accepted (bigger: closed, code 1009)
+  std::size_t max_connections = 32;                ///< TCP connections at once (HTTP + WebSocket); beyond: 503 and close
+  std::size_t max_queued_bytes = 16u << 20;        ///< per-connection replies not yet written; beyond: the client is dropped
+  std::size_t max_request_bytes = 16u << 10;       ///< HTTP request header and body limit, each (431/413 beyond)
+  std::chrono::milliseconds http_timeout{10'000};  ///< to receive one whole HTTP request, and to write a response
   std::chrono::milliseconds ws_handshake_timeout{5'000};  ///< WebSocket opening / closing handshake
   std::chrono::milliseconds ws_idle_timeout{30'000};      ///< silence before a WebSocket is dropped (pinged at half)
   std::chrono::milliseconds stop_grace{1'000};            ///< stop() waits this long for closing handshakes, then cuts
 };
 
 struct ServerOptions {
-  std::string address = "127.0.0.1";  ///< IP literal to bind; non-loopback needs allow_remote
-  std::uint16_t port = 0;             ///< 0 picks a free port
-  std::string web_root;               ///< the built front end (must hold index.html)
-  bool allow_remote = false;          ///< permit a non-loopback address
+  std::string address = "127.0.0.1";         ///< IP literal to bind; non-loopback needs allow_remote
+  std::uint16_t port = 0;                    ///< 0 picks a free port
+  std::string web_root;                      ///< the built front end (must hold index.html)
+  bool allow_remote = false;                 ///< permit a non-loopback address
   std::vector<std::string> allowed_origins;  ///< extra browser origins allowed to open /ws, e.g. "http://localhost:5173"
-  int threads = 2;                    ///< io threads run() uses, 1 … 16
-  bool stop_on_signals = false;       ///< SIGINT / SIGTERM call stop() (the CLI sets this)
+  int threads = 2;                           ///< io threads run() uses, 1 … 16
+  bool stop_on_signals = false;              ///< SIGINT / SIGTERM call stop() (the CLI sets this)
   ServerLimits limits;
 };
 
