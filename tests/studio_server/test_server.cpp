@@ -3,10 +3,8 @@
 // round trip, binary and oversized frames, floods, connection limits,
 // half-open and reset peers, a reader that never reads, Origin checks and a
 // clean stop. Timeouts are shortened through ServerLimits so each test is quick.
-#include <sys/stat.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>

@@ -4,12 +4,12 @@
 // types, binary and oversized frames, floods, resets) while an experiment
 // session runs, after which the store holds exactly the answered trials
 // and the session resumes at the next one.
-#include <fcntl.h>
 #include <poll.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
