@@ -12,6 +12,7 @@
 
 #include "texel/io.hpp"
 #include "texel/random.hpp"
+#include "../support/json_mutation.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
@@ -22,31 +23,6 @@ void feed(std::uint8_t which, const std::string& text) {
   in[0] = which;
   std::copy(text.begin(), text.end(), in.begin() + 1);
   LLVMFuzzerTestOneInput(in.data(), in.size());
-}
-
-std::string mutate(const std::string& s, const texel::CounterRng& rng, std::uint64_t k) {
-  std::string m = s;
-  if (m.empty()) return m;
-  const auto pos = static_cast<std::size_t>(rng.below(k * 8 + 1, m.size()));
-  switch (rng.below(k * 8, 7)) {
-    case 0: m[pos] = static_cast<char>(m[pos] ^ (1 << rng.below(k * 8 + 2, 8))); break;
-    case 1: m[pos] = "{}[]\",:0-9e.tn\\ "[rng.below(k * 8 + 2, 17)]; break;
-    case 2: m.resize(pos); break;
-    case 3: m.erase(pos, static_cast<std::size_t>(rng.below(k * 8 + 2, 40))); break;
-    case 4: m.insert(pos, m.substr(static_cast<std::size_t>(rng.below(k * 8 + 3, m.size())), 30)); break;
-    case 5: {  // replace a number by an extreme one
-      const auto d = m.find_first_of("0123456789", pos);
-      if (d != std::string::npos) m.replace(d, 1, rng.below(k * 8 + 3, 2) ? "1e308" : "-99999999999");
-      break;
-    }
-    default: {  // replace a string by a number or an object
-      const auto q = m.find('"', pos);
-      const auto e = q == std::string::npos ? q : m.find('"', q + 1);
-      if (e != std::string::npos) m.replace(q, e - q + 1, rng.below(k * 8 + 3, 2) ? "7" : "{}");
-      break;
-    }
-  }
-  return m;
 }
 
 }  // namespace
@@ -60,8 +36,8 @@ TEST(ExperimentFuzzReplay, ShippedProtocolsAndTheirMutations) {
     feed(0, text);
     ++files;
     for (int i = 0; i < 150; ++i, ++k) {
-      std::string m = mutate(text, rng, k);
-      if (i % 3 == 0) m = mutate(m, rng, k + 1000000);
+      std::string m = texel::test_support::mutate_json(text, rng, k);
+      if (i % 3 == 0) m = texel::test_support::mutate_json(m, rng, k + 1000000);
       feed(0, m);
     }
   }
@@ -79,8 +55,8 @@ TEST(ExperimentFuzzReplay, TrialCsvAndResponses) {
   feed(1, csv);
   feed(2, response);
   for (std::uint64_t k = 0; k < 3000; ++k) {
-    feed(1, mutate(csv, rng, k));
-    feed(2, mutate(response, rng, k));
+    feed(1, texel::test_support::mutate_json(csv, rng, k));
+    feed(2, texel::test_support::mutate_json(response, rng, k));
   }
   std::string noise;
   for (std::uint64_t k = 0; k < 2000; ++k) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "texel/random.hpp"
+#include "../support/json_mutation.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
@@ -19,31 +20,6 @@ namespace {
 
 void feed(const std::string& text) {
   LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
-}
-
-std::string mutate(const std::string& s, const texel::CounterRng& rng, std::uint64_t k) {
-  std::string m = s;
-  if (m.empty()) return m;
-  const auto pos = static_cast<std::size_t>(rng.below(k * 8 + 1, m.size()));
-  switch (rng.below(k * 8, 7)) {
-    case 0: m[pos] = static_cast<char>(m[pos] ^ (1 << rng.below(k * 8 + 2, 8))); break;
-    case 1: m[pos] = "{}[]\",:0-9e.tn\\ "[rng.below(k * 8 + 2, 17)]; break;
-    case 2: m.resize(pos); break;
-    case 3: m.erase(pos, static_cast<std::size_t>(rng.below(k * 8 + 2, 40))); break;
-    case 4: m.insert(pos, m.substr(static_cast<std::size_t>(rng.below(k * 8 + 3, m.size())), 30)); break;
-    case 5: {
-      const auto d = m.find_first_of("0123456789", pos);
-      if (d != std::string::npos) m.replace(d, 1, rng.below(k * 8 + 3, 2) ? "1e308" : "-99999999999");
-      break;
-    }
-    default: {
-      const auto q = m.find('"', pos);
-      const auto e = q == std::string::npos ? q : m.find('"', q + 1);
-      if (e != std::string::npos) m.replace(q, e - q + 1, rng.below(k * 8 + 3, 2) ? "7" : "{}");
-      break;
-    }
-  }
-  return m;
 }
 
 const std::string doc =
@@ -78,7 +54,7 @@ TEST(StudioFuzzReplay, ValidMessagesAndTheirMutations) {
     for (const auto& s : seeds) {
       std::string m = s;
       const auto n = rng.below(k * 8 + 5, 4) + 1;
-      for (std::uint64_t i = 0; i < n; ++i) m = mutate(m, rng, ++k);
+      for (std::uint64_t i = 0; i < n; ++i) m = texel::test_support::mutate_json(m, rng, ++k);
       feed(m);
     }
   // Let the lanes drain while the fixture lives (replies are checked as they come).
