@@ -13,7 +13,7 @@ packages=(
   libsndfile1-dev portaudio19-dev libsqlite3-dev
   libboost-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema
-  chromium
+  chromium firefox-esr
 )
 
 # Texel Studio's front end builds with the machine's Node.js (>= 20) and npm

@@ -118,7 +118,13 @@ export function mountExperimenter(root: HTMLElement): void {
         const cur = await client.call<{ type: string; progress?: { done: number; planned: number } }>('experiment.current', {}, 15000);
         if (cur.progress)
           progress = cur.progress.planned > 0 ? `${cur.progress.done} / ${cur.progress.planned} trials` : `${cur.progress.done} trials (adaptive)`;
-        if (cur.type === 'experiment.finished') progress += ', finished';
+        const finished = cur.type === 'experiment.finished';
+        if (finished) {
+          progress += ', finished';
+          status.textContent = `${l.active.protocol} finished for ${l.active.participant}`;
+        }
+        // A finished session still holds the display until it is closed.
+        stopBtn.textContent = finished ? 'Close the session' : 'Stop (suspend)';
         active.dataset.state = cur.type;
       } catch {
         /* list is enough */
