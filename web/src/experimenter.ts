@@ -11,7 +11,11 @@ export function mountExperimenter(root: HTMLElement): void {
   const client = studio();
   const status = h('div', { class: 'status', role: 'status', 'aria-live': 'polite', 'data-testid': 'experimenter-status' });
   const protoSel = h('select', { id: 'protocol', 'data-testid': 'protocol' }) as HTMLSelectElement;
-  const participant = h('input', { id: 'participant', 'data-testid': 'participant', placeholder: 'S01', pattern: '[A-Za-z0-9._-]{1,64}', required: true, autocomplete: 'off' }) as HTMLInputElement;
+  // Browsers compile `pattern` with the RegExp `v` flag, where a literal `-`
+  // in a class must be escaped: unescaped, the pattern is invalid and silently
+  // ignored (Chromium logs a console error, Firefox raises a page error on
+  // every validity check), so any participant id would pass the form.
+  const participant = h('input', { id: 'participant', 'data-testid': 'participant', placeholder: 'S01', pattern: '[A-Za-z0-9._\\-]{1,64}', required: true, autocomplete: 'off' }) as HTMLInputElement;
   const simulate = h('input', { id: 'simulate', 'data-testid': 'simulate', placeholder: 'e.g. default, or target=4sin (blank: a person answers)', autocomplete: 'off' }) as HTMLInputElement;
   const resume = h('input', { type: 'checkbox', id: 'resume', 'data-testid': 'resume' }) as HTMLInputElement;
   const active = h('div', { class: 'active', 'data-testid': 'active-session', 'aria-live': 'polite' });
