@@ -10,6 +10,9 @@
 //   TEXEL_ARTIFACTS  screenshots, latency    (default ../build/browser-artifacts)
 //   TEXEL_PROTOCOLS  shipped protocols       (default ../examples/protocols)
 //   TEXEL_CHROMIUM   browser executable      (default /usr/bin/chromium)
+//   TEXEL_FIREFOX    Firefox ESR executable  (default /usr/bin/firefox-esr;
+//                    firefox.test.mjs only, driven by puppeteer-core over
+//                    WebDriver BiDi)
 
 import { spawn } from 'node:child_process';
 import { mkdirSync, mkdtempSync, rmSync, existsSync } from 'node:fs';
@@ -27,6 +30,7 @@ export const paths = {
   artifacts: fromWeb(process.env.TEXEL_ARTIFACTS ?? '../build/browser-artifacts'),
   protocols: fromWeb(process.env.TEXEL_PROTOCOLS ?? '../examples/protocols'),
   chromium: process.env.TEXEL_CHROMIUM ?? '/usr/bin/chromium',
+  firefox: process.env.TEXEL_FIREFOX ?? '/usr/bin/firefox-esr',
 };
 
 // Flags that work on this closed network (.library/env/machines/cpp.md):
@@ -97,7 +101,8 @@ export async function startStudio({ hardTimeoutMs = 600_000 } = {}) {
     clearTimeout(hard);
     if (proc.exitCode === null && proc.signalCode === null) {
       proc.kill('SIGTERM');
-      const done = await Promise.race([exited, new Promise((r) => setTimeout(() => r(null), 5000))]);
+      // unref: the grace timer must not keep node alive once the server exited
+      const done = await Promise.race([exited, new Promise((r) => setTimeout(() => r(null), 5000).unref())]);
       if (!done) proc.kill('SIGKILL');
       await exited;
     }
@@ -110,6 +115,138 @@ export async function startStudio({ hardTimeoutMs = 600_000 } = {}) {
 /** Debian's Chromium, headless. playwright-core gives every launch a fresh, empty user-data-dir. */
 export async function launchBrowser() {
   return chromium.launch({ executablePath: paths.chromium, headless: true, args: CHROMIUM_FLAGS, timeout: 60_000 });
+}
+
+// Firefox preferences for this closed network, on top of puppeteer's own
+// test defaults (@puppeteer/browsers: no app/add-on updates, no safe
+// browsing lists, no health report): nothing that dials out by itself.
+// Remote services point at a closed loopback port rather than a name, so not
+// even a DNS lookup leaves the machine.
+const NOWHERE = 'http://127.0.0.1:9/';
+export const FIREFOX_PREFS = {
+  // updates (app, add-ons, search engines, plugins/GMP, remote settings)
+  'app.update.auto': false,
+  'app.update.enabled': false,
+  'app.update.url': NOWHERE,
+  'extensions.update.enabled': false,
+  'extensions.blocklist.enabled': false,
+  'extensions.getAddons.cache.enabled': false,
+  'extensions.systemAddon.update.enabled': false,
+  'browser.search.update': false,
+  'media.gmp-manager.updateEnabled': false,
+  'media.gmp-manager.url': NOWHERE,
+  'media.gmp-gmpopenh264.enabled': false,
+  'media.gmp-widevinecdm.enabled': false,
+  // Remote settings: on a release build the server pref counts only with
+  // MOZ_DISABLE_NONLOCAL_CONNECTIONS=1 (set in launchFirefox, as Mozilla's
+  // own test harnesses do); this dummy URL then skips all its network activity.
+  'services.settings.server': 'data:,#remote-settings-dummy/v1',
+  'services.settings.poll_interval': 86400 * 365,
+  // telemetry, studies, normandy, messaging experiments
+  'toolkit.telemetry.enabled': false,
+  'toolkit.telemetry.unified': false,
+  'toolkit.telemetry.archive.enabled': false,
+  'toolkit.telemetry.server': NOWHERE,
+  'toolkit.telemetry.shutdownPingSender.enabled': false,
+  'toolkit.telemetry.firstShutdownPing.enabled': false,
+  'toolkit.telemetry.newProfilePing.enabled': false,
+  'toolkit.telemetry.updatePing.enabled': false,
+  'toolkit.telemetry.bhrPing.enabled': false,
+  'datareporting.healthreport.uploadEnabled': false,
+  'datareporting.policy.dataSubmissionEnabled': false,
+  'app.normandy.enabled': false,
+  'app.normandy.api_url': '',
+  'app.shield.optoutstudies.enabled': false,
+  'messaging-system.rsexperimentloader.enabled': false,
+  'browser.discovery.enabled': false,
+  'browser.ping-centre.telemetry': false,
+  'browser.newtabpage.activity-stream.feeds.telemetry': false,
+  'browser.newtabpage.activity-stream.telemetry': false,
+  'browser.newtabpage.activity-stream.feeds.snippets': false,
+  'browser.newtabpage.activity-stream.feeds.section.topstories': false,
+  'browser.region.update.enabled': false,
+  'browser.region.network.url': '',
+  'browser.search.geoip.url': '',
+  // captive portal and connectivity checks
+  'network.captive-portal-service.enabled': false,
+  'network.connectivity-service.enabled': false,
+  'captivedetect.canonicalURL': NOWHERE,
+  // safe browsing (lists and download checks)
+  'browser.safebrowsing.malware.enabled': false,
+  'browser.safebrowsing.phishing.enabled': false,
+  'browser.safebrowsing.downloads.enabled': false,
+  'browser.safebrowsing.downloads.remote.enabled': false,
+  'browser.safebrowsing.blockedURIs.enabled': false,
+  'browser.safebrowsing.provider.google4.updateURL': '',
+  'browser.safebrowsing.provider.google.updateURL': '',
+  'browser.safebrowsing.provider.mozilla.updateURL': '',
+  // speculative connections, DNS-over-HTTPS, proxies from the environment
+  'network.prefetch-next': false,
+  'network.dns.disablePrefetch': true,
+  'network.http.speculative-parallel-limit': 0,
+  'browser.urlbar.speculativeConnect.enabled': false,
+  'network.trr.mode': 5,
+  'network.proxy.type': 0,
+  // the page's audio (Hear it) may start without a gesture, as with Chromium's flag
+  'media.autoplay.default': 0,
+  'media.autoplay.block-webaudio': false,
+};
+
+/**
+ * Debian's Firefox ESR, headless, driven by puppeteer-core over WebDriver
+ * BiDi (puppeteer-core never downloads a browser), with a fresh profile
+ * directory and FIREFOX_PREFS. Resolves {browser, close}; `close()` always
+ * ends the browser (SIGKILL after 10 s) and removes the profile, and a hard
+ * timeout kills it should the test never get there. A missing Firefox is an
+ * error, not a skip: `make test` installs firefox-esr.
+ */
+export async function launchFirefox({ hardTimeoutMs = 600_000 } = {}) {
+  if (!existsSync(paths.firefox))
+    throw new Error(
+      `Firefox ESR not found at ${paths.firefox}: install Debian's firefox-esr (scripts/install-deps.sh, run by make test) or set TEXEL_FIREFOX`,
+    );
+  const { default: puppeteer } = await import('puppeteer-core');
+  const profile = mkdtempSync(join(tmpdir(), 'texel-firefox-'));
+  let browser;
+  try {
+    browser = await puppeteer.launch({
+      browser: 'firefox',
+      executablePath: paths.firefox,
+      headless: true,
+      userDataDir: profile,
+      extraPrefsFirefox: FIREFOX_PREFS,
+      defaultViewport: { width: 1280, height: 900 },
+      timeout: 60_000,
+      protocolTimeout: 60_000,
+      // MOZ_DISABLE_NONLOCAL_CONNECTIONS: Firefox refuses connections to
+      // anything but this machine (the studio is on 127.0.0.1).
+      env: { ...process.env, MOZ_CRASHREPORTER_DISABLE: '1', MOZ_DISABLE_NONLOCAL_CONNECTIONS: '1' },
+    });
+  } catch (e) {
+    rmSync(profile, { recursive: true, force: true });
+    throw e;
+  }
+  const proc = browser.process();
+  if (proc) live.add(proc);
+  const exited = proc ? (proc.exitCode !== null ? Promise.resolve() : new Promise((r) => proc.once('exit', r))) : Promise.resolve();
+  const hard = setTimeout(() => {
+    console.error(`firefox still running after ${hardTimeoutMs} ms: killed`);
+    proc?.kill('SIGKILL');
+  }, hardTimeoutMs);
+  hard.unref();
+  async function close() {
+    clearTimeout(hard);
+    let grace;
+    await Promise.race([browser.close().catch(() => {}), new Promise((r) => (grace = setTimeout(r, 10_000)))]);
+    clearTimeout(grace);
+    if (proc && proc.exitCode === null && proc.signalCode === null) {
+      proc.kill('SIGKILL');
+      await exited;
+    }
+    if (proc) live.delete(proc);
+    rmSync(profile, { recursive: true, force: true });
+  }
+  return { browser, close, profile };
 }
 
 /**
