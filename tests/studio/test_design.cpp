@@ -49,7 +49,8 @@ TEST(DesignView, MapIsTheRenderersBitForBit) {
 TEST(DesignView, HistogramCountsTheDrawnTexels) {
   const Document doc = tpad_texel(10, -5);
   const DesignView v = design_view(doc);
-  const auto& t = dynamic_cast<const TexelTexture&>(*prepare_surface(doc).regions()[0].texture);
+  const Surface surface = prepare_surface(doc);
+  const auto& t = dynamic_cast<const TexelTexture&>(*surface.regions()[0].texture);
   EXPECT_EQ(v.texels, t.texels().size());
   EXPECT_EQ(std::accumulate(v.histogram.counts.begin(), v.histogram.counts.end(), 0.0), static_cast<double>(v.texels));
   ASSERT_EQ(v.histogram.edges_cpm.size(), v.histogram.counts.size() + 1);

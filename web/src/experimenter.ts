@@ -20,6 +20,7 @@ export function mountExperimenter(root: HTMLElement): void {
   const resume = h('input', { type: 'checkbox', id: 'resume', 'data-testid': 'resume' }) as HTMLInputElement;
   const active = h('div', { class: 'active', 'data-testid': 'active-session', 'aria-live': 'polite' });
   const sessionsBody = h('tbody', {});
+  const shownRows = new Map<number, { key: string; el: HTMLElement }>();
   const openLink = h('a', { href: '#/participant', target: '_blank', rel: 'noopener', class: 'button', 'data-testid': 'open-participant' }, 'Open the participant screen');
 
   async function start(protocol: string, code: string, resumeIt: boolean, sim: string): Promise<void> {
@@ -115,7 +116,18 @@ export function mountExperimenter(root: HTMLElement): void {
     const keep = protoSel.value;
     protoSel.replaceChildren(...l.protocols.map((p) => h('option', { value: p.name }, p.study ? `${p.name} (${p.study})` : p.name)));
     if (keep) protoSel.value = keep;
-    sessionsBody.replaceChildren(...l.sessions.map(row));
+    // Rows are rebuilt only when their session changed: the view refreshes
+    // every 2 s, and a button replaced under the pointer loses its click.
+    const rows = l.sessions.map((s) => {
+      const key = JSON.stringify(s);
+      const old = shownRows.get(s.id);
+      if (old && old.key === key) return old.el;
+      const el = row(s);
+      shownRows.set(s.id, { key, el });
+      return el;
+    });
+    if (rows.length !== sessionsBody.children.length || rows.some((el, k) => sessionsBody.children[k] !== el))
+      sessionsBody.replaceChildren(...rows);
     if (l.active) {
       let progress = '';
       try {
@@ -133,18 +145,24 @@ export function mountExperimenter(root: HTMLElement): void {
       } catch {
         /* list is enough */
       }
-      active.replaceChildren(
-        h('strong', {}, `Session ${l.active.id}: ${l.active.participant}, ${l.active.protocol}`),
-        ' ',
-        h('span', { 'data-testid': 'active-progress' }, progress),
-        ' ',
-        stopBtn,
-        ' ',
-        openLink,
-        (l.active as { simulated?: boolean }).simulated ? simulateBtn : '',
-      );
-    } else {
+      const simulated = (l.active as { simulated?: boolean }).simulated === true;
+      const key = JSON.stringify([l.active.id, l.active.participant, l.active.protocol, progress, simulated]);
+      if (active.dataset.key !== key) {
+        active.dataset.key = key;
+        active.replaceChildren(
+          h('strong', {}, `Session ${l.active.id}: ${l.active.participant}, ${l.active.protocol}`),
+          ' ',
+          h('span', { 'data-testid': 'active-progress' }, progress),
+          ' ',
+          stopBtn,
+          ' ',
+          openLink,
+          simulated ? simulateBtn : '',
+        );
+      }
+    } else if (active.dataset.state !== 'idle') {
       active.dataset.state = 'idle';
+      active.dataset.key = '';
       active.replaceChildren(h('span', {}, 'No session is running.'), ' ', openLink);
     }
     root.dataset.ready = 'true';
