@@ -1,0 +1,252 @@
+/* texel.h — the C ABI of Texel, for device makers embedding C.
+ *
+ * A thin front door over the C++ library (docs/c-api.md): every function calls
+ * the same library code as the `texel` command, so a map rendered here is the
+ * same bytes as `texel render ... -o map.bin`. Style after miniaudio: opaque
+ * handles, a status code from every call plus a description, config structs
+ * with documented defaults, caller-owned buffers.
+ *
+ * Handles. texel_document (a parsed, validated texture document),
+ * texel_surface (a document prepared for rendering), texel_encode_result and
+ * texel_player are opaque. Each is created by a texel_*_create / _load /
+ * _parse / _from_* function that writes it through an out-pointer (set to
+ * NULL on failure) and is owned by the caller until its texel_*_destroy,
+ * which accepts NULL as a no-op. No handle keeps a pointer into another: a
+ * surface may outlive its document, a player the surface it was given.
+ *
+ * Status. Every function that can fail returns texel_status (TEXEL_OK = 0).
+ * texel_last_error() then gives the engine's one-line message (naming the
+ * field, the value and what is allowed); it is thread-local. No C++
+ * exception ever crosses this boundary; running out of memory is
+ * TEXEL_OUT_OF_MEMORY.
+ *
+ * Buffers. Results of data-dependent size are written into caller memory:
+ * functions take (buffer, capacity, size_t* needed). A NULL buffer queries
+ * the size into *needed and returns TEXEL_OK; a buffer shorter than needed
+ * gets nothing written and TEXEL_BUFFER_TOO_SMALL, with *needed set. `needed`
+ * may be NULL when the buffer is given. Text results count their
+ * terminating NUL. Sample windows take (first, out, count): exactly count
+ * samples are written.
+ *
+ * Threads. Documents, surfaces and encode results are immutable after
+ * creation: any number of threads may use one concurrently. A player has one
+ * control thread (set_surface, push, set_gain, collect, destroy) and one
+ * real-time thread (process). Different handles are independent.
+ *
+ * Real time. texel_player_process never allocates, frees, locks, logs or
+ * does I/O, and does not touch texel_last_error (it reports only through its
+ * return value). Everything else may allocate and must stay off the audio
+ * or display callback.
+ *
+ * Units are in the names: _db (dB re 1 cycle/mm), _mm, _cpm (cycles/mm),
+ * _hz, _s.
+ */
+#ifndef TEXEL_H
+#define TEXEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- version */
+
+/* The version this header describes; texel_version() gives the library's. */
+#define TEXEL_VERSION_MAJOR 0
+#define TEXEL_VERSION_MINOR 1
+#define TEXEL_VERSION_PATCH 0
+
+/* The library's version; any pointer may be NULL. */
+void texel_version(int* major, int* minor, int* patch);
+/* The library's version as text, e.g. "0.1.0" (static storage). */
+const char* texel_version_string(void);
+
+/* ----------------------------------------------------------------- status */
+
+typedef enum texel_status {
+  TEXEL_OK = 0,
+  TEXEL_INVALID_ARGUMENT, /* a parameter outside its range or set; a NULL handle or out-pointer */
+  TEXEL_FORMAT_ERROR,     /* a document, profile or bitstream that does not parse or validate */
+  TEXEL_IO_ERROR,         /* a file that cannot be read */
+  TEXEL_BUFFER_TOO_SMALL, /* the caller's buffer (or the player's event queue) has no room */
+  TEXEL_OUT_OF_MEMORY,
+  TEXEL_INTERNAL /* a bug in Texel: please report it with texel_last_error() */
+} texel_status;
+
+/* A fixed name for a status, e.g. "TEXEL_FORMAT_ERROR" ("unknown status"
+ * for a value outside the enum). Static storage. */
+const char* texel_status_string(texel_status status);
+/* The engine's message for the most recent call on this thread that returned
+ * texel_status: "" after a success. Valid until the next such call on this
+ * thread. Never NULL. */
+const char* texel_last_error(void);
+
+/* ---------------------------------------------------------------- handles */
+
+typedef struct texel_document texel_document;
+typedef struct texel_surface texel_surface;
+typedef struct texel_encode_result texel_encode_result;
+typedef struct texel_player texel_player;
+
+/* --------------------------------------------------------------- devices */
+
+/* How a device stores one sample (device bytes, little-endian). */
+typedef enum texel_sample_format {
+  TEXEL_SAMPLE_U16LE = 0, /* round(a·65535) — tpad */
+  TEXEL_SAMPLE_U8 = 1,    /* round(a·255) */
+  TEXEL_SAMPLE_F32LE = 2,
+  TEXEL_SAMPLE_F64LE = 3
+} texel_sample_format;
+
+typedef struct texel_device_info {
+  int64_t samples;          /* samples along the active length, >= 1 */
+  double spacing_mm;        /* distance between samples, mm */
+  double length_mm;         /* samples · spacing_mm */
+  double refresh_hz;        /* output update rate while playing */
+  texel_sample_format format;
+  size_t bytes_per_sample;  /* of `format` */
+} texel_device_info;
+
+/* Looks a device profile up: a built-in name ("tpad", "tpad-tablet",
+ * "generic"), NAME.json in a TEXEL_DEVICE_PATH directory, or a path to a
+ * profile JSON file. Unknown names are TEXEL_INVALID_ARGUMENT. */
+texel_status texel_device_lookup(const char* name_or_path, texel_device_info* out);
+
+/* ------------------------------------------------------------- parameters */
+
+typedef enum texel_parameterization {
+  TEXEL_PARAMETERIZATION_MOMENTS = 0, /* Central Pitch / Irregularity are the mean / SD in cpm, as dB */
+  TEXEL_PARAMETERIZATION_LOG = 1      /* median, and SD of 10·log10 f */
+} texel_parameterization;
+
+/* A fine Texel texture over the whole device (what `texel render` flags
+ * give). Start from texel_params_default(); the defaults are the studies'. */
+typedef struct texel_params {
+  double central_pitch_db;               /* dB re 1 cpm, finite [10] */
+  double irregularity_db;                /* dB, finite [-5] */
+  double texel_length_mm;                /* mm, > 0 and <= 1000 [0.25] */
+  uint64_t seed;                         /* the random draw [1] */
+  texel_parameterization parameterization; /* [MOMENTS] */
+  double quantization_db;                /* frequency quantization step, 0 (off) … 20 dB [0] */
+  double coarse_strength;                /* C, 0 … 1 [0] */
+  double fine_strength;                  /* F, 0 … 1 [1] */
+  double coarse_sine_period_mm;          /* coarse profile: a sinusoid of this period (mm, > 0); 0 = constant [0] */
+  double coarse_sine_phase_deg;          /* its phase, degrees, finite [0] */
+} texel_params;
+
+texel_params texel_params_default(void);
+
+/* -------------------------------------------------------------- documents */
+
+/* Loads and validates a texture document (*.texel.json). */
+texel_status texel_document_load(const char* path, texel_document** out);
+/* Parses and validates document JSON text of `length` bytes (no NUL needed). */
+texel_status texel_document_parse(const char* json, size_t length, texel_document** out);
+/* One Texel texture over the whole of `device` (name or path, as
+ * texel_device_lookup). */
+texel_status texel_document_from_params(const char* device, const texel_params* params, texel_document** out);
+/* One reference texture (`texel reference --list` names them, e.g. "4sin",
+ * "pink", "bandpass-f5-z0.5") with its default parameters over `device`. */
+texel_status texel_document_from_reference(const char* device, const char* name, uint64_t seed, texel_document** out);
+/* The document as JSON text (NUL-terminated), the *.texel.json format. */
+texel_status texel_document_json(const texel_document* doc, char* buffer, size_t capacity, size_t* needed);
+void texel_document_destroy(texel_document* doc);
+
+/* --------------------------------------------------------------- surfaces */
+
+/* Prepares every region's texture for rendering (allocates; O(texels)). */
+texel_status texel_surface_create(const texel_document* doc, texel_surface** out);
+/* Shorthand: texel_document_from_params then texel_surface_create. */
+texel_status texel_surface_from_params(const char* device, const texel_params* params, texel_surface** out);
+/* The surface's device grid and format. */
+texel_status texel_surface_device(const texel_surface* surface, texel_device_info* out);
+/* Samples in the whole map (texel_device_info.samples). */
+texel_status texel_surface_size(const texel_surface* surface, size_t* samples);
+
+/* Amplitudes in [0, 1] of samples [first, first + count) of the map; needs
+ * first + count <= size. Any window gives the same values as the whole map. */
+texel_status texel_surface_render(const texel_surface* surface, int64_t first, double* out, size_t count);
+/* The same window as round(a·65535) in host byte order, whatever the device
+ * format (on a little-endian host this is the tpad .bin file). */
+texel_status texel_surface_render_u16(const texel_surface* surface, int64_t first, uint16_t* out, size_t count);
+/* The same window in the device's own format (texel_device_info.format):
+ * count · bytes_per_sample bytes, exactly `texel render -o map.bin`. */
+texel_status texel_surface_render_native(const texel_surface* surface, int64_t first, size_t count, void* buffer,
+                                         size_t capacity, size_t* needed);
+void texel_surface_destroy(texel_surface* surface);
+
+/* ------------------------------------------------------------------ codec */
+
+/* Encodes a map of `count` amplitudes sampled every `spacing_mm` (the
+ * encoder's defaults, as `texel encode`): a .texel bitstream of a few bytes.
+ * Takes from well under a second to a few seconds. */
+texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
+/* The bitstream bytes (a .texel file). */
+texel_status texel_encode_result_bytes(const texel_encode_result* result, uint8_t* buffer, size_t capacity,
+                                       size_t* needed);
+/* The parameters the bitstream decodes to. A coarse profile other than a
+ * sinusoid is not expressible in texel_params: coarse_sine_period_mm is 0 and
+ * *has_coarse_profile (if not NULL) is 1; render such a result through
+ * texel_decode. */
+texel_status texel_encode_result_params(const texel_encode_result* result, texel_params* out, int* has_coarse_profile);
+/* Distance between the input and the decoded texture under the perceptual
+ * model, in just-noticeable differences. */
+texel_status texel_encode_result_distance(const texel_encode_result* result, double* jnd);
+void texel_encode_result_destroy(texel_encode_result* result);
+
+/* Decodes a bitstream to the document it stands for on `device` (name or
+ * path): rendering it gives `texel decode`'s map byte for byte. */
+texel_status texel_decode(const uint8_t* bytes, size_t size, const char* device, texel_document** out);
+
+/* ----------------------------------------------------------------- player */
+
+typedef enum texel_output_mode {
+  TEXEL_OUTPUT_AMPLITUDE = 0, /* a(x) in [0, 1], for friction displays */
+  TEXEL_OUTPUT_VIBRATION = 1, /* a(x) band-passed, zero-mean, in [-1, 1] */
+  TEXEL_OUTPUT_CARRIER = 2    /* a(x)·sin(2π·carrier_hz·t) */
+} texel_output_mode;
+
+typedef struct texel_player_config {
+  double rate_hz;           /* output rate, 100 … 384000 [48000]; tpad: 8333 */
+  texel_output_mode mode;   /* [AMPLITUDE] */
+  double gain;              /* 0 … 1 [1] */
+  double carrier_hz;        /* carrier mode: 0 … rate/2 [250] */
+  double prediction_s;      /* latency compensation look-ahead, 0 … 0.1 s [0] */
+} texel_player_config;
+
+texel_player_config texel_player_config_default(void);
+
+/* Prepares a player (allocates all it will ever need); silent until
+ * texel_player_set_surface. */
+texel_status texel_player_create(const texel_player_config* config, texel_player** out);
+/* Control thread: renders the surface's whole map into a new player map and
+ * swaps it in (process crossfades to it). Allocates; frees maps process has
+ * retired. The surface may be destroyed afterwards. */
+texel_status texel_player_set_surface(texel_player* player, const texel_surface* surface);
+/* Control thread: queues one finger sample (time-ordered; t_s on the
+ * player's clock, 0 = first output sample; x_mm in device coordinates;
+ * touch 0 = lifted). TEXEL_BUFFER_TOO_SMALL: the event queue is full (let
+ * process run, then push again). */
+texel_status texel_player_push(texel_player* player, double t_s, double x_mm, int touch);
+/* Control thread: queues a gain change (clamped to [0, 1], ramped over a block). */
+texel_status texel_player_set_gain(texel_player* player, double gain);
+/* Control thread: frees maps process has retired; *freed (may be NULL) gets
+ * their number. */
+texel_status texel_player_collect(texel_player* player, size_t* freed);
+/* Real-time thread: the next `frames` output samples into out[0 … frames),
+ * and, if positions_mm is not NULL, the finger position used for each.
+ * Real-time safe: never allocates, frees, locks, logs or does I/O; does not
+ * set texel_last_error. TEXEL_INVALID_ARGUMENT for a NULL player or out. */
+texel_status texel_player_process(texel_player* player, float* out, size_t frames, float* positions_mm);
+/* Output samples produced so far (any thread); 0 for NULL. */
+uint64_t texel_player_samples(const texel_player* player);
+/* Stop the real-time thread first. */
+void texel_player_destroy(texel_player* player);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* TEXEL_H */

@@ -1,0 +1,558 @@
+// The C ABI (include/texel.h): a thin front door over the library.
+//
+// Every entry point that can fail runs its body through `guarded`, which turns
+// the project's exception families into status codes and keeps the message in
+// a thread-local slot for texel_last_error(): no exception crosses the
+// boundary (miniaudio's ma_result + description pattern). Arguments the C
+// caller supplies — NULL pointers, enum values outside their enum, non-finite
+// numbers, windows past the end of the map — are checked here with messages
+// that name the C parameter, the way the CLI names its flags; everything else
+// is the library's own validation.
+//
+// texel_player_process is the exception: it is real-time, so it neither
+// allocates nor touches the (std::string) error slot; it only returns a code.
+#include "texel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <new>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "texel/codec.hpp"
+#include "texel/device.hpp"
+#include "texel/document.hpp"
+#include "texel/error.hpp"
+#include "texel/player.hpp"
+#include "texel/reference.hpp"
+#include "texel/surface.hpp"
+#include "texel/texture.hpp"
+
+struct texel_document {
+  texel::Document doc;
+};
+
+struct texel_surface {
+  texel::DeviceProfile device;
+  texel::Surface surface;
+};
+
+struct texel_encode_result {
+  texel::codec::EncodeResult result;
+};
+
+struct texel_player {
+  texel::Player player;
+  explicit texel_player(const texel::PlayerConfig& c) : player(c) {}
+};
+
+namespace {
+
+using texel::InvalidArgument;
+
+// The last error of this thread. `fixed` points at static text when building
+// a message could itself fail (out of memory).
+thread_local std::string t_message;
+thread_local const char* t_fixed = nullptr;
+
+texel_status fail(texel_status status, const char* what) noexcept {
+  try {
+    t_message.assign(what);
+    t_fixed = nullptr;
+  } catch (...) {
+    t_fixed = "out of memory while reporting an error";
+  }
+  return status;
+}
+
+// Thrown (and caught by `guarded`) when a caller buffer or the player's event
+// queue has no room: not an error of the library, so not a texel::Error.
+struct BufferTooSmall {
+  std::string message;
+};
+
+template <class F>
+texel_status guarded(F&& body) noexcept {
+  t_message.clear();  // keeps its capacity: never allocates
+  t_fixed = nullptr;
+  try {
+    body();
+    return TEXEL_OK;
+  } catch (const BufferTooSmall& e) {
+    return fail(TEXEL_BUFFER_TOO_SMALL, e.message.c_str());
+  } catch (const texel::InvalidArgument& e) {
+    return fail(TEXEL_INVALID_ARGUMENT, e.what());
+  } catch (const texel::FormatError& e) {
+    return fail(TEXEL_FORMAT_ERROR, e.what());
+  } catch (const texel::IoError& e) {
+    return fail(TEXEL_IO_ERROR, e.what());
+  } catch (const std::bad_alloc&) {
+    t_fixed = "out of memory";
+    return TEXEL_OUT_OF_MEMORY;
+  } catch (const std::exception& e) {
+    return fail(TEXEL_INTERNAL, e.what());
+  } catch (...) {
+    t_fixed = "unknown exception inside Texel";
+    return TEXEL_INTERNAL;
+  }
+}
+
+template <class T>
+T& need(T* p, const char* name) {
+  if (!p) throw InvalidArgument(std::string(name) + " is NULL");
+  return *p;
+}
+
+const char* need_text(const char* p, const char* name) {
+  if (!p) throw InvalidArgument(std::string(name) + " is NULL");
+  return p;
+}
+
+void need_finite(double v, const char* name) {
+  if (!std::isfinite(v)) throw InvalidArgument(std::string(name) + " is not a finite number");
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// The (buffer, capacity, needed) rule of texel.h for a result of `size`
+// bytes: true when the caller gave a buffer with room for it.
+bool check_buffer(std::size_t size, const void* buffer, std::size_t capacity, std::size_t* needed) {
+  if (!buffer && !needed) throw InvalidArgument("buffer and needed are both NULL; give a buffer or ask for the size");
+  if (needed) *needed = size;
+  if (!buffer) return false;
+  if (capacity < size)
+    throw BufferTooSmall{"buffer holds " + std::to_string(capacity) + " bytes; " + std::to_string(size) + " needed"};
+  return true;
+}
+
+void copy_out(const void* data, std::size_t size, void* buffer, std::size_t capacity, std::size_t* needed) {
+  if (check_buffer(size, buffer, capacity, needed) && size) std::memcpy(buffer, data, size);
+}
+
+texel_sample_format to_c(texel::SampleFormat f) {
+  switch (f) {
+    case texel::SampleFormat::u16le: return TEXEL_SAMPLE_U16LE;
+    case texel::SampleFormat::u8: return TEXEL_SAMPLE_U8;
+    case texel::SampleFormat::f32le: return TEXEL_SAMPLE_F32LE;
+    case texel::SampleFormat::f64le: return TEXEL_SAMPLE_F64LE;
+  }
+  return TEXEL_SAMPLE_U16LE;
+}
+
+texel_device_info info_of(const texel::DeviceProfile& d) {
+  texel_device_info i{};
+  i.samples = d.samples;
+  i.spacing_mm = d.spacing_mm;
+  i.length_mm = d.length_mm();
+  i.refresh_hz = d.refresh_hz;
+  i.format = to_c(d.format);
+  i.bytes_per_sample = texel::bytes_per_sample(d.format);
+  return i;
+}
+
+// texel_params -> TexelSpec, checking what the C caller can get wrong with
+// the C field names (the CLI checks the same values under its flag names).
+texel::TexelSpec spec_of(const texel_params& p) {
+  need_finite(p.central_pitch_db, "central_pitch_db");
+  need_finite(p.irregularity_db, "irregularity_db");
+  need_finite(p.texel_length_mm, "texel_length_mm");
+  need_finite(p.quantization_db, "quantization_db");
+  need_finite(p.coarse_strength, "coarse_strength");
+  need_finite(p.fine_strength, "fine_strength");
+  need_finite(p.coarse_sine_period_mm, "coarse_sine_period_mm");
+  need_finite(p.coarse_sine_phase_deg, "coarse_sine_phase_deg");
+  texel::TexelSpec s;
+  s.central_pitch = texel::Decibels(p.central_pitch_db);
+  s.irregularity = texel::Decibels(p.irregularity_db);
+  s.texel_length = texel::Millimetres(p.texel_length_mm);
+  s.seed = p.seed;
+  switch (static_cast<int>(p.parameterization)) {
+    case TEXEL_PARAMETERIZATION_MOMENTS: s.parameterization = texel::Parameterization::moments; break;
+    case TEXEL_PARAMETERIZATION_LOG: s.parameterization = texel::Parameterization::log; break;
+    default:
+      throw InvalidArgument("parameterization is " + std::to_string(static_cast<int>(p.parameterization)) +
+                            "; allowed: TEXEL_PARAMETERIZATION_MOMENTS (0), TEXEL_PARAMETERIZATION_LOG (1)");
+  }
+  if (!(p.quantization_db >= 0.0 && p.quantization_db <= 20.0))
+    throw InvalidArgument("quantization_db is " + num(p.quantization_db) + "; allowed: 0 (off) … 20 dB");
+  s.quantization_db = p.quantization_db;
+  s.coarse_strength = p.coarse_strength;
+  s.fine_strength = p.fine_strength;
+  if (p.coarse_sine_period_mm < 0.0)
+    throw InvalidArgument("coarse_sine_period_mm is " + num(p.coarse_sine_period_mm) +
+                          "; allowed: 0 (constant profile) or a period > 0 mm");
+  if (p.coarse_sine_period_mm > 0.0)
+    s.coarse = texel::SineProfile{texel::Millimetres(p.coarse_sine_period_mm), p.coarse_sine_phase_deg};
+  texel::validate(s);
+  return s;
+}
+
+texel_params params_of(const texel::TexelSpec& s, int* has_profile) {
+  texel_params p = texel_params_default();
+  p.central_pitch_db = s.central_pitch.value();
+  p.irregularity_db = s.irregularity.value();
+  p.texel_length_mm = s.texel_length.value();
+  p.seed = s.seed;
+  p.parameterization =
+      s.parameterization == texel::Parameterization::log ? TEXEL_PARAMETERIZATION_LOG : TEXEL_PARAMETERIZATION_MOMENTS;
+  p.quantization_db = s.quantization_db;
+  p.coarse_strength = s.coarse_strength;
+  p.fine_strength = s.fine_strength;
+  int other = 0;
+  if (const auto* sine = std::get_if<texel::SineProfile>(&s.coarse)) {
+    p.coarse_sine_period_mm = sine->period.value();
+    p.coarse_sine_phase_deg = sine->phase_deg;
+  } else if (!std::holds_alternative<texel::ConstantProfile>(s.coarse)) {
+    other = 1;
+  }
+  if (has_profile) *has_profile = other;
+  return p;
+}
+
+// Checks a window [first, first + count) against the map's size.
+void check_window(const texel_surface& s, std::int64_t first, std::size_t count) {
+  const auto size = static_cast<std::uint64_t>(s.surface.grid().count);
+  if (first < 0 || static_cast<std::uint64_t>(first) > size || count > size - static_cast<std::uint64_t>(first))
+    throw InvalidArgument("window first=" + std::to_string(first) + " count=" + std::to_string(count) +
+                          " is outside the map's " + std::to_string(size) + " samples");
+}
+
+// Renders a window chunk by chunk (bounded scratch memory), handing each
+// chunk's amplitudes and its offset in the window to `emit`.
+template <class Emit>
+void render_chunks(const texel_surface& s, std::int64_t first, std::size_t count, Emit&& emit) {
+  constexpr std::size_t chunk = std::size_t{1} << 16;
+  std::vector<double> scratch(std::min(count, chunk));
+  for (std::size_t done = 0; done < count; done += chunk) {
+    const std::size_t len = std::min(chunk, count - done);
+    std::span<double> part(scratch.data(), len);
+    s.surface.render(first + static_cast<std::int64_t>(done), part);
+    emit(std::span<const double>(part), done);
+  }
+}
+
+texel::DeviceProfile device_named(const char* name) { return texel::load_device(need_text(name, "device")); }
+
+template <class Handle, class Make>
+texel_status create(Handle** out, Make&& make) {
+  if (out) *out = nullptr;
+  return guarded([&] {
+    need(out, "out");
+    *out = make().release();
+  });
+}
+
+}  // namespace
+
+extern "C" {
+
+// ---------------------------------------------------------------- version
+
+void texel_version(int* major, int* minor, int* patch) {
+  if (major) *major = TEXEL_VERSION_MAJOR_;
+  if (minor) *minor = TEXEL_VERSION_MINOR_;
+  if (patch) *patch = TEXEL_VERSION_PATCH_;
+}
+
+const char* texel_version_string(void) { return TEXEL_VERSION_STRING; }
+
+// ----------------------------------------------------------------- status
+
+const char* texel_status_string(texel_status status) {
+  switch (status) {
+    case TEXEL_OK: return "TEXEL_OK";
+    case TEXEL_INVALID_ARGUMENT: return "TEXEL_INVALID_ARGUMENT";
+    case TEXEL_FORMAT_ERROR: return "TEXEL_FORMAT_ERROR";
+    case TEXEL_IO_ERROR: return "TEXEL_IO_ERROR";
+    case TEXEL_BUFFER_TOO_SMALL: return "TEXEL_BUFFER_TOO_SMALL";
+    case TEXEL_OUT_OF_MEMORY: return "TEXEL_OUT_OF_MEMORY";
+    case TEXEL_INTERNAL: return "TEXEL_INTERNAL";
+  }
+  return "unknown status";
+}
+
+const char* texel_last_error(void) { return t_fixed ? t_fixed : t_message.c_str(); }
+
+// ---------------------------------------------------------------- devices
+
+texel_status texel_device_lookup(const char* name_or_path, texel_device_info* out) {
+  return guarded([&] {
+    need(out, "out");
+    *out = info_of(device_named(name_or_path));
+  });
+}
+
+texel_params texel_params_default(void) {
+  const texel::TexelSpec s;
+  texel_params p{};
+  p.central_pitch_db = s.central_pitch.value();
+  p.irregularity_db = s.irregularity.value();
+  p.texel_length_mm = s.texel_length.value();
+  p.seed = s.seed;
+  p.parameterization = TEXEL_PARAMETERIZATION_MOMENTS;
+  p.quantization_db = s.quantization_db;
+  p.coarse_strength = s.coarse_strength;
+  p.fine_strength = s.fine_strength;
+  p.coarse_sine_period_mm = 0.0;
+  p.coarse_sine_phase_deg = 0.0;
+  return p;
+}
+
+// -------------------------------------------------------------- documents
+
+texel_status texel_document_load(const char* path, texel_document** out) {
+  return create(out, [&] {
+    return std::make_unique<texel_document>(texel_document{texel::load_document(need_text(path, "path"))});
+  });
+}
+
+texel_status texel_document_parse(const char* json, std::size_t length, texel_document** out) {
+  return create(out, [&] {
+    const std::string_view text(need_text(json, "json"), length);
+    return std::make_unique<texel_document>(texel_document{texel::parse_document(text, "json")});
+  });
+}
+
+texel_status texel_document_from_params(const char* device, const texel_params* params, texel_document** out) {
+  return create(out, [&] {
+    const texel::TexelSpec spec = spec_of(need(params, "params"));
+    return std::make_unique<texel_document>(texel_document{texel::make_document(device_named(device), spec)});
+  });
+}
+
+texel_status texel_document_from_reference(const char* device, const char* name, std::uint64_t seed,
+                                           texel_document** out) {
+  return create(out, [&] {
+    texel::ReferenceSpec spec;
+    spec.name = need_text(name, "name");
+    spec.seed = seed;
+    texel::validate(spec);
+    texel::Document doc = texel::make_reference_document(device_named(device), spec);
+    doc.description = "Texel reference " + spec.name;  // as `texel reference`
+    return std::make_unique<texel_document>(texel_document{std::move(doc)});
+  });
+}
+
+texel_status texel_document_json(const texel_document* doc, char* buffer, std::size_t capacity, std::size_t* needed) {
+  return guarded([&] {
+    const std::string text = texel::document_json(need(doc, "doc").doc);
+    copy_out(text.c_str(), text.size() + 1, buffer, capacity, needed);
+  });
+}
+
+void texel_document_destroy(texel_document* doc) { delete doc; }
+
+// --------------------------------------------------------------- surfaces
+
+texel_status texel_surface_create(const texel_document* doc, texel_surface** out) {
+  return create(out, [&] {
+    const texel::Document& d = need(doc, "doc").doc;
+    return std::make_unique<texel_surface>(texel_surface{d.device, texel::prepare_surface(d)});
+  });
+}
+
+texel_status texel_surface_from_params(const char* device, const texel_params* params, texel_surface** out) {
+  return create(out, [&] {
+    const texel::TexelSpec spec = spec_of(need(params, "params"));
+    const texel::Document d = texel::make_document(device_named(device), spec);
+    return std::make_unique<texel_surface>(texel_surface{d.device, texel::prepare_surface(d)});
+  });
+}
+
+texel_status texel_surface_device(const texel_surface* surface, texel_device_info* out) {
+  return guarded([&] {
+    const texel_surface& s = need(surface, "surface");
+    need(out, "out") = info_of(s.device);
+  });
+}
+
+texel_status texel_surface_size(const texel_surface* surface, std::size_t* samples) {
+  return guarded([&] {
+    const texel_surface& s = need(surface, "surface");
+    need(samples, "samples") = static_cast<std::size_t>(s.surface.grid().count);
+  });
+}
+
+texel_status texel_surface_render(const texel_surface* surface, std::int64_t first, double* out, std::size_t count) {
+  return guarded([&] {
+    const texel_surface& s = need(surface, "surface");
+    check_window(s, first, count);
+    if (count == 0) return;
+    need(out, "out");
+    s.surface.render(first, std::span<double>(out, count));
+  });
+}
+
+texel_status texel_surface_render_u16(const texel_surface* surface, std::int64_t first, std::uint16_t* out,
+                                      std::size_t count) {
+  return guarded([&] {
+    const texel_surface& s = need(surface, "surface");
+    check_window(s, first, count);
+    if (count == 0) return;
+    need(out, "out");
+    render_chunks(s, first, count, [&](std::span<const double> a, std::size_t at) {
+      texel::encode_u16(a, std::span<std::uint16_t>(out + at, a.size()));
+    });
+  });
+}
+
+texel_status texel_surface_render_native(const texel_surface* surface, std::int64_t first, std::size_t count,
+                                         void* buffer, std::size_t capacity, std::size_t* needed) {
+  return guarded([&] {
+    const texel_surface& s = need(surface, "surface");
+    check_window(s, first, count);
+    const std::size_t bps = texel::bytes_per_sample(s.device.format);
+    if (!check_buffer(count * bps, buffer, capacity, needed)) return;  // count <= samples: no overflow
+    auto* bytes = static_cast<std::byte*>(buffer);
+    render_chunks(s, first, count, [&](std::span<const double> a, std::size_t at) {
+      texel::encode_samples(s.device.format, a, std::span<std::byte>(bytes + at * bps, a.size() * bps));
+    });
+  });
+}
+
+void texel_surface_destroy(texel_surface* surface) { delete surface; }
+
+// ------------------------------------------------------------------ codec
+
+texel_status texel_encode(const double* amplitudes, std::size_t count, double spacing_mm, texel_encode_result** out) {
+  return create(out, [&] {
+    if (count > 0) need(amplitudes, "amplitudes");
+    need_finite(spacing_mm, "spacing_mm");
+    texel::codec::Signal signal;
+    if (count > 0) signal.amplitude.assign(amplitudes, amplitudes + count);
+    signal.spacing_mm = spacing_mm;
+    signal.description = "C API map";
+    return std::make_unique<texel_encode_result>(
+        texel_encode_result{texel::codec::encode(signal, texel::codec::EncoderConfig{})});
+  });
+}
+
+texel_status texel_encode_result_bytes(const texel_encode_result* result, std::uint8_t* buffer, std::size_t capacity,
+                                       std::size_t* needed) {
+  return guarded([&] {
+    const auto& bytes = need(result, "result").result.bytes;
+    copy_out(bytes.data(), bytes.size(), buffer, capacity, needed);
+  });
+}
+
+texel_status texel_encode_result_params(const texel_encode_result* result, texel_params* out, int* has_coarse_profile) {
+  return guarded([&] {
+    const auto& r = need(result, "result").result;
+    need(out, "out") = params_of(r.spec, has_coarse_profile);
+  });
+}
+
+texel_status texel_encode_result_distance(const texel_encode_result* result, double* jnd) {
+  return guarded([&] {
+    const auto& r = need(result, "result").result;
+    need(jnd, "jnd") = r.model_distance;
+  });
+}
+
+void texel_encode_result_destroy(texel_encode_result* result) { delete result; }
+
+texel_status texel_decode(const std::uint8_t* bytes, std::size_t size, const char* device, texel_document** out) {
+  return create(out, [&] {
+    if (size > 0) need(bytes, "bytes");
+    const texel::codec::Bitstream b = texel::codec::parse_bitstream(std::span<const std::uint8_t>(bytes, size));
+    texel::Document doc = texel::codec::decode_document(b, device_named(device));
+    return std::make_unique<texel_document>(texel_document{std::move(doc)});
+  });
+}
+
+// ----------------------------------------------------------------- player
+
+texel_player_config texel_player_config_default(void) {
+  const texel::PlayerConfig c;
+  texel_player_config p{};
+  p.rate_hz = c.rate_hz;
+  p.mode = TEXEL_OUTPUT_AMPLITUDE;
+  p.gain = c.gain;
+  p.carrier_hz = c.carrier_hz;
+  p.prediction_s = c.prediction_s;
+  return p;
+}
+
+texel_status texel_player_create(const texel_player_config* config, texel_player** out) {
+  return create(out, [&] {
+    const texel_player_config& c = need(config, "config");
+    texel::PlayerConfig pc;
+    pc.rate_hz = c.rate_hz;
+    switch (static_cast<int>(c.mode)) {
+      case TEXEL_OUTPUT_AMPLITUDE: pc.mode = texel::OutputMode::amplitude; break;
+      case TEXEL_OUTPUT_VIBRATION: pc.mode = texel::OutputMode::vibration; break;
+      case TEXEL_OUTPUT_CARRIER: pc.mode = texel::OutputMode::carrier; break;
+      default:
+        throw InvalidArgument("mode is " + std::to_string(static_cast<int>(c.mode)) +
+                              "; allowed: TEXEL_OUTPUT_AMPLITUDE (0), TEXEL_OUTPUT_VIBRATION (1), TEXEL_OUTPUT_CARRIER (2)");
+    }
+    pc.gain = c.gain;
+    pc.carrier_hz = c.carrier_hz;
+    pc.prediction_s = c.prediction_s;
+    // The library's extrapolation window must cover the look-ahead.
+    pc.extrapolate_s = std::max(pc.extrapolate_s, std::isfinite(c.prediction_s) ? c.prediction_s : 0.0);
+    texel::validate(pc);
+    return std::make_unique<texel_player>(pc);
+  });
+}
+
+texel_status texel_player_set_surface(texel_player* player, const texel_surface* surface) {
+  return guarded([&] {
+    texel_player& p = need(player, "player");
+    const texel_surface& s = need(surface, "surface");
+    p.player.set_map(texel::PlayerMap::from_surface(s.surface));
+  });
+}
+
+texel_status texel_player_push(texel_player* player, double t_s, double x_mm, int touch) {
+  return guarded([&] {
+    texel_player& p = need(player, "player");
+    need_finite(t_s, "t_s");
+    need_finite(x_mm, "x_mm");
+    if (!p.player.push(texel::FingerSample{t_s, x_mm, touch != 0}))
+      throw BufferTooSmall{"the player's event queue is full (" + std::to_string(texel::Player::event_capacity) +
+                           " events); let texel_player_process run, then push again"};
+  });
+}
+
+texel_status texel_player_set_gain(texel_player* player, double gain) {
+  return guarded([&] {
+    texel_player& p = need(player, "player");
+    need_finite(gain, "gain");
+    if (!p.player.set_gain(gain))
+      throw BufferTooSmall{"the player's event queue is full; let texel_player_process run, then try again"};
+  });
+}
+
+texel_status texel_player_collect(texel_player* player, std::size_t* freed) {
+  return guarded([&] {
+    const std::size_t n = need(player, "player").player.collect();
+    if (freed) *freed = n;
+  });
+}
+
+texel_status texel_player_process(texel_player* player, float* out, std::size_t frames, float* positions_mm) {
+  // Real-time: no guarded() (its error slot is a std::string), no allocation.
+  if (!player || (!out && frames > 0)) return TEXEL_INVALID_ARGUMENT;
+  if (frames == 0) return TEXEL_OK;
+  std::span<float> pos;
+  if (positions_mm) pos = std::span<float>(positions_mm, frames);
+  (void)player->player.process(std::span<float>(out, frames), pos);  // noexcept
+  return TEXEL_OK;
+}
+
+std::uint64_t texel_player_samples(const texel_player* player) { return player ? player->player.samples() : 0; }
+
+void texel_player_destroy(texel_player* player) { delete player; }
+
+}  // extern "C"
