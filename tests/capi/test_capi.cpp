@@ -1,0 +1,693 @@
+// The C ABI (include/texel.h): every function with valid and invalid
+// arguments, and rendered values equal to the C++ library's. The same header
+// is exercised from C99 by test_capi_c.c; byte equality with the `texel`
+// command is in test_capi_cli.cpp.
+#include "texel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "../support/temp_dir.hpp"
+#include "texel/codec.hpp"
+#include "texel/device.hpp"
+#include "texel/document.hpp"
+#include "texel/player.hpp"
+#include "texel/reference.hpp"
+#include "texel/surface.hpp"
+
+namespace {
+
+using texel::test_support::TempDir;
+
+constexpr double nan_v = std::numeric_limits<double>::quiet_NaN();
+
+struct DocDel {
+  void operator()(texel_document* d) const { texel_document_destroy(d); }
+};
+struct SurfDel {
+  void operator()(texel_surface* s) const { texel_surface_destroy(s); }
+};
+struct EncDel {
+  void operator()(texel_encode_result* r) const { texel_encode_result_destroy(r); }
+};
+struct PlayerDel {
+  void operator()(texel_player* p) const { texel_player_destroy(p); }
+};
+using Doc = std::unique_ptr<texel_document, DocDel>;
+using Surf = std::unique_ptr<texel_surface, SurfDel>;
+using Enc = std::unique_ptr<texel_encode_result, EncDel>;
+using Play = std::unique_ptr<texel_player, PlayerDel>;
+
+texel_params study_params() {
+  texel_params p = texel_params_default();
+  p.central_pitch_db = 10;
+  p.irregularity_db = -5;
+  p.texel_length_mm = 0.25;
+  p.seed = 7;
+  return p;
+}
+
+Surf make_surface(const texel_params& p, const char* device = "tpad") {
+  texel_surface* s = nullptr;
+  EXPECT_EQ(texel_surface_from_params(device, &p, &s), TEXEL_OK) << texel_last_error();
+  return Surf(s);
+}
+
+std::vector<double> cpp_map(const texel::TexelSpec& spec, const char* device = "tpad") {
+  return texel::prepare_surface(texel::make_document(texel::load_device(device), spec)).render();
+}
+
+texel::TexelSpec study_spec() {
+  texel::TexelSpec s;
+  s.central_pitch = texel::Decibels(10);
+  s.irregularity = texel::Decibels(-5);
+  s.texel_length = texel::Millimetres(0.25);
+  s.seed = 7;
+  return s;
+}
+
+// Expects `status` and a non-empty message containing `fragment`.
+#define EXPECT_FAILS(call, status, fragment)                                     \
+  do {                                                                           \
+    EXPECT_EQ((call), (status)) << texel_last_error();                           \
+    EXPECT_NE(std::string(texel_last_error()).find(fragment), std::string::npos) \
+        << "message: " << texel_last_error();                                    \
+  } while (0)
+
+// ----------------------------------------------------------------- basics
+
+TEST(CApi, VersionMatchesHeader) {
+  int major = -1, minor = -1, patch = -1;
+  texel_version(&major, &minor, &patch);
+  EXPECT_EQ(major, TEXEL_VERSION_MAJOR);
+  EXPECT_EQ(minor, TEXEL_VERSION_MINOR);
+  EXPECT_EQ(patch, TEXEL_VERSION_PATCH);
+  EXPECT_EQ(std::string(texel_version_string()),
+            std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(patch));
+  texel_version(nullptr, nullptr, nullptr);  // any pointer may be NULL
+}
+
+TEST(CApi, StatusStrings) {
+  EXPECT_STREQ(texel_status_string(TEXEL_OK), "TEXEL_OK");
+  EXPECT_STREQ(texel_status_string(TEXEL_INVALID_ARGUMENT), "TEXEL_INVALID_ARGUMENT");
+  EXPECT_STREQ(texel_status_string(TEXEL_FORMAT_ERROR), "TEXEL_FORMAT_ERROR");
+  EXPECT_STREQ(texel_status_string(TEXEL_IO_ERROR), "TEXEL_IO_ERROR");
+  EXPECT_STREQ(texel_status_string(TEXEL_BUFFER_TOO_SMALL), "TEXEL_BUFFER_TOO_SMALL");
+  EXPECT_STREQ(texel_status_string(TEXEL_OUT_OF_MEMORY), "TEXEL_OUT_OF_MEMORY");
+  EXPECT_STREQ(texel_status_string(TEXEL_INTERNAL), "TEXEL_INTERNAL");
+  EXPECT_STREQ(texel_status_string(static_cast<texel_status>(99)), "unknown status");
+  EXPECT_STREQ(texel_status_string(static_cast<texel_status>(-1)), "unknown status");
+}
+
+TEST(CApi, LastErrorIsClearedBySuccessAndIsThreadLocal) {
+  texel_device_info info{};
+  EXPECT_FAILS(texel_device_lookup("no-such-device", &info), TEXEL_INVALID_ARGUMENT, "no-such-device");
+  std::string other;
+  std::thread([&] { other = texel_last_error(); }).join();
+  EXPECT_EQ(other, "");  // another thread sees its own (empty) slot
+  EXPECT_EQ(texel_device_lookup("tpad", &info), TEXEL_OK);
+  EXPECT_STREQ(texel_last_error(), "");
+}
+
+// ---------------------------------------------------------------- devices
+
+TEST(CApi, DeviceLookup) {
+  texel_device_info info{};
+  ASSERT_EQ(texel_device_lookup("tpad", &info), TEXEL_OK) << texel_last_error();
+  const texel::DeviceProfile d = texel::load_device("tpad");
+  EXPECT_EQ(info.samples, d.samples);
+  EXPECT_EQ(info.samples, 19200);
+  EXPECT_DOUBLE_EQ(info.spacing_mm, d.spacing_mm);
+  EXPECT_DOUBLE_EQ(info.length_mm, d.length_mm());
+  EXPECT_DOUBLE_EQ(info.refresh_hz, d.refresh_hz);
+  EXPECT_EQ(info.format, TEXEL_SAMPLE_U16LE);
+  EXPECT_EQ(info.bytes_per_sample, 2u);
+
+  EXPECT_FAILS(texel_device_lookup(nullptr, &info), TEXEL_INVALID_ARGUMENT, "device is NULL");
+  EXPECT_FAILS(texel_device_lookup("tpad", nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_FAILS(texel_device_lookup("nope", &info), TEXEL_INVALID_ARGUMENT, "tpad");  // lists the known names
+}
+
+TEST(CApi, DeviceFromProfileFile) {
+  TempDir dir("capi");
+  const std::string path = dir.write("dev.json", texel::device_profile_json(texel::load_device("generic")));
+  texel_device_info info{};
+  ASSERT_EQ(texel_device_lookup(path.c_str(), &info), TEXEL_OK) << texel_last_error();
+  EXPECT_EQ(info.samples, texel::load_device("generic").samples);
+  const std::string bad = dir.write("bad.json", "{ not json");
+  EXPECT_NE(texel_device_lookup(bad.c_str(), &info), TEXEL_OK);
+  EXPECT_STRNE(texel_last_error(), "");
+}
+
+// ------------------------------------------------------------- parameters
+
+TEST(CApi, ParamsDefaultsAreTheLibrarys) {
+  const texel_params p = texel_params_default();
+  const texel::TexelSpec s;
+  EXPECT_EQ(p.central_pitch_db, s.central_pitch.value());
+  EXPECT_EQ(p.irregularity_db, s.irregularity.value());
+  EXPECT_EQ(p.texel_length_mm, s.texel_length.value());
+  EXPECT_EQ(p.seed, s.seed);
+  EXPECT_EQ(p.parameterization, TEXEL_PARAMETERIZATION_MOMENTS);
+  EXPECT_EQ(p.quantization_db, 0.0);
+  EXPECT_EQ(p.coarse_strength, 0.0);
+  EXPECT_EQ(p.fine_strength, 1.0);
+  EXPECT_EQ(p.coarse_sine_period_mm, 0.0);
+  EXPECT_EQ(p.coarse_sine_phase_deg, 0.0);
+}
+
+TEST(CApi, BadParamsNameTheField) {
+  struct Case {
+    void (*mutate)(texel_params&);
+    const char* field;
+  };
+  const Case cases[] = {
+      {[](texel_params& p) { p.central_pitch_db = nan_v; }, "central_pitch_db"},
+      {[](texel_params& p) { p.irregularity_db = INFINITY; }, "irregularity_db"},
+      {[](texel_params& p) { p.texel_length_mm = nan_v; }, "texel_length_mm"},
+      {[](texel_params& p) { p.texel_length_mm = 0; }, "texel_length_mm"},
+      {[](texel_params& p) { p.texel_length_mm = -1; }, "texel_length_mm"},
+      {[](texel_params& p) { p.quantization_db = -1; }, "quantization_db"},
+      {[](texel_params& p) { p.quantization_db = 21; }, "quantization_db"},
+      {[](texel_params& p) { p.quantization_db = nan_v; }, "quantization_db"},
+      {[](texel_params& p) { p.coarse_strength = 1.5; }, "coarse_strength"},
+      {[](texel_params& p) { p.coarse_strength = nan_v; }, "coarse_strength"},
+      {[](texel_params& p) { p.fine_strength = -0.1; }, "fine_strength"},
+      {[](texel_params& p) { p.coarse_sine_period_mm = -2; }, "coarse_sine_period_mm"},
+      {[](texel_params& p) { p.coarse_sine_period_mm = nan_v; }, "coarse_sine_period_mm"},
+      {[](texel_params& p) { p.coarse_sine_phase_deg = nan_v; }, "coarse_sine_phase_deg"},
+      {[](texel_params& p) { p.parameterization = static_cast<texel_parameterization>(7); }, "parameterization"},
+      {[](texel_params& p) { p.parameterization = static_cast<texel_parameterization>(-1); }, "parameterization"},
+  };
+  for (const Case& c : cases) {
+    texel_params p = texel_params_default();
+    c.mutate(p);
+    texel_surface* s = reinterpret_cast<texel_surface*>(&p);  // must be reset to NULL
+    EXPECT_FAILS(texel_surface_from_params("tpad", &p, &s), TEXEL_INVALID_ARGUMENT, c.field);
+    EXPECT_EQ(s, nullptr);
+    texel_document* d = reinterpret_cast<texel_document*>(&p);
+    EXPECT_FAILS(texel_document_from_params("tpad", &p, &d), TEXEL_INVALID_ARGUMENT, c.field);
+    EXPECT_EQ(d, nullptr);
+  }
+}
+
+// -------------------------------------------------------------- documents
+
+TEST(CApi, DocumentFromParamsRoundTripsThroughJson) {
+  const texel_params p = study_params();
+  texel_document* raw = nullptr;
+  ASSERT_EQ(texel_document_from_params("tpad", &p, &raw), TEXEL_OK) << texel_last_error();
+  Doc doc(raw);
+
+  std::size_t needed = 0;
+  ASSERT_EQ(texel_document_json(doc.get(), nullptr, 0, &needed), TEXEL_OK);
+  const std::string expected = texel::document_json(texel::make_document(texel::load_device("tpad"), study_spec()));
+  EXPECT_EQ(needed, expected.size() + 1);  // with the NUL
+
+  std::vector<char> small(needed - 1, 'x');
+  std::size_t needed2 = 0;
+  EXPECT_FAILS(texel_document_json(doc.get(), small.data(), small.size(), &needed2), TEXEL_BUFFER_TOO_SMALL,
+               std::to_string(needed));
+  EXPECT_EQ(needed2, needed);
+  EXPECT_EQ(small[0], 'x');  // nothing written
+
+  std::vector<char> text(needed);
+  ASSERT_EQ(texel_document_json(doc.get(), text.data(), text.size(), nullptr), TEXEL_OK);
+  EXPECT_EQ(std::string(text.data()), expected);
+
+  texel_document* parsed = nullptr;
+  ASSERT_EQ(texel_document_parse(text.data(), needed - 1, &parsed), TEXEL_OK) << texel_last_error();
+  Doc again(parsed);
+  texel_surface *a = nullptr, *b = nullptr;
+  ASSERT_EQ(texel_surface_create(doc.get(), &a), TEXEL_OK);
+  ASSERT_EQ(texel_surface_create(again.get(), &b), TEXEL_OK);
+  Surf sa(a), sb(b);
+  std::vector<double> ma(19200), mb(19200);
+  ASSERT_EQ(texel_surface_render(a, 0, ma.data(), ma.size()), TEXEL_OK);
+  ASSERT_EQ(texel_surface_render(b, 0, mb.data(), mb.size()), TEXEL_OK);
+  EXPECT_EQ(ma, mb);
+
+  EXPECT_FAILS(texel_document_json(nullptr, text.data(), text.size(), &needed), TEXEL_INVALID_ARGUMENT, "doc is NULL");
+  EXPECT_FAILS(texel_document_json(doc.get(), nullptr, 0, nullptr), TEXEL_INVALID_ARGUMENT, "both NULL");
+}
+
+TEST(CApi, DocumentParseAndLoadErrors) {
+  texel_document* d = nullptr;
+  const std::string bad = "{ \"format\": ";
+  EXPECT_FAILS(texel_document_parse(bad.data(), bad.size(), &d), TEXEL_FORMAT_ERROR, "json");
+  EXPECT_EQ(d, nullptr);
+  const std::string wrong = R"({"format": "something-else", "version": 1})";
+  EXPECT_FAILS(texel_document_parse(wrong.data(), wrong.size(), &d), TEXEL_FORMAT_ERROR, "format");
+  EXPECT_FAILS(texel_document_parse(nullptr, 3, &d), TEXEL_INVALID_ARGUMENT, "json is NULL");
+  EXPECT_FAILS(texel_document_parse(bad.data(), bad.size(), nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_NE(texel_document_parse("", 0, &d), TEXEL_OK);
+
+  EXPECT_FAILS(texel_document_load("/nonexistent/dir/map.texel.json", &d), TEXEL_IO_ERROR, "/nonexistent/dir/map.texel.json");
+  EXPECT_EQ(d, nullptr);
+  EXPECT_FAILS(texel_document_load(nullptr, &d), TEXEL_INVALID_ARGUMENT, "path is NULL");
+  EXPECT_FAILS(texel_document_load("x", nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+
+  TempDir dir("capi");
+  const std::string path = dir.write("bad.texel.json", "[1, 2");
+  EXPECT_EQ(texel_document_load(path.c_str(), &d), TEXEL_FORMAT_ERROR);
+
+  const texel_params p = texel_params_default();
+  EXPECT_FAILS(texel_document_from_params(nullptr, &p, &d), TEXEL_INVALID_ARGUMENT, "device is NULL");
+  EXPECT_FAILS(texel_document_from_params("tpad", nullptr, &d), TEXEL_INVALID_ARGUMENT, "params is NULL");
+  EXPECT_FAILS(texel_document_from_params("nope", &p, &d), TEXEL_INVALID_ARGUMENT, "nope");
+  EXPECT_FAILS(texel_document_from_params("tpad", &p, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+}
+
+TEST(CApi, DocumentLoadFromFile) {
+  TempDir dir("capi");
+  const std::string path = dir.at("map.texel.json");
+  texel::save_document(texel::make_document(texel::load_device("tpad"), study_spec()), path);
+  texel_document* d = nullptr;
+  ASSERT_EQ(texel_document_load(path.c_str(), &d), TEXEL_OK) << texel_last_error();
+  Doc doc(d);
+  texel_surface* s = nullptr;
+  ASSERT_EQ(texel_surface_create(d, &s), TEXEL_OK);
+  Surf surf(s);
+  std::vector<double> m(19200);
+  ASSERT_EQ(texel_surface_render(s, 0, m.data(), m.size()), TEXEL_OK);
+  EXPECT_EQ(m, cpp_map(study_spec()));
+}
+
+TEST(CApi, Reference) {
+  texel_document* d = nullptr;
+  ASSERT_EQ(texel_document_from_reference("tpad", "4sin", 3, &d), TEXEL_OK) << texel_last_error();
+  Doc doc(d);
+  texel_surface* s = nullptr;
+  ASSERT_EQ(texel_surface_create(d, &s), TEXEL_OK);
+  Surf surf(s);
+  texel::ReferenceSpec spec;
+  spec.name = "4sin";
+  spec.seed = 3;
+  const auto expected =
+      texel::prepare_surface(texel::make_reference_document(texel::load_device("tpad"), spec)).render();
+  std::vector<double> m(expected.size());
+  ASSERT_EQ(texel_surface_render(s, 0, m.data(), m.size()), TEXEL_OK);
+  EXPECT_EQ(m, expected);
+
+  EXPECT_FAILS(texel_document_from_reference("tpad", "no-such-reference", 1, &d), TEXEL_INVALID_ARGUMENT,
+               "no-such-reference");
+  EXPECT_EQ(d, nullptr);
+  EXPECT_FAILS(texel_document_from_reference("tpad", nullptr, 1, &d), TEXEL_INVALID_ARGUMENT, "name is NULL");
+  EXPECT_FAILS(texel_document_from_reference(nullptr, "4sin", 1, &d), TEXEL_INVALID_ARGUMENT, "device is NULL");
+  EXPECT_FAILS(texel_document_from_reference("tpad", "4sin", 1, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+}
+
+// --------------------------------------------------------------- surfaces
+
+TEST(CApi, RenderEqualsTheLibrary) {
+  const Surf s = make_surface(study_params());
+  std::size_t n = 0;
+  ASSERT_EQ(texel_surface_size(s.get(), &n), TEXEL_OK);
+  ASSERT_EQ(n, 19200u);
+  texel_device_info info{};
+  ASSERT_EQ(texel_surface_device(s.get(), &info), TEXEL_OK);
+  EXPECT_EQ(info.samples, 19200);
+
+  const std::vector<double> expected = cpp_map(study_spec());
+  std::vector<double> m(n);
+  ASSERT_EQ(texel_surface_render(s.get(), 0, m.data(), n), TEXEL_OK);
+  EXPECT_EQ(m, expected);
+
+  std::vector<std::uint16_t> u(n);
+  ASSERT_EQ(texel_surface_render_u16(s.get(), 0, u.data(), n), TEXEL_OK);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(u[i], texel::to_u16(expected[i])) << i;
+
+  std::size_t needed = 0;
+  ASSERT_EQ(texel_surface_render_native(s.get(), 0, n, nullptr, 0, &needed), TEXEL_OK);
+  EXPECT_EQ(needed, 2 * n);
+  std::vector<std::byte> native(needed);
+  ASSERT_EQ(texel_surface_render_native(s.get(), 0, n, native.data(), native.size(), nullptr), TEXEL_OK);
+  EXPECT_EQ(native, texel::prepare_surface(texel::make_document(texel::load_device("tpad"), study_spec()))
+                        .render_native(texel::SampleFormat::u16le));
+}
+
+TEST(CApi, WindowsEqualTheWholeMap) {
+  const Surf s = make_surface(study_params());
+  const std::vector<double> whole = cpp_map(study_spec());
+  for (const auto& [first, count] : {std::pair<std::int64_t, std::size_t>{0, 1}, {5, 1000}, {12345, 6855}, {19199, 1}}) {
+    std::vector<double> w(count);
+    ASSERT_EQ(texel_surface_render(s.get(), first, w.data(), count), TEXEL_OK);
+    EXPECT_TRUE(std::equal(w.begin(), w.end(), whole.begin() + first)) << first;
+    std::vector<std::uint16_t> u(count);
+    ASSERT_EQ(texel_surface_render_u16(s.get(), first, u.data(), count), TEXEL_OK);
+    for (std::size_t i = 0; i < count; ++i) ASSERT_EQ(u[i], texel::to_u16(whole[first + i]));
+    std::vector<std::uint8_t> b(2 * count);
+    ASSERT_EQ(texel_surface_render_native(s.get(), first, count, b.data(), b.size(), nullptr), TEXEL_OK);
+    for (std::size_t i = 0; i < count; ++i)
+      ASSERT_EQ(b[2 * i] | (b[2 * i + 1] << 8), texel::to_u16(whole[first + i]));  // little-endian
+  }
+  // An empty window at the end is fine and needs no buffer.
+  EXPECT_EQ(texel_surface_render(s.get(), 19200, nullptr, 0), TEXEL_OK);
+  EXPECT_EQ(texel_surface_render_u16(s.get(), 0, nullptr, 0), TEXEL_OK);
+}
+
+TEST(CApi, CoarseSineAndOtherDevices) {
+  texel_params p = study_params();
+  p.coarse_strength = 0.7;
+  p.fine_strength = 0.9;
+  p.coarse_sine_period_mm = 5;
+  p.coarse_sine_phase_deg = 30;
+  p.quantization_db = 1;
+  p.parameterization = TEXEL_PARAMETERIZATION_LOG;
+  p.irregularity_db = 3;  // with 'log', the SD of 10·log10 f: >= 0
+  texel::TexelSpec spec = study_spec();
+  spec.irregularity = texel::Decibels(3);
+  spec.coarse_strength = 0.7;
+  spec.fine_strength = 0.9;
+  spec.coarse = texel::SineProfile{texel::Millimetres(5), 30};
+  spec.quantization_db = 1;
+  spec.parameterization = texel::Parameterization::log;
+  for (const char* device : {"tpad", "generic", "tpad-tablet"}) {
+    const Surf s = make_surface(p, device);
+    std::size_t n = 0;
+    ASSERT_EQ(texel_surface_size(s.get(), &n), TEXEL_OK);
+    std::vector<double> m(n);
+    ASSERT_EQ(texel_surface_render(s.get(), 0, m.data(), n), TEXEL_OK);
+    EXPECT_EQ(m, cpp_map(spec, device)) << device;
+    texel_device_info info{};
+    ASSERT_EQ(texel_surface_device(s.get(), &info), TEXEL_OK);
+    std::size_t needed = 0;
+    ASSERT_EQ(texel_surface_render_native(s.get(), 0, n, nullptr, 0, &needed), TEXEL_OK);
+    EXPECT_EQ(needed, n * info.bytes_per_sample);
+    std::vector<std::byte> bytes(needed);
+    ASSERT_EQ(texel_surface_render_native(s.get(), 0, n, bytes.data(), bytes.size(), &needed), TEXEL_OK);
+    const texel::DeviceProfile d = texel::load_device(device);
+    EXPECT_EQ(bytes, texel::prepare_surface(texel::make_document(d, spec)).render_native(d.format)) << device;
+  }
+}
+
+TEST(CApi, SurfaceErrors) {
+  const Surf s = make_surface(study_params());
+  std::vector<double> m(10);
+  std::vector<std::uint16_t> u(10);
+  std::vector<std::uint8_t> b(20);
+  std::size_t n = 0;
+  texel_device_info info{};
+  EXPECT_FAILS(texel_surface_size(nullptr, &n), TEXEL_INVALID_ARGUMENT, "surface is NULL");
+  EXPECT_FAILS(texel_surface_size(s.get(), nullptr), TEXEL_INVALID_ARGUMENT, "samples is NULL");
+  EXPECT_FAILS(texel_surface_device(nullptr, &info), TEXEL_INVALID_ARGUMENT, "surface is NULL");
+  EXPECT_FAILS(texel_surface_device(s.get(), nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+
+  EXPECT_FAILS(texel_surface_render(nullptr, 0, m.data(), 10), TEXEL_INVALID_ARGUMENT, "surface is NULL");
+  EXPECT_FAILS(texel_surface_render(s.get(), 0, nullptr, 10), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_FAILS(texel_surface_render(s.get(), -1, m.data(), 10), TEXEL_INVALID_ARGUMENT, "outside");
+  EXPECT_FAILS(texel_surface_render(s.get(), 19195, m.data(), 10), TEXEL_INVALID_ARGUMENT, "19200");
+  EXPECT_FAILS(texel_surface_render(s.get(), 19201, m.data(), 0), TEXEL_INVALID_ARGUMENT, "outside");
+  EXPECT_FAILS(texel_surface_render(s.get(), INT64_MAX, m.data(), 10), TEXEL_INVALID_ARGUMENT, "outside");
+  EXPECT_FAILS(texel_surface_render(s.get(), 1, m.data(), SIZE_MAX), TEXEL_INVALID_ARGUMENT, "outside");
+
+  EXPECT_FAILS(texel_surface_render_u16(nullptr, 0, u.data(), 10), TEXEL_INVALID_ARGUMENT, "surface is NULL");
+  EXPECT_FAILS(texel_surface_render_u16(s.get(), 0, nullptr, 10), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_FAILS(texel_surface_render_u16(s.get(), 19195, u.data(), 10), TEXEL_INVALID_ARGUMENT, "outside");
+
+  std::size_t needed = 0;
+  EXPECT_FAILS(texel_surface_render_native(nullptr, 0, 10, b.data(), b.size(), &needed), TEXEL_INVALID_ARGUMENT,
+               "surface is NULL");
+  EXPECT_FAILS(texel_surface_render_native(s.get(), 0, 10, nullptr, 0, nullptr), TEXEL_INVALID_ARGUMENT, "both NULL");
+  EXPECT_FAILS(texel_surface_render_native(s.get(), 19195, 10, b.data(), b.size(), &needed), TEXEL_INVALID_ARGUMENT,
+               "outside");
+  std::fill(b.begin(), b.end(), 0xAB);
+  EXPECT_FAILS(texel_surface_render_native(s.get(), 0, 10, b.data(), 19, &needed), TEXEL_BUFFER_TOO_SMALL, "20 needed");
+  EXPECT_EQ(needed, 20u);
+  EXPECT_EQ(b[0], 0xAB);  // nothing written
+  EXPECT_EQ(texel_surface_render_native(s.get(), 0, 10, b.data(), 20, nullptr), TEXEL_OK);
+
+  texel_surface* out = reinterpret_cast<texel_surface*>(&n);
+  EXPECT_FAILS(texel_surface_create(nullptr, &out), TEXEL_INVALID_ARGUMENT, "doc is NULL");
+  EXPECT_EQ(out, nullptr);
+  const texel_params p = texel_params_default();
+  EXPECT_FAILS(texel_surface_from_params("tpad", &p, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_FAILS(texel_surface_from_params("tpad", nullptr, &out), TEXEL_INVALID_ARGUMENT, "params is NULL");
+  EXPECT_FAILS(texel_surface_from_params(nullptr, &p, &out), TEXEL_INVALID_ARGUMENT, "device is NULL");
+}
+
+TEST(CApi, DestroyNullIsANoOp) {
+  texel_document_destroy(nullptr);
+  texel_surface_destroy(nullptr);
+  texel_encode_result_destroy(nullptr);
+  texel_player_destroy(nullptr);
+}
+
+TEST(CApi, SurfaceOutlivesItsDocument) {
+  const texel_params p = study_params();
+  texel_document* d = nullptr;
+  ASSERT_EQ(texel_document_from_params("tpad", &p, &d), TEXEL_OK);
+  texel_surface* s = nullptr;
+  ASSERT_EQ(texel_surface_create(d, &s), TEXEL_OK);
+  texel_document_destroy(d);
+  Surf surf(s);
+  std::vector<double> m(19200);
+  ASSERT_EQ(texel_surface_render(s, 0, m.data(), m.size()), TEXEL_OK);
+  EXPECT_EQ(m, cpp_map(study_spec()));
+}
+
+// ------------------------------------------------------------------ codec
+
+TEST(CApi, EncodeDecodeRoundTrip) {
+  const Surf s = make_surface(study_params());
+  std::vector<double> m(19200);
+  ASSERT_EQ(texel_surface_render(s.get(), 0, m.data(), m.size()), TEXEL_OK);
+  texel_device_info info{};
+  ASSERT_EQ(texel_surface_device(s.get(), &info), TEXEL_OK);
+
+  texel_encode_result* raw = nullptr;
+  ASSERT_EQ(texel_encode(m.data(), m.size(), info.spacing_mm, &raw), TEXEL_OK) << texel_last_error();
+  Enc enc(raw);
+
+  // The same as the library's encoder with its defaults.
+  texel::codec::Signal sig{m, info.spacing_mm, "test"};
+  const texel::codec::EncodeResult expected = texel::codec::encode(sig, texel::codec::EncoderConfig{});
+
+  std::size_t needed = 0;
+  ASSERT_EQ(texel_encode_result_bytes(raw, nullptr, 0, &needed), TEXEL_OK);
+  ASSERT_EQ(needed, expected.bytes.size());
+  std::vector<std::uint8_t> bytes(needed);
+  EXPECT_FAILS(texel_encode_result_bytes(raw, bytes.data(), needed - 1, &needed), TEXEL_BUFFER_TOO_SMALL, "needed");
+  ASSERT_EQ(texel_encode_result_bytes(raw, bytes.data(), bytes.size(), nullptr), TEXEL_OK);
+  EXPECT_EQ(bytes, expected.bytes);
+
+  texel_params p{};
+  int has_profile = -1;
+  ASSERT_EQ(texel_encode_result_params(raw, &p, &has_profile), TEXEL_OK);
+  EXPECT_EQ(p.central_pitch_db, expected.spec.central_pitch.value());
+  EXPECT_EQ(p.irregularity_db, expected.spec.irregularity.value());
+  EXPECT_EQ(p.texel_length_mm, expected.spec.texel_length.value());
+  EXPECT_EQ(p.seed, expected.spec.seed);
+  EXPECT_EQ(has_profile, 0);  // a fine-only texture
+  EXPECT_NEAR(p.central_pitch_db, 10.0, 0.5);
+  ASSERT_EQ(texel_encode_result_params(raw, &p, nullptr), TEXEL_OK);
+  double jnd = -1;
+  ASSERT_EQ(texel_encode_result_distance(raw, &jnd), TEXEL_OK);
+  EXPECT_EQ(jnd, expected.model_distance);
+
+  // Decode on tpad: the decoder's document, rendered, byte for byte.
+  texel_document* dd = nullptr;
+  ASSERT_EQ(texel_decode(bytes.data(), bytes.size(), "tpad", &dd), TEXEL_OK) << texel_last_error();
+  Doc decoded(dd);
+  texel_surface* ds = nullptr;
+  ASSERT_EQ(texel_surface_create(dd, &ds), TEXEL_OK);
+  Surf dsurf(ds);
+  std::vector<double> dm(19200);
+  ASSERT_EQ(texel_surface_render(ds, 0, dm.data(), dm.size()), TEXEL_OK);
+  const auto want = texel::prepare_surface(texel::codec::decode_document(texel::codec::parse_bitstream(bytes),
+                                                                         texel::load_device("tpad")))
+                        .render();
+  EXPECT_EQ(dm, want);
+
+  // Errors.
+  texel_encode_result* r = nullptr;
+  EXPECT_FAILS(texel_encode(nullptr, 100, 0.005, &r), TEXEL_INVALID_ARGUMENT, "amplitudes is NULL");
+  EXPECT_FAILS(texel_encode(m.data(), m.size(), nan_v, &r), TEXEL_INVALID_ARGUMENT, "spacing_mm");
+  EXPECT_FAILS(texel_encode(m.data(), m.size(), -1, &r), TEXEL_INVALID_ARGUMENT, "spacing");
+  EXPECT_FAILS(texel_encode(m.data(), 10, info.spacing_mm, &r), TEXEL_INVALID_ARGUMENT, "samples");
+  EXPECT_FAILS(texel_encode(nullptr, 0, info.spacing_mm, &r), TEXEL_INVALID_ARGUMENT, "samples");
+  EXPECT_FAILS(texel_encode(m.data(), m.size(), info.spacing_mm, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  std::vector<double> with_nan(m);
+  with_nan[100] = nan_v;
+  EXPECT_EQ(texel_encode(with_nan.data(), with_nan.size(), info.spacing_mm, &r), TEXEL_INVALID_ARGUMENT);
+  EXPECT_EQ(r, nullptr);
+  EXPECT_FAILS(texel_encode_result_bytes(nullptr, bytes.data(), bytes.size(), &needed), TEXEL_INVALID_ARGUMENT,
+               "result is NULL");
+  EXPECT_FAILS(texel_encode_result_bytes(raw, nullptr, 0, nullptr), TEXEL_INVALID_ARGUMENT, "both NULL");
+  EXPECT_FAILS(texel_encode_result_params(nullptr, &p, nullptr), TEXEL_INVALID_ARGUMENT, "result is NULL");
+  EXPECT_FAILS(texel_encode_result_params(raw, nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_FAILS(texel_encode_result_distance(nullptr, &jnd), TEXEL_INVALID_ARGUMENT, "result is NULL");
+  EXPECT_FAILS(texel_encode_result_distance(raw, nullptr), TEXEL_INVALID_ARGUMENT, "jnd is NULL");
+}
+
+TEST(CApi, DecodeErrors) {
+  const texel::codec::Bitstream b;
+  std::vector<std::uint8_t> good = texel::codec::write_bitstream(b);
+  texel_document* d = nullptr;
+  ASSERT_EQ(texel_decode(good.data(), good.size(), "tpad", &d), TEXEL_OK) << texel_last_error();
+  texel_document_destroy(d);
+
+  std::vector<std::uint8_t> bad = good;
+  bad.back() ^= 0xFF;  // CRC
+  d = reinterpret_cast<texel_document*>(&bad);
+  EXPECT_EQ(texel_decode(bad.data(), bad.size(), "tpad", &d), TEXEL_FORMAT_ERROR);
+  EXPECT_STRNE(texel_last_error(), "");
+  EXPECT_EQ(d, nullptr);
+  EXPECT_EQ(texel_decode(good.data(), 3, "tpad", &d), TEXEL_FORMAT_ERROR);  // truncated
+  EXPECT_EQ(texel_decode(good.data(), 0, "tpad", &d), TEXEL_FORMAT_ERROR);
+  EXPECT_FAILS(texel_decode(nullptr, 14, "tpad", &d), TEXEL_INVALID_ARGUMENT, "bytes is NULL");
+  EXPECT_FAILS(texel_decode(good.data(), good.size(), nullptr, &d), TEXEL_INVALID_ARGUMENT, "device is NULL");
+  EXPECT_FAILS(texel_decode(good.data(), good.size(), "nope", &d), TEXEL_INVALID_ARGUMENT, "nope");
+  EXPECT_FAILS(texel_decode(good.data(), good.size(), "tpad", nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+}
+
+// ----------------------------------------------------------------- player
+
+TEST(CApi, PlayerConfigDefaults) {
+  const texel_player_config c = texel_player_config_default();
+  const texel::PlayerConfig l;
+  EXPECT_EQ(c.rate_hz, l.rate_hz);
+  EXPECT_EQ(c.mode, TEXEL_OUTPUT_AMPLITUDE);
+  EXPECT_EQ(c.gain, l.gain);
+  EXPECT_EQ(c.carrier_hz, l.carrier_hz);
+  EXPECT_EQ(c.prediction_s, l.prediction_s);
+}
+
+TEST(CApi, PlayerPlaysTheMapUnderAFinger) {
+  const Surf s = make_surface(study_params());
+  texel_player_config c = texel_player_config_default();
+  c.rate_hz = 8333;
+  texel_player* raw = nullptr;
+  ASSERT_EQ(texel_player_create(&c, &raw), TEXEL_OK) << texel_last_error();
+  Play player(raw);
+  EXPECT_EQ(texel_player_samples(raw), 0u);
+
+  // Silent before a map.
+  std::vector<float> out(256, -1.0f);
+  ASSERT_EQ(texel_player_process(raw, out.data(), out.size(), nullptr), TEXEL_OK);
+  for (float v : out) EXPECT_EQ(v, 0.0f);
+
+  ASSERT_EQ(texel_player_set_surface(raw, s.get()), TEXEL_OK) << texel_last_error();
+  // A swipe at 100 mm/s from 10 mm, queued ahead of time.
+  const double t0 = static_cast<double>(texel_player_samples(raw)) / c.rate_hz;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = t0 + i * 0.001;
+    ASSERT_EQ(texel_player_push(raw, t, 10.0 + 100.0 * (t - t0), 1), TEXEL_OK);
+  }
+  std::vector<float> pos(out.size());
+  float peak = 0;
+  for (int block = 0; block < 4; ++block) {
+    ASSERT_EQ(texel_player_process(raw, out.data(), out.size(), pos.data()), TEXEL_OK);
+    for (float v : out) {
+      EXPECT_GE(v, 0.0f);
+      EXPECT_LE(v, 1.0f);
+      peak = std::max(peak, v);
+    }
+  }
+  EXPECT_GT(peak, 0.5f);
+  EXPECT_GT(pos.back(), 10.0f);
+  EXPECT_EQ(texel_player_samples(raw), 5u * out.size());
+  ASSERT_EQ(texel_player_set_gain(raw, 0.5), TEXEL_OK);
+
+  // A new map: the old one is retired by process and freed by collect.
+  ASSERT_EQ(texel_player_set_surface(raw, s.get()), TEXEL_OK);
+  for (int block = 0; block < 8; ++block) ASSERT_EQ(texel_player_process(raw, out.data(), out.size(), nullptr), TEXEL_OK);
+  std::size_t freed = 99;
+  ASSERT_EQ(texel_player_collect(raw, &freed), TEXEL_OK);
+  EXPECT_EQ(freed, 1u);
+  ASSERT_EQ(texel_player_collect(raw, nullptr), TEXEL_OK);
+}
+
+TEST(CApi, PlayerSurvivesTheSurface) {
+  texel_surface* s = nullptr;
+  const texel_params p = study_params();
+  ASSERT_EQ(texel_surface_from_params("tpad", &p, &s), TEXEL_OK);
+  texel_player_config c = texel_player_config_default();
+  c.mode = TEXEL_OUTPUT_VIBRATION;
+  texel_player* raw = nullptr;
+  ASSERT_EQ(texel_player_create(&c, &raw), TEXEL_OK);
+  Play player(raw);
+  ASSERT_EQ(texel_player_set_surface(raw, s), TEXEL_OK);
+  texel_surface_destroy(s);
+  for (int i = 0; i < 100; ++i) ASSERT_EQ(texel_player_push(raw, i * 0.001, 20.0 + i * 0.1, 1), TEXEL_OK);
+  std::vector<float> out(4800);
+  ASSERT_EQ(texel_player_process(raw, out.data(), out.size(), nullptr), TEXEL_OK);
+  for (float v : out) {
+    EXPECT_GE(v, -1.0f);
+    EXPECT_LE(v, 1.0f);
+  }
+}
+
+TEST(CApi, PlayerErrors) {
+  texel_player_config c = texel_player_config_default();
+  texel_player* p = nullptr;
+  EXPECT_FAILS(texel_player_create(nullptr, &p), TEXEL_INVALID_ARGUMENT, "config is NULL");
+  EXPECT_FAILS(texel_player_create(&c, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  for (int bad_mode : {-1, 3, 1000}) {
+    c = texel_player_config_default();
+    c.mode = static_cast<texel_output_mode>(bad_mode);
+    EXPECT_FAILS(texel_player_create(&c, &p), TEXEL_INVALID_ARGUMENT, "mode");
+    EXPECT_EQ(p, nullptr);
+  }
+  struct Case {
+    void (*mutate)(texel_player_config&);
+    const char* field;
+  };
+  const Case cases[] = {
+      {[](texel_player_config& x) { x.rate_hz = nan_v; }, "rate_hz"},
+      {[](texel_player_config& x) { x.rate_hz = 10; }, "rate_hz"},
+      {[](texel_player_config& x) { x.gain = 2; }, "gain"},
+      {[](texel_player_config& x) { x.gain = nan_v; }, "gain"},
+      {[](texel_player_config& x) { x.carrier_hz = -1; }, "carrier_hz"},
+      {[](texel_player_config& x) { x.prediction_s = 1; }, "prediction_s"},
+      {[](texel_player_config& x) { x.prediction_s = nan_v; }, "prediction_s"},
+  };
+  for (const Case& k : cases) {
+    c = texel_player_config_default();
+    k.mutate(c);
+    EXPECT_FAILS(texel_player_create(&c, &p), TEXEL_INVALID_ARGUMENT, k.field);
+    EXPECT_EQ(p, nullptr);
+  }
+
+  c = texel_player_config_default();
+  ASSERT_EQ(texel_player_create(&c, &p), TEXEL_OK);
+  Play player(p);
+  const Surf s = make_surface(study_params());
+  EXPECT_FAILS(texel_player_set_surface(nullptr, s.get()), TEXEL_INVALID_ARGUMENT, "player is NULL");
+  EXPECT_FAILS(texel_player_set_surface(p, nullptr), TEXEL_INVALID_ARGUMENT, "surface is NULL");
+  EXPECT_FAILS(texel_player_push(nullptr, 0, 0, 1), TEXEL_INVALID_ARGUMENT, "player is NULL");
+  EXPECT_FAILS(texel_player_push(p, nan_v, 0, 1), TEXEL_INVALID_ARGUMENT, "t_s");
+  EXPECT_FAILS(texel_player_push(p, 0, INFINITY, 1), TEXEL_INVALID_ARGUMENT, "x_mm");
+  EXPECT_FAILS(texel_player_set_gain(nullptr, 1), TEXEL_INVALID_ARGUMENT, "player is NULL");
+  EXPECT_FAILS(texel_player_set_gain(p, nan_v), TEXEL_INVALID_ARGUMENT, "gain");
+  EXPECT_EQ(texel_player_set_gain(p, 7), TEXEL_OK);  // clamped, as real-time parameters are
+  EXPECT_FAILS(texel_player_collect(nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "player is NULL");
+  float out[4];
+  EXPECT_EQ(texel_player_process(nullptr, out, 4, nullptr), TEXEL_INVALID_ARGUMENT);
+  EXPECT_EQ(texel_player_process(p, nullptr, 4, nullptr), TEXEL_INVALID_ARGUMENT);
+  EXPECT_EQ(texel_player_process(p, nullptr, 0, nullptr), TEXEL_OK);
+  EXPECT_EQ(texel_player_samples(nullptr), 0u);
+
+  // A full event queue is reported, not dropped silently.
+  texel_status st = TEXEL_OK;
+  int pushed = 0;
+  for (; pushed < 10000 && st == TEXEL_OK; ++pushed) st = texel_player_push(p, pushed * 1e-4, 1.0, 1);
+  EXPECT_EQ(st, TEXEL_BUFFER_TOO_SMALL);
+  EXPECT_NE(std::string(texel_last_error()).find("queue is full"), std::string::npos);
+  EXPECT_LE(pushed, 4097);
+  float big[512];
+  ASSERT_EQ(texel_player_process(p, big, 512, nullptr), TEXEL_OK);
+  EXPECT_EQ(texel_player_push(p, 1.0, 1.0, 1), TEXEL_OK);
+}
+
+}  // namespace
