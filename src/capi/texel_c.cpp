@@ -22,6 +22,7 @@
 #include <new>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -114,6 +115,17 @@ const char* need_text(const char* p, const char* name) {
   return p;
 }
 
+// The integer a C caller stored in an enum. C allows any int there; in C++ a
+// load of an enum object outside its range is undefined (and UBSan's `enum`
+// check stops on it), so the bytes are copied instead of loaded as the enum.
+template <class E>
+long long enum_value(const E& e) {
+  std::underlying_type_t<E> v;
+  static_assert(sizeof v == sizeof e);
+  std::memcpy(&v, &e, sizeof v);
+  return static_cast<long long>(static_cast<int>(v));
+}
+
 void need_finite(double v, const char* name) {
   if (!std::isfinite(v)) throw InvalidArgument(std::string(name) + " is not a finite number");
 }
@@ -176,11 +188,11 @@ texel::TexelSpec spec_of(const texel_params& p) {
   s.irregularity = texel::Decibels(p.irregularity_db);
   s.texel_length = texel::Millimetres(p.texel_length_mm);
   s.seed = p.seed;
-  switch (static_cast<int>(p.parameterization)) {
+  switch (enum_value(p.parameterization)) {
     case TEXEL_PARAMETERIZATION_MOMENTS: s.parameterization = texel::Parameterization::moments; break;
     case TEXEL_PARAMETERIZATION_LOG: s.parameterization = texel::Parameterization::log; break;
     default:
-      throw InvalidArgument("parameterization is " + std::to_string(static_cast<int>(p.parameterization)) +
+      throw InvalidArgument("parameterization is " + std::to_string(enum_value(p.parameterization)) +
                             "; allowed: TEXEL_PARAMETERIZATION_MOMENTS (0), TEXEL_PARAMETERIZATION_LOG (1)");
   }
   if (!(p.quantization_db >= 0.0 && p.quantization_db <= 20.0))
@@ -269,7 +281,7 @@ const char* texel_version_string(void) { return TEXEL_VERSION_STRING; }
 // ----------------------------------------------------------------- status
 
 const char* texel_status_string(texel_status status) {
-  switch (status) {
+  switch (enum_value(status)) {
     case TEXEL_OK: return "TEXEL_OK";
     case TEXEL_INVALID_ARGUMENT: return "TEXEL_INVALID_ARGUMENT";
     case TEXEL_FORMAT_ERROR: return "TEXEL_FORMAT_ERROR";
@@ -488,12 +500,12 @@ texel_status texel_player_create(const texel_player_config* config, texel_player
     const texel_player_config& c = need(config, "config");
     texel::PlayerConfig pc;
     pc.rate_hz = c.rate_hz;
-    switch (static_cast<int>(c.mode)) {
+    switch (enum_value(c.mode)) {
       case TEXEL_OUTPUT_AMPLITUDE: pc.mode = texel::OutputMode::amplitude; break;
       case TEXEL_OUTPUT_VIBRATION: pc.mode = texel::OutputMode::vibration; break;
       case TEXEL_OUTPUT_CARRIER: pc.mode = texel::OutputMode::carrier; break;
       default:
-        throw InvalidArgument("mode is " + std::to_string(static_cast<int>(c.mode)) +
+        throw InvalidArgument("mode is " + std::to_string(enum_value(c.mode)) +
                               "; allowed: TEXEL_OUTPUT_AMPLITUDE (0), TEXEL_OUTPUT_VIBRATION (1), TEXEL_OUTPUT_CARRIER (2)");
     }
     pc.gain = c.gain;

@@ -364,9 +364,11 @@ TEST(CApi, CoarseSineAndOtherDevices) {
   p.coarse_sine_phase_deg = 30;
   p.quantization_db = 1;
   p.parameterization = TEXEL_PARAMETERIZATION_LOG;
-  p.irregularity_db = 3;  // with 'log', the SD of 10·log10 f: >= 0
+  p.irregularity_db = 3;   // with 'log', the SD of 10·log10 f: >= 0
+  p.central_pitch_db = 5;  // inside the band of the coarsest device ("generic": 6.3 dB)
   texel::TexelSpec spec = study_spec();
   spec.irregularity = texel::Decibels(3);
+  spec.central_pitch = texel::Decibels(5);
   spec.coarse_strength = 0.7;
   spec.fine_strength = 0.9;
   spec.coarse = texel::SineProfile{texel::Millimetres(5), 30};
@@ -434,6 +436,23 @@ TEST(CApi, SurfaceErrors) {
   EXPECT_FAILS(texel_surface_from_params("tpad", &p, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
   EXPECT_FAILS(texel_surface_from_params("tpad", nullptr, &out), TEXEL_INVALID_ARGUMENT, "params is NULL");
   EXPECT_FAILS(texel_surface_from_params(nullptr, &p, &out), TEXEL_INVALID_ARGUMENT, "device is NULL");
+}
+
+TEST(CApi, OneSurfaceRendersFromManyThreads) {
+  const Surf s = make_surface(study_params());
+  const std::vector<double> whole = cpp_map(study_spec());
+  std::vector<std::vector<double>> got(4, std::vector<double>(4800));
+  std::vector<texel_status> status(4, TEXEL_INTERNAL);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      status[t] = texel_surface_render(s.get(), static_cast<std::int64_t>(t * 4800), got[t].data(), 4800);
+    });
+  for (auto& t : threads) t.join();
+  for (std::size_t t = 0; t < 4; ++t) {
+    EXPECT_EQ(status[t], TEXEL_OK);
+    EXPECT_TRUE(std::equal(got[t].begin(), got[t].end(), whole.begin() + static_cast<std::ptrdiff_t>(t * 4800)));
+  }
 }
 
 TEST(CApi, DestroyNullIsANoOp) {

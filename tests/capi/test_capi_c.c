@@ -173,8 +173,9 @@ static void test_documents_and_surfaces(void) {
     stream[0] ^= 0xFF;
     CHECK_STATUS(texel_decode(stream, needed, "tpad", &decoded), TEXEL_FORMAT_ERROR);
     CHECK(decoded == NULL);
-    CHECK_STATUS(texel_encode(amplitudes, 10, info.spacing_mm, &r), TEXEL_INVALID_ARGUMENT);
     texel_encode_result_destroy(r);
+    CHECK_STATUS(texel_encode(amplitudes, 10, info.spacing_mm, &r), TEXEL_INVALID_ARGUMENT);
+    CHECK(r == NULL);
     CHECK_STATUS(texel_encode_result_bytes(NULL, stream, sizeof stream, NULL), TEXEL_INVALID_ARGUMENT);
     CHECK_STATUS(texel_encode(amplitudes, n, NAN, &r), TEXEL_INVALID_ARGUMENT);
   }
