@@ -11,8 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev
   libcairo2-dev libkissfft-dev libzstd-dev zstd
   libsndfile1-dev portaudio19-dev libsqlite3-dev
-  libboost-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema
+  libboost-dev libmatio-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-h5py
   chromium firefox-esr
 )
 
