@@ -235,8 +235,8 @@ texel_params params_of(const texel::TexelSpec& s, int* has_profile) {
 void check_window(const texel_surface& s, std::int64_t first, std::size_t count) {
   const auto size = static_cast<std::uint64_t>(s.surface.grid().count);
   if (first < 0 || static_cast<std::uint64_t>(first) > size || count > size - static_cast<std::uint64_t>(first))
-    throw InvalidArgument("window first=" + std::to_string(first) + " count=" + std::to_string(count) +
-                          " is outside the map's " + std::to_string(size) + " samples");
+    throw InvalidArgument("window first=" + std::to_string(first) + " count=" + std::to_string(count) + " is outside the map's " +
+                          std::to_string(size) + " samples");
 }
 
 // Renders a window chunk by chunk (bounded scratch memory), handing each
@@ -323,9 +323,8 @@ texel_params texel_params_default(void) {
 // -------------------------------------------------------------- documents
 
 texel_status texel_document_load(const char* path, texel_document** out) {
-  return create(out, [&] {
-    return std::make_unique<texel_document>(texel_document{texel::load_document(need_text(path, "path"))});
-  });
+  return create(out,
+                [&] { return std::make_unique<texel_document>(texel_document{texel::load_document(need_text(path, "path"))}); });
 }
 
 texel_status texel_document_parse(const char* json, std::size_t length, texel_document** out) {
@@ -342,8 +341,7 @@ texel_status texel_document_from_params(const char* device, const texel_params* 
   });
 }
 
-texel_status texel_document_from_reference(const char* device, const char* name, std::uint64_t seed,
-                                           texel_document** out) {
+texel_status texel_document_from_reference(const char* device, const char* name, std::uint64_t seed, texel_document** out) {
   return create(out, [&] {
     texel::ReferenceSpec spec;
     spec.name = need_text(name, "name");
@@ -405,8 +403,7 @@ texel_status texel_surface_render(const texel_surface* surface, std::int64_t fir
   });
 }
 
-texel_status texel_surface_render_u16(const texel_surface* surface, std::int64_t first, std::uint16_t* out,
-                                      std::size_t count) {
+texel_status texel_surface_render_u16(const texel_surface* surface, std::int64_t first, std::uint16_t* out, std::size_t count) {
   return guarded([&] {
     const texel_surface& s = need(surface, "surface");
     check_window(s, first, count);
@@ -418,8 +415,8 @@ texel_status texel_surface_render_u16(const texel_surface* surface, std::int64_t
   });
 }
 
-texel_status texel_surface_render_native(const texel_surface* surface, std::int64_t first, std::size_t count,
-                                         void* buffer, std::size_t capacity, std::size_t* needed) {
+texel_status texel_surface_render_native(const texel_surface* surface, std::int64_t first, std::size_t count, void* buffer,
+                                         std::size_t capacity, std::size_t* needed) {
   return guarded([&] {
     const texel_surface& s = need(surface, "surface");
     check_window(s, first, count);

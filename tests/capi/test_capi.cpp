@@ -77,11 +77,10 @@ texel::TexelSpec study_spec() {
 }
 
 // Expects `status` and a non-empty message containing `fragment`.
-#define EXPECT_FAILS(call, status, fragment)                                     \
-  do {                                                                           \
-    EXPECT_EQ((call), (status)) << texel_last_error();                           \
-    EXPECT_NE(std::string(texel_last_error()).find(fragment), std::string::npos) \
-        << "message: " << texel_last_error();                                    \
+#define EXPECT_FAILS(call, status, fragment)                                                                           \
+  do {                                                                                                                 \
+    EXPECT_EQ((call), (status)) << texel_last_error();                                                                 \
+    EXPECT_NE(std::string(texel_last_error()).find(fragment), std::string::npos) << "message: " << texel_last_error(); \
   } while (0)
 
 // ----------------------------------------------------------------- basics
@@ -293,14 +292,12 @@ TEST(CApi, Reference) {
   texel::ReferenceSpec spec;
   spec.name = "4sin";
   spec.seed = 3;
-  const auto expected =
-      texel::prepare_surface(texel::make_reference_document(texel::load_device("tpad"), spec)).render();
+  const auto expected = texel::prepare_surface(texel::make_reference_document(texel::load_device("tpad"), spec)).render();
   std::vector<double> m(expected.size());
   ASSERT_EQ(texel_surface_render(s, 0, m.data(), m.size()), TEXEL_OK);
   EXPECT_EQ(m, expected);
 
-  EXPECT_FAILS(texel_document_from_reference("tpad", "no-such-reference", 1, &d), TEXEL_INVALID_ARGUMENT,
-               "no-such-reference");
+  EXPECT_FAILS(texel_document_from_reference("tpad", "no-such-reference", 1, &d), TEXEL_INVALID_ARGUMENT, "no-such-reference");
   EXPECT_EQ(d, nullptr);
   EXPECT_FAILS(texel_document_from_reference("tpad", nullptr, 1, &d), TEXEL_INVALID_ARGUMENT, "name is NULL");
   EXPECT_FAILS(texel_document_from_reference(nullptr, "4sin", 1, &d), TEXEL_INVALID_ARGUMENT, "device is NULL");
@@ -421,8 +418,7 @@ TEST(CApi, SurfaceErrors) {
   EXPECT_FAILS(texel_surface_render_native(nullptr, 0, 10, b.data(), b.size(), &needed), TEXEL_INVALID_ARGUMENT,
                "surface is NULL");
   EXPECT_FAILS(texel_surface_render_native(s.get(), 0, 10, nullptr, 0, nullptr), TEXEL_INVALID_ARGUMENT, "both NULL");
-  EXPECT_FAILS(texel_surface_render_native(s.get(), 19195, 10, b.data(), b.size(), &needed), TEXEL_INVALID_ARGUMENT,
-               "outside");
+  EXPECT_FAILS(texel_surface_render_native(s.get(), 19195, 10, b.data(), b.size(), &needed), TEXEL_INVALID_ARGUMENT, "outside");
   std::fill(b.begin(), b.end(), 0xAB);
   EXPECT_FAILS(texel_surface_render_native(s.get(), 0, 10, b.data(), 19, &needed), TEXEL_BUFFER_TOO_SMALL, "20 needed");
   EXPECT_EQ(needed, 20u);
@@ -445,9 +441,8 @@ TEST(CApi, OneSurfaceRendersFromManyThreads) {
   std::vector<texel_status> status(4, TEXEL_INTERNAL);
   std::vector<std::thread> threads;
   for (std::size_t t = 0; t < 4; ++t)
-    threads.emplace_back([&, t] {
-      status[t] = texel_surface_render(s.get(), static_cast<std::int64_t>(t * 4800), got[t].data(), 4800);
-    });
+    threads.emplace_back(
+        [&, t] { status[t] = texel_surface_render(s.get(), static_cast<std::int64_t>(t * 4800), got[t].data(), 4800); });
   for (auto& t : threads) t.join();
   for (std::size_t t = 0; t < 4; ++t) {
     EXPECT_EQ(status[t], TEXEL_OK);
@@ -523,9 +518,9 @@ TEST(CApi, EncodeDecodeRoundTrip) {
   Surf dsurf(ds);
   std::vector<double> dm(19200);
   ASSERT_EQ(texel_surface_render(ds, 0, dm.data(), dm.size()), TEXEL_OK);
-  const auto want = texel::prepare_surface(texel::codec::decode_document(texel::codec::parse_bitstream(bytes),
-                                                                         texel::load_device("tpad")))
-                        .render();
+  const auto want =
+      texel::prepare_surface(texel::codec::decode_document(texel::codec::parse_bitstream(bytes), texel::load_device("tpad")))
+          .render();
   EXPECT_EQ(dm, want);
 
   // Errors.
@@ -540,8 +535,7 @@ TEST(CApi, EncodeDecodeRoundTrip) {
   with_nan[100] = nan_v;
   EXPECT_EQ(texel_encode(with_nan.data(), with_nan.size(), info.spacing_mm, &r), TEXEL_INVALID_ARGUMENT);
   EXPECT_EQ(r, nullptr);
-  EXPECT_FAILS(texel_encode_result_bytes(nullptr, bytes.data(), bytes.size(), &needed), TEXEL_INVALID_ARGUMENT,
-               "result is NULL");
+  EXPECT_FAILS(texel_encode_result_bytes(nullptr, bytes.data(), bytes.size(), &needed), TEXEL_INVALID_ARGUMENT, "result is NULL");
   EXPECT_FAILS(texel_encode_result_bytes(raw, nullptr, 0, nullptr), TEXEL_INVALID_ARGUMENT, "both NULL");
   EXPECT_FAILS(texel_encode_result_params(nullptr, &p, nullptr), TEXEL_INVALID_ARGUMENT, "result is NULL");
   EXPECT_FAILS(texel_encode_result_params(raw, nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");

@@ -46,7 +46,8 @@ std::vector<std::uint8_t> document_map(texel_document* d) {
 TEST(CApiCli, RenderEqualsTexelRender) {
   TempDir dir("capi-cli");
   const std::string bin = dir.at("a.bin");
-  const auto r = run_cli(TEXEL_CLI, "render --central-pitch 10 --irregularity -5 --texel-length 0.25 --seed 7 --device tpad -o " + bin);
+  const auto r =
+      run_cli(TEXEL_CLI, "render --central-pitch 10 --irregularity -5 --texel-length 0.25 --seed 7 --device tpad -o " + bin);
   ASSERT_EQ(r.status, 0) << r.out;
   const auto expected = read_bytes(bin);
   ASSERT_EQ(expected.size(), 2u * 19200u);
@@ -72,7 +73,8 @@ TEST(CApiCli, CoarseAndLogEqualTexelRender) {
   const auto r = run_cli(TEXEL_CLI,
                          "render --central-pitch 6 --irregularity 2 --texel-length 0.5 --seed 42 --parameterization log "
                          "--quantization 2 --coarse-strength 0.6 --fine-strength 0.8 --coarse-sine 4 --coarse-phase 90 "
-                         "--device tpad-tablet -o " + bin);
+                         "--device tpad-tablet -o " +
+                             bin);
   ASSERT_EQ(r.status, 0) << r.out;
   texel_params p = texel_params_default();
   p.central_pitch_db = 6;

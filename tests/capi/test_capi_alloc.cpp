@@ -1,0 +1,137 @@
+// Allocation rules of the C ABI, with global operator new/delete replaced by
+// counting versions (as tests/player/test_player_alloc.cpp does for Player):
+//  - texel_player_process allocates and frees nothing, while the control
+//    thread's calls around it (push, set_surface, collect) may;
+//  - running out of memory inside any entry point is TEXEL_OUT_OF_MEMORY with
+//    a message, never an exception across the boundary.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <vector>
+
+#include "texel.h"
+
+// The replacements below pair malloc with free on purpose.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
+namespace {
+thread_local bool counting = false;
+thread_local bool fail_allocations = false;
+std::atomic<std::uint64_t> counted_allocations{0};
+std::atomic<std::uint64_t> counted_frees{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (fail_allocations) throw std::bad_alloc();
+  if (counting) counted_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return operator new(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return operator new(n, std::nothrow); }
+void operator delete(void* p) noexcept {
+  if (p && counting) counted_frees.fetch_add(1, std::memory_order_relaxed);
+  std::free(p);
+}
+void operator delete[](void* p) noexcept { operator delete(p); }
+void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
+void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
+// Over-aligned types (the player's queues are cache-line aligned).
+void* operator new(std::size_t n, std::align_val_t a) {
+  if (fail_allocations) throw std::bad_alloc();
+  if (counting) counted_allocations.fetch_add(1, std::memory_order_relaxed);
+  const auto align = static_cast<std::size_t>(a);
+  if (void* p = std::aligned_alloc(align, (n + align - 1) / align * align)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n, std::align_val_t a) { return operator new(n, a); }
+void operator delete(void* p, std::align_val_t) noexcept { operator delete(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { operator delete(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { operator delete(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { operator delete(p); }
+
+namespace {
+
+TEST(CApiAlloc, CountingAllocatorWorks) {
+  counting = true;
+  auto* p = new int(3);
+  delete p;
+  counting = false;
+  EXPECT_EQ(counted_allocations.exchange(0), 1u);
+  EXPECT_EQ(counted_frees.exchange(0), 1u);
+}
+
+TEST(CApiAlloc, ProcessAllocatesNothing) {
+  texel_params params = texel_params_default();
+  texel_surface* surface = nullptr;
+  ASSERT_EQ(texel_surface_from_params("tpad", &params, &surface), TEXEL_OK);
+  texel_player_config config = texel_player_config_default();
+  config.rate_hz = 8333;
+  config.mode = TEXEL_OUTPUT_VIBRATION;
+  texel_player* player = nullptr;
+  ASSERT_EQ(texel_player_create(&config, &player), TEXEL_OK);
+  ASSERT_EQ(texel_player_set_surface(player, surface), TEXEL_OK);
+
+  std::vector<float> out(64), pos(64);
+  double t = 0.0;
+  for (int block = 0; block < 2000; ++block) {
+    // Control side: finger samples every block, a new map now and then.
+    for (int k = 0; k < 8; ++k, t += 1.0 / 1000.0)
+      ASSERT_EQ(texel_player_push(player, t, 5.0 + 40.0 * std::abs(std::sin(t)), block % 300 < 250), TEXEL_OK);
+    if (block % 500 == 250) {
+      ASSERT_EQ(texel_player_set_surface(player, surface), TEXEL_OK);
+    }
+    if (block % 100 == 0) {
+      ASSERT_EQ(texel_player_collect(player, nullptr), TEXEL_OK);
+    }
+    // Real-time side.
+    counting = true;
+    const texel_status st = texel_player_process(player, out.data(), out.size(), block % 2 ? pos.data() : nullptr);
+    counting = false;
+    ASSERT_EQ(st, TEXEL_OK);
+  }
+  EXPECT_EQ(counted_allocations.load(), 0u);
+  EXPECT_EQ(counted_frees.load(), 0u);
+  counting = true;
+  EXPECT_EQ(texel_player_process(nullptr, out.data(), out.size(), nullptr), TEXEL_INVALID_ARGUMENT);  // errors too
+  counting = false;
+  EXPECT_EQ(counted_allocations.load(), 0u);
+  texel_player_destroy(player);
+  texel_surface_destroy(surface);
+}
+
+TEST(CApiAlloc, OutOfMemoryIsAStatus) {
+  texel_params params = texel_params_default();
+  texel_surface* surface = reinterpret_cast<texel_surface*>(&params);
+  texel_player* player = reinterpret_cast<texel_player*>(&params);
+  texel_player_config config = texel_player_config_default();
+  texel_status a, b;
+  {
+    fail_allocations = true;
+    a = texel_surface_from_params("tpad", &params, &surface);
+    b = texel_player_create(&config, &player);
+    fail_allocations = false;
+  }
+  EXPECT_EQ(a, TEXEL_OUT_OF_MEMORY);
+  EXPECT_EQ(b, TEXEL_OUT_OF_MEMORY);
+  EXPECT_STREQ(texel_last_error(), "out of memory");
+  EXPECT_EQ(surface, nullptr);
+  EXPECT_EQ(player, nullptr);
+  // And the library works again afterwards.
+  ASSERT_EQ(texel_surface_from_params("tpad", &params, &surface), TEXEL_OK);
+  EXPECT_STREQ(texel_last_error(), "");
+  texel_surface_destroy(surface);
+}
+
+}  // namespace
