@@ -133,7 +133,7 @@ typedef struct texel_params {
   double coarse_strength;                /* C, 0 … 1 [0] */
   double fine_strength;                  /* F, 0 … 1 [1] */
   double coarse_sine_period_mm;          /* coarse profile: a sinusoid of this period (mm, > 0); 0 = constant [0] */
-  double coarse_sine_phase_deg;          /* its phase, degrees, finite [0] */
+  double coarse_sine_phase_deg;          /* its phase, degrees, finite; used when the period is > 0 [0] */
 } texel_params;
 
 texel_params texel_params_default(void);
