@@ -21,6 +21,7 @@ struct RenderArgs {
   DeviceOptions device;
   std::string output;
   std::optional<std::string> texels_csv;
+  std::string mat_version = "5";
   bool json = false;
 };
 
@@ -86,11 +87,16 @@ void register_render(CLI::App& app) {
   cmd->add_option("document", args->document, "A texture document (.texel.json); flags override its values");
   add_texture_options(*cmd, args->texture);
   add_device_options(*cmd, args->device);
-  cmd->add_option("-o,--output", args->output, "Output: .bin (device native), .csv, .npy, .texel.json, .png or .svg")->required();
+  cmd->add_option("-o,--output", args->output, "Output: .bin (device native), .csv, .npy, .mat (MATLAB), .texel.json, .png or .svg")
+      ->required();
+  cmd->add_option("--mat-version", args->mat_version, "MATLAB file version of a .mat output: 5 (default, compressed) or 7.3 (HDF5)")
+      ->default_str("5");
   cmd->add_option("--texels", args->texels_csv, "Also write one row per texel: index,start_mm,frequency_cpm,amplitude");
   cmd->add_flag("--json", args->json, "Print a JSON summary on stdout");
   cmd->callback([args] {
-    output_kind(args->output);  // reject a bad extension before any work
+    // Reject a bad extension or MAT version before any work.
+    const mat::MatVersion mat_version = mat::parse_mat_version(args->mat_version);
+    if (!is_mat_output(args->output)) output_kind(args->output);
     check_writable(args->output);
     if (args->texels_csv) {
       if (output_extension(*args->texels_csv) != ".csv")
@@ -102,7 +108,7 @@ void register_render(CLI::App& app) {
     const std::vector<double> map = render_map(surface);
     std::vector<PendingFile> extra;
     if (args->texels_csv) extra.push_back({*args->texels_csv, texels_csv(surface)});
-    write_rendered(args->output, doc, surface, map, texel_frequencies(surface), std::move(extra));
+    write_rendered(args->output, doc, surface, map, texel_frequencies(surface), std::move(extra), mat_version);
     if (args->json) print_json(summary(doc, surface, map, *args));
   });
 }

@@ -29,8 +29,95 @@ std::vector<double> texel_frequencies(const Surface& surface) {
   return f;
 }
 
+bool is_mat_output(const std::string& path) { return output_extension(path) == ".mat"; }
+
+std::vector<mat::Variable> map_variables(const Document& doc, const Surface& surface, const std::vector<double>& map) {
+  using mat::Matrix;
+  using mat::Text;
+  const Grid& g = surface.grid();
+  std::vector<double> x(map.size());
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = g.position(static_cast<std::int64_t>(i));
+
+  mat::Struct params;
+  params.add("device", Text{doc.device.name})
+      .add("format", Text{std::string(to_string(doc.device.format))})
+      .add("samples", Matrix::scalar(static_cast<double>(g.count)))
+      .add("spacing_mm", Matrix::scalar(g.spacing_mm))
+      .add("length_mm", Matrix::scalar(g.length_mm()))
+      .add("regions", Matrix::scalar(static_cast<double>(surface.regions().size())));
+  // The first Texel region's parameters (a one-region document's texture);
+  // every region's full description is in `document`.
+  for (const auto& r : surface.regions()) {
+    const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get());
+    if (!t) continue;
+    const TexelSpec& s = t->spec();
+    params.add("central_pitch_db", Matrix::scalar(s.central_pitch.value()))
+        .add("irregularity_db", Matrix::scalar(s.irregularity.value()))
+        .add("texel_length_mm", Matrix::scalar(s.texel_length.value()))
+        .add("seed", Matrix::scalar(static_cast<double>(s.seed)))  // exact below 2^53; `document` has every digit
+        .add("parameterization", Text{std::string(to_string(s.parameterization))})
+        .add("out_of_band", Text{std::string(to_string(s.out_of_band))})
+        .add("band_min_cpm", Matrix::scalar(s.band_min.value()))
+        .add("band_max_cpm", Matrix::scalar(s.band_max.value()))
+        .add("quantization_db", Matrix::scalar(s.quantization_db))
+        .add("phase", Text{std::string(to_string(s.phase))})
+        .add("fill", Text{std::string(to_string(s.fill))})
+        .add("coarse_strength", Matrix::scalar(s.coarse_strength))
+        .add("fine_strength", Matrix::scalar(s.fine_strength));
+    break;
+  }
+  std::string textures;
+  for (const auto& r : surface.regions()) textures += (textures.empty() ? "" : "; ") + r.texture->describe();
+  params.add("texture", Text{textures});
+  params.add("description", Text{doc.description});
+
+  std::vector<mat::Variable> vars;
+  vars.push_back({"amplitude", Matrix::column(map)});
+  vars.push_back({"position_mm", Matrix::column(std::move(x))});
+  vars.push_back({"params", std::move(params)});
+
+  // One row per texel, as columns (struct2table(texels) gives a MATLAB table).
+  std::vector<double> index, start, freq, amp, region;
+  for (std::size_t r = 0; r < surface.regions().size(); ++r) {
+    const auto& reg = surface.regions()[r];
+    const auto* t = dynamic_cast<const TexelTexture*>(reg.texture.get());
+    if (!t) continue;
+    for (std::size_t k = 0; k < t->texels().size(); ++k) {
+      const Texel& tx = t->texels()[k];
+      index.push_back(static_cast<double>(k));
+      start.push_back(reg.start_mm + tx.start_mm);
+      freq.push_back(tx.frequency_cpm);
+      amp.push_back(tx.envelope);
+      region.push_back(static_cast<double>(r + 1));  // MATLAB counts from 1
+    }
+  }
+  if (!index.empty()) {
+    mat::Struct texels;
+    texels.add("index", Matrix::column(std::move(index)))
+        .add("start_mm", Matrix::column(std::move(start)))
+        .add("frequency_cpm", Matrix::column(std::move(freq)))
+        .add("amplitude", Matrix::column(std::move(amp)))
+        .add("region", Matrix::column(std::move(region)));
+    vars.push_back({"texels", std::move(texels)});
+  }
+  vars.push_back({"document", Text{document_json(doc)}});
+  return vars;
+}
+
 void write_rendered(const std::string& path, const Document& doc, const Surface& surface, const std::vector<double>& map,
-                    const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra) {
+                    const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra, mat::MatVersion mat_version) {
+  if (is_mat_output(path)) {
+    check_writable(path);
+    for (const auto& f : extra) check_writable(f.path);
+    mat::write_mat(path, map_variables(doc, surface, map), {.version = mat_version});  // atomic on its own
+    try {
+      commit_files(extra);
+    } catch (...) {
+      std::remove(path.c_str());
+      throw;
+    }
+    return;
+  }
   const OutputKind kind = output_kind(path);
   check_writable(path);
   for (const auto& f : extra) check_writable(f.path);

@@ -7,6 +7,7 @@
 
 #include "common.hpp"
 #include "texel/document.hpp"
+#include "texel/matfile.hpp"
 
 namespace texel::cli {
 
@@ -14,10 +15,20 @@ namespace texel::cli {
 std::vector<double> render_map(const Surface& surface);
 
 /// Writes `surface` to `path` in the format its extension picks. `doc` is
-/// written for .texel.json; `frequencies_cpm` feeds the plot's histogram.
+/// written for .texel.json; `frequencies_cpm` feeds the plot's histogram;
+/// `mat_version` picks v5 or v7.3 for .mat (docs/format.md "MATLAB .mat").
 /// Atomic, and nothing is written if anything fails.
 void write_rendered(const std::string& path, const Document& doc, const Surface& surface, const std::vector<double>& map,
-                    const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra = {});
+                    const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra = {},
+                    mat::MatVersion mat_version = mat::MatVersion::v5);
+
+/// True for a .mat output path (handled beside OutputKind: a MATLAB file is
+/// written by libmatio, not as bytes).
+bool is_mat_output(const std::string& path);
+
+/// The variables of a rendered map's .mat file: amplitude, position_mm,
+/// params, texels (when the surface has Texel regions) and document.
+std::vector<mat::Variable> map_variables(const Document& doc, const Surface& surface, const std::vector<double>& map);
 
 /// Texel frequencies of every Texel region (for histograms and summaries).
 std::vector<double> texel_frequencies(const Surface& surface);

@@ -11,6 +11,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/matfile.hpp"
 
 namespace texel::codec {
 namespace {
@@ -121,6 +122,14 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
     sig.amplitude = parse_npy(read_file(path), path);
     sig.spacing_mm = device_spacing(o, device);
     sig.description = ".npy at " + num(sig.spacing_mm) + " mm";
+  } else if (ext == ".mat") {
+    // The map variable and its grid (docs/format.md "MATLAB .mat"); an
+    // explicit spacing wins over the file's, the file's over the device's.
+    mat::MapData m = mat::read_map(path);
+    sig.amplitude = std::move(m.amplitude);
+    sig.spacing_mm = o.spacing_mm ? *o.spacing_mm : m.spacing_mm ? *m.spacing_mm : device.spacing_mm;
+    sig.description = ".mat '" + m.variable + "' at " + num(sig.spacing_mm) + " mm" +
+                      (o.spacing_mm || m.spacing_mm ? "" : " (device " + device.name + ")");
   } else if (ext == ".csv") {
     sig = load_csv(path, o);
   } else if (ext == ".wav") {
@@ -138,7 +147,7 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
     sig.description = "bitstream decoded on " + device.name;
   } else {
     throw InvalidArgument("input '" + path + "' has extension '" + ext +
-                          "'; allowed: .bin (device map), .npy, .csv (position or time), .wav, .texel.json, .texel");
+                          "'; allowed: .bin (device map), .npy, .mat, .csv (position or time), .wav, .texel.json, .texel");
   }
   if (sig.amplitude.size() < 2) throw FormatError("'" + path + "' holds fewer than 2 samples");
   for (double v : sig.amplitude)
