@@ -1,0 +1,294 @@
+// Binding of the codec (bitstreams, encoder, decoder) and the spectral
+// analysis. Inputs are numpy arrays or paths; the library does the work
+// (codec::load_signal, codec::encode, codec::decode_document,
+// analyse_spectrum), with the GIL released while it runs.
+#include <cstring>
+
+#include "common.hpp"
+#include "texel/codec.hpp"
+#include "texel/error.hpp"
+#include "texel/spectrum.hpp"
+
+namespace texel::python {
+namespace {
+
+std::vector<std::uint8_t> bytes_of(const py::bytes& b) {
+  const std::string_view s = b;
+  return {s.begin(), s.end()};
+}
+
+py::bytes to_bytes(const std::vector<std::uint8_t>& v) {
+  return py::bytes(reinterpret_cast<const char*>(v.data()), v.size());
+}
+
+// Bytes from `bytes`, `bytearray`, a uint8 array or a path to a .texel file.
+codec::Bitstream bitstream_of(const py::handle& source) {
+  if (py::isinstance<codec::Bitstream>(source)) return source.cast<codec::Bitstream>();
+  if (py::isinstance<py::bytes>(source) || py::isinstance<py::bytearray>(source)) {
+    const auto v = bytes_of(py::module_::import("builtins").attr("bytes")(source).cast<py::bytes>());
+    return codec::parse_bitstream(v);
+  }
+  if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
+    const auto v = bytes_of(py::module_::import("pathlib").attr("Path")(source).attr("read_bytes")().cast<py::bytes>());
+    return codec::parse_bitstream(v);
+  }
+  throw py::type_error("expected bytes, a Bitstream or a path to a .texel file");
+}
+
+py::dict percept_dict(const codec::Percept& p) {
+  py::dict d;
+  d["pitch_db"] = p.pitch_db;
+  d["noisiness_db"] = p.noisiness_db;
+  d["centroid_db"] = p.mean_db;
+  d["spread_db"] = p.spread_db;
+  return d;
+}
+
+// The signal an encode() call describes: a path (any format load_signal
+// reads) or an array of amplitudes (float, 0 … 1) or device samples
+// (uint16 / uint8, decoded with the library's decode_samples).
+codec::Signal signal_of(const py::handle& source, const py::object& device, std::optional<double> spacing_mm,
+                        std::optional<double> swipe_speed) {
+  if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
+    codec::LoadOptions o;
+    if (!device.is_none()) o.device = device_of(device, std::nullopt, std::nullopt);
+    o.spacing_mm = spacing_mm;
+    if (swipe_speed) o.swipe_speed = MmPerSecond(*swipe_speed);
+    const auto path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
+    py::gil_scoped_release release;
+    return codec::load_signal(path, o);
+  }
+  const DeviceProfile d = device.is_none() ? load_device("tpad") : device_of(device, std::nullopt, std::nullopt);
+  codec::Signal s;
+  s.spacing_mm = spacing_mm.value_or(d.spacing_mm);
+  s.description = "array";
+  const py::array a = py::array::ensure(source);
+  if (!a) throw py::type_error("encode: source must be a path or a 1-D array");
+  if (a.dtype().is(py::dtype::of<std::uint16_t>()) || a.dtype().is(py::dtype::of<std::uint8_t>())) {
+    const bool u16 = a.dtype().itemsize() == 2;
+    const auto c = py::array::ensure(a, py::array::c_style);
+    if (c.ndim() != 1) throw py::value_error("encode: source must be 1-D");
+    const auto* p = static_cast<const std::byte*>(c.data());
+    s.amplitude = decode_samples(u16 ? SampleFormat::u16le : SampleFormat::u8,
+                                 std::span<const std::byte>(p, static_cast<std::size_t>(c.nbytes())));
+  } else {
+    s.amplitude = as_doubles(source, "encode: source");
+  }
+  return s;
+}
+
+SpectrumOptions spectrum_options(const std::string& window, int zero_pad, bool remove_mean) {
+  SpectrumOptions o;
+  o.window = parse_window(window, "window");
+  o.zero_pad = zero_pad;
+  o.remove_mean = remove_mean;
+  return o;
+}
+
+}  // namespace
+
+void register_codec(py::module_& m) {
+  // -------------------------------------------------------------- bitstream
+  py::class_<codec::Bitstream>(m, "Bitstream",
+                               "A parsed .texel bitstream: the quantized fields it carries (docs/format.md).")
+      .def_property_readonly("central_pitch_db", [](const codec::Bitstream& b) { return b.fine.central_pitch_cdb / 100.0; })
+      .def_property_readonly("irregularity_db", [](const codec::Bitstream& b) { return b.fine.irregularity_cdb / 100.0; })
+      .def_property_readonly("texel_length_mm", [](const codec::Bitstream& b) { return b.fine.texel_length_um / 1000.0; })
+      .def_property_readonly("seed", [](const codec::Bitstream& b) { return b.fine.seed; })
+      .def_property_readonly("has_coarse", [](const codec::Bitstream& b) { return b.coarse.has_value(); },
+                             "True when the stream carries strengths and a coarse profile.")
+      .def_property_readonly("coarse_levels",
+                             [](const codec::Bitstream& b) {
+                               std::vector<std::uint16_t> l;
+                               if (b.coarse) l = b.coarse->levels;
+                               return to_numpy(std::move(l));
+                             },
+                             "Stored coarse levels (0 … 2^bits − 1); empty when fine only.")
+      .def_property_readonly("spec", [](const codec::Bitstream& b) { return spec_dict(codec::to_spec(b)); },
+                             "The texture the stream stands for, as render() keyword arguments.")
+      .def("to_bytes", [](const codec::Bitstream& b) { return to_bytes(codec::write_bitstream(b)); }, "Serializes the stream.")
+      .def("__eq__", [](const codec::Bitstream& a, const codec::Bitstream& b) { return a == b; })
+      .def("__repr__", [](const codec::Bitstream& b) {
+        return "<texel.Bitstream P=" + std::to_string(b.fine.central_pitch_cdb / 100.0) +
+               " dB I=" + std::to_string(b.fine.irregularity_cdb / 100.0) + " dB" + (b.coarse ? " +coarse>" : ">");
+      });
+  m.def("parse_bitstream", [](const py::bytes& data) { return codec::parse_bitstream(bytes_of(data)); }, py::arg("data"),
+        "Parses and validates .texel bytes (raises FormatError naming the field).");
+  m.def(
+      "bitstream_from_document",
+      [](const Document& doc, unsigned bits) {
+        if (doc.regions.size() != 1 || doc.regions[0].reference)
+          throw InvalidArgument("document: a bitstream holds one Texel region; this document has " +
+                                std::to_string(doc.regions.size()) + " region(s)" +
+                                (doc.regions.size() == 1 ? " holding a reference" : ""));
+        const auto& r = doc.regions[0];
+        const double length = r.length_mm.value_or(doc.device.length_mm() - r.start_mm);
+        return codec::from_spec(r.texel, Millimetres(length), bits);
+      },
+      py::arg("document"), py::kw_only(), py::arg("bits") = 8u,
+      "Quantizes a one-region Texel document to a Bitstream (coarse levels with `bits` bits each).");
+
+  // ----------------------------------------------------------------- decoder
+  m.def(
+      "decode_document",
+      [](const py::object& source, const py::object& device, std::optional<double> length_mm, std::optional<double> spacing_mm) {
+        return codec::decode_document(bitstream_of(source), device_of(device, length_mm, spacing_mm));
+      },
+      py::arg("source"), py::kw_only(), py::arg("device") = "tpad", py::arg("length_mm") = py::none(),
+      py::arg("spacing_mm") = py::none(), "The document a bitstream (bytes, Bitstream or .texel path) stands for on a device.");
+  m.def(
+      "decode",
+      [](const py::object& source, const py::object& device, std::optional<double> length_mm, std::optional<double> spacing_mm,
+         const std::string& dtype) {
+        const Document doc = codec::decode_document(bitstream_of(source), device_of(device, length_mm, spacing_mm));
+        return render_document_array(doc, dtype);
+      },
+      py::arg("source"), py::kw_only(), py::arg("device") = "tpad", py::arg("length_mm") = py::none(),
+      py::arg("spacing_mm") = py::none(), py::arg("dtype") = "native",
+      "Decodes a bitstream (bytes, Bitstream or .texel path) and renders it on a device, exactly as\n"
+      "`texel decode IN.texel -o map.bin`; dtype as for render().");
+
+  // ----------------------------------------------------------------- encoder
+  py::class_<codec::EncodeResult>(m, "EncodeResult", "What encode() found: the Texel parameters, the bitstream and the model's view.")
+      .def_property_readonly("bytes", [](const codec::EncodeResult& r) { return to_bytes(r.bytes); }, "The .texel bitstream.")
+      .def_readonly("bitstream", &codec::EncodeResult::bitstream)
+      .def_property_readonly("spec", [](const codec::EncodeResult& r) { return spec_dict(r.spec); },
+                             "The decoded texture as render() keyword arguments.")
+      .def_property_readonly("central_pitch_db", [](const codec::EncodeResult& r) { return r.spec.central_pitch.value(); })
+      .def_property_readonly("irregularity_db", [](const codec::EncodeResult& r) { return r.spec.irregularity.value(); })
+      .def_property_readonly("texel_length_mm", [](const codec::EncodeResult& r) { return r.spec.texel_length.value(); })
+      .def_property_readonly("coarse_strength", [](const codec::EncodeResult& r) { return r.spec.coarse_strength; })
+      .def_property_readonly("fine_strength", [](const codec::EncodeResult& r) { return r.spec.fine_strength; })
+      .def_property_readonly("percept", [](const codec::EncodeResult& r) { return percept_dict(r.input); },
+                             "The input's fine part under the perceptual model: pitch_db, noisiness_db, centroid_db, spread_db.")
+      .def_property_readonly("decoded_percept", [](const codec::EncodeResult& r) { return percept_dict(r.decoded); })
+      .def_readonly("model_distance", &codec::EncodeResult::model_distance, "Model distance input ↔ decoded (JND units).")
+      .def_readonly("coarse", &codec::EncodeResult::coarse, "A coarse profile was found.")
+      .def_readonly("coarse_correlation", &codec::EncodeResult::coarse_correlation)
+      .def_readonly("texel_recovered", &codec::EncodeResult::texel_recovered,
+                    "The input was recognised as a Texel rendering (texel length recovered).")
+      .def_readonly("irregularity_identifiable", &codec::EncodeResult::irregularity_identifiable)
+      .def_readonly("irregularity_bound_db", &codec::EncodeResult::irregularity_bound_db)
+      .def_readonly("evaluations", &codec::EncodeResult::evaluations)
+      .def_readonly("seconds", &codec::EncodeResult::seconds, "Encoding time (s).")
+      .def_readonly("samples", &codec::EncodeResult::samples)
+      .def_readonly("spacing_mm", &codec::EncodeResult::spacing_mm)
+      .def("__repr__", [](const codec::EncodeResult& r) {
+        return "<texel.EncodeResult P=" + std::to_string(r.spec.central_pitch.value()) + " dB I=" +
+               std::to_string(r.spec.irregularity.value()) + " dB, " + std::to_string(r.bytes.size()) + " bytes>";
+      });
+  m.def(
+      "encode",
+      [](const py::object& source, const py::object& device, std::optional<double> spacing_mm,
+         std::optional<double> swipe_speed_mm_s, double boundary_mm, double texel_length_mm, std::uint64_t seed,
+         const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes) {
+        codec::EncoderConfig c;
+        if (swipe_speed_mm_s) c.model.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
+        c.boundary = Millimetres(boundary_mm);
+        c.texel_length = Millimetres(texel_length_mm);
+        c.seed = seed;
+        c.parameterization = parse_parameterization(parameterization, "parameterization");
+        c.coarse_bits = coarse_bits;
+        c.max_bytes = max_bytes;
+        const codec::Signal signal = signal_of(source, device, spacing_mm, swipe_speed_mm_s);
+        py::gil_scoped_release release;
+        return codec::encode(signal, c);
+      },
+      py::arg("source"), py::kw_only(), py::arg("device") = py::none(), py::arg("spacing_mm") = py::none(),
+      py::arg("swipe_speed_mm_s") = py::none(), py::arg("boundary_mm") = 1.0, py::arg("texel_length_mm") = 0.25,
+      py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("coarse_bits") = 6u,
+      py::arg("max_bytes") = py::none(),
+      R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
+
+source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array: float amplitudes
+                  0 … 1, or uint16/uint8 device samples
+device            grid and format of .bin/.npy input and of arrays (default tpad)
+spacing_mm        sample spacing of arrays / .bin / .npy (mm) [the device's]
+swipe_speed_mm_s  swipe speed of time recordings and of the perceptual model (mm/s) [100]
+boundary_mm       fine/coarse boundary (mm) [1]
+texel_length_mm   texel length of the encoding (mm) [0.25]
+seed              seed written to the bitstream [1]
+parameterization  'moments' or 'log' ['moments']
+coarse_bits       bits per coarse level, 1 … 16 [6]
+max_bytes         bitstream budget (bytes) [none]
+
+The GIL is released while encoding.)doc");
+
+  // ---------------------------------------------------------------- spectrum
+  py::class_<Spectrum>(m, "Spectrum", "One-sided magnitude spectrum on bins k·bin_cpm.")
+      .def_readonly("bin_cpm", &Spectrum::bin_cpm, "Bin spacing (cycles/mm).")
+      .def_readonly("resolution_cpm", &Spectrum::resolution_cpm, "1 / signal length (cycles/mm).")
+      .def_readonly("samples", &Spectrum::samples)
+      .def_readonly("nfft", &Spectrum::nfft)
+      .def_property_readonly("frequency_cpm", [](const Spectrum& s) { return py::array_t<double>(s.frequency_cpm.size(), s.frequency_cpm.data()); },
+                             "Bin frequencies (cycles/mm).")
+      .def_property_readonly("magnitude", [](const Spectrum& s) { return py::array_t<double>(s.magnitude.size(), s.magnitude.data()); },
+                             "Amplitude-calibrated |X_k| (a sinusoid of amplitude A peaks at A).")
+      .def_property_readonly("power", [](const Spectrum& s) { return py::array_t<double>(s.power.size(), s.power.data()); },
+                             "Mean-square amplitude per bin (sums to the variance).");
+  m.def(
+      "magnitude_spectrum",
+      [](const py::object& samples, double spacing_mm, const std::string& window, int zero_pad, bool remove_mean) {
+        const auto x = as_doubles(samples, "samples");
+        const auto o = spectrum_options(window, zero_pad, remove_mean);
+        py::gil_scoped_release release;
+        return magnitude_spectrum(x, spacing_mm, o);
+      },
+      py::arg("samples"), py::arg("spacing_mm"), py::kw_only(), py::arg("window") = "blackman-harris", py::arg("zero_pad") = 4,
+      py::arg("remove_mean") = true,
+      "Magnitude spectrum of amplitudes sampled every spacing_mm (mm); window rectangular | hann |\n"
+      "blackman-harris | flat-top, zero_pad 1 … 16.");
+  m.def(
+      "analyse_spectrum",
+      [](const py::object& samples, double spacing_mm) {
+        const auto x = as_doubles(samples, "samples");
+        SpectralReport r;
+        {
+          py::gil_scoped_release release;
+          r = analyse_spectrum(x, spacing_mm);
+        }
+        py::dict d;
+        d["spectrum"] = py::cast(std::move(r.spectrum));
+        py::dict psd;
+        psd["bin_cpm"] = r.psd.bin_cpm;
+        psd["segment"] = r.psd.segment;
+        psd["segments"] = r.psd.segments;
+        psd["frequency_cpm"] = to_numpy(std::move(r.psd.frequency_cpm));
+        psd["density"] = to_numpy(std::move(r.psd.density));
+        d["psd"] = psd;
+        py::list peaks;
+        for (const Peak& p : r.peaks) {
+          py::dict pd;
+          pd["frequency_cpm"] = p.frequency.value();
+          pd["amplitude"] = p.amplitude;
+          pd["level_db"] = p.level_db;
+          peaks.append(pd);
+        }
+        d["peaks"] = peaks;
+        py::dict s;
+        s["centroid_cpm"] = r.summary.centroid.value();
+        s["log_centroid_db"] = r.summary.log_centroid.value();
+        s["spread_cpm"] = r.summary.spread.value();
+        s["log_spread_db"] = r.summary.log_spread_db;
+        s["total_power"] = r.summary.total_power;
+        d["summary"] = s;
+        py::list bands;
+        for (const BandEnergy& b : r.bands) {
+          py::dict bd;
+          bd["lo_cpm"] = b.lo_cpm;
+          bd["hi_cpm"] = b.hi_cpm;
+          bd["mean_square"] = b.mean_square;
+          bd["fraction"] = b.fraction;
+          bands.append(bd);
+        }
+        d["bands"] = bands;
+        d["mean"] = r.mean;
+        d["rms"] = r.rms;
+        return d;
+      },
+      py::arg("samples"), py::arg("spacing_mm"),
+      "Everything `texel spectrum` reports for amplitudes sampled every spacing_mm (mm): spectrum,\n"
+      "psd (Welch, a²/(cycle/mm)), peaks, summary (centroids, spreads), bands, mean, rms.");
+}
+
+}  // namespace texel::python

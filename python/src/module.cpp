@@ -1,0 +1,83 @@
+// texel._texel: the extension module behind the `texel` package. This file
+// only defines the exception classes and calls each area's registration;
+// python/texel/__init__.py re-exports everything.
+//
+// Errors: texel::Error and its families become texel.Error and subclasses
+// carrying the engine's message unchanged. InvalidArgument is also a
+// ValueError and IoError also an OSError, so ordinary Python handlers
+// (`except ValueError`, `except OSError`) catch them too.
+#include <exception>
+
+#include "common.hpp"
+#include "texel/error.hpp"
+
+namespace texel::python {
+namespace {
+
+PyObject* new_exception(py::module_& m, const char* name, const char* doc, PyObject* bases) {
+  const std::string qualified = std::string("texel.") + name;
+  PyObject* type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases, nullptr);
+  if (!type) throw py::error_already_set();
+  m.add_object(name, py::handle(type));  // the module keeps a reference
+  return type;
+}
+
+py::ssize_t as_ssize(std::size_t n) { return static_cast<py::ssize_t>(n); }
+
+// The exception types, created once at import (the translator must be a
+// plain function, so it finds them here).
+PyObject* error_type = nullptr;
+PyObject* invalid_type = nullptr;
+PyObject* format_type = nullptr;
+PyObject* io_type = nullptr;
+
+void translate(std::exception_ptr p) {
+  try {
+    if (p) std::rethrow_exception(p);
+  } catch (const texel::InvalidArgument& e) {
+    PyErr_SetString(invalid_type, e.what());
+  } catch (const texel::FormatError& e) {
+    PyErr_SetString(format_type, e.what());
+  } catch (const texel::IoError& e) {
+    PyErr_SetString(io_type, e.what());
+  } catch (const texel::Error& e) {
+    PyErr_SetString(error_type, e.what());
+  }
+}
+
+}  // namespace
+
+py::array bytes_as_numpy(std::vector<std::byte>&& bytes, const py::dtype& dtype) {
+  auto* owned = new std::vector<std::byte>(std::move(bytes));
+  py::capsule owner(owned, [](void* p) { delete static_cast<std::vector<std::byte>*>(p); });
+  const auto item = static_cast<std::size_t>(dtype.itemsize());
+  return py::array(dtype, {as_ssize(owned->size() / item)}, {as_ssize(item)}, owned->data(), owner);
+}
+
+std::vector<double> as_doubles(const py::handle& values, const char* name) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+  if (!a) throw py::type_error(std::string(name) + " must be a 1-D array of numbers");
+  if (a.ndim() != 1) throw py::value_error(std::string(name) + " must be 1-D; it has " + std::to_string(a.ndim()) + " dimensions");
+  return {a.data(), a.data() + a.size()};
+}
+
+}  // namespace texel::python
+
+PYBIND11_MODULE(_texel, m) {
+  namespace py = pybind11;
+  using namespace texel::python;
+  m.doc() = "Texel: multi-scale virtual haptic textures (the C++ engine's Python binding).";
+
+  error_type = new_exception(m, "Error", "Base of every error the Texel engine raises on purpose.", PyExc_RuntimeError);
+  invalid_type = new_exception(m, "InvalidArgument", "A parameter outside its allowed range or set (also a ValueError).",
+                               py::make_tuple(py::handle(error_type), py::handle(PyExc_ValueError)).release().ptr());
+  format_type = new_exception(m, "FormatError", "A file or byte string that does not parse or validate.", error_type);
+  io_type = new_exception(m, "IoError", "An operating-system level failure: unreadable input, unwritable output (also an OSError).",
+                          py::make_tuple(py::handle(error_type), py::handle(PyExc_OSError)).release().ptr());
+  py::register_exception_translator(&translate);
+
+  register_render(m);
+  register_codec(m);
+  register_player(m);
+  register_experiment(m);
+}

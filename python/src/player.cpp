@@ -1,0 +1,182 @@
+// Binding of the player over arrays: simulated finger traces, off-line
+// rendering of a trace through the real-time Player (render_trace), and the
+// swipe measures. swipe() composes them the way `texel swipe` does.
+#include <cmath>
+
+#include "common.hpp"
+#include "texel/error.hpp"
+#include "texel/finger.hpp"
+#include "texel/player.hpp"
+#include "texel/surface.hpp"
+
+namespace texel::python {
+namespace {
+
+py::dict trace_dict(const std::vector<FingerSample>& trace) {
+  std::vector<double> t(trace.size()), x(trace.size());
+  std::vector<bool> touch(trace.size());
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    t[i] = trace[i].t_s;
+    x[i] = trace[i].x_mm;
+  }
+  py::array_t<bool> tc(static_cast<py::ssize_t>(trace.size()));
+  auto tv = tc.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < trace.size(); ++i) tv(static_cast<py::ssize_t>(i)) = trace[i].touch;
+  py::dict d;
+  d["t_s"] = to_numpy(std::move(t));
+  d["x_mm"] = to_numpy(std::move(x));
+  d["touch"] = tc;
+  return d;
+}
+
+std::vector<FingerSample> trace_of(const py::object& t_s, const py::object& x_mm, const py::object& touch) {
+  const auto t = as_doubles(t_s, "t_s");
+  const auto x = as_doubles(x_mm, "x_mm");
+  if (t.size() != x.size())
+    throw InvalidArgument("x_mm has " + std::to_string(x.size()) + " samples and t_s " + std::to_string(t.size()) + "; they must match");
+  std::vector<FingerSample> trace(t.size());
+  std::vector<double> on;
+  if (!touch.is_none()) {
+    on = as_doubles(touch, "touch");
+    if (on.size() != t.size())
+      throw InvalidArgument("touch has " + std::to_string(on.size()) + " samples and t_s " + std::to_string(t.size()) + "; they must match");
+  }
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (i > 0 && !(t[i] >= t[i - 1])) throw InvalidArgument("t_s[" + std::to_string(i) + "] is not >= the sample before; times must be non-decreasing");
+    trace[i] = FingerSample{t[i], x[i], on.empty() ? true : on[i] != 0.0};
+  }
+  return trace;
+}
+
+PlayerConfig player_config(double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain) {
+  PlayerConfig c;
+  c.rate_hz = rate_hz;
+  c.mode = parse_output_mode(output, "output");
+  c.carrier_hz = carrier_hz;
+  c.prediction_s = prediction_s;
+  c.extrapolate_s = std::max(c.extrapolate_s, prediction_s);
+  c.gain = gain;
+  validate(c);
+  return c;
+}
+
+std::unique_ptr<const PlayerMap> map_of(const Document& doc) { return PlayerMap::from_surface(prepare_surface(doc)); }
+
+py::tuple play(const PlayerMap& map, const PlayerConfig& config, const std::vector<FingerSample>& trace, double duration_s) {
+  if (!(std::isfinite(duration_s) && duration_s > 0 && duration_s <= 86400))
+    throw InvalidArgument("duration_s is " + std::to_string(duration_s) + "; allowed > 0 … 86400 s");
+  const double frames_d = std::round(duration_s * config.rate_hz);
+  if (frames_d > 2e9) throw InvalidArgument("duration_s × rate_hz is " + std::to_string(frames_d) + " samples; at most 2e9");
+  std::vector<float> out, positions;
+  {
+    py::gil_scoped_release release;
+    out = render_trace(map, config, trace, static_cast<std::size_t>(frames_d), &positions);
+  }
+  return py::make_tuple(to_numpy(std::move(out)), to_numpy(std::move(positions)));
+}
+
+#define TEXEL_PLAYER_ARGS                                                                                   \
+  py::arg("rate_hz") = 48000.0, py::arg("output") = "vibration", py::arg("carrier_hz") = 250.0, \
+  py::arg("prediction_s") = 0.0, py::arg("gain") = 1.0
+
+}  // namespace
+
+void register_player(py::module_& m) {
+  m.def(
+      "simulate_swipe",
+      [](double speed_mm_s, const std::string& pattern, double start_mm, double extent_mm, double surface_mm, double turn_s,
+         double duration_s, double rate_hz, double lead_in_s) {
+        SwipeConfig c;
+        c.pattern = parse_swipe_pattern(pattern, "pattern");
+        c.speed_mm_s = speed_mm_s;
+        c.start_mm = start_mm;
+        c.extent_mm = extent_mm;
+        c.surface_mm = surface_mm;
+        c.turn_s = turn_s;
+        c.duration_s = duration_s;
+        c.rate_hz = rate_hz;
+        c.lead_in_s = lead_in_s;
+        return trace_dict(simulate_swipe(c));
+      },
+      py::kw_only(), py::arg("speed_mm_s") = 100.0, py::arg("pattern") = "constant", py::arg("start_mm") = 0.0,
+      py::arg("extent_mm") = 0.0, py::arg("surface_mm") = 0.0, py::arg("turn_s") = 0.1, py::arg("duration_s") = 1.0,
+      py::arg("rate_hz") = 1000.0, py::arg("lead_in_s") = 0.0,
+      R"doc(A simulated finger trace as numpy columns t_s (s), x_mm (mm), touch (bool).
+
+speed_mm_s  cruising speed (mm/s) [100]
+pattern     'constant' (one-way strokes) or 'back-and-forth' ['constant']
+start_mm    landing position (mm) [0]
+extent_mm   travel of one stroke (mm); 0 = to the end of surface_mm [0]
+surface_mm  surface length used when extent_mm is 0 (mm)
+turn_s      back-and-forth: time to stop and turn (s) [0.1]
+duration_s  length of the trace (s) [1]
+rate_hz     trace sample rate (Hz) [1000]
+lead_in_s   lifted time before the finger lands (s) [0])doc");
+  m.def(
+      "render_trace",
+      [](const Document& doc, const py::object& t_s, const py::object& x_mm, const py::object& touch, double duration_s,
+         double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain) {
+        const auto trace = trace_of(t_s, x_mm, touch);
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain);
+        return play(*map_of(doc), c, trace, duration_s);
+      },
+      py::arg("document"), py::arg("t_s"), py::arg("x_mm"), py::arg("touch") = py::none(), py::kw_only(),
+      py::arg("duration_s"), TEXEL_PLAYER_ARGS,
+      R"doc(Plays a document's map under a finger trace through the real-time Player, off line.
+
+t_s, x_mm     finger sample times (s, non-decreasing) and positions (mm, device coordinates)
+touch         finger on the surface per sample (default: always)
+duration_s    output length (s); frames = round(duration_s · rate_hz)
+rate_hz       output rate (Hz) [48000]; 8333 = the tpad's refresh rate
+output        'amplitude', 'vibration' (zero-mean, band-limited) or 'carrier' ['vibration']
+carrier_hz    carrier frequency for output='carrier' (Hz) [250]
+prediction_s  latency compensation look-ahead (s) [0]
+gain          output gain 0 … 1 [1]
+
+Returns (output, positions_mm): float32 arrays of one value per output sample. The GIL is released.)doc");
+  m.def(
+      "swipe",
+      [](const Document& doc, double speed_mm_s, const std::string& pattern, std::optional<double> start_mm,
+         std::optional<double> extent_mm, double turn_s, double duration_s, double rate_hz, const std::string& output,
+         double carrier_hz, double prediction_s, double gain) {
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain);
+        if (!(std::isfinite(speed_mm_s) && speed_mm_s > 0))
+          throw InvalidArgument("speed_mm_s is " + std::to_string(speed_mm_s) + "; it must be > 0 mm/s");
+        if (!(std::isfinite(duration_s) && duration_s > 0 && duration_s <= 86400))
+          throw InvalidArgument("duration_s is " + std::to_string(duration_s) + "; allowed > 0 … 86400 s");
+        const auto map = map_of(doc);
+        SwipeConfig s;
+        s.pattern = parse_swipe_pattern(pattern, "pattern");
+        s.speed_mm_s = speed_mm_s;
+        s.start_mm = start_mm.value_or(0.0);
+        s.extent_mm = extent_mm.value_or(0.0);
+        s.surface_mm = map->grid().length_mm();
+        s.turn_s = turn_s;
+        s.duration_s = duration_s;
+        return play(*map, c, simulate_swipe(s), duration_s);
+      },
+      py::arg("document"), py::kw_only(), py::arg("speed_mm_s") = 100.0, py::arg("pattern") = "constant",
+      py::arg("start_mm") = py::none(), py::arg("extent_mm") = py::none(), py::arg("turn_s") = 0.1,
+      py::arg("duration_s") = 2.0, TEXEL_PLAYER_ARGS,
+      "What a finger feels under a simulated swipe over a document, exactly as `texel swipe DOC -o x.wav`\n"
+      "(same options, same defaults; see simulate_swipe and render_trace). Returns (output, positions_mm).");
+  m.def(
+      "swipe_measures",
+      [](const py::object& t_s, const py::object& x_mm, const py::object& touch, double still_below_mm_s) {
+        const SwipeMeasures s = swipe_measures(trace_of(t_s, x_mm, touch), still_below_mm_s);
+        py::dict d;
+        d["intervals"] = s.intervals;
+        d["mean_speed_mm_s"] = s.mean_speed_mm_s;
+        d["sd_speed_mm_s"] = s.sd_speed_mm_s;
+        d["directional_proportion"] = s.directional_proportion;
+        d["moving_right"] = s.moving_right;
+        d["moving_left"] = s.moving_left;
+        d["touched_s"] = s.touched_s;
+        d["distance_mm"] = s.distance_mm;
+        return d;
+      },
+      py::arg("t_s"), py::arg("x_mm"), py::arg("touch") = py::none(), py::kw_only(), py::arg("still_below_mm_s") = 0.0,
+      "Swipe behaviour of a trace: mean/SD speed (mm/s), directional proportion (−1 … 1), touched time (s), distance (mm).");
+}
+
+}  // namespace texel::python

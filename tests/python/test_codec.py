@@ -1,0 +1,77 @@
+"""Bitstreams, encode and decode against the CLI; spectra."""
+import numpy as np
+import pytest
+
+import texel
+
+
+@pytest.fixture(scope="module")
+def encoded(cli, tmp_path_factory):
+    d = tmp_path_factory.mktemp("codec")
+    src = d / "in.bin"
+    cli("render", "--central-pitch", 6, "--irregularity", -8, "--seed", 5, "-o", src)
+    out = d / "in.texel"
+    cli("encode", src, "-o", out)
+    return src, out
+
+
+def test_encode_array_equals_cli_bitstream(encoded):
+    src, out = encoded
+    m = np.fromfile(src, dtype="<u2")
+    r = texel.encode(m)
+    assert r.bytes == out.read_bytes()
+    assert texel.encode(str(src)).bytes == out.read_bytes()
+    assert set(r.percept) == {"pitch_db", "noisiness_db", "centroid_db", "spread_db"}
+    assert r.spec["texel_length_mm"] == pytest.approx(0.25)
+    assert r.model_distance >= 0
+
+
+def test_decode_equals_cli(cli, encoded, tmp_path):
+    _, stream = encoded
+    for device in ("tpad", "generic"):
+        out = tmp_path / f"dec-{device}.bin"
+        cli("decode", stream, "--device", device, "-o", out)
+        assert texel.decode(stream.read_bytes(), device=device).tobytes() == out.read_bytes()
+        assert texel.decode(str(stream), device=device).tobytes() == out.read_bytes()
+
+
+def test_bitstream_round_trip(encoded):
+    _, stream = encoded
+    data = stream.read_bytes()
+    b = texel.parse_bitstream(data)
+    assert b.to_bytes() == data
+    assert b.spec["central_pitch_db"] == pytest.approx(b.central_pitch_db)
+    doc = texel.decode_document(b)
+    assert texel.bitstream_from_document(doc) == b or texel.bitstream_from_document(doc).central_pitch_db == b.central_pitch_db
+
+
+def test_bitstream_from_document_decodes_to_the_same_map():
+    doc = texel.document(central_pitch_db=7.5, irregularity_db=-6, seed=12)
+    b = texel.bitstream_from_document(doc)
+    assert texel.decode(b.to_bytes()).tobytes() == doc.render().tobytes()
+
+
+def test_spectrum_of_a_sinusoid():
+    dx = 0.01
+    x = np.arange(4096) * dx
+    a = 0.5 + 0.3 * np.sin(2 * np.pi * 5.0 * x)
+    s = texel.magnitude_spectrum(a, dx)
+    k = int(np.argmax(s.magnitude))
+    assert s.frequency_cpm[k] == pytest.approx(5.0, abs=s.bin_cpm)
+    r = texel.analyse_spectrum(a, dx)
+    assert r["peaks"][0]["frequency_cpm"] == pytest.approx(5.0, rel=1e-3)
+    assert r["peaks"][0]["amplitude"] == pytest.approx(0.3, rel=1e-2)
+    assert r["mean"] == pytest.approx(0.5, abs=1e-3)
+
+
+def test_spectrum_equals_cli_json(cli_json, tmp_path):
+    out = tmp_path / "m.bin"
+    m = texel.render(seed=7)
+    m.tofile(out)
+    j = cli_json("spectrum", out, "--json")
+    r = texel.analyse_spectrum(m.astype(np.float64) / 65535.0, texel.device("tpad").spacing_mm)
+    assert r["spectrum"].nfft == j["nfft"]
+    assert r["mean"] == pytest.approx(j["mean_amplitude"], rel=1e-12)
+    assert r["rms"] == pytest.approx(j["rms_amplitude"], rel=1e-9)
+    assert r["summary"]["centroid_cpm"] == pytest.approx(j["summary"]["centroid_cpm"], rel=1e-9)
+    assert [p["frequency_cpm"] for p in r["peaks"]] == pytest.approx([p["frequency_cpm"] for p in j["peaks"]], rel=1e-9)
