@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -271,12 +272,18 @@ class Reader {
     version_ = Mat_GetVersion(mat_.get());
     if (version_ != MAT_FT_MAT5 && version_ != MAT_FT_MAT73)
       throw FormatError("'" + path_ + "' is a MATLAB v4 file; Texel reads v5 (-v7) and v7.3 .mat files");
+    const std::size_t elements = version_ == MAT_FT_MAT5 ? v5_elements() : 0;
     constexpr std::size_t max_variables = 4096;
     while (matvar_t* v = Mat_VarReadNextInfo(mat_.get())) {
       infos_.push_back(describe(v));
       if (infos_.size() > max_variables)
         throw FormatError("'" + path_ + "' holds more than " + std::to_string(max_variables) + " variables");
     }
+    // matio stops listing at the first variable it cannot parse; say so
+    // rather than pretend the file ends there.
+    if (infos_.size() < elements)
+      throw FormatError("'" + path_ + "': variable " + std::to_string(infos_.size() + 1) + " of " + std::to_string(elements) +
+                        " cannot be read (corrupt, or a class libmatio does not read)" + matio_reason());
   }
 
   const std::vector<Info>& infos() const { return infos_; }
@@ -303,9 +310,9 @@ class Reader {
     if (!info.elements || *info.elements > options_.max_elements)
       throw FormatError(what + " is " + info.shape + ", more than the " + std::to_string(options_.max_elements) +
                         " elements allowed");
-    if (!info.vector) throw FormatError(what + " is " + info.shape + "; a map must be a vector (N×1 or 1×N)");
     const std::size_t n = *info.elements;
     if (n == 0) throw FormatError(what + " is empty");
+    if (!info.vector) throw FormatError(what + " is " + info.shape + "; a map must be a vector (N×1 or 1×N)");
     // v5 data lives in the file: stored uncompressed it needs at least one
     // byte per element (MATLAB may store doubles as uint8), compressed at
     // most deflate's ~1032:1 ratio. A declared size beyond that is a lie.
@@ -351,6 +358,40 @@ class Reader {
   const std::string& path() const { return path_; }
 
  private:
+  /// Walks the top-level data elements of a level-5 file (tag: type, byte
+  /// count) and returns how many there are. matio reads a truncated
+  /// element's data as zeros without an error, so every element must end
+  /// inside the file.
+  std::size_t v5_elements() const {
+    std::ifstream in(path_, std::ios::binary);
+    char endian[2];
+    in.seekg(126);
+    if (!in.read(endian, 2)) throw IoError("cannot read '" + path_ + "'");
+    const bool swap = endian[0] == 'M' && endian[1] == 'I';
+    auto u32 = [swap](const unsigned char* b) {
+      return swap ? (std::uint32_t{b[0]} << 24 | std::uint32_t{b[1]} << 16 | std::uint32_t{b[2]} << 8 | b[3])
+                  : (std::uint32_t{b[3]} << 24 | std::uint32_t{b[2]} << 16 | std::uint32_t{b[1]} << 8 | b[0]);
+    };
+    std::size_t count = 0;
+    std::uintmax_t pos = 128;
+    while (pos < file_size_) {
+      unsigned char tag[8];
+      in.seekg(static_cast<std::streamoff>(pos));
+      if (file_size_ - pos < 8 || !in.read(reinterpret_cast<char*>(tag), 8))
+        throw FormatError("'" + path_ + "' is truncated: a partial element header at byte " + std::to_string(pos));
+      const std::uint32_t type = u32(tag);
+      std::uintmax_t bytes = u32(tag + 4);
+      if (type != MAT_T_COMPRESSED) bytes = (bytes + 7) / 8 * 8;  // uncompressed elements are 8-byte aligned
+      if (bytes > file_size_ - pos - 8)
+        throw FormatError("'" + path_ + "' is truncated: element " + std::to_string(count + 1) + " at byte " +
+                          std::to_string(pos) + " declares " + std::to_string(bytes) + " bytes, the file ends " +
+                          std::to_string(file_size_ - pos - 8) + " bytes later");
+      pos += 8 + bytes;
+      ++count;
+    }
+    return count;
+  }
+
   std::string path_;
   ReadOptions options_;
   std::uintmax_t file_size_ = 0;

@@ -1,0 +1,101 @@
+#!/usr/bin/python3
+"""What `texel render -o X.mat` writes, read by independent readers.
+
+v5 through scipy.io.loadmat, v7.3 through h5py (both Debian packages, run by
+/usr/bin/python3). Checks names, shapes (MATLAB column-major: N×1 columns),
+values (the map equals the .npy output exactly; positions are i·spacing),
+the parameters, the texel listing, the document text, and that the encoder
+accepts the file. Usage: check_cli_mat.py TEXEL_BINARY WORKDIR
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import scipy.io
+
+texel, work = sys.argv[1], sys.argv[2]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+os.chdir(work)
+
+ARGS = ["--central-pitch", "10", "--irregularity", "-5", "--texel-length", "0.25", "--seed", "7", "--device", "tpad"]
+
+
+def run(*args):
+    r = subprocess.run([texel, *args], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"texel {' '.join(args)} failed ({r.returncode}): {r.stderr}")
+    return r.stdout
+
+
+def check(cond, what):
+    if not cond:
+        sys.exit("FAILED: " + what)
+    print("ok:", what)
+
+
+run("render", *ARGS, "-o", "map.npy")
+run("render", *ARGS, "-o", "doc.texel.json")
+summary = json.loads(run("render", *ARGS, "-o", "map.mat", "--json"))
+run("render", *ARGS, "-o", "map73.mat", "--mat-version", "7.3")
+ref = np.load("map.npy")
+n = ref.size
+spacing = summary["spacing_mm"]
+document = open("doc.texel.json", encoding="utf-8").read()
+check(n == 19200, "tpad map has 19200 samples")
+
+# --- v5: scipy.io.loadmat ---------------------------------------------------
+d = scipy.io.loadmat("map.mat")
+names = sorted(k for k in d if not k.startswith("__"))
+check(names == ["amplitude", "document", "params", "position_mm", "texels"], f"v5 variables {names}")
+check(d["__version__"] == "1.0", "v5 file (scipy reports MAT version 1.0 for level-5 files)")
+check(d["amplitude"].shape == (n, 1) and d["amplitude"].dtype == np.float64, "v5 amplitude is N×1 double")
+check(np.array_equal(d["amplitude"][:, 0], ref), "v5 amplitude equals the .npy map exactly")
+check(d["amplitude"].min() >= 0 and d["amplitude"].max() <= 1, "amplitude in [0, 1]")
+check(d["position_mm"].shape == (n, 1), "v5 position_mm is N×1")
+check(np.allclose(d["position_mm"][:, 0], np.arange(n) * spacing, rtol=0, atol=1e-9), "position_mm = i·spacing")
+p = d["params"][0, 0]
+check(p["central_pitch_db"][0, 0] == 10 and p["irregularity_db"][0, 0] == -5, "params: central pitch and irregularity")
+check(p["texel_length_mm"][0, 0] == 0.25 and p["seed"][0, 0] == 7, "params: texel length and seed")
+check(p["device"][0] == "tpad" and p["parameterization"][0] == "moments", "params: device and parameterization (char)")
+check(p["spacing_mm"][0, 0] == spacing and p["samples"][0, 0] == n, "params: spacing and samples")
+t = d["texels"][0, 0]
+k = t["start_mm"].shape[0]
+check(k > 100 and all(t[c].shape == (k, 1) for c in ("index", "start_mm", "frequency_cpm", "amplitude", "region")),
+      f"texels: {k} rows, every column N×1")
+check(np.allclose(np.diff(t["start_mm"][:, 0]), 0.25), "texels: start_mm steps by the texel length")
+check(d["document"][0] == document, "v5 document is the texel.json text")
+
+# --- v7.3: h5py -------------------------------------------------------------
+with open("map73.mat", "rb") as f:
+    check(f.read(19) == b"MATLAB 7.3 MAT-file", "v7.3 header")
+h = h5py.File("map73.mat", "r")
+check(sorted(h.keys()) == ["amplitude", "document", "params", "position_mm", "texels"], f"v7.3 variables {sorted(h.keys())}")
+# HDF5 stores MATLAB's column-major N×1 as a row-major (1, N) dataset.
+check(h["amplitude"].shape == (1, n) and h["amplitude"].attrs["MATLAB_class"] == b"double", "v7.3 amplitude: (1, N) double")
+check(np.array_equal(h["amplitude"][0], ref), "v7.3 amplitude equals the .npy map exactly")
+check(np.allclose(h["position_mm"][0], np.arange(n) * spacing, rtol=0, atol=1e-9), "v7.3 position_mm")
+check(h["params"].attrs["MATLAB_class"] == b"struct", "v7.3 params is a struct")
+check(h["params"]["central_pitch_db"][0, 0] == 10 and h["params"]["seed"][0, 0] == 7, "v7.3 params values")
+dev = h["params"]["device"]
+check(dev.attrs["MATLAB_class"] == b"char" and "".join(map(chr, dev[:, 0])) == "tpad", "v7.3 params.device is char 'tpad'")
+doc73 = h["document"][:, 0].astype(np.uint16).tobytes().decode("utf-16-le")
+check(doc73 == document, "v7.3 document is the texel.json text")
+check(h["texels"]["frequency_cpm"].shape == (1, k), "v7.3 texels columns")
+
+# --- sizes and the encoder ----------------------------------------------------
+print("sizes: .npy", os.path.getsize("map.npy"), "v5", os.path.getsize("map.mat"), "v7.3", os.path.getsize("map73.mat"))
+for f in ("map.mat", "map73.mat"):
+    out = run("encode", f, "--device", "tpad")
+    check("Central Pitch 10.00 dB" in out, f"texel encode {f} recovers the Central Pitch: {out.splitlines()[0]}")
+
+# A hostile input is one line naming the file.
+scipy.io.savemat("complex.mat", {"amplitude": np.array([[1 + 1j], [2 + 0j], [0.5 + 0j]])})
+r = subprocess.run([texel, "encode", "complex.mat"], capture_output=True, text=True)
+check(r.returncode == 2 and "complex.mat" in r.stderr and "complex" in r.stderr and r.stderr.count("\n") <= 1,
+      f"complex .mat rejected: {r.stderr.strip()}")
+print("all .mat checks passed")
