@@ -68,7 +68,7 @@ def test_spectrum_equals_cli_json(cli_json, tmp_path):
     out = tmp_path / "m.bin"
     m = texel.render(seed=7)
     m.tofile(out)
-    j = cli_json("spectrum", out, "--json")
+    j = cli_json("spectrum", out, "--device", "tpad", "--json")
     r = texel.analyse_spectrum(m.astype(np.float64) / 65535.0, texel.device("tpad").spacing_mm)
     assert r["spectrum"].nfft == j["nfft"]
     assert r["mean"] == pytest.approx(j["mean_amplitude"], rel=1e-12)

@@ -86,7 +86,7 @@ def test_texels_listing_equals_cli(cli, tmp_path):
     ("4sin", {}, []),
     ("pink", {}, ["--seed", 3]),
     ("2sin", {"frequencies_cpm": [2.5, 6]}, ["--param", "frequencies_cpm=2.5,6"]),
-    ("bandpass-f5-z0.5", {}, []),
+    ("bandpass-f4-z0.5", {}, []),
 ])
 def test_reference_equals_cli(cli, tmp_path, name, params, flags):
     out = tmp_path / "r.bin"

@@ -61,4 +61,4 @@ def test_store_sessions_and_trials(database):
     assert session["protocol"] == "texel-length" and session["trials_done"] == len(expected)
     trials = s.trials(session["id"])
     assert trials[0]["trial"] == 0 and trials[0]["state_json"]
-    assert texel.Store(str(db)).rows(session["id"]) == texel.read_trials(str(db))
+    assert repr(texel.Store(str(db)).rows(session["id"])) == repr(texel.read_trials(str(db)))  # NaN-aware
