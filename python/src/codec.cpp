@@ -17,9 +17,7 @@ std::vector<std::uint8_t> bytes_of(const py::bytes& b) {
   return {s.begin(), s.end()};
 }
 
-py::bytes to_bytes(const std::vector<std::uint8_t>& v) {
-  return py::bytes(reinterpret_cast<const char*>(v.data()), v.size());
-}
+py::bytes to_bytes(const std::vector<std::uint8_t>& v) { return py::bytes(reinterpret_cast<const char*>(v.data()), v.size()); }
 
 // Bytes from `bytes`, `bytearray`, a uint8 array or a path to a .texel file.
 codec::Bitstream bitstream_of(const py::handle& source) {
@@ -89,31 +87,35 @@ SpectrumOptions spectrum_options(const std::string& window, int zero_pad, bool r
 
 void register_codec(py::module_& m) {
   // -------------------------------------------------------------- bitstream
-  py::class_<codec::Bitstream>(m, "Bitstream",
-                               "A parsed .texel bitstream: the quantized fields it carries (docs/format.md).")
+  py::class_<codec::Bitstream>(m, "Bitstream", "A parsed .texel bitstream: the quantized fields it carries (docs/format.md).")
       .def_property_readonly("central_pitch_db", [](const codec::Bitstream& b) { return b.fine.central_pitch_cdb / 100.0; })
       .def_property_readonly("irregularity_db", [](const codec::Bitstream& b) { return b.fine.irregularity_cdb / 100.0; })
       .def_property_readonly("texel_length_mm", [](const codec::Bitstream& b) { return b.fine.texel_length_um / 1000.0; })
       .def_property_readonly("seed", [](const codec::Bitstream& b) { return b.fine.seed; })
-      .def_property_readonly("has_coarse", [](const codec::Bitstream& b) { return b.coarse.has_value(); },
-                             "True when the stream carries strengths and a coarse profile.")
-      .def_property_readonly("coarse_levels",
-                             [](const codec::Bitstream& b) {
-                               std::vector<std::uint16_t> l;
-                               if (b.coarse) l = b.coarse->levels;
-                               return to_numpy(std::move(l));
-                             },
-                             "Stored coarse levels (0 … 2^bits − 1); empty when fine only.")
-      .def_property_readonly("spec", [](const codec::Bitstream& b) { return spec_dict(codec::to_spec(b)); },
-                             "The texture the stream stands for, as render() keyword arguments.")
-      .def("to_bytes", [](const codec::Bitstream& b) { return to_bytes(codec::write_bitstream(b)); }, "Serializes the stream.")
+      .def_property_readonly(
+          "has_coarse", [](const codec::Bitstream& b) { return b.coarse.has_value(); },
+          "True when the stream carries strengths and a coarse profile.")
+      .def_property_readonly(
+          "coarse_levels",
+          [](const codec::Bitstream& b) {
+            std::vector<std::uint16_t> l;
+            if (b.coarse) l = b.coarse->levels;
+            return to_numpy(std::move(l));
+          },
+          "Stored coarse levels (0 … 2^bits − 1); empty when fine only.")
+      .def_property_readonly(
+          "spec", [](const codec::Bitstream& b) { return spec_dict(codec::to_spec(b)); },
+          "The texture the stream stands for, as render() keyword arguments.")
+      .def(
+          "to_bytes", [](const codec::Bitstream& b) { return to_bytes(codec::write_bitstream(b)); }, "Serializes the stream.")
       .def("__eq__", [](const codec::Bitstream& a, const codec::Bitstream& b) { return a == b; })
       .def("__repr__", [](const codec::Bitstream& b) {
         return "<texel.Bitstream P=" + std::to_string(b.fine.central_pitch_cdb / 100.0) +
                " dB I=" + std::to_string(b.fine.irregularity_cdb / 100.0) + " dB" + (b.coarse ? " +coarse>" : ">");
       });
-  m.def("parse_bitstream", [](const py::bytes& data) { return codec::parse_bitstream(bytes_of(data)); }, py::arg("data"),
-        "Parses and validates .texel bytes (raises FormatError naming the field).");
+  m.def(
+      "parse_bitstream", [](const py::bytes& data) { return codec::parse_bitstream(bytes_of(data)); }, py::arg("data"),
+      "Parses and validates .texel bytes (raises FormatError naming the field).");
   m.def(
       "bitstream_from_document",
       [](const Document& doc, unsigned bits) {
@@ -149,18 +151,22 @@ void register_codec(py::module_& m) {
       "`texel decode IN.texel -o map.bin`; dtype as for render().");
 
   // ----------------------------------------------------------------- encoder
-  py::class_<codec::EncodeResult>(m, "EncodeResult", "What encode() found: the Texel parameters, the bitstream and the model's view.")
-      .def_property_readonly("bytes", [](const codec::EncodeResult& r) { return to_bytes(r.bytes); }, "The .texel bitstream.")
+  py::class_<codec::EncodeResult>(m, "EncodeResult",
+                                  "What encode() found: the Texel parameters, the bitstream and the model's view.")
+      .def_property_readonly(
+          "bytes", [](const codec::EncodeResult& r) { return to_bytes(r.bytes); }, "The .texel bitstream.")
       .def_readonly("bitstream", &codec::EncodeResult::bitstream)
-      .def_property_readonly("spec", [](const codec::EncodeResult& r) { return spec_dict(r.spec); },
-                             "The decoded texture as render() keyword arguments.")
+      .def_property_readonly(
+          "spec", [](const codec::EncodeResult& r) { return spec_dict(r.spec); },
+          "The decoded texture as render() keyword arguments.")
       .def_property_readonly("central_pitch_db", [](const codec::EncodeResult& r) { return r.spec.central_pitch.value(); })
       .def_property_readonly("irregularity_db", [](const codec::EncodeResult& r) { return r.spec.irregularity.value(); })
       .def_property_readonly("texel_length_mm", [](const codec::EncodeResult& r) { return r.spec.texel_length.value(); })
       .def_property_readonly("coarse_strength", [](const codec::EncodeResult& r) { return r.spec.coarse_strength; })
       .def_property_readonly("fine_strength", [](const codec::EncodeResult& r) { return r.spec.fine_strength; })
-      .def_property_readonly("percept", [](const codec::EncodeResult& r) { return percept_dict(r.input); },
-                             "The input's fine part under the perceptual model: pitch_db, noisiness_db, centroid_db, spread_db.")
+      .def_property_readonly(
+          "percept", [](const codec::EncodeResult& r) { return percept_dict(r.input); },
+          "The input's fine part under the perceptual model: pitch_db, noisiness_db, centroid_db, spread_db.")
       .def_property_readonly("decoded_percept", [](const codec::EncodeResult& r) { return percept_dict(r.decoded); })
       .def_readonly("model_distance", &codec::EncodeResult::model_distance, "Model distance input ↔ decoded (JND units).")
       .def_readonly("coarse", &codec::EncodeResult::coarse, "A coarse profile was found.")
@@ -174,8 +180,8 @@ void register_codec(py::module_& m) {
       .def_readonly("samples", &codec::EncodeResult::samples)
       .def_readonly("spacing_mm", &codec::EncodeResult::spacing_mm)
       .def("__repr__", [](const codec::EncodeResult& r) {
-        return "<texel.EncodeResult P=" + std::to_string(r.spec.central_pitch.value()) + " dB I=" +
-               std::to_string(r.spec.irregularity.value()) + " dB, " + std::to_string(r.bytes.size()) + " bytes>";
+        return "<texel.EncodeResult P=" + std::to_string(r.spec.central_pitch.value()) +
+               " dB I=" + std::to_string(r.spec.irregularity.value()) + " dB, " + std::to_string(r.bytes.size()) + " bytes>";
       });
   m.def(
       "encode",
@@ -220,12 +226,15 @@ The GIL is released while encoding.)doc");
       .def_readonly("resolution_cpm", &Spectrum::resolution_cpm, "1 / signal length (cycles/mm).")
       .def_readonly("samples", &Spectrum::samples)
       .def_readonly("nfft", &Spectrum::nfft)
-      .def_property_readonly("frequency_cpm", [](const Spectrum& s) { return py::array_t<double>(s.frequency_cpm.size(), s.frequency_cpm.data()); },
-                             "Bin frequencies (cycles/mm).")
-      .def_property_readonly("magnitude", [](const Spectrum& s) { return py::array_t<double>(s.magnitude.size(), s.magnitude.data()); },
-                             "Amplitude-calibrated |X_k| (a sinusoid of amplitude A peaks at A).")
-      .def_property_readonly("power", [](const Spectrum& s) { return py::array_t<double>(s.power.size(), s.power.data()); },
-                             "Mean-square amplitude per bin (sums to the variance).");
+      .def_property_readonly(
+          "frequency_cpm", [](const Spectrum& s) { return py::array_t<double>(s.frequency_cpm.size(), s.frequency_cpm.data()); },
+          "Bin frequencies (cycles/mm).")
+      .def_property_readonly(
+          "magnitude", [](const Spectrum& s) { return py::array_t<double>(s.magnitude.size(), s.magnitude.data()); },
+          "Amplitude-calibrated |X_k| (a sinusoid of amplitude A peaks at A).")
+      .def_property_readonly(
+          "power", [](const Spectrum& s) { return py::array_t<double>(s.power.size(), s.power.data()); },
+          "Mean-square amplitude per bin (sums to the variance).");
   m.def(
       "magnitude_spectrum",
       [](const py::object& samples, double spacing_mm, const std::string& window, int zero_pad, bool remove_mean) {

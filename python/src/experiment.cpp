@@ -26,15 +26,23 @@ using namespace texel::experiment;
 // trial_columns() order; a column this table does not know (a newer
 // library) falls back to its CSV cell text, so none is ever dropped.
 struct Columns {
-  std::vector<std::pair<const char*, std::string TrialRow::*>> strings{
-      {"participant", &TrialRow::participant}, {"protocol", &TrialRow::protocol},   {"study", &TrialRow::study},
-      {"block", &TrialRow::block},             {"task", &TrialRow::task},           {"condition", &TrialRow::condition},
-      {"reference", &TrialRow::reference},     {"variable", &TrialRow::variable},   {"response", &TrialRow::response},
-      {"correct_answer", &TrialRow::correct_answer}, {"shown_at", &TrialRow::shown_at}, {"answered_at", &TrialRow::answered_at}};
+  std::vector<std::pair<const char*, std::string TrialRow::*>> strings{{"participant", &TrialRow::participant},
+                                                                       {"protocol", &TrialRow::protocol},
+                                                                       {"study", &TrialRow::study},
+                                                                       {"block", &TrialRow::block},
+                                                                       {"task", &TrialRow::task},
+                                                                       {"condition", &TrialRow::condition},
+                                                                       {"reference", &TrialRow::reference},
+                                                                       {"variable", &TrialRow::variable},
+                                                                       {"response", &TrialRow::response},
+                                                                       {"correct_answer", &TrialRow::correct_answer},
+                                                                       {"shown_at", &TrialRow::shown_at},
+                                                                       {"answered_at", &TrialRow::answered_at}};
   std::vector<std::pair<const char*, int TrialRow::*>> ints{
       {"block_index", &TrialRow::block_index}, {"trial", &TrialRow::trial}, {"trial_in_block", &TrialRow::trial_in_block}};
-  std::vector<std::pair<const char*, bool TrialRow::*>> bools{
-      {"practice", &TrialRow::practice}, {"reversal", &TrialRow::reversal}, {"procedure_finished", &TrialRow::procedure_finished}};
+  std::vector<std::pair<const char*, bool TrialRow::*>> bools{{"practice", &TrialRow::practice},
+                                                              {"reversal", &TrialRow::reversal},
+                                                              {"procedure_finished", &TrialRow::procedure_finished}};
   std::vector<std::pair<const char*, double TrialRow::*>> numbers{
       {"intensity", &TrialRow::intensity},
       {"next_intensity", &TrialRow::next_intensity},
@@ -105,9 +113,12 @@ py::dict rows_columns(const std::vector<TrialRow>& rows) {
     py::object dtype = py::str("object");
     if (!rows.empty()) {
       const py::object first = cells[0];
-      if (py::isinstance<py::bool_>(first)) dtype = np.attr("bool_");
-      else if (py::isinstance<py::int_>(first)) dtype = np.attr("int64");
-      else if (py::isinstance<py::float_>(first)) dtype = np.attr("float64");
+      if (py::isinstance<py::bool_>(first))
+        dtype = np.attr("bool_");
+      else if (py::isinstance<py::int_>(first))
+        dtype = np.attr("int64");
+      else if (py::isinstance<py::float_>(first))
+        dtype = np.attr("float64");
     }
     out[py::str(name)] = np.attr("array")(cells, py::arg("dtype") = dtype);
   }
@@ -167,14 +178,15 @@ StaircaseConfig staircase_config(double start_value, std::vector<double> step_si
   return c;
 }
 
-#define TEXEL_STAIRCASE_ARGS                                                                                               \
-  py::arg("start_value"), py::arg("step_sizes"), py::kw_only(), py::arg("n_up") = 1, py::arg("n_down") = 3,             \
-      py::arg("n_reversals") = py::none(), py::arg("n_trials") = 0, py::arg("step_type") = "lin",                         \
-      py::arg("min_value") = py::none(), py::arg("max_value") = py::none(), py::arg("apply_initial_rule") = true
+#define TEXEL_STAIRCASE_ARGS                                                                                    \
+  py::arg("start_value"), py::arg("step_sizes"), py::kw_only(),                                                 \
+      py::arg("n_up") = 1, py::arg("n_down") = 3, py::arg("n_reversals") = py::none(), py::arg("n_trials") = 0, \
+      py::arg("step_type") = "lin", py::arg("min_value") = py::none(), py::arg("max_value") = py::none(),       \
+      py::arg("apply_initial_rule") = true
 
-#define TEXEL_BOX_ARGS                                                                                            \
+#define TEXEL_BOX_ARGS                                                                                     \
   py::arg("pitch_min_db") = -20.0, py::arg("pitch_max_db") = 19.7, py::arg("irregularity_min_db") = -30.0, \
-      py::arg("irregularity_max_db") = 5.0
+  py::arg("irregularity_max_db") = 5.0
 
 GuidedConfig guided_config(double pmin, double pmax, double imin, double imax, int iterations, double shrink_rate,
                            const std::string& unsure, const std::string& bound, std::uint64_t seed) {
@@ -191,9 +203,11 @@ GuidedConfig guided_config(double pmin, double pmax, double imin, double imax, i
   return c;
 }
 
-#define TEXEL_GUIDED_ARGS                                                                                       \
+#define TEXEL_GUIDED_ARGS                                                                                               \
   py::kw_only(), TEXEL_BOX_ARGS, py::arg("iterations") = 5, py::arg("shrink_rate") = 0.2, py::arg("unsure") = "ignore", \
-      py::arg("bound") = "per_axis", py::arg("seed") = std::uint64_t{1}
+                                 py::arg("bound") = "per_axis", py::arg("seed") = std::uint64_t {                       \
+    1                                                                                                                   \
+  }
 
 BayesConfig bayes_config(double pmin, double pmax, double imin, double imax, int comparisons, std::optional<double> sd_stop_db,
                          double noise_db, double unsure_band_db, double lapse, double irregularity_weight, double grid_step_db,
@@ -216,16 +230,21 @@ BayesConfig bayes_config(double pmin, double pmax, double imin, double imax, int
   return c;
 }
 
-#define TEXEL_BAYES_ARGS                                                                                               \
-  py::kw_only(), TEXEL_BOX_ARGS, py::arg("comparisons") = 20, py::arg("sd_stop_db") = py::none(),                   \
-      py::arg("noise_db") = 2.0, py::arg("unsure_band_db") = 1.0, py::arg("lapse") = 0.04,                           \
-      py::arg("irregularity_weight") = 1.0, py::arg("grid_step_db") = 0.5, py::arg("candidates") = 64,              \
-      py::arg("particles") = 256, py::arg("seed") = std::uint64_t{1}
+#define TEXEL_BAYES_ARGS                                                                                                         \
+  py::kw_only(), TEXEL_BOX_ARGS, py::arg("comparisons") = 20, py::arg("sd_stop_db") = py::none(), py::arg("noise_db") = 2.0,     \
+                                 py::arg("unsure_band_db") = 1.0, py::arg("lapse") = 0.04, py::arg("irregularity_weight") = 1.0, \
+                                 py::arg("grid_step_db") = 0.5, py::arg("candidates") = 64, py::arg("particles") = 256,          \
+                                 py::arg("seed") = std::uint64_t {                                                               \
+    1                                                                                                                            \
+  }
 
 std::vector<double> box_column(const std::vector<MatchBox>& boxes, int which) {
   std::vector<double> v;
   for (const auto& b : boxes)
-    v.push_back(which == 0 ? b.center.pitch_db : which == 1 ? b.center.irregularity_db : which == 2 ? b.pitch_half_db : b.irregularity_half_db);
+    v.push_back(which == 0   ? b.center.pitch_db
+                : which == 1 ? b.center.irregularity_db
+                : which == 2 ? b.pitch_half_db
+                             : b.irregularity_half_db);
   return v;
 }
 
@@ -271,24 +290,29 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       .def("answer", &Staircase::answer, py::arg("correct"), "The answer for the intensity next() returned.")
       .def_property_readonly("finished", &Staircase::finished)
       .def_property_readonly("trials", &Staircase::trials, "Answered trials.")
-      .def_property_readonly("intensities", [](const Staircase& s) { return std::vector<double>(s.intensities()); },
-                             "Presented intensities, one per answered trial.")
+      .def_property_readonly(
+          "intensities", [](const Staircase& s) { return std::vector<double>(s.intensities()); },
+          "Presented intensities, one per answered trial.")
       .def_property_readonly("responses", [](const Staircase& s) { return std::vector<bool>(s.responses()); })
-      .def_property_readonly("reversal_trials", [](const Staircase& s) { return s.reversal_trials(); },
-                             "0-based trial indices of the reversals.")
+      .def_property_readonly(
+          "reversal_trials", [](const Staircase& s) { return s.reversal_trials(); }, "0-based trial indices of the reversals.")
       .def_property_readonly("reversal_intensities", [](const Staircase& s) { return s.reversal_intensities(); })
       .def_property_readonly("last_was_reversal", &Staircase::last_was_reversal)
       .def_property_readonly("current_step", &Staircase::current_step, "Step size in force (units of step_type).")
       .def_property_readonly("convergent_value", &Staircase::convergent_value,
                              "The value computed after the last answer (what next() would present).")
       .def_property_readonly("n_reversals", &Staircase::n_reversals, "Effective number of reversals required.")
-      .def("mean_last_reversals", &Staircase::mean_last_reversals, py::arg("k"), "Mean of the last min(k, n) reversal intensities.")
+      .def("mean_last_reversals", &Staircase::mean_last_reversals, py::arg("k"),
+           "Mean of the last min(k, n) reversal intensities.")
       .def("mean_reversals_excluding_first", &Staircase::mean_reversals_excluding_first, py::arg("k"))
       .def("state_json", &Staircase::state_json, "Compact JSON snapshot of the state (what the store records).");
 
   // ------------------------------------------------------ matching optimizers
   py::class_<MatchPoint>(m, "MatchPoint", "A point of the matching space: Central Pitch (dB re 1 cpm), Irregularity (dB).")
-      .def(py::init([](double p, double i) { return MatchPoint{p, i}; }), py::arg("pitch_db"), py::arg("irregularity_db"))
+      .def(py::init([](double p, double i) {
+             return MatchPoint{p, i};
+           }),
+           py::arg("pitch_db"), py::arg("irregularity_db"))
       .def(py::init([](const py::tuple& t) {
         if (t.size() != 2) throw py::value_error("MatchPoint: a tuple (pitch_db, irregularity_db) of two numbers");
         return MatchPoint{t[0].cast<double>(), t[1].cast<double>()};
@@ -298,7 +322,8 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       .def("__iter__", [](const MatchPoint& p) { return py::iter(py::make_tuple(p.pitch_db, p.irregularity_db)); })
       .def("__eq__", [](const MatchPoint& a, const MatchPoint& b) { return a == b; })
       .def("__repr__", [](const MatchPoint& p) {
-        return "MatchPoint(pitch_db=" + std::to_string(p.pitch_db) + ", irregularity_db=" + std::to_string(p.irregularity_db) + ")";
+        return "MatchPoint(pitch_db=" + std::to_string(p.pitch_db) + ", irregularity_db=" + std::to_string(p.irregularity_db) +
+               ")";
       });
   py::implicitly_convertible<py::tuple, MatchPoint>();
   py::class_<MatchQuestion>(m, "MatchQuestion", "One comparison: which of a, b feels more like the reference?")
@@ -318,8 +343,9 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
         opt.answer('a')             # 'a', 'b' or 'unsure'
     opt.estimate                    # best match)doc")
       .def("next", &MatchOptimizer::next, "The next comparison (raises texel.Error when finished).")
-      .def("answer", [](MatchOptimizer& o, const std::string& c) { o.answer(choice_of(c)); }, py::arg("choice"),
-           "The answer to next(): 'a', 'b' or 'unsure'.")
+      .def(
+          "answer", [](MatchOptimizer& o, const std::string& c) { o.answer(choice_of(c)); }, py::arg("choice"),
+          "The answer to next(): 'a', 'b' or 'unsure'.")
       .def_property_readonly("finished", &MatchOptimizer::finished)
       .def_property_readonly("estimate", &MatchOptimizer::estimate, "Current best match (dB).")
       .def_property_readonly("uncertainty", &MatchOptimizer::uncertainty,
@@ -328,14 +354,15 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       .def_property_readonly("budget", &MatchOptimizer::budget, "Planned comparisons.")
       .def_property_readonly("name", &MatchOptimizer::name, "'guided' or 'bayesian'.")
       .def("state_json", &MatchOptimizer::state_json, "Compact JSON snapshot of the state.")
-      .def("replay",
-           [](MatchOptimizer& o, const std::vector<std::string>& choices) {
-             const auto cs = choices_of(choices);
-             replay(o, cs);
-           },
-           py::arg("choices"), "Answers `choices` in order ('a' | 'b' | 'unsure').");
-  py::class_<GuidedOptimizer, MatchOptimizer>(m, "GuidedOptimizer",
-                                              "Guided exploration (Vardar's thesis): four comparisons per iteration, a shrinking box.")
+      .def(
+          "replay",
+          [](MatchOptimizer& o, const std::vector<std::string>& choices) {
+            const auto cs = choices_of(choices);
+            replay(o, cs);
+          },
+          py::arg("choices"), "Answers `choices` in order ('a' | 'b' | 'unsure').");
+  py::class_<GuidedOptimizer, MatchOptimizer>(
+      m, "GuidedOptimizer", "Guided exploration (Vardar's thesis): four comparisons per iteration, a shrinking box.")
       .def(py::init([](double pmin, double pmax, double imin, double imax, int it, double sr, const std::string& unsure,
                        const std::string& bound, std::uint64_t seed) {
              return GuidedOptimizer(guided_config(pmin, pmax, imin, imax, it, sr, unsure, bound, seed));
@@ -364,11 +391,12 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
                                                 candidates, particles, seed));
            }),
            TEXEL_BAYES_ARGS)
-      .def("likelihood",
-           [](const BayesOptimizer& o, const MatchQuestion& q, const std::string& c, const MatchPoint& t) {
-             return o.likelihood(q, choice_of(c), t);
-           },
-           py::arg("question"), py::arg("choice"), py::arg("target"), "P(choice | target) under the optimizer's model.")
+      .def(
+          "likelihood",
+          [](const BayesOptimizer& o, const MatchQuestion& q, const std::string& c, const MatchPoint& t) {
+            return o.likelihood(q, choice_of(c), t);
+          },
+          py::arg("question"), py::arg("choice"), py::arg("target"), "P(choice | target) under the optimizer's model.")
       .def_property_readonly("choices", [](const BayesOptimizer& o) { return choice_names(o.choices()); });
   m.def(
       "optimizer",
@@ -403,8 +431,12 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
            py::arg("target"), py::kw_only(), py::arg("noise_db") = 2.0, py::arg("unsure_band_db") = 1.0,
            py::arg("irregularity_weight") = 1.0, TEXEL_BOX_ARGS, py::arg("seed") = std::uint64_t{1})
       .def("distance", &Matcher::distance, py::arg("point"))
-      .def("choose", [](const Matcher& mt, const MatchQuestion& q, std::uint64_t trial) { return std::string(to_string(mt.choose(q, trial))); },
-           py::arg("question"), py::arg("trial"), "'a', 'b' or 'unsure' for a comparison on trial `trial`.")
+      .def(
+          "choose",
+          [](const Matcher& mt, const MatchQuestion& q, std::uint64_t trial) {
+            return std::string(to_string(mt.choose(q, trial)));
+          },
+          py::arg("question"), py::arg("trial"), "'a', 'b' or 'unsure' for a comparison on trial `trial`.")
       .def("adjust", &Matcher::adjust, py::arg("trial"), "A slider match: target + noise, clamped to the box.")
       .def("confidence", &Matcher::confidence, py::arg("trial"), "1 … 5.");
   py::class_<Rater>(m, "Rater", "A simulated similarity rater: exponential decay with distance plus rating noise.")
@@ -430,43 +462,47 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       .def_property_readonly("schema_version", &Store::schema_version)
       .def_property_readonly("path", &Store::path)
       .def("participants", &Store::participants)
-      .def("sessions",
-           [](const Store& s) {
-             py::list l;
-             for (const auto& x : s.sessions()) l.append(session_dict(x));
-             return l;
-           },
-           "Every session as a dict (id, participant, protocol, study, seed, status, trials_done, …).")
-      .def("session", [](const Store& s, std::int64_t id) { return session_dict(s.session(id)); }, py::arg("session_id"))
-      .def("trials",
-           [](const Store& s, std::int64_t id) {
-             py::list l;
-             for (const auto& t : s.trials(id)) {
-               py::dict d;
-               d["trial"] = t.trial;
-               d["question_json"] = t.question_json;
-               d["response_json"] = t.response_json;
-               d["state_json"] = t.state_json;
-               d["row"] = rows_records({t.row})[0];
-               py::list events;
-               for (const auto& e : t.events) {
-                 py::dict ed;
-                 ed["t_s"] = e.t_s;
-                 ed["kind"] = e.kind;
-                 ed["detail"] = e.detail;
-                 ed["at"] = e.at;
-                 events.append(ed);
-               }
-               d["events"] = events;
-               l.append(d);
-             }
-             return l;
-           },
-           py::arg("session_id"), "Every stored trial of a session: question, response, state (JSON text), row, events.")
-      .def("rows", [](const Store& s, std::optional<std::int64_t> id, bool as_columns) { return rows_py(s.rows(id), as_columns); },
-           py::arg("session_id") = py::none(), py::kw_only(), py::arg("columns") = false,
-           "Long-format rows (the export CSV's), as a list of dicts (columns=False) or a dict of numpy\n"
-           "columns (columns=True; pandas.DataFrame accepts either). Missing numbers are NaN.");
+      .def(
+          "sessions",
+          [](const Store& s) {
+            py::list l;
+            for (const auto& x : s.sessions()) l.append(session_dict(x));
+            return l;
+          },
+          "Every session as a dict (id, participant, protocol, study, seed, status, trials_done, …).")
+      .def(
+          "session", [](const Store& s, std::int64_t id) { return session_dict(s.session(id)); }, py::arg("session_id"))
+      .def(
+          "trials",
+          [](const Store& s, std::int64_t id) {
+            py::list l;
+            for (const auto& t : s.trials(id)) {
+              py::dict d;
+              d["trial"] = t.trial;
+              d["question_json"] = t.question_json;
+              d["response_json"] = t.response_json;
+              d["state_json"] = t.state_json;
+              d["row"] = rows_records({t.row})[0];
+              py::list events;
+              for (const auto& e : t.events) {
+                py::dict ed;
+                ed["t_s"] = e.t_s;
+                ed["kind"] = e.kind;
+                ed["detail"] = e.detail;
+                ed["at"] = e.at;
+                events.append(ed);
+              }
+              d["events"] = events;
+              l.append(d);
+            }
+            return l;
+          },
+          py::arg("session_id"), "Every stored trial of a session: question, response, state (JSON text), row, events.")
+      .def(
+          "rows", [](const Store& s, std::optional<std::int64_t> id, bool as_columns) { return rows_py(s.rows(id), as_columns); },
+          py::arg("session_id") = py::none(), py::kw_only(), py::arg("columns") = false,
+          "Long-format rows (the export CSV's), as a list of dicts (columns=False) or a dict of numpy\n"
+          "columns (columns=True; pandas.DataFrame accepts either). Missing numbers are NaN.");
   m.def(
       "read_trials",
       [](const std::string& path, std::optional<std::int64_t> id, bool as_columns) {

@@ -57,7 +57,8 @@ py::array bytes_as_numpy(std::vector<std::byte>&& bytes, const py::dtype& dtype)
 std::vector<double> as_doubles(const py::handle& values, const char* name) {
   auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
   if (!a) throw py::type_error(std::string(name) + " must be a 1-D array of numbers");
-  if (a.ndim() != 1) throw py::value_error(std::string(name) + " must be 1-D; it has " + std::to_string(a.ndim()) + " dimensions");
+  if (a.ndim() != 1)
+    throw py::value_error(std::string(name) + " must be 1-D; it has " + std::to_string(a.ndim()) + " dimensions");
   return {a.data(), a.data() + a.size()};
 }
 
@@ -72,8 +73,9 @@ PYBIND11_MODULE(_texel, m) {
   invalid_type = new_exception(m, "InvalidArgument", "A parameter outside its allowed range or set (also a ValueError).",
                                py::make_tuple(py::handle(error_type), py::handle(PyExc_ValueError)).release().ptr());
   format_type = new_exception(m, "FormatError", "A file or byte string that does not parse or validate.", error_type);
-  io_type = new_exception(m, "IoError", "An operating-system level failure: unreadable input, unwritable output (also an OSError).",
-                          py::make_tuple(py::handle(error_type), py::handle(PyExc_OSError)).release().ptr());
+  io_type =
+      new_exception(m, "IoError", "An operating-system level failure: unreadable input, unwritable output (also an OSError).",
+                    py::make_tuple(py::handle(error_type), py::handle(PyExc_OSError)).release().ptr());
   py::register_exception_translator(&translate);
 
   register_render(m);

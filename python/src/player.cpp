@@ -33,16 +33,19 @@ std::vector<FingerSample> trace_of(const py::object& t_s, const py::object& x_mm
   const auto t = as_doubles(t_s, "t_s");
   const auto x = as_doubles(x_mm, "x_mm");
   if (t.size() != x.size())
-    throw InvalidArgument("x_mm has " + std::to_string(x.size()) + " samples and t_s " + std::to_string(t.size()) + "; they must match");
+    throw InvalidArgument("x_mm has " + std::to_string(x.size()) + " samples and t_s " + std::to_string(t.size()) +
+                          "; they must match");
   std::vector<FingerSample> trace(t.size());
   std::vector<double> on;
   if (!touch.is_none()) {
     on = as_doubles(touch, "touch");
     if (on.size() != t.size())
-      throw InvalidArgument("touch has " + std::to_string(on.size()) + " samples and t_s " + std::to_string(t.size()) + "; they must match");
+      throw InvalidArgument("touch has " + std::to_string(on.size()) + " samples and t_s " + std::to_string(t.size()) +
+                            "; they must match");
   }
   for (std::size_t i = 0; i < t.size(); ++i) {
-    if (i > 0 && !(t[i] >= t[i - 1])) throw InvalidArgument("t_s[" + std::to_string(i) + "] is not >= the sample before; times must be non-decreasing");
+    if (i > 0 && !(t[i] >= t[i - 1]))
+      throw InvalidArgument("t_s[" + std::to_string(i) + "] is not >= the sample before; times must be non-decreasing");
     trace[i] = FingerSample{t[i], x[i], on.empty() ? true : on[i] != 0.0};
   }
   return trace;
@@ -75,9 +78,9 @@ py::tuple play(const PlayerMap& map, const PlayerConfig& config, const std::vect
   return py::make_tuple(to_numpy(std::move(out)), to_numpy(std::move(positions)));
 }
 
-#define TEXEL_PLAYER_ARGS                                                                                   \
-  py::arg("rate_hz") = 48000.0, py::arg("output") = "vibration", py::arg("carrier_hz") = 250.0, \
-  py::arg("prediction_s") = 0.0, py::arg("gain") = 1.0
+#define TEXEL_PLAYER_ARGS                                                                                                      \
+  py::arg("rate_hz") = 48000.0, py::arg("output") = "vibration", py::arg("carrier_hz") = 250.0, py::arg("prediction_s") = 0.0, \
+  py::arg("gain") = 1.0
 
 }  // namespace
 
@@ -120,8 +123,8 @@ lead_in_s   lifted time before the finger lands (s) [0])doc");
         const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain);
         return play(*map_of(doc), c, trace, duration_s);
       },
-      py::arg("document"), py::arg("t_s"), py::arg("x_mm"), py::arg("touch") = py::none(), py::kw_only(),
-      py::arg("duration_s"), TEXEL_PLAYER_ARGS,
+      py::arg("document"), py::arg("t_s"), py::arg("x_mm"), py::arg("touch") = py::none(), py::kw_only(), py::arg("duration_s"),
+      TEXEL_PLAYER_ARGS,
       R"doc(Plays a document's map under a finger trace through the real-time Player, off line.
 
 t_s, x_mm     finger sample times (s, non-decreasing) and positions (mm, device coordinates)
@@ -156,8 +159,8 @@ Returns (output, positions_mm): float32 arrays of one value per output sample. T
         return play(*map, c, simulate_swipe(s), duration_s);
       },
       py::arg("document"), py::kw_only(), py::arg("speed_mm_s") = 100.0, py::arg("pattern") = "constant",
-      py::arg("start_mm") = py::none(), py::arg("extent_mm") = py::none(), py::arg("turn_s") = 0.1,
-      py::arg("duration_s") = 2.0, TEXEL_PLAYER_ARGS,
+      py::arg("start_mm") = py::none(), py::arg("extent_mm") = py::none(), py::arg("turn_s") = 0.1, py::arg("duration_s") = 2.0,
+      TEXEL_PLAYER_ARGS,
       "What a finger feels under a simulated swipe over a document, exactly as `texel swipe DOC -o x.wav`\n"
       "(same options, same defaults; see simulate_swipe and render_trace). Returns (output, positions_mm).");
   m.def(

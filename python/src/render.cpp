@@ -26,17 +26,17 @@ py::dtype dtype_of(SampleFormat f) {
 
 // The keyword arguments of a Texel texture, mirroring the document fields
 // (docs/format.md) with units in their names; defaults are TexelSpec's.
-#define TEXEL_SPEC_ARGS                                                                                              \
-  py::arg("central_pitch_db") = 10.0, py::arg("irregularity_db") = -5.0, py::arg("texel_length_mm") = 0.25,       \
-  py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("out_of_band") = "redraw", \
-  py::arg("band_min_cpm") = 0.01, py::arg("band_max_cpm") = 0.0, py::arg("quantization_db") = 0.0,                \
-  py::arg("phase") = "continuous", py::arg("fill") = "whole", py::arg("coarse_strength") = 0.0,                   \
-  py::arg("fine_strength") = 1.0, py::arg("coarse") = py::none()
+#define TEXEL_SPEC_ARGS                                                                                                         \
+  py::arg("central_pitch_db") = 10.0, py::arg("irregularity_db") = -5.0, py::arg("texel_length_mm") = 0.25,                     \
+  py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("out_of_band") = "redraw",               \
+  py::arg("band_min_cpm") = 0.01, py::arg("band_max_cpm") = 0.0, py::arg("quantization_db") = 0.0,                              \
+  py::arg("phase") = "continuous", py::arg("fill") = "whole", py::arg("coarse_strength") = 0.0, py::arg("fine_strength") = 1.0, \
+  py::arg("coarse") = py::none()
 
 TexelSpec make_spec(double central_pitch_db, double irregularity_db, double texel_length_mm, std::uint64_t seed,
-                    const std::string& parameterization, const std::string& out_of_band, double band_min_cpm,
-                    double band_max_cpm, double quantization_db, const std::string& phase, const std::string& fill,
-                    double coarse_strength, double fine_strength, const std::optional<CoarseProfile>& coarse) {
+                    const std::string& parameterization, const std::string& out_of_band, double band_min_cpm, double band_max_cpm,
+                    double quantization_db, const std::string& phase, const std::string& fill, double coarse_strength,
+                    double fine_strength, const std::optional<CoarseProfile>& coarse) {
   TexelSpec s;
   s.central_pitch = Decibels(central_pitch_db);
   s.irregularity = Decibels(irregularity_db);
@@ -131,7 +131,8 @@ py::dict region_dict(const RegionSpec& r) {
 }  // namespace
 
 DeviceProfile device_of(const py::handle& device, std::optional<double> length_mm, std::optional<double> spacing_mm) {
-  DeviceProfile d = py::isinstance<DeviceProfile>(device) ? device.cast<DeviceProfile>() : load_device(device.cast<std::string>());
+  DeviceProfile d =
+      py::isinstance<DeviceProfile>(device) ? device.cast<DeviceProfile>() : load_device(device.cast<std::string>());
   return with_grid(std::move(d), length_mm, spacing_mm);
 }
 
@@ -156,12 +157,17 @@ py::dict spec_dict(const TexelSpec& s) {
 
 py::array render_document_array(const Document& doc, const std::string& dtype) {
   std::optional<SampleFormat> format;
-  if (dtype == "native") format = doc.device.format;
-  else if (dtype == "uint16") format = SampleFormat::u16le;
-  else if (dtype == "uint8") format = SampleFormat::u8;
-  else if (dtype == "float32") format = SampleFormat::f32le;
+  if (dtype == "native")
+    format = doc.device.format;
+  else if (dtype == "uint16")
+    format = SampleFormat::u16le;
+  else if (dtype == "uint8")
+    format = SampleFormat::u8;
+  else if (dtype == "float32")
+    format = SampleFormat::f32le;
   else if (dtype != "float64")
-    throw InvalidArgument("dtype is '" + dtype + "'; allowed: native (the device's sample format), float64 (amplitudes 0 … 1), uint16, uint8, float32");
+    throw InvalidArgument("dtype is '" + dtype +
+                          "'; allowed: native (the device's sample format), float64 (amplitudes 0 … 1), uint16, uint8, float32");
   if (!format) {
     std::vector<double> map;
     {
@@ -185,20 +191,22 @@ void register_render(py::module_& m) {
       .def_readonly("description", &DeviceProfile::description)
       .def_readonly("samples", &DeviceProfile::samples, "Samples along the active length.")
       .def_readonly("spacing_mm", &DeviceProfile::spacing_mm, "Sample spacing Δx (mm).")
-      .def_property_readonly("format", [](const DeviceProfile& d) { return std::string(to_string(d.format)); },
-                             "Native sample format: u16le, u8, f32le or f64le.")
+      .def_property_readonly(
+          "format", [](const DeviceProfile& d) { return std::string(to_string(d.format)); },
+          "Native sample format: u16le, u8, f32le or f64le.")
       .def_readonly("refresh_hz", &DeviceProfile::refresh_hz, "Output update rate while playing (Hz).")
       .def_readonly("band_min_cpm", &DeviceProfile::band_min_cpm, "Lowest renderable frequency (cycles/mm).")
       .def_readonly("band_max_cpm", &DeviceProfile::band_max_cpm, "Highest renderable frequency (cycles/mm); 0 = Nyquist.")
       .def_property_readonly("length_mm", &DeviceProfile::length_mm, "Active length (mm).")
       .def_property_readonly("nyquist_cpm", &DeviceProfile::nyquist_cpm, "Spatial Nyquist frequency 1/(2Δx) (cycles/mm).")
-      .def_property_readonly("positions_mm",
-                             [](const DeviceProfile& d) {
-                               std::vector<double> x(static_cast<std::size_t>(d.samples));
-                               for (std::size_t i = 0; i < x.size(); ++i) x[i] = d.grid().position(static_cast<std::int64_t>(i));
-                               return to_numpy(std::move(x));
-                             },
-                             "Position of every sample (mm).")
+      .def_property_readonly(
+          "positions_mm",
+          [](const DeviceProfile& d) {
+            std::vector<double> x(static_cast<std::size_t>(d.samples));
+            for (std::size_t i = 0; i < x.size(); ++i) x[i] = d.grid().position(static_cast<std::int64_t>(i));
+            return to_numpy(std::move(x));
+          },
+          "Position of every sample (mm).")
       .def("to_json", &device_profile_json, "The profile as JSON text (the device file schema).")
       .def("__repr__", [](const DeviceProfile& d) {
         return "<texel.DeviceProfile '" + d.name + "': " + std::to_string(d.samples) + " samples>";
@@ -215,7 +223,9 @@ void register_render(py::module_& m) {
       .def_readwrite("value", &ConstantProfile::value)
       .def("__repr__", [](const ConstantProfile& p) { return "ConstantProfile(value=" + std::to_string(p.value) + ")"; });
   py::class_<SineProfile>(m, "SineProfile", "Coarse profile c(x) = 0.5 + 0.5·sin(2π(x/period_mm + phase_deg/360)).")
-      .def(py::init([](double period_mm, double phase_deg) { return SineProfile{Millimetres(period_mm), phase_deg}; }),
+      .def(py::init([](double period_mm, double phase_deg) {
+             return SineProfile{Millimetres(period_mm), phase_deg};
+           }),
            py::arg("period_mm") = 5.0, py::arg("phase_deg") = 0.0)
       .def_property(
           "period_mm", [](const SineProfile& p) { return p.period.value(); },
@@ -232,8 +242,11 @@ void register_render(py::module_& m) {
       .def(py::init([](std::vector<std::pair<double, double>> points) { return PointsProfile{std::move(points)}; }),
            py::arg("points"))
       .def_readwrite("points", &PointsProfile::points);
-  py::class_<SampledProfile>(m, "SampledProfile", "Coarse profile sampled every spacing_mm from position 0 (linear interpolation).")
-      .def(py::init([](double spacing_mm, std::vector<double> values) { return SampledProfile{spacing_mm, std::move(values)}; }),
+  py::class_<SampledProfile>(m, "SampledProfile",
+                             "Coarse profile sampled every spacing_mm from position 0 (linear interpolation).")
+      .def(py::init([](double spacing_mm, std::vector<double> values) {
+             return SampledProfile{spacing_mm, std::move(values)};
+           }),
            py::arg("spacing_mm"), py::arg("values"))
       .def_readwrite("spacing_mm", &SampledProfile::spacing_mm)
       .def_readwrite("values", &SampledProfile::values);
@@ -244,13 +257,14 @@ void register_render(py::module_& m) {
       .def_readonly("version", &Document::version)
       .def_readwrite("description", &Document::description)
       .def_readonly("device", &Document::device)
-      .def_property_readonly("regions",
-                             [](const Document& d) {
-                               py::list l;
-                               for (const auto& r : d.regions) l.append(region_dict(r));
-                               return l;
-                             },
-                             "The regions as dicts (name, start_mm, length_mm, kind, and the texel spec or reference).")
+      .def_property_readonly(
+          "regions",
+          [](const Document& d) {
+            py::list l;
+            for (const auto& r : d.regions) l.append(region_dict(r));
+            return l;
+          },
+          "The regions as dicts (name, start_mm, length_mm, kind, and the texel spec or reference).")
       .def("to_json", &document_json, "The document as JSON text (the *.texel.json format).")
       .def("save", &save_document, py::arg("path"), "Writes the document atomically (temporary file + rename).")
       .def("render", &render_document_array, py::kw_only(), py::arg("dtype") = "native",
@@ -270,8 +284,8 @@ void register_render(py::module_& m) {
          double bmax, double q, const std::string& phase, const std::string& fill, double c, double f,
          const std::optional<CoarseProfile>& coarse, const py::object& device, std::optional<double> length_mm,
          std::optional<double> spacing_mm, const std::string& description) {
-        Document doc =
-            make_document(device_of(device, length_mm, spacing_mm), make_spec(cp, irr, l, seed, par, oob, bmin, bmax, q, phase, fill, c, f, coarse));
+        Document doc = make_document(device_of(device, length_mm, spacing_mm),
+                                     make_spec(cp, irr, l, seed, par, oob, bmin, bmax, q, phase, fill, c, f, coarse));
         doc.description = description;
         return doc;
       },
@@ -288,8 +302,8 @@ void register_render(py::module_& m) {
          double bmax, double q, const std::string& phase, const std::string& fill, double c, double f,
          const std::optional<CoarseProfile>& coarse, const py::object& device, std::optional<double> length_mm,
          std::optional<double> spacing_mm, const std::string& dtype) {
-        const Document doc =
-            make_document(device_of(device, length_mm, spacing_mm), make_spec(cp, irr, l, seed, par, oob, bmin, bmax, q, phase, fill, c, f, coarse));
+        const Document doc = make_document(device_of(device, length_mm, spacing_mm),
+                                           make_spec(cp, irr, l, seed, par, oob, bmin, bmax, q, phase, fill, c, f, coarse));
         return render_document_array(doc, dtype);
       },
       py::kw_only(), TEXEL_SPEC_ARGS, py::arg("device") = "tpad", py::arg("length_mm") = py::none(),
@@ -377,15 +391,17 @@ The GIL is released during synthesis.)doc");
       py::arg("name"), py::kw_only(), py::arg("device") = "tpad", py::arg("seed") = std::uint64_t{1},
       py::arg("length_mm") = py::none(), py::arg("spacing_mm") = py::none(),
       "A document holding one reference texture over the whole device (parameters as for reference()).");
-  m.def("reference_names",
-        [] {
-          std::vector<std::string> names;
-          for (const auto& i : reference_catalogue()) names.push_back(i.name);
-          return names;
-        },
-        "Names of every reference generator, in listing order.");
-  m.def("reference_info", [](const std::string& name) { return reference_info_dict(reference_info(name)); }, py::arg("name"),
-        "A generator's family, description and parameters (key, kind, unit, default, range).");
+  m.def(
+      "reference_names",
+      [] {
+        std::vector<std::string> names;
+        for (const auto& i : reference_catalogue()) names.push_back(i.name);
+        return names;
+      },
+      "Names of every reference generator, in listing order.");
+  m.def(
+      "reference_info", [](const std::string& name) { return reference_info_dict(reference_info(name)); }, py::arg("name"),
+      "A generator's family, description and parameters (key, kind, unit, default, range).");
 }
 
 }  // namespace texel::python

@@ -57,3 +57,9 @@ def test_every_public_method_is_in_the_stub():
 def test_public_functions_have_docstrings():
     undocumented = [n for n in texel.__all__ if callable(getattr(texel, n)) and not getattr(texel, n).__doc__]
     assert not undocumented
+
+
+def test_every_stubbed_name_exists():
+    names, _ = stub_names()
+    extra = sorted(n for n in names if not n.startswith("_") and not hasattr(texel, n))
+    assert not extra, f"in __init__.pyi but not in the module: {extra}"
