@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+
+#include "texel/device.hpp"
+#include "texel/document.hpp"
+#include "texel/texture.hpp"
 
 namespace texel::python {
 
@@ -38,16 +43,7 @@ void register_codec(py::module_& m);
 void register_player(py::module_& m);
 void register_experiment(py::module_& m);
 
-}  // namespace texel::python
-
 // Declarations shared between areas (defined in render.cpp).
-#include <optional>
-
-#include "texel/device.hpp"
-#include "texel/document.hpp"
-#include "texel/texture.hpp"
-
-namespace texel::python {
 
 /// A device profile from a name/path or a DeviceProfile object, with the
 /// optional grid overrides (library: with_grid).
