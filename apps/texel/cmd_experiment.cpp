@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -29,6 +30,8 @@
 #include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/io.hpp"
+#include "texel/matfile.hpp"
+#include "texel/experiment/table.hpp"
 
 namespace texel::cli {
 namespace {
@@ -473,6 +476,32 @@ void status(const std::string& db, bool as_json, const std::optional<std::string
   }
 }
 
+/// The export as MATLAB variables (docs/format.md "MATLAB .mat"): a 1×1
+/// struct `trials` with one N×1 field per TrialRow column, in CSV order
+/// (struct2table(trials) gives a table). Values go through the one CSV
+/// serializer, so the .mat and the .csv cannot disagree: text fields (and
+/// any column that is not all numbers) become N×1 cell arrays of char,
+/// the others doubles with NaN for missing (MATLAB's missing).
+std::vector<texel::mat::Variable> trials_variables(const std::vector<ex::TrialRow>& rows) {
+  static const std::vector<std::string> text = {"participant", "protocol", "study",    "block",          "task",     "condition",
+                                                "reference",   "variable", "response", "correct_answer", "shown_at", "answered_at"};
+  const ex::Table table = ex::parse_csv_table(ex::trials_csv(rows), "export");
+  texel::mat::Struct trials;
+  for (const auto& name : table.columns) {
+    const bool is_text = std::find(text.begin(), text.end(), name) != text.end();
+    std::optional<std::vector<double>> numbers;
+    if (!is_text) try {
+        numbers = table.numbers(name);
+      } catch (const texel::FormatError&) {
+      }
+    if (numbers)
+      trials.add(name, texel::mat::Matrix::column(std::move(*numbers)));
+    else
+      trials.add(name, texel::mat::StringColumn{table.strings(name)});
+  }
+  return {{"trials", std::move(trials)}};
+}
+
 }  // namespace
 
 void register_experiment(CLI::App& app) {
@@ -550,20 +579,30 @@ void register_experiment(CLI::App& app) {
     std::string db;
     std::string output;
     std::optional<std::int64_t> session;
+    std::string mat_version = "5";
   };
   auto e = std::make_shared<ExportArgs>();
   auto* export_cmd =
       cmd->add_subcommand("export", "Export every trial as long-format CSV (one row per trial; docs/experiments.md)");
   export_cmd->add_option("--db", e->db, "Session database")->required();
-  export_cmd->add_option("-o,--output", e->output, "Output .csv")->required();
+  export_cmd->add_option("-o,--output", e->output, "Output .csv, or .mat (MATLAB: struct 'trials', one column per field)")
+      ->required();
   export_cmd->add_option("--session", e->session, "Only this session id");
+  export_cmd->add_option("--mat-version", e->mat_version, "MATLAB file version of a .mat output: 5 (default) or 7.3 (HDF5)")
+      ->default_str("5");
   export_cmd->callback([e] {
-    if (output_extension(e->output) != ".csv") throw InvalidArgument("--output is '" + e->output + "'; allowed: a .csv file");
+    const std::string ext = output_extension(e->output);
+    if (ext != ".csv" && ext != ".mat")
+      throw InvalidArgument("--output is '" + e->output + "'; allowed: a .csv or .mat file");
+    const texel::mat::MatVersion mat_version = texel::mat::parse_mat_version(e->mat_version);
     check_writable(e->output);
     const ex::Store store = ex::Store::open(e->db, ex::StoreMode::read_only);
     if (e->session) (void)store.session(*e->session);
     const auto rows = store.rows(e->session);
-    write_file_atomic(e->output, ex::trials_csv(rows));
+    if (ext == ".mat")
+      texel::mat::write_mat(e->output, trials_variables(rows), {.version = mat_version});  // atomic
+    else
+      write_file_atomic(e->output, ex::trials_csv(rows));
     std::cerr << "wrote " << rows.size() << " trials to " << e->output << "\n";
   });
 

@@ -16,6 +16,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/matfile.hpp"
 #include "texel/plot.hpp"
 
 namespace texel::cli {
@@ -64,6 +65,7 @@ struct Args {
   std::optional<double> swipe_speed;
   bool json = false;
   std::optional<std::string> output;
+  std::string mat_version = "5";
   std::optional<std::string> spectrum_csv;
   std::optional<std::string> psd_csv;
   std::string window = "blackman-harris";
@@ -258,6 +260,34 @@ SpectrumPlot make_spectrum_plot(const std::string& title, const LoadedSignal& si
   return p;
 }
 
+/// The .mat variables of a spectrum (docs/format.md "MATLAB .mat"): N×1
+/// columns, and the peaks as a struct of columns.
+std::vector<mat::Variable> spectrum_variables(const std::string& source, const LoadedSignal& sig, const SpectralReport& r) {
+  using mat::Matrix;
+  std::vector<double> pf, pa, pl;
+  for (const Peak& p : r.peaks) pf.push_back(p.frequency.value()), pa.push_back(p.amplitude), pl.push_back(p.level_db);
+  mat::Struct peaks;
+  peaks.add("frequency_cpm", Matrix::column(std::move(pf)))
+      .add("amplitude", Matrix::column(std::move(pa)))
+      .add("level_db", Matrix::column(std::move(pl)));
+  mat::Struct params;
+  params.add("source", mat::Text{source})
+      .add("spacing_mm", Matrix::scalar(sig.spacing_mm))
+      .add("samples", Matrix::scalar(static_cast<double>(sig.samples.size())))
+      .add("window", mat::Text{std::string(to_string(r.spectrum.window))})
+      .add("nfft", Matrix::scalar(static_cast<double>(r.spectrum.nfft)))
+      .add("bin_cpm", Matrix::scalar(r.spectrum.bin_cpm))
+      .add("psd_segment", Matrix::scalar(static_cast<double>(r.psd.segment)))
+      .add("mean", Matrix::scalar(r.mean))
+      .add("rms", Matrix::scalar(r.rms));
+  return {{"frequency_cpm", Matrix::column(r.spectrum.frequency_cpm)},
+          {"magnitude", Matrix::column(r.spectrum.magnitude)},
+          {"psd_frequency_cpm", Matrix::column(r.psd.frequency_cpm)},
+          {"psd", Matrix::column(r.psd.density)},
+          {"peaks", std::move(peaks)},
+          {"params", std::move(params)}};
+}
+
 void register_spectrum(CLI::App& app) {
   auto a = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("spectrum", "Spectrum of a texture map: peaks, centroids, spread, band energy, plot");
@@ -267,7 +297,11 @@ void register_spectrum(CLI::App& app) {
   cmd->add_option("--region", a->region, "Analyse one region of a document (name or index)");
   cmd->add_option("--swipe-speed", a->swipe_speed, "Finger speed, mm/s: adds temporal frequencies (Hz = cycles/mm × mm/s)");
   cmd->add_flag("--json", a->json, "Print the report as JSON");
-  cmd->add_option("-o,--output", a->output, "Plot: .png or .svg (excerpt on top, spectrum below on a log-frequency axis)");
+  cmd->add_option("-o,--output", a->output,
+                  "Plot: .png or .svg (excerpt on top, spectrum below on a log-frequency axis); or .mat (MATLAB: "
+                  "frequency_cpm, magnitude, psd_frequency_cpm, psd, peaks)");
+  cmd->add_option("--mat-version", a->mat_version, "MATLAB file version of a .mat output: 5 (default) or 7.3 (HDF5)")
+      ->default_str("5");
   cmd->add_option("--spectrum-csv", a->spectrum_csv, "Also write frequency_cpm,magnitude rows");
   cmd->add_option("--psd-csv", a->psd_csv, "Also write frequency_cpm,psd rows (Welch, a²/(cycle/mm))");
   const std::string g = "Analysis";
@@ -283,9 +317,10 @@ void register_spectrum(CLI::App& app) {
   cmd->add_option("--band", a->bands, "Band for band energy, LOW:HIGH in cycles/mm (repeatable) [decades]")->group(g);
   cmd->callback([a] {
     // Validate everything cheap before reading or rendering anything.
+    const mat::MatVersion mat_version = mat::parse_mat_version(a->mat_version);
+    const bool mat_output = a->output && output_extension(*a->output) == ".mat";
     if (a->output) {
-      const PlotFormat f = plot_format_for_path(*a->output);
-      (void)f;
+      if (!mat_output) (void)plot_format_for_path(*a->output);
       check_writable(*a->output);
     }
     for (const auto* p : {&a->spectrum_csv, &a->psd_csv})
@@ -321,7 +356,10 @@ void register_spectrum(CLI::App& app) {
           {*a->spectrum_csv, csv_columns("frequency_cpm", "magnitude", r.spectrum.frequency_cpm, r.spectrum.magnitude)});
     if (a->psd_csv) files.push_back({*a->psd_csv, csv_columns("frequency_cpm", "psd", r.psd.frequency_cpm, r.psd.density)});
     if (a->output) {
-      plot_spectrum(make_spectrum_plot(a->file, sig, r, a->swipe_speed), *a->output);  // atomic on its own
+      if (mat_output)
+        mat::write_mat(*a->output, spectrum_variables(a->file, sig, r), {.version = mat_version});  // atomic on its own
+      else
+        plot_spectrum(make_spectrum_plot(a->file, sig, r, a->swipe_speed), *a->output);  // atomic on its own
       try {
         commit_files(files);
       } catch (...) {

@@ -5,8 +5,11 @@ v5 through scipy.io.loadmat, v7.3 through h5py (both Debian packages, run by
 /usr/bin/python3). Checks names, shapes (MATLAB column-major: N×1 columns),
 values (the map equals the .npy output exactly; positions are i·spacing),
 the parameters, the texel listing, the document text, and that the encoder
-accepts the file. Usage: check_cli_mat.py TEXEL_BINARY WORKDIR
+accepts the file. Also `texel spectrum -o s.mat` and `texel experiment export -o trials.mat`
+against their CSV outputs. Usage: check_cli_mat.py TEXEL_BINARY WORKDIR
+[PROTOCOLS_DIR]
 """
+import csv
 import json
 import os
 import shutil
@@ -17,7 +20,8 @@ import h5py
 import numpy as np
 import scipy.io
 
-texel, work = sys.argv[1], sys.argv[2]
+texel, work = sys.argv[1], os.path.abspath(sys.argv[2])
+protocols = os.path.abspath(sys.argv[3]) if len(sys.argv) > 3 else None
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 os.chdir(work)
@@ -98,4 +102,40 @@ scipy.io.savemat("complex.mat", {"amplitude": np.array([[1 + 1j], [2 + 0j], [0.5
 r = subprocess.run([texel, "encode", "complex.mat"], capture_output=True, text=True)
 check(r.returncode == 2 and "complex.mat" in r.stderr and "complex" in r.stderr and r.stderr.count("\n") <= 1,
       f"complex .mat rejected: {r.stderr.strip()}")
+# --- spectrum ------------------------------------------------------------------
+run("spectrum", "map.npy", "--device", "tpad", "-o", "s.mat", "--spectrum-csv", "s.csv", "--psd-csv", "p.csv")
+run("spectrum", "map.npy", "--device", "tpad", "-o", "s73.mat", "--mat-version", "7.3")
+s = scipy.io.loadmat("s.mat")
+sc = np.loadtxt("s.csv", delimiter=",", skiprows=1)
+pc = np.loadtxt("p.csv", delimiter=",", skiprows=1)
+check(s["frequency_cpm"].shape == (sc.shape[0], 1) and s["magnitude"].shape == (sc.shape[0], 1), "spectrum columns N×1")
+check(np.allclose(s["frequency_cpm"][:, 0], sc[:, 0], rtol=1e-12) and np.allclose(s["magnitude"][:, 0], sc[:, 1], rtol=1e-12),
+      "spectrum .mat equals --spectrum-csv")
+check(np.allclose(s["psd"][:, 0], pc[:, 1], rtol=1e-12), "psd .mat equals --psd-csv")
+check(s["peaks"][0, 0]["frequency_cpm"].shape[1] == 1 and s["params"][0, 0]["spacing_mm"][0, 0] == spacing, "spectrum peaks, params")
+with h5py.File("s73.mat", "r") as h5:
+    check(np.array_equal(h5["magnitude"][0], s["magnitude"][:, 0]), "spectrum v7.3 equals v5")
+
+# --- experiment export ------------------------------------------------------------
+if protocols:
+    run("experiment", "run", os.path.join(protocols, "texel-length.json"), "--participant", "S01", "--db", "s.db",
+        "--simulate", "threshold=6mm", "--quiet")
+    run("experiment", "export", "--db", "s.db", "-o", "trials.csv")
+    run("experiment", "export", "--db", "s.db", "-o", "trials.mat")
+    run("experiment", "export", "--db", "s.db", "-o", "trials73.mat", "--mat-version", "7.3")
+    rows = list(csv.DictReader(open("trials.csv", encoding="utf-8")))
+    header = next(csv.reader(open("trials.csv", encoding="utf-8")))
+    t = scipy.io.loadmat("trials.mat")["trials"][0, 0]
+    check(list(t.dtype.names) == header, f"export: one field per CSV column, in order ({len(header)})")
+    nr = len(rows)
+    check(nr > 5 and all(t[c].shape == (nr, 1) for c in header), f"export: every field is {nr}×1")
+    check(t["participant"].dtype == object and t["participant"][0, 0][0] == "S01", "export: text as cell of char")
+    check(t["trial"].dtype == np.float64 and list(t["trial"][:, 0]) == [float(r["trial"]) for r in rows], "export: numbers")
+    miss = [i for i, r in enumerate(rows) if r["rating"] == ""]
+    check(all(np.isnan(t["rating"][i, 0]) for i in miss), "export: missing is NaN")
+    check([x[0] if x.size else "" for x in t["shown_at"][:, 0]] == [r["shown_at"] for r in rows], "export: time stamps")
+    with h5py.File("trials73.mat", "r") as h5:
+        check(h5["trials"]["trial"].shape == (1, nr) and h5["trials"]["participant"].attrs["MATLAB_class"] == b"cell",
+              "export v7.3: columns and a cell column")
+
 print("all .mat checks passed")
