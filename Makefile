@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD := build
 PY := /usr/bin/python3
 
-.PHONY: all deps configure build web demo test test-unit test-browser test-asan test-determinism bench format clean
+.PHONY: all deps configure build python web demo test test-unit test-browser test-asan test-determinism bench format clean
 
 all: build
 
@@ -16,6 +16,11 @@ configure: deps
 
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
+
+# The Python package texel (python/README.md): build/python/texel, for
+# PYTHONPATH=build/python /usr/bin/python3.
+python: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target texel_python
 
 # Texel Studio's front end (web/, TypeScript + Vite + uPlot), built once into
 # build/web and rebuilt only when its sources or lockfile change. `npm ci`
