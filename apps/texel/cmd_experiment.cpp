@@ -29,9 +29,9 @@
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
+#include "texel/experiment/table.hpp"
 #include "texel/io.hpp"
 #include "texel/matfile.hpp"
-#include "texel/experiment/table.hpp"
 
 namespace texel::cli {
 namespace {
@@ -483,8 +483,9 @@ void status(const std::string& db, bool as_json, const std::optional<std::string
 /// any column that is not all numbers) become N×1 cell arrays of char,
 /// the others doubles with NaN for missing (MATLAB's missing).
 std::vector<texel::mat::Variable> trials_variables(const std::vector<ex::TrialRow>& rows) {
-  static const std::vector<std::string> text = {"participant", "protocol", "study",    "block",          "task",     "condition",
-                                                "reference",   "variable", "response", "correct_answer", "shown_at", "answered_at"};
+  static const std::vector<std::string> text = {"participant", "protocol",       "study",     "block",
+                                                "task",        "condition",      "reference", "variable",
+                                                "response",    "correct_answer", "shown_at",  "answered_at"};
   const ex::Table table = ex::parse_csv_table(ex::trials_csv(rows), "export");
   texel::mat::Struct trials;
   for (const auto& name : table.columns) {
@@ -592,8 +593,7 @@ void register_experiment(CLI::App& app) {
       ->default_str("5");
   export_cmd->callback([e] {
     const std::string ext = output_extension(e->output);
-    if (ext != ".csv" && ext != ".mat")
-      throw InvalidArgument("--output is '" + e->output + "'; allowed: a .csv or .mat file");
+    if (ext != ".csv" && ext != ".mat") throw InvalidArgument("--output is '" + e->output + "'; allowed: a .csv or .mat file");
     const texel::mat::MatVersion mat_version = texel::mat::parse_mat_version(e->mat_version);
     check_writable(e->output);
     const ex::Store store = ex::Store::open(e->db, ex::StoreMode::read_only);

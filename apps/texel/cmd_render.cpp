@@ -87,9 +87,11 @@ void register_render(CLI::App& app) {
   cmd->add_option("document", args->document, "A texture document (.texel.json); flags override its values");
   add_texture_options(*cmd, args->texture);
   add_device_options(*cmd, args->device);
-  cmd->add_option("-o,--output", args->output, "Output: .bin (device native), .csv, .npy, .mat (MATLAB), .texel.json, .png or .svg")
+  cmd->add_option("-o,--output", args->output,
+                  "Output: .bin (device native), .csv, .npy, .mat (MATLAB), .texel.json, .png or .svg")
       ->required();
-  cmd->add_option("--mat-version", args->mat_version, "MATLAB file version of a .mat output: 5 (default, compressed) or 7.3 (HDF5)")
+  cmd->add_option("--mat-version", args->mat_version,
+                  "MATLAB file version of a .mat output: 5 (default, compressed) or 7.3 (HDF5)")
       ->default_str("5");
   cmd->add_option("--texels", args->texels_csv, "Also write one row per texel: index,start_mm,frequency_cpm,amplitude");
   cmd->add_flag("--json", args->json, "Print a JSON summary on stdout");

@@ -96,10 +96,10 @@ struct ReadOptions {
 
 /// A map read from a .mat file.
 struct MapData {
-  std::string variable;                  ///< the variable the amplitudes came from
-  std::vector<double> amplitude;         ///< as stored (integers as their values)
-  std::optional<double> spacing_mm;      ///< from `spacing_mm`, else from `position_mm`
-  std::vector<double> position_mm;       ///< empty when the file has none
+  std::string variable;              ///< the variable the amplitudes came from
+  std::vector<double> amplitude;     ///< as stored (integers as their values)
+  std::optional<double> spacing_mm;  ///< from `spacing_mm`, else from `position_mm`
+  std::vector<double> position_mm;   ///< empty when the file has none
 };
 
 /// Reads the map of a .mat file (v5 or v7.3). The map is the variable named

@@ -122,7 +122,8 @@ class Builder {
                             std::to_string(m.cols) + " but holds " + std::to_string(m.data.size()) + " values");
     std::size_t dims[2] = {m.rows, m.cols};
     // matio copies `data` (no MAT_F_DONT_COPY_DATA); the const_cast is its C signature.
-    return check(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, m.data.empty() ? nullptr : const_cast<double*>(m.data.data()), 0),
+    return check(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
+                               m.data.empty() ? nullptr : const_cast<double*>(m.data.data()), 0),
                  name);
   }
 
@@ -228,7 +229,7 @@ bool numeric_class(matio_classes c) {
 struct Info {
   VarPtr var;
   std::string name;
-  std::string shape;  ///< "19200x1"
+  std::string shape;                    ///< "19200x1"
   std::optional<std::size_t> elements;  ///< none when a dimension product overflows
   bool vector = false;                  ///< at most one dimension differs from 1
 };
@@ -266,7 +267,8 @@ class Reader {
     if (::access(path_.c_str(), R_OK) != 0) throw IoError("cannot read '" + path_ + "': " + std::strerror(errno));
     // A v5/v7.3 file starts with a 128-byte header; matio would also try v4,
     // a format Texel does not exchange.
-    if (file_size_ < 128) throw FormatError("'" + path_ + "' is not a MATLAB v5/v7.3 .mat file (" + std::to_string(file_size_) + " bytes)");
+    if (file_size_ < 128)
+      throw FormatError("'" + path_ + "' is not a MATLAB v5/v7.3 .mat file (" + std::to_string(file_size_) + " bytes)");
     mat_.reset(Mat_Open(path_.c_str(), MAT_ACC_RDONLY));
     if (!mat_) throw FormatError("'" + path_ + "' is not a MATLAB .mat file" + matio_reason());
     version_ = Mat_GetVersion(mat_.get());
@@ -319,8 +321,8 @@ class Reader {
     if (version_ == MAT_FT_MAT5) {
       const std::size_t ratio = v->compression == MAT_COMPRESSION_NONE ? 1 : 1100;
       if (n / ratio > file_size_)
-        throw FormatError(what + " declares " + info.shape + " elements but the file has only " +
-                          std::to_string(file_size_) + " bytes");
+        throw FormatError(what + " declares " + info.shape + " elements but the file has only " + std::to_string(file_size_) +
+                          " bytes");
     }
     const std::size_t width = Mat_SizeOfClass(v->class_type);
     if (width == 0 || width > 8) throw FormatError(what + " has an unsupported element type");
@@ -458,7 +460,8 @@ void write_mat(const std::string& path, const std::vector<Variable>& variables, 
       if (Mat_VarWrite(mat.get(), v.get(), compression) != 0)
         throw IoError("cannot write '" + path + "': libmatio failed on variable '" + var.name + "'" + matio_reason());
     }
-    if (Mat_Close(mat.release()) != 0) throw IoError("cannot write '" + path + "': libmatio cannot close the file" + matio_reason());
+    if (Mat_Close(mat.release()) != 0)
+      throw IoError("cannot write '" + path + "': libmatio cannot close the file" + matio_reason());
     commit(tmp, path);
   } catch (...) {
     ::unlink(tmp.c_str());

@@ -77,7 +77,7 @@ void expect_rejected(const std::string& file, const std::string& fragment) {
 std::string v5_bytes(const std::vector<std::int32_t>& dims, std::size_t data_bytes, std::uint32_t data_tag_bytes) {
   std::string out(116, ' ');
   std::memcpy(out.data(), "MATLAB 5.0 MAT-file, hand-made hostile file", 43);
-  out.append(8, '\0');       // subsystem offset
+  out.append(8, '\0');        // subsystem offset
   out.append("\x00\x01", 2);  // version 0x0100, little-endian
   out.append("IM", 2);
   auto u32 = [](std::string& s, std::uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); };
@@ -87,15 +87,13 @@ std::string v5_bytes(const std::vector<std::int32_t>& dims, std::size_t data_byt
   for (auto d : dims) u32(body, static_cast<std::uint32_t>(d));
   if (dims.size() % 2) u32(body, 0);
   u32(body, (3u << 16) | 1u), body.append("map\0", 4);  // name "map", small element
-  u32(body, 9), u32(body, data_tag_bytes);                // miDOUBLE real part
+  u32(body, 9), u32(body, data_tag_bytes);              // miDOUBLE real part
   body.append(data_bytes, '\0');
   u32(out, 14), u32(out, static_cast<std::uint32_t>(body.size()));
   return out + body;
 }
 
-void write_bytes(const std::string& file, const std::string& bytes) {
-  std::ofstream(file, std::ios::binary) << bytes;
-}
+void write_bytes(const std::string& file, const std::string& bytes) { std::ofstream(file, std::ios::binary) << bytes; }
 
 }  // namespace
 
@@ -123,7 +121,8 @@ TEST_F(MatFile, ColumnMajorShapesAndClassesAreWhatMatlabSees) {
   // A 3×2 table: column 0 = {1,2,3}, column 1 = {10,20,30}.
   Struct s;
   s.add("k", Matrix::scalar(2.5)).add("name", Text{"tpad µ"}).add("labels", StringColumn{{"a", "bc", ""}});
-  write_mat(f, {{"table", Matrix{3, 2, {1, 2, 3, 10, 20, 30}}}, {"row", Matrix{1, 4, {1, 2, 3, 4}}}, {"p", s}, {"doc", Text{"{}"}}});
+  write_mat(f,
+            {{"table", Matrix{3, 2, {1, 2, 3, 10, 20, 30}}}, {"row", Matrix{1, 4, {1, 2, 3, 4}}}, {"p", s}, {"doc", Text{"{}"}}});
   const auto vars = list_variables(f);
   ASSERT_EQ(vars.size(), 4u);
   EXPECT_EQ(vars[0], "table double 3x2");
@@ -281,7 +280,8 @@ TEST_F(MatFile, HugeDeclaredDimensionsAreRejectedBeforeAllocating) {
 TEST_F(MatFile, TruncatedAndForeignFilesAreRejected) {
   write_mat(path("full.mat"), {{"amplitude", Matrix::column(ramp(5000))}}, {.compress = false});
   const std::string bytes = read_file(path("full.mat"));
-  for (std::size_t keep : {std::size_t{0}, std::size_t{60}, std::size_t{128}, std::size_t{200}, bytes.size() / 2, bytes.size() - 1}) {
+  for (std::size_t keep :
+       {std::size_t{0}, std::size_t{60}, std::size_t{128}, std::size_t{200}, bytes.size() / 2, bytes.size() - 1}) {
     const std::string f = path("cut" + std::to_string(keep) + ".mat");
     write_bytes(f, bytes.substr(0, keep));
     EXPECT_THROW((void)read_map(f), FormatError) << "kept " << keep << " of " << bytes.size() << " bytes";
