@@ -25,11 +25,10 @@ void register_decode(CLI::App& app) {
   auto* cmd = app.add_subcommand("decode", "Decode a .texel bitstream and render it for a device");
   cmd->add_option("input", a->input, "Bitstream (.texel)")->required();
   add_device_options(*cmd, a->device);
-  cmd->add_option("-o,--output", a->output, "Output: .bin (device native), .csv, .npy, .texel.json, .png or .svg")->required();
+  cmd->add_option("-o,--output", a->output, "Output: .bin (device native), .csv, .npy, .mat, .texel.json, .png or .svg")->required();
   cmd->add_flag("--json", a->json, "Print the decoded parameters as JSON");
   cmd->callback([a] {
-    output_kind(a->output);  // reject a bad extension before any work
-    check_writable(a->output);
+    check_render_output(a->output);  // reject a bad extension before any work
     const std::string bytes = read_file(a->input);
     codec::Bitstream b;
     try {

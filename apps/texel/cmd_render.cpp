@@ -98,8 +98,7 @@ void register_render(CLI::App& app) {
   cmd->callback([args] {
     // Reject a bad extension or MAT version before any work.
     const mat::MatVersion mat_version = mat::parse_mat_version(args->mat_version);
-    if (!is_mat_output(args->output)) output_kind(args->output);
-    check_writable(args->output);
+    check_render_output(args->output);
     if (args->texels_csv) {
       if (output_extension(*args->texels_csv) != ".csv")
         throw InvalidArgument("--texels '" + *args->texels_csv + "' must be a .csv file");

@@ -121,7 +121,7 @@ OutputKind output_kind(const std::string& path) {
   if (ext == ".png") return OutputKind::png;
   if (ext == ".svg") return OutputKind::svg;
   throw InvalidArgument("output '" + path + "' has extension '" + ext +
-                        "'; allowed: .bin (device native), .csv, .npy, .texel.json, .png, .svg");
+                        "'; allowed: .bin (device native), .csv, .npy, .mat, .texel.json, .png, .svg");
 }
 
 void commit_files(const std::vector<PendingFile>& files) {

@@ -31,6 +31,11 @@ std::vector<double> texel_frequencies(const Surface& surface) {
 
 bool is_mat_output(const std::string& path) { return output_extension(path) == ".mat"; }
 
+void check_render_output(const std::string& path) {
+  if (!is_mat_output(path)) output_kind(path);
+  check_writable(path);
+}
+
 std::vector<mat::Variable> map_variables(const Document& doc, const Surface& surface, const std::vector<double>& map) {
   using mat::Matrix;
   using mat::Text;

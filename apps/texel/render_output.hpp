@@ -26,6 +26,10 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
 /// written by libmatio, not as bytes).
 bool is_mat_output(const std::string& path);
 
+/// Rejects, before any work, an output path write_rendered() cannot write
+/// (unknown extension) or cannot create. Throws InvalidArgument / IoError.
+void check_render_output(const std::string& path);
+
 /// The variables of a rendered map's .mat file: amplitude, position_mm,
 /// params, texels (when the surface has Texel regions) and document.
 std::vector<mat::Variable> map_variables(const Document& doc, const Surface& surface, const std::vector<double>& map);
