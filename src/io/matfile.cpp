@@ -145,7 +145,8 @@ class Builder {
 
   VarPtr make(const char* name, const Struct& s) const {
     std::vector<const char*> names;
-    for (const auto& [field, value] : s.fields) {
+    for (const auto& entry : s.fields) {  // not a structured binding: clang 14 cannot capture one
+      const std::string& field = entry.first;
       if (!valid_identifier(field))
         throw InvalidArgument("'" + path_ + "': struct '" + where(name) + "' has field name '" + field +
                               "'; MATLAB names are a letter, then letters, digits or '_' (at most 63)");
@@ -156,9 +157,10 @@ class Builder {
     std::size_t dims[2] = {1, 1};
     names.push_back(nullptr);  // matio takes a null-terminated list
     VarPtr var = check(Mat_VarCreateStruct2(name, 2, dims, names.data()), name);
-    for (const auto& [field, value] : s.fields) {
-      VarPtr f = std::visit([&](const auto& v) { return make(field.c_str(), v); }, value);
-      Mat_VarSetStructFieldByName(var.get(), field.c_str(), 0, f.release());  // the struct owns it now
+    for (const auto& entry : s.fields) {  // not a structured binding: clang 14 cannot capture one
+      const char* field = entry.first.c_str();
+      VarPtr f = std::visit([&](const auto& v) { return make(field, v); }, entry.second);
+      Mat_VarSetStructFieldByName(var.get(), field, 0, f.release());  // the struct owns it now
     }
     return var;
   }
