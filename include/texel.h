@@ -101,12 +101,12 @@ typedef enum texel_sample_format {
 } texel_sample_format;
 
 typedef struct texel_device_info {
-  int64_t samples;          /* samples along the active length, >= 1 */
-  double spacing_mm;        /* distance between samples, mm */
-  double length_mm;         /* samples · spacing_mm */
-  double refresh_hz;        /* output update rate while playing */
+  int64_t samples;   /* samples along the active length, >= 1 */
+  double spacing_mm; /* distance between samples, mm */
+  double length_mm;  /* samples · spacing_mm */
+  double refresh_hz; /* output update rate while playing */
   texel_sample_format format;
-  size_t bytes_per_sample;  /* of `format` */
+  size_t bytes_per_sample; /* of `format` */
 } texel_device_info;
 
 /* Looks a device profile up: a built-in name ("tpad", "tpad-tablet",
@@ -124,16 +124,16 @@ typedef enum texel_parameterization {
 /* A fine Texel texture over the whole device (what `texel render` flags
  * give). Start from texel_params_default(); the defaults are the studies'. */
 typedef struct texel_params {
-  double central_pitch_db;               /* dB re 1 cpm, finite [10] */
-  double irregularity_db;                /* dB, finite [-5] */
-  double texel_length_mm;                /* mm, > 0 and <= 1000 [0.25] */
-  uint64_t seed;                         /* the random draw [1] */
+  double central_pitch_db;                 /* dB re 1 cpm, finite [10] */
+  double irregularity_db;                  /* dB, finite [-5] */
+  double texel_length_mm;                  /* mm, > 0 and <= 1000 [0.25] */
+  uint64_t seed;                           /* the random draw [1] */
   texel_parameterization parameterization; /* [MOMENTS] */
-  double quantization_db;                /* frequency quantization step, 0 (off) … 20 dB [0] */
-  double coarse_strength;                /* C, 0 … 1 [0] */
-  double fine_strength;                  /* F, 0 … 1 [1] */
-  double coarse_sine_period_mm;          /* coarse profile: a sinusoid of this period (mm, > 0); 0 = constant [0] */
-  double coarse_sine_phase_deg;          /* its phase, degrees, finite; used when the period is > 0 [0] */
+  double quantization_db;                  /* frequency quantization step, 0 (off) … 20 dB [0] */
+  double coarse_strength;                  /* C, 0 … 1 [0] */
+  double fine_strength;                    /* F, 0 … 1 [1] */
+  double coarse_sine_period_mm;            /* coarse profile: a sinusoid of this period (mm, > 0); 0 = constant [0] */
+  double coarse_sine_phase_deg;            /* its phase, degrees, finite; used when the period is > 0 [0] */
 } texel_params;
 
 texel_params texel_params_default(void);
@@ -173,8 +173,8 @@ texel_status texel_surface_render(const texel_surface* surface, int64_t first, d
 texel_status texel_surface_render_u16(const texel_surface* surface, int64_t first, uint16_t* out, size_t count);
 /* The same window in the device's own format (texel_device_info.format):
  * count · bytes_per_sample bytes, exactly `texel render -o map.bin`. */
-texel_status texel_surface_render_native(const texel_surface* surface, int64_t first, size_t count, void* buffer,
-                                         size_t capacity, size_t* needed);
+texel_status texel_surface_render_native(const texel_surface* surface, int64_t first, size_t count, void* buffer, size_t capacity,
+                                         size_t* needed);
 void texel_surface_destroy(texel_surface* surface);
 
 /* ------------------------------------------------------------------ codec */
@@ -184,8 +184,7 @@ void texel_surface_destroy(texel_surface* surface);
  * Takes from well under a second to a few seconds. */
 texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
 /* The bitstream bytes (a .texel file). */
-texel_status texel_encode_result_bytes(const texel_encode_result* result, uint8_t* buffer, size_t capacity,
-                                       size_t* needed);
+texel_status texel_encode_result_bytes(const texel_encode_result* result, uint8_t* buffer, size_t capacity, size_t* needed);
 /* The parameters the bitstream decodes to. A coarse profile other than a
  * sinusoid is not expressible in texel_params: coarse_sine_period_mm is 0 and
  * *has_coarse_profile (if not NULL) is 1; render such a result through
@@ -209,11 +208,11 @@ typedef enum texel_output_mode {
 } texel_output_mode;
 
 typedef struct texel_player_config {
-  double rate_hz;           /* output rate, 100 … 384000 [48000]; tpad: 8333 */
-  texel_output_mode mode;   /* [AMPLITUDE] */
-  double gain;              /* 0 … 1 [1] */
-  double carrier_hz;        /* carrier mode: 0 … rate/2 [250] */
-  double prediction_s;      /* latency compensation look-ahead, 0 … 0.1 s [0] */
+  double rate_hz;         /* output rate, 100 … 384000 [48000]; tpad: 8333 */
+  texel_output_mode mode; /* [AMPLITUDE] */
+  double gain;            /* 0 … 1 [1] */
+  double carrier_hz;      /* carrier mode: 0 … rate/2 [250] */
+  double prediction_s;    /* latency compensation look-ahead, 0 … 0.1 s [0] */
 } texel_player_config;
 
 texel_player_config texel_player_config_default(void);

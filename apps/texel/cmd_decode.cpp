@@ -25,7 +25,8 @@ void register_decode(CLI::App& app) {
   auto* cmd = app.add_subcommand("decode", "Decode a .texel bitstream and render it for a device");
   cmd->add_option("input", a->input, "Bitstream (.texel)")->required();
   add_device_options(*cmd, a->device);
-  cmd->add_option("-o,--output", a->output, "Output: .bin (device native), .csv, .npy, .mat, .texel.json, .png or .svg")->required();
+  cmd->add_option("-o,--output", a->output, "Output: .bin (device native), .csv, .npy, .mat, .texel.json, .png or .svg")
+      ->required();
   cmd->add_flag("--json", a->json, "Print the decoded parameters as JSON");
   cmd->callback([a] {
     check_render_output(a->output);  // reject a bad extension before any work

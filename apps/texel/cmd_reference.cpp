@@ -123,7 +123,8 @@ void register_reference(CLI::App& app) {
       return;
     }
     if (!a->name) throw InvalidArgument("reference: give a reference NAME (see texel reference --list)");
-    if (!a->output) throw InvalidArgument("reference: give an output file with -o (.bin, .csv, .npy, .mat, .texel.json, .png, .svg)");
+    if (!a->output)
+      throw InvalidArgument("reference: give an output file with -o (.bin, .csv, .npy, .mat, .texel.json, .png, .svg)");
     check_render_output(*a->output);  // reject a bad extension before any work
     ReferenceSpec spec;
     spec.name = *a->name;

@@ -130,7 +130,8 @@ SpectrumView spectrum_view(std::span<const double> samples, double spacing_mm, s
   const double step = std::log(f1 / f0) / static_cast<double>(points);
   std::size_t k = 1;
   for (std::size_t p = 0; p < points && k < s.frequency_cpm.size(); ++p) {
-    const double top = p + 1 == points ? std::numeric_limits<double>::infinity() : f0 * std::exp(step * static_cast<double>(p + 1));
+    const double top =
+        p + 1 == points ? std::numeric_limits<double>::infinity() : f0 * std::exp(step * static_cast<double>(p + 1));
     std::size_t best = k;
     bool any = false;
     for (; k < s.frequency_cpm.size() && s.frequency_cpm[k] < top; ++k) {

@@ -56,10 +56,10 @@ using ojson = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
 namespace ex = texel::experiment;
 
-constexpr std::size_t max_queued_jobs = 64;     // per client, both lanes
-constexpr std::size_t max_nesting = 64;         // JSON depth
+constexpr std::size_t max_queued_jobs = 64;  // per client, both lanes
+constexpr std::size_t max_nesting = 64;      // JSON depth
 constexpr std::size_t max_id_chars = 64;
-constexpr std::size_t max_name_chars = 255;     // file names, participant codes, protocol names
+constexpr std::size_t max_name_chars = 255;          // file names, participant codes, protocol names
 constexpr std::size_t max_trace_samples = 1u << 18;  // finger samples kept per trial for swipe measures
 constexpr double max_abs_mm = 1e6;
 
@@ -83,9 +83,12 @@ std::size_t nesting_depth(std::string_view text, std::size_t limit) {
   bool in_string = false, escaped = false;
   for (const char c : text) {
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
@@ -137,8 +140,8 @@ class Fields {
     const bool fits = v.is_number_unsigned() ? v.get<std::uint64_t>() <= static_cast<std::uint64_t>(hi) : true;
     const std::int64_t i = fits ? v.get<std::int64_t>() : hi;
     if (!fits || i < lo || i > hi)
-      throw Reject{"invalid", type_ + ": " + key + " is " + v.dump() + "; allowed: " + std::to_string(lo) + " … " +
-                                  std::to_string(hi)};
+      throw Reject{"invalid",
+                   type_ + ": " + key + " is " + v.dump() + "; allowed: " + std::to_string(lo) + " … " + std::to_string(hi)};
     return i;
   }
   [[nodiscard]] bool boolean(const char* key, bool fallback) const {
@@ -170,9 +173,7 @@ class Fields {
   std::string type_;
 };
 
-ojson spectrum_json(const SpectrumView& s) {
-  return ojson{{"frequency_cpm", s.frequency_cpm}, {"magnitude_db", s.magnitude_db}};
-}
+ojson spectrum_json(const SpectrumView& s) { return ojson{{"frequency_cpm", s.frequency_cpm}, {"magnitude_db", s.magnitude_db}}; }
 
 std::string hex(std::span<const std::uint8_t> bytes) {
   static constexpr char digits[] = "0123456789abcdef";
@@ -423,13 +424,22 @@ struct Service::Impl {
     } else if (type == "feel.state") {
       feel_state(*c, msg, id);
     } else if (type == "design" || type == "feel.select") {
-      if (type == "design") (void)Fields(msg, type, {"document", "region", "bins"});
-      else (void)Fields(msg, type, {"document"});
+      if (type == "design")
+        (void)Fields(msg, type, {"document", "region", "bins"});
+      else
+        (void)Fields(msg, type, {"document"});
       enqueue_design_lane(c, Job{type, std::move(msg), id, Clock::now()});
     } else if (type == "match" || type == "import" || type == "export" || type.rfind("experiment.", 0) == 0) {
-      static const std::vector<std::string> fifo_types = {
-          "match", "import", "export", "experiment.list", "experiment.start", "experiment.current", "experiment.select",
-          "experiment.preview", "experiment.answer", "experiment.stop"};
+      static const std::vector<std::string> fifo_types = {"match",
+                                                          "import",
+                                                          "export",
+                                                          "experiment.list",
+                                                          "experiment.start",
+                                                          "experiment.current",
+                                                          "experiment.select",
+                                                          "experiment.preview",
+                                                          "experiment.answer",
+                                                          "experiment.stop"};
       if (std::find(fifo_types.begin(), fifo_types.end(), type) == fifo_types.end()) unknown_type(type);
       enqueue_fifo(c, Job{type, std::move(msg), id, Clock::now()});
     } else {
@@ -540,7 +550,9 @@ struct Service::Impl {
     }
     if (device && j.contains("device_grid") && j["device_grid"].is_object()) {
       const json& g = j["device_grid"];
-      auto opt = [&](const char* k) { return g.contains(k) && g[k].is_number() ? std::optional(g[k].get<double>()) : std::nullopt; };
+      auto opt = [&](const char* k) {
+        return g.contains(k) && g[k].is_number() ? std::optional(g[k].get<double>()) : std::nullopt;
+      };
       device = with_grid(*device, opt("length_mm"), opt("spacing_mm"));
     }
     if (device) check_cost(j, *device, where);
@@ -550,8 +562,8 @@ struct Service::Impl {
   void check_cost(const json& j, const DeviceProfile& device, const std::string& where) const {
     const auto cap = options.max_map_samples;
     if (static_cast<double>(device.samples) > static_cast<double>(cap))
-      throw Reject{"too_large", where + ".device has " + std::to_string(device.samples) + " samples; allowed: at most " +
-                                    std::to_string(cap)};
+      throw Reject{"too_large",
+                   where + ".device has " + std::to_string(device.samples) + " samples; allowed: at most " + std::to_string(cap)};
     std::vector<const json*> textures;
     if (j.contains("texture")) textures.push_back(&j["texture"]);
     if (j.contains("regions") && j["regions"].is_array())
@@ -561,9 +573,9 @@ struct Service::Impl {
       if (!t->is_object() || !t->contains("texel_length_mm") || !(*t)["texel_length_mm"].is_number()) continue;
       const double length = (*t)["texel_length_mm"].get<double>();
       if (length > 0 && device.length_mm() / length > static_cast<double>(cap))
-        throw Reject{"too_large", where + ": texel_length_mm " + json(length).dump() + " makes more than " +
-                                      std::to_string(cap) + " texels; allowed: at least " +
-                                      json(device.length_mm() / static_cast<double>(cap)).dump() + " mm on this device"};
+        throw Reject{"too_large", where + ": texel_length_mm " + json(length).dump() + " makes more than " + std::to_string(cap) +
+                                      " texels; allowed: at least " + json(device.length_mm() / static_cast<double>(cap)).dump() +
+                                      " mm on this device"};
     }
   }
 
@@ -584,8 +596,8 @@ struct Service::Impl {
     ojson r = reply("design", job.id);
     r["grid"] = {{"origin_mm", v.grid.origin_mm}, {"spacing_mm", v.grid.spacing_mm}, {"count", v.grid.count}};
     static_assert(std::endian::native == std::endian::little, "map_f32 is little-endian float32");
-    r["map_f32"] = detail::base64_encode(
-        std::span(reinterpret_cast<const unsigned char*>(v.map.data()), v.map.size() * sizeof(float)));
+    r["map_f32"] =
+        detail::base64_encode(std::span(reinterpret_cast<const unsigned char*>(v.map.data()), v.map.size() * sizeof(float)));
     r["regions"] = ojson::array();
     for (const auto& g : v.regions)
       r["regions"].push_back({{"name", g.name}, {"kind", g.kind}, {"start_mm", g.start_mm}, {"length_mm", g.length_mm}});
@@ -611,16 +623,26 @@ struct Service::Impl {
 
   void run_fifo_job(Client& c, const Job& job) {
     const std::string& t = job.type;
-    if (t == "match") match(c, job);
-    else if (t == "import") import(c, job);
-    else if (t == "export") export_(c, job);
-    else if (t == "experiment.list") experiment_list(c, job);
-    else if (t == "experiment.start") experiment_start(c, job);
-    else if (t == "experiment.current") experiment_current(c, job);
-    else if (t == "experiment.select") experiment_select(c, job);
-    else if (t == "experiment.preview") experiment_preview(c, job);
-    else if (t == "experiment.answer") experiment_answer(c, job);
-    else experiment_stop(c, job);
+    if (t == "match")
+      match(c, job);
+    else if (t == "import")
+      import(c, job);
+    else if (t == "export")
+      export_(c, job);
+    else if (t == "experiment.list")
+      experiment_list(c, job);
+    else if (t == "experiment.start")
+      experiment_start(c, job);
+    else if (t == "experiment.current")
+      experiment_current(c, job);
+    else if (t == "experiment.select")
+      experiment_select(c, job);
+    else if (t == "experiment.preview")
+      experiment_preview(c, job);
+    else if (t == "experiment.answer")
+      experiment_answer(c, job);
+    else
+      experiment_stop(c, job);
   }
 
   void match(Client& c, const Job& job) {
@@ -779,7 +801,10 @@ struct Service::Impl {
 
   ojson session_json() const {
     const ex::SessionInfo& i = active->info;
-    return ojson{{"id", i.id}, {"participant", i.participant}, {"protocol", i.protocol}, {"study", i.study},
+    return ojson{{"id", i.id},
+                 {"participant", i.participant},
+                 {"protocol", i.protocol},
+                 {"study", i.study},
                  {"simulated", !active->simulate.empty()}};
   }
 

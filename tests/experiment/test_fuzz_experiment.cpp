@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "../support/json_mutation.hpp"
 #include "texel/io.hpp"
 #include "texel/random.hpp"
-#include "../support/json_mutation.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 

@@ -131,9 +131,9 @@ TEST(Session, ResponseEventsFromAFrontEndAreKeptWithTheTrial) {
   const ex::StoredTrial t = s.answer(r);
   ASSERT_EQ(t.events.size(), 3u);
   EXPECT_EQ(t.events[2].kind, "answer");
-  for (const char* bad : {R"({"events":{}})", R"({"events":[1]})", R"({"events":[{"kind":"show","t_s":-1}]})",
-                          R"({"events":[{"t_s":0}]})", R"({"events":[{"t_s":0,"kind":"show","extra":1}]})",
-                          R"({"events":[{"t_s":0,"kind":7}]})"})
+  for (const char* bad :
+       {R"({"events":{}})", R"({"events":[1]})", R"({"events":[{"kind":"show","t_s":-1}]})", R"({"events":[{"t_s":0}]})",
+        R"({"events":[{"t_s":0,"kind":"show","extra":1}]})", R"({"events":[{"t_s":0,"kind":7}]})"})
     EXPECT_THROW((void)ex::Response::from_json(nlohmann::json::parse(bad)), texel::FormatError) << bad;
 }
 

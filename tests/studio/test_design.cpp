@@ -135,7 +135,8 @@ TEST(ImportExport, DocumentAndBitstreamRoundTrip) {
   const Document doc = two_regions();
   const ExportFile json = export_file(doc, ExportFormat::document);
   EXPECT_EQ(json.name, "texture.texel.json");
-  const ImportResult back = import_file(json.name, std::span(reinterpret_cast<const std::uint8_t*>(json.data.data()), json.data.size()), {});
+  const ImportResult back =
+      import_file(json.name, std::span(reinterpret_cast<const std::uint8_t*>(json.data.data()), json.data.size()), {});
   EXPECT_EQ(back.kind, ImportKind::document);
   EXPECT_EQ(document_json(back.document), document_json(doc));
 
@@ -158,7 +159,8 @@ TEST(ImportExport, DeviceFilesAndSignalsGoThroughTheCodec) {
   const ExportFile csv = export_file(doc, ExportFormat::csv);
   EXPECT_EQ(parse_csv_columns(csv.data, "csv").second.size(), map.size());
   for (const ExportFile* f : {&bin, &npy}) {
-    const ImportResult r = import_file(f->name, std::span(reinterpret_cast<const std::uint8_t*>(f->data.data()), f->data.size()), {});
+    const ImportResult r =
+        import_file(f->name, std::span(reinterpret_cast<const std::uint8_t*>(f->data.data()), f->data.size()), {});
     EXPECT_EQ(r.kind, ImportKind::signal);
     ASSERT_TRUE(r.encoded);
     EXPECT_NEAR(r.encoded->spec.central_pitch.value(), 10.0, 0.5) << f->name;

@@ -29,12 +29,12 @@
 namespace texel::studio {
 
 struct ServiceOptions {
-  std::string db_path = "texel-studio.db";  ///< experiment store (created on first use)
-  std::string backend = "null";             ///< "null", "audio" or "serial:PATH"
-  std::string audio_device;                 ///< PortAudio device for "audio" (index or name substring)
-  std::string protocols_dir;                ///< shipped protocols offered in the experimenter view ("" = none)
+  std::string db_path = "texel-studio.db";   ///< experiment store (created on first use)
+  std::string backend = "null";              ///< "null", "audio" or "serial:PATH"
+  std::string audio_device;                  ///< PortAudio device for "audio" (index or name substring)
+  std::string protocols_dir;                 ///< shipped protocols offered in the experimenter view ("" = none)
   std::size_t max_message_bytes = 4u << 20;  ///< larger messages are refused
-  double max_messages_per_s = 2000.0;       ///< per client, token bucket (burst = one second's worth)
+  double max_messages_per_s = 2000.0;        ///< per client, token bucket (burst = one second's worth)
   /// Largest device map (samples) and texel count a client's document may
   /// ask to render; tpad is 19,200 samples. Bounds memory and time per message.
   std::size_t max_map_samples = std::size_t{1} << 21;
