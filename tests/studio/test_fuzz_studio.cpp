@@ -11,16 +11,14 @@
 #include <thread>
 #include <vector>
 
-#include "texel/random.hpp"
 #include "../support/json_mutation.hpp"
+#include "texel/random.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
 namespace {
 
-void feed(const std::string& text) {
-  LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
-}
+void feed(const std::string& text) { LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()); }
 
 const std::string doc =
     R"({"format":"texel-document","version":2,"device":"tpad","regions":[{"start_mm":0,"length_mm":50.88,"texture":{"kind":"reference","name":"4sin","seed":1}},{"start_mm":50.88,"texture":{"kind":"texel","central_pitch_db":8,"irregularity_db":-3,"texel_length_mm":0.25,"seed":1,"coarse":{"kind":"sine","period_mm":5,"phase_deg":0},"coarse_strength":0.5}}]})";

@@ -109,10 +109,12 @@ ServiceOptions options(const std::string& db) {
 }
 
 json tpad_document(double pitch_db = 10.0) {
-  return json{{"format", "texel-document"},
-              {"version", 1},
-              {"device", "tpad"},
-              {"texture", {{"kind", "texel"}, {"central_pitch_db", pitch_db}, {"irregularity_db", -5}, {"texel_length_mm", 0.25}, {"seed", 1}}}};
+  return json{
+      {"format", "texel-document"},
+      {"version", 1},
+      {"device", "tpad"},
+      {"texture",
+       {{"kind", "texel"}, {"central_pitch_db", pitch_db}, {"irregularity_db", -5}, {"texel_length_mm", 0.25}, {"seed", 1}}}};
 }
 
 void expect_error(const json& r, const std::string& code) {
@@ -242,9 +244,10 @@ TEST(Service, DesignRepliesWithTheLibrarysNumbers) {
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
-  std::printf("design message round trip (tpad, parse + render + analyse + serialize + parse reply): median %.2f ms, p95 %.2f ms, "
-              "reply %zu bytes\n",
-              ms[ms.size() / 2], ms[ms.size() * 95 / 100], r.dump().size());
+  std::printf(
+      "design message round trip (tpad, parse + render + analyse + serialize + parse reply): median %.2f ms, p95 %.2f ms, "
+      "reply %zu bytes\n",
+      ms[ms.size() / 2], ms[ms.size() * 95 / 100], r.dump().size());
   r = c.ask({{"type", "design"}, {"document", doc}});
   ASSERT_EQ(r["type"], "design") << r.dump();
   EXPECT_EQ(r["grid"]["count"], 19200);
@@ -366,7 +369,7 @@ TEST(Service, QueuesAreBoundedAndDisconnectDropsQueuedWork) {
   s.disconnect(c.id);
   const std::size_t after = c.inbox.count();
   std::this_thread::sleep_for(1500ms);
-  EXPECT_EQ(c.inbox.count(), after);  // nothing after disconnect returned
+  EXPECT_EQ(c.inbox.count(), after);      // nothing after disconnect returned
   s.handle(c.id, R"({"type":"hello"})");  // a gone client is ignored
   EXPECT_EQ(c.inbox.count(), after);
   // Another client is served promptly: the dropped matches are gone.
@@ -455,8 +458,8 @@ TEST(Service, SimulatedSessionRunsToTheEnd) {
   texel::test_support::TempDir dir("studio");
   Service s(options(dir.at("db")));
   Client c(s);
-  const json started = c.ask(
-      {{"type", "experiment.start"}, {"protocol", "guided-exploration"}, {"participant", "SIM1"}, {"simulate", "default"}});
+  const json started =
+      c.ask({{"type", "experiment.start"}, {"protocol", "guided-exploration"}, {"participant", "SIM1"}, {"simulate", "default"}});
   ASSERT_EQ(started["type"], "experiment.started") << started.dump();
   json q = c.ask({{"type", "experiment.current"}});
   int answered = 0;
