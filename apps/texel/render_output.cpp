@@ -109,23 +109,30 @@ std::vector<mat::Variable> map_variables(const Document& doc, const Surface& sur
   return vars;
 }
 
+namespace {
+// The main file `path` was already written atomically by its own writer
+// (matio, Cairo): commit the extra files, and take the main one back if that
+// fails, so a failed command leaves no partial output.
+void commit_extras_after(const std::string& path, const std::vector<PendingFile>& extra) {
+  try {
+    commit_files(extra);
+  } catch (...) {
+    std::remove(path.c_str());
+    throw;
+  }
+}
+}  // namespace
+
 void write_rendered(const std::string& path, const Document& doc, const Surface& surface, const std::vector<double>& map,
                     const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra, mat::MatVersion mat_version) {
+  check_render_output(path);
+  for (const auto& f : extra) check_writable(f.path);
   if (is_mat_output(path)) {
-    check_writable(path);
-    for (const auto& f : extra) check_writable(f.path);
     mat::write_mat(path, map_variables(doc, surface, map), {.version = mat_version});  // atomic on its own
-    try {
-      commit_files(extra);
-    } catch (...) {
-      std::remove(path.c_str());
-      throw;
-    }
+    commit_extras_after(path, extra);
     return;
   }
   const OutputKind kind = output_kind(path);
-  check_writable(path);
-  for (const auto& f : extra) check_writable(f.path);
   const Grid& g = surface.grid();
   PendingFile main{path, {}};
   switch (kind) {
@@ -155,12 +162,7 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
       plot.frequencies_cpm = frequencies_cpm;
       plot.excerpt_mm = std::min(6.0, g.length_mm());
       plot_map(plot, path);  // atomic on its own
-      try {
-        commit_files(extra);
-      } catch (...) {
-        std::remove(path.c_str());
-        throw;
-      }
+      commit_extras_after(path, extra);
       return;
     }
   }
