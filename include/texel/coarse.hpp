@@ -34,7 +34,7 @@ struct PointsProfile {
 };
 /// A signal sampled every `spacing` from position 0 (linear interpolation).
 struct SampledProfile {
-  double spacing_mm = 0.0;
+  Millimetres spacing{0.0};
   std::vector<double> values;
 };
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "texel/grid.hpp"
+#include "texel/units.hpp"
 
 namespace texel {
 
@@ -30,26 +31,26 @@ std::size_t bytes_per_sample(SampleFormat f);
 /// A region of the default layout (e.g. the studies' left/right halves).
 struct RegionLayout {
   std::string name;
-  double start_mm = 0.0;
-  double length_mm = 0.0;
+  Millimetres start{0.0};
+  Millimetres length{0.0};
 };
 
 struct DeviceProfile {
   std::string name;  ///< e.g. "tpad"
   std::string description;
   std::int64_t samples = 0;  ///< samples along the active length, >= 1
-  double spacing_mm = 0.0;   ///< Δx, > 0
+  Millimetres spacing{0.0};  ///< Δx, > 0
   SampleFormat format = SampleFormat::u16le;
-  double refresh_hz = 0.0;           ///< output update rate while playing, > 0
-  double band_min_cpm = 0.01;        ///< lowest renderable frequency
-  double band_max_cpm = 0.0;         ///< 0 = Nyquist of the grid
+  Hertz refresh{0.0};                ///< output update rate while playing, > 0
+  CyclesPerMm band_min{0.01};        ///< lowest renderable frequency
+  CyclesPerMm band_max{0.0};         ///< 0 = Nyquist of the grid
   std::vector<RegionLayout> layout;  ///< named regions; empty = whole surface
 
-  [[nodiscard]] Grid grid() const { return Grid{0.0, spacing_mm, samples}; }
-  [[nodiscard]] double length_mm() const { return static_cast<double>(samples) * spacing_mm; }
-  [[nodiscard]] double nyquist_cpm() const { return 0.5 / spacing_mm; }
-  /// The upper band edge in force: band_max_cpm, or the Nyquist frequency.
-  [[nodiscard]] double band_top_cpm() const { return band_max_cpm > 0 ? band_max_cpm : nyquist_cpm(); }
+  [[nodiscard]] Grid grid() const { return Grid{Millimetres(0.0), spacing, samples}; }
+  [[nodiscard]] Millimetres length() const { return Millimetres(static_cast<double>(samples) * spacing.value()); }
+  [[nodiscard]] CyclesPerMm nyquist() const { return CyclesPerMm(0.5 / spacing.value()); }
+  /// The upper band edge in force: band_max, or the Nyquist frequency.
+  [[nodiscard]] CyclesPerMm band_top() const { return band_max.value() > 0 ? band_max : nyquist(); }
   [[nodiscard]] std::size_t native_bytes() const { return static_cast<std::size_t>(samples) * bytes_per_sample(format); }
 };
 
@@ -71,7 +72,7 @@ std::vector<std::string> builtin_device_names();
 /// Overrides the active length and/or sample spacing (CLI --length/--spacing).
 /// The sample count becomes round(length / spacing); a layout that no longer
 /// fits is dropped. Throws InvalidArgument for non-positive or non-finite values.
-DeviceProfile with_grid(DeviceProfile profile, std::optional<double> length_mm, std::optional<double> spacing_mm);
+DeviceProfile with_grid(DeviceProfile profile, std::optional<Millimetres> length, std::optional<Millimetres> spacing);
 
 /// Encodes amplitudes (clamped to [0, 1]) into device-native bytes.
 void encode_samples(SampleFormat format, std::span<const double> amplitudes, std::span<std::byte> out);

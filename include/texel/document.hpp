@@ -26,9 +26,9 @@ namespace texel {
 /// coarse profile may also be a reference (the coarse-study test texture).
 struct RegionSpec {
   std::string name;  ///< optional label, e.g. "left"
-  double start_mm = 0.0;
-  std::optional<double> length_mm;  ///< none = to the end of the device
-  TexelSpec texel;                  ///< used when `reference` is empty
+  Millimetres start{0.0};             ///< left edge on the device (JSON start_mm)
+  std::optional<Millimetres> length;  ///< none = to the end of the device (JSON length_mm)
+  TexelSpec texel;                    ///< used when `reference` is empty
   /// Set: the region holds this reference instead of a Texel rendering.
   std::optional<ReferenceSpec> reference;
   /// Set (Texel regions only): the coarse profile is this reference, prepared

@@ -1,22 +1,26 @@
 // A uniform sampling grid along the swipe axis: sample i sits at
-// origin + i·spacing (mm). Devices, surfaces and textures all speak in grids,
-// and the position of a sample depends only on its global index, so any
-// window of a grid renders to the same values as the whole.
+// origin + i·spacing. Devices, surfaces and textures all speak in grids, and
+// the position of a sample depends only on its global index, so any window of
+// a grid renders to the same values as the whole.
 #pragma once
 
 #include <cstdint>
 
+#include "texel/units.hpp"
+
 namespace texel {
 
 struct Grid {
-  double origin_mm = 0.0;   ///< position of sample 0 (mm)
-  double spacing_mm = 0.0;  ///< distance between samples (mm), > 0
-  std::int64_t count = 0;   ///< number of samples
+  Millimetres origin{0.0};   ///< position of sample 0
+  Millimetres spacing{0.0};  ///< distance between samples, > 0
+  std::int64_t count = 0;    ///< number of samples
 
-  [[nodiscard]] constexpr double position(std::int64_t i) const { return origin_mm + static_cast<double>(i) * spacing_mm; }
-  [[nodiscard]] constexpr double length_mm() const { return static_cast<double>(count) * spacing_mm; }
-  /// Spatial Nyquist frequency 1/(2·Δx) in cycles/mm: the highest renderable frequency.
-  [[nodiscard]] constexpr double nyquist_cpm() const { return 0.5 / spacing_mm; }
+  [[nodiscard]] constexpr Millimetres position(std::int64_t i) const {
+    return Millimetres(origin.value() + static_cast<double>(i) * spacing.value());
+  }
+  [[nodiscard]] constexpr Millimetres length() const { return Millimetres(static_cast<double>(count) * spacing.value()); }
+  /// Spatial Nyquist frequency 1/(2·Δx): the highest renderable frequency.
+  [[nodiscard]] constexpr CyclesPerMm nyquist() const { return CyclesPerMm(0.5 / spacing.value()); }
 };
 
 }  // namespace texel

@@ -113,15 +113,15 @@ std::string format_reference_value(const ReferenceValue& value);
 
 /// One sinusoidal component of a signal-defined reference (before scaling).
 struct ReferenceComponent {
-  double frequency_cpm;  ///< > 0, below the grid's Nyquist frequency
-  double amplitude;      ///< >= 0
-  double phase_cycles;   ///< in [0, 1)
+  CyclesPerMm frequency;  ///< > 0, below the grid's Nyquist frequency
+  double amplitude;       ///< >= 0
+  double phase_cycles;    ///< in [0, 1)
 };
 
 /// One interval of an amplitude-defined reference (a patch or a pulse).
 struct ReferenceFeature {
-  double start_mm;
-  double length_mm;
+  Millimetres start;
+  Millimetres length;
 };
 
 /// A reference prepared for a grid: an immutable Texture.
@@ -133,7 +133,7 @@ class ReferenceTexture final : public Texture {
   /// fixed from the grid's samples. Rendering on another grid evaluates the
   /// same function of x with the same scale (values clamped to [0, 1]).
   /// Validates; throws InvalidArgument. Allocates.
-  ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Grid& grid);
+  ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling);
 
   [[nodiscard]] Millimetres length() const override { return length_; }
   void render(const Grid& grid, std::int64_t first, std::span<double> out) const override;
@@ -144,12 +144,12 @@ class ReferenceTexture final : public Texture {
   [[nodiscard]] const std::vector<ReferenceComponent>& components() const { return components_; }
   /// Patches or pulses (amplitude-defined references); empty otherwise.
   [[nodiscard]] const std::vector<ReferenceFeature>& features() const { return features_; }
-  /// The gaps between consecutive features (mm), in spatial order.
-  [[nodiscard]] std::vector<double> gaps_mm() const;
+  /// The gaps between consecutive features, in spatial order.
+  [[nodiscard]] std::vector<Millimetres> gaps() const;
   /// max|y| over the prepared grid's samples (1 for amplitude-defined references).
   [[nodiscard]] double peak() const { return peak_; }
   /// Slow, obviously-correct single-sample evaluation (tests).
-  [[nodiscard]] double amplitude_at(double x_mm) const;
+  [[nodiscard]] double amplitude_at(Millimetres x) const;
 
  private:
   enum class Shape { sum, patch, pulse };
@@ -174,7 +174,10 @@ class ReferenceTexture final : public Texture {
 std::vector<double> render_reference(const ReferenceSpec& spec, const Grid& grid);
 
 /// A reference as a coarse profile (references.md, coarse-feature study):
-/// the reference prepared over `length` and sampled every `spacing_mm`.
-SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, double spacing_mm);
+/// the reference prepared over `length` and sampled every `spacing`.
+SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, Millimetres spacing);
+
+/// The one way to prepare a texture of any kind (see texel/texture.hpp).
+std::shared_ptr<const Texture> prepare(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling);
 
 }  // namespace texel

@@ -18,8 +18,8 @@ namespace texel {
 
 struct Region {
   std::string name;
-  double start_mm = 0.0;   ///< left edge on the device (mm)
-  double length_mm = 0.0;  ///< > 0
+  Millimetres start{0.0};   ///< left edge on the device
+  Millimetres length{0.0};  ///< > 0
   std::shared_ptr<const Texture> texture;
 };
 

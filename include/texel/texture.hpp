@@ -40,6 +40,23 @@ class Texture {
   virtual void render(const Grid& grid, std::int64_t first, std::span<double> out) const = 0;
   /// Short human-readable description, e.g. "texel P=10 dB I=-5 dB L=0.25 mm".
   [[nodiscard]] virtual std::string describe() const = 0;
+  /// The amplitude at one position `x` (the texture's own coordinates):
+  /// exactly the value render() gives a grid sample that sits at `x`.
+  [[nodiscard]] double sample(Millimetres x) const;
+};
+
+/// What a texture is prepared for, the same for every kind of texture: the
+/// grid it will be sampled on (in the texture's own coordinates, 0 mm at its
+/// left edge; origin and spacing matter, not the count) and the top of the
+/// renderable band (0 = the grid's Nyquist frequency). Texel textures bound
+/// their pitch distribution by `band_top` when their spec leaves band_max at
+/// 0; references are defined up to the grid's Nyquist frequency
+/// (references.md) and take their amplitude scale from the grid's samples.
+struct Sampling {
+  Grid grid;
+  CyclesPerMm band_top{0.0};
+  /// band_top, or the grid's Nyquist frequency when it is 0.
+  [[nodiscard]] CyclesPerMm top() const { return band_top.value() > 0.0 ? band_top : grid.nyquist(); }
 };
 
 enum class PhaseMode { continuous, reset };
@@ -73,17 +90,18 @@ void validate(const TexelSpec& spec);
 
 /// One texel of a prepared texture.
 struct Texel {
-  double start_mm;       ///< left edge, k·L
-  double frequency_cpm;  ///< f_k after truncation and quantization
-  double phase_cycles;   ///< oscillation phase at start_mm, in cycles [0, 1)
-  double envelope;       ///< e_k = 1 − C·(1 − c_k)
+  Millimetres start;      ///< left edge, k·L
+  CyclesPerMm frequency;  ///< f_k after truncation and quantization
+  double phase_cycles;    ///< oscillation phase at `start`, in cycles [0, 1)
+  double envelope;        ///< e_k = 1 − C·(1 − c_k)
 };
 
 class TexelTexture final : public Texture {
  public:
-  /// Prepares `spec` over `length`. `nyquist` is the rendering grid's Nyquist
-  /// frequency, used as band_max when spec.band_max is 0. Allocates.
-  TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerMm nyquist);
+  /// Prepares `spec` over [0, length) for `sampling` (its band top bounds the
+  /// pitch distribution when spec.band_max is 0). Validates; throws
+  /// InvalidArgument. Allocates.
+  TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling);
 
   [[nodiscard]] Millimetres length() const override { return length_; }
   void render(const Grid& grid, std::int64_t first, std::span<double> out) const override;
@@ -93,12 +111,13 @@ class TexelTexture final : public Texture {
   [[nodiscard]] const std::vector<Texel>& texels() const { return texels_; }
   [[nodiscard]] const PitchDistribution& distribution() const { return distribution_; }
   /// End of the textured span: texel count · L, or the length with a partial final texel.
-  [[nodiscard]] double textured_end_mm() const { return end_mm_; }
+  [[nodiscard]] Millimetres textured_end() const { return Millimetres(end_mm_); }
 
-  /// Index of the texel containing position x (mm), or -1 if none.
-  [[nodiscard]] std::int64_t texel_at(double x_mm) const;
-  /// Slow, obviously-correct single-sample evaluation (for tests and players).
-  [[nodiscard]] double amplitude_at(double x_mm) const;
+  /// Index of the texel containing position x, or -1 if none.
+  [[nodiscard]] std::int64_t texel_at(Millimetres x) const;
+  /// Slow, obviously-correct single-sample evaluation (tests); sample(x) is
+  /// the renderer's own value.
+  [[nodiscard]] double amplitude_at(Millimetres x) const;
 
   /// Positions within this distance below a texel boundary count as on it, so
   /// that k·L computed in floating point lands in texel k (1 picometre).
@@ -116,5 +135,9 @@ class TexelTexture final : public Texture {
 
 /// Number of texels a span of `length` holds under `fill`.
 std::size_t texel_count(Millimetres length, Millimetres texel_length, Fill fill);
+
+/// The one way to prepare a texture of any kind (ReferenceSpec's overload is
+/// in texel/reference.hpp): `spec` over [0, length) for `sampling`.
+std::shared_ptr<const Texture> prepare(const TexelSpec& spec, Millimetres length, const Sampling& sampling);
 
 }  // namespace texel

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <compare>
+#include <optional>
 
 namespace texel {
 
@@ -66,6 +67,11 @@ Decibels to_db(CyclesPerMm f);
 constexpr Hertz temporal(CyclesPerMm f, MmPerSecond v) { return Hertz(f.value() * v.value()); }
 /// Spatial position reached after time t at speed v.
 constexpr Millimetres travelled(MmPerSecond v, Seconds t) { return Millimetres(v.value() * t.value()); }
+
+/// An optional plain number as an optional quantity (for parsed, optional fields).
+inline std::optional<Millimetres> millimetres(std::optional<double> v) {
+  return v ? std::optional<Millimetres>(Millimetres(*v)) : std::nullopt;
+}
 
 namespace literals {
 constexpr Millimetres operator""_mm(long double v) { return Millimetres(static_cast<double>(v)); }

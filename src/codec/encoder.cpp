@@ -803,7 +803,7 @@ double distance(const Percept& a, const Percept& b, const PerceptualModel& model
 
 EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   const auto t0 = std::chrono::steady_clock::now();
-  const double dx = signal.spacing_mm;
+  const double dx = signal.spacing.value();
   const std::size_t n = signal.amplitude.size();
   if (!(std::isfinite(dx) && dx > 0.0)) throw InvalidArgument("signal spacing is " + num(dx) + " mm; it must be > 0");
   if (!(cfg.boundary.value() > 0.0 && std::isfinite(cfg.boundary.value())))
@@ -825,7 +825,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
 
   EncodeResult res;
   res.samples = n;
-  res.spacing_mm = dx;
+  res.spacing = Millimetres(dx);
   // The band the decoded texture draws from: the analysed grid's Nyquist
   // frequency, rounded down to the stream's 0.01 dB steps (device independent).
   Bitstream b;

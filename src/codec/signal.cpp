@@ -72,7 +72,7 @@ Signal load_wav(const std::string& path, const LoadOptions& o) {
   normalize_full_range(y, path);
   Signal sig;
   sig.amplitude = std::move(y);
-  sig.spacing_mm = v.value() / info.samplerate;
+  sig.spacing = Millimetres(v.value() / info.samplerate);
   sig.description = "audio " + std::to_string(info.samplerate) + " Hz at " + num(v.value()) + " mm/s";
   return sig;
 }
@@ -88,25 +88,25 @@ Signal load_csv(const std::string& path, const LoadOptions& o) {
     const MmPerSecond v = need_speed(o, path);
     const double dt = uniform_step(x, path, "time");
     normalize_full_range(y, path);
-    sig.spacing_mm = v.value() * dt;
+    sig.spacing = Millimetres(v.value() * dt);
     sig.description = "time/value CSV at " + num(v.value()) + " mm/s";
   } else {
-    sig.spacing_mm = uniform_step(x, path, "position");
+    sig.spacing = Millimetres(uniform_step(x, path, "position"));
     sig.description = "position/amplitude CSV";
   }
   sig.amplitude = std::move(y);
   return sig;
 }
 
-double device_spacing(const LoadOptions& o, const DeviceProfile& d) { return o.spacing_mm ? *o.spacing_mm : d.spacing_mm; }
+double device_spacing(const LoadOptions& o, const DeviceProfile& d) { return o.spacing.value() ? *o.spacing.value() : d.spacing.value(); }
 
 }  // namespace
 
 Signal load_signal(const std::string& path, const LoadOptions& o) {
   const std::string ext = output_extension(path);
   const DeviceProfile device = o.device ? *o.device : load_device("tpad");
-  if (o.spacing_mm && !(std::isfinite(*o.spacing_mm) && *o.spacing_mm > 0))
-    throw InvalidArgument("--spacing is " + num(*o.spacing_mm) + "; it must be a finite number of mm > 0");
+  if (o.spacing.value() && !(std::isfinite(*o.spacing.value()) && *o.spacing.value() > 0))
+    throw InvalidArgument("--spacing is " + num(*o.spacing.value()) + "; it must be a finite number of mm > 0");
   Signal sig;
   if (ext == ".bin") {
     const std::string bytes = read_file(path);
@@ -116,20 +116,20 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
                         std::string(to_string(device.format)) + " samples of device '" + device.name +
                         "' (choose it with --device)");
     sig.amplitude = decode_samples(device.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
-    sig.spacing_mm = device_spacing(o, device);
+    sig.spacing = Millimetres(device_spacing(o, device));
     sig.description = "device map (" + device.name + ", " + std::string(to_string(device.format)) + ")";
   } else if (ext == ".npy") {
     sig.amplitude = parse_npy(read_file(path), path);
-    sig.spacing_mm = device_spacing(o, device);
-    sig.description = ".npy at " + num(sig.spacing_mm) + " mm";
+    sig.spacing = Millimetres(device_spacing(o, device));
+    sig.description = ".npy at " + num(sig.spacing.value()) + " mm";
   } else if (ext == ".mat") {
     // The map variable and its grid (docs/format.md "MATLAB .mat"); an
     // explicit spacing wins over the file's, the file's over the device's.
     mat::MapData m = mat::read_map(path);
     sig.amplitude = std::move(m.amplitude);
-    sig.spacing_mm = o.spacing_mm ? *o.spacing_mm : m.spacing_mm ? *m.spacing_mm : device.spacing_mm;
-    sig.description = ".mat '" + m.variable + "' at " + num(sig.spacing_mm) + " mm" +
-                      (o.spacing_mm || m.spacing_mm ? "" : " (device " + device.name + ")");
+    sig.spacing = Millimetres(o.spacing.value() ? *o.spacing.value() : m.spacing.value() ? *m.spacing.value() : device.spacing.value());
+    sig.description = ".mat '" + m.variable + "' at " + num(sig.spacing.value()) + " mm" +
+                      (o.spacing.value() || m.spacing.value() ? "" : " (device " + device.name + ")");
   } else if (ext == ".csv") {
     sig = load_csv(path, o);
   } else if (ext == ".wav") {
@@ -137,13 +137,13 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
   } else if (ext == ".texel.json") {
     const Document doc = load_document(path);
     sig.amplitude = prepare_surface(doc).render();
-    sig.spacing_mm = doc.device.spacing_mm;
+    sig.spacing = Millimetres(doc.device.spacing.value());
     sig.description = "document on " + doc.device.name;
   } else if (ext == ".texel") {
     const std::string bytes = read_file(path);
     const Bitstream b = parse_bitstream(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()));
     sig.amplitude = prepare_surface(decode_document(b, device)).render();
-    sig.spacing_mm = device.spacing_mm;
+    sig.spacing = Millimetres(device.spacing.value());
     sig.description = "bitstream decoded on " + device.name;
   } else {
     throw InvalidArgument("input '" + path + "' has extension '" + ext +

@@ -33,7 +33,7 @@ double interpolate_points(const std::vector<std::pair<double, double>>& pts, dou
 }
 
 double interpolate_sampled(const SampledProfile& p, double x) {
-  const double pos = x / p.spacing_mm;
+  const double pos = x / p.spacing.value();
   if (pos <= 0.0) return p.values.front();
   const double last = static_cast<double>(p.values.size() - 1);
   if (pos >= last) return p.values.back();
@@ -68,8 +68,8 @@ struct Validator {
     }
   }
   void operator()(const SampledProfile& p) const {
-    if (!(std::isfinite(p.spacing_mm) && p.spacing_mm > 0.0))
-      throw InvalidArgument("coarse.spacing_mm is " + num(p.spacing_mm) + " mm; it must be a finite number > 0");
+    if (!(std::isfinite(p.spacing.value()) && p.spacing.value() > 0.0))
+      throw InvalidArgument("coarse.spacing.value() is " + num(p.spacing.value()) + " mm; it must be a finite number > 0");
     if (p.values.empty()) throw InvalidArgument("coarse sampled profile has no values");
     for (std::size_t i = 0; i < p.values.size(); ++i)
       check_unit_interval(p.values[i], "coarse.samples[" + std::to_string(i) + "]");

@@ -57,29 +57,29 @@ std::size_t bytes_per_sample(SampleFormat f) {
 void validate(const DeviceProfile& p) {
   const std::string at = "device '" + p.name + "': ";
   if (p.name.empty()) throw InvalidArgument("device profile has an empty name");
-  if (!(std::isfinite(p.spacing_mm) && p.spacing_mm > 0.0))
-    throw InvalidArgument(at + "spacing_mm is " + num(p.spacing_mm) + " mm; it must be a finite number > 0");
+  if (!(std::isfinite(p.spacing.value()) && p.spacing.value() > 0.0))
+    throw InvalidArgument(at + "spacing_mm is " + num(p.spacing.value()) + " mm; it must be a finite number > 0");
   constexpr std::int64_t max_samples = std::int64_t{1} << 34;
   if (p.samples < 1 || p.samples > max_samples)
     throw InvalidArgument(at + "samples is " + std::to_string(p.samples) + "; allowed: 1 … " + std::to_string(max_samples));
-  if (!(std::isfinite(p.refresh_hz) && p.refresh_hz > 0.0))
-    throw InvalidArgument(at + "refresh_hz is " + num(p.refresh_hz) + "; it must be a finite number > 0");
-  if (!(std::isfinite(p.band_min_cpm) && p.band_min_cpm > 0.0))
-    throw InvalidArgument(at + "band_min_cpm is " + num(p.band_min_cpm) + "; it must be > 0");
-  if (!(std::isfinite(p.band_max_cpm) && p.band_max_cpm >= 0.0) || (p.band_max_cpm > 0.0 && p.band_max_cpm <= p.band_min_cpm))
-    throw InvalidArgument(at + "band_max_cpm is " + num(p.band_max_cpm) + "; allowed: 0 (Nyquist) or above band_min_cpm");
-  if (p.band_max_cpm > p.nyquist_cpm() * (1 + 1e-12))
-    throw InvalidArgument(at + "band_max_cpm " + num(p.band_max_cpm) + " cpm is above the grid's Nyquist frequency " +
-                          num(p.nyquist_cpm()) + " cpm");
-  if (p.band_min_cpm >= p.band_top_cpm())
-    throw InvalidArgument(at + "band_min_cpm " + num(p.band_min_cpm) + " cpm is not below the band's top " +
-                          num(p.band_top_cpm()) + " cpm");
+  if (!(std::isfinite(p.refresh.value()) && p.refresh.value() > 0.0))
+    throw InvalidArgument(at + "refresh_hz is " + num(p.refresh.value()) + "; it must be a finite number > 0");
+  if (!(std::isfinite(p.band_min.value()) && p.band_min.value() > 0.0))
+    throw InvalidArgument(at + "band_min_cpm is " + num(p.band_min.value()) + "; it must be > 0");
+  if (!(std::isfinite(p.band_max.value()) && p.band_max.value() >= 0.0) || (p.band_max.value() > 0.0 && p.band_max.value() <= p.band_min.value()))
+    throw InvalidArgument(at + "band_max_cpm is " + num(p.band_max.value()) + "; allowed: 0 (Nyquist) or above band_min_cpm");
+  if (p.band_max.value() > p.nyquist().value() * (1 + 1e-12))
+    throw InvalidArgument(at + "band_max_cpm " + num(p.band_max.value()) + " cpm is above the grid's Nyquist frequency " +
+                          num(p.nyquist().value()) + " cpm");
+  if (p.band_min.value() >= p.band_top().value())
+    throw InvalidArgument(at + "band_min_cpm " + num(p.band_min.value()) + " cpm is not below the band's top " +
+                          num(p.band_top().value()) + " cpm");
   double prev_end = 0.0;
   for (const auto& r : p.layout) {
-    if (!(r.start_mm >= prev_end - 1e-9 && r.length_mm > 0.0 && r.start_mm + r.length_mm <= p.length_mm() + 1e-3))
-      throw InvalidArgument(at + "layout region '" + r.name + "' (" + num(r.start_mm) + " mm + " + num(r.length_mm) +
-                            " mm) must lie inside 0 … " + num(p.length_mm()) + " mm, in order, without overlap");
-    prev_end = r.start_mm + r.length_mm;
+    if (!(r.start.value() >= prev_end - 1e-9 && r.length.value() > 0.0 && r.start.value() + r.length.value() <= p.length().value() + 1e-3))
+      throw InvalidArgument(at + "layout region '" + r.name + "' (" + num(r.start.value()) + " mm + " + num(r.length.value()) +
+                            " mm) must lie inside 0 … " + num(p.length().value()) + " mm, in order, without overlap");
+    prev_end = r.start.value() + r.length.value();
   }
 }
 
@@ -91,11 +91,11 @@ DeviceProfile parse_device_profile(std::string_view json_text, std::string_view 
     p.name = o.string("name");
     p.description = o.string_or("description", "");
     p.samples = o.integer("samples", 1, std::int64_t{1} << 34);
-    p.spacing_mm = o.number("spacing_mm", 1e-9, 1e6);
+    p.spacing = Millimetres(o.number("spacing_mm", 1e-9, 1e6));
     p.format = parse_sample_format(o.string("format"), "format");
-    p.refresh_hz = o.number("refresh_hz", 1e-6, 1e9);
-    p.band_min_cpm = o.number_or("band_min_cpm", 0.01, 1e-12, 1e12);
-    p.band_max_cpm = o.number_or("band_max_cpm", 0.0, 0.0, 1e12);
+    p.refresh = Hertz(o.number("refresh_hz", 1e-6, 1e9));
+    p.band_min = CyclesPerMm(o.number_or("band_min_cpm", 0.01, 1e-12, 1e12));
+    p.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, 1e12));
     if (o.has("layout")) {
       const auto& arr = o.raw("layout");
       if (!arr.is_array()) throw FormatError("layout must be an array of regions");
@@ -103,8 +103,8 @@ DeviceProfile parse_device_profile(std::string_view json_text, std::string_view 
         detail::JsonObject r(arr[i], "layout[" + std::to_string(i) + "]");
         RegionLayout reg;
         reg.name = r.string("name");
-        reg.start_mm = r.number("start_mm", 0.0, 1e9);
-        reg.length_mm = r.number("length_mm", 1e-9, 1e9);
+        reg.start = Millimetres(r.number("start_mm", 0.0, 1e9));
+        reg.length = Millimetres(r.number("length_mm", 1e-9, 1e9));
         r.finish();
         p.layout.push_back(reg);
       }
@@ -124,13 +124,13 @@ std::string device_profile_json(const DeviceProfile& p) {
   j["name"] = p.name;
   j["description"] = p.description;
   j["samples"] = p.samples;
-  j["spacing_mm"] = p.spacing_mm;
+  j["spacing_mm"] = p.spacing.value();
   j["format"] = std::string(to_string(p.format));
-  j["refresh_hz"] = p.refresh_hz;
-  j["band_min_cpm"] = p.band_min_cpm;
-  j["band_max_cpm"] = p.band_max_cpm;
+  j["refresh_hz"] = p.refresh.value();
+  j["band_min_cpm"] = p.band_min.value();
+  j["band_max_cpm"] = p.band_max.value();
   j["layout"] = nlohmann::ordered_json::array();
-  for (const auto& r : p.layout) j["layout"].push_back({{"name", r.name}, {"start_mm", r.start_mm}, {"length_mm", r.length_mm}});
+  for (const auto& r : p.layout) j["layout"].push_back({{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}});
   return j.dump(2) + "\n";
 }
 
@@ -166,7 +166,9 @@ DeviceProfile load_device(std::string_view name_or_path) {
                         " (or give a path to a profile .json, or put NAME.json in a TEXEL_DEVICE_PATH directory)");
 }
 
-DeviceProfile with_grid(DeviceProfile p, std::optional<double> length_mm, std::optional<double> spacing_mm) {
+DeviceProfile with_grid(DeviceProfile p, std::optional<Millimetres> new_length, std::optional<Millimetres> new_spacing) {
+  const std::optional<double> length_mm = new_length ? std::optional<double>(new_length->value()) : std::nullopt;
+  const std::optional<double> spacing_mm = new_spacing ? std::optional<double>(new_spacing->value()) : std::nullopt;
   if (spacing_mm) {
     if (!(std::isfinite(*spacing_mm) && *spacing_mm > 0.0))
       throw InvalidArgument("spacing is " + num(*spacing_mm) + " mm; it must be a finite number > 0");
@@ -176,16 +178,16 @@ DeviceProfile with_grid(DeviceProfile p, std::optional<double> length_mm, std::o
       throw InvalidArgument("length is " + num(*length_mm) + " mm; it must be a finite number > 0");
   }
   if (!length_mm && !spacing_mm) return p;
-  const double length = length_mm ? *length_mm : p.length_mm();
-  const double spacing = spacing_mm ? *spacing_mm : p.spacing_mm;
+  const double length = length_mm ? *length_mm : p.length().value();
+  const double spacing = spacing_mm ? *spacing_mm : p.spacing.value();
   const double count = std::round(length / spacing);
   if (!(count >= 1.0) || count > static_cast<double>(std::int64_t{1} << 34))
     throw InvalidArgument("length " + num(length) + " mm at spacing " + num(spacing) + " mm gives " + num(count) +
                           " samples; allowed: 1 … 17179869184");
   p.samples = static_cast<std::int64_t>(count);
-  p.spacing_mm = spacing;
-  if (p.band_max_cpm > p.nyquist_cpm()) p.band_max_cpm = 0.0;
-  std::erase_if(p.layout, [&](const RegionLayout& r) { return r.start_mm + r.length_mm > p.length_mm() + 1e-3; });
+  p.spacing = Millimetres(spacing);
+  if (p.band_max.value() > p.nyquist().value()) p.band_max = CyclesPerMm(0.0);
+  std::erase_if(p.layout, [&](const RegionLayout& r) { return r.start.value() + r.length.value() > p.length().value() + 1e-3; });
   validate(p);
   return p;
 }

@@ -127,7 +127,7 @@ std::size_t texel_count(Millimetres length, Millimetres texel_length, Fill fill)
   return static_cast<std::size_t>(std::max(n, 0.0));
 }
 
-TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerMm nyquist)
+TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling)
     : spec_(spec), length_(length), distribution_([&] {
         validate(spec);
         if (!(std::isfinite(length.value()) && length.value() > 0.0))
@@ -138,7 +138,7 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerM
         c.parameterization = spec.parameterization;
         c.out_of_band = spec.out_of_band;
         c.band_min = spec.band_min;
-        c.band_max = spec.band_max.value() > 0.0 ? spec.band_max : nyquist;
+        c.band_max = spec.band_max.value() > 0.0 ? spec.band_max : sampling.top();
         c.quantization_db = spec.quantization_db;
         return PitchDistribution(c);
       }()) {
@@ -156,8 +156,8 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerM
   const double F = spec.fine_strength;
   for (std::size_t k = 0; k < n; ++k) {
     Texel& t = texels_[k];
-    t.start_mm = static_cast<double>(k) * L;
-    t.frequency_cpm = distribution_.draw(spec.seed, k);
+    t.start = Millimetres(static_cast<double>(k) * L);
+    t.frequency = CyclesPerMm(distribution_.draw(spec.seed, k));
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
     t.envelope = 1.0 - C * (1.0 - coarse[k]);
@@ -165,12 +165,13 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, CyclesPerM
     gain_[k] = t.envelope * F * 0.5;
     // Continuous phase: the next texel starts where this one ends. Keep the
     // phase in [0, 1) cycles so precision does not decay along the surface.
-    const double next = phase + t.frequency_cpm * L;
+    const double next = phase + t.frequency.value() * L;
     phase = next - detmath::floor_exact(next);
   }
 }
 
-std::int64_t TexelTexture::texel_at(double x) const {
+std::int64_t TexelTexture::texel_at(Millimetres at) const {
+  const double x = at.value();
   const double shifted = x + boundary_tolerance_mm;
   if (!(shifted >= 0.0) || !(x < end_mm_ - boundary_tolerance_mm) || texels_.empty()) return -1;
   const double k = std::floor(shifted / spec_.texel_length.value());
@@ -179,12 +180,13 @@ std::int64_t TexelTexture::texel_at(double x) const {
   return static_cast<std::int64_t>(k);
 }
 
-double TexelTexture::amplitude_at(double x) const {
-  const std::int64_t k = texel_at(x);
+double TexelTexture::amplitude_at(Millimetres at) const {
+  const double x = at.value();
+  const std::int64_t k = texel_at(at);
   if (k < 0) return 0.0;
   const auto i = static_cast<std::size_t>(k);
   const Texel& t = texels_[i];
-  const double u = t.phase_cycles + t.frequency_cpm * (x - t.start_mm);
+  const double u = t.phase_cycles + t.frequency.value() * (x - t.start.value());
   return offset_[i] + gain_[i] * detmath::sin_cycles(u);
 }
 
@@ -197,7 +199,7 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
   // order, with floor_exact (exact here: the quotient is at most ~1e12 texels)
   // in place of std::floor, which is a library call without SSE4.1.
   auto texel_of = [&](std::int64_t j) -> std::int64_t {
-    const double x = grid.position(first + j);
+    const double x = grid.position(first + j).value();
     const double shifted = x + boundary_tolerance_mm;
     if (!(shifted >= 0.0) || !(x < end_mm_ - boundary_tolerance_mm) || texels_.empty()) return -1;
     const double k = detmath::floor_exact(shifted / L);
@@ -216,7 +218,7 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
     // Estimate it from the boundary, then settle it with texel_of so the rule
     // is the one amplitude_at uses; the texel found past the run starts the next.
     const double boundary = std::min(static_cast<double>(k + 1) * L, end_mm_) - boundary_tolerance_mm;
-    const double estimate = std::ceil((boundary - grid.origin_mm) / grid.spacing_mm) - static_cast<double>(first);
+    const double estimate = std::ceil((boundary - grid.origin.value()) / grid.spacing.value()) - static_cast<double>(first);
     std::int64_t end = estimate >= static_cast<double>(n) ? n : std::max(j + 1, static_cast<std::int64_t>(estimate));
     while (end > j + 1 && texel_of(end - 1) != k) --end;
     std::int64_t next = -1;
@@ -227,10 +229,10 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
     for (std::int64_t a = j; a < end;) {
       const std::int64_t len = std::min<std::int64_t>(end - a, 1 << 30);
       const Run run{static_cast<double>(first + a),
-                    grid.origin_mm,
-                    grid.spacing_mm,
-                    t.start_mm,
-                    t.frequency_cpm,
+                    grid.origin.value(),
+                    grid.spacing.value(),
+                    t.start.value(),
+                    t.frequency.value(),
                     t.phase_cycles,
                     offset_[ik],
                     gain_[ik]};
@@ -246,6 +248,18 @@ std::string TexelTexture::describe() const {
   return "texel P=" + num(spec_.central_pitch.value()) + " dB I=" + num(spec_.irregularity.value()) +
          " dB L=" + num(spec_.texel_length.value()) + " mm seed=" + std::to_string(spec_.seed) + " (" +
          std::string(to_string(spec_.parameterization)) + ")";
+}
+
+double Texture::sample(Millimetres x) const {
+  // A one-sample window of a grid whose sample 0 sits at x: the renderer's
+  // own value there (position(0) = x + 0·spacing = x exactly).
+  double value = 0.0;
+  render(Grid{x, Millimetres(1.0), 1}, 0, std::span<double>(&value, 1));
+  return value;
+}
+
+std::shared_ptr<const Texture> prepare(const TexelSpec& spec, Millimetres length, const Sampling& sampling) {
+  return std::make_shared<const TexelTexture>(spec, length, sampling);
 }
 
 }  // namespace texel

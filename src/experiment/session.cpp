@@ -242,7 +242,7 @@ struct Session::Impl {
         order_rng(ctx.seed, stream_order),
         trial_rng(ctx.seed, stream_trial),
         device(load_device(protocol.device)) {
-    half_mm = device.length_mm() / 2.0;
+    half_mm = device.length().value() / 2.0;
     for (const auto& r : device.layout)
       if (r.name == "left" && r.length_mm > 0) half_mm = r.length_mm;
     start_block();

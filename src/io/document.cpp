@@ -156,7 +156,7 @@ ordered coarse_json(const CoarseProfile& profile) {
     j["kind"] = "points";
     j["points"] = ordered::array();
     for (std::size_t i = 0; i < sp->values.size(); ++i)
-      j["points"].push_back({static_cast<double>(i) * sp->spacing_mm, sp->values[i]});
+      j["points"].push_back({static_cast<double>(i) * sp->spacing.value(), sp->values[i]});
   }
   return j;
 }
@@ -282,7 +282,7 @@ Document parse_document(std::string_view text, std::string_view origin) {
       const auto spacing = g.optional_number("spacing_mm", 1e-9, 1e6);
       g.finish();
       try {
-        doc.device = with_grid(doc.device, length, spacing);
+        doc.device = with_grid(doc.device, millimetres(length), millimetres(spacing));
       } catch (const InvalidArgument& e) {
         throw FormatError(std::string("device_grid: ") + e.what());
       }
@@ -306,8 +306,8 @@ Document parse_document(std::string_view text, std::string_view origin) {
         JsonObject r(arr[i], path);
         RegionSpec spec;
         spec.name = r.string_or("name", "");
-        spec.start_mm = r.number_or("start_mm", 0.0, 0.0, 1e9);
-        spec.length_mm = r.optional_number("length_mm", 1e-9, 1e9);
+        spec.start = Millimetres(r.number_or("start_mm", 0.0, 0.0, 1e9));
+        spec.length = millimetres(r.optional_number("length_mm", 1e-9, 1e9));
         parse_texture(r.raw("texture"), path + ".texture", spec);
         r.finish();
         doc.regions.push_back(std::move(spec));
@@ -334,7 +334,7 @@ std::string document_json(const Document& doc) {
     j["device"] = doc.device.name;
   }
   const bool whole =
-      doc.regions.size() == 1 && doc.regions[0].start_mm == 0.0 && !doc.regions[0].length_mm && doc.regions[0].name.empty();
+      doc.regions.size() == 1 && doc.regions[0].start.value() == 0.0 && !doc.regions[0].length && doc.regions[0].name.empty();
   const auto texture_json = [](const RegionSpec& r) {
     return r.reference ? reference_json(*r.reference) : texel_json(r.texel, r.coarse_reference);
   };
@@ -345,8 +345,8 @@ std::string document_json(const Document& doc) {
     for (const auto& r : doc.regions) {
       ordered rj;
       if (!r.name.empty()) rj["name"] = r.name;
-      rj["start_mm"] = r.start_mm;
-      if (r.length_mm) rj["length_mm"] = *r.length_mm;
+      rj["start_mm"] = r.start.value();
+      if (r.length) rj["length_mm"] = r.length->value();
       rj["texture"] = texture_json(r);
       j["regions"].push_back(std::move(rj));
     }
@@ -389,22 +389,22 @@ Surface prepare_surface(const Document& doc) {
     const std::string label = doc.regions.size() == 1 ? std::string() : "region " + std::to_string(i) + ": ";
     Region r;
     r.name = spec.name;
-    r.start_mm = spec.start_mm;
-    r.length_mm = spec.length_mm ? *spec.length_mm : grid.length_mm() - spec.start_mm;
-    if (!(r.length_mm > 0.0))
-      throw InvalidArgument(label + "start_mm " + detail::num(spec.start_mm) + " mm is at or past the device's end (" +
-                            detail::num(grid.length_mm()) + " mm)");
+    r.start = spec.start;
+    r.length = spec.length ? *spec.length : grid.length() - spec.start;
+    if (!(r.length.value() > 0.0))
+      throw InvalidArgument(label + "start_mm " + detail::num(spec.start.value()) + " mm is at or past the device's end (" +
+                            detail::num(grid.length().value()) + " mm)");
     try {
       // The texture's own coordinates: 0 mm at the region's left edge (as Surface::render passes them).
-      const Grid local{grid.origin_mm - r.start_mm, grid.spacing_mm, grid.count};
+      const Sampling local{Grid{grid.origin - r.start, grid.spacing, grid.count}, doc.device.band_top()};
       if (spec.reference) {
-        r.texture = std::make_shared<ReferenceTexture>(*spec.reference, Millimetres(r.length_mm), local);
+        r.texture = prepare(*spec.reference, r.length, local);
       } else if (spec.coarse_reference) {
         TexelSpec texel = spec.texel;
-        texel.coarse = reference_profile(*spec.coarse_reference, Millimetres(r.length_mm), grid.spacing_mm);
-        r.texture = std::make_shared<TexelTexture>(texel, Millimetres(r.length_mm), CyclesPerMm(doc.device.band_top_cpm()));
+        texel.coarse = reference_profile(*spec.coarse_reference, r.length, grid.spacing);
+        r.texture = prepare(texel, r.length, local);
       } else {
-        r.texture = std::make_shared<TexelTexture>(spec.texel, Millimetres(r.length_mm), CyclesPerMm(doc.device.band_top_cpm()));
+        r.texture = prepare(spec.texel, r.length, local);
       }
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(label + e.what());

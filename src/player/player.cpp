@@ -21,9 +21,9 @@ PlayerMap::PlayerMap(Grid grid, std::vector<float> values) : grid_(grid), values
   if (grid_.count < 1 || static_cast<std::size_t>(grid_.count) != values_.size())
     throw InvalidArgument("player map: grid has " + std::to_string(grid_.count) + " samples but " +
                           std::to_string(values_.size()) + " values were given; they must match and be >= 1");
-  if (!(std::isfinite(grid_.spacing_mm) && grid_.spacing_mm > 0))
-    throw InvalidArgument("player map: spacing_mm is " + num(grid_.spacing_mm) + "; it must be a finite number > 0");
-  inv_spacing_ = 1.0 / grid_.spacing_mm;
+  if (!(std::isfinite(grid_.spacing.value()) && grid_.spacing.value() > 0))
+    throw InvalidArgument("player map: spacing_mm is " + num(grid_.spacing.value()) + "; it must be a finite number > 0");
+  inv_spacing_ = 1.0 / grid_.spacing.value();
 }
 
 std::unique_ptr<const PlayerMap> PlayerMap::from_surface(const Surface& surface) {
@@ -38,7 +38,7 @@ std::unique_ptr<const PlayerMap> PlayerMap::from_texture(const Texture& texture,
 }
 
 float PlayerMap::sample(double x_mm) const noexcept {
-  const double u = (x_mm - grid_.origin_mm) * inv_spacing_;
+  const double u = (x_mm - grid_.origin.value()) * inv_spacing_;
   const std::int64_t last = grid_.count - 1;
   if (!(u > 0.0)) return values_.front();  // also NaN
   if (u >= static_cast<double>(last)) return values_[static_cast<std::size_t>(last)];
@@ -50,7 +50,7 @@ float PlayerMap::sample(double x_mm) const noexcept {
 }
 
 bool PlayerMap::on_surface(double x_mm) const noexcept {
-  return x_mm >= grid_.origin_mm && x_mm < grid_.origin_mm + grid_.length_mm();
+  return x_mm >= grid_.origin.value() && x_mm < grid_.origin.value() + grid_.length().value();
 }
 
 // --------------------------------------------------------------- PlayerConfig

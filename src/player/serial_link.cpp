@@ -166,7 +166,7 @@ void SerialLink::upload_map(std::uint8_t id, std::span<const float> amplitudes, 
 }
 
 void SerialLink::upload_map(std::uint8_t id, const PlayerMap& map) {
-  upload_map(id, map.values(), map.grid().spacing_mm, map.grid().origin_mm);
+  upload_map(id, map.values(), map.grid().spacing.value(), map.grid().origin.value());
 }
 
 void SerialLink::select(std::uint8_t id) {

@@ -82,7 +82,7 @@ void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, 
     std::fill(acc.begin(), acc.end(), 0.0);
     const double base = static_cast<double>(first + static_cast<std::int64_t>(i));
     for (const auto& c : comps)
-      accumulate_component(base, grid.origin_mm, grid.spacing_mm, c.frequency_cpm, c.amplitude, c.phase_cycles, acc.data(),
+      accumulate_component(base, grid.origin.value(), grid.spacing.value(), c.frequency.value(), c.amplitude, c.phase_cycles, acc.data(),
                            static_cast<std::int32_t>(len));
     std::copy_n(acc.begin(), len, out.begin() + static_cast<std::ptrdiff_t>(i));
   }
@@ -150,7 +150,7 @@ std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const s
       gain = detmath::exp(exponent * detmath::log(f));
     }
     const auto [mag, phase] = noise_draw(rng, k);
-    comps.push_back({f, gain * mag, phase});
+    comps.push_back({CyclesPerMm(f), gain * mag, phase});
   }
   return comps;
 }
@@ -166,7 +166,7 @@ std::vector<ReferenceComponent> sine_components(const ReferenceSpec& s, double n
     if (!(f[i] < nyquist))
       throw InvalidArgument(field(s, "frequencies_cpm") + "[" + std::to_string(i) + "] is " + num(f[i]) +
                             " cpm, at or above the grid's Nyquist frequency " + num(nyquist) + " cpm (it would alias)");
-    comps.push_back({f[i], w[i], random ? rng.uniform(i) : 0.0});
+    comps.push_back({CyclesPerMm(f[i]), w[i], random ? rng.uniform(i) : 0.0});
   }
   return comps;
 }
@@ -197,7 +197,7 @@ std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, doub
       if (n % 2 == 0) phase += 0.5;
     }
     phase -= std::floor(phase);
-    comps.push_back({f, a, phase});
+    comps.push_back({CyclesPerMm(f), a, phase});
   }
   return comps;
 }
@@ -218,7 +218,7 @@ std::vector<ReferenceFeature> lay_out(double start, double feature, const std::v
   double pos = start;
   std::size_t i = 0;
   while (pos + feature <= length + 1e-9 && out.size() < max_features) {
-    out.push_back({pos, feature});
+    out.push_back({Millimetres(pos), Millimetres(feature)});
     if (gaps.empty()) break;
     pos += feature + gaps[i % gaps.size()];
     ++i;
@@ -255,7 +255,7 @@ std::vector<ReferenceFeature> pulse_features(const ReferenceSpec& s, double leng
   std::vector<ReferenceFeature> f =
       lay_out(number(s, "start_mm"), number(s, "pulse_mm"), numbers(s, "gaps_mm"), length, std::size_t(-1));
   if (word(s, "mirror") == "yes") {
-    for (auto& p : f) p.start_mm = length - p.start_mm - p.length_mm;
+    for (auto& p : f) p.start = Millimetres(length - p.start.value() - p.length.value());
     std::reverse(f.begin(), f.end());
   }
   return f;
@@ -263,15 +263,16 @@ std::vector<ReferenceFeature> pulse_features(const ReferenceSpec& s, double leng
 
 }  // namespace
 
-ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Grid& grid)
-    : spec_(spec), length_(length), grid_(grid) {
+ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling)
+    : spec_(spec), length_(length), grid_(sampling.grid) {
+  const Grid& grid = sampling.grid;
   validate(spec_);
   if (!(std::isfinite(length.value()) && length.value() > 0.0))
     throw InvalidArgument("reference length is " + num(length.value()) + " mm; it must be > 0");
-  if (!(std::isfinite(grid.spacing_mm) && grid.spacing_mm > 0.0 && std::isfinite(grid.origin_mm)))
-    throw InvalidArgument("reference grid spacing is " + num(grid.spacing_mm) + " mm; it must be > 0");
+  if (!(std::isfinite(grid.spacing.value()) && grid.spacing.value() > 0.0 && std::isfinite(grid.origin.value())))
+    throw InvalidArgument("reference grid spacing is " + num(grid.spacing.value()) + " mm; it must be > 0");
   const ReferenceInfo& info = reference_info(spec_.name);
-  const double nyquist = grid.nyquist_cpm();
+  const double nyquist = grid.nyquist().value();
   const double L = length.value();
   if (info.family == "band-pass noise" || info.family == "colour of noise") {
     components_ = noise_components(spec_, info.family, L, nyquist);
@@ -291,12 +292,12 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
                           " mm texture; lower start_mm or the feature length");
 
   // Samples of the prepared grid inside [0, L).
-  const double sp = grid.spacing_mm;
-  std::int64_t a = static_cast<std::int64_t>(std::ceil(-grid.origin_mm / sp)) - 1;
-  while (grid.position(a) < 0.0) ++a;
-  std::int64_t b = static_cast<std::int64_t>(std::floor((L - grid.origin_mm) / sp)) + 1;
-  while (b > a && !(grid.position(b - 1) < L)) --b;
-  while (grid.position(b) < L) ++b;
+  const double sp = grid.spacing.value();
+  std::int64_t a = static_cast<std::int64_t>(std::ceil(-grid.origin.value() / sp)) - 1;
+  while (grid.position(a).value() < 0.0) ++a;
+  std::int64_t b = static_cast<std::int64_t>(std::floor((L - grid.origin.value()) / sp)) + 1;
+  while (b > a && !(grid.position(b - 1).value() < L)) --b;
+  while (grid.position(b).value() < L) ++b;
   cache_first_ = a;
   cache_.resize(static_cast<std::size_t>(b - a));
   if (shape_ == Shape::sum) {
@@ -319,7 +320,7 @@ void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<
   if (shape_ == Shape::sum) {
     synthesize(components_, grid, first, out);
     for (std::size_t i = 0; i < out.size(); ++i) {
-      const double x = grid.position(first + static_cast<std::int64_t>(i));
+      const double x = grid.position(first + static_cast<std::int64_t>(i)).value();
       const double v = 0.5 + scale_ * out[i];
       out[i] = !(x >= 0.0 && x < L) ? 0.0 : (v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v));
     }
@@ -328,23 +329,23 @@ void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<
   // Features are sorted and disjoint: walk them alongside the samples.
   std::size_t j = 0;
   for (std::size_t i = 0; i < out.size(); ++i) {
-    const double x = grid.position(first + static_cast<std::int64_t>(i));
+    const double x = grid.position(first + static_cast<std::int64_t>(i)).value();
     out[i] = 0.0;
     if (!(x >= 0.0 && x < L)) continue;
-    if (i == 0 || x < grid.position(first + static_cast<std::int64_t>(i) - 1)) {
+    if (i == 0 || x < grid.position(first + static_cast<std::int64_t>(i) - 1).value()) {
       j = static_cast<std::size_t>(std::upper_bound(features_.begin(), features_.end(), x,
-                                                    [](double v, const ReferenceFeature& f) { return v < f.start_mm; }) -
+                                                    [](double v, const ReferenceFeature& f) { return v < f.start.value(); }) -
                                    features_.begin());
       j = j > 0 ? j - 1 : 0;
     }
-    while (j + 1 < features_.size() && x >= features_[j + 1].start_mm) ++j;
+    while (j + 1 < features_.size() && x >= features_[j + 1].start.value()) ++j;
     const ReferenceFeature& f = features_[j];
-    const double t = x - f.start_mm;
-    if (!(t >= 0.0 && t < f.length_mm)) continue;
+    const double t = x - f.start.value();
+    if (!(t >= 0.0 && t < f.length.value())) continue;
     if (shape_ == Shape::patch) {
       out[i] = 1.0;
     } else {
-      const double v = 0.5 - 0.5 * detmath::cos_cycles(t / f.length_mm);
+      const double v = 0.5 - 0.5 * detmath::cos_cycles(t / f.length.value());
       out[i] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
     }
   }
@@ -352,7 +353,7 @@ void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<
 
 void ReferenceTexture::render(const Grid& grid, std::int64_t first, std::span<double> out) const {
   const auto n = static_cast<std::int64_t>(out.size());
-  const bool same_grid = grid.origin_mm == grid_.origin_mm && grid.spacing_mm == grid_.spacing_mm;
+  const bool same_grid = grid.origin.value() == grid_.origin.value() && grid.spacing.value() == grid_.spacing.value();
   const std::int64_t cache_end = cache_first_ + static_cast<std::int64_t>(cache_.size());
   if (same_grid && first >= cache_first_ && first + n <= cache_end) {
     std::copy_n(cache_.begin() + (first - cache_first_), n, out.begin());
@@ -361,30 +362,31 @@ void ReferenceTexture::render(const Grid& grid, std::int64_t first, std::span<do
   evaluate(grid, first, out);
 }
 
-double ReferenceTexture::amplitude_at(double x_mm) const {
+double ReferenceTexture::amplitude_at(Millimetres x) const {
+  const double x_mm = x.value();
   const double L = length_.value();
   if (!(x_mm >= 0.0 && x_mm < L)) return 0.0;
   if (shape_ == Shape::sum) {
     double y = 0.0;
-    for (const auto& c : components_) y = y + c.amplitude * detmath::sin_cycles(c.phase_cycles + c.frequency_cpm * x_mm);
+    for (const auto& c : components_) y = y + c.amplitude * detmath::sin_cycles(c.phase_cycles + c.frequency.value() * x_mm);
     const double v = 0.5 + scale_ * y;
     return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
   }
   for (const auto& f : features_) {
-    const double t = x_mm - f.start_mm;
-    if (t >= 0.0 && t < f.length_mm) {
+    const double t = x_mm - f.start.value();
+    if (t >= 0.0 && t < f.length.value()) {
       if (shape_ == Shape::patch) return 1.0;
-      const double v = 0.5 - 0.5 * detmath::cos_cycles(t / f.length_mm);
+      const double v = 0.5 - 0.5 * detmath::cos_cycles(t / f.length.value());
       return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
     }
   }
   return 0.0;
 }
 
-std::vector<double> ReferenceTexture::gaps_mm() const {
-  std::vector<double> g;
+std::vector<Millimetres> ReferenceTexture::gaps() const {
+  std::vector<Millimetres> g;
   for (std::size_t i = 1; i < features_.size(); ++i)
-    g.push_back(features_[i].start_mm - (features_[i - 1].start_mm + features_[i - 1].length_mm));
+    g.push_back(features_[i].start - (features_[i - 1].start + features_[i - 1].length));
   return g;
 }
 
@@ -399,23 +401,29 @@ std::string ReferenceTexture::describe() const {
 std::vector<double> render_reference(const ReferenceSpec& spec, const Grid& grid) {
   if (grid.count <= 0)
     throw InvalidArgument("reference grid has " + std::to_string(grid.count) + " samples; it needs at least 1");
-  const ReferenceTexture t(spec, Millimetres(grid.length_mm()), Grid{0.0, grid.spacing_mm, grid.count});
+  const Grid local{Millimetres(0.0), grid.spacing, grid.count};
+  const ReferenceTexture t(spec, grid.length(), Sampling{local});
   std::vector<double> out(static_cast<std::size_t>(grid.count));
-  t.render(Grid{0.0, grid.spacing_mm, grid.count}, 0, out);
+  t.render(local, 0, out);
   return out;
 }
 
-SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, double spacing_mm) {
+SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, Millimetres spacing) {
+  const double spacing_mm = spacing.value();
   if (!(std::isfinite(spacing_mm) && spacing_mm > 0.0))
     throw InvalidArgument("reference profile spacing is " + num(spacing_mm) + " mm; it must be > 0");
-  const Grid grid{0.0, spacing_mm, 0};
-  const ReferenceTexture t(spec, length, grid);
+  const Grid grid{Millimetres(0.0), spacing, 0};
+  const ReferenceTexture t(spec, length, Sampling{grid});
   const auto count = static_cast<std::int64_t>(std::ceil(length.value() / spacing_mm));
   SampledProfile p;
-  p.spacing_mm = spacing_mm;
+  p.spacing = spacing;
   p.values.resize(static_cast<std::size_t>(std::max<std::int64_t>(count, 1)));
   t.render(grid, 0, p.values);
   return p;
+}
+
+std::shared_ptr<const Texture> prepare(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling) {
+  return std::make_shared<const ReferenceTexture>(spec, length, sampling);
 }
 
 }  // namespace texel

@@ -44,7 +44,7 @@ const Region& surface_region(const Surface& surface, const RegionSpec& spec) {
 // membership rule as Surface::render (start <= position < end).
 std::pair<std::size_t, std::size_t> region_samples(const Grid& grid, const Region& r) {
   const double end = r.start_mm + r.length_mm;
-  auto first = static_cast<std::int64_t>(std::floor((r.start_mm - grid.origin_mm) / grid.spacing_mm));
+  auto first = static_cast<std::int64_t>(std::floor((r.start_mm - grid.origin.value()) / grid.spacing.value()));
   first = std::clamp<std::int64_t>(first - 1, 0, grid.count);
   while (first < grid.count && grid.position(first) < r.start_mm) ++first;
   std::int64_t last = first;
@@ -165,7 +165,7 @@ DesignView design_view(const Document& doc, const DesignOptions& options) {
     const Region& sr = surface_region(surface, spec);
     v.regions.push_back({spec.name, spec.reference ? "reference" : "texel", sr.start_mm, sr.length_mm});
   }
-  if (samples.size() >= 4) v.spectrum = spectrum_view(samples, v.grid.spacing_mm, options.spectrum_points);
+  if (samples.size() >= 4) v.spectrum = spectrum_view(samples, v.grid.spacing.value(), options.spectrum_points);
 
   if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
     v.texels = t->texels().size();
@@ -199,7 +199,7 @@ MatchView match_region(const Document& doc, const MatchOptions& options) {
   if (target.size() < 4)
     throw InvalidArgument(region_label(doc, options.region) + " holds " + std::to_string(target.size()) +
                           " samples; at least 4 are needed to encode it");
-  codec::Signal signal{target, surface.grid().spacing_mm, "studio " + region_label(doc, options.region)};
+  codec::Signal signal{target, surface.grid().spacing.value(), "studio " + region_label(doc, options.region)};
 
   MatchView m;
   m.result = codec::encode(signal, options.encoder);
@@ -212,8 +212,8 @@ MatchView match_region(const Document& doc, const MatchOptions& options) {
   m.document.version = required_version(m.document);
   const Surface matched = prepare_surface(m.document);
   const std::vector<double> rendered = render_region(matched, surface_region(matched, dst));
-  m.target = spectrum_view(target, signal.spacing_mm, options.spectrum_points);
-  if (rendered.size() >= 4) m.match = spectrum_view(rendered, signal.spacing_mm, options.spectrum_points);
+  m.target = spectrum_view(target, signal.spacing.value(), options.spectrum_points);
+  if (rendered.size() >= 4) m.match = spectrum_view(rendered, signal.spacing.value(), options.spectrum_points);
   return m;
 }
 
@@ -326,7 +326,7 @@ ExportFile export_file(const Document& doc, ExportFormat as, std::optional<std::
   } else {
     const std::vector<double> map = surface.render();
     std::vector<double> x(map.size());
-    for (std::size_t i = 0; i < x.size(); ++i) x[i] = surface.grid().position(static_cast<std::int64_t>(i));
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = surface.grid().position(static_cast<std::int64_t>(i)).value();
     f = {base + ".csv", "text/csv", csv_columns("position_mm", "amplitude", x, map)};
   }
   return f;

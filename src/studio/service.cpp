@@ -572,9 +572,9 @@ struct Service::Impl {
     for (const json* t : textures) {
       if (!t->is_object() || !t->contains("texel_length_mm") || !(*t)["texel_length_mm"].is_number()) continue;
       const double length = (*t)["texel_length_mm"].get<double>();
-      if (length > 0 && device.length_mm() / length > static_cast<double>(cap))
+      if (length > 0 && device.length().value() / length > static_cast<double>(cap))
         throw Reject{"too_large", where + ": texel_length_mm " + json(length).dump() + " makes more than " + std::to_string(cap) +
-                                      " texels; allowed: at least " + json(device.length_mm() / static_cast<double>(cap)).dump() +
+                                      " texels; allowed: at least " + json(device.length().value() / static_cast<double>(cap)).dump() +
                                       " mm on this device"};
     }
   }
@@ -594,7 +594,7 @@ struct Service::Impl {
     const DesignView v = design_view(doc, o);
 
     ojson r = reply("design", job.id);
-    r["grid"] = {{"origin_mm", v.grid.origin_mm}, {"spacing_mm", v.grid.spacing_mm}, {"count", v.grid.count}};
+    r["grid"] = {{"origin_mm", v.grid.origin.value()}, {"spacing_mm", v.grid.spacing.value()}, {"count", v.grid.count}};
     static_assert(std::endian::native == std::endian::little, "map_f32 is little-endian float32");
     r["map_f32"] =
         detail::base64_encode(std::span(reinterpret_cast<const unsigned char*>(v.map.data()), v.map.size() * sizeof(float)));
