@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
 
   std::vector<float> map(19200);
   for (std::size_t i = 0; i < map.size(); ++i) map[i] = static_cast<float>(0.5 + 0.5 * std::sin(0.37 * static_cast<double>(i)));
-  const PlayerMap proto(Grid{0.0, 0.0053, 19200}, map);
+  const PlayerMap proto(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, map);
 
   std::vector<Result> results;
   std::vector<float> out(frames);

@@ -55,7 +55,7 @@ Surface tpad_surface() {
 Surface big_surface() {
   TexelSpec spec;
   spec.texel_length = Millimetres(0.25);
-  return prepare_surface(make_document(with_grid(load_device("generic"), 100000.0, 0.001), spec));
+  return prepare_surface(make_document(with_grid(load_device("generic"), Millimetres(100000.0), Millimetres(0.001)), spec));
 }
 
 // Prepared once, on first use, so filtering out a case skips its setup.
@@ -143,7 +143,7 @@ void bm_prepare(benchmark::State& state) {
   spec.seed = 7;
   std::size_t texels = 0;
   for (auto _ : state) {
-    TexelTexture t(spec, Millimetres(device.length_mm()), CyclesPerMm(device.band_top_cpm()));
+    TexelTexture t(spec, device.length(), Sampling{device.grid(), device.band_top()});
     texels = t.texels().size();
     benchmark::DoNotOptimize(t.texels().data());
     benchmark::ClobberMemory();

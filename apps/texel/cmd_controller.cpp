@@ -56,7 +56,7 @@ void run(const ControllerArgs& a) {
   controller::HostHal hal(fd);
   controller::Info info;
   info.name = "texel-reference (host)";
-  info.refresh_mhz = static_cast<std::uint32_t>(std::llround(d.refresh_hz * 1000.0));
+  info.refresh_mhz = static_cast<std::uint32_t>(std::llround(d.refresh.value() * 1000.0));
   // ~200 KB of static map storage: allocated once, before the loop.
   auto ctl = std::make_unique<controller::Controller<>>(hal, info);
 
@@ -70,7 +70,7 @@ void run(const ControllerArgs& a) {
   };
   std::thread loop([&] { ctl->run(stop); });
   const bool tty = ::isatty(STDERR_FILENO) == 1 && !a.quiet;
-  if (!a.quiet) std::cerr << "controller: " << where << ", refresh " << detail::num(d.refresh_hz) << " Hz; Ctrl-C stops\n";
+  if (!a.quiet) std::cerr << "controller: " << where << ", refresh " << detail::num(d.refresh.value()) << " Hz; Ctrl-C stops\n";
   while (!stop()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     if (tty) {

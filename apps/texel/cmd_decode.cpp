@@ -61,7 +61,7 @@ void register_decode(CLI::App& app) {
       j["fine_strength"] = s.fine_strength;
       j["coarse_profile"] = kind_name(s.coarse);
       // The texture is device independent; a coarse grid samples it with aliasing.
-      j["aliased"] = s.band_max.value() > device.nyquist_cpm();
+      j["aliased"] = s.band_max.value() > device.nyquist().value();
       print_json(j);
     }
   });

@@ -68,7 +68,7 @@ nlohmann::ordered_json result_json(const std::string& input, const codec::Signal
   j["source"] = sig.description;
   if (output) j["output"] = *output;
   j["samples"] = r.samples;
-  j["spacing_mm"] = r.spacing_mm;
+  j["spacing_mm"] = r.spacing.value();
   j["swipe_speed_mm_s"] = cfg.model.swipe_speed.value();
   const TexelSpec& s = r.spec;
   nlohmann::ordered_json e;

@@ -37,15 +37,15 @@ ordered document_info(const Document& doc, const std::string& path) {
   if (!doc.description.empty()) j["description"] = doc.description;
   j["device"] = {{"name", doc.device.name},
                  {"samples", doc.device.samples},
-                 {"spacing_mm", doc.device.spacing_mm},
-                 {"length_mm", doc.device.length_mm()},
+                 {"spacing_mm", doc.device.spacing.value()},
+                 {"length_mm", doc.device.length().value()},
                  {"format", std::string(to_string(doc.device.format))},
                  {"native_bytes", doc.device.native_bytes()},
-                 {"nyquist_cpm", doc.device.nyquist_cpm()}};
+                 {"nyquist_cpm", doc.device.nyquist().value()}};
   j["document_bytes"] = document_json(doc).size();
   j["regions"] = ordered::array();
   for (const auto& r : surface.regions()) {
-    ordered rj{{"name", r.name}, {"start_mm", r.start_mm}, {"length_mm", r.length_mm}, {"texture", r.texture->describe()}};
+    ordered rj{{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}, {"texture", r.texture->describe()}};
     if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
       const auto& s = t->spec();
       rj["texels"] = t->texels().size();
@@ -115,7 +115,7 @@ void register_info(CLI::App& app) {
       j["format"] = std::string(to_string(d.format));
       j["bytes"] = bytes.size();
       j["matches_device"] = static_cast<std::int64_t>(data.size()) == d.samples;
-      j["length_mm"] = static_cast<double>(data.size()) * d.spacing_mm;
+      j["length_mm"] = static_cast<double>(data.size()) * d.spacing.value();
       j["amplitude"] = stats(data);
     } else if (ext == ".npy") {
       j["file"] = args->file;
@@ -149,9 +149,9 @@ void register_devices(CLI::App& app) {
       if (*json) {
         all.push_back(ordered::parse(device_profile_json(d)));
       } else {
-        std::cout << d.name << ": " << d.samples << " samples x " << num(d.spacing_mm) << " mm = " << num(d.length_mm())
-                  << " mm, " << to_string(d.format) << ", " << num(d.refresh_hz) << " Hz, Nyquist "
-                  << detail::fixed(d.nyquist_cpm(), 2) << " cpm\n    " << d.description << "\n";
+        std::cout << d.name << ": " << d.samples << " samples x " << num(d.spacing.value()) << " mm = " << num(d.length().value())
+                  << " mm, " << to_string(d.format) << ", " << num(d.refresh.value()) << " Hz, Nyquist "
+                  << detail::fixed(d.nyquist().value(), 2) << " cpm\n    " << d.description << "\n";
       }
     }
     if (*json) print_json(all);

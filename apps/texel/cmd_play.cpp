@@ -94,7 +94,7 @@ void run(const PlayArgs& a) {
   }
 
   double duration = 5.0;
-  const auto trace = finger_trace(a.finger, surface.grid().length_mm(), duration);
+  const auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
   Player player(config, PlayerMap::from_surface(surface));
 
   interrupted = false;

@@ -143,7 +143,7 @@ void register_reference(CLI::App& app) {
                 {"texture", surface.regions()[0].texture->describe()},
                 {"device", doc.device.name},
                 {"samples", surface.grid().count},
-                {"spacing_mm", surface.grid().spacing_mm},
+                {"spacing_mm", surface.grid().spacing.value()},
                 {"device_bytes", doc.device.native_bytes()}};
       print_json(j);
     }
@@ -186,7 +186,7 @@ void register_atlas(CLI::App& app) {
       write_rendered(stem + ".texel.json", doc, surface, map, {});
       LoadedSignal sig;
       sig.samples = map;
-      sig.spacing_mm = surface.grid().spacing_mm;
+      sig.spacing_mm = surface.grid().spacing.value();
       sig.source = "device " + device.name;
       AnalysisOptions opt;
       opt.peaks.max_peaks = 12;

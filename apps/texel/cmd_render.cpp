@@ -34,7 +34,7 @@ std::string texels_csv(const Surface& surface) {
     if (!t) continue;
     for (std::size_t k = 0; k < t->texels().size(); ++k) {
       const Texel& x = t->texels()[k];
-      out += std::to_string(k) + "," + detail::num(region.start_mm + x.start_mm) + "," + detail::num(x.frequency_cpm) + "," +
+      out += std::to_string(k) + "," + detail::num(region.start.value() + x.start.value()) + "," + detail::num(x.frequency.value()) + "," +
              detail::num(x.envelope);
       if (many) out += "," + (region.name.empty() ? std::to_string(r) : region.name);
       out += "\n";
@@ -49,8 +49,8 @@ nlohmann::ordered_json summary(const Document& doc, const Surface& surface, cons
   if (a.texels_csv) j["texels_csv"] = *a.texels_csv;
   j["device"] = doc.device.name;
   j["samples"] = surface.grid().count;
-  j["spacing_mm"] = surface.grid().spacing_mm;
-  j["length_mm"] = surface.grid().length_mm();
+  j["spacing_mm"] = surface.grid().spacing.value();
+  j["length_mm"] = surface.grid().length().value();
   j["format"] = std::string(to_string(doc.device.format));
   j["device_bytes"] = doc.device.native_bytes();
   j["document_bytes"] = document_json(doc).size();
@@ -60,15 +60,15 @@ nlohmann::ordered_json summary(const Document& doc, const Surface& surface, cons
   for (const auto& r : surface.regions()) {
     nlohmann::ordered_json rj;
     rj["name"] = r.name;
-    rj["start_mm"] = r.start_mm;
-    rj["length_mm"] = r.length_mm;
+    rj["start_mm"] = r.start.value();
+    rj["length_mm"] = r.length.value();
     rj["texture"] = r.texture->describe();
     if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
       const auto& tx = t->texels();
       double m = 0.0, s2 = 0.0;
-      for (const auto& x : tx) m += x.frequency_cpm;
+      for (const auto& x : tx) m += x.frequency.value();
       m /= static_cast<double>(std::max<std::size_t>(tx.size(), 1));
-      for (const auto& x : tx) s2 += (x.frequency_cpm - m) * (x.frequency_cpm - m);
+      for (const auto& x : tx) s2 += (x.frequency.value() - m) * (x.frequency.value() - m);
       rj["texels"] = tx.size();
       rj["frequency_mean_cpm"] = m;
       rj["frequency_sd_cpm"] = tx.size() > 1 ? std::sqrt(s2 / static_cast<double>(tx.size() - 1)) : 0.0;

@@ -180,7 +180,7 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
       throw FormatError(path + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
                         std::string(to_string(d.format)) + " samples for device " + d.name);
     sig.samples = decode_samples(d.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
-    sig.spacing_mm = spacing_mm.value_or(d.spacing_mm);
+    sig.spacing_mm = spacing_mm.value_or(d.spacing.value());
     sig.source = "device " + d.name + " (" + std::string(to_string(d.format)) + ")";
   } else if (ext == ".csv") {
     auto [x, a] = parse_csv_columns(read_file(path), path);
@@ -193,7 +193,7 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
     if (spacing_mm)
       sig.spacing_mm = *spacing_mm;
     else if (device)
-      sig.spacing_mm = load_device(*device).spacing_mm;
+      sig.spacing_mm = load_device(*device).spacing.value();
     else
       throw InvalidArgument("'" + path + "' carries no sample spacing: give --device or --spacing");
     sig.source = "npy";
@@ -208,7 +208,7 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
     const Surface surface = prepare_surface(doc);
     std::vector<double> map = render_map(surface);
     const Grid& g = surface.grid();
-    sig.spacing_mm = g.spacing_mm;
+    sig.spacing_mm = g.spacing.value();
     sig.source = "document on device " + doc.device.name;
     if (region) {
       const auto& regions = surface.regions();
@@ -223,8 +223,8 @@ LoadedSignal load_signal(const std::string& path, const std::optional<std::strin
       }
       std::vector<double> part;
       for (std::int64_t i = 0; i < g.count; ++i) {
-        const double x = g.position(i);
-        if (x >= chosen->start_mm && x < chosen->start_mm + chosen->length_mm) {
+        const double x = g.position(i).value();
+        if (x >= chosen->start.value() && x < chosen->start.value() + chosen->length.value()) {
           if (part.empty()) sig.origin_mm = x;
           part.push_back(map[static_cast<std::size_t>(i)]);
         }

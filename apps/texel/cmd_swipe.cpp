@@ -50,7 +50,7 @@ void run(const SwipeArgs& a) {
   const Surface surface = prepare_surface(doc);
   const auto map = PlayerMap::from_surface(surface);
   double duration = 2.0;
-  const auto trace = finger_trace(a.finger, surface.grid().length_mm(), duration);
+  const auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
   const double frames_d = std::round(duration * config.rate_hz);
   if (frames_d > 2e9) throw InvalidArgument("--duration × --rate is " + detail::num(frames_d) + " samples; at most 2e9");
   const auto frames = static_cast<std::size_t>(frames_d);

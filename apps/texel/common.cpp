@@ -94,7 +94,7 @@ DeviceProfile resolve_device(const DeviceOptions& o, const DeviceProfile* curren
     throw InvalidArgument("--length is " + detail::num(*o.length_mm) + "; it must be a finite number of mm > 0");
   if (o.spacing_mm && !(std::isfinite(*o.spacing_mm) && *o.spacing_mm > 0))
     throw InvalidArgument("--spacing is " + detail::num(*o.spacing_mm) + "; it must be a finite number of mm > 0");
-  return with_grid(std::move(d), o.length_mm, o.spacing_mm);
+  return with_grid(std::move(d), millimetres(o.length_mm), millimetres(o.spacing_mm));
 }
 
 Document build_document(const std::optional<std::string>& doc_path, const DeviceOptions& d, const TextureOptions& t) {

@@ -25,7 +25,7 @@ std::vector<double> texel_frequencies(const Surface& surface) {
   std::vector<double> f;
   for (const auto& r : surface.regions())
     if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get()))
-      for (const auto& texel : t->texels()) f.push_back(texel.frequency_cpm);
+      for (const auto& texel : t->texels()) f.push_back(texel.frequency.value());
   return f;
 }
 
@@ -41,14 +41,14 @@ std::vector<mat::Variable> map_variables(const Document& doc, const Surface& sur
   using mat::Text;
   const Grid& g = surface.grid();
   std::vector<double> x(map.size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = g.position(static_cast<std::int64_t>(i));
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = g.position(static_cast<std::int64_t>(i)).value();
 
   mat::Struct params;
   params.add("device", Text{doc.device.name})
       .add("format", Text{std::string(to_string(doc.device.format))})
       .add("samples", Matrix::scalar(static_cast<double>(g.count)))
-      .add("spacing_mm", Matrix::scalar(g.spacing_mm))
-      .add("length_mm", Matrix::scalar(g.length_mm()))
+      .add("spacing_mm", Matrix::scalar(g.spacing.value()))
+      .add("length_mm", Matrix::scalar(g.length().value()))
       .add("regions", Matrix::scalar(static_cast<double>(surface.regions().size())));
   // The first Texel region's parameters (a one-region document's texture);
   // every region's full description is in `document`.
@@ -90,8 +90,8 @@ std::vector<mat::Variable> map_variables(const Document& doc, const Surface& sur
     for (std::size_t k = 0; k < t->texels().size(); ++k) {
       const Texel& tx = t->texels()[k];
       index.push_back(static_cast<double>(k));
-      start.push_back(reg.start_mm + tx.start_mm);
-      freq.push_back(tx.frequency_cpm);
+      start.push_back(reg.start.value() + tx.start.value());
+      freq.push_back(tx.frequency.value());
       amp.push_back(tx.envelope);
       region.push_back(static_cast<double>(r + 1));  // MATLAB counts from 1
     }
@@ -144,7 +144,7 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
     }
     case OutputKind::csv: {
       std::vector<double> x(map.size());
-      for (std::size_t i = 0; i < x.size(); ++i) x[i] = g.position(static_cast<std::int64_t>(i));
+      for (std::size_t i = 0; i < x.size(); ++i) x[i] = g.position(static_cast<std::int64_t>(i)).value();
       main.bytes = csv_columns("position_mm", "amplitude", x, map);
       break;
     }
@@ -157,10 +157,10 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
                    (surface.regions().size() == 1 ? surface.regions()[0].texture->describe()
                                                   : std::to_string(surface.regions().size()) + " regions");
       plot.positions_mm.resize(map.size());
-      for (std::size_t i = 0; i < map.size(); ++i) plot.positions_mm[i] = g.position(static_cast<std::int64_t>(i));
+      for (std::size_t i = 0; i < map.size(); ++i) plot.positions_mm[i] = g.position(static_cast<std::int64_t>(i)).value();
       plot.amplitudes = map;
       plot.frequencies_cpm = frequencies_cpm;
-      plot.excerpt_mm = std::min(6.0, g.length_mm());
+      plot.excerpt_mm = std::min(6.0, g.length().value());
       plot_map(plot, path);  // atomic on its own
       commit_extras_after(path, extra);
       return;

@@ -43,13 +43,13 @@ namespace texel::codec {
 /// A texture signal on a uniform spatial grid (sample i at i·spacing mm).
 struct Signal {
   std::vector<double> amplitude;  ///< nominally in [0, 1]
-  double spacing_mm = 0.0;        ///< > 0
+  Millimetres spacing{0.0};       ///< > 0
   std::string description;        ///< where it came from, for reports
 };
 
 struct LoadOptions {
   std::optional<DeviceProfile> device;     ///< grid and format of .bin/.npy (default tpad)
-  std::optional<double> spacing_mm;        ///< overrides the device's spacing for .bin/.npy
+  std::optional<Millimetres> spacing;      ///< overrides the device's spacing for .bin/.npy
   std::optional<MmPerSecond> swipe_speed;  ///< needed for time recordings (.wav, time/value .csv)
 };
 
@@ -122,7 +122,7 @@ struct EncodeResult {
   int evaluations = 0;
   double seconds = 0.0;
   std::size_t samples = 0;
-  double spacing_mm = 0.0;
+  Millimetres spacing{0.0};
 };
 
 /// Encodes a signal. Throws InvalidArgument for unusable input (too short,

@@ -50,7 +50,7 @@ codec::Signal signal_of(const py::handle& source, const py::object& device, std:
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
     codec::LoadOptions o;
     if (!device.is_none()) o.device = device_of(device, std::nullopt, std::nullopt);
-    o.spacing_mm = spacing_mm;
+    o.spacing = millimetres(spacing_mm);
     if (swipe_speed) o.swipe_speed = MmPerSecond(*swipe_speed);
     const auto path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
     py::gil_scoped_release release;
@@ -58,7 +58,7 @@ codec::Signal signal_of(const py::handle& source, const py::object& device, std:
   }
   const DeviceProfile d = device.is_none() ? load_device("tpad") : device_of(device, std::nullopt, std::nullopt);
   codec::Signal s;
-  s.spacing_mm = spacing_mm.value_or(d.spacing_mm);
+  s.spacing = Millimetres(spacing_mm.value_or(d.spacing.value()));
   s.description = "array";
   const py::array a = py::array::ensure(source);
   if (!a) throw py::type_error("encode: source must be a path or a 1-D array");
@@ -124,7 +124,7 @@ void register_codec(py::module_& m) {
                                 std::to_string(doc.regions.size()) + " region(s)" +
                                 (doc.regions.size() == 1 ? " holding a reference" : ""));
         const auto& r = doc.regions[0];
-        const double length = r.length_mm.value_or(doc.device.length_mm() - r.start_mm);
+        const double length = r.length ? r.length->value() : doc.device.length().value() - r.start.value();
         return codec::from_spec(r.texel, Millimetres(length), bits);
       },
       py::arg("document"), py::kw_only(), py::arg("bits") = 8u,
@@ -178,7 +178,7 @@ void register_codec(py::module_& m) {
       .def_readonly("evaluations", &codec::EncodeResult::evaluations)
       .def_readonly("seconds", &codec::EncodeResult::seconds, "Encoding time (s).")
       .def_readonly("samples", &codec::EncodeResult::samples)
-      .def_readonly("spacing_mm", &codec::EncodeResult::spacing_mm)
+      .def_property_readonly("spacing_mm", [](const codec::EncodeResult& r) { return r.spacing.value(); })
       .def("__repr__", [](const codec::EncodeResult& r) {
         return "<texel.EncodeResult P=" + std::to_string(r.spec.central_pitch.value()) +
                " dB I=" + std::to_string(r.spec.irregularity.value()) + " dB, " + std::to_string(r.bytes.size()) + " bytes>";

@@ -153,7 +153,7 @@ Returns (output, positions_mm): float32 arrays of one value per output sample. T
         s.speed_mm_s = speed_mm_s;
         s.start_mm = start_mm.value_or(0.0);
         s.extent_mm = extent_mm.value_or(0.0);
-        s.surface_mm = map->grid().length_mm();
+        s.surface_mm = map->grid().length().value();
         s.turn_s = turn_s;
         s.duration_s = duration_s;
         return play(*map, c, simulate_swipe(s), duration_s);

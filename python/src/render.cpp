@@ -112,8 +112,8 @@ py::dict reference_info_dict(const ReferenceInfo& info) {
 py::dict region_dict(const RegionSpec& r) {
   py::dict d;
   d["name"] = r.name;
-  d["start_mm"] = r.start_mm;
-  d["length_mm"] = r.length_mm ? py::cast(*r.length_mm) : py::none();
+  d["start_mm"] = r.start.value();
+  d["length_mm"] = r.length ? py::cast(r.length->value()) : py::none();
   if (r.reference) {
     d["kind"] = "reference";
     d["reference"] = r.reference->name;
@@ -133,7 +133,7 @@ py::dict region_dict(const RegionSpec& r) {
 DeviceProfile device_of(const py::handle& device, std::optional<double> length_mm, std::optional<double> spacing_mm) {
   DeviceProfile d =
       py::isinstance<DeviceProfile>(device) ? device.cast<DeviceProfile>() : load_device(device.cast<std::string>());
-  return with_grid(std::move(d), length_mm, spacing_mm);
+  return with_grid(std::move(d), millimetres(length_mm), millimetres(spacing_mm));
 }
 
 py::dict spec_dict(const TexelSpec& s) {
@@ -190,20 +190,20 @@ void register_render(py::module_& m) {
       .def_readonly("name", &DeviceProfile::name)
       .def_readonly("description", &DeviceProfile::description)
       .def_readonly("samples", &DeviceProfile::samples, "Samples along the active length.")
-      .def_readonly("spacing_mm", &DeviceProfile::spacing_mm, "Sample spacing Δx (mm).")
+      .def_property_readonly("spacing_mm", [](const DeviceProfile& d) { return d.spacing.value(); }, "Sample spacing Δx (mm).")
       .def_property_readonly(
           "format", [](const DeviceProfile& d) { return std::string(to_string(d.format)); },
           "Native sample format: u16le, u8, f32le or f64le.")
-      .def_readonly("refresh_hz", &DeviceProfile::refresh_hz, "Output update rate while playing (Hz).")
-      .def_readonly("band_min_cpm", &DeviceProfile::band_min_cpm, "Lowest renderable frequency (cycles/mm).")
-      .def_readonly("band_max_cpm", &DeviceProfile::band_max_cpm, "Highest renderable frequency (cycles/mm); 0 = Nyquist.")
-      .def_property_readonly("length_mm", &DeviceProfile::length_mm, "Active length (mm).")
-      .def_property_readonly("nyquist_cpm", &DeviceProfile::nyquist_cpm, "Spatial Nyquist frequency 1/(2Δx) (cycles/mm).")
+      .def_property_readonly("refresh_hz", [](const DeviceProfile& d) { return d.refresh.value(); }, "Output update rate while playing (Hz).")
+      .def_property_readonly("band_min_cpm", [](const DeviceProfile& d) { return d.band_min.value(); }, "Lowest renderable frequency (cycles/mm).")
+      .def_property_readonly("band_max_cpm", [](const DeviceProfile& d) { return d.band_max.value(); }, "Highest renderable frequency (cycles/mm); 0 = Nyquist.")
+      .def_property_readonly("length_mm", [](const DeviceProfile& d) { return d.length().value(); }, "Active length (mm).")
+      .def_property_readonly("nyquist_cpm", [](const DeviceProfile& d) { return d.nyquist().value(); }, "Spatial Nyquist frequency 1/(2Δx) (cycles/mm).")
       .def_property_readonly(
           "positions_mm",
           [](const DeviceProfile& d) {
             std::vector<double> x(static_cast<std::size_t>(d.samples));
-            for (std::size_t i = 0; i < x.size(); ++i) x[i] = d.grid().position(static_cast<std::int64_t>(i));
+            for (std::size_t i = 0; i < x.size(); ++i) x[i] = d.grid().position(static_cast<std::int64_t>(i)).value();
             return to_numpy(std::move(x));
           },
           "Position of every sample (mm).")
@@ -245,10 +245,12 @@ void register_render(py::module_& m) {
   py::class_<SampledProfile>(m, "SampledProfile",
                              "Coarse profile sampled every spacing_mm from position 0 (linear interpolation).")
       .def(py::init([](double spacing_mm, std::vector<double> values) {
-             return SampledProfile{spacing_mm, std::move(values)};
+             return SampledProfile{Millimetres(spacing_mm), std::move(values)};
            }),
            py::arg("spacing_mm"), py::arg("values"))
-      .def_readwrite("spacing_mm", &SampledProfile::spacing_mm)
+      .def_property(
+          "spacing_mm", [](const SampledProfile& p) { return p.spacing.value(); },
+          [](SampledProfile& p, double v) { p.spacing = Millimetres(v); })
       .def_readwrite("values", &SampledProfile::values);
   m.def("read_profile_csv", &read_profile_csv, py::arg("path"), "Reads a CSV of position_mm,value rows as a PointsProfile.");
 
@@ -342,8 +344,8 @@ Returns a 1-D numpy array owning its buffer (no copy). The GIL is released while
           const auto* t = dynamic_cast<const TexelTexture*>(reg.texture.get());
           if (!t) continue;
           for (const Texel& x : t->texels()) {
-            start.push_back(reg.start_mm + x.start_mm);
-            freq.push_back(x.frequency_cpm);
+            start.push_back(reg.start.value() + x.start.value());
+            freq.push_back(x.frequency.value());
             phase.push_back(x.phase_cycles);
             env.push_back(x.envelope);
             region.push_back(static_cast<std::int64_t>(r));

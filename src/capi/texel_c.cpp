@@ -164,9 +164,9 @@ texel_sample_format to_c(texel::SampleFormat f) {
 texel_device_info info_of(const texel::DeviceProfile& d) {
   texel_device_info i{};
   i.samples = d.samples;
-  i.spacing = Millimetres(d.spacing.value());
+  i.spacing_mm = d.spacing.value();
   i.length_mm = d.length().value();
-  i.refresh_hz = d.refresh_hz;
+  i.refresh_hz = d.refresh.value();
   i.format = to_c(d.format);
   i.bytes_per_sample = texel::bytes_per_sample(d.format);
   return i;
@@ -439,7 +439,7 @@ texel_status texel_encode(const double* amplitudes, std::size_t count, double sp
     need_finite(spacing_mm, "spacing_mm");
     texel::codec::Signal signal;
     if (count > 0) signal.amplitude.assign(amplitudes, amplitudes + count);
-    signal.spacing = Millimetres(spacing_mm);
+    signal.spacing = texel::Millimetres(spacing_mm);
     signal.description = "C API map";
     return std::make_unique<texel_encode_result>(
         texel_encode_result{texel::codec::encode(signal, texel::codec::EncoderConfig{})});

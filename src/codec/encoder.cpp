@@ -347,9 +347,9 @@ struct Fitter {
       s.fine_strength = two_scale->F;
       s.coarse = ValuesProfile{two_scale->c};
     }
-    const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx), band_max);
+    const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx), Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max});
     std::vector<double> a(samples);
-    t.render(Grid{0.0, dx, static_cast<std::int64_t>(samples)}, 0, a);
+    t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(samples)}, 0, a);
     if (two_scale) return perceive(split(a, dx, cfg, SplitMode::two_scale, two_scale->window).fine, dx, cfg.model, f_min);
     return perceive(centred(a), dx, cfg.model, f_min);
   }
@@ -435,7 +435,7 @@ std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double
 /// A fine-only Texel texture of the encoder's settings.
 TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, Millimetres length,
                           std::uint64_t seed = 0x5EED0001) {
-  return TexelTexture(fine_spec(p_db, i_db, cfg, band_max, seed), length, band_max);
+  return TexelTexture(fine_spec(p_db, i_db, cfg, band_max, seed), length, Sampling{Grid{}, band_max});
 }
 
 struct FineFit {
@@ -877,7 +877,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, quick);
     std::vector<double> r(n);
     fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
-        .render(Grid{0.0, dx, static_cast<std::int64_t>(n)}, 0, r);
+        .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, r);
     const Split own = split(r, dx, fit_cfg);
     const double shape = shape_distance_db(a, r, dx);
     if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
@@ -953,9 +953,9 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
 
   // The decoded texture on the input's grid, under the model.
   if (has_fine) {
-    const TexelTexture t(res.spec, Millimetres(len), band_max);
+    const TexelTexture t(res.spec, Millimetres(len), Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max});
     std::vector<double> d(n);
-    t.render(Grid{0.0, dx, static_cast<std::int64_t>(n)}, 0, d);
+    t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, d);
     EncoderConfig c2 = fit_cfg;
     const Split dsp = res.coarse ? split(d, dx, c2, SplitMode::two_scale, sp.window) : split(d, dx, c2, SplitMode::fine_only);
     res.decoded = perceive(dsp.fine, dx, cfg.model, res.coarse ? 1.0 / cfg.boundary.value() : 0.0);

@@ -98,15 +98,15 @@ Signal load_csv(const std::string& path, const LoadOptions& o) {
   return sig;
 }
 
-double device_spacing(const LoadOptions& o, const DeviceProfile& d) { return o.spacing.value() ? *o.spacing.value() : d.spacing.value(); }
+double device_spacing(const LoadOptions& o, const DeviceProfile& d) { return (o.spacing ? *o.spacing : d.spacing).value(); }
 
 }  // namespace
 
 Signal load_signal(const std::string& path, const LoadOptions& o) {
   const std::string ext = output_extension(path);
   const DeviceProfile device = o.device ? *o.device : load_device("tpad");
-  if (o.spacing.value() && !(std::isfinite(*o.spacing.value()) && *o.spacing.value() > 0))
-    throw InvalidArgument("--spacing is " + num(*o.spacing.value()) + "; it must be a finite number of mm > 0");
+  if (o.spacing && !(std::isfinite(o.spacing->value()) && o.spacing->value() > 0))
+    throw InvalidArgument("--spacing is " + num(o.spacing->value()) + "; it must be a finite number of mm > 0");
   Signal sig;
   if (ext == ".bin") {
     const std::string bytes = read_file(path);
@@ -127,9 +127,9 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
     // explicit spacing wins over the file's, the file's over the device's.
     mat::MapData m = mat::read_map(path);
     sig.amplitude = std::move(m.amplitude);
-    sig.spacing = Millimetres(o.spacing.value() ? *o.spacing.value() : m.spacing.value() ? *m.spacing.value() : device.spacing.value());
+    sig.spacing = Millimetres(o.spacing ? o.spacing->value() : m.spacing_mm ? *m.spacing_mm : device.spacing.value());
     sig.description = ".mat '" + m.variable + "' at " + num(sig.spacing.value()) + " mm" +
-                      (o.spacing.value() || m.spacing.value() ? "" : " (device " + device.name + ")");
+                      (o.spacing || m.spacing_mm ? "" : " (device " + device.name + ")");
   } else if (ext == ".csv") {
     sig = load_csv(path, o);
   } else if (ext == ".wav") {
@@ -143,7 +143,7 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
     const std::string bytes = read_file(path);
     const Bitstream b = parse_bitstream(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()));
     sig.amplitude = prepare_surface(decode_document(b, device)).render();
-    sig.spacing = Millimetres(device.spacing.value());
+    sig.spacing = device.spacing;
     sig.description = "bitstream decoded on " + device.name;
   } else {
     throw InvalidArgument("input '" + path + "' has extension '" + ext +

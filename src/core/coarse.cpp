@@ -69,7 +69,7 @@ struct Validator {
   }
   void operator()(const SampledProfile& p) const {
     if (!(std::isfinite(p.spacing.value()) && p.spacing.value() > 0.0))
-      throw InvalidArgument("coarse.spacing.value() is " + num(p.spacing.value()) + " mm; it must be a finite number > 0");
+      throw InvalidArgument("coarse.spacing_mm is " + num(p.spacing.value()) + " mm; it must be a finite number > 0");
     if (p.values.empty()) throw InvalidArgument("coarse sampled profile has no values");
     for (std::size_t i = 0; i < p.values.size(); ++i)
       check_unit_interval(p.values[i], "coarse.samples[" + std::to_string(i) + "]");

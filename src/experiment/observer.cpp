@@ -144,7 +144,7 @@ MatchPoint perceptual_target(const std::string& reference_name, const std::strin
   const Surface surface = prepare_surface(make_reference_document(profile, spec));
   codec::Signal signal;
   signal.amplitude = surface.render();
-  signal.spacing = Millimetres(profile.spacing.value());
+  signal.spacing = profile.spacing;
   signal.description = "reference " + reference_name + " on " + profile.name;
   const codec::EncodeResult r = codec::encode(signal, codec::EncoderConfig{});
   return {r.spec.central_pitch.value(), r.spec.irregularity.value()};

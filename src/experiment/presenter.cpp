@@ -58,7 +58,7 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
     so.path = b.substr(7);
     so.rate_hz = config.rate_hz;
     so.stream = SerialStream::drive;
-    const PlayerMap blank_map(Grid{0.0, 1.0, 1}, std::vector<float>{0.0f});
+    const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
     backend_ = make_serial_backend(so, blank_map);
   } else {
     throw InvalidArgument("backend is '" + b + "'; allowed: null, audio, serial:PATH");
@@ -102,7 +102,7 @@ void Presenter::show(std::unique_ptr<const PlayerMap> map) {
 
 void Presenter::blank() {
   // A one-sample map at rest: the finger is off it, so the player fades out.
-  player_->set_map(std::make_unique<const PlayerMap>(Grid{0.0, 1.0, 1}, std::vector<float>{0.0f}));
+  player_->set_map(std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f}));
 }
 
 void Presenter::pump() {

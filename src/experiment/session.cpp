@@ -244,7 +244,7 @@ struct Session::Impl {
         device(load_device(protocol.device)) {
     half_mm = device.length().value() / 2.0;
     for (const auto& r : device.layout)
-      if (r.name == "left" && r.length_mm > 0) half_mm = r.length_mm;
+      if (r.name == "left" && r.length.value() > 0) half_mm = r.length.value();
     start_block();
   }
 

@@ -511,16 +511,16 @@ MapData read_map(const std::string& path, const ReadOptions& options) {
       if (std::fabs(out.position_mm[i] - out.position_mm[i - 1] - step) > 0.01 * step)
         throw FormatError(what + " is not uniformly sampled at element " + std::to_string(i + 1) + " (step " +
                           num(out.position_mm[i] - out.position_mm[i - 1]) + " mm, expected " + num(step) + " mm)");
-    out.spacing = Millimetres(step);
+    out.spacing_mm = step;
   }
   if (const Info* sp = r.find("spacing_mm")) {
     const std::string what = "'" + path + "': variable 'spacing_mm'";
     if (sp->elements != std::size_t{1}) throw FormatError(what + " is " + sp->shape + "; it must be a scalar (mm)");
     const std::vector<double> v = r.vector(*sp);
     if (!(v[0] > 0.0)) throw FormatError(what + " is " + num(v[0]) + "; it must be > 0 mm");
-    if (out.spacing.value() && std::fabs(*out.spacing.value() - v[0]) > 0.01 * v[0])
-      throw FormatError(what + " is " + num(v[0]) + " mm but 'position_mm' steps by " + num(*out.spacing.value()) + " mm");
-    out.spacing = Millimetres(v[0]);
+    if (out.spacing_mm && std::fabs(*out.spacing_mm - v[0]) > 0.01 * v[0])
+      throw FormatError(what + " is " + num(v[0]) + " mm but 'position_mm' steps by " + num(*out.spacing_mm) + " mm");
+    out.spacing_mm = v[0];
   }
   return out;
 }

@@ -36,19 +36,20 @@ void check_region(const Document& doc, std::size_t i, std::string_view field) {
 // The surface keeps its regions sorted by start; documents need not be.
 const Region& surface_region(const Surface& surface, const RegionSpec& spec) {
   for (const Region& r : surface.regions())
-    if (r.start_mm == spec.start_mm) return r;
-  throw Error("internal: no surface region starts at " + num(spec.start_mm) + " mm");
+    if (r.start == spec.start) return r;
+  throw Error("internal: no surface region starts at " + num(spec.start.value()) + " mm");
 }
 
 // Samples [first, last) of the grid that belong to region r: the same
 // membership rule as Surface::render (start <= position < end).
 std::pair<std::size_t, std::size_t> region_samples(const Grid& grid, const Region& r) {
-  const double end = r.start_mm + r.length_mm;
-  auto first = static_cast<std::int64_t>(std::floor((r.start_mm - grid.origin.value()) / grid.spacing.value()));
+  const double start = r.start.value();
+  const double end = start + r.length.value();
+  auto first = static_cast<std::int64_t>(std::floor((start - grid.origin.value()) / grid.spacing.value()));
   first = std::clamp<std::int64_t>(first - 1, 0, grid.count);
-  while (first < grid.count && grid.position(first) < r.start_mm) ++first;
+  while (first < grid.count && grid.position(first).value() < start) ++first;
   std::int64_t last = first;
-  while (last < grid.count && grid.position(last) < end) ++last;
+  while (last < grid.count && grid.position(last).value() < end) ++last;
   return {static_cast<std::size_t>(first), static_cast<std::size_t>(last)};
 }
 
@@ -83,7 +84,7 @@ double bin_probability(const PitchDistribution& d, double a, double b) {
 HistogramView histogram_of(const TexelTexture& t, std::size_t bins) {
   std::vector<double> f;
   f.reserve(t.texels().size());
-  for (const Texel& k : t.texels()) f.push_back(k.frequency_cpm);
+  for (const Texel& k : t.texels()) f.push_back(k.frequency.value());
   const Histogram h = make_histogram(f, bins, AxisScale::log10);
   HistogramView v{h.edges, h.counts, {}};
   v.expected.reserve(h.counts.size());
@@ -98,7 +99,7 @@ HistogramView histogram_of(const TexelTexture& t, std::size_t bins) {
 
 // The region's spec as a bitstream (InvalidArgument when a field is not representable).
 std::vector<std::uint8_t> region_bitstream(const TexelTexture& t, const Region& r) {
-  return codec::write_bitstream(codec::from_spec(t.spec(), Millimetres(r.length_mm)));
+  return codec::write_bitstream(codec::from_spec(t.spec(), r.length));
 }
 
 std::vector<double> render_region(const Surface& surface, const Region& r, std::vector<double>* whole = nullptr) {
@@ -163,7 +164,7 @@ DesignView design_view(const Document& doc, const DesignOptions& options) {
   v.map.assign(map.begin(), map.end());
   for (const RegionSpec& spec : doc.regions) {
     const Region& sr = surface_region(surface, spec);
-    v.regions.push_back({spec.name, spec.reference ? "reference" : "texel", sr.start_mm, sr.length_mm});
+    v.regions.push_back({spec.name, spec.reference ? "reference" : "texel", sr.start, sr.length});
   }
   if (samples.size() >= 4) v.spectrum = spectrum_view(samples, v.grid.spacing.value(), options.spectrum_points);
 
@@ -199,7 +200,7 @@ MatchView match_region(const Document& doc, const MatchOptions& options) {
   if (target.size() < 4)
     throw InvalidArgument(region_label(doc, options.region) + " holds " + std::to_string(target.size()) +
                           " samples; at least 4 are needed to encode it");
-  codec::Signal signal{target, surface.grid().spacing.value(), "studio " + region_label(doc, options.region)};
+  codec::Signal signal{target, surface.grid().spacing, "studio " + region_label(doc, options.region)};
 
   MatchView m;
   m.result = codec::encode(signal, options.encoder);

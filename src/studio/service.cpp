@@ -553,7 +553,7 @@ struct Service::Impl {
       auto opt = [&](const char* k) {
         return g.contains(k) && g[k].is_number() ? std::optional(g[k].get<double>()) : std::nullopt;
       };
-      device = with_grid(*device, opt("length_mm"), opt("spacing_mm"));
+      device = with_grid(*device, millimetres(opt("length_mm")), millimetres(opt("spacing_mm")));
     }
     if (device) check_cost(j, *device, where);
     return parse_document(j.dump(), where);
@@ -600,7 +600,7 @@ struct Service::Impl {
         detail::base64_encode(std::span(reinterpret_cast<const unsigned char*>(v.map.data()), v.map.size() * sizeof(float)));
     r["regions"] = ojson::array();
     for (const auto& g : v.regions)
-      r["regions"].push_back({{"name", g.name}, {"kind", g.kind}, {"start_mm", g.start_mm}, {"length_mm", g.length_mm}});
+      r["regions"].push_back({{"name", g.name}, {"kind", g.kind}, {"start_mm", g.start.value()}, {"length_mm", g.length.value()}});
     r["region"] = v.analysed;
     r["spectrum"] = spectrum_json(v.spectrum);
     if (v.regions[v.analysed].kind == "texel") {

@@ -126,9 +126,9 @@ TEST(CApi, DeviceLookup) {
   const texel::DeviceProfile d = texel::load_device("tpad");
   EXPECT_EQ(info.samples, d.samples);
   EXPECT_EQ(info.samples, 19200);
-  EXPECT_DOUBLE_EQ(info.spacing_mm, d.spacing_mm);
-  EXPECT_DOUBLE_EQ(info.length_mm, d.length_mm());
-  EXPECT_DOUBLE_EQ(info.refresh_hz, d.refresh_hz);
+  EXPECT_DOUBLE_EQ(info.spacing_mm, d.spacing.value());
+  EXPECT_DOUBLE_EQ(info.length_mm, d.length().value());
+  EXPECT_DOUBLE_EQ(info.refresh_hz, d.refresh.value());
   EXPECT_EQ(info.format, TEXEL_SAMPLE_U16LE);
   EXPECT_EQ(info.bytes_per_sample, 2u);
 
@@ -484,7 +484,7 @@ TEST(CApi, EncodeDecodeRoundTrip) {
   Enc enc(raw);
 
   // The same as the library's encoder with its defaults.
-  texel::codec::Signal sig{m, info.spacing_mm, "test"};
+  texel::codec::Signal sig{m, texel::Millimetres(info.spacing_mm), "test"};
   const texel::codec::EncodeResult expected = texel::codec::encode(sig, texel::codec::EncoderConfig{});
 
   std::size_t needed = 0;

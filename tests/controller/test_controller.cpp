@@ -283,7 +283,7 @@ TEST(HostController, HostGoingAwayIsCountedAndTheMapKept) {
 
 TEST(HostController, PlayerDrivesTheDisplayThroughTheSerialBackend) {
   Rig rig;
-  auto map = std::make_unique<const PlayerMap>(Grid{0, 0.01, 5000}, ramp_map(5000));
+  auto map = std::make_unique<const PlayerMap>(Grid{Millimetres(0), Millimetres(0.01), 5000}, ramp_map(5000));
   SerialOptions o;
   o.path = rig.path;
   o.rate_hz = 1000;

@@ -64,7 +64,7 @@ TEST(Coarse, PointsProfileInterpolatesLinearlyAndHoldsBeyondTheEnds) {
 }
 
 TEST(Coarse, SampledProfileInterpolates) {
-  const SampledProfile p{0.5, {0.0, 1.0, 0.0}};
+  const SampledProfile p{Millimetres(0.5), {0.0, 1.0, 0.0}};
   const auto c = sample_at_texel_centres(p, Millimetres(0.5), 3);  // centres 0.25, 0.75, 1.25
   EXPECT_EQ(c, (std::vector<double>{0.5, 0.5, 0.0}));
 }

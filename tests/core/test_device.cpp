@@ -69,33 +69,33 @@ TEST(Device, TpadIsTheReferenceDevice) {
   // rendering.md §8: 19,200 unsigned 16-bit values, one per 0.0053 mm.
   const DeviceProfile d = load_device("tpad");
   EXPECT_EQ(d.samples, 19200);
-  EXPECT_EQ(d.spacing_mm, 0.0053);
+  EXPECT_EQ(d.spacing.value(), 0.0053);
   EXPECT_EQ(d.format, SampleFormat::u16le);
   EXPECT_EQ(d.native_bytes(), 38400u);
-  EXPECT_NEAR(d.length_mm(), 101.76, 1e-9);
-  EXPECT_NEAR(d.band_top_cpm(), 94.33962264150944, 1e-12);
-  EXPECT_EQ(d.band_min_cpm, 0.01);
+  EXPECT_NEAR(d.length().value(), 101.76, 1e-9);
+  EXPECT_NEAR(d.band_top().value(), 94.33962264150944, 1e-12);
+  EXPECT_EQ(d.band_min.value(), 0.01);
   ASSERT_EQ(d.layout.size(), 2u);  // the studies' left/right halves
   EXPECT_EQ(d.layout[0].name, "left");
-  EXPECT_EQ(d.layout[1].start_mm, 50.88);
+  EXPECT_EQ(d.layout[1].start.value(), 50.88);
   EXPECT_EQ(d.grid().count, 19200);
 }
 
 TEST(Device, WithGridOverridesLengthAndSpacing) {
-  const DeviceProfile g = with_grid(load_device("generic"), 2000.0, 0.005);
+  const DeviceProfile g = with_grid(load_device("generic"), Millimetres(2000.0), Millimetres(0.005));
   EXPECT_EQ(g.samples, 400000);
-  EXPECT_EQ(g.spacing_mm, 0.005);
-  EXPECT_NEAR(g.band_top_cpm(), 100.0, 1e-12);
-  const DeviceProfile t = with_grid(load_device("tpad"), 50.0, std::nullopt);
+  EXPECT_EQ(g.spacing.value(), 0.005);
+  EXPECT_NEAR(g.band_top().value(), 100.0, 1e-12);
+  const DeviceProfile t = with_grid(load_device("tpad"), Millimetres(50.0), std::nullopt);
   EXPECT_EQ(t.samples, std::llround(50.0 / 0.0053));
   EXPECT_TRUE(t.layout.empty() || t.layout.size() == 1) << "regions past the new end are dropped";
   EXPECT_LE(t.layout.size(), 1u);
   const DeviceProfile same = with_grid(load_device("tpad"), std::nullopt, std::nullopt);
   EXPECT_EQ(device_profile_json(same), device_profile_json(load_device("tpad")));
-  EXPECT_THROW(with_grid(load_device("tpad"), 0.0, std::nullopt), InvalidArgument);
-  EXPECT_THROW(with_grid(load_device("tpad"), -5.0, std::nullopt), InvalidArgument);
-  EXPECT_THROW(with_grid(load_device("tpad"), std::nullopt, 0.0), InvalidArgument);
-  EXPECT_THROW(with_grid(load_device("tpad"), std::nullopt, NAN), InvalidArgument);
+  EXPECT_THROW(with_grid(load_device("tpad"), Millimetres(0.0), std::nullopt), InvalidArgument);
+  EXPECT_THROW(with_grid(load_device("tpad"), Millimetres(-5.0), std::nullopt), InvalidArgument);
+  EXPECT_THROW(with_grid(load_device("tpad"), std::nullopt, Millimetres(0.0)), InvalidArgument);
+  EXPECT_THROW(with_grid(load_device("tpad"), std::nullopt, Millimetres(NAN)), InvalidArgument);
 }
 
 TEST(Device, UserProfileFromAFile) {
@@ -106,7 +106,7 @@ TEST(Device, UserProfileFromAFile) {
   EXPECT_EQ(p.samples, 1000);
   EXPECT_EQ(p.format, SampleFormat::u8);
   EXPECT_EQ(p.native_bytes(), 1000u);
-  EXPECT_EQ(p.band_top_cpm(), 50.0);
+  EXPECT_EQ(p.band_top().value(), 50.0);
 }
 
 TEST(Device, UserProfileFromTexelDevicePath) {
@@ -165,16 +165,16 @@ TEST(Device, ProfileJsonRoundTrips) {
     EXPECT_EQ(b.name, a.name);
     EXPECT_EQ(b.description, a.description);
     EXPECT_EQ(b.samples, a.samples);
-    EXPECT_EQ(b.spacing_mm, a.spacing_mm);
+    EXPECT_EQ(b.spacing.value(), a.spacing.value());
     EXPECT_EQ(b.format, a.format);
-    EXPECT_EQ(b.refresh_hz, a.refresh_hz);
-    EXPECT_EQ(b.band_min_cpm, a.band_min_cpm);
-    EXPECT_EQ(b.band_max_cpm, a.band_max_cpm);
+    EXPECT_EQ(b.refresh.value(), a.refresh.value());
+    EXPECT_EQ(b.band_min.value(), a.band_min.value());
+    EXPECT_EQ(b.band_max.value(), a.band_max.value());
     ASSERT_EQ(b.layout.size(), a.layout.size());
     for (std::size_t i = 0; i < a.layout.size(); ++i) {
       EXPECT_EQ(b.layout[i].name, a.layout[i].name);
-      EXPECT_EQ(b.layout[i].start_mm, a.layout[i].start_mm);
-      EXPECT_EQ(b.layout[i].length_mm, a.layout[i].length_mm);
+      EXPECT_EQ(b.layout[i].start.value(), a.layout[i].start.value());
+      EXPECT_EQ(b.layout[i].length.value(), a.layout[i].length.value());
     }
   }
 }

@@ -27,7 +27,7 @@ struct Case {
 
 std::vector<Case> cases() {
   std::vector<Case> c;
-  const Grid tpad{0.0, 0.0053, 19200};
+  const Grid tpad{Millimetres(0.0), Millimetres(0.0053), 19200};
   {
     TexelSpec s;
     s.seed = 7;
@@ -39,7 +39,7 @@ std::vector<Case> cases() {
     s.texel_length = Millimetres(1.0);
     s.central_pitch = Decibels(6.0);
     s.irregularity = Decibels(3.0);
-    c.push_back({"generic 2000 mm, 1 mm texels", s, 2000.0, Grid{0.0, 0.005, 400000}});
+    c.push_back({"generic 2000 mm, 1 mm texels", s, 2000.0, Grid{Millimetres(0.0), Millimetres(0.005), 400000}});
   }
   {
     TexelSpec s;
@@ -63,7 +63,7 @@ std::vector<Case> cases() {
     s.texel_length = Millimetres(0.01);
     s.fill = Fill::partial_final_texel;
     s.central_pitch = Decibels(15.0);
-    c.push_back({"offset grid, partial texel, short texels", s, 33.33, Grid{-0.37, 0.0013, 30000}});
+    c.push_back({"offset grid, partial texel, short texels", s, 33.33, Grid{Millimetres(-0.37), Millimetres(0.0013), 30000}});
   }
   return c;
 }
@@ -76,8 +76,8 @@ void expect_window_exact(const TexelTexture& t, const Grid& g, std::int64_t firs
   t.render(g, first, out);
   std::int64_t mismatches = 0;
   for (std::int64_t j = 0; j < len; ++j) {
-    const double x = g.position(first + j);
-    const double want = t.amplitude_at(x);
+    const double x = g.position(first + j).value();
+    const double want = t.amplitude_at(Millimetres(x));
     const double got = out[static_cast<std::size_t>(j)];
     if (bits(got) != bits(want) && ++mismatches <= 3)
       ADD_FAILURE() << name << ": sample " << first + j << " (x = " << x << " mm) rendered " << got << ", amplitude_at gives "
@@ -88,7 +88,7 @@ void expect_window_exact(const TexelTexture& t, const Grid& g, std::int64_t firs
 
 TEST(RenderExact, WholeGridMatchesAmplitudeAt) {
   for (const Case& c : cases()) {
-    const TexelTexture t(c.spec, Millimetres(c.length_mm), CyclesPerMm(c.grid.nyquist_cpm()));
+    const TexelTexture t(c.spec, Millimetres(c.length_mm), Sampling{c.grid});
     expect_window_exact(t, c.grid, 0, c.grid.count, c.name);
   }
 }
@@ -98,7 +98,7 @@ TEST(RenderExact, EveryWindowMatchesAmplitudeAt) {
   const std::int64_t firsts[] = {0, 1, 3, 7, 47, 1001};
   const std::int64_t lens[] = {1, 2, 3, 5, 8, 9, 17, 100, 4099};
   for (const Case& c : cases()) {
-    const TexelTexture t(c.spec, Millimetres(c.length_mm), CyclesPerMm(c.grid.nyquist_cpm()));
+    const TexelTexture t(c.spec, Millimetres(c.length_mm), Sampling{c.grid});
     for (std::int64_t first : firsts)
       for (std::int64_t len : lens) expect_window_exact(t, c.grid, first, len, c.name);
     expect_window_exact(t, c.grid, c.grid.count - 9, 9, c.name);

@@ -24,7 +24,7 @@ std::shared_ptr<const Texture> texture(double p_db, std::uint64_t seed, double l
   s.seed = seed;
   s.coarse = SineProfile{Millimetres(5.0), 0.0};
   s.coarse_strength = 0.4;
-  return std::make_shared<TexelTexture>(s, Millimetres(length_mm), CyclesPerMm(g.nyquist_cpm()));
+  return std::make_shared<TexelTexture>(s, Millimetres(length_mm), Sampling{g});
 }
 
 }  // namespace
@@ -35,7 +35,7 @@ TEST(Surface, EachHalfEqualsItsTextureRenderedAlone) {
   const double half = 50.88;
   auto left = texture(10.0, 1, half, g);
   auto right = texture(15.0, 2, half, g);
-  const Surface surface(g, {Region{"left", 0.0, half, left}, Region{"right", half, half, right}});
+  const Surface surface(g, {Region{"left", Millimetres(0.0), Millimetres(half), left}, Region{"right", Millimetres(half), Millimetres(half), right}});
   const auto map = surface.render();
   ASSERT_EQ(map.size(), 19200u);
 
@@ -46,7 +46,7 @@ TEST(Surface, EachHalfEqualsItsTextureRenderedAlone) {
   // Right: rendered alone on its own 50.88 mm device (positions j·Δx from its
   // left edge). On the surface the positions are i·Δx − 50.88 mm, equal up to
   // rounding (< 1e-13 mm), so amplitudes agree within 2π·f·1e-13 < 1e-10.
-  const Grid own{0.0, g.spacing_mm, 9600};
+  const Grid own{Millimetres(0.0), g.spacing, 9600};
   right->render(own, 0, alone);
   double worst = 0.0;
   for (std::size_t j = 0; j < 9600; ++j) worst = std::max(worst, std::fabs(map[9600 + j] - alone[j]));
@@ -56,11 +56,11 @@ TEST(Surface, EachHalfEqualsItsTextureRenderedAlone) {
 }
 
 TEST(Surface, SamplesInNoRegionAreAtRest) {
-  const Grid g{0.0, 0.01, 1000};  // 10 mm
-  const Surface s(g, {Region{"mid", 3.0, 4.0, texture(10.0, 1, 4.0, g)}});
+  const Grid g{Millimetres(0.0), Millimetres(0.01), 1000};  // 10 mm
+  const Surface s(g, {Region{"mid", Millimetres(3.0), Millimetres(4.0), texture(10.0, 1, 4.0, g)}});
   const auto map = s.render();
   for (std::size_t i = 0; i < map.size(); ++i) {
-    const double x = g.position(static_cast<std::int64_t>(i));
+    const double x = g.position(static_cast<std::int64_t>(i)).value();
     if (x < 3.0 - 1e-9 || x >= 7.0 - 1e-9) {
       ASSERT_EQ(map[i], 0.0) << "x = " << x;
     }
@@ -71,7 +71,7 @@ TEST(Surface, SamplesInNoRegionAreAtRest) {
 }
 
 TEST(Surface, RejectsOverlappingAndOutOfRangeRegions) {
-  const Grid g{0.0, 0.01, 1000};
+  const Grid g{Millimetres(0.0), Millimetres(0.01), 1000};
   auto t = texture(10.0, 1, 6.0, g);
   auto message = [&](std::vector<Region> r) {
     try {
@@ -81,19 +81,19 @@ TEST(Surface, RejectsOverlappingAndOutOfRangeRegions) {
     }
     return std::string("(accepted)");
   };
-  EXPECT_NE(message({Region{"a", 0.0, 6.0, t}, Region{"b", 5.0, 5.0, t}}).find("overlap"), std::string::npos);
-  EXPECT_NE(message({Region{"a", 5.0, 6.0, t}}).find("past the device"), std::string::npos);
-  EXPECT_NE(message({Region{"a", -1.0, 2.0, t}}).find("start_mm"), std::string::npos);
-  EXPECT_NE(message({Region{"a", 0.0, 0.0, t}}).find("length_mm"), std::string::npos);
-  EXPECT_NE(message({Region{"a", 0.0, 1.0, nullptr}}).find("no texture"), std::string::npos);
-  EXPECT_EQ(message({Region{"a", 0.0, 5.0, t}, Region{"b", 5.0, 5.0, t}}), "(accepted)");  // touching is fine
+  EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(6.0), t}, Region{"b", Millimetres(5.0), Millimetres(5.0), t}}).find("overlap"), std::string::npos);
+  EXPECT_NE(message({Region{"a", Millimetres(5.0), Millimetres(6.0), t}}).find("past the device"), std::string::npos);
+  EXPECT_NE(message({Region{"a", Millimetres(-1.0), Millimetres(2.0), t}}).find("start_mm"), std::string::npos);
+  EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(0.0), t}}).find("length_mm"), std::string::npos);
+  EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(1.0), nullptr}}).find("no texture"), std::string::npos);
+  EXPECT_EQ(message({Region{"a", Millimetres(0.0), Millimetres(5.0), t}, Region{"b", Millimetres(5.0), Millimetres(5.0), t}}), "(accepted)");  // touching is fine
 }
 
 RC_GTEST_PROP(Surface, AnyWindowEqualsTheWholeMap, ()) {
   const Grid g = load_device("tpad").grid();
   const auto seed = *rc::gen::arbitrary<std::uint64_t>();
-  const Surface s(g, {Region{"left", 0.0, 50.88, texture(10.0, seed, 50.88, g)},
-                      Region{"right", 50.88, 50.88, texture(12.0, seed + 1, 50.88, g)}});
+  const Surface s(g, {Region{"left", Millimetres(0.0), Millimetres(50.88), texture(10.0, seed, 50.88, g)},
+                      Region{"right", Millimetres(50.88), Millimetres(50.88), texture(12.0, seed + 1, 50.88, g)}});
   const auto full = s.render();
   for (int w = 0; w < 10; ++w) {
     const auto first = *rc::gen::inRange<std::size_t>(0, full.size());

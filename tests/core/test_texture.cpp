@@ -12,10 +12,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "texel/device.hpp"
+#include "texel/reference.hpp"
 #include "texel/error.hpp"
 #include "texel/texture.hpp"
 
@@ -27,7 +30,7 @@ constexpr double tpad_dx = 0.0053;
 constexpr double tpad_nyquist = 0.5 / tpad_dx;
 
 TexelTexture make(const TexelSpec& spec, double length_mm = 101.76) {
-  return TexelTexture(spec, Millimetres(length_mm), CyclesPerMm(tpad_nyquist));
+  return TexelTexture(spec, Millimetres(length_mm), Sampling{Grid{}, CyclesPerMm(tpad_nyquist)});
 }
 
 std::vector<double> render(const TexelTexture& t, const Grid& g) {
@@ -37,7 +40,7 @@ std::vector<double> render(const TexelTexture& t, const Grid& g) {
 }
 
 Grid tpad_grid(double length_mm = 101.76) {
-  return Grid{0.0, tpad_dx, static_cast<std::int64_t>(std::llround(length_mm / tpad_dx))};
+  return Grid{Millimetres(0.0), Millimetres(tpad_dx), static_cast<std::int64_t>(std::llround(length_mm / tpad_dx))};
 }
 
 double ref_sin(double cycles) { return std::sin(2.0 * std::numbers::pi * cycles); }
@@ -64,10 +67,10 @@ BoundaryJumps boundary_jumps(const TexelTexture& t, double delta = 1e-4) {
   const double L = t.spec().texel_length.value();
   for (std::size_t k = 0; k + 1 < tx.size(); ++k) {
     const double b = static_cast<double>(k + 1) * L;
-    const Grid g{b - 4.5 * delta, delta, 9};
+    const Grid g{Millimetres(b - 4.5 * delta), Millimetres(delta), 9};
     const auto a = render(t, g);
     const double gain = std::max(tx[k].envelope, tx[k + 1].envelope) * t.spec().fine_strength / 2.0;
-    const double slope = gain * 2.0 * std::numbers::pi * std::max(tx[k].frequency_cpm, tx[k + 1].frequency_cpm);
+    const double slope = gain * 2.0 * std::numbers::pi * std::max(tx[k].frequency.value(), tx[k + 1].frequency.value());
     const double bound = slope * delta * (1.0 + 1e-9) + 1e-12;
     double step = 0.0;
     for (std::size_t i = 0; i + 1 < a.size(); ++i) step = std::max(step, std::fabs(a[i + 1] - a[i]));
@@ -103,7 +106,7 @@ TEST_P(Continuity, NoPhaseJumpAtTexelBoundaries) {
   // Continuity of the stored phases: texel k+1 starts where texel k ends.
   const auto& tx = t.texels();
   for (std::size_t k = 0; k + 1 < tx.size(); ++k) {
-    const double end = tx[k].phase_cycles + tx[k].frequency_cpm * c.L;
+    const double end = tx[k].phase_cycles + tx[k].frequency.value() * c.L;
     const double d = std::fabs(tx[k + 1].phase_cycles - (end - std::floor(end)));
     ASSERT_LT(std::min(d, 1.0 - d), 1e-12) << "texel " << k;
   }
@@ -155,13 +158,13 @@ RC_GTEST_PROP(Texture, AmplitudesObeyTheStrengthFormulas, ()) {
     const double x = static_cast<double>(i) * tpad_dx;
     RC_ASSERT(a[i] >= 0.0);
     RC_ASSERT(a[i] <= 1.0);
-    const std::int64_t k = t.texel_at(x);
+    const std::int64_t k = t.texel_at(Millimetres(x));
     if (k < 0) {
       RC_ASSERT(a[i] == 0.0);
       continue;
     }
     const Texel& tk = tx[static_cast<std::size_t>(k)];
-    const double sine = ref_sin(tk.phase_cycles + tk.frequency_cpm * (x - tk.start_mm));
+    const double sine = ref_sin(tk.phase_cycles + tk.frequency.value() * (x - tk.start.value()));
     const double a_ref = tk.envelope * (1.0 - F * (1.0 - sine) / 2.0);
     RC_ASSERT(std::fabs(a[i] - a_ref) <= 1e-12);
     // The fine oscillation stays under the texel's envelope and above e·(1 − F).
@@ -181,7 +184,7 @@ TEST(Texture, CornerCaseFineOnlyIsFullRangeSinusoid) {
   double lo = 1.0, hi = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const double x = static_cast<double>(i) * tpad_dx;
-    const auto k = t.texel_at(x);
+    const auto k = t.texel_at(Millimetres(x));
     if (k < 0) {  // past the 407 whole texels (101.75 mm): at rest
       ASSERT_GE(x, 101.75 - 1e-9);
       ASSERT_EQ(a[i], 0.0);
@@ -189,7 +192,7 @@ TEST(Texture, CornerCaseFineOnlyIsFullRangeSinusoid) {
     }
     const Texel& tk = t.texels()[static_cast<std::size_t>(k)];
     ASSERT_EQ(tk.envelope, 1.0);
-    ASSERT_NEAR(a[i], (1.0 + ref_sin(tk.phase_cycles + tk.frequency_cpm * (x - tk.start_mm))) / 2.0, 1e-12);
+    ASSERT_NEAR(a[i], (1.0 + ref_sin(tk.phase_cycles + tk.frequency.value() * (x - tk.start.value()))) / 2.0, 1e-12);
     lo = std::min(lo, a[i]);
     hi = std::max(hi, a[i]);
   }
@@ -210,7 +213,7 @@ TEST(Texture, CornerCaseCoarseOnlyIsTheBareCoarseMap) {
   ASSERT_EQ(t.texels().size(), 20u);
   const auto a = render(t, tpad_grid(10.0));
   for (std::size_t i = 0; i < a.size(); ++i) {
-    const auto k = t.texel_at(static_cast<double>(i) * tpad_dx);
+    const auto k = t.texel_at(Millimetres(static_cast<double>(i) * tpad_dx));
     const double want = k < 0 ? 0.0 : v.values[static_cast<std::size_t>(k)];
     ASSERT_EQ(a[i], want) << "sample " << i;  // dyadic values: exact
   }
@@ -224,7 +227,7 @@ TEST(Texture, CornerCaseNoStrengthIsAFlatSurface) {
   s.coarse_strength = 0.0;
   s.fine_strength = 0.0;
   const auto t = make(s, 10.0);  // 33 whole texels = 9.9 mm, then 0.1 mm at rest
-  ASSERT_NEAR(t.textured_end_mm(), 9.9, 1e-12);
+  ASSERT_NEAR(t.textured_end().value(), 9.9, 1e-12);
   const auto a = render(t, tpad_grid(10.0));
   for (std::size_t i = 0; i < a.size(); ++i) {
     const double x = static_cast<double>(i) * tpad_dx;
@@ -239,7 +242,7 @@ TEST(Texture, PartialFillRendersTheFinalTexel) {
   s.fill = Fill::partial_final_texel;
   const auto t = make(s, 10.0);
   EXPECT_EQ(t.texels().size(), 34u);
-  EXPECT_EQ(t.textured_end_mm(), 10.0);
+  EXPECT_EQ(t.textured_end().value(), 10.0);
   const auto a = render(t, tpad_grid(10.0));
   EXPECT_EQ(a.back(), 1.0);  // x = 9.9958 mm, inside the partial texel
   EXPECT_EQ(texel_count(Millimetres(10.0), Millimetres(0.3), Fill::whole_texels), 33u);
@@ -260,7 +263,7 @@ TEST(Texture, CoarseLayoutDoesNotDependOnTheSeedButFineLayoutDoes) {
   std::size_t freq_differ = 0;
   for (std::size_t k = 0; k < t1.texels().size(); ++k) {
     ASSERT_EQ(t1.texels()[k].envelope, t2.texels()[k].envelope) << "texel " << k;
-    freq_differ += t1.texels()[k].frequency_cpm != t2.texels()[k].frequency_cpm;
+    freq_differ += t1.texels()[k].frequency.value() != t2.texels()[k].frequency.value();
   }
   EXPECT_EQ(freq_differ, t1.texels().size());
   EXPECT_NE(t1.texels()[0].phase_cycles, t2.texels()[0].phase_cycles);
@@ -313,11 +316,11 @@ RC_GTEST_PROP(Texture, AnyWindowEqualsTheFullRender, ()) {
 
 TEST(Texture, OutsideTheTexturedSpanIsAtRest) {
   const auto t = make(TexelSpec{}, 10.0);
-  EXPECT_EQ(t.amplitude_at(-0.001), 0.0);
-  EXPECT_EQ(t.amplitude_at(10.0), 0.0);
-  EXPECT_EQ(t.amplitude_at(1e9), 0.0);
+  EXPECT_EQ(t.amplitude_at(Millimetres(-0.001)), 0.0);
+  EXPECT_EQ(t.amplitude_at(Millimetres(10.0)), 0.0);
+  EXPECT_EQ(t.amplitude_at(Millimetres(1e9)), 0.0);
   std::vector<double> out(100, -1.0);
-  t.render(Grid{-1.0, 0.005, 100}, 0, out);  // positions -1 … -0.505 mm
+  t.render(Grid{Millimetres(-1.0), Millimetres(0.005), 100}, 0, out);  // positions -1 … -0.505 mm
   EXPECT_TRUE(std::all_of(out.begin(), out.end(), [](double v) { return v == 0.0; }));
 }
 
@@ -348,4 +351,47 @@ TEST(Texture, RejectsBadSpecsNamingTheField) {
   s = TexelSpec{};
   s.coarse = SineProfile{Millimetres(0.0), 0.0};
   EXPECT_NE(message(s).find("coarse.period_mm"), std::string::npos);
+}
+
+TEST(Texture, SampleIsTheRenderersValueAtAnyPosition) {
+  // sample(x) is the renderer's own value (not the slow reference path), for
+  // every kind of texture and through the one prepare() signature.
+  const DeviceProfile tpad = load_device("tpad");
+  const Sampling sampling{tpad.grid(), tpad.band_top()};
+  TexelSpec spec;
+  spec.seed = 11;
+  spec.coarse = SineProfile{Millimetres(7.0), 30.0};
+  spec.coarse_strength = 0.3;
+  ReferenceSpec pink;
+  pink.name = "pink";
+  ReferenceSpec patch;
+  patch.name = "patch-4.6";
+  const std::vector<std::shared_ptr<const Texture>> textures{prepare(spec, tpad.length(), sampling),
+                                                             prepare(pink, tpad.length(), sampling),
+                                                             prepare(patch, tpad.length(), sampling)};
+  for (const auto& t : textures) {
+    std::vector<double> map(static_cast<std::size_t>(tpad.samples));
+    t->render(tpad.grid(), 0, map);
+    for (std::int64_t i = 0; i < tpad.samples; i += 97)
+      ASSERT_EQ(t->sample(tpad.grid().position(i)), map[static_cast<std::size_t>(i)]) << t->describe() << " sample " << i;
+    EXPECT_EQ(t->sample(Millimetres(-1.0)), 0.0) << t->describe();
+    EXPECT_EQ(t->sample(tpad.length() + Millimetres(1.0)), 0.0) << t->describe();
+  }
+}
+
+TEST(Texture, PrepareIsTheConstructorUnderOneSignature) {
+  const DeviceProfile tpad = load_device("tpad");
+  const Sampling sampling{tpad.grid(), tpad.band_top()};
+  TexelSpec spec;
+  spec.seed = 5;
+  const auto prepared = prepare(spec, Millimetres(20.0), sampling);
+  const TexelTexture direct(spec, Millimetres(20.0), sampling);
+  const auto* t = dynamic_cast<const TexelTexture*>(prepared.get());
+  ASSERT_NE(t, nullptr);
+  ASSERT_EQ(t->texels().size(), direct.texels().size());
+  for (std::size_t k = 0; k < direct.texels().size(); ++k)
+    EXPECT_EQ(t->texels()[k].frequency.value(), direct.texels()[k].frequency.value());
+  // band_top 0 means the grid's Nyquist frequency.
+  EXPECT_EQ((Sampling{tpad.grid()}.top().value()), tpad.nyquist().value());
+  EXPECT_EQ(sampling.top().value(), tpad.band_top().value());
 }

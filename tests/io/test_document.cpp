@@ -36,7 +36,7 @@ bool same_coarse(const CoarseProfile& a, const CoarseProfile& b) {
   if (const auto* x = std::get_if<PointsProfile>(&a)) return x->points == std::get<PointsProfile>(b).points;
   const auto& x = std::get<SampledProfile>(a);
   const auto& y = std::get<SampledProfile>(b);
-  return x.spacing_mm == y.spacing_mm && x.values == y.values;
+  return x.spacing.value() == y.spacing.value() && x.values == y.values;
 }
 
 void expect_same(const TexelSpec& a, const TexelSpec& b) {
@@ -65,8 +65,8 @@ void expect_same(const Document& a, const Document& b) {
   ASSERT_EQ(a.regions.size(), b.regions.size());
   for (std::size_t i = 0; i < a.regions.size(); ++i) {
     EXPECT_EQ(a.regions[i].name, b.regions[i].name);
-    EXPECT_EQ(a.regions[i].start_mm, b.regions[i].start_mm);
-    EXPECT_EQ(a.regions[i].length_mm, b.regions[i].length_mm);
+    EXPECT_EQ(a.regions[i].start, b.regions[i].start);
+    EXPECT_EQ(a.regions[i].length, b.regions[i].length);
     EXPECT_EQ(a.regions[i].reference.has_value(), b.regions[i].reference.has_value());
     EXPECT_EQ(a.regions[i].coarse_reference.has_value(), b.regions[i].coarse_reference.has_value());
     expect_same(a.regions[i].texel, b.regions[i].texel);
@@ -152,21 +152,21 @@ RC_GTEST_PROP(Document, RoundTripsThroughJson, ()) {
     DeviceProfile dev;  // an inline, user-defined device
     dev.name = "rig";
     dev.samples = 5000;
-    dev.spacing_mm = 0.004;
+    dev.spacing = Millimetres(0.004);
     dev.format = SampleFormat::f32le;
-    dev.refresh_hz = 1000.0;
+    dev.refresh = Hertz(1000.0);
     d.device = dev;
     d.device_inline = true;
   } else {
     d.device = load_device("tpad");
   }
-  const double total = d.device.length_mm();
+  const double total = d.device.length().value();
   if (layout == 1) {
     for (int r = 0; r < 2; ++r) {
       RegionSpec spec;
       spec.name = r == 0 ? "left" : "right";
-      spec.start_mm = r * 50.88;
-      spec.length_mm = 50.88;
+      spec.start = Millimetres(r * 50.88);
+      spec.length = Millimetres(50.88);
       spec.texel = random_spec(50.88);
       d.regions.push_back(spec);
     }
@@ -289,7 +289,7 @@ TEST(Document, RendersLikeTheTextureItDescribes) {
   s.coarse_strength = 0.3;
   const DeviceProfile tpad = load_device("tpad");
   const Surface surface = prepare_surface(make_document(tpad, s));
-  const TexelTexture alone(s, Millimetres(tpad.length_mm()), CyclesPerMm(tpad.band_top_cpm()));
+  const TexelTexture alone(s, tpad.length(), Sampling{tpad.grid(), tpad.band_top()});
   std::vector<double> want(static_cast<std::size_t>(tpad.samples));
   alone.render(tpad.grid(), 0, want);
   const auto got = surface.render();

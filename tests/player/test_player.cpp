@@ -25,9 +25,9 @@ namespace {
 constexpr double pi = std::numbers::pi;
 
 std::unique_ptr<const PlayerMap> make_map(double length_mm, double spacing_mm, const std::function<double(double)>& f) {
-  Grid g{0.0, spacing_mm, static_cast<std::int64_t>(std::llround(length_mm / spacing_mm))};
+  Grid g{Millimetres(0.0), Millimetres(spacing_mm), static_cast<std::int64_t>(std::llround(length_mm / spacing_mm))};
   std::vector<float> v(static_cast<std::size_t>(g.count));
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(f(g.position(static_cast<std::int64_t>(i))));
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(f(g.position(static_cast<std::int64_t>(i)).value()));
   return std::make_unique<const PlayerMap>(g, std::move(v));
 }
 
@@ -219,11 +219,11 @@ TEST(Player, RegionBoundaryMatchesTheSurfaceMap) {
   doc.regions.clear();
   RegionSpec left, right;
   left.name = "left";
-  left.length_mm = 50.88;
+  left.length = Millimetres(50.88);
   left.texel.central_pitch = Decibels(5);
   right.name = "right";
-  right.start_mm = 50.88;
-  right.length_mm = 50.88;
+  right.start = Millimetres(50.88);
+  right.length = Millimetres(50.88);
   right.texel.central_pitch = Decibels(15);
   right.texel.seed = 7;
   doc.regions = {left, right};
@@ -237,7 +237,7 @@ TEST(Player, RegionBoundaryMatchesTheSurfaceMap) {
   for (std::size_t i = 1000; i < out.size(); ++i) {
     const double x = 45 + 50 * static_cast<double>(i) / c.rate_hz;
     ASSERT_NEAR(pos[i], x, 1e-4);
-    const double u = x / surface.grid().spacing_mm;
+    const double u = x / surface.grid().spacing.value();
     const auto k = static_cast<std::size_t>(u);
     const double expect = ref[k] + (ref[k + 1] - ref[k]) * (u - static_cast<double>(k));
     ASSERT_NEAR(out[i], expect, 1e-5) << "x=" << x;
@@ -310,7 +310,7 @@ TEST(Player, ConfigIsValidated) {
   c.lowpass_hz = 30000;
   EXPECT_THROW(validate(c), InvalidArgument);
   EXPECT_THROW(parse_output_mode("loud"), InvalidArgument);
-  EXPECT_THROW(PlayerMap(Grid{0, 0.1, 3}, std::vector<float>(2)), InvalidArgument);
+  EXPECT_THROW(PlayerMap(Grid{Millimetres(0), Millimetres(0.1), 3}, std::vector<float>(2)), InvalidArgument);
 }
 
 // -------------------------------------------------------- finger sources

@@ -65,7 +65,7 @@ TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
     std::vector<float> v(19200);
     for (std::size_t i = 0; i < v.size(); ++i)
       v[i] = static_cast<float>(level * (0.5 + 0.5 * std::sin(0.05 * static_cast<double>(i))));
-    return std::make_unique<const PlayerMap>(Grid{0.0, 0.0053, 19200}, std::move(v));
+    return std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, std::move(v));
   };
   for (OutputMode mode : {OutputMode::vibration, OutputMode::carrier, OutputMode::amplitude}) {
     PlayerConfig c;

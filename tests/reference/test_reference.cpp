@@ -14,7 +14,7 @@
 using namespace texel;
 
 namespace {
-const Grid tpad{0.0, 0.0053, 19200};
+const Grid tpad{Millimetres(0.0), Millimetres(0.0053), 19200};
 
 ReferenceSpec spec(const std::string& name, std::uint64_t seed = 1) {
   ReferenceSpec s;
@@ -50,7 +50,7 @@ TEST(ReferenceParams, ValidatesKeysRangesAndKinds) {
   // A frequency at or above Nyquist is an error, not silent aliasing.
   ReferenceSpec hi = spec("2sin");
   set_reference_param(hi, "frequencies_cpm=2.5,100");
-  EXPECT_THROW(ReferenceTexture(hi, Millimetres(10), tpad), InvalidArgument);
+  EXPECT_THROW(ReferenceTexture(hi, Millimetres(10), Sampling{tpad}), InvalidArgument);
 }
 
 TEST(ReferenceDeterminism, SameSeedSameBytesAnyWindow) {
@@ -61,11 +61,11 @@ TEST(ReferenceDeterminism, SameSeedSameBytesAnyWindow) {
     const auto c = render_reference(spec(n, 8), tpad);
     EXPECT_NE(a, c) << n;
     // A window rendered on its own equals the same samples of the whole (exact).
-    const ReferenceTexture t(spec(n, 7), Millimetres(tpad.length_mm()), tpad);
-    const Grid other{0.0, 0.0053, 19200};
+    const ReferenceTexture t(spec(n, 7), tpad.length(), Sampling{tpad});
+    const Grid other{Millimetres(0.0), Millimetres(0.0053), 19200};
     std::vector<double> w(777);
     // Evaluate without the cache (different origin object, same values) and compare.
-    const Grid shifted{1e-300, 0.0053, 19200};  // not bit-equal: forces evaluation; positions round to the same doubles
+    const Grid shifted{Millimetres(1e-300), Millimetres(0.0053), 19200};  // not bit-equal: forces evaluation; positions round to the same doubles
     t.render(shifted, 5000, w);
     for (std::size_t i = 0; i < w.size(); ++i) EXPECT_EQ(w[i], a[5000 + i]) << n << " " << i;
     (void)other;
@@ -85,7 +85,7 @@ TEST(ReferenceAmplitude, SignalReferencesSpanTheFullRange) {
 
 TEST(ReferenceScalar, KernelMatchesSlowEvaluation) {
   // The vector kernel against the scalar amplitude_at, bit for bit.
-  const ReferenceTexture t(spec("3sin"), Millimetres(tpad.length_mm()), tpad);
+  const ReferenceTexture t(spec("3sin"), tpad.length(), Sampling{tpad});
   std::vector<double> a(19200);
   t.render(tpad, 0, a);
   for (std::int64_t i = 0; i < 19200; i += 37) EXPECT_EQ(a[static_cast<std::size_t>(i)], t.amplitude_at(tpad.position(i)));
@@ -98,9 +98,10 @@ TEST(PatchTexture, GapStatisticsAsSpecified) {
     const int top = static_cast<int>(std::lround(2 * c));
     std::vector<double> all;
     for (std::uint64_t seed = 1; seed <= 200; ++seed) {
-      const ReferenceTexture t(spec(name, seed), Millimetres(1000.0), Grid{0.0, 0.01, 100000});
-      for (const auto& f : t.features()) EXPECT_NEAR(f.length_mm, 2.6, 1e-12);
-      for (double g : t.gaps_mm()) {
+      const ReferenceTexture t(spec(name, seed), Millimetres(1000.0), Sampling{Grid{Millimetres(0.0), Millimetres(0.01), 100000}});
+      for (const auto& f : t.features()) EXPECT_NEAR(f.length.value(), 2.6, 1e-12);
+      for (const Millimetres gap : t.gaps()) {
+        const double g = gap.value();
         EXPECT_NEAR(g, std::round(g), 1e-9);
         EXPECT_GE(g, -1e-9);
         EXPECT_LE(g, top + 1e-9);
@@ -113,25 +114,25 @@ TEST(PatchTexture, GapStatisticsAsSpecified) {
     for (int v = 0; v <= top; ++v) EXPECT_GT(std::count(all.begin(), all.end(), v), 0) << name << " gap " << v;
   }
   // c = 4.6: support {0 … 9} [choice], mean 4.5.
-  const ReferenceTexture t(spec("patch-4.6"), Millimetres(5000.0), Grid{0.0, 0.05, 100000});
-  for (double g : t.gaps_mm()) EXPECT_LE(g, 9 + 1e-9);
+  const ReferenceTexture t(spec("patch-4.6"), Millimetres(5000.0), Sampling{Grid{Millimetres(0.0), Millimetres(0.05), 100000}});
+  for (const Millimetres g : t.gaps()) EXPECT_LE(g.value(), 9 + 1e-9);
 }
 
 TEST(PatchTexture, ShufflesPreserveTheGapMultiset) {
-  const ReferenceTexture base(spec("patch-13.5", 3), Millimetres(101.76), tpad);
-  auto g0 = base.gaps_mm();
+  const ReferenceTexture base(spec("patch-13.5", 3), Millimetres(101.76), Sampling{tpad});
+  auto g0 = base.gaps();
   ASSERT_GE(g0.size(), 3u);
   int differing = 0;
   for (int k = 1; k <= 64; ++k) {
     ReferenceSpec s = spec("patch-13.5", 3);
     s.params["shuffle"] = double(k);
-    const ReferenceTexture t(s, Millimetres(101.76), tpad);
-    auto g = t.gaps_mm();
+    const ReferenceTexture t(s, Millimetres(101.76), Sampling{tpad});
+    auto g = t.gaps();
     ASSERT_EQ(g.size(), g0.size());
     differing += g != g0;
     auto a = g0, b = g;
-    for (auto& x : a) x = std::round(x * 1e6);
-    for (auto& x : b) x = std::round(x * 1e6);
+    for (auto& x : a) x = Millimetres(std::round(x.value() * 1e6));
+    for (auto& x : b) x = Millimetres(std::round(x.value() * 1e6));
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     EXPECT_EQ(a, b) << "shuffle " << k;  // identical multiset (to 1 nm)
@@ -163,13 +164,13 @@ TEST(ReferenceDocument, ReferenceLeftTexelRightOnOneMap) {
   const auto map = prepare_surface(doc).render();
   ASSERT_EQ(map.size(), 19200u);
   // Left half: exactly the reference rendered over 50.88 mm on the same grid.
-  const ReferenceTexture ref(doc.regions[0].reference.value(), Millimetres(50.88), Grid{0.0, 0.0053, 19200});
+  const ReferenceTexture ref(doc.regions[0].reference.value(), Millimetres(50.88), Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}});
   std::vector<double> left(9600);
-  ref.render(Grid{0.0, 0.0053, 19200}, 0, left);
+  ref.render(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, 0, left);
   for (std::size_t i = 0; i < 9600; ++i) ASSERT_EQ(map[i], left[i]) << i;
   // Right half: exactly the Texel rendering of the right region alone.
   Document right = make_document(doc.device, doc.regions[1].texel);
-  right.regions[0].start_mm = 50.88;
+  right.regions[0].start = Millimetres(50.88);
   const auto rmap = prepare_surface(right).render();
   for (std::size_t i = 9600; i < 19200; ++i) ASSERT_EQ(map[i], rmap[i]) << i;
   // Round trip: written as version 2, parsed back to the same map.

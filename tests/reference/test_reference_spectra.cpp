@@ -12,7 +12,7 @@
 using namespace texel;
 
 namespace {
-const Grid tpad{0.0, 0.0053, 19200};
+const Grid tpad{Millimetres(0.0), Millimetres(0.0053), 19200};
 
 ReferenceSpec spec(const std::string& name, std::uint64_t seed = 1) {
   ReferenceSpec s;
@@ -31,7 +31,7 @@ TEST(SinusoidReferences, PeaksAtTheirFrequenciesWithEqualHeights) {
       {"2sin", {2.5, 6}}, {"3sin", {2.5, 6, 8.5}}, {"4sin", {2.5, 6, 8.5, 11}}};
   for (const auto& [name, freqs] : cases) {
     const auto a = render_reference(spec(name), tpad);
-    const Spectrum s = magnitude_spectrum(a, tpad.spacing_mm);
+    const Spectrum s = magnitude_spectrum(a, tpad.spacing.value());
     const auto peaks = find_peaks(s, {.threshold_db = -40.0});
     ASSERT_EQ(peaks.size(), freqs.size()) << name;
     for (std::size_t i = 0; i < freqs.size(); ++i) {
@@ -47,7 +47,7 @@ TEST(SinusoidReferences, RandomPhasesKeepTheSpectrum) {
   s.params["phase"] = std::string("random");
   const auto a = render_reference(s, tpad);
   EXPECT_NE(a, render_reference(spec("4sin"), tpad));
-  const auto peaks = find_peaks(magnitude_spectrum(a, tpad.spacing_mm));
+  const auto peaks = find_peaks(magnitude_spectrum(a, tpad.spacing.value()));
   ASSERT_EQ(peaks.size(), 4u);
   for (const auto& p : peaks) EXPECT_NEAR(p.level_db, 0.0, 0.1);
 }
@@ -55,11 +55,11 @@ TEST(SinusoidReferences, RandomPhasesKeepTheSpectrum) {
 namespace {
 /// Welch PSD averaged over seeds on a 100 mm, 0.01 mm grid (Nyquist 50 cpm).
 Psd mean_psd(const std::string& name, int seeds) {
-  const Grid g{0.0, 0.01, 10000};
+  const Grid g{Millimetres(0.0), Millimetres(0.01), 10000};
   Psd mean;
   for (int seed = 1; seed <= seeds; ++seed) {
     const auto a = render_reference(spec(name, static_cast<std::uint64_t>(seed)), g);
-    Psd p = welch_psd(a, g.spacing_mm, {.segment = 2000});
+    Psd p = welch_psd(a, g.spacing.value(), {.segment = 2000});
     if (seed == 1)
       mean = p;
     else
@@ -100,11 +100,11 @@ TEST(NoiseColours, SlopesAndFlatness) {
 
 TEST(NoiseColours, BandEdgesAreRespected) {
   // Nothing synthesised outside the band: every component in [0.5, 50) cpm.
-  const Grid g{0.0, 0.01, 10000};
-  const ReferenceTexture t(spec("pink"), Millimetres(100.0), g);
+  const Grid g{Millimetres(0.0), Millimetres(0.01), 10000};
+  const ReferenceTexture t(spec("pink"), Millimetres(100.0), Sampling{g});
   for (const auto& c : t.components()) {
-    EXPECT_GE(c.frequency_cpm, 0.5 - 1e-12);
-    EXPECT_LT(c.frequency_cpm, g.nyquist_cpm());
+    EXPECT_GE(c.frequency.value(), 0.5 - 1e-12);
+    EXPECT_LT(c.frequency.value(), g.nyquist().value());
   }
 }
 
@@ -115,7 +115,7 @@ TEST(Waveforms, HarmonicRatiosAndNoAliasing) {
   // synthesised component below Nyquist and the next harmonic above it.
   for (const std::string name : {"square", "tri", "saw"}) {
     const auto a = render_reference(spec(name), tpad);
-    const Spectrum s = magnitude_spectrum(a, tpad.spacing_mm, {.zero_pad = 4});
+    const Spectrum s = magnitude_spectrum(a, tpad.spacing.value(), {.zero_pad = 4});
     const auto peaks = find_peaks(s, {.threshold_db = -120.0, .max_peaks = 1000});
     auto level_at = [&](double f) {
       for (const auto& p : peaks)
@@ -135,10 +135,10 @@ TEST(Waveforms, HarmonicRatiosAndNoAliasing) {
         EXPECT_TRUE(an == 0.0 || db20(an / a1) < -100.0) << name << " harmonic " << n << ": " << db20(an / a1);
       }
     }
-    const ReferenceTexture t(spec(name), Millimetres(tpad.length_mm()), tpad);
-    const double top = t.components().back().frequency_cpm;
-    EXPECT_LT(top, tpad.nyquist_cpm());
-    EXPECT_GE(top + (name == "saw" ? 1.0 : 2.0), tpad.nyquist_cpm());
+    const ReferenceTexture t(spec(name), tpad.length(), Sampling{tpad});
+    const double top = t.components().back().frequency.value();
+    EXPECT_LT(top, tpad.nyquist().value());
+    EXPECT_GE(top + (name == "saw" ? 1.0 : 2.0), tpad.nyquist().value());
   }
 }
 
@@ -152,7 +152,7 @@ TEST(BandpassNoise, CentreAndMinus3dBWidth) {
   // of a noisy estimate biases picked edges inward.)
   // bandpass-f20-z5 is excluded: its upper −3 dB edge (202 cpm) lies beyond
   // any device's Nyquist frequency, so its width cannot be seen on a grid.
-  const Grid g{0.0, 0.01, 20000};  // 200 mm, resolution 0.005 cpm, Nyquist 50 cpm
+  const Grid g{Millimetres(0.0), Millimetres(0.01), 20000};  // 200 mm, resolution 0.005 cpm, Nyquist 50 cpm
   for (double fc : {1.0, 4.0, 20.0})
     for (double zeta : {0.05, 0.5, 5.0}) {
       if (fc == 20.0 && zeta == 5.0) continue;
@@ -169,7 +169,7 @@ TEST(BandpassNoise, CentreAndMinus3dBWidth) {
         s.params["band_min_cpm"] = f1 / 4;
         s.params["band_max_cpm"] = std::min(49.0, f2 * 4);
         const auto a = render_reference(s, g);
-        const Spectrum sp = magnitude_spectrum(a, g.spacing_mm, {.window = Window::rectangular, .zero_pad = 1});
+        const Spectrum sp = magnitude_spectrum(a, g.spacing.value(), {.window = Window::rectangular, .zero_pad = 1});
         if (power.empty()) {
           power = sp.power;
           freq = sp.frequency_cpm;

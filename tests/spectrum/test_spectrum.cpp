@@ -91,8 +91,8 @@ TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
   // property is about the plain DFT), 16× zero padding. For each f_i the
   // Texel rendering's highest peak within ±2N/L sits at f_i within 0.05·N/L
   // and has the sum's height within 0.3 dB.
-  const Grid g{0.0, 0.0053, 19200};
-  const double L = g.length_mm();
+  const Grid g{Millimetres(0.0), Millimetres(0.0053), 19200};
+  const double L = g.length().value();
   for (std::size_t N : {3u, 4u, 6u}) {
     TexelSpec spec;
     spec.parameterization = Parameterization::log;
@@ -106,9 +106,9 @@ TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
     std::unique_ptr<TexelTexture> t;
     for (std::uint64_t seed = 1; seed < 1000; ++seed) {
       spec.seed = seed;
-      t = std::make_unique<TexelTexture>(spec, Millimetres(L), CyclesPerMm(g.nyquist_cpm()));
+      t = std::make_unique<TexelTexture>(spec, Millimetres(L), Sampling{g});
       std::set<double> distinct;
-      for (const auto& x : t->texels()) distinct.insert(x.frequency_cpm);
+      for (const auto& x : t->texels()) distinct.insert(x.frequency.value());
       if (t->texels().size() == N && distinct.size() == N) break;
     }
     ASSERT_EQ(t->texels().size(), N);
@@ -116,26 +116,26 @@ TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
     t->render(g, 0, texel);
     for (std::size_t i = 0; i < sum.size(); ++i) {
       double y = 0;
-      for (const auto& x : t->texels()) y += std::sin(2 * std::numbers::pi * x.frequency_cpm * g.position(i));
+      for (const auto& x : t->texels()) y += std::sin(2 * std::numbers::pi * x.frequency.value() * g.position(i).value());
       sum[i] = 0.5 + 0.5 * y / static_cast<double>(N);
     }
     const SpectrumOptions opt{.window = Window::rectangular, .zero_pad = 16};
-    const auto pt = find_peaks(magnitude_spectrum(texel, g.spacing_mm, opt), {.threshold_db = -60, .max_peaks = 1000});
-    const auto ps = find_peaks(magnitude_spectrum(sum, g.spacing_mm, opt), {.threshold_db = -60, .max_peaks = 1000});
+    const auto pt = find_peaks(magnitude_spectrum(texel, g.spacing.value(), opt), {.threshold_db = -60, .max_peaks = 1000});
+    const auto ps = find_peaks(magnitude_spectrum(sum, g.spacing.value(), opt), {.threshold_db = -60, .max_peaks = 1000});
     const double wide = static_cast<double>(N) / L;
     for (const auto& x : t->texels()) {
       auto best = [&](const std::vector<Peak>& peaks, double span) {
         const Peak* b = nullptr;
         for (const auto& p : peaks)
-          if (std::abs(p.frequency.value() - x.frequency_cpm) < span && (!b || p.amplitude > b->amplitude)) b = &p;
+          if (std::abs(p.frequency.value() - x.frequency.value()) < span && (!b || p.amplitude > b->amplitude)) b = &p;
         return b;
       };
       const Peak* a = best(pt, 2 * wide);
       const Peak* b = best(ps, 2 / L);
-      ASSERT_TRUE(a && b) << "f = " << x.frequency_cpm;
-      EXPECT_NEAR(a->frequency.value(), x.frequency_cpm, 0.05 * wide) << "N " << N;
-      EXPECT_NEAR(b->frequency.value(), x.frequency_cpm, 0.05 / L) << "N " << N;
-      EXPECT_NEAR(db20(a->amplitude / b->amplitude), 0.0, 0.3) << "N " << N << " f " << x.frequency_cpm;
+      ASSERT_TRUE(a && b) << "f = " << x.frequency.value();
+      EXPECT_NEAR(a->frequency.value(), x.frequency.value(), 0.05 * wide) << "N " << N;
+      EXPECT_NEAR(b->frequency.value(), x.frequency.value(), 0.05 / L) << "N " << N;
+      EXPECT_NEAR(db20(a->amplitude / b->amplitude), 0.0, 0.3) << "N " << N << " f " << x.frequency.value();
     }
   }
 }
@@ -150,7 +150,7 @@ TEST(TexelLogCentroid, WithinHalfADecibelOfTheMedianForNarrowDistributions) {
     spec.irregularity = Decibels(0.5);
     const Document doc = make_document(load_device("tpad"), spec);
     const auto map = prepare_surface(doc).render();
-    const SpectralReport r = analyse_spectrum(map, doc.device.spacing_mm);
+    const SpectralReport r = analyse_spectrum(map, doc.device.spacing.value());
     EXPECT_NEAR(r.summary.log_centroid.value(), pitch, 0.5) << "pitch " << pitch;
   }
 }

@@ -52,8 +52,8 @@ struct HistogramView {
 struct RegionView {
   std::string name;
   std::string kind;  ///< "texel" | "reference"
-  double start_mm = 0.0;
-  double length_mm = 0.0;
+  Millimetres start{0.0};
+  Millimetres length{0.0};
 };
 
 struct DesignOptions {
