@@ -33,7 +33,7 @@ void register_decode(CLI::App& app) {
     const std::string bytes = read_file(a->input);
     codec::Bitstream b;
     try {
-      b = codec::parse_bitstream(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()));
+      b = codec::parse_bitstream(byte_view(bytes));
     } catch (const FormatError& e) {
       throw FormatError("'" + a->input + "': " + e.what());
     }

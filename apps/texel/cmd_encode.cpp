@@ -221,7 +221,7 @@ void register_encode(CLI::App& app) {
     const codec::EncoderConfig cfg = config_of(*a);
     const codec::Signal sig = codec::load_signal(a->inputs[0], load_options(*a));
     const codec::EncodeResult r = codec::encode(sig, cfg);
-    if (a->output) write_file_atomic(*a->output, std::string_view(reinterpret_cast<const char*>(r.bytes.data()), r.bytes.size()));
+    if (a->output) write_file_atomic(*a->output, r.bytes);
     if (a->json)
       print_json(result_json(a->inputs[0], sig, r, cfg, a->output));
     else

@@ -45,7 +45,8 @@ ordered document_info(const Document& doc, const std::string& path) {
   j["document_bytes"] = document_json(doc).size();
   j["regions"] = ordered::array();
   for (const auto& r : surface.regions()) {
-    ordered rj{{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}, {"texture", r.texture->describe()}};
+    ordered rj{
+        {"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}, {"texture", r.texture->describe()}};
     if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
       const auto& s = t->spec();
       rj["texels"] = t->texels().size();

@@ -34,8 +34,8 @@ std::string texels_csv(const Surface& surface) {
     if (!t) continue;
     for (std::size_t k = 0; k < t->texels().size(); ++k) {
       const Texel& x = t->texels()[k];
-      out += std::to_string(k) + "," + detail::num(region.start.value() + x.start.value()) + "," + detail::num(x.frequency.value()) + "," +
-             detail::num(x.envelope);
+      out += std::to_string(k) + "," + detail::num(region.start.value() + x.start.value()) + "," +
+             detail::num(x.frequency.value()) + "," + detail::num(x.envelope);
       if (many) out += "," + (region.name.empty() ? std::to_string(r) : region.name);
       out += "\n";
     }

@@ -86,10 +86,10 @@ struct Bitstream {
 };
 
 /// Serializes; throws InvalidArgument if a field is outside what the format allows.
-std::vector<std::uint8_t> write_bitstream(const Bitstream& b);
+std::vector<std::byte> write_bitstream(const Bitstream& b);
 /// Parses and validates (structure, CRC, ranges, and that the texture it
 /// describes is renderable). Throws FormatError with a one-line message.
-Bitstream parse_bitstream(std::span<const std::uint8_t> bytes);
+Bitstream parse_bitstream(std::span<const std::byte> bytes);
 
 /// The TexelSpec a bitstream stands for (exact, deterministic doubles).
 TexelSpec to_spec(const Bitstream& b);
@@ -105,6 +105,6 @@ Bitstream from_spec(const TexelSpec& spec, Millimetres length, unsigned bits = 8
 std::size_t coarse_section_bytes(const CoarseFields& c);
 
 /// CRC-8 (polynomial 0x07, initial value 0, no reflection, no final xor).
-std::uint8_t crc8(std::span<const std::uint8_t> bytes);
+std::uint8_t crc8(std::span<const std::byte> bytes);
 
 }  // namespace texel::codec

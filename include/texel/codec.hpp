@@ -109,7 +109,7 @@ struct EncoderConfig {
 
 struct EncodeResult {
   Bitstream bitstream;
-  std::vector<std::uint8_t> bytes;
+  std::vector<std::byte> bytes;
   TexelSpec spec;                   ///< what the bitstream decodes to
   Percept input;                    ///< the input's fine part under the model
   Percept decoded;                  ///< the decoded texture's, on the input's grid

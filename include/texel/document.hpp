@@ -25,7 +25,7 @@ namespace texel {
 /// version 2, a reference texture ("kind": "reference"); a Texel texture's
 /// coarse profile may also be a reference (the coarse-study test texture).
 struct RegionSpec {
-  std::string name;  ///< optional label, e.g. "left"
+  std::string name;                   ///< optional label, e.g. "left"
   Millimetres start{0.0};             ///< left edge on the device (JSON start_mm)
   std::optional<Millimetres> length;  ///< none = to the end of the device (JSON length_mm)
   TexelSpec texel;                    ///< used when `reference` is empty

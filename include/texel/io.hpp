@@ -11,6 +11,9 @@
 
 namespace texel {
 
+/// The bytes of a text or file buffer, as the byte spans the parsers take.
+inline std::span<const std::byte> byte_view(std::string_view s) { return std::as_bytes(std::span(s.data(), s.size())); }
+
 /// Reads a whole file; throws IoError naming the path.
 std::string read_file(const std::string& path);
 /// Writes `data` to a temporary file beside `path`, then renames it over

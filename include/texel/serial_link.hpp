@@ -8,6 +8,7 @@
 // becomes an IoError naming the port — never a crash.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -77,7 +78,7 @@ class SerialLink {
   void stream_drive(double amplitude);
   DisplayStatus status();
   /// Sends raw bytes (tests: garbage, truncated frames).
-  void send_raw(std::span<const std::uint8_t> bytes);
+  void send_raw(std::span<const std::byte> bytes);
 
   [[nodiscard]] const std::string& name() const { return name_; }
 

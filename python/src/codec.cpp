@@ -12,12 +12,12 @@
 namespace texel::python {
 namespace {
 
-std::vector<std::uint8_t> bytes_of(const py::bytes& b) {
-  const std::string_view s = b;
+std::vector<std::byte> bytes_of(const py::bytes& b) {
+  const auto s = std::as_bytes(std::span(std::string_view(b)));
   return {s.begin(), s.end()};
 }
 
-py::bytes to_bytes(const std::vector<std::uint8_t>& v) { return py::bytes(reinterpret_cast<const char*>(v.data()), v.size()); }
+py::bytes to_bytes(std::span<const std::byte> v) { return py::bytes(reinterpret_cast<const char*>(v.data()), v.size()); }
 
 // Bytes from `bytes`, `bytearray`, a uint8 array or a path to a .texel file.
 codec::Bitstream bitstream_of(const py::handle& source) {

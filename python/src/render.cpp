@@ -190,15 +190,23 @@ void register_render(py::module_& m) {
       .def_readonly("name", &DeviceProfile::name)
       .def_readonly("description", &DeviceProfile::description)
       .def_readonly("samples", &DeviceProfile::samples, "Samples along the active length.")
-      .def_property_readonly("spacing_mm", [](const DeviceProfile& d) { return d.spacing.value(); }, "Sample spacing Δx (mm).")
+      .def_property_readonly(
+          "spacing_mm", [](const DeviceProfile& d) { return d.spacing.value(); }, "Sample spacing Δx (mm).")
       .def_property_readonly(
           "format", [](const DeviceProfile& d) { return std::string(to_string(d.format)); },
           "Native sample format: u16le, u8, f32le or f64le.")
-      .def_property_readonly("refresh_hz", [](const DeviceProfile& d) { return d.refresh.value(); }, "Output update rate while playing (Hz).")
-      .def_property_readonly("band_min_cpm", [](const DeviceProfile& d) { return d.band_min.value(); }, "Lowest renderable frequency (cycles/mm).")
-      .def_property_readonly("band_max_cpm", [](const DeviceProfile& d) { return d.band_max.value(); }, "Highest renderable frequency (cycles/mm); 0 = Nyquist.")
-      .def_property_readonly("length_mm", [](const DeviceProfile& d) { return d.length().value(); }, "Active length (mm).")
-      .def_property_readonly("nyquist_cpm", [](const DeviceProfile& d) { return d.nyquist().value(); }, "Spatial Nyquist frequency 1/(2Δx) (cycles/mm).")
+      .def_property_readonly(
+          "refresh_hz", [](const DeviceProfile& d) { return d.refresh.value(); }, "Output update rate while playing (Hz).")
+      .def_property_readonly(
+          "band_min_cpm", [](const DeviceProfile& d) { return d.band_min.value(); }, "Lowest renderable frequency (cycles/mm).")
+      .def_property_readonly(
+          "band_max_cpm", [](const DeviceProfile& d) { return d.band_max.value(); },
+          "Highest renderable frequency (cycles/mm); 0 = Nyquist.")
+      .def_property_readonly(
+          "length_mm", [](const DeviceProfile& d) { return d.length().value(); }, "Active length (mm).")
+      .def_property_readonly(
+          "nyquist_cpm", [](const DeviceProfile& d) { return d.nyquist().value(); },
+          "Spatial Nyquist frequency 1/(2Δx) (cycles/mm).")
       .def_property_readonly(
           "positions_mm",
           [](const DeviceProfile& d) {

@@ -473,7 +473,7 @@ void texel_encode_result_destroy(texel_encode_result* result) { delete result; }
 texel_status texel_decode(const std::uint8_t* bytes, std::size_t size, const char* device, texel_document** out) {
   return create(out, [&] {
     if (size > 0) need(bytes, "bytes");
-    const texel::codec::Bitstream b = texel::codec::parse_bitstream(std::span<const std::uint8_t>(bytes, size));
+    const texel::codec::Bitstream b = texel::codec::parse_bitstream(std::as_bytes(std::span<const std::uint8_t>(bytes, size)));
     texel::Document doc = texel::codec::decode_document(b, device_named(device));
     return std::make_unique<texel_document>(texel_document{std::move(doc)});
   });

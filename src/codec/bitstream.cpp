@@ -224,16 +224,16 @@ std::int16_t to_cdb(double db, const std::string& field) {
 
 }  // namespace
 
-std::uint8_t crc8(std::span<const std::uint8_t> bytes) {
+std::uint8_t crc8(std::span<const std::byte> bytes) {
   std::uint8_t crc = 0;
-  for (std::uint8_t b : bytes) {
-    crc ^= b;
+  for (const std::byte b : bytes) {
+    crc ^= std::to_integer<std::uint8_t>(b);
     for (int i = 0; i < 8; ++i) crc = static_cast<std::uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : crc << 1);
   }
   return crc;
 }
 
-std::vector<std::uint8_t> write_bitstream(const Bitstream& b) {
+std::vector<std::byte> write_bitstream(const Bitstream& b) {
   const FineFields& f = b.fine;
   if (f.texel_length_um == 0) throw InvalidArgument("texel_length_um is 0; the bitstream allows 1 … 65535 µm");
   if (f.quantization_ddb > 200)
@@ -280,11 +280,15 @@ std::vector<std::uint8_t> write_bitstream(const Bitstream& b) {
       write_levels(bw, c);
     }
   }
-  w.u8(crc8(w.out));
-  return w.out;
+  std::vector<std::byte> out(w.out.size() + 1);
+  std::transform(w.out.begin(), w.out.end(), out.begin(), [](std::uint8_t v) { return std::byte{v}; });
+  out.back() = std::byte{crc8(std::span<const std::byte>(out).first(w.out.size()))};
+  return out;
 }
 
-Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
+Bitstream parse_bitstream(std::span<const std::byte> input) {
+  // The readers work on octets; unsigned char may alias any object.
+  const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(input.data()), input.size());
   if (bytes.empty()) throw FormatError("bitstream is empty; a .texel bitstream is at least 12 bytes");
   if (bytes[0] != bitstream_magic)
     throw FormatError("not a Texel bitstream: first byte is " + hex(bytes[0]) + ", expected " + hex(bitstream_magic) + " ('T')");
@@ -367,7 +371,7 @@ Bitstream parse_bitstream(std::span<const std::uint8_t> bytes) {
   if (r.remaining() != 0)
     throw FormatError("bitstream oversized: " + std::to_string(r.remaining()) + " unexpected byte(s) at offset " +
                       std::to_string(r.offset()) + " before the CRC");
-  const std::uint8_t want = crc8(bytes.first(bytes.size() - 1));
+  const std::uint8_t want = crc8(input.first(input.size() - 1));
   if (bytes.back() != want)
     throw FormatError("bitstream CRC mismatch: stored " + hex(bytes.back()) + ", computed " + hex(want) +
                       " (corrupted or truncated)");

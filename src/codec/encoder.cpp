@@ -347,7 +347,8 @@ struct Fitter {
       s.fine_strength = two_scale->F;
       s.coarse = ValuesProfile{two_scale->c};
     }
-    const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx), Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max});
+    const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx),
+                         Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max});
     std::vector<double> a(samples);
     t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(samples)}, 0, a);
     if (two_scale) return perceive(split(a, dx, cfg, SplitMode::two_scale, two_scale->window).fine, dx, cfg.model, f_min);

@@ -141,7 +141,7 @@ Signal load_signal(const std::string& path, const LoadOptions& o) {
     sig.description = "document on " + doc.device.name;
   } else if (ext == ".texel") {
     const std::string bytes = read_file(path);
-    const Bitstream b = parse_bitstream(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()));
+    const Bitstream b = parse_bitstream(byte_view(bytes));
     sig.amplitude = prepare_surface(decode_document(b, device)).render();
     sig.spacing = device.spacing;
     sig.description = "bitstream decoded on " + device.name;

@@ -66,7 +66,8 @@ void validate(const DeviceProfile& p) {
     throw InvalidArgument(at + "refresh_hz is " + num(p.refresh.value()) + "; it must be a finite number > 0");
   if (!(std::isfinite(p.band_min.value()) && p.band_min.value() > 0.0))
     throw InvalidArgument(at + "band_min_cpm is " + num(p.band_min.value()) + "; it must be > 0");
-  if (!(std::isfinite(p.band_max.value()) && p.band_max.value() >= 0.0) || (p.band_max.value() > 0.0 && p.band_max.value() <= p.band_min.value()))
+  if (!(std::isfinite(p.band_max.value()) && p.band_max.value() >= 0.0) ||
+      (p.band_max.value() > 0.0 && p.band_max.value() <= p.band_min.value()))
     throw InvalidArgument(at + "band_max_cpm is " + num(p.band_max.value()) + "; allowed: 0 (Nyquist) or above band_min_cpm");
   if (p.band_max.value() > p.nyquist().value() * (1 + 1e-12))
     throw InvalidArgument(at + "band_max_cpm " + num(p.band_max.value()) + " cpm is above the grid's Nyquist frequency " +
@@ -76,7 +77,8 @@ void validate(const DeviceProfile& p) {
                           num(p.band_top().value()) + " cpm");
   double prev_end = 0.0;
   for (const auto& r : p.layout) {
-    if (!(r.start.value() >= prev_end - 1e-9 && r.length.value() > 0.0 && r.start.value() + r.length.value() <= p.length().value() + 1e-3))
+    if (!(r.start.value() >= prev_end - 1e-9 && r.length.value() > 0.0 &&
+          r.start.value() + r.length.value() <= p.length().value() + 1e-3))
       throw InvalidArgument(at + "layout region '" + r.name + "' (" + num(r.start.value()) + " mm + " + num(r.length.value()) +
                             " mm) must lie inside 0 … " + num(p.length().value()) + " mm, in order, without overlap");
     prev_end = r.start.value() + r.length.value();
@@ -130,7 +132,8 @@ std::string device_profile_json(const DeviceProfile& p) {
   j["band_min_cpm"] = p.band_min.value();
   j["band_max_cpm"] = p.band_max.value();
   j["layout"] = nlohmann::ordered_json::array();
-  for (const auto& r : p.layout) j["layout"].push_back({{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}});
+  for (const auto& r : p.layout)
+    j["layout"].push_back({{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}});
   return j.dump(2) + "\n";
 }
 

@@ -11,7 +11,8 @@ namespace texel {
 using detail::num;
 
 Surface::Surface(Grid grid, std::vector<Region> regions) : grid_(grid), regions_(std::move(regions)) {
-  if (!(grid_.spacing.value() > 0.0) || grid_.count < 0) throw InvalidArgument("surface grid must have spacing > 0 and count >= 0");
+  if (!(grid_.spacing.value() > 0.0) || grid_.count < 0)
+    throw InvalidArgument("surface grid must have spacing > 0 and count >= 0");
   const double total = grid_.length().value();
   std::sort(regions_.begin(), regions_.end(), [](const Region& a, const Region& b) { return a.start.value() < b.start.value(); });
   for (std::size_t i = 0; i < regions_.size(); ++i) {
@@ -24,11 +25,12 @@ Surface::Surface(Grid grid, std::vector<Region> regions) : grid_(grid), regions_
       throw InvalidArgument(name + " length_mm is " + num(r.length.value()) + " mm; it must be > 0");
     // 1 µm of slack: layouts written with rounded decimals (50.88 + 50.88).
     if (r.start.value() + r.length.value() > total + 1e-3)
-      throw InvalidArgument(name + " ends at " + num(r.start.value() + r.length.value()) + " mm, past the device's active length " +
-                            num(total) + " mm");
+      throw InvalidArgument(name + " ends at " + num(r.start.value() + r.length.value()) +
+                            " mm, past the device's active length " + num(total) + " mm");
     if (i > 0 && r.start.value() < regions_[i - 1].start.value() + regions_[i - 1].length.value() - 1e-9)
       throw InvalidArgument(name + " starts at " + num(r.start.value()) + " mm, inside the previous region (which ends at " +
-                            num(regions_[i - 1].start.value() + regions_[i - 1].length.value()) + " mm); regions must not overlap");
+                            num(regions_[i - 1].start.value() + regions_[i - 1].length.value()) +
+                            " mm); regions must not overlap");
   }
 }
 

@@ -60,7 +60,9 @@ std::uint8_t SerialLink::send(Type type, const std::uint8_t* payload, std::size_
   return seq;
 }
 
-void SerialLink::send_raw(std::span<const std::uint8_t> bytes) { write_all(bytes.data(), bytes.size()); }
+void SerialLink::send_raw(std::span<const std::byte> bytes) {
+  write_all(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+}
 
 std::string SerialLink::request(Type type, const std::uint8_t* payload, std::size_t n, Type expect, const char* what) {
   for (int attempt = 0; attempt < attempts; ++attempt) {

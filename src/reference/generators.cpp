@@ -82,8 +82,8 @@ void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, 
     std::fill(acc.begin(), acc.end(), 0.0);
     const double base = static_cast<double>(first + static_cast<std::int64_t>(i));
     for (const auto& c : comps)
-      accumulate_component(base, grid.origin.value(), grid.spacing.value(), c.frequency.value(), c.amplitude, c.phase_cycles, acc.data(),
-                           static_cast<std::int32_t>(len));
+      accumulate_component(base, grid.origin.value(), grid.spacing.value(), c.frequency.value(), c.amplitude, c.phase_cycles,
+                           acc.data(), static_cast<std::int32_t>(len));
     std::copy_n(acc.begin(), len, out.begin() + static_cast<std::ptrdiff_t>(i));
   }
 }

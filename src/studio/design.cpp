@@ -98,7 +98,7 @@ HistogramView histogram_of(const TexelTexture& t, std::size_t bins) {
 }
 
 // The region's spec as a bitstream (InvalidArgument when a field is not representable).
-std::vector<std::uint8_t> region_bitstream(const TexelTexture& t, const Region& r) {
+std::vector<std::byte> region_bitstream(const TexelTexture& t, const Region& r) {
   return codec::write_bitstream(codec::from_spec(t.spec(), r.length));
 }
 
@@ -236,7 +236,7 @@ ImportKind import_kind(std::string_view name) {
                         "'; allowed: .texel.json, .json, .texel, .bin, .npy, .csv, .wav");
 }
 
-ImportResult import_file(std::string_view name, std::span<const std::uint8_t> bytes, const ImportOptions& options) {
+ImportResult import_file(std::string_view name, std::span<const std::byte> bytes, const ImportOptions& options) {
   ImportResult out;
   out.kind = import_kind(name);
   const std::string origin(name);
@@ -316,8 +316,8 @@ ExportFile export_file(const Document& doc, ExportFormat as, std::optional<std::
     const Region& r = surface_region(surface, doc.regions[*i]);
     const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get());
     if (!t) throw InvalidArgument(region_label(doc, *i) + " holds a reference texture; only Texel regions have a bitstream");
-    const std::vector<std::uint8_t> bytes = region_bitstream(*t, r);
-    f = {base + ".texel", "application/octet-stream", std::string(bytes.begin(), bytes.end())};
+    const std::vector<std::byte> bytes = region_bitstream(*t, r);
+    f = {base + ".texel", "application/octet-stream", std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size())};
   } else if (as == ExportFormat::device) {
     const std::vector<std::byte> bytes = surface.render_native(doc.device.format);
     f = {base + "." + doc.device.name + ".bin", "application/octet-stream",

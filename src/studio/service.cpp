@@ -175,12 +175,12 @@ class Fields {
 
 ojson spectrum_json(const SpectrumView& s) { return ojson{{"frequency_cpm", s.frequency_cpm}, {"magnitude_db", s.magnitude_db}}; }
 
-std::string hex(std::span<const std::uint8_t> bytes) {
+std::string hex(std::span<const std::byte> bytes) {
   static constexpr char digits[] = "0123456789abcdef";
   std::string h;
-  for (const auto b : bytes) {
-    h += digits[b >> 4];
-    h += digits[b & 15];
+  for (const std::byte b : bytes) {
+    h += digits[std::to_integer<unsigned>(b) >> 4];
+    h += digits[std::to_integer<unsigned>(b) & 15];
   }
   return h;
 }
@@ -574,8 +574,8 @@ struct Service::Impl {
       const double length = (*t)["texel_length_mm"].get<double>();
       if (length > 0 && device.length().value() / length > static_cast<double>(cap))
         throw Reject{"too_large", where + ": texel_length_mm " + json(length).dump() + " makes more than " + std::to_string(cap) +
-                                      " texels; allowed: at least " + json(device.length().value() / static_cast<double>(cap)).dump() +
-                                      " mm on this device"};
+                                      " texels; allowed: at least " +
+                                      json(device.length().value() / static_cast<double>(cap)).dump() + " mm on this device"};
     }
   }
 
@@ -600,7 +600,8 @@ struct Service::Impl {
         detail::base64_encode(std::span(reinterpret_cast<const unsigned char*>(v.map.data()), v.map.size() * sizeof(float)));
     r["regions"] = ojson::array();
     for (const auto& g : v.regions)
-      r["regions"].push_back({{"name", g.name}, {"kind", g.kind}, {"start_mm", g.start.value()}, {"length_mm", g.length.value()}});
+      r["regions"].push_back(
+          {{"name", g.name}, {"kind", g.kind}, {"start_mm", g.start.value()}, {"length_mm", g.length.value()}});
     r["region"] = v.analysed;
     r["spectrum"] = spectrum_json(v.spectrum);
     if (v.regions[v.analysed].kind == "texel") {
@@ -679,7 +680,7 @@ struct Service::Impl {
         throw Reject{"invalid", "import: device is " + clipped(dev) + "; allowed: a built-in device"};
       o.device = load_device(dev);
     }
-    ImportResult res = import_file(name, *bytes, o);
+    ImportResult res = import_file(name, std::as_bytes(std::span(*bytes)), o);
     // A document's inline device may be anything: apply the service's caps.
     const json doc = json::parse(document_json(res.document));
     (void)document_of(doc, "document");

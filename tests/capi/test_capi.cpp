@@ -519,7 +519,8 @@ TEST(CApi, EncodeDecodeRoundTrip) {
   std::vector<double> dm(19200);
   ASSERT_EQ(texel_surface_render(ds, 0, dm.data(), dm.size()), TEXEL_OK);
   const auto want =
-      texel::prepare_surface(texel::codec::decode_document(texel::codec::parse_bitstream(bytes), texel::load_device("tpad")))
+      texel::prepare_surface(texel::codec::decode_document(texel::codec::parse_bitstream(std::as_bytes(std::span(bytes))),
+                                                           texel::load_device("tpad")))
           .render();
   EXPECT_EQ(dm, want);
 
@@ -545,7 +546,9 @@ TEST(CApi, EncodeDecodeRoundTrip) {
 
 TEST(CApi, DecodeErrors) {
   const texel::codec::Bitstream b;
-  std::vector<std::uint8_t> good = texel::codec::write_bitstream(b);
+  const std::vector<std::byte> encoded = texel::codec::write_bitstream(b);
+  std::vector<std::uint8_t> good(encoded.size());
+  std::memcpy(good.data(), encoded.data(), encoded.size());
   texel_document* d = nullptr;
   ASSERT_EQ(texel_decode(good.data(), good.size(), "tpad", &d), TEXEL_OK) << texel_last_error();
   texel_document_destroy(d);

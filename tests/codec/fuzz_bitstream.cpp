@@ -16,12 +16,12 @@
 #include "texel/error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const std::span<const std::uint8_t> bytes(data, size);
+  const std::span<const std::byte> bytes = std::as_bytes(std::span(data, size));
   try {
     const texel::codec::Bitstream b = texel::codec::parse_bitstream(bytes);
     // Accepted: it must be canonical (write(parse(x)) == x) and convertible.
     const auto again = texel::codec::write_bitstream(b);
-    if (again.size() != size || !std::equal(again.begin(), again.end(), data)) std::abort();
+    if (again.size() != size || !std::equal(again.begin(), again.end(), bytes.begin())) std::abort();
     (void)texel::codec::to_spec(b);
   } catch (const texel::FormatError&) {
     // Rejected with a message: the expected outcome for most inputs.

@@ -35,7 +35,13 @@ Bitstream coarse_example(unsigned bits, std::uint8_t predictor, std::uint32_t st
   return b;
 }
 
-std::string message_of(const std::vector<std::uint8_t>& bytes) {
+std::vector<std::byte> bytes_of(std::initializer_list<unsigned> octets) {
+  std::vector<std::byte> out;
+  for (unsigned o : octets) out.push_back(static_cast<std::byte>(o));
+  return out;
+}
+
+std::string message_of(const std::vector<std::byte>& bytes) {
   try {
     (void)parse_bitstream(bytes);
   } catch (const FormatError& e) {
@@ -55,16 +61,16 @@ TEST(Bitstream, FineOnlyFitsIn16Bytes) {
 
 TEST(Bitstream, GoldenBytesOfTheDefaultStream) {
   // 'T', version 1, flags 0, P 1000 cdB, I -500 cdB, L 250 µm, q 0, band top 1974 cdB, seed 1, CRC.
-  const std::vector<std::uint8_t> want{0x54, 0x01, 0x00, 0xE8, 0x03, 0x0C, 0xFE, 0xFA, 0x00, 0x00, 0xB6, 0x07, 0x01};
+  const std::vector<std::byte> want = bytes_of({0x54, 0x01, 0x00, 0xE8, 0x03, 0x0C, 0xFE, 0xFA, 0x00, 0x00, 0xB6, 0x07, 0x01});
   auto got = write_bitstream(Bitstream{});
   ASSERT_EQ(got.size(), 14u);
-  EXPECT_EQ(std::vector<std::uint8_t>(got.begin(), got.end() - 1), want);
-  EXPECT_EQ(got.back(), crc8(want));
+  EXPECT_EQ(std::vector<std::byte>(got.begin(), got.end() - 1), want);
+  EXPECT_EQ(got.back(), std::byte{crc8(want)});
 }
 
 TEST(Bitstream, Crc8CheckValue) {
   const std::string s = "123456789";  // the CRC-8/SMBUS check value
-  EXPECT_EQ(crc8(std::span(reinterpret_cast<const std::uint8_t*>(s.data()), s.size())), 0xF4);
+  EXPECT_EQ(crc8(std::as_bytes(std::span(s.data(), s.size()))), 0xF4);
 }
 
 RC_GTEST_PROP(Bitstream, EveryFineFieldRoundTrips, ()) {
@@ -201,27 +207,27 @@ TEST(Bitstream, RejectsTruncatedStreams) {
   for (const Bitstream& b : {Bitstream{}, coarse_example(6, 1, 1, 300)}) {
     const auto bytes = write_bitstream(b);
     for (std::size_t n = 0; n < bytes.size(); ++n) {
-      const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+      const std::vector<std::byte> cut(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
       EXPECT_THROW((void)parse_bitstream(cut), FormatError) << n;
     }
   }
-  EXPECT_NE(message_of({0x54, 0x01, 0x00}).find("truncated"), std::string::npos);
+  EXPECT_NE(message_of(bytes_of({0x54, 0x01, 0x00})).find("truncated"), std::string::npos);
 }
 
 TEST(Bitstream, RejectsOversizedStreams) {
   auto bytes = write_bitstream(Bitstream{});
-  bytes.insert(bytes.end() - 1, 0x00);
-  bytes.back() = crc8(std::span(bytes.data(), bytes.size() - 1));  // a valid CRC over the extra byte
+  bytes.insert(bytes.end() - 1, std::byte{0x00});
+  bytes.back() = std::byte{crc8(std::span(bytes.data(), bytes.size() - 1))};  // a valid CRC over the extra byte
   EXPECT_NE(message_of(bytes).find("oversized"), std::string::npos) << message_of(bytes);
 }
 
 TEST(Bitstream, RejectsWrongMagicAndVersion) {
   auto bytes = write_bitstream(Bitstream{});
   auto v2 = bytes;
-  v2[1] = 2;
+  v2[1] = std::byte{2};
   EXPECT_NE(message_of(v2).find("unsupported bitstream version 2"), std::string::npos) << message_of(v2);
   auto bad = bytes;
-  bad[0] = 0x7B;  // '{': a JSON document given by mistake
+  bad[0] = std::byte{0x7B};  // '{': a JSON document given by mistake
   EXPECT_NE(message_of(bad).find("not a Texel bitstream"), std::string::npos);
   EXPECT_NE(message_of({}).find("empty"), std::string::npos);
 }
@@ -231,7 +237,7 @@ TEST(Bitstream, RejectsCorruption) {
   for (std::size_t i = 2; i < bytes.size(); ++i)
     for (int bit = 0; bit < 8; ++bit) {
       auto v = bytes;
-      v[i] ^= static_cast<std::uint8_t>(1u << bit);
+      v[i] ^= static_cast<std::byte>(1u << bit);
       EXPECT_THROW((void)parse_bitstream(v), FormatError) << i << ":" << bit;  // CRC-8 catches every single-bit error
     }
 }

@@ -226,12 +226,14 @@ TEST(HostController, RefusesBadRequestsAndKeepsTheLastGoodMap) {
   const std::uint8_t sel[1] = {0xFF};
   std::size_t n = ser::encode_frame(ser::Type::select, 99, sel, 1, f);
   f[n - 1] ^= 0xFF;  // wrong checksum: must NOT take effect
-  link.send_raw({f, n});
-  link.send_raw(std::vector<std::uint8_t>{0xA5, 0x5A, 0x05, 0x01, 0x01});  // partial header
-  link.send_raw(std::vector<std::uint8_t>{0x00, 0x11, 0xA5, 0x22});        // noise
+  link.send_raw(std::as_bytes(std::span(f, n)));
+  const std::vector<std::uint8_t> partial{0xA5, 0x5A, 0x05, 0x01, 0x01};
+  link.send_raw(std::as_bytes(std::span(partial)));  // partial header
+  const std::vector<std::uint8_t> noise{0x00, 0x11, 0xA5, 0x22};
+  link.send_raw(std::as_bytes(std::span(noise)));  // noise
   std::uint8_t unknown[ser::max_frame];
   n = ser::encode_frame(static_cast<ser::Type>(0x42), 1, nullptr, 0, unknown);
-  link.send_raw({unknown, n});
+  link.send_raw(std::as_bytes(std::span(unknown, n)));
 
   // The link recovers and the last good map is still selected and intact.
   const DisplayStatus s = link.status();

@@ -35,7 +35,8 @@ TEST(Surface, EachHalfEqualsItsTextureRenderedAlone) {
   const double half = 50.88;
   auto left = texture(10.0, 1, half, g);
   auto right = texture(15.0, 2, half, g);
-  const Surface surface(g, {Region{"left", Millimetres(0.0), Millimetres(half), left}, Region{"right", Millimetres(half), Millimetres(half), right}});
+  const Surface surface(g, {Region{"left", Millimetres(0.0), Millimetres(half), left},
+                            Region{"right", Millimetres(half), Millimetres(half), right}});
   const auto map = surface.render();
   ASSERT_EQ(map.size(), 19200u);
 
@@ -81,12 +82,15 @@ TEST(Surface, RejectsOverlappingAndOutOfRangeRegions) {
     }
     return std::string("(accepted)");
   };
-  EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(6.0), t}, Region{"b", Millimetres(5.0), Millimetres(5.0), t}}).find("overlap"), std::string::npos);
+  EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(6.0), t}, Region{"b", Millimetres(5.0), Millimetres(5.0), t}})
+                .find("overlap"),
+            std::string::npos);
   EXPECT_NE(message({Region{"a", Millimetres(5.0), Millimetres(6.0), t}}).find("past the device"), std::string::npos);
   EXPECT_NE(message({Region{"a", Millimetres(-1.0), Millimetres(2.0), t}}).find("start_mm"), std::string::npos);
   EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(0.0), t}}).find("length_mm"), std::string::npos);
   EXPECT_NE(message({Region{"a", Millimetres(0.0), Millimetres(1.0), nullptr}}).find("no texture"), std::string::npos);
-  EXPECT_EQ(message({Region{"a", Millimetres(0.0), Millimetres(5.0), t}, Region{"b", Millimetres(5.0), Millimetres(5.0), t}}), "(accepted)");  // touching is fine
+  EXPECT_EQ(message({Region{"a", Millimetres(0.0), Millimetres(5.0), t}, Region{"b", Millimetres(5.0), Millimetres(5.0), t}}),
+            "(accepted)");  // touching is fine
 }
 
 RC_GTEST_PROP(Surface, AnyWindowEqualsTheWholeMap, ()) {

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "texel/device.hpp"
-#include "texel/reference.hpp"
 #include "texel/error.hpp"
+#include "texel/reference.hpp"
 #include "texel/texture.hpp"
 
 using namespace texel;
@@ -366,9 +366,8 @@ TEST(Texture, SampleIsTheRenderersValueAtAnyPosition) {
   pink.name = "pink";
   ReferenceSpec patch;
   patch.name = "patch-4.6";
-  const std::vector<std::shared_ptr<const Texture>> textures{prepare(spec, tpad.length(), sampling),
-                                                             prepare(pink, tpad.length(), sampling),
-                                                             prepare(patch, tpad.length(), sampling)};
+  const std::vector<std::shared_ptr<const Texture>> textures{
+      prepare(spec, tpad.length(), sampling), prepare(pink, tpad.length(), sampling), prepare(patch, tpad.length(), sampling)};
   for (const auto& t : textures) {
     std::vector<double> map(static_cast<std::size_t>(tpad.samples));
     t->render(tpad.grid(), 0, map);

@@ -65,7 +65,8 @@ TEST(ReferenceDeterminism, SameSeedSameBytesAnyWindow) {
     const Grid other{Millimetres(0.0), Millimetres(0.0053), 19200};
     std::vector<double> w(777);
     // Evaluate without the cache (different origin object, same values) and compare.
-    const Grid shifted{Millimetres(1e-300), Millimetres(0.0053), 19200};  // not bit-equal: forces evaluation; positions round to the same doubles
+    const Grid shifted{Millimetres(1e-300), Millimetres(0.0053),
+                       19200};  // not bit-equal: forces evaluation; positions round to the same doubles
     t.render(shifted, 5000, w);
     for (std::size_t i = 0; i < w.size(); ++i) EXPECT_EQ(w[i], a[5000 + i]) << n << " " << i;
     (void)other;
@@ -98,7 +99,8 @@ TEST(PatchTexture, GapStatisticsAsSpecified) {
     const int top = static_cast<int>(std::lround(2 * c));
     std::vector<double> all;
     for (std::uint64_t seed = 1; seed <= 200; ++seed) {
-      const ReferenceTexture t(spec(name, seed), Millimetres(1000.0), Sampling{Grid{Millimetres(0.0), Millimetres(0.01), 100000}});
+      const ReferenceTexture t(spec(name, seed), Millimetres(1000.0),
+                               Sampling{Grid{Millimetres(0.0), Millimetres(0.01), 100000}});
       for (const auto& f : t.features()) EXPECT_NEAR(f.length.value(), 2.6, 1e-12);
       for (const Millimetres gap : t.gaps()) {
         const double g = gap.value();
@@ -164,7 +166,8 @@ TEST(ReferenceDocument, ReferenceLeftTexelRightOnOneMap) {
   const auto map = prepare_surface(doc).render();
   ASSERT_EQ(map.size(), 19200u);
   // Left half: exactly the reference rendered over 50.88 mm on the same grid.
-  const ReferenceTexture ref(doc.regions[0].reference.value(), Millimetres(50.88), Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}});
+  const ReferenceTexture ref(doc.regions[0].reference.value(), Millimetres(50.88),
+                             Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}});
   std::vector<double> left(9600);
   ref.render(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, 0, left);
   for (std::size_t i = 0; i < 9600; ++i) ASSERT_EQ(map[i], left[i]) << i;

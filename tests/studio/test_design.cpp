@@ -135,14 +135,12 @@ TEST(ImportExport, DocumentAndBitstreamRoundTrip) {
   const Document doc = two_regions();
   const ExportFile json = export_file(doc, ExportFormat::document);
   EXPECT_EQ(json.name, "texture.texel.json");
-  const ImportResult back =
-      import_file(json.name, std::span(reinterpret_cast<const std::uint8_t*>(json.data.data()), json.data.size()), {});
+  const ImportResult back = import_file(json.name, byte_view(json.data), {});
   EXPECT_EQ(back.kind, ImportKind::document);
   EXPECT_EQ(document_json(back.document), document_json(doc));
 
   const ExportFile bits = export_file(doc, ExportFormat::bitstream);
-  const ImportResult decoded =
-      import_file("x.texel", std::span(reinterpret_cast<const std::uint8_t*>(bits.data.data()), bits.data.size()), {});
+  const ImportResult decoded = import_file("x.texel", byte_view(bits.data), {});
   EXPECT_EQ(decoded.kind, ImportKind::bitstream);
   EXPECT_EQ(decoded.document.regions.size(), 1u);
   EXPECT_NEAR(decoded.document.regions[0].texel.central_pitch.value(), 8.0, 1e-9);
@@ -159,14 +157,13 @@ TEST(ImportExport, DeviceFilesAndSignalsGoThroughTheCodec) {
   const ExportFile csv = export_file(doc, ExportFormat::csv);
   EXPECT_EQ(parse_csv_columns(csv.data, "csv").second.size(), map.size());
   for (const ExportFile* f : {&bin, &npy}) {
-    const ImportResult r =
-        import_file(f->name, std::span(reinterpret_cast<const std::uint8_t*>(f->data.data()), f->data.size()), {});
+    const ImportResult r = import_file(f->name, byte_view(f->data), {});
     EXPECT_EQ(r.kind, ImportKind::signal);
     ASSERT_TRUE(r.encoded);
     EXPECT_NEAR(r.encoded->spec.central_pitch.value(), 10.0, 0.5) << f->name;
   }
   const std::string junk = "not a number\n";
-  EXPECT_THROW((void)import_file("a.csv", std::span(reinterpret_cast<const std::uint8_t*>(junk.data()), junk.size()), {}), Error);
+  EXPECT_THROW((void)import_file("a.csv", byte_view(junk), {}), Error);
   EXPECT_THROW((void)import_file("a.exe", {}, {}), InvalidArgument);
   EXPECT_THROW((void)parse_export_format("png"), InvalidArgument);
 }

@@ -73,10 +73,10 @@ struct DesignView {
   // Texel regions only (empty / 0 for a reference region):
   std::size_t texels = 0;
   HistogramView histogram;
-  std::vector<std::uint8_t> encoded;  ///< the region's .texel bitstream
-  std::string encoded_error;          ///< why `encoded` is empty for a Texel region (not representable)
-  double central_pitch_cpm = 0.0;     ///< the Central Pitch in cycles/mm
-  double irregularity_cpm = 0.0;      ///< the Irregularity's dB value in cycles/mm
+  std::vector<std::byte> encoded;  ///< the region's .texel bitstream
+  std::string encoded_error;       ///< why `encoded` is empty for a Texel region (not representable)
+  double central_pitch_cpm = 0.0;  ///< the Central Pitch in cycles/mm
+  double irregularity_cpm = 0.0;   ///< the Irregularity's dB value in cycles/mm
 };
 
 /// Renders and analyses a document. Throws InvalidArgument for a bad region
@@ -138,7 +138,7 @@ struct ImportResult {
 /// import_kind). Signals go through codec::load_signal and codec::encode and
 /// come back as the decoded document on `options.device`. Throws
 /// InvalidArgument / FormatError naming `name` and the problem.
-ImportResult import_file(std::string_view name, std::span<const std::uint8_t> bytes, const ImportOptions& options);
+ImportResult import_file(std::string_view name, std::span<const std::byte> bytes, const ImportOptions& options);
 
 enum class ExportFormat { document, bitstream, device, npy, csv };
 std::string_view to_string(ExportFormat f);
