@@ -145,22 +145,31 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
     // A 1-D or (n,1) array reads the same either way; checked via shape below.
   }
   const std::string shape = value_of("shape");
+  // The shape is outside input: every dimension is checked against the data
+  // the file actually holds before any size arithmetic, so a declared
+  // (2**62,) or a product that overflows size_t is a FormatError, never a
+  // wrapped count or an allocation sized by the header alone.
+  const std::size_t data_bytes = b.size() - data_at;
   std::vector<std::size_t> dims;
   for (std::size_t i = 0; i < shape.size();) {
     if (std::isdigit(static_cast<unsigned char>(shape[i]))) {
       std::size_t v = 0;
       auto r = std::from_chars(shape.data() + i, shape.data() + shape.size(), v);
+      if (r.ec != std::errc() || v > data_bytes)
+        throw FormatError(where + ": .npy shape " + shape + " declares a dimension of " + std::string(shape.data() + i, r.ptr) +
+                          " elements; the file holds only " + std::to_string(data_bytes) + " data bytes");
       dims.push_back(v);
       i = static_cast<std::size_t>(r.ptr - shape.data());
     } else {
       ++i;
     }
   }
-  std::size_t n = 1;
   int non_unit = 0;
+  std::size_t n = 1;
   for (auto d : dims) {
-    n *= d;
-    if (d != 1) ++non_unit;
+    if (d == 1) continue;
+    ++non_unit;
+    n = d;  // the one dimension that is not 1 (at most data_bytes: no overflow below)
   }
   if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
   std::size_t width = 0;
