@@ -394,6 +394,12 @@ Surface prepare_surface(const Document& doc) {
     if (!(r.length_mm > 0.0))
       throw InvalidArgument(label + "start_mm " + detail::num(spec.start_mm) + " mm is at or past the device's end (" +
                             detail::num(grid.length_mm()) + " mm)");
+    // Checked before the texture is built, not only by Surface afterwards: a
+    // region's texture is prepared over its own length, so a 1e9 mm region
+    // on a 100 mm device would allocate 10^11 texels first.
+    if (r.start_mm + r.length_mm > grid.length_mm() + 1e-3)
+      throw InvalidArgument(label + "start_mm " + detail::num(r.start_mm) + " mm + length_mm " + detail::num(r.length_mm) +
+                            " mm ends past the device's active length " + detail::num(grid.length_mm()) + " mm");
     try {
       // The texture's own coordinates: 0 mm at the region's left edge (as Surface::render passes them).
       const Grid local{grid.origin_mm - r.start_mm, grid.spacing_mm, grid.count};
