@@ -94,6 +94,24 @@ BackendStats Backend::stats() {
   return s;
 }
 
+void Backend::start(Player& player) {
+  stop();
+  attachment_.attach(player);  // throws if another backend drives the player
+  try {
+    do_start(player);
+  } catch (...) {
+    attachment_.detach();
+    throw;
+  }
+}
+
+// The attachment goes only after the real-time side has stopped: a player
+// that sees itself detached may be destroyed at once.
+void Backend::stop() noexcept {
+  do_stop();
+  attachment_.detach();
+}
+
 // Real-time safe: relaxed atomic loads and stores only.
 void Backend::record(const BlockInfo& info, double seconds) noexcept {
   const auto ns = static_cast<std::uint64_t>(seconds * 1e9);
@@ -120,20 +138,19 @@ class NullBackend final : public Backend {
       throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
   }
   ~NullBackend() override { stop(); }
-  void start(Player& player) override {
-    stop();
-    running_ = true;
-    thread_ = std::thread([this, &player] { loop(player); });
-  }
-  void stop() override {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
-  }
   [[nodiscard]] std::string describe() const override {
     return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
   }
 
  private:
+  void do_start(Player& player) override {
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void do_stop() noexcept override {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
   void loop(Player& player) {
     const auto period = std::chrono::duration<double>(static_cast<double>(buffer_.size()) / rate_);
     const auto t0 = Clock::now();
@@ -236,19 +253,21 @@ class AudioBackend final : public Backend {
     stop();
     if (stream_) Pa_CloseStream(stream_);
   }
-  void start(Player& player) override {
-    player_ = &player;
-    pa_check(Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
-  }
-  void stop() override {
-    if (stream_ && Pa_IsStreamActive(stream_) == 1) Pa_StopStream(stream_);
-  }
   [[nodiscard]] std::string describe() const override {
     return "audio '" + device_name_ + "', " + detail::num(options_.rate_hz) + " Hz, " + std::to_string(options_.block_frames) +
            " frames per block";
   }
 
  private:
+  void do_start(Player& player) override {
+    player_ = &player;
+    pa_check(Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
+  }
+  // Pa_StopStream returns after the last callback has returned.
+  void do_stop() noexcept override {
+    if (stream_ && Pa_IsStreamStopped(stream_) == 0) Pa_StopStream(stream_);
+    player_ = nullptr;
+  }
   // PortAudio's callback: calls only the real-time-safe process() and
   // relaxed atomics.
   static int callback(const void*, void* output, unsigned long frames, const PaStreamCallbackTimeInfo*,
@@ -281,15 +300,6 @@ class SerialBackend final : public Backend {
     }
   }
   ~SerialBackend() override { stop(); }
-  void start(Player& player) override {
-    stop();
-    running_ = true;
-    thread_ = std::thread([this, &player] { loop(player); });
-  }
-  void stop() override {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
-  }
   [[nodiscard]] std::string describe() const override {
     return "serial " + options_.path + " → '" + info_.name + "' (protocol " + std::to_string(info_.version) + ", " +
            detail::num(info_.refresh_hz) + " Hz refresh), streaming " +
@@ -302,6 +312,14 @@ class SerialBackend final : public Backend {
   }
 
  private:
+  void do_start(Player& player) override {
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void do_stop() noexcept override {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
   // The streaming thread does I/O by nature; process() itself stays
   // real-time safe, and errors end the loop instead of escaping the thread.
   void loop(Player& player) {
