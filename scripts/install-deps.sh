@@ -14,6 +14,9 @@ packages=(
   libboost-dev libmatio-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-h5py
   chromium firefox-esr
+  # GNU Octave runs examples/matlab/*.m in the examples.matlab_* ctests: a
+  # test-only tool (GPL, never linked); 74 MB download, 243 MB installed.
+  octave
 )
 
 # Texel Studio's front end builds with the machine's Node.js (>= 20) and npm
