@@ -184,13 +184,13 @@ void register_atlas(CLI::App& app) {
       const std::string stem = (fs::path(a->out) / info.name).string();
       write_rendered(stem + ".bin", doc, surface, map, {});
       write_rendered(stem + ".texel.json", doc, surface, map, {});
-      LoadedSignal sig;
+      Signal sig;
       sig.samples = map;
-      sig.spacing_mm = surface.grid().spacing_mm;
-      sig.source = "device " + device.name;
+      sig.spacing = Millimetres(surface.grid().spacing_mm);
+      sig.description = "device " + device.name;
       AnalysisOptions opt;
       opt.peaks.max_peaks = 12;
-      const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing_mm, opt);
+      const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing.value(), opt);
       const SpectrumPlot plot = make_spectrum_plot(info.name + ": " + info.description, sig, r, std::nullopt);
       plot_spectrum(plot, stem + "-spectrum.png");
       for (std::size_t i = 0; i < overview_names.size(); ++i)

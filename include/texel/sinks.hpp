@@ -32,8 +32,8 @@ enum class WavEncoding { pcm16, pcm24, float32 };
 /// [−1, 1] by the PCM encodings. Throws IoError naming the path.
 void write_wav(const std::string& path, std::span<const float> samples, double rate_hz,
                WavEncoding encoding = WavEncoding::pcm16);
-/// Reads a WAV's first channel (tests, tools). Throws IoError / FormatError.
-std::vector<float> read_wav(const std::string& path, double* rate_hz = nullptr);
+// WAV files are read by the one signal loader's audio reader
+// (texel::read_recording, texel/signal.hpp).
 
 /// "time_s,position_mm,output" with one row per output sample.
 std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output);

@@ -53,20 +53,6 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
   }
 }
 
-std::vector<float> read_wav(const std::string& path, double* rate_hz) {
-  SF_INFO info{};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (!f) throw IoError("cannot read '" + path + "': " + sf_strerror(nullptr));
-  std::vector<float> all(static_cast<std::size_t>(info.frames) * static_cast<std::size_t>(info.channels));
-  const sf_count_t got = sf_readf_float(f, all.data(), info.frames);
-  sf_close(f);
-  if (got != info.frames) throw FormatError("'" + path + "': truncated audio data");
-  std::vector<float> out(static_cast<std::size_t>(info.frames));
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = all[i * static_cast<std::size_t>(info.channels)];
-  if (rate_hz) *rate_hz = info.samplerate;
-  return out;
-}
-
 std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output) {
   std::string out = "time_s,position_mm,output\n";
   out.reserve(out.size() + output.size() * 32);

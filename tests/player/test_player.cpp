@@ -17,6 +17,7 @@
 #include "texel/error.hpp"
 #include "texel/finger.hpp"
 #include "texel/player.hpp"
+#include "texel/signal.hpp"
 #include "texel/sinks.hpp"
 #include "texel/spsc_queue.hpp"
 
@@ -437,13 +438,13 @@ TEST(Sinks, WavRoundTripIsAtomic) {
   for (std::size_t i = 0; i < s.size(); ++i) s[i] = 0.5f * std::sin(2 * pi * 440 * i / 48000.0);
   const std::string path = (dir / "a.wav").string();
   write_wav(path, s, 48000, WavEncoding::float32);
-  double rate = 0;
-  const auto back = read_wav(path, &rate);
-  EXPECT_EQ(rate, 48000);
+  const Recording rec = read_recording(path);
+  const auto& back = rec.samples;
+  EXPECT_EQ(rec.rate.value(), 48000);
   ASSERT_EQ(back.size(), s.size());
   for (std::size_t i = 0; i < s.size(); ++i) ASSERT_EQ(back[i], s[i]);
   write_wav(path, s, 48000);  // pcm16 over the old file
-  EXPECT_NEAR(read_wav(path)[100], s[100], 1.0 / 32768);
+  EXPECT_NEAR(read_recording(path).samples[100], s[100], 1.0 / 32768);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);  // no temporaries left
   EXPECT_THROW(write_wav((dir / "no" / "b.wav").string(), s, 48000), IoError);
   std::filesystem::remove_all(dir);
