@@ -300,6 +300,11 @@ TEST_F(MatFile, DeclaredMembersMustFitTheFile) {
   const std::string crash = path("crash.mat");
   fs::copy_file(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_mat/crash-corrupt-compressed-struct.mat", crash);
   expect_rejected(crash, "is corrupt: a matrix is truncated, or its compressed stream is corrupt");
+  // No v5/v7.3 marker at bytes 124-127: libmatio would fall back to v4 and
+  // malloc a name length from the file (1.7 GB for the fuzzer's 972 bytes).
+  const std::string v4 = path("v4.mat");
+  fs::copy_file(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_mat/crash-v4-fallback.mat", v4);
+  expect_rejected(v4, "is not a MATLAB v5/v7.3 .mat file (no version and byte-order mark at bytes 124-127)");
   // Texel's own files, compressed or not, with structs and cells, still read.
   Struct s;
   s.add("names", StringColumn{{"a", "bc", ""}}).add("m", Matrix::column(ramp(3)));
