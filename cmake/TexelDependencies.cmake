@@ -9,9 +9,8 @@
 # dependencies are still needed when the consumer links. Header-only private
 # dependencies (nlohmann-json, Boost.Math, Boost.Beast) are linked as
 # $<BUILD_INTERFACE:...>, so they are looked up for the build only (BUILD)
-# and an installed Texel never asks for them;
-# the exception is nlohmann-json for the experiment component, whose public
-# headers use nlohmann::json.
+# and an installed Texel never asks for them; the exception is nlohmann-json
+# for the experiment component, whose public headers use nlohmann::json.
 #
 #   texel_find_dependencies(<component> <missing-var> [BUILD])
 #
@@ -19,7 +18,8 @@
 # experiment, studio, capi. Sets <missing-var> to the Debian packages that
 # were not found (empty when everything is there).
 
-# texel_pkg_module(<PREFIX> <pkg-config module>): PkgConfig::<PREFIX>, once.
+# _texel_pkg_module(<PREFIX> <pkg-config module> <debian package>): the
+# imported target PkgConfig::<PREFIX>, created once.
 macro(_texel_pkg_module prefix module debian)
   if(NOT TARGET PkgConfig::${prefix})
     find_package(PkgConfig QUIET)
@@ -87,7 +87,9 @@ function(texel_find_dependencies component missing_var)
 endfunction()
 
 # The Texel components each component needs (its link interface), in an
-# order where every component comes after the ones it needs.
+# order where every component comes after the ones it needs. The options'
+# checks in cmake/TexelComponents.cmake state the same graph; keep them in
+# step (tests/consumer loads one component and checks what comes along).
 set(TEXEL_COMPONENTS core controller spectrum plot player io codec experiment studio capi)
 set(TEXEL_COMPONENT_NEEDS_core "")
 set(TEXEL_COMPONENT_NEEDS_controller "")
