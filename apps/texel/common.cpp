@@ -221,6 +221,22 @@ void Progress::done() {
   active_ = false;
 }
 
+void make_output_directory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw IoError("cannot create '" + dir + "': " + ec.message());
+}
+
+void add_output_set_options(CLI::App& cmd, OutputSetArgs& a) {
+  cmd.add_option("--out", a.out, "Output directory [" + a.out + "]");
+  cmd.add_option("--device", a.device, "Device profile [tpad]");
+}
+
+DeviceProfile prepare_output_set(const OutputSetArgs& a) {
+  make_output_directory(a.out);
+  return load_device(a.device);
+}
+
 void print_json(const nlohmann::ordered_json& j) { std::cout << j.dump(2) << "\n"; }
 
 }  // namespace texel::cli

@@ -104,6 +104,18 @@ class Progress {
   int last_percent_ = -1;
 };
 
+/// Creates an output directory (and its parents); throws IoError naming it.
+void make_output_directory(const std::string& dir);
+
+/// Commands that write a set of files into a directory for one device (demo, atlas).
+struct OutputSetArgs {
+  std::string out;
+  std::string device = "tpad";
+};
+void add_output_set_options(CLI::App& cmd, OutputSetArgs& a);
+/// Creates the directory and loads the device.
+DeviceProfile prepare_output_set(const OutputSetArgs& a);
+
 /// Prints `j` to stdout, indented.
 void print_json(const nlohmann::ordered_json& j);
 
