@@ -1,9 +1,7 @@
 // libFuzzer target for WAV recordings (any format libsndfile reads), through
 // the one signal loader: texel::decode_signal(bytes, SignalFormat::wav, ...)
 // (signal.hpp; libsndfile over virtual I/O on the bytes, channels mixed,
-// 100 mm/s, at most 2^20 samples). Where that loader is not in the tree yet,
-// the codec's file reader (codec::load_signal on a copy under /dev/shm).
-// Every input is either
+// 100 mm/s, at most 2^20 samples). Every input is either
 //   - accepted: at least 2 finite samples in [0, 1] on a spacing > 0 (a
 //     recording is scaled to full range), no more than the cap; or
 //   - rejected with a texel::Error (FormatError; InvalidArgument for a
@@ -20,17 +18,7 @@
 #include <vector>
 
 #include "texel/error.hpp"
-
-#if __has_include("texel/signal.hpp")
 #include "texel/signal.hpp"
-#else
-#include <unistd.h>
-
-#include <cstdio>
-#include <string>
-
-#include "texel/codec.hpp"
-#endif
 
 namespace {
 
@@ -47,25 +35,12 @@ void check(const std::vector<double>& samples, double spacing_mm) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-#if __has_include("texel/signal.hpp")
     texel::SignalOptions o;
     o.swipe_speed = texel::MmPerSecond(100.0);
     o.channels = texel::ChannelPolicy::mix;
     o.max_samples = max_samples;
     const texel::Signal s = texel::decode_signal(std::as_bytes(std::span(data, size)), texel::SignalFormat::wav, o, "fuzz.wav");
     check(s.samples, s.spacing.value());
-#else
-    static const std::string path = std::string(::access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp") + "/texel-fuzz-wav-" +
-                                    std::to_string(::getpid()) + ".wav";
-    std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) std::abort();
-    if (size > 0 && std::fwrite(data, 1, size, f) != size) std::abort();
-    std::fclose(f);
-    texel::codec::LoadOptions o;
-    o.swipe_speed = texel::MmPerSecond(100.0);
-    const texel::codec::Signal s = texel::codec::load_signal(path, o);
-    check(s.amplitude, s.spacing_mm);
-#endif
   } catch (const texel::Error&) {
     // Rejected with a message: the expected outcome for most inputs.
   }
