@@ -46,10 +46,7 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
 
 nlohmann::ordered_json percept_json(const codec::Percept& p) {
   nlohmann::ordered_json j;
-  j["pitch_db"] = p.pitch_db;
-  j["noisiness_db"] = p.noisiness_db;
-  j["centroid_db"] = p.mean_db;
-  j["spread_db"] = p.spread_db;
+  for (const auto& [name, value] : codec::fields(p)) j[name] = value;
   return j;
 }
 

@@ -25,11 +25,13 @@
 // Texel renderings.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "texel/bitstream.hpp"
@@ -81,6 +83,10 @@ struct Percept {
   double mean_db = 0.0;       ///< physical: power-weighted mean frequency, dB re 1 cpm
   double spread_db = 0.0;     ///< physical: power-weighted SD of 10·log10 f, dB
 };
+
+/// A percept as named fields, the names every front door reports it under
+/// (pitch_db, noisiness_db, centroid_db, spread_db).
+std::array<std::pair<const char*, double>, 4> fields(const Percept& p);
 
 /// Percept of a zero-mean fine signal sampled every `spacing_mm`, from its
 /// content above `f_min_cpm` (and above 0.01 cpm).

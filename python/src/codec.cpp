@@ -36,10 +36,7 @@ codec::Bitstream bitstream_of(const py::handle& source) {
 
 py::dict percept_dict(const codec::Percept& p) {
   py::dict d;
-  d["pitch_db"] = p.pitch_db;
-  d["noisiness_db"] = p.noisiness_db;
-  d["centroid_db"] = p.mean_db;
-  d["spread_db"] = p.spread_db;
+  for (const auto& [name, value] : codec::fields(p)) d[name] = value;
   return d;
 }
 

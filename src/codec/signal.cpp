@@ -39,6 +39,10 @@ texel::Signal load_signal(const std::string& path, const SignalOptions& o) {
   return codec::decode_signal(std::as_bytes(std::span(bytes.data(), bytes.size())), SignalFormat::bitstream, o, path);
 }
 
+std::array<std::pair<const char*, double>, 4> fields(const Percept& p) {
+  return {{{"pitch_db", p.pitch_db}, {"noisiness_db", p.noisiness_db}, {"centroid_db", p.mean_db}, {"spread_db", p.spread_db}}};
+}
+
 Signal encoder_signal(const texel::Signal& s) { return Signal{s.samples, s.spacing.value(), s.description}; }
 
 std::size_t zstd_size(std::span<const std::byte> bytes) {
