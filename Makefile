@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD := build
 PY := /usr/bin/python3
 
-.PHONY: all deps configure build python web demo test test-unit test-browser test-asan test-determinism bench format clean
+.PHONY: all deps configure build python web demo test test-unit test-browser test-asan test-determinism bench fuzz format clean
 
 all: build
 
@@ -88,8 +88,21 @@ bench: build web
 	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null
 	$(PY) bench/studio_latency.py $(BUILD)/browser-artifacts/latency.json
 
+# The libFuzzer targets of every parser of outside input (docs/fuzzing.md):
+# a clang build in build-fuzz with the whole library instrumented, then each
+# target for FUZZ_SECONDS of wall time, two at a time. Their seed corpora are
+# replayed by `make test` (ctest fuzz.*.replay) under any compiler.
+FUZZ_SECONDS ?= 600
+FUZZ_TARGETS := fuzz_document fuzz_npy fuzz_csv fuzz_serial fuzz_mat fuzz_wav fuzz_bitstream fuzz_experiment
+
+fuzz: deps
+	@cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTEXEL_FUZZ=ON \
+	  -DTEXEL_BUILD_BENCH=OFF -DTEXEL_WITH_PYTHON=OFF >/dev/null
+	@cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS)
+	bash scripts/fuzz.sh build-fuzz $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
 
 clean:
-	rm -rf build build-asan build-debug build-clang build-det out
+	rm -rf build build-asan build-debug build-clang build-det build-fuzz out

@@ -10,4 +10,18 @@ function(texel_target_settings target)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
+  if(TEXEL_FUZZ)
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
 endfunction()
+
+# libFuzzer builds (docs/fuzzing.md; clang only): every target gets coverage
+# instrumentation and the sanitizers, so the fuzz targets under tests/ see the
+# library's branches, not only their own.
+option(TEXEL_FUZZ "Instrument every target for libFuzzer (clang; implies TEXEL_SANITIZE)" OFF)
+if(TEXEL_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "TEXEL_FUZZ needs clang (libFuzzer): configure with -DCMAKE_CXX_COMPILER=clang++")
+  endif()
+  set(TEXEL_SANITIZE ON CACHE BOOL "Build with AddressSanitizer and UndefinedBehaviorSanitizer" FORCE)
+endif()

@@ -4,16 +4,30 @@
 # only one dpkg query. Runs as root (CI, containers) or through sudo.
 set -euo pipefail
 
+# Exactly what is used, grouped by who uses it; the library components'
+# own lists are in cmake/TexelDependencies.cmake.
 packages=(
+  # toolchain: the release/asan presets (GCC), the clang preset, libFuzzer and
+  # the determinism check (clang + its sanitizer runtimes), `make format`
   build-essential cmake ninja-build pkg-config git
   g++ clang libclang-rt-14-dev clang-format
-  libcli11-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev
-  libcairo2-dev libkissfft-dev libzstd-dev zstd
-  libsndfile1-dev portaudio19-dev libsqlite3-dev
-  libboost-dev libmatio-dev
+  # libraries, per component: core (nlohmann-json), spectrum (kissfft),
+  # plot (cairo), player (sndfile, portaudio), io (matio, sndfile),
+  # codec (sndfile, zstd), experiment (sqlite, Boost.Math), studio (Boost.Beast)
+  nlohmann-json3-dev libkissfft-dev libcairo2-dev libsndfile1-dev portaudio19-dev
+  libmatio-dev libzstd-dev libsqlite3-dev libboost-dev
+  # the texel command line
+  libcli11-dev
+  # tests and benchmarks
+  libgtest-dev librapidcheck-dev libbenchmark-dev
+  # the Python package and the Python-side checks (pytest, the statistics
+  # oracle, the protocol schema, reading .mat v5/v7.3 files)
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-h5py
+  # Texel Studio's browser tests
   chromium firefox-esr
+  # GNU Octave runs examples/matlab/*.m in the examples.matlab_* ctests: a
+  # test-only tool (GPL, never linked); 74 MB download, 243 MB installed.
+  octave
 )
 
 # Texel Studio's front end builds with the machine's Node.js (>= 20) and npm

@@ -15,21 +15,16 @@
 namespace texel::cli {
 void register_demo(CLI::App& app) {
   struct Args {
-    std::string out = "out/demo";
-    std::string device = "tpad";
+    OutputSetArgs set{"out/demo"};
     bool plots = true;
   };
   auto args = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("demo", "Render the demonstration set into a directory");
-  cmd->add_option("--out", args->out, "Output directory [out/demo]");
-  cmd->add_option("--device", args->device, "Device profile [tpad]");
+  add_output_set_options(*cmd, args->set);
   cmd->add_flag("!--no-plots", args->plots, "Skip the PNG plots");
   cmd->callback([args] {
     namespace fs = std::filesystem;
-    std::error_code ec;
-    fs::create_directories(args->out, ec);
-    if (ec) throw IoError("cannot create '" + args->out + "': " + ec.message());
-    const DeviceProfile device = load_device(args->device);
+    const DeviceProfile device = prepare_output_set(args->set);
     std::cout << std::left << std::setw(28) << "texture" << std::right << std::setw(8) << "texels" << std::setw(18)
               << "raw device bytes" << std::setw(16) << "document bytes"
               << "\n";
@@ -39,7 +34,7 @@ void register_demo(CLI::App& app) {
       const Surface surface = prepare_surface(doc);
       const std::vector<double> map = render_map(surface);
       const std::vector<double> freqs = texel_frequencies(surface);
-      const std::string stem = (fs::path(args->out) / t.name).string();
+      const std::string stem = (fs::path(args->set.out) / t.name).string();
       write_rendered(stem + ".bin", doc, surface, map, freqs);
       write_rendered(stem + ".texel.json", doc, surface, map, freqs);
       if (args->plots) write_rendered(stem + ".png", doc, surface, map, freqs);

@@ -21,8 +21,7 @@ namespace {
 struct EncodeArgs {
   std::vector<std::string> inputs;
   std::optional<std::string> output;
-  DeviceOptions device;
-  std::optional<double> swipe_speed;
+  SignalArgs input;
   double boundary_mm = 1.0;
   double texel_length_mm = 0.25;
   std::uint64_t seed = 1;
@@ -35,7 +34,7 @@ struct EncodeArgs {
 
 codec::EncoderConfig config_of(const EncodeArgs& a) {
   codec::EncoderConfig c;
-  if (a.swipe_speed) c.model.swipe_speed = MmPerSecond(*a.swipe_speed);
+  if (a.input.swipe_speed) c.model.swipe_speed = MmPerSecond(*a.input.swipe_speed);
   c.boundary = Millimetres(a.boundary_mm);
   c.texel_length = Millimetres(a.texel_length_mm);
   c.seed = a.seed;
@@ -45,23 +44,13 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   return c;
 }
 
-codec::LoadOptions load_options(const EncodeArgs& a) {
-  codec::LoadOptions o;
-  if (a.device.device || a.device.length_mm || a.device.spacing_mm) o.device = resolve_device(a.device, nullptr);
-  if (a.swipe_speed) o.swipe_speed = MmPerSecond(*a.swipe_speed);
-  return o;
-}
-
 nlohmann::ordered_json percept_json(const codec::Percept& p) {
   nlohmann::ordered_json j;
-  j["pitch_db"] = p.pitch_db;
-  j["noisiness_db"] = p.noisiness_db;
-  j["centroid_db"] = p.mean_db;
-  j["spread_db"] = p.spread_db;
+  for (const auto& [name, value] : codec::fields(p)) j[name] = value;
   return j;
 }
 
-nlohmann::ordered_json result_json(const std::string& input, const codec::Signal& sig, const codec::EncodeResult& r,
+nlohmann::ordered_json result_json(const std::string& input, const Signal& sig, const codec::EncodeResult& r,
                                    const codec::EncoderConfig& cfg, const std::optional<std::string>& output) {
   nlohmann::ordered_json j;
   j["input"] = input;
@@ -131,23 +120,24 @@ struct ReportRow {
 
 void run_report(const EncodeArgs& a) {
   const codec::EncoderConfig cfg = config_of(a);
-  const codec::LoadOptions lo = load_options(a);
-  const DeviceProfile device = lo.device ? *lo.device : load_device("tpad");
+  const SignalOptions lo = signal_options(a.input);
+  // The raw size is the map as a device stores it: the given device's format, else u16 (tpad's).
+  const SampleFormat format = lo.device ? lo.device->format : SampleFormat::u16le;
   std::vector<ReportRow> rows;
   for (const auto& path : a.inputs) {
-    const codec::Signal sig = codec::load_signal(path, lo);
-    const codec::EncodeResult r = codec::encode(sig, cfg);
+    const Signal sig = codec::load_signal(path, lo);
+    const codec::EncodeResult r = codec::encode(codec::encoder_signal(sig), cfg);
     ReportRow row;
     row.name = std::filesystem::path(path).filename().string();
-    row.samples = sig.amplitude.size();
+    row.samples = sig.samples.size();
     // Raw = the map as the device stores it (.bin files: their own bytes).
-    std::vector<std::byte> raw(sig.amplitude.size() * bytes_per_sample(device.format));
+    std::vector<std::byte> raw(sig.samples.size() * bytes_per_sample(format));
     if (output_extension(path) == ".bin") {
       const std::string bytes = read_file(path);
       raw.assign(reinterpret_cast<const std::byte*>(bytes.data()),
                  reinterpret_cast<const std::byte*>(bytes.data()) + bytes.size());
     } else {
-      encode_samples(device.format, sig.amplitude, raw);
+      encode_samples(format, sig.samples, raw);
     }
     row.raw = raw.size();
     row.zstd = codec::zstd_size(raw);
@@ -186,17 +176,10 @@ void run_report(const EncodeArgs& a) {
 void register_encode(CLI::App& app) {
   auto a = std::make_shared<EncodeArgs>();
   auto* cmd = app.add_subcommand("encode", "Encode a texture signal into Texel parameters and a .texel bitstream");
-  cmd->add_option(
-         "input", a->inputs,
-         "Texture signal: .bin (device map), .npy, .csv (position_mm,amplitude or time_s,value), .wav, .texel.json, .texel; "
-         "several with --report")
-      ->required();
+  cmd->add_option("input", a->inputs, std::string(kInputHelp) + "; several with --report")->required();
   cmd->add_option("-o,--output", a->output, "Output bitstream (.texel); without it, only the estimates are printed");
-  add_device_options(*cmd, a->device);
+  add_signal_options(*cmd, a->input);  // --swipe-speed also sets the model's temporal frequencies [100]
   const std::string g = "Encoder";
-  cmd->add_option("--swipe-speed", a->swipe_speed,
-                  "Finger speed, mm/s: turns time recordings into positions and sets the model's temporal frequencies [100]")
-      ->group(g);
   cmd->add_option("--boundary", a->boundary_mm, "Fine/coarse boundary, mm [1]")->group(g);
   cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
@@ -219,9 +202,9 @@ void register_encode(CLI::App& app) {
       check_writable(*a->output);
     }
     const codec::EncoderConfig cfg = config_of(*a);
-    const codec::Signal sig = codec::load_signal(a->inputs[0], load_options(*a));
-    const codec::EncodeResult r = codec::encode(sig, cfg);
-    if (a->output) write_file_atomic(*a->output, r.bytes);
+    const Signal sig = load_input(a->inputs[0], a->input);
+    const codec::EncodeResult r = codec::encode(codec::encoder_signal(sig), cfg);
+    if (a->output) write_file_atomic(*a->output, std::string_view(reinterpret_cast<const char*>(r.bytes.data()), r.bytes.size()));
     if (a->json)
       print_json(result_json(a->inputs[0], sig, r, cfg, a->output));
     else

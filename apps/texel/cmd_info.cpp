@@ -1,4 +1,4 @@
-// texel info: what a document or a rendered file holds.
+// texel info: what a document holds, or any input signal as texel::load_signal reads it.
 // texel devices: the device profiles Texel knows.
 #include <algorithm>
 #include <iostream>
@@ -93,44 +93,30 @@ void print_text(const ordered& j, int indent = 0) {
 void register_info(CLI::App& app) {
   struct Args {
     std::string file;
-    std::optional<std::string> device;
+    SignalArgs input;
     bool json = false;
   };
   auto args = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand("info", "Describe a texture document or a rendered file (.bin needs --device)");
-  cmd->add_option("file", args->file, "A .texel.json, .bin, .csv or .npy file")->required();
-  cmd->add_option("--device", args->device, "Device of a .bin file [tpad]");
+  auto* cmd = app.add_subcommand("info", "Describe a texture document, or any input signal as the library reads it");
+  cmd->add_option("file", args->file, kInputHelp)->required();
+  add_signal_options(*cmd, args->input);
   cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([args] {
-    const std::string ext = output_extension(args->file);
+    const auto& in = args->input;
     ordered j;
-    if (ext == ".texel.json" || ext == ".json") {
+    if (signal_format_of(args->file) == SignalFormat::document && !in.device && !in.spacing_mm && !in.region) {
       j = document_info(load_document(args->file), args->file);
-    } else if (ext == ".bin") {
-      const DeviceProfile d = load_device(args->device.value_or("tpad"));
-      const std::string bytes = read_file(args->file);
-      const auto data = decode_samples(d.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
-      j["file"] = args->file;
-      j["kind"] = "device-native";
-      j["device"] = d.name;
-      j["format"] = std::string(to_string(d.format));
-      j["bytes"] = bytes.size();
-      j["matches_device"] = static_cast<std::int64_t>(data.size()) == d.samples;
-      j["length_mm"] = static_cast<double>(data.size()) * d.spacing.value();
-      j["amplitude"] = stats(data);
-    } else if (ext == ".npy") {
-      j["file"] = args->file;
-      j["kind"] = "npy";
-      j["amplitude"] = stats(parse_npy(read_file(args->file), args->file));
-    } else if (ext == ".csv") {
-      auto [x, a] = parse_csv_columns(read_file(args->file), args->file);
-      j["file"] = args->file;
-      j["kind"] = "csv";
-      j["first_mm"] = x.front();
-      j["last_mm"] = x.back();
-      j["amplitude"] = stats(a);
     } else {
-      throw InvalidArgument("info: '" + args->file + "' has extension '" + ext + "'; allowed: .texel.json, .bin, .csv, .npy");
+      const Signal s = load_input(args->file, in);
+      j["file"] = args->file;
+      j["kind"] = std::string(to_string(s.format));
+      j["source"] = s.description;
+      j["spacing_mm"] = s.spacing.value();
+      j["origin_mm"] = s.origin.value();
+      j["length_mm"] = s.length().value();
+      if (s.sample_rate) j["sample_rate_hz"] = s.sample_rate->value();
+      j["scaled_to_full_range"] = s.scaled;
+      j["amplitude"] = stats(s.samples);
     }
     if (args->json)
       print_json(j);

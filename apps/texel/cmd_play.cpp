@@ -173,9 +173,7 @@ void register_play(CLI::App& app) {
                   "Serial: stream finger positions (the display looks up its map) or drive values [position]");
   cmd->add_option("--baud", a->baud, "Serial baud rate [921600]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
-  add_finger_options(*cmd, a->finger);
-  add_device_options(*cmd, a->device);
-  add_texture_options(*cmd, a->texture);
+  add_player_options(*cmd, a->finger, a->device, a->texture);
   cmd->callback([a] { run(*a); });
 }
 

@@ -152,22 +152,17 @@ void register_reference(CLI::App& app) {
 
 void register_atlas(CLI::App& app) {
   struct Args {
-    std::string out = "out/demo/references";
-    std::string device = "tpad";
+    OutputSetArgs set{"out/demo/references"};
     std::uint64_t seed = 1;
   };
   auto a = std::make_shared<Args>();
   auto* cmd =
       app.add_subcommand("atlas", "Write every reference, its spectrum plot and the second study's overview into a directory");
-  cmd->add_option("--out", a->out, "Output directory [out/demo/references]");
-  cmd->add_option("--device", a->device, "Device profile [tpad]");
+  add_output_set_options(*cmd, a->set);
   cmd->add_option("--seed", a->seed, "Seed of the seeded references [1]");
   cmd->callback([a] {
     namespace fs = std::filesystem;
-    std::error_code ec;
-    fs::create_directories(a->out, ec);
-    if (ec) throw IoError("cannot create '" + a->out + "': " + ec.message());
-    const DeviceProfile device = load_device(a->device);
+    const DeviceProfile device = prepare_output_set(a->set);
     const std::vector<std::string> overview_names = second_study_names();
     std::vector<Figure> cells(overview_names.size());
     std::cout << std::left << std::setw(20) << "reference" << std::right << std::setw(10) << "bytes" << std::setw(14)
@@ -181,16 +176,16 @@ void register_atlas(CLI::App& app) {
       doc.description = "Texel reference " + info.name + ": " + info.description;
       const Surface surface = prepare_surface(doc);
       const std::vector<double> map = render_map(surface);
-      const std::string stem = (fs::path(a->out) / info.name).string();
+      const std::string stem = (fs::path(a->set.out) / info.name).string();
       write_rendered(stem + ".bin", doc, surface, map, {});
       write_rendered(stem + ".texel.json", doc, surface, map, {});
-      LoadedSignal sig;
+      Signal sig;
       sig.samples = map;
-      sig.spacing_mm = surface.grid().spacing.value();
-      sig.source = "device " + device.name;
+      sig.spacing = Millimetres(surface.grid().spacing_mm);
+      sig.description = "device " + device.name;
       AnalysisOptions opt;
       opt.peaks.max_peaks = 12;
-      const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing_mm, opt);
+      const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing.value(), opt);
       const SpectrumPlot plot = make_spectrum_plot(info.name + ": " + info.description, sig, r, std::nullopt);
       plot_spectrum(plot, stem + "-spectrum.png");
       for (std::size_t i = 0; i < overview_names.size(); ++i)
@@ -211,8 +206,8 @@ void register_atlas(CLI::App& app) {
     grid.title = "Second-study references on " + device.name + ": sums of sinusoids, colours of noise, shaped waveforms";
     grid.columns = 3;
     grid.cells = std::move(cells);
-    save_figure_grid(grid, (fs::path(a->out) / "overview.png").string());
-    std::cout << "overview: " << (fs::path(a->out) / "overview.png").string() << "\n";
+    save_figure_grid(grid, (fs::path(a->set.out) / "overview.png").string());
+    std::cout << "overview: " << (fs::path(a->set.out) / "overview.png").string() << "\n";
   });
 }
 

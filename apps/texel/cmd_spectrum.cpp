@@ -28,18 +28,6 @@ using ordered = nlohmann::ordered_json;
 
 double db_of(double cpm) { return 10.0 * std::log10(cpm); }
 
-/// Checks that CSV positions are uniformly spaced (to 0.1 % of a step) and returns the step.
-double uniform_spacing(const std::vector<double>& x, const std::string& path) {
-  if (x.size() < 2) throw FormatError(path + ": needs at least 2 rows to know the sample spacing");
-  const double step = (x.back() - x.front()) / static_cast<double>(x.size() - 1);
-  if (!(step > 0.0)) throw FormatError(path + ": positions must increase");
-  for (std::size_t i = 1; i < x.size(); ++i)
-    if (std::abs((x[i] - x[i - 1]) - step) > 1e-3 * step)
-      throw FormatError(path + ": row " + std::to_string(i + 1) + " position " + num(x[i]) +
-                        " mm breaks the uniform spacing of " + num(step) + " mm (spectra need uniformly sampled maps)");
-  return step;
-}
-
 std::pair<double, double> parse_band(const std::string& text) {
   const auto colon = text.find(':');
   auto number = [&](std::string_view t) {
@@ -59,10 +47,7 @@ std::pair<double, double> parse_band(const std::string& text) {
 
 struct Args {
   std::string file;
-  std::optional<std::string> device;
-  std::optional<double> spacing;
-  std::optional<std::string> region;
-  std::optional<double> swipe_speed;
+  SignalArgs input;
   bool json = false;
   std::optional<std::string> output;
   std::string mat_version = "5";
@@ -78,19 +63,19 @@ struct Args {
   double excerpt_mm = 6.0;
 };
 
-ordered report_json(const Args& a, const LoadedSignal& sig, const SpectralReport& r) {
+ordered report_json(const Args& a, const Signal& sig, const SpectralReport& r) {
   // A plain flag and value rather than optional<MmPerSecond>: GCC 12 warns
   // (falsely) about the optional's payload inside nlohmann's conversions.
-  const bool has_speed = a.swipe_speed.has_value();
-  const MmPerSecond speed(a.swipe_speed.value_or(1.0));
+  const bool has_speed = a.input.swipe_speed.has_value();
+  const MmPerSecond speed(a.input.swipe_speed.value_or(1.0));
   const MmPerSecond* v = has_speed ? &speed : nullptr;
   ordered j;
   j["file"] = a.file;
-  j["source"] = sig.source;
+  j["source"] = sig.description;
   j["samples"] = sig.samples.size();
-  j["spacing_mm"] = sig.spacing_mm;
-  j["length_mm"] = static_cast<double>(sig.samples.size()) * sig.spacing_mm;
-  j["nyquist_cpm"] = 0.5 / sig.spacing_mm;
+  j["spacing_mm"] = sig.spacing.value();
+  j["length_mm"] = static_cast<double>(sig.samples.size()) * sig.spacing.value();
+  j["nyquist_cpm"] = 0.5 / sig.spacing.value();
   j["resolution_cpm"] = r.spectrum.resolution_cpm;
   j["window"] = std::string(to_string(r.spectrum.window));
   j["nfft"] = r.spectrum.nfft;
@@ -136,11 +121,11 @@ ordered report_json(const Args& a, const LoadedSignal& sig, const SpectralReport
   return j;
 }
 
-void print_report(const Args& a, const LoadedSignal& sig, const SpectralReport& r) {
-  const std::optional<double> v = a.swipe_speed;
-  std::cout << a.file << ": " << sig.samples.size() << " samples × " << num(sig.spacing_mm) << " mm ("
-            << fixed(static_cast<double>(sig.samples.size()) * sig.spacing_mm, 2) << " mm), " << sig.source << "\n";
-  std::cout << "resolution " << num(r.spectrum.resolution_cpm) << " cpm, Nyquist " << fixed(0.5 / sig.spacing_mm, 2)
+void print_report(const Args& a, const Signal& sig, const SpectralReport& r) {
+  const std::optional<double> v = a.input.swipe_speed;
+  std::cout << a.file << ": " << sig.samples.size() << " samples × " << num(sig.spacing.value()) << " mm ("
+            << fixed(static_cast<double>(sig.samples.size()) * sig.spacing.value(), 2) << " mm), " << sig.description << "\n";
+  std::cout << "resolution " << num(r.spectrum.resolution_cpm) << " cpm, Nyquist " << fixed(0.5 / sig.spacing.value(), 2)
             << " cpm, window " << to_string(r.spectrum.window) << "\n";
   std::cout << "peaks (within " << num(a.threshold_db) << " dB of the highest):\n";
   std::cout << "  frequency_cpm      dB re 1 cpm   amplitude   level_dB" << (v ? "   frequency_Hz" : "") << "\n";
@@ -164,94 +149,15 @@ void print_report(const Args& a, const LoadedSignal& sig, const SpectralReport& 
 
 }  // namespace
 
-LoadedSignal load_signal(const std::string& path, const std::optional<std::string>& device,
-                         const std::optional<double>& spacing_mm, const std::optional<std::string>& region) {
-  const std::string ext = output_extension(path);
-  if (spacing_mm && !(std::isfinite(*spacing_mm) && *spacing_mm > 0.0))
-    throw InvalidArgument("--spacing is " + num(*spacing_mm) + "; it must be a finite number of mm > 0");
-  if (region && ext != ".texel.json") throw InvalidArgument("--region applies to .texel.json documents only");
-  LoadedSignal sig;
-  if (ext == ".bin") {
-    if (!device) throw InvalidArgument("'" + path + "' is device-native: name its device with --device (e.g. --device tpad)");
-    const DeviceProfile d = load_device(*device);
-    const std::string bytes = read_file(path);
-    const std::size_t width = bytes_per_sample(d.format);
-    if (bytes.size() % width != 0)
-      throw FormatError(path + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
-                        std::string(to_string(d.format)) + " samples for device " + d.name);
-    sig.samples = decode_samples(d.format, std::span(reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()));
-    sig.spacing_mm = spacing_mm.value_or(d.spacing.value());
-    sig.source = "device " + d.name + " (" + std::string(to_string(d.format)) + ")";
-  } else if (ext == ".csv") {
-    auto [x, a] = parse_csv_columns(read_file(path), path);
-    sig.spacing_mm = uniform_spacing(x, path);
-    sig.origin_mm = x.front();
-    sig.samples = std::move(a);
-    sig.source = "csv";
-  } else if (ext == ".npy") {
-    sig.samples = parse_npy(read_file(path), path);
-    if (spacing_mm)
-      sig.spacing_mm = *spacing_mm;
-    else if (device)
-      sig.spacing_mm = load_device(*device).spacing.value();
-    else
-      throw InvalidArgument("'" + path + "' carries no sample spacing: give --device or --spacing");
-    sig.source = "npy";
-  } else if (ext == ".texel.json" || ext == ".json") {
-    Document doc = load_document(path);
-    if (device || spacing_mm) {
-      DeviceOptions o;
-      o.device = device;
-      o.spacing_mm = spacing_mm;
-      doc.device = resolve_device(o, &doc.device);
-    }
-    const Surface surface = prepare_surface(doc);
-    std::vector<double> map = render_map(surface);
-    const Grid& g = surface.grid();
-    sig.spacing_mm = g.spacing.value();
-    sig.source = "document on device " + doc.device.name;
-    if (region) {
-      const auto& regions = surface.regions();
-      const Region* chosen = nullptr;
-      for (std::size_t i = 0; i < regions.size(); ++i)
-        if (regions[i].name == *region || std::to_string(i) == *region) chosen = &regions[i];
-      if (!chosen) {
-        std::string names;
-        for (std::size_t i = 0; i < regions.size(); ++i)
-          names += (names.empty() ? "" : ", ") + (regions[i].name.empty() ? std::to_string(i) : regions[i].name);
-        throw InvalidArgument("--region '" + *region + "' is not in " + path + "; its regions: " + names);
-      }
-      std::vector<double> part;
-      for (std::int64_t i = 0; i < g.count; ++i) {
-        const double x = g.position(i).value();
-        if (x >= chosen->start.value() && x < chosen->start.value() + chosen->length.value()) {
-          if (part.empty()) sig.origin_mm = x;
-          part.push_back(map[static_cast<std::size_t>(i)]);
-        }
-      }
-      map = std::move(part);
-      sig.source += ", region " + *region;
-    }
-    sig.samples = std::move(map);
-  } else {
-    throw InvalidArgument("spectrum: '" + path + "' has extension '" + ext +
-                          "'; allowed: .bin (with --device), .csv, .npy, .texel.json");
-  }
-  if (sig.samples.size() < 16)
-    throw InvalidArgument("'" + path + "' holds " + std::to_string(sig.samples.size()) +
-                          " samples; a spectrum needs at least 16");
-  return sig;
-}
-
-SpectrumPlot make_spectrum_plot(const std::string& title, const LoadedSignal& sig, const SpectralReport& r,
+SpectrumPlot make_spectrum_plot(const std::string& title, const Signal& sig, const SpectralReport& r,
                                 std::optional<double> swipe_speed_mm_s) {
   SpectrumPlot p;
   p.title = title;
-  const double length = static_cast<double>(sig.samples.size()) * sig.spacing_mm;
+  const double length = static_cast<double>(sig.samples.size()) * sig.spacing.value();
   p.excerpt_mm = std::min(6.0, length);
-  const auto n = std::min(sig.samples.size(), static_cast<std::size_t>(std::ceil(p.excerpt_mm / sig.spacing_mm)) + 1);
+  const auto n = std::min(sig.samples.size(), static_cast<std::size_t>(std::ceil(p.excerpt_mm / sig.spacing.value())) + 1);
   for (std::size_t i = 0; i < n; ++i) {
-    p.positions_mm.push_back(sig.origin_mm + static_cast<double>(i) * sig.spacing_mm);
+    p.positions_mm.push_back(sig.origin.value() + static_cast<double>(i) * sig.spacing.value());
     p.amplitudes.push_back(sig.samples[i]);
   }
   p.spectrum = r.spectrum;
@@ -262,7 +168,7 @@ SpectrumPlot make_spectrum_plot(const std::string& title, const LoadedSignal& si
 
 /// The .mat variables of a spectrum (docs/format.md "MATLAB .mat"): N×1
 /// columns, and the peaks as a struct of columns.
-std::vector<mat::Variable> spectrum_variables(const std::string& source, const LoadedSignal& sig, const SpectralReport& r) {
+std::vector<mat::Variable> spectrum_variables(const std::string& source, const Signal& sig, const SpectralReport& r) {
   using mat::Matrix;
   std::vector<double> pf, pa, pl;
   for (const Peak& p : r.peaks) pf.push_back(p.frequency.value()), pa.push_back(p.amplitude), pl.push_back(p.level_db);
@@ -272,7 +178,7 @@ std::vector<mat::Variable> spectrum_variables(const std::string& source, const L
       .add("level_db", Matrix::column(std::move(pl)));
   mat::Struct params;
   params.add("source", mat::Text{source})
-      .add("spacing_mm", Matrix::scalar(sig.spacing_mm))
+      .add("spacing_mm", Matrix::scalar(sig.spacing.value()))
       .add("samples", Matrix::scalar(static_cast<double>(sig.samples.size())))
       .add("window", mat::Text{std::string(to_string(r.spectrum.window))})
       .add("nfft", Matrix::scalar(static_cast<double>(r.spectrum.nfft)))
@@ -291,11 +197,8 @@ std::vector<mat::Variable> spectrum_variables(const std::string& source, const L
 void register_spectrum(CLI::App& app) {
   auto a = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("spectrum", "Spectrum of a texture map: peaks, centroids, spread, band energy, plot");
-  cmd->add_option("file", a->file, "A .bin (with --device), .csv, .npy (with --device or --spacing) or .texel.json")->required();
-  cmd->add_option("--device", a->device, "Device of a .bin file; sample spacing of a .npy; re-targets a document");
-  cmd->add_option("--spacing", a->spacing, "Sample spacing, mm (overrides the device's)");
-  cmd->add_option("--region", a->region, "Analyse one region of a document (name or index)");
-  cmd->add_option("--swipe-speed", a->swipe_speed, "Finger speed, mm/s: adds temporal frequencies (Hz = cycles/mm × mm/s)");
+  cmd->add_option("file", a->file, kInputHelp)->required();
+  add_signal_options(*cmd, a->input);  // --swipe-speed also adds temporal frequencies (Hz = cycles/mm × mm/s)
   cmd->add_flag("--json", a->json, "Print the report as JSON");
   cmd->add_option("-o,--output", a->output,
                   "Plot: .png or .svg (excerpt on top, spectrum below on a log-frequency axis); or .mat (MATLAB: "
@@ -328,8 +231,6 @@ void register_spectrum(CLI::App& app) {
         if (output_extension(**p) != ".csv") throw InvalidArgument("'" + **p + "' must be a .csv file");
         check_writable(**p);
       }
-    if (a->swipe_speed && !(std::isfinite(*a->swipe_speed) && *a->swipe_speed > 0.0))
-      throw InvalidArgument("--swipe-speed is " + num(*a->swipe_speed) + "; it must be a finite speed in mm/s > 0");
     if (a->max_peaks < 1 || a->max_peaks > 100000)
       throw InvalidArgument("--max-peaks is " + std::to_string(a->max_peaks) + "; allowed: 1 … 100000");
     if (!(a->threshold_db <= 0.0 && a->threshold_db >= -300.0))
@@ -347,8 +248,11 @@ void register_spectrum(CLI::App& app) {
     opt.peaks.max_peaks = a->max_peaks;
     for (const auto& b : a->bands) opt.bands.push_back(parse_band(b));
 
-    const LoadedSignal sig = load_signal(a->file, a->device, a->spacing, a->region);
-    const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing_mm, opt);
+    const Signal sig = load_input(a->file, a->input);
+    if (sig.samples.size() < 16)
+      throw InvalidArgument("'" + a->file + "' holds " + std::to_string(sig.samples.size()) +
+                            " samples; a spectrum needs at least 16");
+    const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing.value(), opt);
 
     std::vector<PendingFile> files;
     if (a->spectrum_csv)
@@ -359,7 +263,7 @@ void register_spectrum(CLI::App& app) {
       if (mat_output)
         mat::write_mat(*a->output, spectrum_variables(a->file, sig, r), {.version = mat_version});  // atomic on its own
       else
-        plot_spectrum(make_spectrum_plot(a->file, sig, r, a->swipe_speed), *a->output);  // atomic on its own
+        plot_spectrum(make_spectrum_plot(a->file, sig, r, a->input.swipe_speed), *a->output);  // atomic on its own
       try {
         commit_files(files);
       } catch (...) {

@@ -118,9 +118,7 @@ void register_swipe(CLI::App& app) {
   cmd->add_option("--plot", a->plot, "Also draw position, output and its temporal spectrum (.png or .svg)");
   cmd->add_option("--wav-format", a->wav_format, "WAV sample encoding: pcm16, pcm24 or float [pcm16]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
-  add_finger_options(*cmd, a->finger);
-  add_device_options(*cmd, a->device);
-  add_texture_options(*cmd, a->texture);
+  add_player_options(*cmd, a->finger, a->device, a->texture);
   cmd->callback([a] { run(*a); });
 }
 

@@ -1,5 +1,6 @@
 #include "common.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -7,11 +8,72 @@
 
 #include <unistd.h>
 
+#include "texel/codec.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
 namespace texel::cli {
+
+void add_signal_options(CLI::App& cmd, SignalArgs& a) {
+  const std::string g = "Input signal";
+  cmd.add_option("--device", a.device,
+                 "Device profile (tpad, tpad-tablet, generic or a .json): format and spacing of a .bin, spacing of a "
+                 ".npy, the device a document is re-targeted to and a .texel decoded on")
+      ->group(g);
+  cmd.add_option("--spacing", a.spacing_mm, "Sample spacing, mm: overrides the device's; must agree with a file's own grid")
+      ->group(g);
+  cmd.add_option("--region", a.region, "Part of the input: START:END in mm, or a document region's name or index")->group(g);
+  cmd.add_option("--swipe-speed", a.swipe_speed,
+                 "Finger speed, mm/s: turns a time recording (.wav, time_s,value .csv) into positions")
+      ->group(g);
+  cmd.add_option("--channel", a.channel, "Channel of a multi-channel recording: 0-based index, or 'mix' [single channel only]")
+      ->group(g);
+}
+
+SignalOptions signal_options(const SignalArgs& a) {
+  SignalOptions o;
+  if (a.device) o.device = load_device(*a.device);
+  if (a.spacing_mm) o.spacing = Millimetres(*a.spacing_mm);
+  if (a.swipe_speed) o.swipe_speed = MmPerSecond(*a.swipe_speed);
+  if (a.region) {
+    const std::string& r = *a.region;
+    const auto colon = r.find(':');
+    double lo = 0.0;
+    double hi = 0.0;
+    if (colon != std::string::npos && parse_csv_number(std::string_view(r).substr(0, colon), lo) &&
+        parse_csv_number(std::string_view(r).substr(colon + 1), hi))
+      o.region = SignalOptions::Region{"", Millimetres(lo), Millimetres(hi)};
+    else if (colon != std::string::npos)
+      throw InvalidArgument("--region '" + r + "' must be START:END in mm (e.g. 10:50) or a document region's name");
+    else
+      o.region = SignalOptions::Region{r, {}, {}};
+  }
+  if (a.channel) {
+    unsigned c = 0;
+    const auto [end, ec] = std::from_chars(a.channel->data(), a.channel->data() + a.channel->size(), c);
+    if (*a.channel == "mix")
+      o.channels = ChannelPolicy::mix;
+    else if (ec == std::errc() && end == a.channel->data() + a.channel->size())
+      o.channels = ChannelPolicy::select, o.channel = c;
+    else
+      throw InvalidArgument("--channel is '" + *a.channel + "'; allowed: a channel index (0, 1, ...) or 'mix'");
+  }
+  return o;
+}
+
+Signal load_input(const std::string& path, const SignalArgs& a) { return codec::load_signal(path, signal_options(a)); }
+
+std::string flag_of_field(std::string_view field) {
+  static const std::pair<std::string_view, std::string_view> flags[] = {{"device", "--device"},
+                                                                        {"spacing", "--spacing"},
+                                                                        {"region", "--region"},
+                                                                        {"swipe_speed", "--swipe-speed"},
+                                                                        {"channel", "--channel"}};
+  for (const auto& [f, flag] : flags)
+    if (f == field) return std::string(flag);
+  return std::string(field);  // a field with no flag (max_samples) keeps its library name
+}
 
 void add_texture_options(CLI::App& cmd, TextureOptions& o) {
   const std::string g = "Texture";
@@ -157,6 +219,22 @@ void Progress::done() {
     std::fflush(stderr);
   }
   active_ = false;
+}
+
+void make_output_directory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw IoError("cannot create '" + dir + "': " + ec.message());
+}
+
+void add_output_set_options(CLI::App& cmd, OutputSetArgs& a) {
+  cmd.add_option("--out", a.out, "Output directory [" + a.out + "]");
+  cmd.add_option("--device", a.device, "Device profile [tpad]");
+}
+
+DeviceProfile prepare_output_set(const OutputSetArgs& a) {
+  make_output_directory(a.out);
+  return load_device(a.device);
 }
 
 void print_json(const nlohmann::ordered_json& j) { std::cout << j.dump(2) << "\n"; }

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "texel/document.hpp"
+#include "texel/signal.hpp"
 
 namespace texel::cli {
 
@@ -40,6 +41,29 @@ struct DeviceOptions {
   std::optional<double> length_mm;
   std::optional<double> spacing_mm;
 };
+
+/// How a command reads its input signal (texel/signal.hpp): one option block
+/// for every command that reads one (info, spectrum, encode).
+struct SignalArgs {
+  std::optional<std::string> device;
+  std::optional<double> spacing_mm;
+  std::optional<std::string> region;   ///< START:END in mm, or a document region's name or index
+  std::optional<double> swipe_speed;   ///< mm/s
+  std::optional<std::string> channel;  ///< "mix" or a 0-based channel index
+};
+void add_signal_options(CLI::App& cmd, SignalArgs& a);
+/// Help text of an input-signal argument: the formats load_signal reads.
+inline constexpr const char* kInputHelp =
+    "Input: .bin (needs --device), .npy (--device or --spacing), .csv (position_mm,amplitude or time_s,value), "
+    ".wav (--swipe-speed), .mat, .texel.json, .texel (--device)";
+/// The library options the flags describe (throws InvalidArgument naming the flag).
+SignalOptions signal_options(const SignalArgs& a);
+/// Reads `path` through the one loader (codec::load_signal: every format, bitstreams too).
+Signal load_input(const std::string& path, const SignalArgs& a);
+
+/// The CLI's flag for a library option field ("swipe_speed" -> "--swipe-speed"),
+/// the one place the two spellings meet; main() rewrites FieldErrors with it.
+std::string flag_of_field(std::string_view field);
 
 void add_texture_options(CLI::App& cmd, TextureOptions& o);
 void add_device_options(CLI::App& cmd, DeviceOptions& o);
@@ -79,6 +103,18 @@ class Progress {
   bool active_ = false;
   int last_percent_ = -1;
 };
+
+/// Creates an output directory (and its parents); throws IoError naming it.
+void make_output_directory(const std::string& dir);
+
+/// Commands that write a set of files into a directory for one device (demo, atlas).
+struct OutputSetArgs {
+  std::string out;
+  std::string device = "tpad";
+};
+void add_output_set_options(CLI::App& cmd, OutputSetArgs& a);
+/// Creates the directory and loads the device.
+DeviceProfile prepare_output_set(const OutputSetArgs& a);
 
 /// Prints `j` to stdout, indented.
 void print_json(const nlohmann::ordered_json& j);

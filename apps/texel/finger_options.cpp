@@ -7,6 +7,12 @@
 
 namespace texel::cli {
 
+void add_player_options(CLI::App& cmd, FingerOptions& finger, DeviceOptions& device, TextureOptions& texture) {
+  add_finger_options(cmd, finger);
+  add_device_options(cmd, device);
+  add_texture_options(cmd, texture);
+}
+
 void add_finger_options(CLI::App& cmd, FingerOptions& o) {
   cmd.add_option("--speed", o.speed_mm_s, "Swipe speed (mm/s) [100]");
   cmd.add_option("--pattern", o.pattern, "Simulated swipe: constant (repeated one-way strokes) or back-and-forth [constant]");

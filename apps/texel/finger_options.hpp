@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common.hpp"
 #include "texel/finger.hpp"
 #include "texel/player.hpp"
 
@@ -29,6 +30,9 @@ struct FingerOptions {
 };
 
 void add_finger_options(CLI::App& cmd, FingerOptions& o);
+/// The option groups of a command that plays a texture (swipe, play): finger,
+/// device and texture, in that order.
+void add_player_options(CLI::App& cmd, FingerOptions& finger, DeviceOptions& device, TextureOptions& texture);
 
 /// The player configuration the options describe (validated).
 PlayerConfig player_config(const FingerOptions& o, double default_rate_hz);

@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "common.hpp"
 #include "texel/error.hpp"
 
 int main(int argc, char** argv) {
@@ -47,6 +48,9 @@ int main(int argc, char** argv) {
     for (auto& c : msg)
       if (c == '\n') c = ' ';
     std::cerr << "texel: " << msg << " (see texel --help)\n";
+    return 2;
+  } catch (const texel::FieldError& e) {
+    std::cerr << "texel: " << texel::cli::flag_of_field(e.field()) << " " << e.detail() << "\n";
     return 2;
   } catch (const texel::Error& e) {
     std::cerr << "texel: " << e.what() << "\n";

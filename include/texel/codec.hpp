@@ -25,40 +25,41 @@
 // Texel renderings.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "texel/bitstream.hpp"
 #include "texel/document.hpp"
+#include "texel/signal.hpp"
 #include "texel/units.hpp"
 
 namespace texel::codec {
 
 // --- signals ----------------------------------------------------------------
 
-/// A texture signal on a uniform spatial grid (sample i at i·spacing mm).
+/// The encoder's input: a texture signal on a uniform spatial grid (sample i
+/// at i·spacing mm). Files are read by texel::load_signal (texel/signal.hpp).
 struct Signal {
   std::vector<double> amplitude;  ///< nominally in [0, 1]
   Millimetres spacing{0.0};       ///< > 0
   std::string description;        ///< where it came from, for reports
 };
 
-struct LoadOptions {
-  std::optional<DeviceProfile> device;     ///< grid and format of .bin/.npy (default tpad)
-  std::optional<Millimetres> spacing;      ///< overrides the device's spacing for .bin/.npy
-  std::optional<MmPerSecond> swipe_speed;  ///< needed for time recordings (.wav, time/value .csv)
-};
-
-/// Loads any texture signal: a device map (.bin), .npy, a position/amplitude
-/// or time/value .csv, a .wav recording, a texture document (.texel.json) or a
-/// bitstream (.texel). Time recordings become positions at the swipe speed and
-/// are scaled to the full amplitude range (a = 0.5 + 0.5·y/max|y|). Throws
-/// InvalidArgument / FormatError / IoError naming the file and the problem.
-Signal load_signal(const std::string& path, const LoadOptions& options);
+/// texel::load_signal (every format, texel/signal.hpp), plus the one format
+/// only the codec can decode: a bitstream (.texel), rendered on
+/// options.device like a document. Front doors that accept bitstreams call this.
+texel::Signal load_signal(const std::string& path, const SignalOptions& options = {});
+/// texel::decode_signal plus bitstreams, from memory.
+texel::Signal decode_signal(std::span<const std::byte> bytes, SignalFormat format, const SignalOptions& options,
+                            std::string_view origin);
+/// The encoder's view of a loaded signal (its samples from its origin on).
+Signal encoder_signal(const texel::Signal& signal);
 
 // --- the perceptual model ---------------------------------------------------
 
@@ -82,6 +83,10 @@ struct Percept {
   double mean_db = 0.0;       ///< physical: power-weighted mean frequency, dB re 1 cpm
   double spread_db = 0.0;     ///< physical: power-weighted SD of 10·log10 f, dB
 };
+
+/// A percept as named fields, the names every front door reports it under
+/// (pitch_db, noisiness_db, centroid_db, spread_db).
+std::array<std::pair<const char*, double>, 4> fields(const Percept& p);
 
 /// Percept of a zero-mean fine signal sampled every `spacing_mm`, from its
 /// content above `f_min_cpm` (and above 0.01 cpm).

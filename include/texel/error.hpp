@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace texel {
 
@@ -18,6 +19,22 @@ class Error : public std::runtime_error {
 class InvalidArgument : public Error {
  public:
   using Error::Error;
+};
+
+/// An InvalidArgument about one named library option field ("spacing",
+/// "swipe_speed", "region" ...): what() is "<field> <detail>". Front doors
+/// that spell the field differently (the CLI's --spacing) rewrite the field
+/// name in one place and keep the detail.
+class FieldError : public InvalidArgument {
+ public:
+  FieldError(std::string field, std::string detail)
+      : InvalidArgument(field + " " + detail), field_(std::move(field)), detail_(std::move(detail)) {}
+  [[nodiscard]] const std::string& field() const { return field_; }
+  [[nodiscard]] const std::string& detail() const { return detail_; }
+
+ private:
+  std::string field_;
+  std::string detail_;
 };
 
 /// A file or byte string that does not parse or validate.

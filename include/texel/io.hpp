@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -37,5 +38,24 @@ std::string csv_columns(std::string_view header_a, std::string_view header_b, st
                         std::span<const double> b);
 /// Reads a two-column numeric CSV (optional header), returning the columns.
 std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::string_view text, std::string_view origin);
+
+/// One number of a CSV field: spaces and tabs around it are ignored, a
+/// leading '+' is allowed, the rest must be a whole decimal number (or
+/// nan/inf, which callers reject where they mean nothing).
+bool parse_csv_number(std::string_view field, double& out);
+
+/// The one reader of the numeric CSV files (signals, finger traces, coarse
+/// profiles; the trial tables of experiments are RFC 4180 tables with named
+/// columns, a different format: experiment/table.hpp). Fields are separated
+/// by ',', ';' or a tab; CR LF line ends, blank lines and lines starting with
+/// '#' are allowed; a first line that is not numeric is the header. Calls
+/// `row(line, values)` for each row (line is 1-based) and returns the header
+/// ("" when there is none). Throws FormatError "origin:line: ..." for a
+/// non-numeric field or a row with fewer than `min_columns` or more than
+/// `max_columns` (at most 16) fields, `expected` naming the columns
+/// ("time_s,position_mm[,touch]"). An empty file is not an error here.
+std::string read_numeric_csv(std::string_view text, std::string_view origin, std::size_t min_columns, std::size_t max_columns,
+                             std::string_view expected,
+                             const std::function<void(std::size_t line, std::span<const double> values)>& row);
 
 }  // namespace texel

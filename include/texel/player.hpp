@@ -41,6 +41,22 @@
 //              from a signal generator or amplifier.
 // Touch and lift fade the output in and out with a raised-cosine ramp of
 // touch_ramp_s (no click); a finger beyond the surface counts as lifted.
+//
+// Lifetime. A Player is small (< 1 KiB: its queues' rings are allocated by
+// the constructor, i.e. at prepare) and can live on any stack. Whatever calls
+// process() from its own thread — a Backend (sinks.hpp) — is a PlayerDriver
+// and holds a PlayerAttachment to the one player it drives, so neither can
+// dangle whichever goes first:
+//   - the driver goes first (or stops): it stops calling process(), then its
+//     attachment detaches; the player carries on and can be driven again;
+//   - the player goes first: ~Player asks the attached driver to stop
+//     (PlayerDriver::stop_driving joins its thread / stops its stream) and
+//     waits for it, then frees its maps; the driver stays usable (stats,
+//     start on another player).
+// A player has at most one driver (two real-time threads would break the
+// SPSC queues): attaching a second throws. Attach, detach and destruction
+// all happen on the control thread; the real-time thread never sees the
+// attachment, so the handshake puts no lock or atomic on the audio path.
 #pragma once
 
 #include <atomic>
@@ -102,6 +118,10 @@ struct PlayerConfig {
   double crossfade_s = 0.02;           ///< crossfade when a new map is swapped in (s), 0.0005 … 1
   double highpass_hz = 20.0;           ///< vibration: DC-blocker corner (Hz), 0.1 … rate/4
   double lowpass_hz = 0.0;             ///< vibration: low-pass corner (Hz); 0 = 0.4·rate; at most 0.45·rate
+  /// Finger samples and commands that can wait for process(): a power of two,
+  /// 16 … 1,048,576 (default 4096: 4 s of a 1 kHz position sensor queued
+  /// ahead). The ring (40 B per event) is allocated at prepare.
+  std::size_t event_capacity = 4096;
 };
 /// Throws InvalidArgument naming the field, the value and the allowed range.
 void validate(const PlayerConfig& config);
@@ -122,20 +142,68 @@ struct BlockInfo {
   bool crossfading = false;
 };
 
+class Player;
+
+/// Whatever calls Player::process() from its own real-time thread (the
+/// backends of sinks.hpp). See "Lifetime" above.
+class PlayerDriver {
+ public:
+  /// Control thread, called by ~Player while this driver is still attached:
+  /// stop calling process() and return only when no call is in progress
+  /// (join the thread, stop the stream), then detach.
+  virtual void stop_driving() noexcept = 0;
+
+ protected:
+  PlayerDriver() = default;
+  PlayerDriver(const PlayerDriver&) = default;
+  PlayerDriver& operator=(const PlayerDriver&) = default;
+  ~PlayerDriver() = default;
+};
+
+/// The RAII link between a driver and the one player it drives: while it is
+/// attached, the player knows whom to stop before it goes away. A member of
+/// the driver; control thread only; neither copyable nor movable (the player
+/// holds its address).
+class PlayerAttachment {
+ public:
+  explicit PlayerAttachment(PlayerDriver& driver) noexcept : driver_(&driver) {}
+  ~PlayerAttachment() { detach(); }
+  PlayerAttachment(const PlayerAttachment&) = delete;
+  PlayerAttachment& operator=(const PlayerAttachment&) = delete;
+
+  /// Before the driver's first process() call. Detaches from a previous
+  /// player first. Throws InvalidArgument if another driver is attached to
+  /// `player` (one real-time thread per player).
+  void attach(Player& player);
+  /// After the driver's last process() call has returned. Safe to call twice.
+  void detach() noexcept;
+  /// The player driven, or null.
+  [[nodiscard]] Player* player() const noexcept { return player_; }
+
+ private:
+  friend class Player;
+  PlayerDriver* driver_;
+  Player* player_ = nullptr;
+};
+
 class Player {
  public:
-  static constexpr std::size_t event_capacity = 4096;
   static constexpr std::size_t retire_capacity = 16;
 
-  /// prepare: validates `config` and allocates all state; `map` may be null
-  /// (silence until set_map).
+  /// prepare: validates `config` and allocates all state (the event and
+  /// retire rings included); `map` may be null (silence until set_map).
   explicit Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map = nullptr);
-  /// Frees every map. Call only after the real-time thread has stopped.
+  /// Stops an attached driver first (see "Lifetime"), then frees every map.
+  /// A real-time thread that is not an attached driver must have stopped.
   ~Player();
   Player(const Player&) = delete;
   Player& operator=(const Player&) = delete;
 
   [[nodiscard]] const PlayerConfig& config() const { return config_; }
+  /// Capacity of the event queue (config().event_capacity).
+  [[nodiscard]] std::size_t event_capacity() const { return events_.capacity(); }
+  /// True while a driver (a started Backend) is attached. Control thread.
+  [[nodiscard]] bool attached() const { return attachment_ != nullptr; }
 
   // -------------------------------------------------------- control thread
   /// Swaps in a new map; process() crossfades to it. If a previous map was
@@ -150,7 +218,7 @@ class Player {
   /// Frees maps process() has retired. Returns how many.
   std::size_t collect();
   /// Free slots in the event queue (approximate while process() runs).
-  [[nodiscard]] std::size_t event_space() const { return event_capacity - events_.size(); }
+  [[nodiscard]] std::size_t event_space() const { return events_.capacity() - events_.size(); }
 
   // ------------------------------------------------------- real-time thread
   /// Fills `out` with the next out.size() samples and, if `position_mm` is
@@ -178,12 +246,15 @@ class Player {
     }
   };
 
+  friend class PlayerAttachment;
+
   void take_events(double tau) noexcept;
   double finger_position(double tau) noexcept;
 
   PlayerConfig config_;
-  SpscQueue<PlayerEvent, event_capacity> events_;
-  SpscQueue<const PlayerMap*, retire_capacity> retired_;
+  SpscQueue<PlayerEvent> events_;
+  SpscQueue<const PlayerMap*> retired_;
+  PlayerAttachment* attachment_ = nullptr;  // the driver's link; control thread only
   std::atomic<const PlayerMap*> pending_{nullptr};
   std::atomic<std::uint64_t> samples_done_{0};
 

@@ -7,6 +7,12 @@
 // PortAudio callback, a paced thread for `null`, or the streaming thread for
 // serial. Statistics are published through relaxed atomics (real-time safe)
 // for a level meter on the control thread.
+//
+// Ownership rule (player.hpp, "Lifetime"): start(player) attaches the
+// backend to the player, stop() or the backend's destructor detaches it. The
+// two may be destroyed in either order: a backend destroyed first stops its
+// thread; a player destroyed first stops the backend before freeing anything.
+// A player takes one started backend at a time.
 #pragma once
 
 #include <atomic>
@@ -26,8 +32,8 @@ enum class WavEncoding { pcm16, pcm24, float32 };
 /// [−1, 1] by the PCM encodings. Throws IoError naming the path.
 void write_wav(const std::string& path, std::span<const float> samples, double rate_hz,
                WavEncoding encoding = WavEncoding::pcm16);
-/// Reads a WAV's first channel (tests, tools). Throws IoError / FormatError.
-std::vector<float> read_wav(const std::string& path, double* rate_hz = nullptr);
+// WAV files are read by the one signal loader's audio reader
+// (texel::read_recording, texel/signal.hpp).
 
 /// "time_s,position_mm,output" with one row per output sample.
 std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output);
@@ -43,13 +49,21 @@ struct BackendStats {
   bool touching = false;
 };
 
-class Backend {
+class Backend : private PlayerDriver {
  public:
   virtual ~Backend() = default;
-  /// Starts calling player.process() on the backend's real-time thread.
-  virtual void start(Player& player) = 0;
-  /// Stops and joins; safe to call twice.
-  virtual void stop() = 0;
+  Backend(const Backend&) = delete;
+  Backend& operator=(const Backend&) = delete;
+  /// Attaches to `player` and starts calling player.process() on the
+  /// backend's real-time thread; stops a previous run first. Throws
+  /// InvalidArgument if another backend drives `player`, IoError if the
+  /// device cannot start.
+  void start(Player& player);
+  /// Stops (joins the thread, stops the stream) and detaches; safe to call
+  /// twice, and called by ~Player if the player goes first.
+  void stop() noexcept;
+  /// The player being driven, or null (stopped, or its player went away).
+  [[nodiscard]] const Player* player() const noexcept { return attachment_.player(); }
   /// A one-line description ("null 48000 Hz, 64 frames").
   [[nodiscard]] virtual std::string describe() const = 0;
   /// An error the real-time side met (e.g. the serial link dropped); empty if none.
@@ -59,6 +73,13 @@ class Backend {
   BackendStats stats();
 
  protected:
+  Backend() : attachment_(*this) {}
+  /// Implementations: begin calling player.process(); `player` outlives the
+  /// run (until do_stop() returns).
+  virtual void do_start(Player& player) = 0;
+  /// Implementations: return only once no process() call is running or can
+  /// start; idempotent. Derived destructors call stop().
+  virtual void do_stop() noexcept = 0;
   /// Called by implementations after each block (relaxed atomics only).
   void record(const BlockInfo& info, double seconds) noexcept;
   void record_underrun() noexcept { underruns_.fetch_add(1, std::memory_order_relaxed); }
@@ -71,6 +92,8 @@ class Backend {
   std::atomic<std::uint64_t> underruns_{0};
   std::atomic<double> position_{0.0};
   std::atomic<bool> touching_{false};
+  void stop_driving() noexcept override { stop(); }
+  PlayerAttachment attachment_;
 };
 
 /// Runs the player in real time with no output device: a thread wakes every

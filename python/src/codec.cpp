@@ -7,6 +7,7 @@
 #include "common.hpp"
 #include "texel/codec.hpp"
 #include "texel/error.hpp"
+#include "texel/signal.hpp"
 #include "texel/spectrum.hpp"
 
 namespace texel::python {
@@ -35,11 +36,37 @@ codec::Bitstream bitstream_of(const py::handle& source) {
 
 py::dict percept_dict(const codec::Percept& p) {
   py::dict d;
-  d["pitch_db"] = p.pitch_db;
-  d["noisiness_db"] = p.noisiness_db;
-  d["centroid_db"] = p.mean_db;
-  d["spread_db"] = p.spread_db;
+  for (const auto& [name, value] : codec::fields(p)) d[name] = value;
   return d;
+}
+
+// The library options of a load_signal()/encode() call (texel/signal.hpp).
+SignalOptions signal_options(const py::object& device, std::optional<double> spacing_mm, const py::object& region,
+                             std::optional<double> swipe_speed, const py::object& channel, std::size_t max_samples) {
+  SignalOptions o;
+  if (!device.is_none()) o.device = device_of(device, std::nullopt, std::nullopt);
+  if (spacing_mm) o.spacing = Millimetres(*spacing_mm);
+  if (swipe_speed) o.swipe_speed = MmPerSecond(*swipe_speed);
+  if (py::isinstance<py::str>(region)) {
+    o.region = SignalOptions::Region{region.cast<std::string>(), {}, {}};
+  } else if (!region.is_none()) {
+    const auto span = region.cast<std::pair<double, double>>();
+    o.region = SignalOptions::Region{"", Millimetres(span.first), Millimetres(span.second)};
+  }
+  if (py::isinstance<py::str>(channel)) {
+    if (channel.cast<std::string>() != "mix")
+      throw InvalidArgument("channel is '" + channel.cast<std::string>() + "'; allowed: an index or 'mix'");
+    o.channels = ChannelPolicy::mix;
+  } else if (!channel.is_none()) {
+    o.channels = ChannelPolicy::select;
+    o.channel = channel.cast<unsigned>();
+  }
+  o.max_samples = max_samples;
+  return o;
+}
+
+std::string path_of(const py::handle& source) {
+  return py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
 }
 
 // The signal an encode() call describes: a path (any format load_signal
@@ -48,13 +75,10 @@ py::dict percept_dict(const codec::Percept& p) {
 codec::Signal signal_of(const py::handle& source, const py::object& device, std::optional<double> spacing_mm,
                         std::optional<double> swipe_speed) {
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
-    codec::LoadOptions o;
-    if (!device.is_none()) o.device = device_of(device, std::nullopt, std::nullopt);
-    o.spacing = millimetres(spacing_mm);
-    if (swipe_speed) o.swipe_speed = MmPerSecond(*swipe_speed);
-    const auto path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
+    const SignalOptions o = signal_options(device, spacing_mm, py::none(), swipe_speed, py::none(), SignalOptions{}.max_samples);
+    const std::string path = path_of(source);
     py::gil_scoped_release release;
-    return codec::load_signal(path, o);
+    return codec::encoder_signal(codec::load_signal(path, o));
   }
   const DeviceProfile d = device.is_none() ? load_device("tpad") : device_of(device, std::nullopt, std::nullopt);
   codec::Signal s;
@@ -149,6 +173,59 @@ void register_codec(py::module_& m) {
       py::arg("spacing_mm") = py::none(), py::arg("dtype") = "native",
       "Decodes a bitstream (bytes, Bitstream or .texel path) and renders it on a device, exactly as\n"
       "`texel decode IN.texel -o map.bin`; dtype as for render().");
+
+  // ----------------------------------------------------------------- signals
+  py::class_<Signal>(m, "Signal", "A texture signal as texel::load_signal read it: samples on a uniform grid.")
+      .def_property_readonly(
+          "samples",
+          [](py::object self) {
+            const auto& s = self.cast<const Signal&>();
+            // Zero copy: the array keeps the Signal alive.
+            py::array_t<double> a(static_cast<py::ssize_t>(s.samples.size()), s.samples.data(), self);
+            a.attr("setflags")(py::arg("write") = false);
+            return a;
+          },
+          "Amplitudes, 0 … 1 (read-only view)")
+      .def_property_readonly("spacing_mm", [](const Signal& s) { return s.spacing.value(); })
+      .def_property_readonly("origin_mm", [](const Signal& s) { return s.origin.value(); })
+      .def_property_readonly("length_mm", [](const Signal& s) { return s.length().value(); })
+      .def_property_readonly("format", [](const Signal& s) { return std::string(to_string(s.format)); })
+      .def_property_readonly("scaled", [](const Signal& s) { return s.scaled; })
+      .def_property_readonly("sample_rate_hz",
+                             [](const Signal& s) -> std::optional<double> {
+                               if (s.sample_rate) return s.sample_rate->value();
+                               return std::nullopt;
+                             })
+      .def_readonly("description", &Signal::description)
+      .def("__len__", [](const Signal& s) { return s.samples.size(); })
+      .def("__repr__", [](const Signal& s) {
+        return "<texel.Signal " + std::string(to_string(s.format)) + ", " + std::to_string(s.samples.size()) + " samples × " +
+               std::to_string(s.spacing.value()) + " mm>";
+      });
+  m.def(
+      "load_signal",
+      [](const py::object& path, const py::object& device, std::optional<double> spacing_mm, const py::object& region,
+         std::optional<double> swipe_speed_mm_s, const py::object& channel, std::size_t max_samples) {
+        const SignalOptions o = signal_options(device, spacing_mm, region, swipe_speed_mm_s, channel, max_samples);
+        const std::string p = path_of(path);
+        py::gil_scoped_release release;
+        return codec::load_signal(p, o);
+      },
+      py::arg("path"), py::kw_only(), py::arg("device") = py::none(), py::arg("spacing_mm") = py::none(),
+      py::arg("region") = py::none(), py::arg("swipe_speed_mm_s") = py::none(), py::arg("channel") = py::none(),
+      py::arg("max_samples") = SignalOptions{}.max_samples,
+      R"doc(Reads any texture signal file with the library's one loader (the same samples `texel info`,
+`texel spectrum` and `texel encode` see).
+
+path              .bin (needs device), .npy (device or spacing_mm), .csv (position_mm,amplitude or
+                  time_s,value), .wav (swipe_speed_mm_s), .mat, .texel.json, .texel (needs device)
+device            a device name, profile path or Device: grid and sample format of a .bin
+spacing_mm        sample spacing, mm; must agree with a file's own grid
+region            (start_mm, end_mm), or a document region's name or index
+swipe_speed_mm_s  turns a time recording into positions
+channel           a multi-channel recording's channel index, or "mix" (default: mono files only)
+max_samples       largest size a file may declare, checked before allocating
+Raises InvalidArgument naming the keyword, FormatError or IoError naming the file.)doc");
 
   // ----------------------------------------------------------------- encoder
   py::class_<codec::EncodeResult>(m, "EncodeResult",

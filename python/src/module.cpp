@@ -7,6 +7,8 @@
 // ValueError and IoError also an OSError, so ordinary Python handlers
 // (`except ValueError`, `except OSError`) catch them too.
 #include <exception>
+#include <string_view>
+#include <utility>
 
 #include "common.hpp"
 #include "texel/error.hpp"
@@ -34,6 +36,14 @@ PyObject* io_type = nullptr;
 void translate(std::exception_ptr p) {
   try {
     if (p) std::rethrow_exception(p);
+  } catch (const texel::FieldError& e) {
+    // The library's option field, spelled as this package's keyword.
+    static const std::pair<std::string_view, std::string_view> keywords[] = {{"spacing", "spacing_mm"},
+                                                                             {"swipe_speed", "swipe_speed_mm_s"}};
+    std::string field = e.field();
+    for (const auto& [f, k] : keywords)
+      if (f == field) field = k;
+    PyErr_SetString(invalid_type, (field + " " + e.detail()).c_str());
   } catch (const texel::InvalidArgument& e) {
     PyErr_SetString(invalid_type, e.what());
   } catch (const texel::FormatError& e) {

@@ -148,6 +148,22 @@ class EncodeResult:
     samples: int
     spacing_mm: float
 
+# ---------------------------------------------------------------- signals
+class Signal:
+    samples: npt.NDArray[np.float64]
+    spacing_mm: float
+    origin_mm: float
+    length_mm: float
+    format: str
+    scaled: bool
+    sample_rate_hz: Optional[float]
+    description: str
+    def __len__(self) -> int: ...
+
+def load_signal(path: _Path, *, device: Optional[_Device] = None, spacing_mm: Optional[float] = None,
+                region: Union[None, str, tuple[float, float]] = None, swipe_speed_mm_s: Optional[float] = None,
+                channel: Union[None, int, Literal["mix"]] = None, max_samples: int = 67108864) -> Signal: ...
+
 def encode(source: Union[_Path, _Array], *, device: Optional[_Device] = None, spacing_mm: Optional[float] = None,
            swipe_speed_mm_s: Optional[float] = None, boundary_mm: float = 1.0, texel_length_mm: float = 0.25,
            seed: int = 1, parameterization: str = "moments", coarse_bits: int = 6,

@@ -529,7 +529,7 @@ texel_status texel_player_push(texel_player* player, double t_s, double x_mm, in
     need_finite(t_s, "t_s");
     need_finite(x_mm, "x_mm");
     if (!p.player.push(texel::FingerSample{t_s, x_mm, touch != 0}))
-      throw BufferTooSmall{"the player's event queue is full (" + std::to_string(texel::Player::event_capacity) +
+      throw BufferTooSmall{"the player's event queue is full (" + std::to_string(p.player.event_capacity()) +
                            " events); let texel_player_process run, then push again"};
   });
 }

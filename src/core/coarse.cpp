@@ -1,14 +1,13 @@
 #include "texel/coarse.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "texel/detail/format.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
+#include "texel/io.hpp"
 
 namespace texel {
 namespace {
@@ -119,33 +118,15 @@ std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millim
 }
 
 PointsProfile read_profile_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw IoError("cannot read coarse profile '" + path + "'");
-  PointsProfile profile;
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos || line[0] == '#') continue;
-    std::replace(line.begin(), line.end(), ';', ',');
-    const auto comma = line.find(',');
-    const std::string where = path + ":" + std::to_string(line_no);
-    if (comma == std::string::npos) throw FormatError(where + ": expected 'position_mm,value', got '" + line + "'");
-    const std::string a = line.substr(0, comma);
-    const std::string b = line.substr(comma + 1);
-    double x = 0.0;
-    double v = 0.0;
-    const auto pa = std::from_chars(a.data() + a.find_first_not_of(" \t"), a.data() + a.size(), x);
-    const auto bstart = b.find_first_not_of(" \t");
-    const auto pb = bstart == std::string::npos ? std::from_chars_result{b.data(), std::errc::invalid_argument}
-                                                : std::from_chars(b.data() + bstart, b.data() + b.size(), v);
-    if (pa.ec != std::errc() || pb.ec != std::errc()) {
-      if (profile.points.empty() && line_no == 1) continue;  // header row
-      throw FormatError(where + ": expected two numbers 'position_mm,value', got '" + line + "'");
-    }
-    profile.points.emplace_back(x, v);
+  std::string text;
+  try {
+    text = read_file(path);
+  } catch (const IoError& e) {
+    throw IoError("cannot read coarse profile: " + std::string(e.what()));
   }
+  PointsProfile profile;
+  read_numeric_csv(text, path, 2, 2, "position_mm,value",
+                   [&](std::size_t, std::span<const double> v) { profile.points.emplace_back(v[0], v[1]); });
   if (profile.points.empty()) throw FormatError(path + ": no position_mm,value rows");
   try {
     validate(CoarseProfile{profile});

@@ -4,7 +4,6 @@
 #include "texel/experiment/table.hpp"
 
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +12,7 @@
 #include <sstream>
 
 #include "texel/error.hpp"
+#include "texel/io.hpp"
 
 namespace texel::experiment {
 namespace {
@@ -72,10 +72,8 @@ std::vector<double> Table::numbers(std::string_view name) const {
       r.push_back(std::numeric_limits<double>::quiet_NaN());
       continue;
     }
-    if (s.size() > 1 && s.front() == '+' && s[1] != '-') s.remove_prefix(1);  // from_chars rejects a leading '+'
     double v = 0;
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || end != s.data() + s.size())
+    if (!parse_csv_number(s, v))  // the numeric CSV files' number rule (texel/io.hpp)
       throw FormatError((origin.empty() ? std::string("table") : origin) + ":" +
                         std::to_string(i < lines.size() ? lines[i] : i + 2) + ": column '" + std::string(name) + "' has '" +
                         cells[i][c] + "', which is not a number (empty, NA or NaN mark a missing value)");

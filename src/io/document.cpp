@@ -394,6 +394,12 @@ Surface prepare_surface(const Document& doc) {
     if (!(r.length.value() > 0.0))
       throw InvalidArgument(label + "start_mm " + detail::num(spec.start.value()) + " mm is at or past the device's end (" +
                             detail::num(grid.length().value()) + " mm)");
+    // Checked before the texture is built, not only by Surface afterwards: a
+    // region's texture is prepared over its own length, so a 1e9 mm region
+    // on a 100 mm device would allocate 10^11 texels first.
+    if (r.start.value() + r.length.value() > grid.length().value() + 1e-3)
+      throw InvalidArgument(label + "start_mm " + detail::num(r.start.value()) + " mm + length_mm " + detail::num(r.length.value()) +
+                            " mm ends past the device's active length " + detail::num(grid.length().value()) + " mm");
     try {
       // The texture's own coordinates: 0 mm at the region's left edge (as Surface::render passes them).
       const Sampling local{Grid{grid.origin - r.start, grid.spacing, grid.count}, doc.device.band_top()};

@@ -145,22 +145,31 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
     // A 1-D or (n,1) array reads the same either way; checked via shape below.
   }
   const std::string shape = value_of("shape");
+  // The shape is outside input: every dimension is checked against the data
+  // the file actually holds before any size arithmetic, so a declared
+  // (2**62,) or a product that overflows size_t is a FormatError, never a
+  // wrapped count or an allocation sized by the header alone.
+  const std::size_t data_bytes = b.size() - data_at;
   std::vector<std::size_t> dims;
   for (std::size_t i = 0; i < shape.size();) {
     if (std::isdigit(static_cast<unsigned char>(shape[i]))) {
       std::size_t v = 0;
       auto r = std::from_chars(shape.data() + i, shape.data() + shape.size(), v);
+      if (r.ec != std::errc() || v > data_bytes)
+        throw FormatError(where + ": .npy shape " + shape + " declares a dimension of " + std::string(shape.data() + i, r.ptr) +
+                          " elements; the file holds only " + std::to_string(data_bytes) + " data bytes");
       dims.push_back(v);
       i = static_cast<std::size_t>(r.ptr - shape.data());
     } else {
       ++i;
     }
   }
-  std::size_t n = 1;
   int non_unit = 0;
+  std::size_t n = 1;
   for (auto d : dims) {
-    n *= d;
-    if (d != 1) ++non_unit;
+    if (d == 1) continue;
+    ++non_unit;
+    n = d;  // the one dimension that is not 1 (at most data_bytes: no overflow below)
   }
   if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
   std::size_t width = 0;
@@ -216,9 +225,25 @@ std::string csv_columns(std::string_view ha, std::string_view hb, std::span<cons
   return out;
 }
 
-std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::string_view text, std::string_view origin) {
-  std::vector<double> a;
-  std::vector<double> b;
+bool parse_csv_number(std::string_view s, double& v) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  if (s.size() > 1 && s.front() == '+' && s[1] != '-') s.remove_prefix(1);  // from_chars rejects a leading '+'
+  if (s.empty()) return false;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  return r.ec == std::errc() && r.ptr == s.data() + s.size();
+}
+
+std::string read_numeric_csv(std::string_view text, std::string_view origin, std::size_t min_columns, std::size_t max_columns,
+                             std::string_view expected,
+                             const std::function<void(std::size_t line, std::span<const double> values)>& row) {
+  constexpr std::size_t most = 16;
+  if (max_columns > most || min_columns < 1 || min_columns > max_columns)
+    throw InvalidArgument("read_numeric_csv: columns must satisfy 1 <= min <= max <= 16");
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte-order mark (Excel)
+  const auto at = [&](std::size_t line) { return std::string(origin) + ":" + std::to_string(line) + ": "; };
+  std::string header;
+  double values[most];
   std::size_t line_no = 0;
   while (!text.empty()) {
     const auto nl = text.find('\n');
@@ -226,25 +251,42 @@ std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::strin
     text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line.empty() || line[0] == '#') continue;
-    const auto comma = line.find_first_of(",;\t");
-    auto parse = [](std::string_view s, double& v) {
-      while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
-      while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
-      auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-      return r.ec == std::errc() && r.ptr == s.data() + s.size();
-    };
-    double x = 0.0;
-    double y = 0.0;
-    const bool ok = comma != std::string_view::npos && parse(line.substr(0, comma), x) && parse(line.substr(comma + 1), y);
-    if (!ok) {
-      if (a.empty() && line_no == 1) continue;  // header
-      throw FormatError(std::string(origin) + ":" + std::to_string(line_no) + ": expected two numbers, got '" +
-                        std::string(line) + "'");
+    if (line.find_first_not_of(" \t") == std::string_view::npos || line.front() == '#') continue;
+    std::size_t n = 0;
+    bool numeric = true;
+    for (std::size_t pos = 0;;) {
+      const auto sep = line.find_first_of(",;\t", pos);
+      const auto field = line.substr(pos, sep == std::string_view::npos ? std::string_view::npos : sep - pos);
+      if (n == max_columns)
+        throw FormatError(at(line_no) + "more than " + std::to_string(max_columns) + " columns; expected " +
+                          std::string(expected));
+      if (!parse_csv_number(field, values[n])) numeric = false;
+      ++n;
+      if (sep == std::string_view::npos) break;
+      pos = sep + 1;
     }
-    a.push_back(x);
-    b.push_back(y);
+    if (!numeric) {
+      if (line_no == 1) {
+        header = std::string(line);
+        continue;
+      }
+      throw FormatError(at(line_no) + "'" + std::string(line) + "' is not numeric; expected " + std::string(expected));
+    }
+    if (n < min_columns)
+      throw FormatError(at(line_no) + std::to_string(n) + " column" + (n == 1 ? "" : "s") + "; expected " +
+                        std::string(expected));
+    row(line_no, std::span<const double>(values, n));
   }
+  return header;
+}
+
+std::pair<std::vector<double>, std::vector<double>> parse_csv_columns(std::string_view text, std::string_view origin) {
+  std::vector<double> a;
+  std::vector<double> b;
+  read_numeric_csv(text, origin, 2, 2, "two columns of numbers", [&](std::size_t, std::span<const double> v) {
+    a.push_back(v[0]);
+    b.push_back(v[1]);
+  });
   if (a.empty()) throw FormatError(std::string(origin) + ": no numeric rows");
   return {std::move(a), std::move(b)};
 }

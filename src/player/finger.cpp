@@ -1,7 +1,6 @@
 // Finger sources (simulated swipes, CSV traces) and swipe measures.
 #include "texel/finger.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -106,60 +105,20 @@ std::vector<FingerSample> simulate_swipe(const SwipeConfig& c) {
   return trace;
 }
 
-namespace {
-
-bool parse_double(std::string_view text, double& out) {
-  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
-  while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r')) text.remove_suffix(1);
-  if (text.empty()) return false;
-  if (text.front() == '+') text.remove_prefix(1);
-  const auto res = std::from_chars(text.data(), text.data() + text.size(), out);
-  return res.ec == std::errc() && res.ptr == text.data() + text.size();
-}
-
-}  // namespace
-
 std::vector<FingerSample> parse_trace_csv(std::string_view text, std::string_view origin) {
   std::vector<FingerSample> trace;
-  std::size_t line_no = 0;
   const std::string where(origin);
-  while (!text.empty()) {
-    const std::size_t nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line.empty() || line.front() == '#') continue;
-    double cols[3] = {0, 0, 1};
-    int n = 0;
-    bool numeric = true;
-    std::size_t pos = 0;
-    while (true) {
-      const std::size_t comma = line.find(',', pos);
-      const std::string_view cell = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
-      if (n >= 3)
-        throw FormatError(where + ":" + std::to_string(line_no) + ": more than 3 columns; expected time_s,position_mm[,touch]");
-      if (!parse_double(cell, cols[n])) numeric = false;
-      ++n;
-      if (comma == std::string_view::npos) break;
-      pos = comma + 1;
-    }
-    if (!numeric) {
-      if (trace.empty() && line_no == 1) continue;  // header
-      throw FormatError(where + ":" + std::to_string(line_no) + ": '" + std::string(line) +
-                        "' is not numeric; expected time_s,position_mm[,touch]");
-    }
-    if (n < 2) throw FormatError(where + ":" + std::to_string(line_no) + ": 1 column; expected time_s,position_mm[,touch]");
-    if (!std::isfinite(cols[0]) || !std::isfinite(cols[1]))
-      throw FormatError(where + ":" + std::to_string(line_no) + ": time and position must be finite");
+  const char* expected = "time_s,position_mm[,touch]";
+  read_numeric_csv(text, origin, 2, 3, expected, [&](std::size_t line, std::span<const double> cols) {
+    const std::string at = where + ":" + std::to_string(line) + ": ";
+    if (!std::isfinite(cols[0]) || !std::isfinite(cols[1])) throw FormatError(at + "time and position must be finite");
     if (!trace.empty() && cols[0] < trace.back().t_s)
-      throw FormatError(where + ":" + std::to_string(line_no) + ": time " + num(cols[0]) + " s is earlier than the previous " +
-                        num(trace.back().t_s) + " s; times must not decrease");
-    if (n == 3 && cols[2] != 0 && cols[2] != 1)
-      throw FormatError(where + ":" + std::to_string(line_no) + ": touch is " + num(cols[2]) + "; allowed 0 or 1");
-    trace.push_back(FingerSample{cols[0], cols[1], cols[2] != 0});
-  }
-  if (trace.empty()) throw FormatError(where + ": no samples; expected rows of time_s,position_mm[,touch]");
+      throw FormatError(at + "time " + num(cols[0]) + " s is earlier than the previous " + num(trace.back().t_s) +
+                        " s; times must not decrease");
+    if (cols.size() == 3 && cols[2] != 0 && cols[2] != 1) throw FormatError(at + "touch is " + num(cols[2]) + "; allowed 0 or 1");
+    trace.push_back(FingerSample{cols[0], cols[1], cols.size() < 3 || cols[2] != 0});
+  });
+  if (trace.empty()) throw FormatError(where + ": no samples; expected rows of " + expected);
   return trace;
 }
 

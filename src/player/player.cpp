@@ -90,12 +90,40 @@ void validate(const PlayerConfig& c) {
   check_range("crossfade_s", c.crossfade_s, 0.0005, 1.0, "s");
   check_range("highpass_hz", c.highpass_hz, 0.1, c.rate_hz / 4, "Hz");
   if (c.lowpass_hz != 0.0) check_range("lowpass_hz", c.lowpass_hz, 1.0, 0.45 * c.rate_hz, "Hz (0 = 0.4·rate)");
+  const std::size_t n = c.event_capacity;
+  if (n < 16 || n > (std::size_t{1} << 20) || (n & (n - 1)) != 0)
+    throw InvalidArgument("player: event_capacity is " + std::to_string(n) + "; allowed a power of two, 16 … 1048576");
+}
+
+namespace {
+const PlayerConfig& validated(const PlayerConfig& c) {
+  validate(c);
+  return c;
+}
+}  // namespace
+
+// ----------------------------------------------------------- PlayerAttachment
+
+void PlayerAttachment::attach(Player& player) {
+  if (player_ == &player) return;
+  if (player.attachment_)
+    throw InvalidArgument("player: already driven by another backend; stop that one first (one real-time thread per player)");
+  detach();
+  player.attachment_ = this;
+  player_ = &player;
+}
+
+void PlayerAttachment::detach() noexcept {
+  if (!player_) return;
+  player_->attachment_ = nullptr;
+  player_ = nullptr;
 }
 
 // --------------------------------------------------------------------- Player
 
-Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map) : config_(config) {
-  validate(config_);
+// prepare: the only allocations a Player makes are its two rings, here.
+Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
+    : config_(validated(config)), events_(config_.event_capacity), retired_(retire_capacity) {
   const double rate = config_.rate_hz;
   current_ = map.release();
   fade_step_ = 1.0 / (config_.crossfade_s * rate);
@@ -117,6 +145,13 @@ Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
 }
 
 Player::~Player() {
+  // An attached driver may be inside process() right now: stop it and wait
+  // before anything is freed. stop_driving() detaches; detach() again in case
+  // a driver forgot to.
+  if (PlayerAttachment* a = attachment_) {
+    a->driver_->stop_driving();
+    a->detach();
+  }
   collect();
   delete pending_.exchange(nullptr);
   delete current_;

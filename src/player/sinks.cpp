@@ -53,20 +53,6 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
   }
 }
 
-std::vector<float> read_wav(const std::string& path, double* rate_hz) {
-  SF_INFO info{};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (!f) throw IoError("cannot read '" + path + "': " + sf_strerror(nullptr));
-  std::vector<float> all(static_cast<std::size_t>(info.frames) * static_cast<std::size_t>(info.channels));
-  const sf_count_t got = sf_readf_float(f, all.data(), info.frames);
-  sf_close(f);
-  if (got != info.frames) throw FormatError("'" + path + "': truncated audio data");
-  std::vector<float> out(static_cast<std::size_t>(info.frames));
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = all[i * static_cast<std::size_t>(info.channels)];
-  if (rate_hz) *rate_hz = info.samplerate;
-  return out;
-}
-
 std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output) {
   std::string out = "time_s,position_mm,output\n";
   out.reserve(out.size() + output.size() * 32);
@@ -92,6 +78,24 @@ BackendStats Backend::stats() {
   s.position_mm = position_.load(std::memory_order_relaxed);
   s.touching = touching_.load(std::memory_order_relaxed);
   return s;
+}
+
+void Backend::start(Player& player) {
+  stop();
+  attachment_.attach(player);  // throws if another backend drives the player
+  try {
+    do_start(player);
+  } catch (...) {
+    attachment_.detach();
+    throw;
+  }
+}
+
+// The attachment goes only after the real-time side has stopped: a player
+// that sees itself detached may be destroyed at once.
+void Backend::stop() noexcept {
+  do_stop();
+  attachment_.detach();
 }
 
 // Real-time safe: relaxed atomic loads and stores only.
@@ -120,20 +124,19 @@ class NullBackend final : public Backend {
       throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
   }
   ~NullBackend() override { stop(); }
-  void start(Player& player) override {
-    stop();
-    running_ = true;
-    thread_ = std::thread([this, &player] { loop(player); });
-  }
-  void stop() override {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
-  }
   [[nodiscard]] std::string describe() const override {
     return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
   }
 
  private:
+  void do_start(Player& player) override {
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void do_stop() noexcept override {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
   void loop(Player& player) {
     const auto period = std::chrono::duration<double>(static_cast<double>(buffer_.size()) / rate_);
     const auto t0 = Clock::now();
@@ -236,19 +239,21 @@ class AudioBackend final : public Backend {
     stop();
     if (stream_) Pa_CloseStream(stream_);
   }
-  void start(Player& player) override {
-    player_ = &player;
-    pa_check(Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
-  }
-  void stop() override {
-    if (stream_ && Pa_IsStreamActive(stream_) == 1) Pa_StopStream(stream_);
-  }
   [[nodiscard]] std::string describe() const override {
     return "audio '" + device_name_ + "', " + detail::num(options_.rate_hz) + " Hz, " + std::to_string(options_.block_frames) +
            " frames per block";
   }
 
  private:
+  void do_start(Player& player) override {
+    player_ = &player;
+    pa_check(Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
+  }
+  // Pa_StopStream returns after the last callback has returned.
+  void do_stop() noexcept override {
+    if (stream_ && Pa_IsStreamStopped(stream_) == 0) Pa_StopStream(stream_);
+    player_ = nullptr;
+  }
   // PortAudio's callback: calls only the real-time-safe process() and
   // relaxed atomics.
   static int callback(const void*, void* output, unsigned long frames, const PaStreamCallbackTimeInfo*,
@@ -281,15 +286,6 @@ class SerialBackend final : public Backend {
     }
   }
   ~SerialBackend() override { stop(); }
-  void start(Player& player) override {
-    stop();
-    running_ = true;
-    thread_ = std::thread([this, &player] { loop(player); });
-  }
-  void stop() override {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
-  }
   [[nodiscard]] std::string describe() const override {
     return "serial " + options_.path + " → '" + info_.name + "' (protocol " + std::to_string(info_.version) + ", " +
            detail::num(info_.refresh_hz) + " Hz refresh), streaming " +
@@ -302,6 +298,14 @@ class SerialBackend final : public Backend {
   }
 
  private:
+  void do_start(Player& player) override {
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void do_stop() noexcept override {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
   // The streaming thread does I/O by nature; process() itself stays
   // real-time safe, and errors end the loop instead of escaping the thread.
   void loop(Player& player) {

@@ -171,6 +171,21 @@ std::vector<ReferenceComponent> sine_components(const ReferenceSpec& s, double n
   return comps;
 }
 
+/// Cost bounds of a reference, checked before anything is allocated: the
+/// harmonics of a waveform (each synthesized at every sample) and the
+/// features of a patch or pulse layout (one entry each).
+constexpr double max_harmonics = 1 << 16;
+constexpr double max_layout_features = 1 << 22;
+
+/// Refuses a layout of more than max_layout_features features of `feature`
+/// mm over `length` mm (0.001 mm patches over a kilometre-spaced device: 10^11).
+void check_feature_count(const ReferenceSpec& s, const char* key, double feature, double length) {
+  if (length / feature > max_layout_features)
+    throw InvalidArgument(field(s, key) + " is " + num(feature) + " mm: up to " + num(std::ceil(length / feature)) +
+                          " features over the " + num(length) + " mm texture; at most " + num(max_layout_features) +
+                          " (lengthen " + key + " or shorten the texture)");
+}
+
 std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, double nyquist) {
   const double f0 = number(s, "fundamental_cpm");
   const double hi = band_top(number(s, "band_max_cpm"), nyquist);
@@ -178,6 +193,13 @@ std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, doub
   if (!(f0 < hi))
     throw InvalidArgument(field(s, "fundamental_cpm") + " is " + num(f0) + " cpm, not below the band's top " + num(hi) +
                           " cpm (the grid's Nyquist frequency or band_max_cpm)");
+  // Every harmonic below the band's top is synthesized at every sample: a
+  // fundamental far below 1/length (1e-6 cpm on a 94 cpm grid: 10^8
+  // harmonics) would take hours and gigabytes, so it is refused up front.
+  if (hi / f0 > max_harmonics)
+    throw InvalidArgument(field(s, "fundamental_cpm") + " is " + num(f0) + " cpm: " + num(std::floor(hi / f0)) +
+                          " harmonics below the band's top " + num(hi) + " cpm; at most " + num(max_harmonics) +
+                          " (raise fundamental_cpm or lower band_max_cpm)");
   std::vector<ReferenceComponent> comps;
   for (std::uint64_t n = 1;; ++n) {
     const double nd = static_cast<double>(n);
@@ -229,6 +251,7 @@ std::vector<ReferenceFeature> lay_out(double start, double feature, const std::v
 std::vector<ReferenceFeature> patch_features(const ReferenceSpec& s, double length) {
   const double patch = number(s, "patch_mm");
   const double start = number(s, "start_mm");
+  check_feature_count(s, "patch_mm", patch, length);
   std::vector<double> gaps = numbers(s, "gaps_mm");
   const auto shuffle = static_cast<std::uint64_t>(number(s, "shuffle"));
   const bool drawn = gaps.empty();
@@ -252,6 +275,7 @@ std::vector<ReferenceFeature> patch_features(const ReferenceSpec& s, double leng
 }
 
 std::vector<ReferenceFeature> pulse_features(const ReferenceSpec& s, double length) {
+  check_feature_count(s, "pulse_mm", number(s, "pulse_mm"), length);
   std::vector<ReferenceFeature> f =
       lay_out(number(s, "start_mm"), number(s, "pulse_mm"), numbers(s, "gaps_mm"), length, std::size_t(-1));
   if (word(s, "mirror") == "yes") {

@@ -249,35 +249,16 @@ ImportResult import_file(std::string_view name, std::span<const std::byte> bytes
     out.document = codec::decode_document(codec::parse_bitstream(bytes), options.device);
     return out;
   }
-  // codec::load_signal reads files (it owns the .csv/.wav parsing): hand it
-  // the bytes in a private temporary directory, under a fixed name with the
-  // format's extension only (the client's name never becomes a path).
-  std::string dir_template = (std::filesystem::temp_directory_path() / "texel-studio-XXXXXX").string();
-  if (!mkdtemp(dir_template.data())) throw IoError("cannot create a temporary directory for '" + origin + "'");
-  const std::filesystem::path dir(dir_template);
-  const std::filesystem::path path = dir / ("import" + output_extension(origin));
+  // The one loader, from memory (texel/signal.hpp): the client's name only labels errors.
+  SignalOptions lo;
+  lo.device = options.device;
+  lo.swipe_speed = options.swipe_speed;
   codec::Signal signal;
   try {
-    {
-      std::ofstream f(path, std::ios::binary);
-      f.write(text.data(), static_cast<std::streamsize>(text.size()));
-      if (!f) throw IoError("cannot write a temporary copy of '" + origin + "'");
-    }
-    codec::LoadOptions lo;
-    lo.device = options.device;
-    lo.swipe_speed = options.swipe_speed;
-    signal = codec::load_signal(path.string(), lo);
+    signal = codec::encoder_signal(codec::decode_signal(std::as_bytes(bytes), signal_format_of(origin), lo, origin));
   } catch (const Error& e) {
-    std::error_code ec;
-    std::filesystem::remove_all(dir, ec);
-    // The temporary path means nothing to the client: name its file instead.
-    std::string what = e.what();
-    for (auto at = what.find(path.string()); at != std::string::npos; at = what.find(path.string()))
-      what.replace(at, path.string().size(), origin);
-    throw FormatError(what);
+    throw FormatError(e.what());  // the studio reports every bad upload as a format problem
   }
-  std::error_code ec;
-  std::filesystem::remove_all(dir, ec);
   out.encoded = codec::encode(signal, options.encoder);
   out.document = codec::decode_document(out.encoded->bitstream, options.device);
   return out;

@@ -22,6 +22,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "texel/io.hpp"
 
 namespace fs = std::filesystem;
@@ -348,4 +350,97 @@ TEST_F(Cli, ValidDocumentWithRegionsRenders) {
   EXPECT_EQ(r.err, "");
   EXPECT_NE(r.out.find("\"samples\": 19200"), std::string::npos) << r.out;
   EXPECT_EQ(texel::parse_npy(slurp(dir / "out.npy"), "out.npy").size(), 19200u);
+}
+
+// ------------------------------------------------------- the one signal loader
+
+namespace {
+
+/// A PCM16 WAV of `channels` channels, a sine in channel 0 (hand-made so the
+/// test needs no audio library).
+std::string stereo_wav(unsigned channels, unsigned rate, std::size_t frames) {
+  std::string out;
+  auto u32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  auto u16 = [&](std::uint16_t v) {
+    out.push_back(static_cast<char>(v & 0xFF));
+    out.push_back(static_cast<char>(v >> 8));
+  };
+  const auto data = static_cast<std::uint32_t>(frames * channels * 2);
+  out += "RIFF";
+  u32(36 + data);
+  out += "WAVEfmt ";
+  u32(16);
+  u16(1);
+  u16(static_cast<std::uint16_t>(channels));
+  u32(rate);
+  u32(rate * channels * 2);
+  u16(static_cast<std::uint16_t>(channels * 2));
+  u16(16);
+  out += "data";
+  u32(data);
+  for (std::size_t i = 0; i < frames; ++i)
+    for (unsigned c = 0; c < channels; ++c)
+      u16(static_cast<std::uint16_t>(c == 0 ? static_cast<std::int16_t>(16000 * std::sin(0.3 * static_cast<double>(i))) : 0));
+  return out;
+}
+
+}  // namespace
+
+TEST_F(Cli, InfoSpectrumAndEncodeReadTheSameFileToTheSameSamples) {
+  ASSERT_EQ(run({"render", "--central-pitch", "6", "--seed", "4", "-o", "m.bin"}).status, 0);
+  ASSERT_EQ(run({"render", "--central-pitch", "6", "--seed", "4", "-o", "m.csv"}).status, 0);
+  for (const std::string file : {"m.bin", "m.csv"}) {
+    const std::vector<std::string> input = {file, "--device", "tpad", "--region", "10:60", "--json"};
+    auto with = [&](std::vector<std::string> cmd) {
+      cmd.insert(cmd.end(), input.begin(), input.end());
+      return cmd;
+    };
+    const Result info = run(with({"info"}));
+    const Result spectrum = run(with({"spectrum"}));
+    const Result encode = run(with({"encode"}));
+    ASSERT_EQ(info.status, 0) << info.err;
+    ASSERT_EQ(spectrum.status, 0) << spectrum.err;
+    ASSERT_EQ(encode.status, 0) << encode.err;
+    const auto i = nlohmann::json::parse(info.out);
+    const auto s = nlohmann::json::parse(spectrum.out);
+    const auto e = nlohmann::json::parse(encode.out);
+    EXPECT_EQ(i["amplitude"]["samples"], s["samples"]) << file;
+    EXPECT_EQ(i["amplitude"]["samples"], e["samples"]) << file;
+    EXPECT_NEAR(i["spacing_mm"].get<double>(), s["spacing_mm"].get<double>(), 1e-12) << file;
+    EXPECT_NEAR(i["spacing_mm"].get<double>(), e["spacing_mm"].get<double>(), 1e-12) << file;
+    EXPECT_NEAR(i["amplitude"]["mean"].get<double>(), s["mean_amplitude"].get<double>(), 1e-9) << file;
+    EXPECT_GE(i["origin_mm"].get<double>(), 10.0) << file;
+  }
+}
+
+TEST_F(Cli, InfoAndSpectrumReadRecordings) {
+  write("r.wav", stereo_wav(1, 8000, 4000));
+  const Result r = run({"info", "r.wav", "--swipe-speed", "100", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["kind"], "wav");
+  EXPECT_EQ(j["sample_rate_hz"], 8000.0);
+  EXPECT_NEAR(j["spacing_mm"].get<double>(), 100.0 / 8000, 1e-15);
+  EXPECT_EQ(run({"spectrum", "r.wav", "--swipe-speed", "100", "--json"}).status, 0);
+}
+
+TEST_F(Cli, SignalErrorsNameTheFlags) {
+  ASSERT_EQ(run({"render", "-o", "m.bin"}).status, 0);
+  ASSERT_EQ(run({"render", "-o", "m.csv"}).status, 0);
+  write("st.wav", stereo_wav(2, 8000, 400));
+  expect_rejected({"info", "m.bin"}, "--device is required");
+  expect_rejected({"spectrum", "m.bin"}, "--device is required");
+  expect_rejected({"encode", "m.bin"}, "--device is required");
+  expect_rejected({"spectrum", "m.csv", "--spacing", "0.5"}, "--spacing is 0.5 mm, but 'm.csv' is sampled every 0.0053 mm");
+  expect_rejected({"info", "m.csv", "--region", "1000:2000"}, "--region [1000, 2000) mm holds 0 samples");
+  expect_rejected({"info", "m.csv", "--region", "1:x"}, "--region '1:x' must be START:END");
+  expect_rejected({"encode", "st.wav"}, "--swipe-speed is required");
+  expect_rejected({"info", "st.wav", "--swipe-speed", "100"}, "--channel is not chosen, and 'st.wav' has 2 channels");
+  expect_rejected({"info", "st.wav", "--swipe-speed", "100", "--channel", "2"}, "--channel is 2");
+  expect_rejected({"info", "st.wav", "--swipe-speed", "100", "--channel", "left"}, "--channel is 'left'");
+  expect_rejected({"info", "m.txt"}, "allowed: .bin");
+  EXPECT_EQ(run({"info", "st.wav", "--swipe-speed", "100", "--channel", "mix"}).status, 0);
+  EXPECT_EQ(run({"info", "st.wav", "--swipe-speed", "100", "--channel", "1"}).status, 2);  // silent: constant
 }

@@ -17,7 +17,7 @@ namespace {
 using namespace texel;
 using namespace texel::codec;
 
-Signal render_signal(const TexelSpec& spec, const std::string& device = "tpad") {
+codec::Signal render_signal(const TexelSpec& spec, const std::string& device = "tpad") {
   const DeviceProfile d = load_device(device);
   return Signal{prepare_surface(make_document(d, spec)).render(), d.spacing, "test"};
 }
@@ -143,7 +143,7 @@ TEST(Encoder, RejectsUnusableInput) {
   EXPECT_EQ(flat.bytes.size(), 17u);
   Signal tiny{std::vector<double>(10, 0.5), Millimetres(0.0053), "tiny"};
   EXPECT_THROW((void)encode(tiny, EncoderConfig{}), InvalidArgument);
-  Signal nan = render_signal(TexelSpec{});
+  codec::Signal nan = render_signal(TexelSpec{});
   nan.amplitude[100] = std::nan("");
   EXPECT_THROW((void)encode(nan, EncoderConfig{}), InvalidArgument);
   EncoderConfig bad;

@@ -252,6 +252,40 @@ TEST(Document, ErrorsNameTheJsonPath) {
             std::string::npos);
 }
 
+// Findings of fuzz_document (tests/fuzz/corpus/fuzz_document/crash-*): a few
+// hundred bytes of document whose own lengths, not the device's, made
+// preparing it allocate 10^11 entries. Each is now a FormatError naming the
+// field, raised before anything that size is allocated.
+TEST(Document, CostlyLengthsAreRejectedBeforeAllocating) {
+  // A region far longer than the device, with a texel length the device's own
+  // length would allow (used to prepare 10^11 texels before Surface noticed).
+  EXPECT_NE(load_error(R"({"format": "texel-document", "version": 1, "device": "tpad", "regions": [
+      {"start_mm": 0, "length_mm": 1e9, "texture": {"kind": "texel", "central_pitch_db": 0, "irregularity_db": -5,
+       "texel_length_mm": 0.01, "seed": 1}}]})")
+                .find("length_mm 1e+09 mm ends past the device's active length"),
+            std::string::npos);
+  // 0.001 mm patches over a kilometre-spaced device: 10^11 drawn gaps.
+  const std::string km_device = R"("device": {"name": "km", "samples": 100, "spacing_mm": 1e6, "format": "u16le",
+      "refresh_hz": 1000, "band_min_cpm": 1e-9})";
+  EXPECT_NE(load_error(R"({"format": "texel-document", "version": 2, )" + km_device +
+                       R"(, "texture": {"kind": "reference", "name": "patch-2.5", "params": {"patch_mm": 0.001}}})")
+                .find("patch_mm is 0.001 mm: up to"),
+            std::string::npos);
+  EXPECT_NE(load_error(R"({"format": "texel-document", "version": 2, )" + km_device +
+                       R"(, "texture": {"kind": "reference", "name": "pulse-a", "params": {"pulse_mm": 0.001}}})")
+                .find("pulse_mm is 0.001 mm: up to"),
+            std::string::npos);
+  // A 10^-6 cpm square wave on the tpad grid: 10^8 harmonics below Nyquist.
+  EXPECT_NE(load_error(R"({"format": "texel-document", "version": 2, "device": "tpad",
+      "texture": {"kind": "reference", "name": "square", "params": {"fundamental_cpm": 1e-6}}})")
+                .find("fundamental_cpm is 1e-06 cpm"),
+            std::string::npos);
+  // The shipped lengths still prepare.
+  EXPECT_EQ(load_error(R"({"format": "texel-document", "version": 2, "device": "tpad",
+      "texture": {"kind": "reference", "name": "patch-4.6"}})"),
+            "(accepted)");
+}
+
 TEST(Document, MalformedAndTruncatedJsonAreRejected) {
   EXPECT_NE(load_error("{ not json").find("malformed JSON"), std::string::npos);
   EXPECT_NE(load_error("").find("malformed JSON"), std::string::npos);

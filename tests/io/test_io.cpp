@@ -103,6 +103,32 @@ TEST(Npy, RejectsMalformedFilesNamingTheOrigin) {
             std::string::npos);
 }
 
+// A declared shape is outside input: (2**62,) float64 needs 2^65 bytes, which
+// wraps to 0 in size_t arithmetic and used to "match" an empty data section,
+// then ask for 2^62 doubles. Every such shape must be a FormatError naming the
+// shape before any size arithmetic (fuzz_npy; corpus crasher
+// tests/fuzz/corpus/fuzz_npy/crash-shape-2pow62.npy).
+TEST(Npy, HugeDeclaredShapeIsRejectedBeforeSizeArithmetic) {
+  const auto header = [](const std::string& shape) {
+    return "{'descr': '<f8', 'fortran_order': False, 'shape': " + shape + ", }";
+  };
+  for (const std::string shape : {"(4611686018427387904,)", "(2305843009213693952,)", "(1, 4611686018427387904)",
+                                  "(18446744073709551615,)", "(99999999999999999999999999,)"}) {
+    SCOPED_TRACE(shape);
+    const std::string what = format_error_of([&] { parse_npy(npy_with(header(shape), ""), "huge.npy"); });
+    EXPECT_NE(what.find("huge.npy: .npy shape " + shape + " declares"), std::string::npos) << what;
+    // Some data bytes do not make a declared size plausible either.
+    EXPECT_NE(format_error_of([&] { parse_npy(npy_with(header(shape), std::string(64, '\0')), "huge.npy"); }).find("declares"),
+              std::string::npos);
+  }
+  // A product of dimensions that overflows size_t is rejected the same way.
+  EXPECT_NE(format_error_of([&] { parse_npy(npy_with(header("(4294967296, 4294967296)"), ""), "x.npy"); }).find("declares"),
+            std::string::npos);
+  // An honest shape still reads, including an empty one.
+  EXPECT_EQ(parse_npy(npy_with(header("(0,)"), ""), "x.npy").size(), 0u);
+  EXPECT_EQ(parse_npy(npy_with(header("(2,)"), raw_bytes<double>({0.25, 0.75})), "x.npy"), (std::vector<double>{0.25, 0.75}));
+}
+
 RC_GTEST_PROP(Csv, ColumnsRoundTripExactly, ()) {
   const auto n = *rc::gen::inRange<std::size_t>(1, 200);
   std::vector<double> a(n), b(n);

@@ -277,6 +277,43 @@ TEST_F(MatFile, HugeDeclaredDimensionsAreRejectedBeforeAllocating) {
   EXPECT_EQ(read_map(path("honest.mat")).amplitude, (std::vector<double>{0, 0}));
 }
 
+// Findings of fuzz_mat: libmatio allocates by the member counts declared in
+// a variable's headers while listing a file, so those are checked first
+// (matfile.cpp, "v5 pre-check").
+TEST_F(MatFile, DeclaredMembersMustFitTheFile) {
+  // A cell declaring 2^30 members in a 48-byte file (libmatio: 8 GiB of pointers).
+  std::string bytes(116, ' ');
+  std::memcpy(bytes.data(), "MATLAB 5.0 MAT-file, hand-made hostile file", 43);
+  bytes.append(8, '\0');
+  bytes.append("\x00\x01", 2);
+  bytes.append("IM", 2);
+  auto u32 = [](std::string& s, std::uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); };
+  std::string body;
+  u32(body, 6), u32(body, 8), u32(body, 1), u32(body, 0);  // array flags: mxCELL_CLASS
+  u32(body, 5), u32(body, 8), u32(body, 1u << 30), u32(body, 1);
+  u32(body, (1u << 16) | 1u), body.append("c\0\0\0", 4);
+  u32(bytes, 14), u32(bytes, static_cast<std::uint32_t>(body.size()));
+  write_bytes(path("cell.mat"), bytes + body);
+  expect_rejected(path("cell.mat"), "is corrupt: a cell declares 1073741824 members in 0 bytes");
+  // The fuzzer's crasher: Texel's own map file with three bytes changed
+  // inside its compressed elements (libmatio asked for 1.6 GB).
+  const std::string crash = path("crash.mat");
+  fs::copy_file(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_mat/crash-corrupt-compressed-struct.mat", crash);
+  expect_rejected(crash, "is corrupt: a matrix is truncated, or its compressed stream is corrupt");
+  // No v5/v7.3 marker at bytes 124-127: libmatio would fall back to v4 and
+  // malloc a name length from the file (1.7 GB for the fuzzer's 972 bytes).
+  const std::string v4 = path("v4.mat");
+  fs::copy_file(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_mat/crash-v4-fallback.mat", v4);
+  expect_rejected(v4, "is not a MATLAB v5/v7.3 .mat file (no version and byte-order mark at bytes 124-127)");
+  // Texel's own files, compressed or not, with structs and cells, still read.
+  Struct s;
+  s.add("names", StringColumn{{"a", "bc", ""}}).add("m", Matrix::column(ramp(3)));
+  for (bool compress : {true, false}) {
+    write_mat(path("ok.mat"), {{"amplitude", Matrix::column(ramp(5))}, {"texel", s}}, {.compress = compress});
+    EXPECT_EQ(read_map(path("ok.mat")).amplitude.size(), 5u);
+  }
+}
+
 TEST_F(MatFile, TruncatedAndForeignFilesAreRejected) {
   write_mat(path("full.mat"), {{"amplitude", Matrix::column(ramp(5000))}}, {.compress = false});
   const std::string bytes = read_file(path("full.mat"));

@@ -1,12 +1,14 @@
 // The real-time player: analytic spectra, interpolation, prediction, ramps,
 // crossfades, regions, off-surface positions; finger sources and measures;
-// file sinks and the null backend.
+// file sinks and the null backend; who may outlive whom (player vs backend).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <thread>
@@ -15,6 +17,7 @@
 #include "texel/error.hpp"
 #include "texel/finger.hpp"
 #include "texel/player.hpp"
+#include "texel/signal.hpp"
 #include "texel/sinks.hpp"
 #include "texel/spsc_queue.hpp"
 
@@ -49,7 +52,8 @@ float max_step(std::span<const float> y, std::size_t from = 0, std::size_t to = 
 // ------------------------------------------------------------------ queue
 
 TEST(SpscQueue, FifoFullEmpty) {
-  SpscQueue<int, 4> q;
+  SpscQueue<int> q(4);
+  EXPECT_EQ(q.capacity(), 4u);
   int v = 0;
   EXPECT_FALSE(q.try_pop(v));
   for (int i = 0; i < 4; ++i) EXPECT_TRUE(q.try_push(i));
@@ -61,8 +65,18 @@ TEST(SpscQueue, FifoFullEmpty) {
   EXPECT_EQ(q.front(), nullptr);
 }
 
+TEST(SpscQueue, CapacityIsAPowerOfTwoChosenAtConstruction) {
+  for (std::size_t bad : {std::size_t{0}, std::size_t{1}, std::size_t{3}, std::size_t{100}, SpscQueue<int>::max_capacity * 2})
+    EXPECT_THROW(SpscQueue<int>{bad}, InvalidArgument) << bad;
+  SpscQueue<int> q(1024);
+  int pushed = 0;
+  while (q.try_push(pushed)) ++pushed;
+  EXPECT_EQ(pushed, 1024);
+  EXPECT_EQ(q.size(), 1024u);
+}
+
 TEST(SpscQueue, TwoThreadsKeepOrder) {
-  SpscQueue<std::uint64_t, 64> q;
+  SpscQueue<std::uint64_t> q(64);
   constexpr std::uint64_t n = 50000;
   std::thread producer([&] {
     for (std::uint64_t i = 0; i < n;) {
@@ -309,8 +323,29 @@ TEST(Player, ConfigIsValidated) {
   c = {};
   c.lowpass_hz = 30000;
   EXPECT_THROW(validate(c), InvalidArgument);
+  for (std::size_t n : {std::size_t{0}, std::size_t{8}, std::size_t{1000}, std::size_t{1} << 21}) {
+    c = {};
+    c.event_capacity = n;
+    EXPECT_THROW(Player{c}, InvalidArgument) << n;
+  }
   EXPECT_THROW(parse_output_mode("loud"), InvalidArgument);
   EXPECT_THROW(PlayerMap(Grid{Millimetres(0), Millimetres(0.1), 3}, std::vector<float>(2)), InvalidArgument);
+}
+
+TEST(Player, EventCapacityIsChosenAtPrepare) {
+  PlayerConfig c;
+  c.event_capacity = 64;
+  Player p(c);
+  EXPECT_EQ(p.event_capacity(), 64u);
+  std::size_t queued = 0;
+  while (p.push({static_cast<double>(queued) * 1e-3, 1.0, true})) ++queued;
+  EXPECT_EQ(queued, 64u);
+  EXPECT_FALSE(p.set_gain(0.5));
+  EXPECT_EQ(p.event_space(), 0u);
+  std::vector<float> out(64);
+  p.process(out);  // 64 samples at 48 kHz: consumes the samples due by then
+  EXPECT_GT(p.event_space(), 0u);
+  EXPECT_EQ(Player(PlayerConfig{}).event_capacity(), 4096u);
 }
 
 // -------------------------------------------------------- finger sources
@@ -403,13 +438,13 @@ TEST(Sinks, WavRoundTripIsAtomic) {
   for (std::size_t i = 0; i < s.size(); ++i) s[i] = 0.5f * std::sin(2 * pi * 440 * i / 48000.0);
   const std::string path = (dir / "a.wav").string();
   write_wav(path, s, 48000, WavEncoding::float32);
-  double rate = 0;
-  const auto back = read_wav(path, &rate);
-  EXPECT_EQ(rate, 48000);
+  const Recording rec = read_recording(path);
+  const auto& back = rec.samples;
+  EXPECT_EQ(rec.rate.value(), 48000);
   ASSERT_EQ(back.size(), s.size());
   for (std::size_t i = 0; i < s.size(); ++i) ASSERT_EQ(back[i], s[i]);
   write_wav(path, s, 48000);  // pcm16 over the old file
-  EXPECT_NEAR(read_wav(path)[100], s[100], 1.0 / 32768);
+  EXPECT_NEAR(read_recording(path).samples[100], s[100], 1.0 / 32768);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);  // no temporaries left
   EXPECT_THROW(write_wav((dir / "no" / "b.wav").string(), s, 48000), IoError);
   std::filesystem::remove_all(dir);
@@ -433,4 +468,100 @@ TEST(Sinks, NullBackendRunsInRealTime) {
   EXPECT_LT(s.blocks, 400u);
   EXPECT_GT(s.worst_block_s, 0.0);
   EXPECT_TRUE(s.touching);
+}
+
+// ---------------------------------------------------------------- lifetime
+// player.hpp, "Lifetime": a backend and the player it drives may be
+// destroyed in either order. Run under ASan (make test-asan) a dangling
+// process() call would be a heap-use-after-free.
+
+// The queues' rings live on the heap, so a Player fits on any thread's stack
+// (it was 160 KiB with its 4096-event ring inline).
+static_assert(sizeof(Player) <= 1024, "a Player must stay small enough for any stack");
+
+TEST(PlayerLifetime, PlayerIsSmallAndLivesOnTheStack) {
+  EXPECT_LE(sizeof(Player), 1024u);
+  PlayerConfig c;
+  c.event_capacity = 1 << 20;  // a large queue costs heap, not stack
+  Player p(c, make_map(100, 0.01, [](double) { return 0.5; }));
+  EXPECT_EQ(p.event_capacity(), std::size_t{1} << 20);
+  p.push({0.0, 10, true});
+  std::vector<float> out(480);
+  EXPECT_GT(p.process(out).peak, 0.0f);
+}
+
+TEST(PlayerLifetime, BackendDestroyedFirstLeavesThePlayerUsable) {
+  Player p(PlayerConfig{}, make_map(100, 0.01, [](double) { return 0.5; }));
+  p.push({0.0, 10, true});
+  {
+    auto backend = make_null_backend(48000, 64);
+    backend->start(p);
+    EXPECT_TRUE(p.attached());
+    EXPECT_EQ(backend->player(), &p);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }  // destroyed while running: stops its thread, then detaches
+  EXPECT_FALSE(p.attached());
+  const std::uint64_t n = p.samples();
+  EXPECT_GT(n, 0u);
+  std::vector<float> out(64);
+  p.process(out);  // this thread may drive it now
+  EXPECT_EQ(p.samples(), n + 64);
+  auto again = make_null_backend(48000, 64);  // and a new backend may too
+  again->start(p);
+  EXPECT_TRUE(p.attached());
+  again->stop();
+  EXPECT_FALSE(p.attached());
+}
+
+TEST(PlayerLifetime, PlayerDestroyedFirstStopsTheBackend) {
+  auto backend = make_null_backend(48000, 16);
+  {
+    auto p = std::make_unique<Player>(PlayerConfig{}, make_map(100, 0.01, [](double) { return 0.5; }));
+    p->push({0.0, 10, true});
+    backend->start(*p);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_EQ(backend->player(), p.get());
+  }  // ~Player stops the backend's thread before freeing its maps and rings
+  EXPECT_EQ(backend->player(), nullptr);
+  const std::uint64_t blocks = backend->stats().blocks;
+  EXPECT_GT(blocks, 0u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(backend->stats().blocks, blocks) << "the backend still runs after its player went away";
+  backend->stop();  // still safe, and the backend is reusable
+  Player q(PlayerConfig{});
+  backend->start(q);
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_GT(backend->stats().blocks, blocks);
+}  // q goes before backend here too: stopped by ~Player, then ~Backend finds nothing to do
+
+TEST(PlayerLifetime, OnePlayerTakesOneBackend) {
+  Player p(PlayerConfig{});
+  auto first = make_null_backend(48000, 64);
+  auto second = make_null_backend(48000, 64);
+  first->start(p);
+  EXPECT_THROW(second->start(p), InvalidArgument);  // two real-time threads would break the SPSC queues
+  EXPECT_EQ(second->player(), nullptr);
+  EXPECT_EQ(first->player(), &p);
+  // Restarting on another player releases the first.
+  Player q(PlayerConfig{});
+  first->start(q);
+  EXPECT_EQ(first->player(), &q);
+  second->start(p);
+  EXPECT_EQ(second->player(), &p);
+  first->start(q);  // restart on the same player
+  EXPECT_EQ(first->player(), &q);
+}
+
+TEST(PlayerLifetime, ManyStartsStopsAndDestructionsInEitherOrder) {
+  for (int k = 0; k < 20; ++k) {
+    auto backend = make_null_backend(48000, 8);
+    auto p = std::make_unique<Player>(PlayerConfig{}, make_map(10, 0.01, [](double) { return 1.0; }));
+    p->push({0.0, 5, true});
+    backend->start(*p);
+    std::this_thread::sleep_for(std::chrono::microseconds(500 * (k % 4)));
+    if (k % 2)
+      p.reset();
+    else
+      backend.reset();
+  }
 }

@@ -58,6 +58,32 @@ TEST(PlayerAlloc, CountingAllocatorWorks) {
   EXPECT_EQ(rt_frees.exchange(0), 1u);
 }
 
+// The event and retire rings are allocated by the constructor (prepare) and
+// nowhere else: pushing, commands, processing and collecting allocate
+// nothing on any thread, whatever the queue's capacity.
+TEST(PlayerAlloc, QueuesAllocateAtPrepareOnly) {
+  for (std::size_t capacity : {std::size_t{16}, std::size_t{4096}, std::size_t{1} << 20}) {
+    PlayerConfig c;
+    c.event_capacity = capacity;
+    auto map = std::make_unique<const PlayerMap>(Grid{0.0, 0.01, 1000}, std::vector<float>(1000, 0.5f));
+    std::vector<float> out(64);  // caller-supplied memory
+    const std::uint64_t before = all_allocations.load();
+    Player player(c, std::move(map));
+    const std::uint64_t prepared = all_allocations.load();
+    EXPECT_EQ(prepared - before, 2u) << "prepare: one event ring and one retire ring, capacity " << capacity;
+    double t = 0;
+    for (int block = 0; block < 200; ++block) {
+      while (player.push({t, 1.0 + 5.0 * t, true})) t += 1e-4;
+      (void)player.set_gain(0.5);
+      (void)player.set_carrier(100.0);
+      player.process(out);
+      (void)player.collect();
+    }
+    EXPECT_EQ(all_allocations.load(), prepared) << "allocated after prepare, capacity " << capacity;
+    EXPECT_EQ(player.event_capacity(), capacity);
+  }
+}
+
 TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
   constexpr std::uint64_t blocks = 1000000;
   constexpr std::size_t frames = 64;

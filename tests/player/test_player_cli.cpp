@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "texel/player.hpp"
+#include "texel/signal.hpp"
 #include "texel/sinks.hpp"
 
 namespace fs = std::filesystem;
@@ -43,8 +44,9 @@ TEST_F(Cli, SwipeWavPeaksAtCentralPitchTimesSpeed) {
   const std::string wav = (dir / "s.wav").string();
   const CliRun r = run("swipe " + doc + " --speed 100 --duration 2 -o " + wav);
   ASSERT_EQ(r.status, 0) << r.out;
-  double rate = 0;
-  const auto s = texel::read_wav(wav, &rate);
+  const texel::Recording rec = texel::read_recording(wav);
+  const std::vector<float> s(rec.samples.begin(), rec.samples.end());
+  const double rate = rec.rate.value();
   EXPECT_EQ(rate, 48000);
   EXPECT_EQ(s.size(), 96000u);
   // Central Pitch 10 dB = 10 cycles/mm; at 100 mm/s: 1000 Hz (texel

@@ -135,7 +135,7 @@ struct ImportResult {
 };
 
 /// Reads a file's bytes: `name` picks the format by its extension (see
-/// import_kind). Signals go through codec::load_signal and codec::encode and
+/// import_kind). Signals go through codec::decode_signal and codec::encode and
 /// come back as the decoded document on `options.device`. Throws
 /// InvalidArgument / FormatError naming `name` and the problem.
 ImportResult import_file(std::string_view name, std::span<const std::byte> bytes, const ImportOptions& options);
