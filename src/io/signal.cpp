@@ -85,7 +85,7 @@ Millimetres device_spacing(const SignalOptions& o, std::string_view origin, cons
   if (o.spacing) return *o.spacing;
   if (o.device) return Millimetres(o.device->spacing_mm);
   throw FieldError("spacing", std::string("is required: ") + in_quotes(origin) + " " + what +
-                                  " carries no sample spacing; give spacing or device");
+                                  " stores no sample spacing; give it, or a device whose spacing applies");
 }
 
 Signal from_recording(Recording r, const SignalOptions& o, std::string_view origin) {

@@ -107,7 +107,7 @@ TEST(CApiCli, DecodeEqualsTexelDecode) {
   TempDir dir("capi-cli");
   const std::string map = dir.at("in.bin"), stream = dir.at("in.texel"), out = dir.at("out.bin");
   ASSERT_EQ(run_cli(TEXEL_CLI, "render --central-pitch 12 --seed 3 -o " + map).status, 0);
-  const auto e = run_cli(TEXEL_CLI, "encode " + map + " -o " + stream);
+  const auto e = run_cli(TEXEL_CLI, "encode " + map + " --device tpad -o " + stream);
   ASSERT_EQ(e.status, 0) << e.out;
   const auto d = run_cli(TEXEL_CLI, "decode " + stream + " --device generic -o " + out);
   ASSERT_EQ(d.status, 0) << d.out;
@@ -121,7 +121,7 @@ TEST(CApiCli, EncodeEqualsTexelEncode) {
   TempDir dir("capi-cli");
   const std::string map = dir.at("in.bin"), stream = dir.at("in.texel");
   ASSERT_EQ(run_cli(TEXEL_CLI, "render --central-pitch 8 --irregularity -3 --seed 9 -o " + map).status, 0);
-  const auto e = run_cli(TEXEL_CLI, "encode " + map + " -o " + stream);
+  const auto e = run_cli(TEXEL_CLI, "encode " + map + " --device tpad -o " + stream);
   ASSERT_EQ(e.status, 0) << e.out;
   texel_params p = texel_params_default();
   p.central_pitch_db = 8;
