@@ -181,7 +181,7 @@ void register_atlas(CLI::App& app) {
       write_rendered(stem + ".texel.json", doc, surface, map, {});
       Signal sig;
       sig.samples = map;
-      sig.spacing = Millimetres(surface.grid().spacing_mm);
+      sig.spacing = surface.grid().spacing;
       sig.description = "device " + device.name;
       AnalysisOptions opt;
       opt.peaks.max_peaks = 12;

@@ -37,7 +37,7 @@ int main(int argc, char** argv) try {
   const texel::codec::EncodeResult r = texel::codec::encode(texel::codec::encoder_signal(signal), config);
 
   texel::write_file_atomic(output, std::string_view(reinterpret_cast<const char*>(r.bytes.data()), r.bytes.size()));
-  std::printf("%s: %s, %zu samples every %.6f mm\n", recording.c_str(), signal.description.c_str(), r.samples, r.spacing_mm);
+  std::printf("%s: %s, %zu samples every %.6f mm\n", recording.c_str(), signal.description.c_str(), r.samples, r.spacing.value());
   std::printf("parameters: central pitch %.2f dB, irregularity %.2f dB, texel length %.3f mm%s\n", r.spec.central_pitch.value(),
               r.spec.irregularity.value(), r.spec.texel_length.value(), r.coarse ? ", with a coarse profile" : "");
   std::printf("felt pitch: input %.2f dB, decoded %.2f dB (model distance %.2f JND)\n", r.input.pitch_db, r.decoded.pitch_db,

@@ -36,7 +36,7 @@ int main(int argc, char** argv) try {
   // (100 of the tpad's 101.76 mm), sampled at 1 kHz like a position sensor.
   texel::SwipeConfig swipe;
   swipe.speed_mm_s = 100.0;
-  swipe.surface_mm = surface.grid().length_mm();
+  swipe.surface_mm = surface.grid().length().value();
   swipe.duration_s = 1.0;
   const std::vector<texel::FingerSample> trace = texel::simulate_swipe(swipe);
 

@@ -21,7 +21,7 @@ texel::Signal decode_signal(std::span<const std::byte> bytes, SignalFormat forma
   if (!o.device)
     throw FieldError("device", "is required: '" + std::string(origin) +
                                    "' is a bitstream (.texel), which describes a texture, not a grid to render it on");
-  const Bitstream b = parse_bitstream(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()));
+  const Bitstream b = parse_bitstream(bytes);
   texel::Signal s = signal_of_document(decode_document(b, *o.device), o, origin);
   s.format = SignalFormat::bitstream;
   s.description = "bitstream decoded on " + o.device->name;
@@ -43,7 +43,7 @@ std::array<std::pair<const char*, double>, 4> fields(const Percept& p) {
   return {{{"pitch_db", p.pitch_db}, {"noisiness_db", p.noisiness_db}, {"centroid_db", p.mean_db}, {"spread_db", p.spread_db}}};
 }
 
-Signal encoder_signal(const texel::Signal& s) { return Signal{s.samples, s.spacing.value(), s.description}; }
+Signal encoder_signal(const texel::Signal& s) { return Signal{s.samples, s.spacing, s.description}; }
 
 std::size_t zstd_size(std::span<const std::byte> bytes) {
   std::vector<char> out(ZSTD_compressBound(bytes.size()));

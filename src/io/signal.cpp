@@ -83,7 +83,7 @@ void scale_full_range(std::vector<double>& y, std::string_view origin) {
 
 Millimetres device_spacing(const SignalOptions& o, std::string_view origin, const char* what) {
   if (o.spacing) return *o.spacing;
-  if (o.device) return Millimetres(o.device->spacing_mm);
+  if (o.device) return o.device->spacing;
   throw FieldError("spacing", std::string("is required: ") + in_quotes(origin) + " " + what +
                                   " stores no sample spacing; give it, or a device whose spacing applies");
 }
@@ -177,7 +177,7 @@ Signal decode_device_map(std::span<const std::byte> bytes, const SignalOptions& 
   if (bytes.size() / width > o.max_samples) too_many(origin, bytes.size() / width, o);
   Signal s;
   s.samples = decode_samples(d.format, bytes);
-  s.spacing = o.spacing.value_or(Millimetres(d.spacing_mm));
+  s.spacing = o.spacing.value_or(d.spacing);
   s.description = "device map (" + d.name + ", " + std::string(to_string(d.format)) + ")";
   return s;
 }
@@ -219,13 +219,13 @@ Signal decode_csv(std::string_view text, const SignalOptions& o, std::string_vie
 Signal render_document(Document doc, const SignalOptions& o, std::string_view origin,
                        std::optional<SignalOptions::Region>& span) {
   if (o.device) doc.device = *o.device;
-  if (o.spacing) doc.device = with_grid(doc.device, std::nullopt, o.spacing->value());
+  if (o.spacing) doc.device = with_grid(doc.device, std::nullopt, o.spacing);
   if (doc.device.samples > 0 && static_cast<std::uint64_t>(doc.device.samples) > o.max_samples)
     too_many(origin, static_cast<std::size_t>(doc.device.samples), o);
   const Surface surface = prepare_surface(doc);
   Signal s;
   s.samples = surface.render();
-  s.spacing = Millimetres(surface.grid().spacing_mm);
+  s.spacing = surface.grid().spacing;
   s.origin = Millimetres(surface.grid().position(0));
   s.description = "document on " + doc.device.name;
   if (o.region && !o.region->name.empty()) {
@@ -240,8 +240,7 @@ Signal render_document(Document doc, const SignalOptions& o, std::string_view or
       throw FieldError("region", "'" + o.region->name + "' is not in " + in_quotes(origin) + "; its regions: " + names);
     }
     s.description += ", region " + o.region->name;
-    span =
-        SignalOptions::Region{o.region->name, Millimetres(chosen->start_mm), Millimetres(chosen->start_mm + chosen->length_mm)};
+    span = SignalOptions::Region{o.region->name, chosen->start, chosen->start + chosen->length};
   }
   return s;
 }

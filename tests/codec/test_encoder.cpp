@@ -19,14 +19,14 @@ using namespace texel::codec;
 
 codec::Signal render_signal(const TexelSpec& spec, const std::string& device = "tpad") {
   const DeviceProfile d = load_device(device);
-  return Signal{prepare_surface(make_document(d, spec)).render(), d.spacing, "test"};
+  return codec::Signal{prepare_surface(make_document(d, spec)).render(), d.spacing, "test"};
 }
 
 EncodeResult encode_reference(const std::string& name) {
   const DeviceProfile d = load_device("tpad");
   ReferenceSpec rs;
   rs.name = name;
-  return encode(Signal{render_reference(rs, d.grid()), d.spacing, name}, EncoderConfig{});
+  return encode(codec::Signal{render_reference(rs, d.grid()), d.spacing, name}, EncoderConfig{});
 }
 
 TEST(Encoder, AcceptanceCase) {
@@ -137,11 +137,11 @@ TEST(EncoderTrends, BandPassPitchFollowsCentreAndIrregularityFollowsZeta) {
 
 TEST(Encoder, RejectsUnusableInput) {
   // A flat surface is encodable: no fine part, e = 0.5 as a constant envelope.
-  const EncodeResult flat = encode(Signal{std::vector<double>(19200, 0.5), Millimetres(0.0053), "flat"}, EncoderConfig{});
+  const EncodeResult flat = encode(codec::Signal{std::vector<double>(19200, 0.5), Millimetres(0.0053), "flat"}, EncoderConfig{});
   EXPECT_EQ(flat.spec.fine_strength, 0.0);
   EXPECT_NEAR(flat.spec.coarse_strength, 0.5, 0.5 / 255);
   EXPECT_EQ(flat.bytes.size(), 17u);
-  Signal tiny{std::vector<double>(10, 0.5), Millimetres(0.0053), "tiny"};
+  codec::Signal tiny{std::vector<double>(10, 0.5), Millimetres(0.0053), "tiny"};
   EXPECT_THROW((void)encode(tiny, EncoderConfig{}), InvalidArgument);
   codec::Signal nan = render_signal(TexelSpec{});
   nan.amplitude[100] = std::nan("");

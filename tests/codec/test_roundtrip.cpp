@@ -45,7 +45,7 @@ TEST(RoundTrip, CentralPitchAndIrregularityAcrossTheGrid) {
         pc.irregularity = s.irregularity;
         pc.band_max = CyclesPerMm(94.18);
         const double mass = PitchDistribution(pc).band_mass();
-        const Signal sig{prepare_surface(make_document(d, s)).render(), d.spacing, "grid"};
+        const codec::Signal sig{prepare_surface(make_document(d, s)).render(), d.spacing, "grid"};
         const EncodeResult r = encode(sig, EncoderConfig{});
         const double dp = r.spec.central_pitch.value() - P;
         const double di = r.spec.irregularity.value() - I;

@@ -60,7 +60,7 @@ bool within_caps(std::string_view text) {
       auto opt = [&](const char* k) {
         return g.contains(k) && g[k].is_number() ? std::optional<double>(g[k].get<double>()) : std::nullopt;
       };
-      device = texel::with_grid(*device, opt("length_mm"), opt("spacing_mm"));
+      device = texel::with_grid(*device, texel::millimetres(opt("length_mm")), texel::millimetres(opt("spacing_mm")));
     }
   } catch (const texel::Error&) {
     return true;  // parse_document rejects it at the same step, before preparing anything
@@ -69,7 +69,7 @@ bool within_caps(std::string_view text) {
   auto texel_count_ok = [&](const nlohmann::json& t) {
     if (!t.is_object() || !t.contains("texel_length_mm") || !t["texel_length_mm"].is_number()) return true;
     const double length = t["texel_length_mm"].get<double>();
-    return !(length > 0) || device->length_mm() / length <= max_texels;
+    return !(length > 0) || device->length().value() / length <= max_texels;
   };
   if (j.contains("texture") && !texel_count_ok(j["texture"])) return false;
   if (j.contains("regions") && j["regions"].is_array())

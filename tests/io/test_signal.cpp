@@ -83,7 +83,7 @@ class SignalLoader : public ::testing::Test {
   }
   [[nodiscard]] std::vector<double> positions() const {
     std::vector<double> x(map.size());
-    for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<double>(i) * tpad.spacing_mm;
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<double>(i) * tpad.spacing.value();
     return x;
   }
   /// A sine of `frames` frames in channel 0 and silence in the others.
@@ -129,7 +129,7 @@ TEST_F(SignalLoader, EveryMapFormatReadsTheSameSamples) {
   const std::string csv = put("m.csv", csv_columns("position_mm", "amplitude", positions(), map));
   const std::string json = put("m.texel.json", document_json(doc));
   const std::string mat = (dir / "m.mat").string();
-  mat::write_mat(mat, {{"amplitude", mat::Matrix::column(map)}, {"spacing_mm", mat::Matrix::scalar(tpad.spacing_mm)}});
+  mat::write_mat(mat, {{"amplitude", mat::Matrix::column(map)}, {"spacing_mm", mat::Matrix::scalar(tpad.spacing.value())}});
 
   SignalOptions o;
   o.device = tpad;
@@ -139,7 +139,7 @@ TEST_F(SignalLoader, EveryMapFormatReadsTheSameSamples) {
   for (const std::string& path : {npy, csv, mat}) {
     const Signal s = load_signal(path, o);
     EXPECT_EQ(s.samples, map) << path;
-    EXPECT_NEAR(s.spacing.value(), tpad.spacing_mm, 1e-12) << path;
+    EXPECT_NEAR(s.spacing.value(), tpad.spacing.value(), 1e-12) << path;
     EXPECT_EQ(s.origin.value(), 0.0) << path;
     EXPECT_FALSE(s.scaled) << path;
   }
@@ -154,9 +154,8 @@ TEST_F(SignalLoader, EveryMapFormatReadsTheSameSamples) {
 }
 
 TEST_F(SignalLoader, BitstreamsDecodeThroughTheCodecOnTheGivenDevice) {
-  const std::vector<std::uint8_t> bytes =
-      codec::write_bitstream(codec::from_spec(doc.regions.front().texel, Millimetres(tpad.length_mm())));
-  const std::string path = put("m.texel", std::string(bytes.begin(), bytes.end()));
+  const std::vector<std::byte> bytes = codec::write_bitstream(codec::from_spec(doc.regions.front().texel, tpad.length()));
+  const std::string path = put("m.texel", std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   EXPECT_EQ(field_of([&] { codec::load_signal(path); }), "device");
   SignalOptions o;
   o.device = tpad;
@@ -224,7 +223,7 @@ TEST_F(SignalLoader, SpacingPolicy) {
   SignalOptions o;
   o.spacing = Millimetres(0.5);
   EXPECT_EQ(field_of([&] { load_signal(csv, o); }), "spacing");
-  o.spacing = Millimetres(tpad.spacing_mm * 1.005);  // within the 1 % tolerance
+  o.spacing = Millimetres(tpad.spacing.value() * 1.005);  // within the 1 % tolerance
   EXPECT_NO_THROW(load_signal(csv, o));
   o.spacing = Millimetres(-1.0);
   EXPECT_EQ(field_of([&] { load_signal(csv, o); }), "spacing");
@@ -245,10 +244,10 @@ TEST_F(SignalLoader, Regions) {
   SignalOptions o;
   o.region = SignalOptions::Region{"", Millimetres(10.0), Millimetres(20.0)};
   const Signal s = load_signal(csv, o);
-  const auto first = static_cast<std::size_t>(std::ceil(10.0 / tpad.spacing_mm));
-  EXPECT_NEAR(s.origin.value(), static_cast<double>(first) * tpad.spacing_mm, 1e-9);
+  const auto first = static_cast<std::size_t>(std::ceil(10.0 / tpad.spacing.value()));
+  EXPECT_NEAR(s.origin.value(), static_cast<double>(first) * tpad.spacing.value(), 1e-9);
   EXPECT_GE(s.origin.value(), 10.0);
-  EXPECT_LT(s.origin.value() + (static_cast<double>(s.samples.size()) - 1) * tpad.spacing_mm, 20.0);
+  EXPECT_LT(s.origin.value() + (static_cast<double>(s.samples.size()) - 1) * tpad.spacing.value(), 20.0);
   EXPECT_EQ(s.samples.front(), map[first]);
   o.region = SignalOptions::Region{"", Millimetres(1000.0), Millimetres(2000.0)};
   EXPECT_EQ(field_of([&] { load_signal(csv, o); }), "region");

@@ -65,7 +65,7 @@ TEST(PlayerAlloc, QueuesAllocateAtPrepareOnly) {
   for (std::size_t capacity : {std::size_t{16}, std::size_t{4096}, std::size_t{1} << 20}) {
     PlayerConfig c;
     c.event_capacity = capacity;
-    auto map = std::make_unique<const PlayerMap>(Grid{0.0, 0.01, 1000}, std::vector<float>(1000, 0.5f));
+    auto map = std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(0.01), 1000}, std::vector<float>(1000, 0.5f));
     std::vector<float> out(64);  // caller-supplied memory
     const std::uint64_t before = all_allocations.load();
     Player player(c, std::move(map));
