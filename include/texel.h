@@ -183,6 +183,35 @@ void texel_surface_destroy(texel_surface* surface);
  * encoder's defaults, as `texel encode`): a .texel bitstream of a few bytes.
  * Takes from well under a second to a few seconds. */
 texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
+/* What the encoder is given besides the samples; every field has the
+ * default of `texel encode` (texel_encode_options_default()). */
+typedef struct texel_encode_options {
+  double boundary_mm;                      /* fine/coarse boundary, mm, > 0 [1] */
+  double texel_length_mm;                  /* texel length of the encoding, 0.001 … 65.535 mm [0.25] */
+  texel_parameterization parameterization; /* [MOMENTS] */
+  uint64_t seed;                           /* seed written to the bitstream [1] */
+  unsigned coarse_bits;                    /* bits per coarse level, 1 … 16 [6] */
+  size_t max_bytes;                        /* bitstream budget in bytes; 0 = none [0] */
+  int recover_texel;                       /* 1: recognise Texel renderings and recover their parameters [1] */
+  double swipe_speed_mm_s;                 /* finger speed of the perceptual model, mm/s, > 0 [100] */
+} texel_encode_options;
+
+texel_encode_options texel_encode_options_default(void);
+
+/* texel_encode with options (NULL = the defaults). */
+texel_status texel_encode_with(const double* amplitudes, size_t count, double spacing_mm, const texel_encode_options* options,
+                               texel_encode_result** out);
+
+/* Encodes a file through the engine's one signal loader, as `texel encode
+ * PATH`: .bin (needs `device`), .npy, .csv, .mat, .wav and time/value .csv
+ * recordings (need swipe_speed_mm_s > 0: the finger speed that turns time
+ * into position), a *.texel.json document or a .texel bitstream (rendered on
+ * `device`, or on the document's own). `device` may be NULL (name or path
+ * otherwise, as texel_device_lookup); swipe_speed_mm_s 0 = none, > 0 also
+ * sets the perceptual model's speed (as `texel encode --swipe-speed`). */
+texel_status texel_encode_file(const char* path, const char* device, double swipe_speed_mm_s, const texel_encode_options* options,
+                               texel_encode_result** out);
+
 /* The bitstream bytes (a .texel file). */
 texel_status texel_encode_result_bytes(const texel_encode_result* result, uint8_t* buffer, size_t capacity, size_t* needed);
 /* The parameters the bitstream decodes to. A coarse profile other than a

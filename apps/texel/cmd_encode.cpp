@@ -30,6 +30,7 @@ struct EncodeArgs {
   std::optional<std::size_t> max_bytes;
   bool json = false;
   bool report = false;
+  bool estimate = false;  ///< estimate from samples even when the input holds Texel parameters
 };
 
 codec::EncoderConfig config_of(const EncodeArgs& a) {
@@ -54,6 +55,7 @@ nlohmann::ordered_json result_json(const std::string& input, const Signal& sig, 
                                    const codec::EncoderConfig& cfg, const std::optional<std::string>& output) {
   nlohmann::ordered_json j;
   j["input"] = input;
+  j["method"] = "estimated";
   j["source"] = sig.description;
   if (output) j["output"] = *output;
   j["samples"] = r.samples;
@@ -106,6 +108,45 @@ void print_summary(const std::string& input, const codec::EncodeResult& r, const
               << detail::fixed(s.fine_strength, 3);
   std::cout << "\n  " << r.samples << " samples (" << r.samples * 2 << " bytes as u16) -> " << r.bytes.size() << " bytes"
             << (out ? " in " + *out : std::string()) << "; model distance " << detail::fixed(r.model_distance, 2) << " JND\n";
+}
+
+nlohmann::ordered_json transcoded_json(const std::string& input, const codec::Transcoded& t,
+                                       const std::optional<std::string>& output) {
+  nlohmann::ordered_json j;
+  j["input"] = input;
+  j["method"] = "transcoded";
+  if (output) j["output"] = *output;
+  j["exact"] = t.exact;
+  j["losses"] = t.losses;
+  const TexelSpec& s = t.spec;
+  nlohmann::ordered_json p;
+  p["central_pitch_db"] = s.central_pitch.value();
+  p["irregularity_db"] = s.irregularity.value();
+  p["texel_length_mm"] = s.texel_length.value();
+  p["parameterization"] = std::string(to_string(s.parameterization));
+  p["seed"] = s.seed;
+  p["quantization_db"] = s.quantization_db;
+  p["band_max_cpm"] = s.band_max.value();
+  p["coarse"] = t.bitstream.coarse.has_value();
+  p["coarse_strength"] = s.coarse_strength;
+  p["fine_strength"] = s.fine_strength;
+  if (t.bitstream.coarse && t.bitstream.coarse->bits > 0) {
+    p["coarse_levels"] = t.bitstream.coarse->levels.size();
+    p["coarse_bits"] = t.bitstream.coarse->bits;
+  }
+  j["parameters"] = p;
+  j["sizes"] = {{"bitstream_bytes", t.bytes.size()}};
+  return j;
+}
+
+void print_transcoded(const std::string& input, const codec::Transcoded& t, const std::optional<std::string>& out) {
+  const TexelSpec& s = t.spec;
+  std::cout << input << ": transcoded " << (t.exact ? "exactly" : "with losses") << ": Central Pitch "
+            << detail::num(s.central_pitch.value()) << " dB, Irregularity " << detail::num(s.irregularity.value())
+            << " dB, texel " << detail::num(s.texel_length.value()) << " mm, seed " << s.seed;
+  if (t.bitstream.coarse)
+    std::cout << ", coarse strength " << detail::num(s.coarse_strength) << ", fine strength " << detail::num(s.fine_strength);
+  std::cout << "\n  " << t.bytes.size() << " bytes" << (out ? " in " + *out : std::string()) << "\n";
 }
 
 /// One row of the compression report.
@@ -188,9 +229,12 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")
       ->group(g);
   cmd->add_flag("--json", a->json, "Print estimates, model distance and sizes as JSON");
+  cmd->add_flag("--estimate", a->estimate,
+                "Estimate parameters from the rendered samples even when the input (a document or .texel) holds them; "
+                "without it such an input is transcoded exactly");
   cmd->add_flag("--report", a->report,
                 "Compression report over the inputs: raw device bytes, zstd -22 --ultra, .texel bytes (Markdown table)");
-  cmd->callback([a] {
+  cmd->callback([a, cmd] {
     if (a->report) {
       if (a->output) throw InvalidArgument("--report writes no bitstream; drop -o");
       run_report(*a);
@@ -200,6 +244,28 @@ void register_encode(CLI::App& app) {
     if (a->output) {
       if (output_extension(*a->output) != ".texel") throw InvalidArgument("output '" + *a->output + "' must end in .texel");
       check_writable(*a->output);
+    }
+    // A document or bitstream already holds Texel parameters: transcoded
+    // exactly unless --estimate asks for estimation from its samples.
+    if (!a->estimate) {
+      codec::TranscodeOptions to;
+      if (cmd->count("--coarse-bits")) to.coarse_bits = a->coarse_bits;
+      to.max_bytes = a->max_bytes;
+      if (auto t = codec::transcode_file(a->inputs[0], signal_options(a->input), to)) {
+        for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization"})
+          if (cmd->count(flag))
+            throw InvalidArgument(std::string(flag) + " applies to estimation; '" + a->inputs[0] +
+                                  "' holds Texel parameters and is transcoded with its own (add --estimate to re-estimate it)");
+        if (!t->exact)
+          for (const auto& loss : t->losses) std::cerr << "texel: warning: not exact: " << loss << "\n";
+        if (a->output)
+          write_file_atomic(*a->output, std::string_view(reinterpret_cast<const char*>(t->bytes.data()), t->bytes.size()));
+        if (a->json)
+          print_json(transcoded_json(a->inputs[0], *t, a->output));
+        else
+          print_transcoded(a->inputs[0], *t, a->output);
+        return;
+      }
     }
     const codec::EncoderConfig cfg = config_of(*a);
     const Signal sig = load_input(a->inputs[0], a->input);

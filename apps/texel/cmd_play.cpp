@@ -59,39 +59,29 @@ void run(const PlayArgs& a) {
   const Surface surface = prepare_surface(doc);
   const auto map = PlayerMap::from_surface(surface);
 
-  std::unique_ptr<Backend> backend;
+  const BackendChoice choice = parse_backend(a.backend);
+  BackendOptions bo;
+  bo.block_frames = a.block;
+  bo.audio_device = a.audio_device;
+  bo.baud = a.baud;
   PlayerConfig config;
-  if (a.backend == "null" || a.backend == "audio") {
-    config = player_config(a.finger, 48000.0);
-    if (a.backend == "null") {
-      backend = make_null_backend(config.rate_hz, a.block);
-    } else {
-      AudioOptions o;
-      o.device = a.audio_device;
-      o.rate_hz = config.rate_hz;
-      o.block_frames = a.block;
-      backend = make_audio_backend(o);
-    }
-  } else if (a.backend.rfind("serial:", 0) == 0) {
-    SerialOptions o;
-    o.path = a.backend.substr(7);
-    o.baud = a.baud;
+  if (choice.kind == BackendChoice::Kind::serial) {
     if (a.stream == "position")
-      o.stream = SerialStream::position;
+      bo.stream = SerialStream::position;
     else if (a.stream == "drive")
-      o.stream = SerialStream::drive;
+      bo.stream = SerialStream::drive;
     else
       throw InvalidArgument("--stream is '" + a.stream + "'; allowed: position, drive");
     FingerOptions f = a.finger;
     if (!f.rate_hz) f.rate_hz = 1000.0;  // one frame per millisecond, like a position sensor
-    if (o.stream == SerialStream::drive && f.output == "vibration")
+    if (bo.stream == SerialStream::drive && f.output == "vibration")
       f.output = "amplitude";  // a friction display takes amplitudes
     config = player_config(f, 1000.0);
-    o.rate_hz = config.rate_hz;
-    backend = make_serial_backend(o, *map);
   } else {
-    throw InvalidArgument("--backend is '" + a.backend + "'; allowed: audio, null, serial:PATH");
+    config = player_config(a.finger, 48000.0);
   }
+  bo.rate_hz = config.rate_hz;
+  const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
 
   double duration = 5.0;
   const auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);

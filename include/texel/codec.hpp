@@ -134,6 +134,49 @@ struct EncodeResult {
 /// constant, non-finite).
 EncodeResult encode(const Signal& signal, const EncoderConfig& config);
 
+// --- transcoder -------------------------------------------------------------
+//
+// A document or bitstream that already holds Texel parameters becomes a
+// bitstream exactly, without estimation: the same parameters at the
+// bitstream's resolution, the same seed and options (docs/encoder.md,
+// "Transcoding").
+
+struct TranscodeOptions {
+  /// Bits per coarse level, 1 … 16. Default: the fewest that store the
+  /// profile's per-texel values exactly, else 16.
+  std::optional<unsigned> coarse_bits;
+  std::optional<std::size_t> max_bytes;  ///< largest bitstream, bytes (FieldError "max_bytes" when over)
+};
+
+struct Transcoded {
+  Bitstream bitstream;
+  std::vector<std::byte> bytes;
+  TexelSpec spec;  ///< what the bitstream decodes to
+  /// Decoding renders the document's bytes: every fine field is stored to the
+  /// bit (so on every device) and the per-texel envelopes and fine strength
+  /// are equal on the document's device.
+  bool exact = true;
+  /// Each value the bitstream could not hold, e.g. "central_pitch_db 8.004 is
+  /// stored as 8 (0.01 dB steps)"; empty when exact.
+  std::vector<std::string> losses;
+};
+
+/// Why `doc` cannot be transcoded (several regions, a reference, a region
+/// that is not the whole device), or nothing when it can.
+std::optional<std::string> not_transcodable(const Document& doc);
+/// Transcodes a one-region Texel document; InvalidArgument when
+/// not_transcodable says why not.
+Transcoded transcode(const Document& doc, const TranscodeOptions& options = {});
+/// A bitstream as itself: the canonical bytes (re-encoding is idempotent).
+Transcoded transcode(const Bitstream& b);
+/// A file that already holds Texel parameters — a bitstream, or a document
+/// that not_transcodable accepts (re-targeted to signal.device if given) —
+/// transcoded; nothing (and *why_not, if given, says why) for sample data, a
+/// document that is not one Texel texture over its device, or options that
+/// ask for part of the signal (region, spacing). Throws as the parsers do.
+std::optional<Transcoded> transcode_file(const std::string& path, const SignalOptions& signal = {},
+                                         const TranscodeOptions& options = {}, std::string* why_not = nullptr);
+
 // --- decoder ----------------------------------------------------------------
 
 /// The document a bitstream stands for on `device`: one region over the whole

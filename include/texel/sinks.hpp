@@ -20,6 +20,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "texel/player.hpp"
@@ -124,5 +125,29 @@ struct SerialOptions {
 /// drive values) at options.rate_hz. Link failures end streaming and are
 /// reported by error(). Throws IoError / SerialError from the set-up.
 std::unique_ptr<Backend> make_serial_backend(const SerialOptions& options, const PlayerMap& map);
+
+/// The output a backend name selects. Every front door (the CLI's
+/// --backend, the experiment presenter) spells it the same way: "null",
+/// "audio" or "serial:PATH".
+struct BackendChoice {
+  enum class Kind { null, audio, serial };
+  Kind kind = Kind::null;
+  std::string serial_path;  ///< Kind::serial: the tty or pseudo-terminal
+};
+/// Parses a backend name; throws FieldError("backend", ...) listing the
+/// allowed names.
+BackendChoice parse_backend(std::string_view name);
+
+/// What the chosen backend is opened with.
+struct BackendOptions {
+  double rate_hz = 48000.0;       ///< the player's output rate (serial: frames streamed per second)
+  std::size_t block_frames = 64;  ///< null and audio: frames per block
+  std::string audio_device;       ///< audio: PortAudio device index or name substring
+  int baud = 921600;              ///< serial
+  SerialStream stream = SerialStream::position;
+};
+/// Opens the backend `choice` names. A serial display is given `map` first.
+/// Throws like the make_*_backend functions.
+std::unique_ptr<Backend> make_backend(const BackendChoice& choice, const BackendOptions& options, const PlayerMap& map);
 
 }  // namespace texel

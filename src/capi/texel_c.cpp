@@ -255,6 +255,36 @@ void render_chunks(const texel_surface& s, std::int64_t first, std::size_t count
 
 texel::DeviceProfile device_named(const char* name) { return texel::load_device(need_text(name, "device")); }
 
+// texel_encode_options -> EncoderConfig with the C field names; the encoder
+// validates ranges itself (its FieldErrors name the same fields).
+texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
+  need_finite(o.boundary_mm, "boundary_mm");
+  need_finite(o.texel_length_mm, "texel_length_mm");
+  need_finite(o.swipe_speed_mm_s, "swipe_speed_mm_s");
+  texel::codec::EncoderConfig c;
+  c.boundary = texel::Millimetres(o.boundary_mm);
+  c.texel_length = texel::Millimetres(o.texel_length_mm);
+  switch (enum_value(o.parameterization)) {
+    case TEXEL_PARAMETERIZATION_MOMENTS: c.parameterization = texel::Parameterization::moments; break;
+    case TEXEL_PARAMETERIZATION_LOG: c.parameterization = texel::Parameterization::log; break;
+    default:
+      throw InvalidArgument("parameterization is " + std::to_string(enum_value(o.parameterization)) +
+                            "; allowed: TEXEL_PARAMETERIZATION_MOMENTS (0), TEXEL_PARAMETERIZATION_LOG (1)");
+  }
+  c.seed = o.seed;
+  c.coarse_bits = o.coarse_bits;
+  if (o.max_bytes > 0) c.max_bytes = o.max_bytes;
+  if (o.recover_texel != 0 && o.recover_texel != 1)
+    throw InvalidArgument("recover_texel is " + std::to_string(o.recover_texel) + "; allowed: 0, 1");
+  c.recover_texel = o.recover_texel == 1;
+  c.model.swipe_speed = texel::MmPerSecond(o.swipe_speed_mm_s);
+  return c;
+}
+
+std::unique_ptr<texel_encode_result> encoded(const texel::codec::Signal& signal, const texel::codec::EncoderConfig& config) {
+  return std::make_unique<texel_encode_result>(texel_encode_result{texel::codec::encode(signal, config)});
+}
+
 template <class Handle, class Make>
 texel_status create(Handle** out, Make&& make) {
   if (out) *out = nullptr;
@@ -433,16 +463,53 @@ void texel_surface_destroy(texel_surface* surface) { delete surface; }
 
 // ------------------------------------------------------------------ codec
 
-texel_status texel_encode(const double* amplitudes, std::size_t count, double spacing_mm, texel_encode_result** out) {
+texel_encode_options texel_encode_options_default(void) {
+  const texel::codec::EncoderConfig c;
+  texel_encode_options o{};
+  o.boundary_mm = c.boundary.value();
+  o.texel_length_mm = c.texel_length.value();
+  o.parameterization =
+      c.parameterization == texel::Parameterization::log ? TEXEL_PARAMETERIZATION_LOG : TEXEL_PARAMETERIZATION_MOMENTS;
+  o.seed = c.seed;
+  o.coarse_bits = c.coarse_bits;
+  o.max_bytes = c.max_bytes.value_or(0);
+  o.recover_texel = c.recover_texel ? 1 : 0;
+  o.swipe_speed_mm_s = c.model.swipe_speed.value();
+  return o;
+}
+
+texel_status texel_encode_with(const double* amplitudes, std::size_t count, double spacing_mm,
+                               const texel_encode_options* options, texel_encode_result** out) {
   return create(out, [&] {
     if (count > 0) need(amplitudes, "amplitudes");
     need_finite(spacing_mm, "spacing_mm");
+    const texel::codec::EncoderConfig config = options ? config_of(*options) : texel::codec::EncoderConfig{};
     texel::codec::Signal signal;
     if (count > 0) signal.amplitude.assign(amplitudes, amplitudes + count);
     signal.spacing = texel::Millimetres(spacing_mm);
     signal.description = "C API map";
-    return std::make_unique<texel_encode_result>(
-        texel_encode_result{texel::codec::encode(signal, texel::codec::EncoderConfig{})});
+    return encoded(signal, config);
+  });
+}
+
+texel_status texel_encode(const double* amplitudes, std::size_t count, double spacing_mm, texel_encode_result** out) {
+  return texel_encode_with(amplitudes, count, spacing_mm, nullptr, out);
+}
+
+texel_status texel_encode_file(const char* path, const char* device, double swipe_speed_mm_s, const texel_encode_options* options,
+                               texel_encode_result** out) {
+  return create(out, [&] {
+    need_text(path, "path");
+    need_finite(swipe_speed_mm_s, "swipe_speed_mm_s");
+    if (swipe_speed_mm_s < 0.0)
+      throw InvalidArgument("swipe_speed_mm_s is " + num(swipe_speed_mm_s) + "; allowed: 0 (none) or a speed > 0 mm/s");
+    texel::SignalOptions lo;
+    if (device) lo.device = texel::load_device(device);
+    if (swipe_speed_mm_s > 0.0) lo.swipe_speed = texel::MmPerSecond(swipe_speed_mm_s);
+    texel::codec::EncoderConfig config = options ? config_of(*options) : texel::codec::EncoderConfig{};
+    if (lo.swipe_speed) config.model.swipe_speed = *lo.swipe_speed;  // as texel encode --swipe-speed
+    const texel::Signal signal = texel::codec::load_signal(path, lo);
+    return encoded(texel::codec::encoder_signal(signal), config);
   });
 }
 

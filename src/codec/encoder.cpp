@@ -808,13 +808,13 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   const std::size_t n = signal.amplitude.size();
   if (!(std::isfinite(dx) && dx > 0.0)) throw InvalidArgument("signal spacing is " + num(dx) + " mm; it must be > 0");
   if (!(cfg.boundary.value() > 0.0 && std::isfinite(cfg.boundary.value())))
-    throw InvalidArgument("--boundary is " + num(cfg.boundary.value()) + " mm; it must be > 0");
+    throw FieldError("boundary", "is " + num(cfg.boundary.value()) + " mm; it must be > 0");
   if (!(cfg.texel_length.value() >= 0.001 && cfg.texel_length.value() <= 65.535))
-    throw InvalidArgument("--texel-length is " + num(cfg.texel_length.value()) + " mm; allowed: 0.001 … 65.535 mm");
+    throw FieldError("texel_length", "is " + num(cfg.texel_length.value()) + " mm; allowed: 0.001 … 65.535 mm");
   if (!(cfg.model.swipe_speed.value() > 0.0 && std::isfinite(cfg.model.swipe_speed.value())))
-    throw InvalidArgument("--swipe-speed is " + num(cfg.model.swipe_speed.value()) + " mm/s; it must be > 0");
+    throw FieldError("swipe_speed", "is " + num(cfg.model.swipe_speed.value()) + " mm/s; it must be > 0");
   if (cfg.coarse_bits < 1 || cfg.coarse_bits > 16)
-    throw InvalidArgument("--coarse-bits is " + std::to_string(cfg.coarse_bits) + "; allowed: 1 … 16");
+    throw FieldError("coarse_bits", "is " + std::to_string(cfg.coarse_bits) + "; allowed: 1 … 16");
   const double len = static_cast<double>(n) * dx;
   if (n < 64 || len < 4.0 * cfg.texel_length.value())
     throw InvalidArgument("the input has " + std::to_string(n) + " samples over " + num(len) +
@@ -931,9 +931,9 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
         chosen = &o, chosen_err = err, chosen_size = size;
     }
     if (!chosen)
-      throw InvalidArgument("--max-bytes " + std::to_string(*cfg.max_bytes) +
-                            " is too small for this texture's coarse profile; it needs at least " +
-                            std::to_string(fixed + coarse_section_bytes(options.back())) + " bytes");
+      throw FieldError("max_bytes", std::to_string(*cfg.max_bytes) +
+                                        " is too small for this texture's coarse profile; it needs at least " +
+                                        std::to_string(fixed + coarse_section_bytes(options.back())) + " bytes");
     b.coarse = *chosen;
     decoded_c = decoded_profile(*chosen, sp.c.size());
     res.coarse_correlation = correlation(sp.c, decoded_c);

@@ -31,38 +31,27 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
     throw InvalidArgument("swipe speed is " + std::to_string(options_.swipe_speed_mm_s) + "; allowed: 0 … 10000 mm/s");
   if (!(options_.finger_lead_s >= 0 && options_.finger_lead_s <= 0.1))
     throw InvalidArgument("finger lead is " + std::to_string(options_.finger_lead_s) + " s; allowed: 0 … 0.1 s");
+  const BackendChoice choice = parse_backend(options_.backend);
   PlayerConfig config;
-  const std::string& b = options_.backend;
-  if (b == "null" || b == "audio") {
-    config.rate_hz = options_.rate_hz;
-    config.mode = OutputMode::vibration;
-    period_s_ = static_cast<double>(options_.block_frames) / config.rate_hz;
-    player_ = std::make_unique<Player>(config);
-    if (b == "null") {
-      backend_ = make_null_backend(config.rate_hz, options_.block_frames);
-    } else {
-      AudioOptions ao;
-      ao.device = options_.audio_device;
-      ao.rate_hz = config.rate_hz;
-      ao.block_frames = options_.block_frames;
-      backend_ = make_audio_backend(ao);
-    }
-  } else if (b.rfind("serial:", 0) == 0 && b.size() > 7) {
+  BackendOptions bo;
+  if (choice.kind == BackendChoice::Kind::serial) {
     // A friction display takes amplitudes; the player's output is streamed
     // as drive values, so switching stimuli needs no map upload.
     config.rate_hz = 1000.0;
     config.mode = OutputMode::amplitude;
     period_s_ = 1.0 / config.rate_hz;
-    player_ = std::make_unique<Player>(config);
-    SerialOptions so;
-    so.path = b.substr(7);
-    so.rate_hz = config.rate_hz;
-    so.stream = SerialStream::drive;
-    const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
-    backend_ = make_serial_backend(so, blank_map);
+    bo.stream = SerialStream::drive;
   } else {
-    throw InvalidArgument("backend is '" + b + "'; allowed: null, audio, serial:PATH");
+    config.rate_hz = options_.rate_hz;
+    config.mode = OutputMode::vibration;
+    period_s_ = static_cast<double>(options_.block_frames) / config.rate_hz;
+    bo.block_frames = options_.block_frames;
+    bo.audio_device = options_.audio_device;
   }
+  bo.rate_hz = config.rate_hz;
+  player_ = std::make_unique<Player>(config);
+  const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
+  backend_ = make_backend(choice, bo, blank_map);
   pump();
   backend_->start(*player_);
   running_ = true;

@@ -113,46 +113,86 @@ namespace {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// ------------------------------------------------------- paced backends
+
+// A backend whose own thread calls the player once per period, on deadlines
+// counted from the start (so lateness does not accumulate): the null backend
+// and the serial link share this. A tick that starts more than a period late
+// counts as an underrun; an exception from a tick (the serial link's I/O)
+// ends the loop and is reported by error() instead of escaping the thread.
+class PacedBackend : public Backend {
+ public:
+  [[nodiscard]] std::string error() const override {
+    std::lock_guard lock(error_mutex_);
+    return error_;
+  }
+
+ protected:
+  explicit PacedBackend(double period_s) : period_(period_s) {}
+  // One period's work. process() inside it stays real-time safe; the tick
+  // itself may do I/O (it runs on this backend's thread, not an audio one).
+  virtual void tick(Player& player) = 0;
+
+ private:
+  void do_start(Player& player) final {
+    {
+      std::lock_guard lock(error_mutex_);
+      error_.clear();
+    }
+    running_ = true;
+    thread_ = std::thread([this, &player] { loop(player); });
+  }
+  void do_stop() noexcept final {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
+  void loop(Player& player) {
+    const auto t0 = Clock::now();
+    const auto late = std::chrono::duration_cast<Clock::duration>(period_);
+    try {
+      for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
+        const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(period_ * static_cast<double>(k));
+        if (Clock::now() > deadline + late) record_underrun();
+        std::this_thread::sleep_until(deadline);
+        tick(player);
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(error_mutex_);
+      error_ = e.what();
+    }
+  }
+  std::chrono::duration<double> period_;
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+  mutable std::mutex error_mutex_;
+  std::string error_;
+};
+
 // ------------------------------------------------------------------ null
 
-class NullBackend final : public Backend {
+class NullBackend final : public PacedBackend {
  public:
-  NullBackend(double rate, std::size_t block) : rate_(rate), buffer_(block) {
-    if (!(rate >= 100 && rate <= 384000))
-      throw InvalidArgument("null backend: rate is " + detail::num(rate) + " Hz; allowed 100 … 384000");
-    if (block < 1 || block > 65536)
-      throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
-  }
+  NullBackend(double rate, std::size_t block) : PacedBackend(checked_period(rate, block)), rate_(rate), buffer_(block) {}
   ~NullBackend() override { stop(); }
   [[nodiscard]] std::string describe() const override {
     return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
   }
 
  private:
-  void do_start(Player& player) override {
-    running_ = true;
-    thread_ = std::thread([this, &player] { loop(player); });
+  static double checked_period(double rate, std::size_t block) {
+    if (!(rate >= 100 && rate <= 384000))
+      throw InvalidArgument("null backend: rate is " + detail::num(rate) + " Hz; allowed 100 … 384000");
+    if (block < 1 || block > 65536)
+      throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
+    return static_cast<double>(block) / rate;
   }
-  void do_stop() noexcept override {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
-  }
-  void loop(Player& player) {
-    const auto period = std::chrono::duration<double>(static_cast<double>(buffer_.size()) / rate_);
-    const auto t0 = Clock::now();
-    for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
-      const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(k));
-      if (Clock::now() > deadline + std::chrono::duration_cast<Clock::duration>(period)) record_underrun();
-      std::this_thread::sleep_until(deadline);
-      const auto b0 = Clock::now();
-      const BlockInfo info = player.process(buffer_);
-      record(info, seconds_since(b0));
-    }
+  void tick(Player& player) override {
+    const auto b0 = Clock::now();
+    const BlockInfo info = player.process(buffer_);
+    record(info, seconds_since(b0));
   }
   double rate_;
   std::vector<float> buffer_;
-  std::atomic<bool> running_{false};
-  std::thread thread_;
 };
 
 // ------------------------------------------------------------- PortAudio
@@ -274,11 +314,10 @@ class AudioBackend final : public Backend {
 
 // ---------------------------------------------------------------- serial
 
-class SerialBackend final : public Backend {
+class SerialBackend final : public PacedBackend {
  public:
-  SerialBackend(const SerialOptions& o, const PlayerMap& map) : options_(o), link_(o.path, o.baud) {
-    if (!(o.rate_hz >= 1 && o.rate_hz <= 20000))
-      throw InvalidArgument("serial backend: rate is " + detail::num(o.rate_hz) + " Hz; allowed 1 … 20000");
+  SerialBackend(const SerialOptions& o, const PlayerMap& map)
+      : PacedBackend(checked_period(o.rate_hz)), options_(o), link_(o.path, o.baud) {
     info_ = link_.hello();
     if (o.stream == SerialStream::position) {
       link_.upload_map(0, map);
@@ -292,50 +331,29 @@ class SerialBackend final : public Backend {
            (options_.stream == SerialStream::position ? "positions" : "drive values") + " at " + detail::num(options_.rate_hz) +
            " Hz";
   }
-  [[nodiscard]] std::string error() const override {
-    std::lock_guard lock(error_mutex_);
-    return error_;
-  }
 
  private:
-  void do_start(Player& player) override {
-    running_ = true;
-    thread_ = std::thread([this, &player] { loop(player); });
-  }
-  void do_stop() noexcept override {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
+  static double checked_period(double rate_hz) {
+    if (!(rate_hz >= 1 && rate_hz <= 20000))
+      throw InvalidArgument("serial backend: rate is " + detail::num(rate_hz) + " Hz; allowed 1 … 20000");
+    return 1.0 / rate_hz;
   }
   // The streaming thread does I/O by nature; process() itself stays
-  // real-time safe, and errors end the loop instead of escaping the thread.
-  void loop(Player& player) {
-    const auto period = std::chrono::duration<double>(1.0 / options_.rate_hz);
-    const auto t0 = Clock::now();
+  // real-time safe.
+  void tick(Player& player) override {
     float out[1];
     float pos[1];
-    try {
-      for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
-        std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(k)));
-        const auto b0 = Clock::now();
-        const BlockInfo info = player.process(out, pos);
-        record(info, seconds_since(b0));
-        if (options_.stream == SerialStream::position)
-          link_.stream_position(pos[0], info.touching);
-        else
-          link_.stream_drive(out[0]);
-      }
-    } catch (const std::exception& e) {
-      std::lock_guard lock(error_mutex_);
-      error_ = e.what();
-    }
+    const auto b0 = Clock::now();
+    const BlockInfo info = player.process(out, pos);
+    record(info, seconds_since(b0));
+    if (options_.stream == SerialStream::position)
+      link_.stream_position(pos[0], info.touching);
+    else
+      link_.stream_drive(out[0]);
   }
   SerialOptions options_;
   SerialLink link_;
   DisplayInfo info_;
-  std::atomic<bool> running_{false};
-  std::thread thread_;
-  mutable std::mutex error_mutex_;
-  std::string error_;
 };
 
 }  // namespace
@@ -349,6 +367,33 @@ std::unique_ptr<Backend> make_audio_backend(const AudioOptions& options) { retur
 std::vector<std::string> audio_output_devices() {
   PaSession session;
   return list_outputs();
+}
+
+BackendChoice parse_backend(std::string_view name) {
+  if (name == "null") return {BackendChoice::Kind::null, {}};
+  if (name == "audio") return {BackendChoice::Kind::audio, {}};
+  if (name.starts_with("serial:") && name.size() > 7) return {BackendChoice::Kind::serial, std::string(name.substr(7))};
+  throw FieldError("backend", "is '" + std::string(name) + "'; allowed: null, audio, serial:PATH");
+}
+
+std::unique_ptr<Backend> make_backend(const BackendChoice& choice, const BackendOptions& options, const PlayerMap& map) {
+  switch (choice.kind) {
+    case BackendChoice::Kind::null: return make_null_backend(options.rate_hz, options.block_frames);
+    case BackendChoice::Kind::audio: {
+      AudioOptions o;
+      o.device = options.audio_device;
+      o.rate_hz = options.rate_hz;
+      o.block_frames = options.block_frames;
+      return make_audio_backend(o);
+    }
+    case BackendChoice::Kind::serial: break;
+  }
+  SerialOptions o;
+  o.path = choice.serial_path;
+  o.baud = options.baud;
+  o.rate_hz = options.rate_hz;
+  o.stream = options.stream;
+  return make_serial_backend(o, map);
 }
 
 std::unique_ptr<Backend> make_serial_backend(const SerialOptions& options, const PlayerMap& map) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "texel/document.hpp"
 #include "texel/player.hpp"
 #include "texel/reference.hpp"
+#include "texel/signal.hpp"
 #include "texel/surface.hpp"
 
 namespace {
@@ -542,6 +544,107 @@ TEST(CApi, EncodeDecodeRoundTrip) {
   EXPECT_FAILS(texel_encode_result_params(raw, nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
   EXPECT_FAILS(texel_encode_result_distance(nullptr, &jnd), TEXEL_INVALID_ARGUMENT, "result is NULL");
   EXPECT_FAILS(texel_encode_result_distance(raw, nullptr), TEXEL_INVALID_ARGUMENT, "jnd is NULL");
+}
+
+TEST(CApi, EncodeOptionsAndFiles) {
+  const texel_encode_options d = texel_encode_options_default();
+  const texel::codec::EncoderConfig c;
+  EXPECT_EQ(d.boundary_mm, c.boundary.value());
+  EXPECT_EQ(d.texel_length_mm, c.texel_length.value());
+  EXPECT_EQ(d.parameterization, TEXEL_PARAMETERIZATION_MOMENTS);
+  EXPECT_EQ(d.seed, c.seed);
+  EXPECT_EQ(d.coarse_bits, c.coarse_bits);
+  EXPECT_EQ(d.max_bytes, 0u);
+  EXPECT_EQ(d.recover_texel, 1);
+  EXPECT_EQ(d.swipe_speed_mm_s, c.model.swipe_speed.value());
+
+  const Surf s = make_surface(study_params());
+  std::vector<double> m(19200);
+  ASSERT_EQ(texel_surface_render(s.get(), 0, m.data(), m.size()), TEXEL_OK);
+
+  // Options reach the encoder: a seed and the log parameterization, as the library's encode with the same config.
+  texel_encode_options o = d;
+  o.seed = 99;
+  o.parameterization = TEXEL_PARAMETERIZATION_LOG;
+  o.recover_texel = 0;
+  texel_encode_result* raw = nullptr;
+  ASSERT_EQ(texel_encode_with(m.data(), m.size(), 0.005, &o, &raw), TEXEL_OK) << texel_last_error();
+  Enc enc(raw);
+  texel::codec::EncoderConfig cfg;
+  cfg.seed = 99;
+  cfg.parameterization = texel::Parameterization::log;
+  cfg.recover_texel = false;
+  const auto want = texel::codec::encode(texel::codec::Signal{m, texel::Millimetres(0.005), "t"}, cfg);
+  std::vector<std::uint8_t> bytes(want.bytes.size());
+  std::size_t needed = 0;
+  ASSERT_EQ(texel_encode_result_bytes(raw, bytes.data(), bytes.size(), &needed), TEXEL_OK);
+  EXPECT_EQ(0, std::memcmp(bytes.data(), want.bytes.data(), bytes.size()));
+  texel_params p{};
+  ASSERT_EQ(texel_encode_result_params(raw, &p, nullptr), TEXEL_OK);
+  EXPECT_EQ(p.seed, 99u);
+  EXPECT_EQ(p.parameterization, TEXEL_PARAMETERIZATION_LOG);
+
+  // NULL options = the defaults = texel_encode.
+  texel_encode_result* r1 = nullptr;
+  texel_encode_result* r2 = nullptr;
+  ASSERT_EQ(texel_encode_with(m.data(), m.size(), 0.005, nullptr, &r1), TEXEL_OK);
+  ASSERT_EQ(texel_encode(m.data(), m.size(), 0.005, &r2), TEXEL_OK);
+  Enc e1(r1), e2(r2);
+  double j1 = 0, j2 = 1;
+  ASSERT_EQ(texel_encode_result_distance(r1, &j1), TEXEL_OK);
+  ASSERT_EQ(texel_encode_result_distance(r2, &j2), TEXEL_OK);
+  EXPECT_EQ(j1, j2);
+
+  // Bad options name the C field (the encoder's own field names).
+  texel_encode_result* r = nullptr;
+  auto bad = [&](auto mutate, const char* what) {
+    texel_encode_options x = d;
+    mutate(x);
+    EXPECT_FAILS(texel_encode_with(m.data(), m.size(), 0.005, &x, &r), TEXEL_INVALID_ARGUMENT, what);
+    EXPECT_EQ(r, nullptr);
+  };
+  bad([](texel_encode_options& x) { x.boundary_mm = 0; }, "boundary");
+  bad([](texel_encode_options& x) { x.boundary_mm = nan_v; }, "boundary_mm");
+  bad([](texel_encode_options& x) { x.texel_length_mm = 100; }, "texel_length");
+  bad([](texel_encode_options& x) { x.coarse_bits = 17; }, "coarse_bits");
+  bad([](texel_encode_options& x) { x.swipe_speed_mm_s = -1; }, "swipe_speed");
+  bad([](texel_encode_options& x) { x.recover_texel = 2; }, "recover_texel");
+  bad([](texel_encode_options& x) { std::memset(&x.parameterization, 7, 1); }, "parameterization");
+
+  // A file through the one signal loader: the .bin of this map on tpad
+  // encodes as the map itself does.
+  TempDir dir("capi");
+  const std::string bin = dir.at("map.bin");
+  std::vector<std::uint16_t> u16(m.size());
+  ASSERT_EQ(texel_surface_render_u16(s.get(), 0, u16.data(), u16.size()), TEXEL_OK);
+  {
+    std::FILE* f = std::fopen(bin.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(u16.data(), 2, u16.size(), f), u16.size());
+    std::fclose(f);
+  }
+  texel_encode_result* rf = nullptr;
+  ASSERT_EQ(texel_encode_file(bin.c_str(), "tpad", 0, nullptr, &rf), TEXEL_OK) << texel_last_error();
+  Enc ef(rf);
+  const auto sig = texel::codec::load_signal(bin, [] {
+    texel::SignalOptions lo;
+    lo.device = texel::load_device("tpad");
+    return lo;
+  }());
+  const auto want_file = texel::codec::encode(texel::codec::encoder_signal(sig), texel::codec::EncoderConfig{});
+  ASSERT_EQ(texel_encode_result_bytes(rf, nullptr, 0, &needed), TEXEL_OK);
+  std::vector<std::uint8_t> fb(needed);
+  ASSERT_EQ(texel_encode_result_bytes(rf, fb.data(), fb.size(), nullptr), TEXEL_OK);
+  ASSERT_EQ(fb.size(), want_file.bytes.size());
+  EXPECT_EQ(0, std::memcmp(fb.data(), want_file.bytes.data(), fb.size()));
+
+  EXPECT_FAILS(texel_encode_file(bin.c_str(), nullptr, 0, nullptr, &r), TEXEL_INVALID_ARGUMENT, "device");
+  EXPECT_FAILS(texel_encode_file(nullptr, "tpad", 0, nullptr, &r), TEXEL_INVALID_ARGUMENT, "path is NULL");
+  EXPECT_FAILS(texel_encode_file(bin.c_str(), "tpad", -5, nullptr, &r), TEXEL_INVALID_ARGUMENT, "swipe_speed_mm_s");
+  EXPECT_FAILS(texel_encode_file(bin.c_str(), "tpad", nan_v, nullptr, &r), TEXEL_INVALID_ARGUMENT, "swipe_speed_mm_s");
+  EXPECT_FAILS(texel_encode_file(bin.c_str(), "tpad", 0, nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  EXPECT_EQ(texel_encode_file(dir.at("missing.bin").c_str(), "tpad", 0, nullptr, &r), TEXEL_IO_ERROR);
+  EXPECT_EQ(r, nullptr);
 }
 
 TEST(CApi, DecodeErrors) {

@@ -178,6 +178,18 @@ static void test_documents_and_surfaces(void) {
     CHECK(r == NULL);
     CHECK_STATUS(texel_encode_result_bytes(NULL, stream, sizeof stream, NULL), TEXEL_INVALID_ARGUMENT);
     CHECK_STATUS(texel_encode(amplitudes, n, NAN, &r), TEXEL_INVALID_ARGUMENT);
+    {
+      texel_encode_options options = texel_encode_options_default();
+      options.seed = 5;
+      CHECK_STATUS(texel_encode_with(amplitudes, n, info.spacing_mm, &options, &r), TEXEL_OK);
+      CHECK_STATUS(texel_encode_result_params(r, &got, NULL), TEXEL_OK);
+      CHECK(got.seed == 5);
+      texel_encode_result_destroy(r);
+      options.coarse_bits = 0;
+      CHECK_STATUS(texel_encode_with(amplitudes, n, info.spacing_mm, &options, &r), TEXEL_INVALID_ARGUMENT);
+      CHECK(r == NULL);
+      CHECK_STATUS(texel_encode_file("/nonexistent/map.npy", NULL, 0.0, NULL, &r), TEXEL_IO_ERROR);
+    }
   }
 
   free(bytes);

@@ -444,3 +444,39 @@ TEST_F(Cli, SignalErrorsNameTheFlags) {
   EXPECT_EQ(run({"info", "st.wav", "--swipe-speed", "100", "--channel", "mix"}).status, 0);
   EXPECT_EQ(run({"info", "st.wav", "--swipe-speed", "100", "--channel", "1"}).status, 2);  // silent: constant
 }
+
+// Issue #11, item 1: a document is transcoded, not re-estimated.
+TEST_F(Cli, EncodeTranscodesADocumentExactly) {
+  ASSERT_EQ(run({"render", "--central-pitch", "8", "--irregularity", "0", "--texel-length", "0.5", "--seed", "3", "--device",
+                 "tpad", "-o", "d.texel.json"})
+                .status,
+            0);
+  const Result e = run({"encode", "d.texel.json", "-o", "d.texel", "--json"});
+  ASSERT_EQ(e.status, 0) << e.err;
+  EXPECT_EQ(e.err, "");
+  const auto j = nlohmann::json::parse(e.out);
+  EXPECT_EQ(j["method"], "transcoded");
+  EXPECT_EQ(j["exact"], true);
+  EXPECT_EQ(j["parameters"]["central_pitch_db"], 8.0);
+  EXPECT_EQ(j["parameters"]["seed"], 3);
+  ASSERT_EQ(run({"decode", "d.texel", "--device", "tpad", "-o", "a.bin"}).status, 0);
+  ASSERT_EQ(run({"render", "d.texel.json", "--device", "tpad", "-o", "b.bin"}).status, 0);
+  EXPECT_EQ(slurp(dir / "a.bin"), slurp(dir / "b.bin"));
+  // Re-encoding the bitstream gives the same bytes.
+  ASSERT_EQ(run({"encode", "d.texel", "-o", "e.texel"}).status, 0);
+  EXPECT_EQ(slurp(dir / "e.texel"), slurp(dir / "d.texel"));
+  // --estimate re-estimates from the samples.
+  const Result est = run({"encode", "d.texel.json", "--estimate", "--json"});
+  ASSERT_EQ(est.status, 0) << est.err;
+  EXPECT_EQ(nlohmann::json::parse(est.out)["method"], "estimated");
+  // Estimation flags with a transcoded input are refused, naming --estimate.
+  expect_rejected({"encode", "d.texel.json", "--seed", "4", "-o", "x.texel"}, "--estimate");
+  // A value between the bitstream's steps: a warning, and --json says so.
+  ASSERT_EQ(run({"render", "--central-pitch", "8.004", "--seed", "3", "-o", "q.texel.json"}).status, 0);
+  const Result q = run({"encode", "q.texel.json", "--json"});
+  ASSERT_EQ(q.status, 0) << q.err;
+  EXPECT_NE(q.err.find("warning: not exact: central_pitch_db 8.004 is stored as 8"), std::string::npos) << q.err;
+  const auto qj = nlohmann::json::parse(q.out);
+  EXPECT_EQ(qj["exact"], false);
+  EXPECT_EQ(qj["losses"].size(), 1u);
+}

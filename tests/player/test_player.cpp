@@ -565,3 +565,30 @@ TEST(PlayerLifetime, ManyStartsStopsAndDestructionsInEitherOrder) {
       backend.reset();
   }
 }
+
+TEST(Backends, OneSpellingForEveryFrontDoor) {
+  EXPECT_EQ(parse_backend("null").kind, BackendChoice::Kind::null);
+  EXPECT_EQ(parse_backend("audio").kind, BackendChoice::Kind::audio);
+  const BackendChoice s = parse_backend("serial:/dev/ttyACM0");
+  EXPECT_EQ(s.kind, BackendChoice::Kind::serial);
+  EXPECT_EQ(s.serial_path, "/dev/ttyACM0");
+  for (const char* bad : {"", "serial:", "Audio", "serial", "null "}) {
+    try {
+      (void)parse_backend(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const FieldError& e) {
+      EXPECT_EQ(e.field(), "backend");
+      EXPECT_NE(std::string(e.what()).find("allowed: null, audio, serial:PATH"), std::string::npos) << e.what();
+    }
+  }
+  // make_backend opens what the choice names (null needs no device).
+  const PlayerMap map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
+  BackendOptions o;
+  o.rate_hz = 8000.0;
+  o.block_frames = 32;
+  const auto backend = make_backend(parse_backend("null"), o, map);
+  Player player(PlayerConfig{});
+  backend->start(player);
+  backend->stop();
+  EXPECT_THROW((void)make_backend(parse_backend("serial:/nonexistent/tty"), o, map), Error);
+}
