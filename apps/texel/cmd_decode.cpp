@@ -41,8 +41,7 @@ void register_decode(CLI::App& app) {
     Document doc = codec::decode_document(b, device);
     doc.description = "decoded from " + a->input;
     const Surface surface = prepare_surface(doc);
-    const std::vector<double> map = render_map(surface);
-    write_rendered(a->output, doc, surface, map, texel_frequencies(surface));
+    write_surface(a->output, doc, surface);
     if (a->json) {
       const TexelSpec& s = doc.regions[0].texel;
       nlohmann::ordered_json j;

@@ -135,8 +135,7 @@ void register_reference(CLI::App& app) {
     Document doc = make_reference_document(resolve_device(a->device, nullptr), spec);
     doc.description = "Texel reference " + spec.name;
     const Surface surface = prepare_surface(doc);
-    const std::vector<double> map = render_map(surface);
-    write_rendered(*a->output, doc, surface, map, {});
+    write_surface(*a->output, doc, surface);
     if (a->json) {
       ordered j{{"output", *a->output},
                 {"reference", spec.name},

@@ -43,7 +43,7 @@ std::string texels_csv(const Surface& surface) {
   return out;
 }
 
-nlohmann::ordered_json summary(const Document& doc, const Surface& surface, const std::vector<double>& map, const RenderArgs& a) {
+nlohmann::ordered_json summary(const Document& doc, const Surface& surface, double mean, const RenderArgs& a) {
   nlohmann::ordered_json j;
   j["output"] = a.output;
   if (a.texels_csv) j["texels_csv"] = *a.texels_csv;
@@ -54,7 +54,6 @@ nlohmann::ordered_json summary(const Document& doc, const Surface& surface, cons
   j["format"] = std::string(to_string(doc.device.format));
   j["device_bytes"] = doc.device.native_bytes();
   j["document_bytes"] = document_json(doc).size();
-  double mean = map.empty() ? 0.0 : std::accumulate(map.begin(), map.end(), 0.0) / static_cast<double>(map.size());
   j["mean_amplitude"] = mean;
   j["regions"] = nlohmann::ordered_json::array();
   for (const auto& r : surface.regions()) {
@@ -106,11 +105,10 @@ void register_render(CLI::App& app) {
     }
     const Document doc = build_document(args->document, args->device, args->texture);
     const Surface surface = prepare_surface(doc);
-    const std::vector<double> map = render_map(surface);
     std::vector<PendingFile> extra;
     if (args->texels_csv) extra.push_back({*args->texels_csv, texels_csv(surface)});
-    write_rendered(args->output, doc, surface, map, texel_frequencies(surface), std::move(extra), mat_version);
-    if (args->json) print_json(summary(doc, surface, map, *args));
+    const double mean = write_surface(args->output, doc, surface, std::move(extra), mat_version);
+    if (args->json) print_json(summary(doc, surface, mean, *args));
   });
 }
 

@@ -1,9 +1,11 @@
 #include "render_output.hpp"
 
 #include <cstdio>
+#include <numeric>
 
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/map_file.hpp"
 #include "texel/plot.hpp"
 
 namespace texel::cli {
@@ -122,6 +124,24 @@ void commit_extras_after(const std::string& path, const std::vector<PendingFile>
   }
 }
 }  // namespace
+
+double write_surface(const std::string& path, const Document& doc, const Surface& surface, std::vector<PendingFile> extra,
+                     mat::MatVersion mat_version) {
+  check_render_output(path);
+  for (const auto& f : extra) check_writable(f.path);
+  if (map_file_kind(path)) {
+    const auto n = static_cast<std::size_t>(surface.grid().count);
+    Progress progress("rendering " + std::to_string(n) + " samples");
+    MapFileOptions o;
+    if (n > (std::size_t{1} << 22)) o.progress = [&](double f) { progress.update(f); };
+    const MapFileStats stats = write_map(path, surface, doc.device.format, o);
+    commit_extras_after(path, extra);
+    return stats.mean_amplitude;
+  }
+  const std::vector<double> map = render_map(surface);
+  write_rendered(path, doc, surface, map, texel_frequencies(surface), std::move(extra), mat_version);
+  return map.empty() ? 0.0 : std::accumulate(map.begin(), map.end(), 0.0) / static_cast<double>(map.size());
+}
 
 void write_rendered(const std::string& path, const Document& doc, const Surface& surface, const std::vector<double>& map,
                     const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra, mat::MatVersion mat_version) {

@@ -22,6 +22,14 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
                     const std::vector<double>& frequencies_cpm, std::vector<PendingFile> extra = {},
                     mat::MatVersion mat_version = mat::MatVersion::v5);
 
+/// Renders `surface` into `path`: .bin, .csv and .npy stream chunk by chunk
+/// through the library's write_map (memory bounded whatever the length);
+/// every other format renders the whole map and goes through
+/// write_rendered. `extra` files are committed after the main one (which is
+/// taken back if they fail). Returns the mean amplitude of the map.
+double write_surface(const std::string& path, const Document& doc, const Surface& surface, std::vector<PendingFile> extra = {},
+                     mat::MatVersion mat_version = mat::MatVersion::v5);
+
 /// True for a .mat output path (handled beside OutputKind: a MATLAB file is
 /// written by libmatio, not as bytes).
 bool is_mat_output(const std::string& path);

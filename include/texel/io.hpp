@@ -21,6 +21,30 @@ std::string read_file(const std::string& path);
 /// `path`: readers see the old file or the new one, never a partial one.
 void write_file_atomic(const std::string& path, std::string_view data);
 void write_file_atomic(const std::string& path, std::span<const std::byte> data);
+/// A file written in pieces that appears atomically: the pieces go to a
+/// temporary file beside `path` (mkstemp), and commit() flushes it to disk
+/// and renames it over `path`. Destroyed without commit() — an exception on
+/// the way — it removes the temporary, so a failed command leaves nothing.
+/// Streaming writers (write_map) use it to keep memory bounded whatever the
+/// length; write_file_atomic is one write and a commit.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::string path);  ///< throws IoError naming the path
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  void write(std::string_view data);
+  void write(std::span<const std::byte> data);
+  void commit();
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  [[noreturn]] void fail(const std::string& why);
+  std::string path_;
+  std::string tmp_;
+  int fd_ = -1;
+};
+
 /// Throws IoError if `path`'s directory does not exist or is not writable,
 /// so a command can fail before doing any work.
 void check_writable(const std::string& path);
@@ -30,6 +54,8 @@ std::string output_extension(const std::string& path);
 
 /// NumPy .npy (format 1.0, little-endian float64, 1-D).
 std::string npy_bytes(std::span<const double> values);
+/// The header of that file for `count` values (the data follows it).
+std::string npy_header(std::size_t count);
 /// Reads a 1-D or single-column .npy of float64/float32/int16/uint16 (little-endian).
 std::vector<double> parse_npy(std::string_view bytes, std::string_view origin);
 

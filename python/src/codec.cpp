@@ -143,16 +143,59 @@ void register_codec(py::module_& m) {
   m.def(
       "bitstream_from_document",
       [](const Document& doc, unsigned bits) {
-        if (doc.regions.size() != 1 || doc.regions[0].reference)
-          throw InvalidArgument("document: a bitstream holds one Texel region; this document has " +
-                                std::to_string(doc.regions.size()) + " region(s)" +
-                                (doc.regions.size() == 1 ? " holding a reference" : ""));
-        const auto& r = doc.regions[0];
-        const double length = r.length ? r.length->value() : doc.device.length().value() - r.start.value();
-        return codec::from_spec(r.texel, Millimetres(length), bits);
+        codec::TranscodeOptions o;
+        o.coarse_bits = bits;
+        return codec::transcode(doc, o).bitstream;
       },
       py::arg("document"), py::kw_only(), py::arg("bits") = 8u,
-      "Quantizes a one-region Texel document to a Bitstream (coarse levels with `bits` bits each).");
+      "Quantizes a one-region Texel document to a Bitstream (coarse levels with `bits` bits each); see transcode().");
+
+  // ------------------------------------------------------------- transcoder
+  py::class_<codec::Transcoded>(m, "Transcoded", "A document or bitstream transcoded exactly (docs/encoder.md, \"Transcoding\").")
+      .def_property_readonly(
+          "bytes", [](const codec::Transcoded& t) { return to_bytes(t.bytes); }, "The .texel bitstream.")
+      .def_readonly("bitstream", &codec::Transcoded::bitstream)
+      .def_property_readonly(
+          "spec", [](const codec::Transcoded& t) { return spec_dict(t.spec); },
+          "What the bitstream decodes to, as render() keyword arguments.")
+      .def_readonly("exact", &codec::Transcoded::exact,
+                    "True when decoding renders the document's bytes (every value stored to the bit).")
+      .def_readonly("losses", &codec::Transcoded::losses, "Each value the bitstream could not hold; empty when exact.")
+      .def("__repr__", [](const codec::Transcoded& t) {
+        return "<texel.Transcoded " + std::to_string(t.bytes.size()) + " bytes, " + (t.exact ? "exact>" : "with losses>");
+      });
+  m.def(
+      "transcode",
+      [](const py::object& source, std::optional<unsigned> coarse_bits, std::optional<std::size_t> max_bytes,
+         const py::object& device) -> codec::Transcoded {
+        codec::TranscodeOptions o;
+        o.coarse_bits = coarse_bits;
+        o.max_bytes = max_bytes;
+        if (py::isinstance<Document>(source)) {
+          Document doc = source.cast<Document>();
+          if (!device.is_none()) doc.device = device_of(device, std::nullopt, std::nullopt);
+          return codec::transcode(doc, o);
+        }
+        if (py::isinstance<py::bytes>(source) || py::isinstance<codec::Bitstream>(source))
+          return codec::transcode(bitstream_of(source));
+        SignalOptions so;
+        if (!device.is_none()) so.device = device_of(device, std::nullopt, std::nullopt);
+        std::string why;
+        auto t = codec::transcode_file(path_of(source), so, o, &why);
+        if (!t) throw InvalidArgument("'" + path_of(source) + "' cannot be transcoded: " + why + " (use encode())");
+        return std::move(*t);
+      },
+      py::arg("source"), py::kw_only(), py::arg("coarse_bits") = py::none(), py::arg("max_bytes") = py::none(),
+      py::arg("device") = py::none(),
+      R"doc(Transcodes what already holds Texel parameters — a Document, a .texel.json or .texel path,
+bitstream bytes or a Bitstream — to a bitstream without estimation: the same parameters at the
+bitstream's resolution and the same seed, so decode() renders the document's bytes (`texel encode
+DOC` does the same). exact/losses say whether every value was stored to the bit.
+
+coarse_bits  bits per coarse level, 1 … 16 (default: the fewest that are exact, else 16 or 8)
+max_bytes    largest bitstream allowed, bytes
+device       re-targets a document first (as `texel render DOC --device D`)
+Raises InvalidArgument when the source is sample data or not one Texel texture over its device.)doc");
 
   // ----------------------------------------------------------------- decoder
   m.def(

@@ -121,6 +121,16 @@ class Bitstream:
 
 def parse_bitstream(data: bytes) -> Bitstream: ...
 def bitstream_from_document(document: Document, *, bits: int = 8) -> Bitstream: ...
+
+class Transcoded:
+    bytes: bytes
+    bitstream: Bitstream
+    spec: dict[str, Any]
+    exact: bool
+    losses: list[str]
+
+def transcode(source: Union[Document, bytes, Bitstream, _Path], *, coarse_bits: Optional[int] = None,
+              max_bytes: Optional[int] = None, device: Optional[_Device] = None) -> Transcoded: ...
 def decode_document(source: Union[bytes, Bitstream, _Path], *, device: _Device = "tpad",
                     length_mm: Optional[float] = None, spacing_mm: Optional[float] = None) -> Document: ...
 def decode(source: Union[bytes, Bitstream, _Path], *, device: _Device = "tpad", length_mm: Optional[float] = None,

@@ -41,41 +41,65 @@ void check_writable(const std::string& path) {
     throw IoError("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
 }
 
-void write_file_atomic(const std::string& path, std::string_view data) {
-  check_writable(path);
-  const fs::path p(path);
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  check_writable(path_);
+  const fs::path p(path_);
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  std::string tmpl = (dir / ("." + p.filename().string() + ".tmp-XXXXXX")).string();
-  const int fd = ::mkstemp(tmpl.data());
-  if (fd < 0) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
+  tmp_ = (dir / ("." + p.filename().string() + ".tmp-XXXXXX")).string();
+  fd_ = ::mkstemp(tmp_.data());
+  if (fd_ < 0) throw IoError("cannot write '" + path_ + "': " + std::strerror(errno));
+}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!tmp_.empty()) ::unlink(tmp_.c_str());
+}
+
+void AtomicFile::fail(const std::string& why) {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  ::unlink(tmp_.c_str());
+  tmp_.clear();
+  throw IoError("cannot write '" + path_ + "': " + why);
+}
+
+void AtomicFile::write(std::string_view data) {
+  if (fd_ < 0) throw IoError("cannot write '" + path_ + "': the file is already committed or failed");
   const char* ptr = data.data();
   std::size_t left = data.size();
   while (left > 0) {
-    const ssize_t w = ::write(fd, ptr, left);
+    const ssize_t w = ::write(fd_, ptr, left);
     if (w < 0) {
       if (errno == EINTR) continue;
-      const std::string why = std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmpl.c_str());
-      throw IoError("cannot write '" + path + "': " + why);
+      fail(std::strerror(errno));
     }
     ptr += w;
     left -= static_cast<std::size_t>(w);
   }
+}
+
+void AtomicFile::write(std::span<const std::byte> data) {
+  write(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
+}
+
+void AtomicFile::commit() {
+  if (fd_ < 0) throw IoError("cannot write '" + path_ + "': the file is already committed or failed");
   // mkstemp creates 0600; give the file the usual permissions (umask applies).
   const mode_t mask = ::umask(0);
   ::umask(mask);
-  ::fchmod(fd, 0666 & ~mask);
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string why = std::strerror(errno);
-    ::unlink(tmpl.c_str());
-    throw IoError("cannot write '" + path + "': " + why);
-  }
-  if (std::rename(tmpl.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    ::unlink(tmpl.c_str());
-    throw IoError("cannot write '" + path + "': " + why);
-  }
+  ::fchmod(fd_, 0666 & ~mask);
+  const int synced = ::fsync(fd_);
+  const int closed = ::close(fd_);
+  fd_ = -1;
+  if (synced != 0 || closed != 0) fail(std::strerror(errno));
+  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail(std::strerror(errno));
+  tmp_.clear();
+}
+
+void write_file_atomic(const std::string& path, std::string_view data) {
+  AtomicFile f(path);
+  f.write(data);
+  f.commit();
 }
 
 void write_file_atomic(const std::string& path, std::span<const std::byte> data) {
@@ -92,7 +116,13 @@ std::string output_extension(const std::string& path) {
 }
 
 std::string npy_bytes(std::span<const double> values) {
-  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(values.size()) + ",), }";
+  std::string out = npy_header(values.size());
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return out;
+}
+
+std::string npy_header(std::size_t count) {
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(count) + ",), }";
   // Magic (6) + version (2) + header length (2) + header, padded with spaces
   // and a final newline to a multiple of 64 bytes (NEP 1).
   const std::size_t unpadded = 10 + header.size() + 1;
@@ -102,7 +132,6 @@ std::string npy_bytes(std::span<const double> values) {
   out.push_back(static_cast<char>(header.size() & 0xFF));
   out.push_back(static_cast<char>((header.size() >> 8) & 0xFF));
   out += header;
-  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
   return out;
 }
 

@@ -117,8 +117,10 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 // A backend whose own thread calls the player once per period, on deadlines
 // counted from the start (so lateness does not accumulate): the null backend
-// and the serial link share this. A tick that starts more than a period late
-// counts as an underrun; an exception from a tick (the serial link's I/O)
+// and the serial link share this. For the null backend, which stands in for a
+// sound card, a block that starts more than a period late counts as an
+// underrun; a serial display holds its last value, so a late frame is not one
+// (count_late false). An exception from a tick (the serial link's I/O)
 // ends the loop and is reported by error() instead of escaping the thread.
 class PacedBackend : public Backend {
  public:
@@ -128,7 +130,7 @@ class PacedBackend : public Backend {
   }
 
  protected:
-  explicit PacedBackend(double period_s) : period_(period_s) {}
+  PacedBackend(double period_s, bool count_late) : period_(period_s), count_late_(count_late) {}
   // One period's work. process() inside it stays real-time safe; the tick
   // itself may do I/O (it runs on this backend's thread, not an audio one).
   virtual void tick(Player& player) = 0;
@@ -152,7 +154,7 @@ class PacedBackend : public Backend {
     try {
       for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
         const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(period_ * static_cast<double>(k));
-        if (Clock::now() > deadline + late) record_underrun();
+        if (count_late_ && Clock::now() > deadline + late) record_underrun();
         std::this_thread::sleep_until(deadline);
         tick(player);
       }
@@ -162,6 +164,7 @@ class PacedBackend : public Backend {
     }
   }
   std::chrono::duration<double> period_;
+  bool count_late_;
   std::atomic<bool> running_{false};
   std::thread thread_;
   mutable std::mutex error_mutex_;
@@ -172,7 +175,7 @@ class PacedBackend : public Backend {
 
 class NullBackend final : public PacedBackend {
  public:
-  NullBackend(double rate, std::size_t block) : PacedBackend(checked_period(rate, block)), rate_(rate), buffer_(block) {}
+  NullBackend(double rate, std::size_t block) : PacedBackend(checked_period(rate, block), true), rate_(rate), buffer_(block) {}
   ~NullBackend() override { stop(); }
   [[nodiscard]] std::string describe() const override {
     return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
@@ -317,7 +320,7 @@ class AudioBackend final : public Backend {
 class SerialBackend final : public PacedBackend {
  public:
   SerialBackend(const SerialOptions& o, const PlayerMap& map)
-      : PacedBackend(checked_period(o.rate_hz)), options_(o), link_(o.path, o.baud) {
+      : PacedBackend(checked_period(o.rate_hz), false), options_(o), link_(o.path, o.baud) {
     info_ = link_.hello();
     if (o.stream == SerialStream::position) {
       link_.upload_map(0, map);

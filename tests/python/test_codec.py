@@ -75,3 +75,28 @@ def test_spectrum_equals_cli_json(cli_json, tmp_path):
     assert r["rms"] == pytest.approx(j["rms_amplitude"], rel=1e-9)
     assert r["summary"]["centroid_cpm"] == pytest.approx(j["summary"]["centroid_cpm"], rel=1e-9)
     assert [p["frequency_cpm"] for p in r["peaks"]] == pytest.approx([p["frequency_cpm"] for p in j["peaks"]], rel=1e-9)
+
+
+def test_transcode_is_exact_and_equals_the_cli(cli, tmp_path):
+    doc = tmp_path / "d.texel.json"
+    cli("render", "--central-pitch", "8", "--irregularity", "0", "--texel-length", "0.5", "--seed", "3",
+        "--device", "tpad", "-o", doc)
+    out = tmp_path / "d.texel"
+    cli("encode", doc, "-o", out)
+    t = texel.transcode(str(doc))
+    assert t.exact and t.losses == []
+    assert t.bytes == out.read_bytes()
+    assert t.spec["seed"] == 3
+    assert texel.transcode(t.bytes).bytes == t.bytes  # idempotent
+    d = texel.load_document(str(doc))
+    assert texel.transcode(d).bytes == t.bytes
+    for device in ("tpad", "generic"):
+        want = tmp_path / f"{device}.bin"
+        cli("render", doc, "--device", device, "-o", want)
+        assert texel.decode(t.bytes, device=device).tobytes() == want.read_bytes()
+    lossy = texel.transcode(texel.document(central_pitch_db=8.004, seed=3))
+    assert not lossy.exact and "central_pitch_db" in lossy.losses[0]
+    with pytest.raises(texel.InvalidArgument, match="cannot be transcoded"):
+        m = tmp_path / "m.bin"
+        cli("render", "--seed", "3", "-o", m)
+        texel.transcode(str(m), device="tpad")

@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""Render-to-file beside dd (issue #11, item 5): whole-process wall time and
+peak resident memory of `texel render` writing 10^7 uint16 samples (20 MB) to
+a .bin, next to `dd` writing the same number of bytes, measured in the same
+run. Texel's file is fsync'ed before it is renamed into place (a file that
+appears is on disk), so dd is timed both without and with conv=fsync.
+
+usage: render_to_file.py TEXEL [SAMPLES] [RUNS]
+"""
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def measure(cmd):
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(p.pid, 0)
+    wall = time.perf_counter() - t0
+    err = p.stderr.read().decode()
+    p.stderr.close()
+    if status != 0:
+        sys.exit(f"{' '.join(cmd)} failed: {err}")
+    return wall, usage.ru_maxrss / 1024.0  # MiB
+
+
+def main():
+    texel = sys.argv[1]
+    samples = int(sys.argv[2]) if len(sys.argv) > 2 else 10_000_000
+    runs = int(sys.argv[3]) if len(sys.argv) > 3 else 5
+    spacing = 0.0053  # tpad's sample spacing, mm
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "map.bin")
+        dd_out = os.path.join(d, "dd.bin")
+        mb = samples * 2 // (1 << 20)
+        cases = {
+            "dd (no fsync)": ["dd", "if=/dev/zero", f"of={dd_out}", "bs=1M", f"count={mb}", "status=none"],
+            "dd conv=fsync": ["dd", "if=/dev/zero", f"of={dd_out}", "bs=1M", f"count={mb}", "conv=fsync", "status=none"],
+            "texel render": [texel, "render", "--device", "tpad", "--length", f"{samples * spacing:.4f}", "--seed", "3",
+                             "-o", out],
+            "texel --version (start-up)": [texel, "--version"],
+        }
+        results = {name: [measure(cmd) for _ in range(runs)] for name, cmd in cases.items()}
+        size = os.path.getsize(out)
+    print(f"\nRender to file: {samples:,} uint16 samples ({size:,} bytes), median of {runs} runs")
+    print(f"{'':28s} {'wall ms':>9s} {'peak MiB':>9s} {'× dd fsync':>11s}")
+    base = statistics.median(w for w, _ in results["dd conv=fsync"])
+    for name, rs in results.items():
+        wall = statistics.median(w for w, _ in rs)
+        peak = max(m for _, m in rs)
+        print(f"{name:28s} {wall * 1e3:9.1f} {peak:9.1f} {wall / base:10.1f}×")
+    render = statistics.median(w for w, _ in results["texel render"])
+    peak = max(m for _, m in results["texel render"])
+    print("(peak MiB is the child's ru_maxrss, which includes the forking Python's ~12 MiB before exec)")
+    print(f"goal: peak < 32 MiB: {'met' if peak < 32 else 'NOT met'} ({peak:.1f}); "
+          f"within 4× of dd conv=fsync: {'met' if render <= 4 * base else 'NOT met'} ({render / base:.1f}×)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,48 @@
+// Streaming a rendered map to a file: memory bounded by one chunk, whatever
+// the map's length (issue #11, item 5).
+//
+// A map of 10^7 samples used to be rendered into a vector of doubles, then
+// encoded into a second buffer, then written: 8 + 2 bytes per sample resident
+// before the first byte reached the disk. write_map renders a window of the
+// surface (Surface::render gives any window the values of the whole map),
+// encodes it and appends it to an AtomicFile, so the file still appears
+// atomically and a failure leaves nothing. The bytes are those of the
+// whole-map writers (encode_samples, csv_columns, npy_bytes), chunk for chunk.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "texel/device.hpp"
+#include "texel/surface.hpp"
+
+namespace texel {
+
+/// The map formats that stream: .bin (the device's own sample format), .csv
+/// ("position_mm,amplitude"), .npy (float64, its header written first).
+enum class MapFileKind { device_native, csv, npy };
+
+/// The kind `path`'s extension names, or nothing for another extension.
+std::optional<MapFileKind> map_file_kind(const std::string& path);
+
+struct MapFileOptions {
+  std::size_t chunk_samples = std::size_t{1} << 16;  ///< samples rendered per chunk (> 0) [65536]
+  /// Called after each chunk with the fraction written (0 … 1]; may be empty.
+  std::function<void(double)> progress;
+};
+
+/// What write_map wrote.
+struct MapFileStats {
+  std::size_t samples = 0;
+  std::size_t bytes = 0;
+  double mean_amplitude = 0.0;  ///< mean of the rendered amplitudes (before encoding)
+};
+
+/// Renders `surface` chunk by chunk into `path` (kind by extension; .bin in
+/// `format`). Throws InvalidArgument for another extension, IoError when the
+/// file cannot be written (nothing is left behind).
+MapFileStats write_map(const std::string& path, const Surface& surface, SampleFormat format, const MapFileOptions& options = {});
+
+}  // namespace texel
