@@ -167,6 +167,9 @@ std::optional<std::string> not_transcodable(const Document& doc);
 /// Transcodes a one-region Texel document; InvalidArgument when
 /// not_transcodable says why not.
 Transcoded transcode(const Document& doc, const TranscodeOptions& options = {});
+/// Reads and parses a .texel file; anything over 1 MiB is refused before it
+/// is read (a bitstream is a few bytes). Throws FormatError / IoError naming the file.
+Bitstream read_bitstream(const std::string& path);
 /// A bitstream as itself: the canonical bytes (re-encoding is idempotent).
 Transcoded transcode(const Bitstream& b);
 /// A file that already holds Texel parameters — a bitstream, or a document

@@ -172,6 +172,21 @@ texel_device_info info_of(const texel::DeviceProfile& d) {
   return i;
 }
 
+// A C parameterization value (any int a C caller stored) as the library's.
+texel::Parameterization parameterization_of(const texel_parameterization& p) {
+  switch (enum_value(p)) {
+    case TEXEL_PARAMETERIZATION_MOMENTS: return texel::Parameterization::moments;
+    case TEXEL_PARAMETERIZATION_LOG: return texel::Parameterization::log;
+    default:
+      throw InvalidArgument("parameterization is " + std::to_string(enum_value(p)) +
+                            "; allowed: TEXEL_PARAMETERIZATION_MOMENTS (0), TEXEL_PARAMETERIZATION_LOG (1)");
+  }
+}
+
+texel_parameterization to_c(texel::Parameterization p) {
+  return p == texel::Parameterization::log ? TEXEL_PARAMETERIZATION_LOG : TEXEL_PARAMETERIZATION_MOMENTS;
+}
+
 // texel_params -> TexelSpec, checking what the C caller can get wrong with
 // the C field names (the CLI checks the same values under its flag names).
 texel::TexelSpec spec_of(const texel_params& p) {
@@ -188,13 +203,7 @@ texel::TexelSpec spec_of(const texel_params& p) {
   s.irregularity = texel::Decibels(p.irregularity_db);
   s.texel_length = texel::Millimetres(p.texel_length_mm);
   s.seed = p.seed;
-  switch (enum_value(p.parameterization)) {
-    case TEXEL_PARAMETERIZATION_MOMENTS: s.parameterization = texel::Parameterization::moments; break;
-    case TEXEL_PARAMETERIZATION_LOG: s.parameterization = texel::Parameterization::log; break;
-    default:
-      throw InvalidArgument("parameterization is " + std::to_string(enum_value(p.parameterization)) +
-                            "; allowed: TEXEL_PARAMETERIZATION_MOMENTS (0), TEXEL_PARAMETERIZATION_LOG (1)");
-  }
+  s.parameterization = parameterization_of(p.parameterization);
   if (!(p.quantization_db >= 0.0 && p.quantization_db <= 20.0))
     throw InvalidArgument("quantization_db is " + num(p.quantization_db) + "; allowed: 0 (off) … 20 dB");
   s.quantization_db = p.quantization_db;
@@ -215,8 +224,7 @@ texel_params params_of(const texel::TexelSpec& s, int* has_profile) {
   p.irregularity_db = s.irregularity.value();
   p.texel_length_mm = s.texel_length.value();
   p.seed = s.seed;
-  p.parameterization =
-      s.parameterization == texel::Parameterization::log ? TEXEL_PARAMETERIZATION_LOG : TEXEL_PARAMETERIZATION_MOMENTS;
+  p.parameterization = to_c(s.parameterization);
   p.quantization_db = s.quantization_db;
   p.coarse_strength = s.coarse_strength;
   p.fine_strength = s.fine_strength;
@@ -264,13 +272,7 @@ texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
   texel::codec::EncoderConfig c;
   c.boundary = texel::Millimetres(o.boundary_mm);
   c.texel_length = texel::Millimetres(o.texel_length_mm);
-  switch (enum_value(o.parameterization)) {
-    case TEXEL_PARAMETERIZATION_MOMENTS: c.parameterization = texel::Parameterization::moments; break;
-    case TEXEL_PARAMETERIZATION_LOG: c.parameterization = texel::Parameterization::log; break;
-    default:
-      throw InvalidArgument("parameterization is " + std::to_string(enum_value(o.parameterization)) +
-                            "; allowed: TEXEL_PARAMETERIZATION_MOMENTS (0), TEXEL_PARAMETERIZATION_LOG (1)");
-  }
+  c.parameterization = parameterization_of(o.parameterization);
   c.seed = o.seed;
   c.coarse_bits = o.coarse_bits;
   if (o.max_bytes > 0) c.max_bytes = o.max_bytes;

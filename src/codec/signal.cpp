@@ -28,15 +28,27 @@ texel::Signal decode_signal(std::span<const std::byte> bytes, SignalFormat forma
   return s;
 }
 
-texel::Signal load_signal(const std::string& path, const SignalOptions& o) {
-  if (signal_format_of(path) != SignalFormat::bitstream) return texel::load_signal(path, o);
-  // Bitstreams are a few bytes; anything past 1 MiB is not one (checked before reading).
+namespace {
+// A bitstream file's bytes: a few bytes, so anything past 1 MiB is not one
+// (checked before reading).
+std::string bitstream_file_bytes(const std::string& path) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (!ec && size > (std::uintmax_t{1} << 20))
     throw FormatError("'" + path + "' has " + std::to_string(size) + " bytes; a bitstream is at most 1 MiB");
-  const std::string bytes = read_file(path);
+  return read_file(path);
+}
+}  // namespace
+
+texel::Signal load_signal(const std::string& path, const SignalOptions& o) {
+  if (signal_format_of(path) != SignalFormat::bitstream) return texel::load_signal(path, o);
+  const std::string bytes = bitstream_file_bytes(path);
   return codec::decode_signal(std::as_bytes(std::span(bytes.data(), bytes.size())), SignalFormat::bitstream, o, path);
+}
+
+Bitstream read_bitstream(const std::string& path) {
+  const std::string bytes = bitstream_file_bytes(path);
+  return parse_bitstream(std::as_bytes(std::span(bytes.data(), bytes.size())));
 }
 
 std::array<std::pair<const char*, double>, 4> fields(const Percept& p) {

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <string>
 #include <variant>
 
@@ -25,7 +24,6 @@
 #include "texel/codec.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
-#include "texel/io.hpp"
 #include "texel/surface.hpp"
 
 namespace texel::codec {
@@ -169,15 +167,7 @@ std::optional<Transcoded> transcode_file(const std::string& path, const SignalOp
   if (format != SignalFormat::document && format != SignalFormat::bitstream) return no("it holds samples, not Texel parameters");
   if (signal.region) return no("a region of it was asked for");
   if (signal.spacing) return no("another sample spacing was asked for");
-  if (format == SignalFormat::bitstream) {
-    // Bitstreams are a few bytes; anything past 1 MiB is not one (checked before reading).
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (!ec && size > (std::uintmax_t{1} << 20))
-      throw FormatError("'" + path + "' has " + std::to_string(size) + " bytes; a bitstream is at most 1 MiB");
-    const std::string bytes = read_file(path);
-    return transcode(parse_bitstream(std::as_bytes(std::span(bytes.data(), bytes.size()))));
-  }
+  if (format == SignalFormat::bitstream) return transcode(read_bitstream(path));
   Document doc = load_document(path);
   if (signal.device) doc.device = *signal.device;  // re-targeted, as `texel render DOC --device X`
   if (auto why = not_transcodable(doc)) return no(std::move(*why));
