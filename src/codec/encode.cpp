@@ -1,0 +1,192 @@
+// The encoder's pipeline (docs/encoder.md): checks, recovery or split and
+// fit, the coarse section, the bitstream and the decoded texture's percept.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "encoder_parts.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel::codec {
+
+using texel::detail::num;
+
+using namespace parts;
+namespace {
+
+/// How much more the envelope must vary than a fine-only texture's own (relative range).
+constexpr double coarse_margin = 0.1;
+/// Largest band-spectrum difference a fine-only explanation may leave (dB).
+constexpr double max_shape_db = 3.0;
+
+}  // namespace
+
+EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double dx = signal.spacing.value();
+  const std::size_t n = signal.amplitude.size();
+  if (!(std::isfinite(dx) && dx > 0.0)) throw InvalidArgument("signal spacing is " + num(dx) + " mm; it must be > 0");
+  if (!(cfg.boundary.value() > 0.0 && std::isfinite(cfg.boundary.value())))
+    throw FieldError("boundary", "is " + num(cfg.boundary.value()) + " mm; it must be > 0");
+  if (!(cfg.texel_length.value() >= 0.001 && cfg.texel_length.value() <= 65.535))
+    throw FieldError("texel_length", "is " + num(cfg.texel_length.value()) + " mm; allowed: 0.001 … 65.535 mm");
+  if (!(cfg.model.swipe_speed.value() > 0.0 && std::isfinite(cfg.model.swipe_speed.value())))
+    throw FieldError("swipe_speed", "is " + num(cfg.model.swipe_speed.value()) + " mm/s; it must be > 0");
+  if (cfg.coarse_bits < 1 || cfg.coarse_bits > 16)
+    throw FieldError("coarse_bits", "is " + std::to_string(cfg.coarse_bits) + "; allowed: 1 … 16");
+  const double len = static_cast<double>(n) * dx;
+  if (n < 64 || len < 4.0 * cfg.texel_length.value())
+    throw InvalidArgument("the input has " + std::to_string(n) + " samples over " + num(len) +
+                          " mm; at least 64 samples and 4 texels are needed");
+  for (double v : signal.amplitude)
+    if (!std::isfinite(v)) throw InvalidArgument("the input holds a non-finite value");
+  std::vector<double> a = signal.amplitude;
+  for (double& v : a) v = std::clamp(v, 0.0, 1.0);
+
+  EncodeResult res;
+  res.samples = n;
+  res.spacing = Millimetres(dx);
+  // The band the decoded texture draws from: the analysed grid's Nyquist
+  // frequency, rounded down to the stream's 0.01 dB steps (device independent).
+  Bitstream b;
+  FineFields& f = b.fine;
+  f.band_max_cdb = static_cast<std::int16_t>(std::floor(db_of(0.5 / dx) * 100.0));
+  const CyclesPerMm band_max = to_cpm(Decibels(f.band_max_cdb / 100.0));
+  f.seed = cfg.seed;
+  f.parameterization = cfg.parameterization;
+  const std::size_t cand = std::min<std::size_t>(n, std::size_t{1} << 16);
+
+  // An input that is itself a fine-only Texel rendering: recover its texel
+  // length and (P, I) from the texels' frequencies; kept if the model says
+  // the result feels the same as the input (else the fit below decides).
+  const std::optional<TexelRecovery> rec = cfg.recover_texel ? recover_texel(a, dx, cfg, band_max) : std::nullopt;
+  const double L_used = rec ? rec->L : cfg.texel_length.value();
+  f.texel_length_um = static_cast<std::uint16_t>(std::lround(L_used * 1000.0));
+  EncoderConfig fit_cfg = cfg;
+  fit_cfg.texel_length = Millimetres(f.texel_length_um / 1000.0);
+
+  Split sp = split(a, dx, fit_cfg, rec ? SplitMode::fine_only : SplitMode::automatic);
+  FineFit fit;
+  bool has_fine = sp.F >= 0.02;
+  bool recovered = false;
+  if (rec && has_fine) {
+    FineFit r;
+    r.input = perceive(sp.fine, dx, fit_cfg.model);
+    Fitter fitter{fit_cfg, r.input, dx, cand, band_max, 0.0, nullptr};
+    const Box box = fit_box(fit_cfg, band_max);
+    r.p_db = std::clamp(rec->p_db, box.p_lo, box.p_hi);
+    r.i_db = std::clamp(rec->i_db, box.i_lo, box.i_hi);
+    r.distance = fitter(r.p_db, r.i_db);
+    // The residual test has decided that the input is this rendering; the
+    // model still reports the distance and whether Irregularity is felt.
+    identifiability(fitter, box, r);
+    r.evaluations = fitter.evaluations;
+    fit = r;
+    recovered = true;
+    res.texel_recovered = true;
+  }
+  if (recovered) {
+  } else if (sp.coarse && has_fine) {
+    // Analysis-by-synthesis for the split too: a fine-only texture with low
+    // or widely spread frequencies has an uneven envelope by itself. Keep the
+    // coarse profile only if the input's envelope varies clearly more than
+    // that of the best fine-only explanation.
+    Split flat = split(a, dx, fit_cfg, SplitMode::fine_only);
+    EncoderConfig quick = fit_cfg;  // the check needs the neighbourhood, not the last 0.1 dB
+    quick.max_evaluations = fit_cfg.max_evaluations / 3;
+    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, quick);
+    std::vector<double> r(n);
+    fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
+        .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, r);
+    const Split own = split(r, dx, fit_cfg);
+    const double shape = shape_distance_db(a, r, dx);
+    if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
+      sp = std::move(flat);
+      fit = flat_fit;
+    } else {
+      fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg, 1.0 / cfg.boundary.value(), &sp);
+      fit.evaluations += flat_fit.evaluations;
+    }
+  } else if (has_fine) {
+    fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg);
+  }
+  res.coarse = sp.coarse;
+  has_fine = sp.F >= 0.02;
+  double p_est = 10.0, i_est = cfg.parameterization == Parameterization::log ? 1.0 : -5.0;
+  if (has_fine) {
+    p_est = fit.p_db;
+    i_est = fit.i_db;
+    res.input = fit.input;
+    res.irregularity_identifiable = fit.identifiable;
+    res.irregularity_bound_db = fit.bound_db;
+    res.evaluations = fit.evaluations;
+  }
+  f.central_pitch_cdb = static_cast<std::int16_t>(std::lround(p_est * 100.0));
+  f.irregularity_cdb = static_cast<std::int16_t>(std::lround(i_est * 100.0));
+
+  // Coarse part and strengths.
+  const double F = has_fine ? sp.F : 0.0;
+  std::vector<double> decoded_c;
+  if (sp.coarse) {
+    std::vector<CoarseFields> options;
+    if (cfg.max_bytes) {
+      for (unsigned bits = 8; bits >= 2; --bits)
+        for (std::uint32_t stride : {1u, 2u, 3u, 4u, 6u, 8u, 12u, 16u, 24u, 32u, 48u, 64u})
+          for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}})
+            options.push_back(coarse_fields(sp.c, sp.C, F, bits, stride, pred));
+    } else {
+      for (std::uint8_t pred : {std::uint8_t{1}, std::uint8_t{2}})
+        options.push_back(coarse_fields(sp.c, sp.C, F, cfg.coarse_bits, 1, pred));
+    }
+    const std::size_t fixed = write_bitstream(b).size();
+    const CoarseFields* chosen = nullptr;
+    double chosen_err = 0;
+    std::size_t chosen_size = 0;
+    for (const auto& o : options) {
+      const std::size_t size = fixed + coarse_section_bytes(o);
+      if (cfg.max_bytes && size > *cfg.max_bytes) continue;
+      const double err = coarse_error(sp.c, o);
+      if (!chosen || err < chosen_err - 1e-12 || (std::fabs(err - chosen_err) <= 1e-12 && size < chosen_size))
+        chosen = &o, chosen_err = err, chosen_size = size;
+    }
+    if (!chosen)
+      throw FieldError("max_bytes", std::to_string(*cfg.max_bytes) +
+                                        " is too small for this texture's coarse profile; it needs at least " +
+                                        std::to_string(fixed + coarse_section_bytes(options.back())) + " bytes");
+    b.coarse = *chosen;
+    decoded_c = decoded_profile(*chosen, sp.c.size());
+    res.coarse_correlation = correlation(sp.c, decoded_c);
+  } else {
+    const auto c8 = static_cast<std::uint8_t>(std::lround(sp.C * 255.0));
+    const auto f8 = static_cast<std::uint8_t>(std::lround(F * 255.0));
+    if (c8 != 0 || f8 != 255) {
+      CoarseFields c;
+      c.coarse_strength = c8;
+      c.fine_strength = f8;
+      c.bits = 0;
+      b.coarse = c;
+    }
+  }
+  res.bytes = write_bitstream(b);
+  res.bitstream = parse_bitstream(res.bytes);  // what a decoder sees
+  res.spec = to_spec(res.bitstream);
+
+  // The decoded texture on the input's grid, under the model.
+  if (has_fine) {
+    const TexelTexture t(res.spec, Millimetres(len), Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max});
+    std::vector<double> d(n);
+    t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, d);
+    EncoderConfig c2 = fit_cfg;
+    const Split dsp = res.coarse ? split(d, dx, c2, SplitMode::two_scale, sp.window) : split(d, dx, c2, SplitMode::fine_only);
+    res.decoded = perceive(dsp.fine, dx, cfg.model, res.coarse ? 1.0 / cfg.boundary.value() : 0.0);
+    res.model_distance = distance(res.input, res.decoded, cfg.model);
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+Document decode_document(const Bitstream& b, const DeviceProfile& device) { return make_document(device, to_spec(b)); }
+
+}  // namespace texel::codec

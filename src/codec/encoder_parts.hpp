@@ -1,0 +1,127 @@
+// What the encoder's stages share (src/codec/, one file per section of
+// docs/encoder.md): spectra.cpp (analysis spectra), split.cpp (§1 the
+// coarse/fine split), model.cpp (§2 the perceptual model), fit.cpp (§3 the
+// analysis-by-synthesis fit), recovery.cpp (§4 parameter recovery of Texel
+// renderings), coarse_fields.cpp (the coarse section of the bitstream) and
+// encode.cpp (the pipeline). Internal to the codec component.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "texel/codec.hpp"
+
+namespace texel::codec::parts {
+
+constexpr double ten_over_ln10 = 4.34294481903251827651;
+inline double db_of(double cpm) { return ten_over_ln10 * std::log(cpm); }
+inline double cpm_of(double db) { return std::pow(10.0, db / 10.0); }
+
+// --- spectra.cpp ---------------------------------------------------------------
+
+/// One-sided power spectrum (arbitrary scale) of a zero-mean signal: a Hann
+/// periodogram zero-padded to a power of two, or Welch's average of
+/// half-overlapping 2^15-sample segments for long signals. Bin i is at
+/// i/(M·spacing) cpm; returns M through `m_out`.
+std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out);
+/// x minus its mean.
+std::vector<double> centred(std::span<const double> x);
+/// How differently two signals of the same length distribute their power
+/// over half-octave bands (dB; docs/encoder.md §1 step 4).
+double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx);
+
+// --- split.cpp -------------------------------------------------------------------
+
+struct Split {
+  std::vector<double> fine;  // zero-mean fine signal (envelope divided out)
+  double range = 0.0;        // relative envelope range (p98 − p2) / p98 at texel centres
+  std::size_t window = 0;    // running-extreme window, samples
+  bool coarse = false;
+  double C = 0.0;
+  double F = 1.0;
+  std::vector<double> c;  // per-texel coarse profile (coarse only)
+};
+
+enum class SplitMode { automatic, fine_only, two_scale };
+
+/// §1 steps 1–3 and 5: the envelope, flat or not, the profile and strengths.
+/// `window` > 0 fixes the running-extreme window (samples) instead of
+/// deriving it from the spectrum: candidates are analysed exactly like the input.
+Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode = SplitMode::automatic,
+            std::size_t window = 0);
+
+double percentile(std::vector<double> v, double q);
+double correlation(const std::vector<double>& a, const std::vector<double>& b);
+
+// --- fit.cpp ---------------------------------------------------------------------
+
+/// The fine-only TexelSpec of a candidate under the encoder's settings.
+TexelSpec fine_spec(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, std::uint64_t seed);
+/// A fine-only Texel texture of the encoder's settings.
+TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, Millimetres length,
+                          std::uint64_t seed = 0x5EED0001);
+
+/// The objective: model distance between the target percept and candidate
+/// renderings of (P, I) on the input's grid, analysed like the input.
+struct Fitter {
+  const EncoderConfig& cfg;
+  const Percept& target;
+  double dx;
+  std::size_t samples;
+  CyclesPerMm band_max;
+  double f_min = 0.0;                // analysis band bottom (the boundary, for the fine part of a two-scale texture)
+  const Split* two_scale = nullptr;  // the input's coarse estimate: candidates carry it and are split alike
+  int evaluations = 0;
+
+  [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
+  /// Mean percept over two candidate draws (common random numbers).
+  double operator()(double p_db, double i_db);
+};
+
+struct Box {
+  double p_lo, p_hi, i_lo, i_hi;
+  [[nodiscard]] bool inside(double p, double i) const { return p >= p_lo && p <= p_hi && i >= i_lo && i <= i_hi; }
+};
+Box fit_box(const EncoderConfig& cfg, CyclesPerMm band_max);
+
+struct FineFit {
+  double p_db = 10.0, i_db = -5.0, distance = 0.0;
+  Percept input;
+  bool identifiable = true;
+  double bound_db = 0.0;
+  int evaluations = 0;
+};
+
+/// §3 step 4: does a much narrower distribution feel different?
+void identifiability(Fitter& fit, const Box& box, FineFit& out);
+/// §3: the fine texture whose percept is closest to that of `fine`.
+FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg,
+                 double f_min = 0.0, const Split* two_scale = nullptr);
+
+// --- recovery.cpp ----------------------------------------------------------------
+
+/// Recovered parameters of an input that is itself a fine-only Texel
+/// rendering (docs/encoder.md §4), if it is one.
+struct TexelRecovery {
+  double L = 0.0, p_db = 0.0, i_db = 0.0, rms = 0.0;
+  std::size_t texels = 0;
+};
+std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double dx, const EncoderConfig& cfg,
+                                           CyclesPerMm band_max);
+
+// --- coarse_fields.cpp ------------------------------------------------------------
+
+/// The coarse section for profile c at `bits` per level, every `stride`-th texel.
+CoarseFields coarse_fields(const std::vector<double>& c, double C, double F, unsigned bits, std::uint32_t stride,
+                           std::uint8_t predictor);
+/// RMS difference between c and the profile the fields decode to.
+double coarse_error(const std::vector<double>& c, const CoarseFields& f);
+/// The per-texel profile the fields decode to.
+std::vector<double> decoded_profile(const CoarseFields& f, std::size_t count);
+
+}  // namespace texel::codec::parts

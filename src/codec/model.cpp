@@ -1,0 +1,87 @@
+// §2 of docs/encoder.md: the perceptual model (threshold, percept, distance).
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "encoder_parts.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel::codec {
+
+using namespace parts;
+using texel::detail::num;
+namespace {
+
+/// Masking floor of the model, dB below the strongest spectral component.
+constexpr double masked_db = 50.0;
+
+}  // namespace
+
+double threshold_db(Hertz f) {
+  const double hz = std::max(f.value(), 1e-6);
+  const double pacinian = 12.0 * std::fabs(std::log2(hz / 250.0));
+  return std::min({pacinian, 30.0, 60.0});
+}
+
+Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
+  std::size_t m = 0;
+  const std::vector<double> p = power_spectrum(fine, m);
+  const double v = model.swipe_speed.value();
+  // Per-bin frequency, dB and sensitivity depend only on (M, Δx, v): cache them.
+  struct Bins {
+    std::size_t m = 0;
+    double dx = 0, v = 0, f_min = 0;
+    std::vector<double> f, d, gain;
+  };
+  thread_local Bins bins;
+  const double f_lo = std::max(0.01, f_min_cpm);
+  if (bins.m != m || bins.dx != spacing_mm || bins.v != v || bins.f_min != f_lo) {
+    bins.m = m, bins.dx = spacing_mm, bins.v = v, bins.f_min = f_lo;
+    const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
+    bins.f.assign(p.size(), 0.0);
+    bins.d.assign(p.size(), 0.0);
+    bins.gain.assign(p.size(), 0.0);
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      const double f = static_cast<double>(i) * df;
+      bins.f[i] = f;
+      bins.d[i] = db_of(f);
+      // Sensitivity at f·v over sqrt(f): amplitude per unit log-frequency.
+      bins.gain[i] = f < f_lo ? 0.0 : std::pow(10.0, -threshold_db(Hertz(f * v)) / 20.0) / std::sqrt(f);
+    }
+  }
+  // Components more than `masked_db` below the strongest are not felt
+  // (and leakage and quantization noise stay out of the spread).
+  double peak = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i)
+    if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]);
+  const double floor = peak * std::pow(10.0, -masked_db / 10.0);
+  double sw = 0, swf = 0, swd = 0, swdd = 0;  // perceptual weights
+  double sp = 0, spf = 0, spd = 0, spdd = 0;  // physical (power) weights
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
+    const double f = bins.f[i], d = bins.d[i];
+    const double w = std::sqrt(p[i]) * bins.gain[i];
+    sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
+    sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+  }
+  if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
+  Percept q;
+  q.pitch_db = db_of(swf / sw);
+  const double md = swd / sw;
+  q.noisiness_db = std::sqrt(std::max(0.0, swdd / sw - md * md));
+  q.mean_db = db_of(spf / sp);
+  const double pd = spd / sp;
+  q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  return q;
+}
+
+double distance(const Percept& a, const Percept& b, const PerceptualModel& model) {
+  const double dp = (a.pitch_db - b.pitch_db) / model.pitch_jnd_db;
+  const double dn = (a.noisiness_db - b.noisiness_db) / model.noisiness_jnd_db;
+  const double dm = a.mean_db - b.mean_db;
+  const double ds = a.spread_db - b.spread_db;
+  return std::sqrt(dp * dp + dn * dn + model.tie_weight * (dm * dm + ds * ds));
+}
+
+}  // namespace texel::codec

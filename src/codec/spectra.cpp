@@ -1,0 +1,108 @@
+// Analysis spectra of the encoder (docs/encoder.md, the model's table: spectrum;
+// §1 step 4: the band-spectrum check). Analysis only (never feeds rendered
+// samples), so the C library's math and the spectrum module's float FFT
+// (noise floor near −130 dB, far below the model's 50 dB masking floor) are
+// fine here.
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <memory>
+#include <numeric>
+#include <vector>
+
+#include "../spectrum/fft.hpp"
+#include "encoder_parts.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel::codec::parts {
+namespace {
+
+std::size_t next_pow2(std::size_t n) {
+  std::size_t m = 1;
+  while (m < n) m <<= 1;
+  return m;
+}
+
+constexpr std::size_t max_segment = 1u << 15;
+
+}  // namespace
+
+/// One-sided power spectrum (arbitrary scale) of a zero-mean signal: a Hann
+/// periodogram zero-padded to a power of two, or Welch's average of
+/// half-overlapping 2^15-sample segments for long signals. Bin i is at
+/// i/(M·spacing) cpm; returns M through `m_out`.
+/// Not texel::welch_psd: that has no zero padding (its bins would sit on a
+/// different grid), a periodic rather than this half-sample-centred Hann
+/// window, and an n/4 auto segment; the model's thresholds and the codec
+/// tests were set with this computation, so only the transform is shared.
+std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out) {
+  const std::size_t n = x.size();
+  const std::size_t seg = std::min(n, max_segment);
+  const std::size_t m = next_pow2(seg);
+  m_out = m;
+  std::vector<double> p(m / 2 + 1, 0.0);
+  std::vector<double> win(seg);
+  for (std::size_t i = 0; i < seg; ++i)
+    win[i] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (static_cast<double>(i) + 0.5) / static_cast<double>(seg));
+  if (m < 2) {
+    // One sample (or none): only the DC bin, and no real FFT of length 1.
+    if (seg == 1) p[0] = x[0] * win[0] * x[0] * win[0];
+    return p;
+  }
+  // One plan per length and thread: an encode runs a few hundred transforms
+  // of the same length.
+  thread_local std::unique_ptr<texel::detail::RealFft> fft;
+  if (!fft || fft->size() != m) fft = std::make_unique<texel::detail::RealFft>(m);
+  std::vector<double> buf(m, 0.0);
+  std::vector<std::complex<double>> X(m / 2 + 1);
+  std::size_t count = 0;
+  const std::size_t hop = seg == n ? n : seg / 2;
+  for (std::size_t start = 0; start + seg <= n; start += hop) {
+    for (std::size_t i = 0; i < seg; ++i) buf[i] = x[start + i] * win[i];
+    fft->forward(buf, X);
+    for (std::size_t i = 0; i <= m / 2; ++i) p[i] += std::norm(X[i]);
+    ++count;
+  }
+  for (double& v : p) v /= static_cast<double>(std::max<std::size_t>(count, 1));
+  return p;
+}
+
+std::vector<double> centred(std::span<const double> x) {
+  const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+  std::vector<double> y(x.begin(), x.end());
+  for (double& v : y) v -= mean;
+  return y;
+}
+
+/// How differently two signals of the same length distribute their power
+/// over half-octave bands (0.01 cpm … Nyquist): the power-weighted mean
+/// absolute level difference in dB, each spectrum normalised to unit power
+/// and floored 40 dB below it.
+double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx) {
+  std::size_t m = 0;
+  const std::vector<double> px = power_spectrum(centred(x), m);
+  const std::vector<double> py = power_spectrum(centred(y), m);
+  const double df = 1.0 / (static_cast<double>(m) * dx);
+  std::vector<double> bx, by;
+  for (std::size_t i = 1; i < px.size(); ++i) {
+    const double f = static_cast<double>(i) * df;
+    if (f < 0.01) continue;
+    const auto band = static_cast<std::size_t>(std::floor(2.0 * std::log2(f / 0.01)));
+    if (band >= bx.size()) bx.resize(band + 1, 0.0), by.resize(band + 1, 0.0);
+    bx[band] += px[i];
+    by[band] += py[i];
+  }
+  const double tx = std::accumulate(bx.begin(), bx.end(), 0.0), ty = std::accumulate(by.begin(), by.end(), 0.0);
+  if (!(tx > 0 && ty > 0)) return 0.0;
+  double num_ = 0.0, den = 0.0;
+  for (std::size_t b = 0; b < bx.size(); ++b) {
+    const double u = bx[b] / tx + 1e-4, v = by[b] / ty + 1e-4;
+    const double w = std::max(u, v);
+    num_ += w * std::fabs(10.0 * std::log10(u / v));
+    den += w;
+  }
+  return num_ / den;
+}
+
+}  // namespace texel::codec::parts

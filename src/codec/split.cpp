@@ -1,0 +1,176 @@
+// §1 of docs/encoder.md: the coarse/fine split (envelope, flat or not,
+// profile and strengths).
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+#include <vector>
+
+#include "encoder_parts.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel::codec::parts {
+namespace {
+
+/// Strengths this close to full scale are full scale (docs/encoder.md).
+constexpr double strength_snap = 0.02;
+
+// --- envelope tools ---------------------------------------------------------
+
+/// Running max (or min) over a centred window of w samples (monotonic deque, O(n)).
+std::vector<double> running_extreme(const std::vector<double>& x, std::size_t w, bool max) {
+  const std::size_t n = x.size();
+  const std::size_t half = w / 2;
+  std::vector<double> out(n);
+  std::deque<std::size_t> dq;
+  std::size_t next = 0;
+  auto better = [&](double a, double b) { return max ? a >= b : a <= b; };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t hi = std::min(n - 1, i + half);
+    for (; next <= hi; ++next) {
+      while (!dq.empty() && better(x[next], x[dq.back()])) dq.pop_back();
+      dq.push_back(next);
+    }
+    const std::size_t lo = i >= half ? i - half : 0;
+    while (dq.front() < lo) dq.pop_front();
+    out[i] = x[dq.front()];
+  }
+  return out;
+}
+
+/// Centred moving average of w samples, windows shortened at the ends.
+std::vector<double> moving_average(const std::vector<double>& x, std::size_t w) {
+  const std::size_t n = x.size();
+  const std::size_t half = w / 2;
+  std::vector<double> cum(n + 1, 0.0);
+  for (std::size_t i = 0; i < n; ++i) cum[i + 1] = cum[i] + x[i];
+  std::vector<double> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t lo = i >= half ? i - half : 0;
+    const std::size_t hi = std::min(n, i + half + 1);
+    out[i] = (cum[hi] - cum[lo]) / static_cast<double>(hi - lo);
+  }
+  return out;
+}
+
+}  // namespace
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto i = static_cast<std::size_t>(pos);
+  const double t = pos - static_cast<double>(i);
+  return i + 1 < v.size() ? v[i] + t * (v[i + 1] - v[i]) : v[i];
+}
+
+double correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  const std::size_t n = std::min(a.size(), b.size());
+  if (n < 2) return 1.0;
+  double ma = 0, mb = 0;
+  for (std::size_t i = 0; i < n; ++i) ma += a[i], mb += b[i];
+  ma /= static_cast<double>(n);
+  mb /= static_cast<double>(n);
+  double sab = 0, saa = 0, sbb = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 1.0;
+}
+
+Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode, std::size_t window) {
+  const std::size_t n = a.size();
+  const double B = cfg.boundary.value();
+  const double L = cfg.texel_length.value();
+
+  // Window for the envelope: about two periods of the fine texture, so that
+  // every window holds a peak and a trough. The fine frequency is the
+  // power-weighted mean above the boundary when that band carries the
+  // texture, else of the whole spectrum (a fine texture below the boundary).
+  Split s;
+  std::size_t w = window;
+  if (w == 0) {
+    std::size_t m = 0;
+    const std::vector<double> p = power_spectrum(centred(a), m);
+    const double df = 1.0 / (static_cast<double>(m) * dx);
+    double pw = 0, pf = 0, hw = 0, hf = 0;
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      const double f = static_cast<double>(i) * df;
+      pw += p[i];
+      pf += p[i] * f;
+      if (f >= 1.0 / B) hw += p[i], hf += p[i] * f;
+    }
+    if (!(pw > 0.0)) {
+      // A flat surface is a texture too: no fine part, a constant envelope.
+      s.F = 0.0;
+      s.C = 1.0 - std::clamp(a.empty() ? 1.0 : a[0], 0.0, 1.0);
+      s.fine.assign(n, 0.0);
+      return s;
+    }
+    const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
+    w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
+  }
+  s.window = w;
+  // One moving average over half the boundary (at least the window) removes
+  // the running extremes' steps; it barely attenuates coarse features (a
+  // 5 mm period keeps 98 % of its amplitude).
+  const auto smooth = std::max(w, static_cast<std::size_t>(std::round(0.5 * B / dx)));
+  const std::vector<double> up_raw = running_extreme(a, w, true);
+  std::vector<double> up = moving_average(up_raw, smooth);
+  // The decision coarse-or-not looks at the envelope low-passed at the
+  // boundary proper (two passes of B): the envelope of a noise fluctuates
+  // at the rate of its bandwidth, which is fine texture, not coarse layout.
+  const auto b_samples = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
+  const std::vector<double> up_slow = moving_average(moving_average(up_raw, b_samples), b_samples);
+  std::vector<double> lo = moving_average(running_extreme(a, w, false), smooth);
+  for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
+
+  const std::size_t k_count =
+      std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
+  std::vector<double> e(k_count), fk(k_count), e_slow(k_count);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    const double x = (static_cast<double>(k) + 0.5) * L;
+    const auto i = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, std::round(x / dx))));
+    e[k] = up[i];
+    e_slow[k] = std::clamp(up_slow[i], 1e-6, 1.0);
+    fk[k] = std::clamp(1.0 - lo[i] / up[i], 0.0, 1.0);
+  }
+  s.F = std::clamp(percentile(fk, 0.5), 0.0, 1.0);
+  const double e_hi = percentile(e_slow, 0.98);
+  const double e_lo = percentile(e_slow, 0.02);
+  s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
+  std::vector<double> fine(n);
+  if (mode == SplitMode::fine_only || (mode == SplitMode::automatic && s.range < cfg.flat_envelope)) {
+    // A flat envelope: strengths from the mean and RMS, which sampling does
+    // not bias (the extremes of a sinusoid near the Nyquist frequency are
+    // rarely sampled): mean = e(1 − F/2), RMS = e·F/(2√2).
+    s.coarse = false;
+    fine = centred(a);
+    double ms = 0.0;
+    for (double v : fine) ms += v * v;
+    const double rms = std::sqrt(ms / static_cast<double>(n));
+    const double mean = std::accumulate(a.begin(), a.end(), 0.0) / static_cast<double>(n);
+    const double env = std::min(1.0, mean + std::sqrt(2.0) * rms);
+    s.F = env > 0 ? std::clamp(2.0 * std::sqrt(2.0) * rms / env, 0.0, 1.0) : 0.0;
+    s.C = 1.0 - env;
+    // Within 2 % of full scale counts as full scale (well inside the
+    // intensity JND), so a fine-only texture stays a 14-byte stream.
+    if (s.C < strength_snap) s.C = 0.0;
+    if (s.F > 1.0 - strength_snap) s.F = 1.0;
+  } else {
+    s.coarse = true;
+    const double e_min = *std::min_element(e.begin(), e.end());
+    s.C = std::clamp(1.0 - e_min, 0.0, 1.0);
+    s.c.resize(k_count);
+    for (std::size_t k = 0; k < k_count; ++k) s.c[k] = s.C > 0 ? std::clamp((e[k] - e_min) / s.C, 0.0, 1.0) : 1.0;
+    for (std::size_t i = 0; i < n; ++i) fine[i] = a[i] / up[i];
+    fine = centred(fine);
+  }
+  s.fine = std::move(fine);
+  return s;
+}
+
+}  // namespace texel::codec::parts
