@@ -61,13 +61,18 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   // An input that is itself a fine-only Texel rendering: recover its texel
   // length and (P, I) from the texels' frequencies; kept if the model says
   // the result feels the same as the input (else the fit below decides).
-  const std::optional<TexelRecovery> rec = cfg.recover_texel ? recover_texel(a, dx, cfg, band_max) : std::nullopt;
-  const double L_used = rec ? rec->L : cfg.texel_length.value();
+  // A coarse profile without fine texture (F = 0) as the renderer draws it
+  // is constant over each texel: its texel length is detected (§1 step 0).
+  std::vector<double> lengths{cfg.texel_length.value()};
+  lengths.insert(lengths.end(), candidate_texel_lengths_mm.begin(), candidate_texel_lengths_mm.end());
+  const std::optional<double> stepped = stepped_texel_length(a, dx, lengths);
+  const std::optional<TexelRecovery> rec = cfg.recover_texel && !stepped ? recover_texel(a, dx, cfg, band_max) : std::nullopt;
+  const double L_used = rec ? rec->L : stepped ? *stepped : cfg.texel_length.value();
   f.texel_length_um = static_cast<std::uint16_t>(std::lround(L_used * 1000.0));
   EncoderConfig fit_cfg = cfg;
   fit_cfg.texel_length = Millimetres(f.texel_length_um / 1000.0);
 
-  Split sp = split(a, dx, fit_cfg, rec ? SplitMode::fine_only : SplitMode::automatic);
+  Split sp = split(a, dx, fit_cfg, rec ? SplitMode::fine_only : stepped ? SplitMode::coarse_only : SplitMode::automatic);
   FineFit fit;
   bool has_fine = sp.F >= 0.02;
   bool recovered = false;

@@ -21,6 +21,9 @@ namespace texel::codec::parts {
 constexpr double ten_over_ln10 = 4.34294481903251827651;
 inline double db_of(double cpm) { return ten_over_ln10 * std::log(cpm); }
 inline double cpm_of(double db) { return std::pow(10.0, db / 10.0); }
+/// Texel lengths (mm) the encoder tries besides --texel-length when it asks
+/// whether the input was drawn by the renderer (§1 step 0, §4).
+constexpr std::array<double, 3> candidate_texel_lengths_mm{0.25, 0.5, 1.0};
 
 // --- spectra.cpp ---------------------------------------------------------------
 
@@ -47,13 +50,20 @@ struct Split {
   std::vector<double> c;  // per-texel coarse profile (coarse only)
 };
 
-enum class SplitMode { automatic, fine_only, two_scale };
+/// automatic: §1 decides; fine_only / two_scale: forced; coarse_only: the
+/// input has no fine texture (F = 0), its envelope is the signal itself.
+enum class SplitMode { automatic, fine_only, two_scale, coarse_only };
 
 /// §1 steps 1–3 and 5: the envelope, flat or not, the profile and strengths.
 /// `window` > 0 fixes the running-extreme window (samples) instead of
 /// deriving it from the spectrum: candidates are analysed exactly like the input.
 Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode = SplitMode::automatic,
             std::size_t window = 0);
+
+/// §1 step 0: the longest of `lengths` (mm) over whose texels the input is
+/// constant (a coarse profile without fine texture, as the renderer draws it
+/// with F = 0), if any.
+std::optional<double> stepped_texel_length(const std::vector<double>& a, double dx, std::span<const double> lengths);
 
 double percentile(std::vector<double> v, double q);
 double correlation(const std::vector<double>& a, const std::vector<double>& b);

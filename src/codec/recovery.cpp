@@ -16,7 +16,6 @@ namespace texel::codec::parts {
 namespace {
 
 // Texel-rendering recovery (docs/encoder.md, "Texel renderings").
-constexpr std::array<double, 3> recovery_texel_lengths_mm{0.25, 0.5, 1.0};  // tried besides --texel-length
 constexpr double recovery_rms = 0.02;    // residual RMS (re amplitude) below which the input is a rendering
 constexpr double recovery_floor = 1e-4;  // residual RMS any rendering's quantization may add (16-bit: ~1e-5)
 
@@ -173,7 +172,7 @@ std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double 
   std::vector<double> y(a.size());
   for (std::size_t i = 0; i < a.size(); ++i) y[i] = (a[i] - c) / g;
   std::vector<double> lengths{cfg.texel_length.value()};
-  for (double L : recovery_texel_lengths_mm) lengths.push_back(L);
+  for (double L : candidate_texel_lengths_mm) lengths.push_back(L);
   std::sort(lengths.begin(), lengths.end(), std::greater<>());
   lengths.erase(std::unique(lengths.begin(), lengths.end()), lengths.end());
   const double len = static_cast<double>(a.size()) * dx;

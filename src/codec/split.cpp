@@ -54,6 +54,51 @@ std::vector<double> moving_average(const std::vector<double>& x, std::size_t w) 
   return out;
 }
 
+/// Within-texel variance, relative to the total, below which the input is
+/// constant over its texels (16-bit quantization adds ~10⁻¹¹ of full scale).
+constexpr double stepped_variance = 1e-6;
+/// Fraction of the AC power at or above the boundary frequency below which
+/// an input has no fine texture (docs/encoder.md §1 step 0).
+constexpr double coarse_only_power = 0.05;
+
+/// §1 step 0: an input without fine texture. Its envelope is the signal:
+/// e_k is the mean over texel k (of cfg.texel_length), F = 0.
+Split coarse_only_split(const std::vector<double>& a, double dx, const EncoderConfig& cfg) {
+  const std::size_t n = a.size();
+  const double L = cfg.texel_length.value();
+  const std::size_t k_count =
+      std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
+  std::vector<double> e(k_count, 0.0);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    // Interior samples (a sample on a texel boundary may belong to either
+    // side), or the nearest one for texels under three samples long.
+    const double x0 = static_cast<double>(k) * L, x1 = x0 + L;
+    auto b = std::min(n - 1, static_cast<std::size_t>(std::ceil((x0 + dx) / dx)));
+    auto end = std::min(n, static_cast<std::size_t>(std::ceil((x1 - dx) / dx)));
+    if (end <= b) b = std::min(n - 1, static_cast<std::size_t>(std::lround((x0 + 0.5 * L) / dx))), end = b + 1;
+    double m = 0.0;
+    for (std::size_t i = b; i < end; ++i) m += a[i];
+    e[k] = std::clamp(m / static_cast<double>(end - b), 0.0, 1.0);
+  }
+  Split s;
+  s.F = 0.0;
+  s.fine.assign(n, 0.0);
+  const double e_hi = percentile(e, 0.98);
+  const double e_lo = percentile(e, 0.02);
+  s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
+  if (s.range < cfg.flat_envelope) {
+    s.C = 1.0 - std::accumulate(e.begin(), e.end(), 0.0) / static_cast<double>(k_count);
+    if (s.C < strength_snap) s.C = 0.0;
+    return s;
+  }
+  s.coarse = true;
+  const double e_min = *std::min_element(e.begin(), e.end());
+  s.C = std::clamp(1.0 - e_min, 0.0, 1.0);
+  s.c.resize(k_count);
+  for (std::size_t k = 0; k < k_count; ++k) s.c[k] = s.C > 0 ? std::clamp((e[k] - e_min) / s.C, 0.0, 1.0) : 1.0;
+  return s;
+}
+
 }  // namespace
 
 double percentile(std::vector<double> v, double q) {
@@ -81,10 +126,39 @@ double correlation(const std::vector<double>& a, const std::vector<double>& b) {
   return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 1.0;
 }
 
+std::optional<double> stepped_texel_length(const std::vector<double>& a, double dx, std::span<const double> lengths) {
+  const std::size_t n = a.size();
+  std::optional<double> best;
+  for (double L : lengths) {
+    const auto texels = static_cast<std::size_t>(std::floor(static_cast<double>(n) * dx / L + 1e-9));
+    if (texels < 4 || L < 4.0 * dx || (best && L <= *best)) continue;
+    // Interior samples of each texel only (a sample on a texel boundary may
+    // round to either side); the rest after the last whole texel is ignored.
+    double within = 0.0, sum = 0.0, sum2 = 0.0;
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < texels; ++k) {
+      const auto b = static_cast<std::size_t>(std::ceil((static_cast<double>(k) * L + dx) / dx));
+      const auto e = std::min(n, static_cast<std::size_t>(std::ceil((static_cast<double>(k + 1) * L - dx) / dx)));
+      if (e <= b) continue;
+      double m = 0.0;
+      for (std::size_t i = b; i < e; ++i) m += a[i];
+      m /= static_cast<double>(e - b);
+      for (std::size_t i = b; i < e; ++i) within += (a[i] - m) * (a[i] - m), sum += a[i], sum2 += a[i] * a[i];
+      count += e - b;
+    }
+    if (count == 0) continue;
+    const double mean = sum / static_cast<double>(count);
+    const double total = std::max(0.0, sum2 - mean * sum);
+    if (within <= stepped_variance * total + 1e-18 * static_cast<double>(count)) best = L;
+  }
+  return best;
+}
+
 Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode, std::size_t window) {
   const std::size_t n = a.size();
   const double B = cfg.boundary.value();
   const double L = cfg.texel_length.value();
+  if (mode == SplitMode::coarse_only) return coarse_only_split(a, dx, cfg);
 
   // Window for the envelope: about two periods of the fine texture, so that
   // every window holds a peak and a trough. The fine frequency is the
@@ -110,6 +184,9 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
       s.fine.assign(n, 0.0);
       return s;
     }
+    // Next to nothing above the boundary: no fine texture, only coarse
+    // features (whose layout touch resolves), e.g. a measured profile.
+    if (mode == SplitMode::automatic && hw < coarse_only_power * pw) return coarse_only_split(a, dx, cfg);
     const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
     w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
   }

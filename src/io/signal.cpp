@@ -185,16 +185,27 @@ Signal decode_device_map(std::span<const std::byte> bytes, const SignalOptions& 
 Signal decode_csv(std::string_view text, const SignalOptions& o, std::string_view origin) {
   std::vector<double> x;
   std::vector<double> y;
+  // Two columns, or three as `texel swipe` writes them (time_s,position_mm,
+  // output: a recording whose value is the last column), in every row.
+  std::size_t columns = 0;
   const std::string header =
-      read_numeric_csv(text, origin, 2, 2, "position_mm,amplitude or time_s,value", [&](std::size_t, std::span<const double> v) {
-        if (x.size() == o.max_samples) too_many(origin, x.size() + 1, o);
-        x.push_back(v[0]);
-        y.push_back(v[1]);
-      });
+      read_numeric_csv(text, origin, 2, 3, "position_mm,amplitude, time_s,value or time_s,position_mm,value",
+                       [&](std::size_t line, std::span<const double> v) {
+                         if (columns == 0) columns = v.size();
+                         if (v.size() != columns)
+                           throw FormatError(in_quotes(origin) + ":" + std::to_string(line) + ": " + std::to_string(v.size()) +
+                                             " columns where the first row has " + std::to_string(columns));
+                         if (x.size() == o.max_samples) too_many(origin, x.size() + 1, o);
+                         x.push_back(v[0]);
+                         y.push_back(v.back());
+                       });
   if (x.empty()) throw FormatError(in_quotes(origin) + " holds no numeric rows");
   // A header whose first column starts with 't' ("time", "t_s") marks a recording.
   const auto first = header.find_first_not_of(" \t\"");
   const bool is_time = first != std::string::npos && (header[first] == 't' || header[first] == 'T');
+  if (columns == 3 && !is_time)
+    throw FormatError(in_quotes(origin) + " has 3 columns, read only as time_s,position_mm,value (a recording, as " +
+                      "texel swipe writes it); its header does not start with a time column");
   Signal s;
   if (is_time) {
     const MmPerSecond v = need_speed(o, origin);

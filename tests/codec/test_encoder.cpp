@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <string>
 
 #include "texel/codec.hpp"
@@ -70,6 +71,63 @@ TEST(Encoder, CoarseRoundTrip) {
   }
   EXPECT_GT(sab / std::sqrt(saa * sbb), 0.95);  // the issue's tolerance
   EXPECT_NEAR(r.spec.central_pitch.value(), 10.0, 0.5);
+}
+
+// Coarse-only maps (C > 0, F = 0; issue #11 item 4) encode as a coarse
+// profile, not as a low-pitch fine texture: the renderer's stepped profile
+// (its texel length detected), and a smooth measured-like profile with
+// nothing above the boundary. The decoded map is the input within the
+// stream's steps: strength in n/255, levels in k/63 (6 bits, the default).
+TEST(Encoder, CoarseOnlyMapsEncodeAsACoarseProfile) {
+  const DeviceProfile d = load_device("tpad");
+  for (double L : {0.25, 0.5, 1.0})
+    for (double C : {0.3, 0.5, 1.0}) {
+      SCOPED_TRACE("L " + std::to_string(L) + " C " + std::to_string(C));
+      TexelSpec s;
+      s.texel_length = Millimetres(L);
+      s.coarse = SineProfile{Millimetres(5.0), 0.0};
+      s.coarse_strength = C;
+      s.fine_strength = 0.0;
+      const codec::Signal in = render_signal(s);
+      const EncodeResult r = encode(in, EncoderConfig{});
+      ASSERT_TRUE(r.coarse);
+      EXPECT_EQ(r.spec.fine_strength, 0.0);
+      // Only C·(1 − c_k) is observable; the encoder normalises min c_k to 0,
+      // so C is the depth at the deepest texel centre, not the profile's.
+      EXPECT_LE(r.spec.coarse_strength, C + 1.0 / 255.0);
+      EXPECT_GT(r.spec.coarse_strength, 0.6 * C);
+      EXPECT_NEAR(r.spec.texel_length.value(), L, 1e-9);  // detected, not the 0.25 mm setting
+      EXPECT_GT(r.coarse_correlation, 0.999);
+      EXPECT_EQ(r.evaluations, 0);  // no fine fit
+      const auto out = prepare_surface(decode_document(r.bitstream, d)).render();
+      ASSERT_EQ(out.size(), in.amplitude.size());
+      double worst = 0.0;
+      for (std::size_t i = 0; i < out.size(); ++i) worst = std::max(worst, std::fabs(out[i] - in.amplitude[i]));
+      EXPECT_LE(worst, 0.5 / 255.0 + C * 0.5 / 63.0 + 1e-9);
+    }
+  // Smooth, not stepped (a measured profile, bumps of 8 and 13 mm): nothing
+  // above 1/B. (A single sinusoid at constant amplitude is also a narrow
+  // Texel rendering, and recovered as one: docs/encoder.md §1 step 0.)
+  std::vector<double> a(d.grid().count);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double x = static_cast<double>(i) * d.spacing.value();
+    a[i] = 0.7 + 0.15 * std::sin(2.0 * std::numbers::pi * x / 8.0) + 0.15 * std::sin(2.0 * std::numbers::pi * x / 13.0);
+  }
+  const EncodeResult r = encode(codec::Signal{a, d.spacing, "smooth"}, EncoderConfig{});
+  ASSERT_TRUE(r.coarse);
+  EXPECT_EQ(r.spec.fine_strength, 0.0);
+  EXPECT_GT(r.coarse_correlation, 0.999);
+  const auto out = prepare_surface(decode_document(r.bitstream, d)).render();
+  const double L = r.spec.texel_length.value();
+  double worst = 0.0;  // the profile is held per texel: at most half a texel's slope off
+  for (std::size_t i = 0; i + 1 < out.size() && static_cast<double>(i + 1) * d.spacing.value() < 100.0; ++i)
+    worst = std::max(worst, std::fabs(out[i] - a[i]));
+  EXPECT_LE(worst, 0.5 * L * (0.3 * 2.0 * std::numbers::pi / 8.0) + 0.5 / 255.0 + 0.6 * 0.5 / 63.0);
+  // A flat map is neither: the 14-byte stream with F = 0.
+  std::vector<double> flat(d.grid().count, 0.8);
+  const EncodeResult f = encode(codec::Signal{flat, d.spacing, "flat"}, EncoderConfig{});
+  EXPECT_FALSE(f.coarse);
+  EXPECT_EQ(f.spec.fine_strength, 0.0);
 }
 
 TEST(Encoder, BitBudgetIsHonoured) {

@@ -1,0 +1,131 @@
+// texel_bench_encode: encode time per map beside the time to render the same
+// map (the baseline, measured in the same run). Maps: the demo set and the
+// nine second-study references, each on a device grid (tpad by default).
+// For every map: median of --repeat encodes and renders, the ratio of the
+// two, the encoder's decision (fine-only / two-scale, recovered or fitted)
+// and its model distance; then the median encode time over the fine-only
+// and over the two-scale maps, against the goals of issue #11 (10 ms and
+// 30 ms).
+//
+//   texel_bench_encode [--device NAME] [--repeat N] [--json PATH]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "texel/codec.hpp"
+#include "texel/demo.hpp"
+#include "texel/reference.hpp"
+
+namespace {
+
+using namespace texel;
+using Clock = std::chrono::steady_clock;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+template <class F>
+double median_ms(int repeat, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < repeat; ++r) {
+    const auto t0 = Clock::now();
+    f();
+    t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  }
+  return median(t);
+}
+
+struct Map {
+  std::string name;
+  std::function<std::vector<double>()> render;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string device_name = "tpad";
+  std::string json_path;
+  int repeat = 3;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--device" && i + 1 < argc) {
+      device_name = argv[++i];
+    } else if (a == "--repeat" && i + 1 < argc) {
+      repeat = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--json" && i + 1 < argc) {
+      json_path = argv[++i];
+    } else {
+      std::cerr << "usage: texel_bench_encode [--device NAME] [--repeat N] [--json PATH]\n";
+      return 2;
+    }
+  }
+  const DeviceProfile device = load_device(device_name);
+  std::vector<Map> maps;
+  for (const DemoTexture& t : demo_set()) {
+    const Document doc = make_document(device, t.spec);
+    maps.push_back({t.name, [doc] { return prepare_surface(doc).render(); }});
+  }
+  for (const std::string& name : second_study_names()) {
+    ReferenceSpec rs;
+    rs.name = name;
+    const Grid grid = device.grid();
+    maps.push_back({name, [rs, grid] { return render_reference(rs, grid); }});
+  }
+
+  std::printf("encode time per map on %s (%lld samples), median of %d; baseline: rendering the same map\n", device_name.c_str(),
+              static_cast<long long>(device.grid().count), repeat);
+  std::printf("%-22s %-10s %-9s %10s %10s %8s %9s\n", "map", "kind", "method", "render ms", "encode ms", "ratio", "distance");
+  nlohmann::json out = nlohmann::json::array();
+  std::vector<double> fine_ms, two_scale_ms, other_ms;  // other: coarse-only or flat
+  for (const Map& m : maps) {
+    std::vector<double> a;
+    const double render_ms = median_ms(repeat, [&] { a = m.render(); });
+    const codec::Signal signal{a, device.spacing, m.name};
+    codec::EncodeResult r;
+    const double encode_ms = median_ms(repeat, [&] { r = codec::encode(signal, codec::EncoderConfig{}); });
+    const bool fine = r.spec.fine_strength > 0.0;
+    const char* kind = r.coarse ? (fine ? "two-scale" : "coarse") : (fine ? "fine-only" : "flat");
+    const char* method = r.texel_recovered ? "recovered" : (fine ? "fitted" : "no fine");
+    if (fine)
+      (r.coarse ? two_scale_ms : fine_ms).push_back(encode_ms);
+    else
+      other_ms.push_back(encode_ms);
+    std::printf("%-22s %-10s %-9s %10.2f %10.2f %8.1f %9.3f\n", m.name.c_str(), kind, method, render_ms, encode_ms,
+                encode_ms / render_ms, r.model_distance);
+    out.push_back({{"map", m.name},
+                   {"kind", kind},
+                   {"method", method},
+                   {"render_ms", render_ms},
+                   {"encode_ms", encode_ms},
+                   {"model_distance", r.model_distance},
+                   {"bytes", r.bytes.size()}});
+  }
+  const double fine_median = median(fine_ms), two_median = median(two_scale_ms);
+  std::printf(
+      "median encode: fine-only %.2f ms over %zu maps (goal < 10 ms: %s); two-scale %.2f ms over %zu maps (goal < 30 ms: %s)\n",
+      fine_median, fine_ms.size(), fine_median < 10.0 ? "met" : "NOT met", two_median, two_scale_ms.size(),
+      two_median < 30.0 ? "met" : "NOT met");
+  std::printf("median encode of coarse-only and flat maps (no fine texture): %.2f ms over %zu maps\n", median(other_ms),
+              other_ms.size());
+  if (!json_path.empty()) {
+    std::ofstream f(json_path);
+    f << nlohmann::json{{"device", device_name},
+                        {"maps", out},
+                        {"median_fine_ms", fine_median},
+                        {"median_two_scale_ms", two_median}}
+             .dump(2)
+      << "\n";
+  }
+  return 0;
+}
