@@ -85,6 +85,7 @@ bench: build web
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
+	$(BUILD)/bin/texel_bench_encode --json $(BUILD)/bench_encode.json
 	$(PY) bench/render_to_file.py $(BUILD)/bin/texel
 	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null
 	$(PY) bench/studio_latency.py $(BUILD)/browser-artifacts/latency.json
