@@ -83,16 +83,17 @@ constexpr std::size_t leaf = 2048;
 constexpr std::size_t max_size = std::size_t{1} << 26;
 
 /// One decimation-in-frequency stage over re/im[0, n): butterflies of span h
-/// with twiddle (c, s)[j·stride].
-void dif_stage(double* re, double* im, std::size_t n, std::size_t h, std::size_t stride, const double* c, const double* s) {
+/// with twiddles (c, s)[j] = e^(−2πi·j/2h), j < h (contiguous, so the loop
+/// vectorizes; lanes perform the scalar operations, so bits do not change).
+void dif_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
   for (std::size_t base = 0; base < n; base += 2 * h) {
     double* ar = re + base;
     double* ai = im + base;
     double* br = ar + h;
     double* bi = ai + h;
     for (std::size_t j = 0; j < h; ++j) {
-      const double wr = c[j * stride];
-      const double wi = s[j * stride];
+      const double wr = c[j];
+      const double wi = s[j];
       const double xr = ar[j];
       const double xi = ai[j];
       const double yr = br[j];
@@ -108,15 +109,15 @@ void dif_stage(double* re, double* im, std::size_t n, std::size_t h, std::size_t
 }
 
 /// One decimation-in-time stage with the conjugate twiddles (the inverse).
-void dit_stage(double* re, double* im, std::size_t n, std::size_t h, std::size_t stride, const double* c, const double* s) {
+void dit_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
   for (std::size_t base = 0; base < n; base += 2 * h) {
     double* ar = re + base;
     double* ai = im + base;
     double* br = ar + h;
     double* bi = ai + h;
     for (std::size_t j = 0; j < h; ++j) {
-      const double wr = c[j * stride];
-      const double wi = s[j * stride];
+      const double wr = c[j];
+      const double wi = s[j];
       const double yr = br[j];
       const double yi = bi[j];
       const double tr = yr * wr + yi * wi;
@@ -137,14 +138,24 @@ DetFft::DetFft(std::size_t n) : n_(n) {
   if (n < 1 || n > max_size || (n & (n - 1)) != 0)
     throw InvalidArgument("FFT size is " + std::to_string(n) + "; it must be a power of two from 1 to 2^26");
   while ((std::size_t{1} << bits_) < n) ++bits_;
-  cos_.resize(n / 2);
-  sin_.resize(n / 2);
+  if (n < 2) return;
+  // Stage h's twiddles e^(−2πi·j/2h), j < h, at offset h − 1: the largest
+  // stage's from detmath, every other stage's copied from it (j/2h is the
+  // same fraction as j·(n/2h)/n, so the values are the same either way).
+  cos_.resize(n - 1);
+  sin_.resize(n - 1);
+  const std::size_t top = n / 2 - 1;
   const double inv = 1.0 / static_cast<double>(n);  // exact: n is a power of two
   for (std::size_t t = 0; t < n / 2; ++t) {
     const double u = static_cast<double>(t) * inv;  // exact
-    cos_[t] = detmath::cos_cycles(u);
-    sin_[t] = -detmath::sin_cycles(u);
+    cos_[top + t] = detmath::cos_cycles(u);
+    sin_[top + t] = -detmath::sin_cycles(u);
   }
+  for (std::size_t h = n / 4; h >= 1; h /= 2)
+    for (std::size_t j = 0; j < h; ++j) {
+      cos_[h - 1 + j] = cos_[top + j * (n / (2 * h))];
+      sin_[h - 1 + j] = sin_[top + j * (n / (2 * h))];
+    }
 }
 
 std::size_t DetFft::bit_reverse(std::size_t i) const {
@@ -153,30 +164,30 @@ std::size_t DetFft::bit_reverse(std::size_t i) const {
   return r;
 }
 
-void DetFft::dif(double* re, double* im, std::size_t n, std::size_t stride) const {
+void DetFft::dif(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    dif_stage(re, im, n, n / 2, stride, cos_.data(), sin_.data());
-    dif(re, im, n / 2, 2 * stride);
-    dif(re + n / 2, im + n / 2, n / 2, 2 * stride);
+    dif_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
+    dif(re, im, n / 2);
+    dif(re + n / 2, im + n / 2, n / 2);
     return;
   }
-  for (std::size_t h = n / 2, s = stride; h >= 1; h /= 2, s *= 2) dif_stage(re, im, n, h, s, cos_.data(), sin_.data());
+  for (std::size_t h = n / 2; h >= 1; h /= 2) dif_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
 }
 
-void DetFft::dit(double* re, double* im, std::size_t n, std::size_t stride) const {
+void DetFft::dit(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    dit(re, im, n / 2, 2 * stride);
-    dit(re + n / 2, im + n / 2, n / 2, 2 * stride);
-    dit_stage(re, im, n, n / 2, stride, cos_.data(), sin_.data());
+    dit(re, im, n / 2);
+    dit(re + n / 2, im + n / 2, n / 2);
+    dit_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
     return;
   }
-  for (std::size_t h = 1, s = stride * (n / 2); h < n; h *= 2, s /= 2) dit_stage(re, im, n, h, s, cos_.data(), sin_.data());
+  for (std::size_t h = 1; h < n; h *= 2) dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
 }
 
-void DetFft::forward_to_bit_reversed(double* re, double* im) const { dif(re, im, n_, 1); }
-void DetFft::inverse_from_bit_reversed(double* re, double* im) const { dit(re, im, n_, 1); }
+void DetFft::forward_to_bit_reversed(double* re, double* im) const { dif(re, im, n_); }
+void DetFft::inverse_from_bit_reversed(double* re, double* im) const { dit(re, im, n_); }
 
 void DetFft::permute(double* re, double* im) const {
   for (std::size_t i = 0; i < n_; ++i) {

@@ -51,7 +51,8 @@ TwoDouble reciprocal(double d);
 /// A deterministic complex FFT of size n = 2^p, 1 <= n <= 2^26.
 class DetFft {
  public:
-  /// Prepares the twiddles e^(−2πi·t/n), t < n/2 (n/2 complex values).
+  /// Prepares the twiddles e^(−2πi·t/n), t < n/2, laid out per stage (n − 1
+  /// complex values).
   /// Throws InvalidArgument if n is not a power of two in range.
   explicit DetFft(std::size_t n);
 
@@ -72,13 +73,15 @@ class DetFft {
 
  private:
   void permute(double* re, double* im) const;
-  void dif(double* re, double* im, std::size_t n, std::size_t stride) const;
-  void dit(double* re, double* im, std::size_t n, std::size_t stride) const;
+  void dif(double* re, double* im, std::size_t n) const;
+  void dit(double* re, double* im, std::size_t n) const;
 
   std::size_t n_ = 1;
   int bits_ = 0;
-  std::vector<double> cos_;  // cos(2π·t/n)
-  std::vector<double> sin_;  // −sin(2π·t/n): the forward twiddle's imaginary part
+  // Twiddles e^(−2πi·j/2h) of every stage h (1, 2, 4 … n/2), j < h, stage h
+  // at offset h − 1: n − 1 values, contiguous per stage.
+  std::vector<double> cos_;
+  std::vector<double> sin_;  // the forward twiddle's imaginary part, −sin
 };
 
 /// A sum of harmonics of one fundamental: harmonic first + j has amplitude
