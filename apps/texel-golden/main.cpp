@@ -1,7 +1,12 @@
-// texel-golden: renders the demonstration set's device files with libtexel
-// alone (no CLI, plots or codecs), for the cross-build determinism check
-// (tests/determinism/cross_build.sh), which builds it with several compilers
-// and options. Usage: texel-golden OUTDIR
+// texel-golden: renders the demonstration set's device files, and any
+// documents given, with libtexel alone (no CLI, plots or codecs), for the
+// cross-build determinism check (tests/determinism/cross_build.sh), which
+// builds it with several compilers and options, and for the golden-digest
+// tests. Usage: texel-golden OUTDIR [DOCUMENT.texel.json ...]
+//   OUTDIR/<demo>.bin                 the demo set on tpad (device format, u16)
+//   OUTDIR/references/<stem>.f64      each document's map as little-endian
+//                                     float64: the exact bits of every
+//                                     amplitude, which a u16 file rounds away
 #include <filesystem>
 #include <iostream>
 
@@ -11,8 +16,8 @@
 #include "texel/io.hpp"
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: texel-golden OUTDIR\n";
+  if (argc < 2) {
+    std::cerr << "usage: texel-golden OUTDIR [DOCUMENT.texel.json ...]\n";
     return 2;
   }
   try {
@@ -22,6 +27,14 @@ int main(int argc, char** argv) {
     for (const auto& t : texel::demo_set()) {
       const texel::Surface surface = texel::prepare_surface(texel::make_document(device, t.spec));
       texel::write_file_atomic((out / (t.name + ".bin")).string(), surface.render_native(device.format));
+    }
+    if (argc > 2) std::filesystem::create_directories(out / "references");
+    for (int i = 2; i < argc; ++i) {
+      std::string stem = std::filesystem::path(argv[i]).filename().string();
+      if (const auto dot = stem.find('.'); dot != std::string::npos) stem.resize(dot);
+      const texel::Surface surface = texel::prepare_surface(texel::load_document(argv[i]));
+      texel::write_file_atomic((out / "references" / (stem + ".f64")).string(),
+                               surface.render_native(texel::SampleFormat::f64le));
     }
     return 0;
   } catch (const texel::Error& e) {

@@ -24,6 +24,8 @@ namespace texel {
 /// The texture a region holds: a Texel texture (format version 1) or, from
 /// version 2, a reference texture ("kind": "reference"); a Texel texture's
 /// coarse profile may also be a reference (the coarse-study test texture).
+/// A reference's `synthesis` follows the document's version (2: direct,
+/// 3: chirp-z), so every document keeps rendering the bytes it was made with.
 struct RegionSpec {
   std::string name;                   ///< optional label, e.g. "left"
   Millimetres start{0.0};             ///< left edge on the device (JSON start_mm)
@@ -37,9 +39,14 @@ struct RegionSpec {
 };
 
 struct Document {
-  /// Version 2 adds references; documents without them are still written as
-  /// version 1, so older readers keep reading them.
-  static constexpr int current_version = 2;
+  /// Version 2 adds references; version 3 synthesises noise and waveform
+  /// references by chirp-z transform (the same textures, new last bits,
+  /// O(N log N) instead of O(N²)). Documents are written with the lowest
+  /// version that renders their bytes (required_version), so Texel-only
+  /// documents stay version 1 and version-2 references stay version 2.
+  static constexpr int current_version = 3;
+  /// The version read (parse_document) or current_version; writers use
+  /// required_version instead.
   int version = current_version;
   DeviceProfile device;             ///< resolved profile (by name or inline)
   bool device_inline = false;       ///< written inline rather than by name
@@ -57,8 +64,13 @@ void save_document(const Document& doc, const std::string& path);
 Document make_document(const DeviceProfile& device, const TexelSpec& spec);
 /// A document holding one reference texture over the whole device.
 Document make_reference_document(const DeviceProfile& device, const ReferenceSpec& spec);
-/// The lowest format version that can hold `doc` (1, or 2 with references).
+/// The lowest format version that renders `doc`'s bytes: 1 without
+/// references, 2 when its references use the direct synthesis, 3 when they
+/// use the chirp-z one. Throws InvalidArgument when references of one
+/// document use both (no version holds that; documents never parse to it).
 int required_version(const Document& doc);
+/// The reference synthesis a document of format `version` renders with.
+ReferenceSynthesis reference_synthesis(int version);
 
 /// Prepares every region's texture for the document's device grid.
 Surface prepare_surface(const Document& doc);

@@ -141,6 +141,7 @@ MatchPoint perceptual_target(const std::string& reference_name, const std::strin
   const DeviceProfile profile = load_device(device);
   ReferenceSpec spec;
   spec.name = reference_name;
+  spec.synthesis = ReferenceSynthesis::direct;  // the bytes the sessions' version-2 stimuli show
   const Surface surface = prepare_surface(make_reference_document(profile, spec));
   codec::Signal signal;
   signal.amplitude = surface.render();

@@ -250,6 +250,9 @@ struct Session::Impl {
 
   [[nodiscard]] const Block& block() const { return protocol.blocks[static_cast<std::size_t>(block_index)]; }
 
+  // Stimuli stay format version 2 (direct reference synthesis), not the
+  // current 3: a study's stimuli must not change under it, and a stored
+  // session's questions, stimulus documents included, are compared on resume.
   std::string doc(const std::vector<json>& regions) const {
     json d = {{"format", "texel-document"}, {"version", 2}, {"device", protocol.device}, {"regions", regions}};
     const std::string text = d.dump();

@@ -314,6 +314,12 @@ Document parse_document(std::string_view text, std::string_view origin) {
       }
     }
     o.finish();
+    // The version fixes the references' bytes: a version-2 document keeps
+    // the direct synthesis it was made with.
+    for (auto& r : doc.regions) {
+      if (r.reference) r.reference->synthesis = reference_synthesis(doc.version);
+      if (r.coarse_reference) r.coarse_reference->synthesis = reference_synthesis(doc.version);
+    }
     (void)prepare_surface(doc);  // layout and distribution errors surface at load time
     return doc;
   } catch (const Error& e) {
@@ -374,10 +380,26 @@ Document make_reference_document(const DeviceProfile& device, const ReferenceSpe
   return doc;
 }
 
+ReferenceSynthesis reference_synthesis(int version) {
+  return version >= 3 ? ReferenceSynthesis::chirp_z : ReferenceSynthesis::direct;
+}
+
 int required_version(const Document& doc) {
-  for (const auto& r : doc.regions)
-    if (r.reference || r.coarse_reference) return 2;
-  return 1;
+  int version = 1;
+  std::size_t first = 0;
+  for (std::size_t i = 0; i < doc.regions.size(); ++i) {
+    for (const auto* ref : {&doc.regions[i].reference, &doc.regions[i].coarse_reference}) {
+      if (!*ref) continue;
+      const int v = (*ref)->synthesis == ReferenceSynthesis::chirp_z ? 3 : 2;
+      if (version > 1 && v != version)
+        throw InvalidArgument("regions " + std::to_string(first) + " and " + std::to_string(i) +
+                              " hold references of different syntheses (format versions " + std::to_string(version) + " and " +
+                              std::to_string(v) + "); one document renders with one (set ReferenceSpec::synthesis alike)");
+      if (version == 1) first = i;
+      version = v;
+    }
+  }
+  return version;
 }
 
 Surface prepare_surface(const Document& doc) {
@@ -398,8 +420,9 @@ Surface prepare_surface(const Document& doc) {
     // region's texture is prepared over its own length, so a 1e9 mm region
     // on a 100 mm device would allocate 10^11 texels first.
     if (r.start.value() + r.length.value() > grid.length().value() + 1e-3)
-      throw InvalidArgument(label + "start_mm " + detail::num(r.start.value()) + " mm + length_mm " + detail::num(r.length.value()) +
-                            " mm ends past the device's active length " + detail::num(grid.length().value()) + " mm");
+      throw InvalidArgument(label + "start_mm " + detail::num(r.start.value()) + " mm + length_mm " +
+                            detail::num(r.length.value()) + " mm ends past the device's active length " +
+                            detail::num(grid.length().value()) + " mm");
     try {
       // The texture's own coordinates: 0 mm at the region's left edge (as Surface::render passes them).
       const Sampling local{Grid{grid.origin - r.start, grid.spacing, grid.count}, doc.device.band_top()};

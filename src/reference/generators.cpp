@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "texel/detail/detfft.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detail/lanes.hpp"
 #include "texel/detmath.hpp"
@@ -88,6 +89,32 @@ void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, 
   }
 }
 
+/// Components that are harmonics of one fundamental (noise: of 1/length;
+/// waveforms: of fundamental_cpm), with each component's harmonic number:
+/// what the chirp-z synthesis needs besides amplitudes and phases. Empty for
+/// sums of sinusoids.
+struct HarmonicLayout {
+  detail::TwoDouble fundamental;
+  std::vector<std::uint64_t> number;  // ascending, one per component
+};
+
+/// The same sum as synthesize() on samples [first, first + out.size()) of
+/// `grid`, by chirp-z transform (detfft): components laid out densely from
+/// the lowest harmonic to the highest, absent ones at amplitude 0.
+void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const HarmonicLayout& layout, const Grid& grid,
+                          std::int64_t first, std::span<double> out) {
+  const std::uint64_t lowest = layout.number.front();
+  const auto count = static_cast<std::size_t>(layout.number.back() - lowest + 1);
+  std::vector<double> amplitude(count, 0.0);
+  std::vector<double> phase(count, 0.0);
+  for (std::size_t i = 0; i < comps.size(); ++i) {
+    const auto j = static_cast<std::size_t>(layout.number[i] - lowest);
+    amplitude[j] = comps[i].amplitude;
+    phase[j] = comps[i].phase_cycles;
+  }
+  detail::sum_harmonics({lowest, layout.fundamental, amplitude, phase}, grid.origin.value(), grid.spacing.value(), first, out);
+}
+
 // ------------------------------------------------------------ parameters
 
 double number(const ReferenceSpec& s, const char* key) { return std::get<double>(reference_value(s, key)); }
@@ -115,8 +142,8 @@ std::pair<std::uint64_t, std::uint64_t> harmonic_range(double lo, double hi, dou
 
 std::string field(const ReferenceSpec& s, const std::string& key) { return "reference '" + s.name + "' parameter " + key; }
 
-std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const std::string& family, double period,
-                                                 double nyquist) {
+std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const std::string& family, double period, double nyquist,
+                                                 HarmonicLayout& layout) {
   std::vector<ReferenceComponent> comps;
   const CounterRng rng(s.seed, Stream::reference);
   double lo = 0.0;
@@ -139,7 +166,16 @@ std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const s
     throw InvalidArgument("reference '" + s.name + "': the band " + num(lo) + " … " + num(hi) + " cpm holds no harmonic of the " +
                           num(period) + " mm texture (spacing " + num(1.0 / period) +
                           " cpm); widen the band or lengthen the texture");
+  // The chirp-z synthesis's FFTs grow with the harmonic count (48 to 200
+  // bytes per harmonic); the direct one's time grows with its square.
+  if (s.synthesis == ReferenceSynthesis::chirp_z && k1 - k0 + 1 > detail::max_chirp_harmonics)
+    throw InvalidArgument("reference '" + s.name + "': the band " + num(lo) + " … " + num(hi) + " cpm holds " +
+                          std::to_string(k1 - k0 + 1) + " harmonics of the " + num(period) + " mm texture; at most " +
+                          std::to_string(detail::max_chirp_harmonics) +
+                          " (narrow the band, shorten the texture or coarsen the grid)");
   comps.reserve(k1 - k0 + 1);
+  layout.fundamental = detail::reciprocal(period);
+  layout.number.reserve(k1 - k0 + 1);
   for (std::uint64_t k = k0; k <= k1; ++k) {
     const double f = static_cast<double>(k) / period;
     double gain = 1.0;
@@ -151,6 +187,7 @@ std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const s
     }
     const auto [mag, phase] = noise_draw(rng, k);
     comps.push_back({CyclesPerMm(f), gain * mag, phase});
+    layout.number.push_back(k);
   }
   return comps;
 }
@@ -186,7 +223,7 @@ void check_feature_count(const ReferenceSpec& s, const char* key, double feature
                           " (lengthen " + key + " or shorten the texture)");
 }
 
-std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, double nyquist) {
+std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, double nyquist, HarmonicLayout& layout) {
   const double f0 = number(s, "fundamental_cpm");
   const double hi = band_top(number(s, "band_max_cpm"), nyquist);
   const double phase0 = number(s, "phase_deg") / 360.0;
@@ -201,6 +238,7 @@ std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, doub
                           " harmonics below the band's top " + num(hi) + " cpm; at most " + num(max_harmonics) +
                           " (raise fundamental_cpm or lower band_max_cpm)");
   std::vector<ReferenceComponent> comps;
+  layout.fundamental = {f0, 0.0};
   for (std::uint64_t n = 1;; ++n) {
     const double nd = static_cast<double>(n);
     const double f = nd * f0;
@@ -220,6 +258,7 @@ std::vector<ReferenceComponent> waveform_components(const ReferenceSpec& s, doub
     }
     phase -= std::floor(phase);
     comps.push_back({CyclesPerMm(f), a, phase});
+    layout.number.push_back(n);
   }
   return comps;
 }
@@ -298,12 +337,13 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
   const ReferenceInfo& info = reference_info(spec_.name);
   const double nyquist = grid.nyquist().value();
   const double L = length.value();
+  HarmonicLayout layout;
   if (info.family == "band-pass noise" || info.family == "colour of noise") {
-    components_ = noise_components(spec_, info.family, L, nyquist);
+    components_ = noise_components(spec_, info.family, L, nyquist, layout);
   } else if (info.family == "sum of sinusoids") {
     components_ = sine_components(spec_, nyquist);
   } else if (info.family == "shaped waveform") {
-    components_ = waveform_components(spec_, nyquist);
+    components_ = waveform_components(spec_, nyquist, layout);
   } else if (info.family == "patch texture") {
     shape_ = Shape::patch;
     features_ = patch_features(spec_, L);
@@ -325,7 +365,10 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
   cache_first_ = a;
   cache_.resize(static_cast<std::size_t>(b - a));
   if (shape_ == Shape::sum) {
-    synthesize(components_, grid, a, cache_);
+    if (spec_.synthesis == ReferenceSynthesis::chirp_z && !layout.number.empty())
+      synthesize_harmonics(components_, layout, grid, a, cache_);
+    else
+      synthesize(components_, grid, a, cache_);
     double peak = 0.0;
     for (double y : cache_) peak = std::max(peak, std::abs(y));
     peak_ = peak > 0.0 ? peak : 1.0;
@@ -377,13 +420,39 @@ void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<
 
 void ReferenceTexture::render(const Grid& grid, std::int64_t first, std::span<double> out) const {
   const auto n = static_cast<std::int64_t>(out.size());
-  const bool same_grid = grid.origin.value() == grid_.origin.value() && grid.spacing.value() == grid_.spacing.value();
   const std::int64_t cache_end = cache_first_ + static_cast<std::int64_t>(cache_.size());
-  if (same_grid && first >= cache_first_ && first + n <= cache_end) {
-    std::copy_n(cache_.begin() + (first - cache_first_), n, out.begin());
+  if (grid.origin.value() == grid_.origin.value() && grid.spacing.value() == grid_.spacing.value()) {
+    // The prepared grid: its samples inside [0, L) are the cache, the others
+    // at rest. (Never re-synthesised: a window's bytes are the whole's.)
+    const std::int64_t a = std::clamp(cache_first_ - first, std::int64_t{0}, n);
+    const std::int64_t b = std::clamp(cache_end - first, a, n);
+    std::fill(out.begin(), out.begin() + a, 0.0);
+    if (b > a) std::copy_n(cache_.begin() + (first + a - cache_first_), b - a, out.begin() + a);
+    std::fill(out.begin() + b, out.end(), 0.0);
     return;
   }
-  evaluate(grid, first, out);
+  // Another grid: a position that coincides with a prepared-grid sample takes
+  // its cached value (so sample(x) is the renderer's own value there); runs
+  // of other positions are evaluated directly.
+  const double o = grid_.origin.value();
+  const double sp = grid_.spacing.value();
+  const auto cached = [&](double x) -> const double* {
+    const double r = std::round((x - o) / sp);
+    if (!(r >= static_cast<double>(cache_first_) - 1.0 && r <= static_cast<double>(cache_end))) return nullptr;
+    const auto i = static_cast<std::int64_t>(r);
+    for (std::int64_t j = std::max(i - 1, cache_first_); j <= std::min(i + 1, cache_end - 1); ++j)
+      if (grid_.position(j).value() == x) return &cache_[static_cast<std::size_t>(j - cache_first_)];
+    return nullptr;
+  };
+  std::int64_t i = 0;
+  while (i < n) {
+    std::int64_t j = i;
+    const double* hit = nullptr;
+    while (j < n && (hit = cached(grid.position(first + j).value())) == nullptr) ++j;
+    if (j > i) evaluate(grid, first + i, out.subspan(static_cast<std::size_t>(i), static_cast<std::size_t>(j - i)));
+    if (j < n) out[static_cast<std::size_t>(j)] = *hit;
+    i = j + 1;
+  }
 }
 
 double ReferenceTexture::amplitude_at(Millimetres x) const {

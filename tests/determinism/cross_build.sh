@@ -9,10 +9,17 @@
 # cli.golden_demo_sha256 test of the main build. The render kernel also picks
 # its SIMD width at run time (AVX-512, AVX2, SSE2); TEXEL_SIMD forces one so
 # every width is compared on this machine.
+# References (issue #11 item 6): the same builds render the reviewed reference
+# documents tests/golden/references/*.texel.json (version 2: direct synthesis,
+# version 3: chirp-z over detfft) as float64 maps — every bit of every
+# amplitude — against tests/golden/references.sha256 (also held by the
+# reference.golden_sha256 test of the main build).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 golden="$root/tests/golden/demo.sha256"
-work="$root/build-det"
+golden_refs="$root/tests/golden/references.sha256"
+ref_docs=("$root"/tests/golden/references/*.texel.json)
+work="${TEXEL_DET_DIR:-$root/build-det}"  # TEXEL_DET_DIR: another directory, e.g. beside a build in use
 jobs=$(nproc 2>/dev/null || echo 2)
 mkdir -p "$work"
 
@@ -41,12 +48,15 @@ for c in "${configs[@]}"; do
   fi
   for simd in auto avx2 sse2; do
     rm -rf "$dir/demo-$simd"
-    TEXEL_SIMD=$simd "$dir/bin/texel-golden" "$dir/demo-$simd"
+    TEXEL_SIMD=$simd "$dir/bin/texel-golden" "$dir/demo-$simd" "${ref_docs[@]}"
     (cd "$dir/demo-$simd" && sha256sum -- *.bin) >"$dir/demo-$simd.sha256"
-    if diff -u "$golden" "$dir/demo-$simd.sha256" >"$dir/diff-$simd.txt"; then
-      echo "determinism: $name ($cxx $flags, SIMD $simd): $(wc -l <"$golden") demo files identical to the golden digests"
+    (cd "$dir/demo-$simd/references" && sha256sum -- *.f64) >"$dir/references-$simd.sha256"
+    if diff -u "$golden" "$dir/demo-$simd.sha256" >"$dir/diff-$simd.txt" &&
+        diff -u "$golden_refs" "$dir/references-$simd.sha256" >>"$dir/diff-$simd.txt"; then
+      echo "determinism: $name ($cxx $flags, SIMD $simd): $(wc -l <"$golden") demo files and" \
+        "$(wc -l <"$golden_refs") reference maps identical to the golden digests"
     else
-      echo "determinism: $name ($cxx $flags, SIMD $simd) DIFFERS from $golden:"
+      echo "determinism: $name ($cxx $flags, SIMD $simd) DIFFERS from $golden or $golden_refs:"
       cat "$dir/diff-$simd.txt"
       fail=1
     fi

@@ -42,6 +42,11 @@ interface DesignerState {
   split: boolean;
   reference: string;
   reference_seed: number;
+  /**
+   * Format version of the reference's bytes (docs/format.md): 3 for a reference made here,
+   * 2 for one imported from a version-2 (or 1) document, which keeps rendering its old bytes.
+   */
+  reference_version: number;
   texel: TexelParams;
   /** Keys of an imported texel texture the controls do not show (kept as they are). */
   extra: Record<string, unknown>;
@@ -122,7 +127,7 @@ export function buildDocument(s: DesignerState): TextureDocument {
   const hv = halves(s.device);
   return {
     format: 'texel-document',
-    version: 2,
+    version: s.reference_version,
     description: 'reference left, rendering right',
     device: s.device,
     regions: [
@@ -146,6 +151,7 @@ function stateFromDocument(doc: TextureDocument, prev: DesignerState): DesignerS
     if (ref && ref.texture.kind === 'reference') {
       s.reference = ref.texture.name;
       s.reference_seed = ref.texture.seed ?? 1;
+      s.reference_version = doc.version >= 3 ? 3 : 2;
     }
     if (tex) texel = tex.texture as TexelTexture;
   }
@@ -237,7 +243,15 @@ function select(id: string, label: string, options: [string, string][], value: s
 // ---------------------------------------------------------------- page
 
 export function mountDesigner(root: HTMLElement): void {
-  const s: DesignerState = { device: 'tpad', split: false, reference: '4sin', reference_seed: 1, texel: defaults(), extra: {} };
+  const s: DesignerState = {
+    device: 'tpad',
+    split: false,
+    reference: '4sin',
+    reference_seed: 1,
+    reference_version: 3,
+    texel: defaults(),
+    extra: {},
+  };
   const client = studio();
 
   const mapPlot = new MapPlot();
@@ -446,6 +460,7 @@ export function mountDesigner(root: HTMLElement): void {
   });
   const refSel = select('reference', 'Reference', [['4sin', '4sin']], s.reference, (v) => {
     s.reference = v;
+    s.reference_version = 3; // a reference chosen here is a new one
     overlays = {};
     changed();
   });

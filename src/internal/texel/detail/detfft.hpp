@@ -93,15 +93,15 @@ struct Harmonics {
   std::span<const double> phase_cycles;
 };
 
-/// The most harmonics sum_harmonics takes: its memory is 40 bytes per FFT
+/// The most harmonics sum_harmonics takes: its memory is 48 bytes per FFT
 /// point (kernel and work spectra, twiddles) and the FFT size lies between the
-/// harmonic count and about four times it, so at most about 640 MiB.
+/// harmonic count and about four times it, so at most about 768 MiB.
 inline constexpr std::size_t max_chirp_harmonics = std::size_t{1} << 22;
 
 /// out[m] = Σ_j amplitude[j]·sin(2π(phase_cycles[j] + (first + j)·f·x_m)),
 /// x_m = origin + (index + m)·spacing, f the fundamental, positions and
 /// products taken exactly (not as Grid::position rounds them). Time
-/// O((samples + harmonics)·log); memory beyond `out` 40 bytes per point of
+/// O((samples + harmonics)·log); memory beyond `out` 48 bytes per point of
 /// one FFT whose size (the block size rule in detfft.cpp) lies between the
 /// harmonic count and the power of two above samples + harmonics. The bits
 /// are a function of the arguments alone.
