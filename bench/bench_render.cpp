@@ -9,6 +9,15 @@
 //                     L1-sized chunks: render to doubles, then encode.
 //   fill/...          std::fill of the same buffer: the memory-bound floor.
 //   prepare/tpad      constructing the TexelTexture (per-texel draws).
+//   reference/chirp-z/white/<L>mm   preparing full-band white noise (seed 1)
+//                     over L mm on a 5 µm grid (200 samples per mm, about 100
+//                     harmonics per mm): the component draws, the chirp-z
+//                     synthesis of every sample (document version 3) and the
+//                     scaling, for L = 100 mm … 4 m. O(N log N): the time per
+//                     N·log2(N) stays flat (bench/summarize.py prints it
+//                     relative to 100 mm).
+//   reference/direct/white/<L>mm    the same with version 2's direct sum
+//                     (O(N²) here), at 100 and 200 mm: the baseline.
 //
 // Results are kept alive with DoNotOptimize/ClobberMemory. Each case runs in
 // several repetitions and reports the median; the 10^8 cases use a fixed,
@@ -17,14 +26,17 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <type_traits>
 #include <vector>
 
 #include "texel/device.hpp"
 #include "texel/document.hpp"
+#include "texel/reference.hpp"
 #include "texel/surface.hpp"
 #include "texel/texture.hpp"
 
@@ -153,6 +165,29 @@ void bm_prepare(benchmark::State& state) {
                                                   benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// Preparing a reference = drawing its components and synthesising (and
+// scaling) every sample of the grid inside its length; the prepared texture's
+// cache is the result, kept alive through its peak.
+void bm_reference(benchmark::State& state, ReferenceSynthesis synthesis, double length_mm) {
+  ReferenceSpec spec;
+  spec.name = "white";
+  spec.synthesis = synthesis;
+  const Grid grid{Millimetres(0.0), Millimetres(0.005), 0};
+  std::size_t harmonics = 0;
+  double peak = 0.0;
+  for (auto _ : state) {
+    const ReferenceTexture t(spec, Millimetres(length_mm), Sampling{grid});
+    harmonics = t.components().size();
+    peak = t.peak();
+    benchmark::DoNotOptimize(peak);
+    benchmark::ClobberMemory();
+  }
+  const auto samples = static_cast<std::int64_t>(std::llround(length_mm / 0.005));
+  report(state, samples, sizeof(double));
+  state.counters["samples"] = static_cast<double>(samples);
+  state.counters["harmonics"] = static_cast<double>(harmonics);
+}
+
 void register_all() {
   auto small = [](benchmark::internal::Benchmark* b) {
     b->Unit(benchmark::kMicrosecond)->MinTime(0.1)->Repetitions(repetitions)->ReportAggregatesOnly(true);
@@ -170,6 +205,15 @@ void register_all() {
   large(benchmark::RegisterBenchmark("render/1e8/u16", bm_render<std::uint16_t>, big));
   large(benchmark::RegisterBenchmark("fill/1e8/f32", bm_fill<float>, big));
   large(benchmark::RegisterBenchmark("render/1e8/f32", bm_render<float>, big));
+  auto synthesis = [](benchmark::internal::Benchmark* b) {
+    b->Unit(benchmark::kMillisecond)->MinTime(0.2)->Repetitions(3)->ReportAggregatesOnly(true);
+  };
+  for (const double length : {100.0, 200.0, 400.0, 800.0, 1600.0, 4000.0})
+    synthesis(benchmark::RegisterBenchmark(("reference/chirp-z/white/" + std::to_string(static_cast<int>(length)) + "mm").c_str(),
+                                           bm_reference, ReferenceSynthesis::chirp_z, length));
+  for (const double length : {100.0, 200.0})
+    synthesis(benchmark::RegisterBenchmark(("reference/direct/white/" + std::to_string(static_cast<int>(length)) + "mm").c_str(),
+                                           bm_reference, ReferenceSynthesis::direct, length));
 }
 
 }  // namespace
