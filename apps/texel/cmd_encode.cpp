@@ -26,6 +26,7 @@ struct EncodeArgs {
   double texel_length_mm = 0.25;
   std::uint64_t seed = 1;
   std::string parameterization = "moments";
+  std::string fit = "least-squares";
   unsigned coarse_bits = 6;
   std::optional<std::size_t> max_bytes;
   bool json = false;
@@ -40,6 +41,7 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   c.texel_length = Millimetres(a.texel_length_mm);
   c.seed = a.seed;
   c.parameterization = parse_parameterization(a.parameterization, "--parameterization");
+  c.fit_method = codec::parse_fit_method(a.fit, "--fit");
   c.coarse_bits = a.coarse_bits;
   c.max_bytes = a.max_bytes;
   return c;
@@ -87,6 +89,7 @@ nlohmann::ordered_json result_json(const std::string& input, const Signal& sig, 
   m["decoded"] = percept_json(r.decoded);
   m["distance_jnd"] = r.model_distance;
   m["evaluations"] = r.evaluations;
+  m["fit"] = std::string(codec::to_string(cfg.fit_method));
   j["model"] = m;
   nlohmann::ordered_json z;
   z["bitstream_bytes"] = r.bytes.size();
@@ -225,6 +228,7 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
+  cmd->add_option("--fit", a->fit, "Search of the perceptual fit: least-squares | simplex (slower) [least-squares]")->group(g);
   cmd->add_option("--coarse-bits", a->coarse_bits, "Bits per coarse level, 1 … 16 [6]")->group(g);
   cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")
       ->group(g);
@@ -252,7 +256,7 @@ void register_encode(CLI::App& app) {
       if (cmd->count("--coarse-bits")) to.coarse_bits = a->coarse_bits;
       to.max_bytes = a->max_bytes;
       if (auto t = codec::transcode_file(a->inputs[0], signal_options(a->input), to)) {
-        for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization"})
+        for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit"})
           if (cmd->count(flag))
             throw InvalidArgument(std::string(flag) + " applies to estimation; '" + a->inputs[0] +
                                   "' holds Texel parameters and is transcoded with its own (add --estimate to re-estimate it)");

@@ -96,16 +96,27 @@ double distance(const Percept& a, const Percept& b, const PerceptualModel& model
 
 // --- encoder ----------------------------------------------------------------
 
+/// How the fit searches (P, I) (docs/encoder.md §3). [choice] least_squares.
+enum class FitMethod {
+  least_squares,  ///< 3 × 3 grid, then Levenberg–Marquardt on the model's residuals (~20 evaluations)
+  simplex,        ///< 3 × 3 grid, then Nelder–Mead and a restart (~120 evaluations; the method before)
+};
+
+std::string_view to_string(FitMethod m);
+/// "least-squares" or "simplex"; errors name `field`.
+FitMethod parse_fit_method(std::string_view text, std::string_view field = "fit_method");
+
 struct EncoderConfig {
   PerceptualModel model;
   Millimetres boundary{1.0};       ///< fine/coarse boundary, mm (> 0)
   Millimetres texel_length{0.25};  ///< texel length of the encoding, mm
   Parameterization parameterization = Parameterization::moments;
-  std::uint64_t seed = 1;                ///< seed written to the bitstream
-  unsigned coarse_bits = 6;              ///< bits per coarse level (1 … 16)
-  std::optional<std::size_t> max_bytes;  ///< bitstream budget, bytes (coarse precision/stride adapt)
-  double flat_envelope = 0.08;           ///< relative envelope range below which the texture is fine only
-  int max_evaluations = 120;             ///< Nelder–Mead budget (each renders 2 candidates)
+  std::uint64_t seed = 1;                           ///< seed written to the bitstream
+  unsigned coarse_bits = 6;                         ///< bits per coarse level (1 … 16)
+  std::optional<std::size_t> max_bytes;             ///< bitstream budget, bytes (coarse precision/stride adapt)
+  double flat_envelope = 0.08;                      ///< relative envelope range below which the texture is fine only
+  FitMethod fit_method = FitMethod::least_squares;  ///< search of the fit
+  int max_evaluations = 120;                        ///< Nelder–Mead budget (each renders 2 candidates)
   /// Recognise inputs that are fine-only Texel renderings and recover their
   /// texel length, Central Pitch and Irregularity from the texels'
   /// frequencies (kept when the model distance is below 1 JND; docs/encoder.md).

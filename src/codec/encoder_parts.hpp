@@ -32,8 +32,12 @@ constexpr std::array<double, 3> candidate_texel_lengths_mm{0.25, 0.5, 1.0};
 /// half-overlapping 2^15-sample segments for long signals. Bin i is at
 /// i/(M·spacing) cpm; returns M through `m_out`.
 std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out);
+/// The same into `p` (reused storage: an encode analyses dozens of signals).
+void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size_t& m_out);
 /// x minus its mean.
 std::vector<double> centred(std::span<const double> x);
+/// x minus its mean, in place.
+void centre(std::vector<double>& x);
 /// How differently two signals of the same length distribute their power
 /// over half-octave bands (dB; docs/encoder.md §1 step 4).
 double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx);
@@ -89,8 +93,14 @@ struct Fitter {
   int evaluations = 0;
 
   [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
-  /// Mean percept over two candidate draws (common random numbers).
+  /// Mean percept over two candidate draws (common random numbers); none if
+  /// (P, I) cannot be rendered. Counts one evaluation.
+  std::optional<Percept> percept(double p_db, double i_db);
+  /// The model distance to the target (1e6 if not renderable).
   double operator()(double p_db, double i_db);
+  /// The distance's terms (pitch and noisiness in JND, the tie-break terms
+  /// weighted): their norm is operator()'s value.
+  std::optional<std::array<double, 4>> residuals(double p_db, double i_db);
 };
 
 struct Box {

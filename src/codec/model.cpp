@@ -26,7 +26,8 @@ double threshold_db(Hertz f) {
 
 Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
   std::size_t m = 0;
-  const std::vector<double> p = power_spectrum(fine, m);
+  thread_local std::vector<double> p;  // reused: the fit perceives hundreds of candidates
+  power_spectrum(fine, p, m);
   const double v = model.swipe_speed.value();
   // Per-bin frequency, dB and sensitivity depend only on (M, Δx, v): cache them.
   struct Bins {

@@ -1,12 +1,16 @@
 // §4 of docs/encoder.md: parameter recovery for inputs that are themselves
 // fine-only Texel renderings.
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <complex>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <utility>
 #include <vector>
 
+#include "../spectrum/fft.hpp"
 #include "encoder_parts.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detmath.hpp"
@@ -18,6 +22,7 @@ namespace {
 // Texel-rendering recovery (docs/encoder.md, "Texel renderings").
 constexpr double recovery_rms = 0.02;    // residual RMS (re amplitude) below which the input is a rendering
 constexpr double recovery_floor = 1e-4;  // residual RMS any rendering's quantization may add (16-bit: ~1e-5)
+constexpr double fits_exactly = 1e-9;  // residual power per sample (RMS 3·10⁻⁵) of a texel fitted to the quantization floor
 
 /// A fine-only Texel rendering is a + g·sin(2π·u(x)) with u piecewise linear:
 /// slope f_k (the texel's frequency) over texel k = [kL, (k+1)L), continuous
@@ -32,6 +37,8 @@ struct Recovered {
 };
 
 Recovered recover_frequencies(const std::vector<double>& y, double dx, double L, double f_top) {
+  // Analysis only: libm's sine (the fit's residuals, not rendered bytes).
+  constexpr double two_pi = 2.0 * std::numbers::pi;
   Recovered r;
   r.L = L;
   const std::size_t n = y.size();
@@ -45,15 +52,33 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
     const auto e = std::min(n, static_cast<std::size_t>(std::ceil(static_cast<double>(k + 1) * L / dx - 1e-6)));
     return std::pair{b, e};
   };
+  // sin and cos of 2π(ph + f·t_i) over a texel's samples by rotation (one
+  // complex product per sample; the drift over a texel, ~10⁻¹⁴, is far
+  // below anything the fit resolves).
+  auto for_each_phase = [&](std::size_t b, std::size_t e, double x0, double ph, double f, auto&& body) {
+    const double t0 = static_cast<double>(b) * dx - x0;
+    std::complex<double> z = std::polar(1.0, two_pi * (ph + f * t0));
+    const std::complex<double> w = std::polar(1.0, two_pi * f * dx);
+    for (std::size_t i = b; i < e; ++i, z *= w) body(i, static_cast<double>(i) * dx - x0, z.imag(), z.real());
+  };
   auto cost = [&](std::size_t b, std::size_t e, double x0, double ph, double f) {
     double s = 0.0;
-    for (std::size_t i = b; i < e; ++i) {
-      const double d = y[i] - detmath::sin_cycles(ph + f * (static_cast<double>(i) * dx - x0));
+    for_each_phase(b, e, x0, ph, f, [&](std::size_t i, double, double sn, double) {
+      const double d = y[i] - sn;
       s += d * d;
-    }
+    });
     return s;
   };
   const double step = 0.1 / L;  // at most 0.05 cycles of phase off at the texel's end
+  // One transform length for every texel: grid steps of at most `step`.
+  const std::size_t m =
+      std::max<std::size_t>(16, std::bit_ceil(static_cast<std::size_t>(std::ceil(std::max(1.0 / (step * dx), L / dx + 2.0)))));
+  thread_local std::unique_ptr<texel::detail::RealFft> fft;
+  if (!fft || fft->size() != m) fft = std::make_unique<texel::detail::RealFft>(m);
+  std::vector<double> buf(m), fs, cs;
+  std::vector<std::complex<double>> spectrum(m / 2 + 1), grid_a(m / 2 + 1), grid_b(m / 2 + 1), geometric;
+  std::size_t geometric_len = 0;
+  std::vector<std::size_t> minima;
   for (std::size_t k = 0; k < texels; ++k) {
     // Not a structured binding: clang 14 cannot capture one in the lambdas below.
     const auto bounds = range(k);
@@ -72,21 +97,24 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
     // lowest few local minima of the grid (aliases near the Nyquist frequency
     // can fit a short texel almost as well as the true frequency).
     bool free_phase = k == 0;
+    const double span = static_cast<double>(e - b) * dx;  // the texel's extent, mm
     auto refine = [&](double& ph, double& fq, double& c0) {
       for (int it = 0; it < 12; ++it) {
         double a11 = 0, a12 = 0, a22 = 0, g1 = 0, g2 = 0;
-        for (std::size_t i = b; i < e; ++i) {
-          const double t = static_cast<double>(i) * dx - x0;
-          const double u = ph + fq * t;
-          const double res = y[i] - detmath::sin_cycles(u);
-          const double c = 2.0 * std::numbers::pi * detmath::cos_cycles(u);
+        for_each_phase(b, e, x0, ph, fq, [&](std::size_t i, double t, double sn, double cs_) {
+          const double res = y[i] - sn;
+          const double c = two_pi * cs_;
           a11 += c * c, a12 += c * c * t, a22 += c * c * t * t, g1 += c * res, g2 += c * t * res;
-        }
+        });
         const double det = a11 * a22 - a12 * a12;
         if (!(std::fabs(det) > 1e-300 && a22 > 1e-300)) break;
         // Phase continuity: only the first texel's start phase is free.
         double dp = free_phase ? (a22 * g1 - a12 * g2) / det : 0.0;
         double df = free_phase ? (a11 * g2 - a12 * g1) / det : g2 / a22;
+        // Converged: a step that moves the phase by less than 10⁻¹⁰ cycles
+        // anywhere in the texel changes nothing the fit is used for (the
+        // residual sits at the input's own rounding floor by then).
+        if (std::fabs(dp) + std::fabs(df) * span < 1e-10) break;
         bool improved = false;
         for (int h = 0; h < 12 && !improved; ++h, dp *= 0.5, df *= 0.5) {
           if (fq + df <= 0.0) continue;
@@ -96,20 +124,68 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
         if (!improved || c0 < 1e-20 * static_cast<double>(e - b)) break;
       }
     };
+    // The grid: cost(f) = Σy² − 2·Σ y·sin 2π(φ + f·t) + Σ sin² 2π(φ + f·t)
+    // for every f = j/(M·dx) at once. The middle sum is Im(e^{2πiφ}·A(f)),
+    // A(f) = Σ y_i e^{2πi f t_i}, one real FFT of the texel's samples
+    // (t_i = i'·dx + δ, δ = b·dx − x0); the last is n/2 − ½·Re(e^{4πi(φ+fδ)}·
+    // G(f)) with G a geometric sum in closed form. So any start phase costs
+    // O(M) after one transform, instead of O(n) per grid point.
+    const std::size_t len = e - b;
+    const double delta = static_cast<double>(b) * dx - x0;
+    std::fill(buf.begin(), buf.end(), 0.0);
+    double yy = 0.0;
+    for (std::size_t i = 0; i < len; ++i) buf[i] = y[b + i], yy += y[b + i] * y[b + i];
+    fft->forward(buf, spectrum);
+    const double df_grid = 1.0 / (static_cast<double>(m) * dx);
+    const std::size_t j_top = std::min(m / 2, static_cast<std::size_t>(std::ceil((f_top + step) / df_grid)));
+    // Per grid point, independent of the start phase: A_j = e^{2πi f_j δ}·
+    // conj(X_j) and B_j = e^{4πi f_j δ}·G_j(len); rotations by recurrence.
+    if (geometric_len != len) {
+      geometric_len = len;
+      geometric.resize(m / 2 + 1);
+      for (std::size_t j = 0; j <= m / 2; ++j) {
+        const double fq = static_cast<double>(j) * df_grid;
+        const std::complex<double> ratio = std::polar(1.0, 4.0 * std::numbers::pi * fq * dx);
+        geometric[j] = std::abs(1.0 - ratio) < 1e-12
+                           ? std::complex<double>(static_cast<double>(len))
+                           : (1.0 - std::polar(1.0, 4.0 * std::numbers::pi * fq * dx * static_cast<double>(len))) / (1.0 - ratio);
+      }
+    }
+    const std::complex<double> turn_delta = std::polar(1.0, 2.0 * std::numbers::pi * df_grid * delta);
+    std::complex<double> rot = 1.0;
+    for (std::size_t j = 0; j <= j_top; ++j, rot *= turn_delta) {
+      grid_a[j] = rot * std::conj(spectrum[j]);
+      grid_b[j] = rot * rot * geometric[j];
+    }
+    auto grid_cost = [&](const std::complex<double>& e1, const std::complex<double>& e2, std::size_t j) {
+      return yy - 2.0 * (e1 * grid_a[j]).imag() + 0.5 * static_cast<double>(len) - 0.5 * (e2 * grid_b[j]).real();
+    };
     double best = 1e300, bf = 0.0, bp = 0.0;
     auto search = [&](const std::vector<double>& starts) {
       for (double ph : starts) {
-        std::vector<double> fs, cs;
-        for (double fq = 0.01; fq <= f_top + step; fq += step) fs.push_back(fq), cs.push_back(cost(b, e, x0, ph, fq));
-        std::vector<std::size_t> minima;
+        fs.clear(), cs.clear();
+        // The band's bottom (0.01 cpm) by direct sum, then the FFT grid.
+        fs.push_back(0.01), cs.push_back(cost(b, e, x0, ph, 0.01));
+        const std::complex<double> e1 = std::polar(1.0, 2.0 * std::numbers::pi * ph);
+        const std::complex<double> e2 = e1 * e1;
+        for (std::size_t j = 1; j <= j_top; ++j) {
+          const double fq = static_cast<double>(j) * df_grid;
+          if (fq > 0.01) fs.push_back(fq), cs.push_back(grid_cost(e1, e2, j));
+        }
+        minima.clear();
         for (std::size_t j = 0; j < cs.size(); ++j)
           if ((j == 0 || cs[j] <= cs[j - 1]) && (j + 1 == cs.size() || cs[j] <= cs[j + 1])) minima.push_back(j);
         std::sort(minima.begin(), minima.end(), [&](std::size_t u, std::size_t v) { return cs[u] < cs[v]; });
         if (minima.size() > 4) minima.resize(4);
         for (std::size_t j : minima) {
-          double p1 = ph, f1 = fs[j], c1 = cs[j];
+          // The grid's cost is a rounding-level approximation (it can even
+          // dip below zero at an exact fit): refine from the direct sum.
+          double p1 = ph, f1 = fs[j], c1 = cost(b, e, x0, ph, f1);
           refine(p1, f1, c1);
           if (c1 < best) best = c1, bf = f1, bp = p1;
+          // A fit at the 16-bit quantization floor is the texel's frequency:
+          // the other minima (aliases) fit worse.
+          if (best < fits_exactly * static_cast<double>(len)) return;
         }
       }
     };

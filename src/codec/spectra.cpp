@@ -36,26 +36,38 @@ constexpr std::size_t max_segment = 1u << 15;
 /// different grid), a periodic rather than this half-sample-centred Hann
 /// window, and an n/4 auto segment; the model's thresholds and the codec
 /// tests were set with this computation, so only the transform is shared.
-std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out) {
+void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size_t& m_out) {
   const std::size_t n = x.size();
   const std::size_t seg = std::min(n, max_segment);
   const std::size_t m = next_pow2(seg);
   m_out = m;
-  std::vector<double> p(m / 2 + 1, 0.0);
-  std::vector<double> win(seg);
-  for (std::size_t i = 0; i < seg; ++i)
-    win[i] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (static_cast<double>(i) + 0.5) / static_cast<double>(seg));
+  p.assign(m / 2 + 1, 0.0);
+  // Per thread: the window of the last segment length, the plan of the last
+  // transform length and the work buffers (an encode analyses a few dozen
+  // signals of the same length).
+  struct Scratch {
+    std::vector<double> win, buf;
+    std::vector<std::complex<double>> X;
+    std::unique_ptr<texel::detail::RealFft> fft;
+  };
+  thread_local Scratch sc;
+  if (sc.win.size() != seg) {
+    sc.win.resize(seg);
+    for (std::size_t i = 0; i < seg; ++i)
+      sc.win[i] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (static_cast<double>(i) + 0.5) / static_cast<double>(seg));
+  }
+  const std::vector<double>& win = sc.win;
   if (m < 2) {
     // One sample (or none): only the DC bin, and no real FFT of length 1.
     if (seg == 1) p[0] = x[0] * win[0] * x[0] * win[0];
-    return p;
+    return;
   }
-  // One plan per length and thread: an encode runs a few hundred transforms
-  // of the same length.
-  thread_local std::unique_ptr<texel::detail::RealFft> fft;
-  if (!fft || fft->size() != m) fft = std::make_unique<texel::detail::RealFft>(m);
-  std::vector<double> buf(m, 0.0);
-  std::vector<std::complex<double>> X(m / 2 + 1);
+  if (!sc.fft || sc.fft->size() != m) sc.fft = std::make_unique<texel::detail::RealFft>(m);
+  sc.buf.assign(m, 0.0);
+  sc.X.resize(m / 2 + 1);
+  std::vector<double>& buf = sc.buf;
+  std::vector<std::complex<double>>& X = sc.X;
+  texel::detail::RealFft* fft = sc.fft.get();
   std::size_t count = 0;
   const std::size_t hop = seg == n ? n : seg / 2;
   for (std::size_t start = 0; start + seg <= n; start += hop) {
@@ -65,7 +77,18 @@ std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out
     ++count;
   }
   for (double& v : p) v /= static_cast<double>(std::max<std::size_t>(count, 1));
+}
+
+std::vector<double> power_spectrum(std::span<const double> x, std::size_t& m_out) {
+  std::vector<double> p;
+  power_spectrum(x, p, m_out);
   return p;
+}
+
+void centre(std::vector<double>& x) {
+  if (x.empty()) return;
+  const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+  for (double& v : x) v -= mean;
 }
 
 std::vector<double> centred(std::span<const double> x) {

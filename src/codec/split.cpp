@@ -18,12 +18,14 @@ constexpr double strength_snap = 0.02;
 
 // --- envelope tools ---------------------------------------------------------
 
-/// Running max (or min) over a centred window of w samples (monotonic deque, O(n)).
-std::vector<double> running_extreme(const std::vector<double>& x, std::size_t w, bool max) {
+/// Running max (or min) over a centred window of w samples (monotonic deque,
+/// O(n)), into `out`.
+void running_extreme(const std::vector<double>& x, std::size_t w, bool max, std::vector<double>& out,
+                     std::deque<std::size_t>& dq) {
   const std::size_t n = x.size();
   const std::size_t half = w / 2;
-  std::vector<double> out(n);
-  std::deque<std::size_t> dq;
+  out.resize(n);
+  dq.clear();
   std::size_t next = 0;
   auto better = [&](double a, double b) { return max ? a >= b : a <= b; };
   for (std::size_t i = 0; i < n; ++i) {
@@ -36,23 +38,30 @@ std::vector<double> running_extreme(const std::vector<double>& x, std::size_t w,
     while (dq.front() < lo) dq.pop_front();
     out[i] = x[dq.front()];
   }
-  return out;
 }
 
-/// Centred moving average of w samples, windows shortened at the ends.
-std::vector<double> moving_average(const std::vector<double>& x, std::size_t w) {
+/// Centred moving average of w samples, windows shortened at the ends, into
+/// `out` (`cum`: scratch).
+void moving_average(const std::vector<double>& x, std::size_t w, std::vector<double>& out, std::vector<double>& cum) {
   const std::size_t n = x.size();
   const std::size_t half = w / 2;
-  std::vector<double> cum(n + 1, 0.0);
+  cum.assign(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) cum[i + 1] = cum[i] + x[i];
-  std::vector<double> out(n);
+  out.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t lo = i >= half ? i - half : 0;
     const std::size_t hi = std::min(n, i + half + 1);
     out[i] = (cum[hi] - cum[lo]) / static_cast<double>(hi - lo);
   }
-  return out;
 }
+
+/// Work buffers of split(), per thread: the fit splits every two-scale
+/// candidate, and fresh signal-sized buffers each time cost more than the
+/// arithmetic (page faults).
+struct SplitScratch {
+  std::vector<double> centred, spectrum, up_raw, up, slow_1, up_slow, lo_raw, lo, cum;
+  std::deque<std::size_t> dq;
+};
 
 /// Within-texel variance, relative to the total, below which the input is
 /// constant over its texels (16-bit quantization adds ~10⁻¹¹ of full scale).
@@ -97,6 +106,28 @@ Split coarse_only_split(const std::vector<double>& a, double dx, const EncoderCo
   s.c.resize(k_count);
   for (std::size_t k = 0; k < k_count; ++k) s.c[k] = s.C > 0 ? std::clamp((e[k] - e_min) / s.C, 0.0, 1.0) : 1.0;
   return s;
+}
+
+/// A flat envelope: strengths from the mean and RMS, which sampling does not
+/// bias (the extremes of a sinusoid near the Nyquist frequency are rarely
+/// sampled): mean = e(1 − F/2), RMS = e·F/(2√2).
+void fine_only_strengths(const std::vector<double>& a, Split& s) {
+  const std::size_t n = a.size();
+  std::vector<double> fine;
+  s.coarse = false;
+  fine = centred(a);
+  double ms = 0.0;
+  for (double v : fine) ms += v * v;
+  const double rms = std::sqrt(ms / static_cast<double>(n));
+  const double mean = std::accumulate(a.begin(), a.end(), 0.0) / static_cast<double>(n);
+  const double env = std::min(1.0, mean + std::sqrt(2.0) * rms);
+  s.F = env > 0 ? std::clamp(2.0 * std::sqrt(2.0) * rms / env, 0.0, 1.0) : 0.0;
+  s.C = 1.0 - env;
+  // Within 2 % of full scale counts as full scale (well inside the
+  // intensity JND), so a fine-only texture stays a 14-byte stream.
+  if (s.C < strength_snap) s.C = 0.0;
+  if (s.F > 1.0 - strength_snap) s.F = 1.0;
+  s.fine = std::move(fine);
 }
 
 }  // namespace
@@ -159,16 +190,32 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
   const double B = cfg.boundary.value();
   const double L = cfg.texel_length.value();
   if (mode == SplitMode::coarse_only) return coarse_only_split(a, dx, cfg);
+  if (mode == SplitMode::fine_only) {
+    // No envelope to estimate: only the strengths (a flat surface has none).
+    Split s;
+    if (n > 0 && std::all_of(a.begin(), a.end(), [&](double v) { return v == a[0]; })) {
+      s.F = 0.0;
+      s.C = 1.0 - std::clamp(a[0], 0.0, 1.0);
+      s.fine.assign(n, 0.0);
+    } else {
+      fine_only_strengths(a, s);
+    }
+    return s;
+  }
 
   // Window for the envelope: about two periods of the fine texture, so that
   // every window holds a peak and a trough. The fine frequency is the
   // power-weighted mean above the boundary when that band carries the
   // texture, else of the whole spectrum (a fine texture below the boundary).
   Split s;
+  thread_local SplitScratch sc;
   std::size_t w = window;
   if (w == 0) {
     std::size_t m = 0;
-    const std::vector<double> p = power_spectrum(centred(a), m);
+    sc.centred.assign(a.begin(), a.end());
+    centre(sc.centred);
+    power_spectrum(sc.centred, sc.spectrum, m);
+    const std::vector<double>& p = sc.spectrum;
     const double df = 1.0 / (static_cast<double>(m) * dx);
     double pw = 0, pf = 0, hw = 0, hf = 0;
     for (std::size_t i = 1; i < p.size(); ++i) {
@@ -195,14 +242,19 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
   // the running extremes' steps; it barely attenuates coarse features (a
   // 5 mm period keeps 98 % of its amplitude).
   const auto smooth = std::max(w, static_cast<std::size_t>(std::round(0.5 * B / dx)));
-  const std::vector<double> up_raw = running_extreme(a, w, true);
-  std::vector<double> up = moving_average(up_raw, smooth);
+  running_extreme(a, w, true, sc.up_raw, sc.dq);
+  moving_average(sc.up_raw, smooth, sc.up, sc.cum);
+  std::vector<double>& up = sc.up;
   // The decision coarse-or-not looks at the envelope low-passed at the
   // boundary proper (two passes of B): the envelope of a noise fluctuates
   // at the rate of its bandwidth, which is fine texture, not coarse layout.
   const auto b_samples = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
-  const std::vector<double> up_slow = moving_average(moving_average(up_raw, b_samples), b_samples);
-  std::vector<double> lo = moving_average(running_extreme(a, w, false), smooth);
+  moving_average(sc.up_raw, b_samples, sc.slow_1, sc.cum);
+  moving_average(sc.slow_1, b_samples, sc.up_slow, sc.cum);
+  const std::vector<double>& up_slow = sc.up_slow;
+  running_extreme(a, w, false, sc.lo_raw, sc.dq);
+  moving_average(sc.lo_raw, smooth, sc.lo, sc.cum);
+  const std::vector<double>& lo = sc.lo;
   for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
 
   const std::size_t k_count =
@@ -221,22 +273,8 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
   s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
   std::vector<double> fine(n);
   if (mode == SplitMode::fine_only || (mode == SplitMode::automatic && s.range < cfg.flat_envelope)) {
-    // A flat envelope: strengths from the mean and RMS, which sampling does
-    // not bias (the extremes of a sinusoid near the Nyquist frequency are
-    // rarely sampled): mean = e(1 − F/2), RMS = e·F/(2√2).
-    s.coarse = false;
-    fine = centred(a);
-    double ms = 0.0;
-    for (double v : fine) ms += v * v;
-    const double rms = std::sqrt(ms / static_cast<double>(n));
-    const double mean = std::accumulate(a.begin(), a.end(), 0.0) / static_cast<double>(n);
-    const double env = std::min(1.0, mean + std::sqrt(2.0) * rms);
-    s.F = env > 0 ? std::clamp(2.0 * std::sqrt(2.0) * rms / env, 0.0, 1.0) : 0.0;
-    s.C = 1.0 - env;
-    // Within 2 % of full scale counts as full scale (well inside the
-    // intensity JND), so a fine-only texture stays a 14-byte stream.
-    if (s.C < strength_snap) s.C = 0.0;
-    if (s.F > 1.0 - strength_snap) s.F = 1.0;
+    fine_only_strengths(a, s);
+    return s;
   } else {
     s.coarse = true;
     const double e_min = *std::min_element(e.begin(), e.end());
@@ -244,7 +282,7 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
     s.c.resize(k_count);
     for (std::size_t k = 0; k < k_count; ++k) s.c[k] = s.C > 0 ? std::clamp((e[k] - e_min) / s.C, 0.0, 1.0) : 1.0;
     for (std::size_t i = 0; i < n; ++i) fine[i] = a[i] / up[i];
-    fine = centred(fine);
+    centre(fine);
   }
   s.fine = std::move(fine);
   return s;

@@ -485,6 +485,11 @@ TEST_F(Cli, SwipeRecordingsEncodeBackToTheirParameters) {
     EXPECT_NEAR(est["coarse_strength"].get<double>(), c.coarse ? 0.6 : 0.0, 0.06);
     EXPECT_NEAR(est["fine_strength"].get<double>(), c.coarse ? 0.5 : 1.0, 0.06);
   }
+  // The fit's search is switchable (--fit), and named in --json.
+  const Result nm = run({"encode", "fine50.csv", "--swipe-speed", "50", "--fit", "simplex", "--json"});
+  ASSERT_EQ(nm.status, 0) << nm.err;
+  EXPECT_EQ(nlohmann::json::parse(nm.out)["model"]["fit"], "simplex");
+  expect_rejected({"encode", "fine50.csv", "--swipe-speed", "50", "--fit", "newton"}, "--fit is 'newton'");
   // A 3-column CSV whose header is not time_s,… is refused, naming the layout.
   write("bad.csv", "position_mm,x,amplitude\n0,0,0.5\n0.1,0,0.6\n0.2,0,0.7\n");
   expect_rejected({"encode", "bad.csv"}, "time_s,position_mm,value");

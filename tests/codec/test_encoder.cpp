@@ -130,6 +130,26 @@ TEST(Encoder, CoarseOnlyMapsEncodeAsACoarseProfile) {
   EXPECT_EQ(f.spec.fine_strength, 0.0);
 }
 
+// The two searches of the fit (docs/encoder.md §3): least squares (the
+// default) lands where the simplex does, with a fraction of its evaluations.
+TEST(Encoder, LeastSquaresFitMatchesTheSimplex) {
+  const DeviceProfile d = load_device("tpad");
+  for (const char* name : {"2sin", "saw"}) {
+    SCOPED_TRACE(name);
+    ReferenceSpec rs;
+    rs.name = name;
+    const codec::Signal in{render_reference(rs, d.grid()), d.spacing, name};
+    EncoderConfig ls, nm;
+    nm.fit_method = FitMethod::simplex;
+    const EncodeResult a = encode(in, ls), b = encode(in, nm);
+    EXPECT_NEAR(a.spec.central_pitch.value(), b.spec.central_pitch.value(), 0.3);
+    EXPECT_LE(a.model_distance, b.model_distance + 0.1);
+    EXPECT_LT(a.evaluations, b.evaluations / 2);
+  }
+  EXPECT_EQ(parse_fit_method("simplex"), FitMethod::simplex);
+  EXPECT_THROW((void)parse_fit_method("newton"), InvalidArgument);
+}
+
 TEST(Encoder, BitBudgetIsHonoured) {
   TexelSpec s;
   s.coarse_strength = 0.6;
