@@ -197,12 +197,15 @@ void identifiability(Fitter& fit, const Box& box, FineFit& out) {
   const double narrower = std::max(box.i_lo, out.i_db - 6.0);
   if (fit(out.p_db, narrower) - out.distance < 0.5) {
     out.identifiable = false;
-    double bound = out.i_db;
-    for (double i = out.i_db + 1.0; i <= box.i_hi; i += 1.0) {
-      if (fit(out.p_db, i) - out.distance >= 0.5) break;
-      bound = i;
+    // The widest distribution (1 dB steps up from the estimate) that still
+    // feels the same, by bisection: the distance grows with the spread.
+    const auto steps = static_cast<int>(std::floor(box.i_hi - out.i_db));
+    int same = 0, differs = steps + 1;  // `same` steps feel the same; `differs` (if ≤ steps) does not
+    while (differs - same > 1) {
+      const int mid = (same + differs) / 2;
+      (fit(out.p_db, out.i_db + mid) - out.distance >= 0.5 ? differs : same) = mid;
     }
-    out.bound_db = bound;
+    out.bound_db = out.i_db + same;
   }
 }
 
@@ -225,26 +228,33 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
   double i0 = cfg.parameterization == Parameterization::log
                   ? std::clamp(out.input.spread_db, box.i_lo, box.i_hi)
                   : std::clamp(db_of(cpm_of(p0) * out.input.spread_db / ten_over_ln10), box.i_lo, box.i_hi);
-  double best_v = fit(p0, i0);
-  const double gp = p0, gi = i0;
-  for (double dp : {-3.0, 0.0, 3.0})
-    for (double di : {-8.0, 0.0, 8.0}) {
-      const double p = gp + dp, i = gi + di;
-      if ((dp == 0.0 && di == 0.0) || !box.inside(p, i)) continue;
-      const double v = fit(p, i);
-      if (v < best_v) best_v = v, p0 = p, i0 = i;
-    }
-  // From the best grid point, least squares: the distance is the norm of
-  // four residuals and a Texel texture's percept moves smoothly with (P, I)
-  // at the scale of the difference steps, so Levenberg–Marquardt converges
-  // in a few iterations where the simplex needed a hundred evaluations.
-  // The simplex (the encoder's method before, kept as an option) needs no
-  // smoothness but ~100 evaluations.
+  // The best of a 3 × 3 grid around the start (±3 dB, ±8 dB): wide
+  // distributions make the objective rough enough to trap a local search
+  // far from the optimum.
+  auto grid_start = [&](double& p, double& i) {
+    double best_v = fit(p, i);
+    const double gp = p, gi = i;
+    for (double dp : {-3.0, 0.0, 3.0})
+      for (double di : {-8.0, 0.0, 8.0}) {
+        const double pp = gp + dp, ii = gi + di;
+        if ((dp == 0.0 && di == 0.0) || !box.inside(pp, ii)) continue;
+        const double v = fit(pp, ii);
+        if (v < best_v) best_v = v, p = pp, i = ii;
+      }
+  };
   std::array<double, 3> best;
   if (cfg.fit_method == FitMethod::simplex) {
+    // The encoder's search before least squares (kept as an option): needs
+    // no smoothness, ~120 evaluations.
+    grid_start(p0, i0);
     best = nelder_mead(fit, box, p0, i0, 1.5, 4.0, cfg.max_evaluations / 2);
     best = nelder_mead(fit, box, best[0], best[1], 0.5, 2.0, cfg.max_evaluations / 2);  // restart: NM can stall
   } else {
+    // Least squares from the best grid point: the distance is the norm of
+    // four residuals and a Texel texture's percept moves smoothly with
+    // (P, I) at the scale of the difference steps, so Levenberg–Marquardt
+    // converges in a few iterations where the simplex needs a hundred.
+    grid_start(p0, i0);
     best = levenberg_marquardt(fit, box, p0, i0);
   }
   out.p_db = best[0];
