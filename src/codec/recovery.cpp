@@ -199,7 +199,12 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
     }
     sse += best;
     used += e - b;
-    if (k >= 8 && sse > 0.05 * 0.05 * static_cast<double>(used)) return r;  // not a Texel rendering of this L
+    // Not a Texel rendering of this L: a running residual RMS above 0.05
+    // after 8 texels, or far above it (0.2) after 3, or a residual that can
+    // no longer end below the acceptance RMS over the whole input.
+    if (k >= 8 && sse > 0.05 * 0.05 * static_cast<double>(used)) return r;
+    if (k >= 2 && sse > 0.2 * 0.2 * static_cast<double>(used)) return r;
+    if (sse > recovery_rms * recovery_rms * static_cast<double>(n)) return r;
     r.f.push_back(bf);
     const double next = bp + bf * L;
     phase = next - std::floor(next);
