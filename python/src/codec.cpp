@@ -307,7 +307,8 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       "encode",
       [](const py::object& source, const py::object& device, std::optional<double> spacing_mm,
          std::optional<double> swipe_speed_mm_s, double boundary_mm, double texel_length_mm, std::uint64_t seed,
-         const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes) {
+         const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes,
+         const std::string& fit) {
         codec::EncoderConfig c;
         if (swipe_speed_mm_s) c.model.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
         c.boundary = Millimetres(boundary_mm);
@@ -316,6 +317,7 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
         c.parameterization = parse_parameterization(parameterization, "parameterization");
         c.coarse_bits = coarse_bits;
         c.max_bytes = max_bytes;
+        c.fit_method = codec::parse_fit_method(fit, "fit");
         const codec::Signal signal = signal_of(source, device, spacing_mm, swipe_speed_mm_s);
         py::gil_scoped_release release;
         return codec::encode(signal, c);
@@ -323,7 +325,7 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       py::arg("source"), py::kw_only(), py::arg("device") = py::none(), py::arg("spacing_mm") = py::none(),
       py::arg("swipe_speed_mm_s") = py::none(), py::arg("boundary_mm") = 1.0, py::arg("texel_length_mm") = 0.25,
       py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("coarse_bits") = 6u,
-      py::arg("max_bytes") = py::none(),
+      py::arg("max_bytes") = py::none(), py::arg("fit") = "least-squares",
       R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
 
 source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array: float amplitudes
@@ -337,6 +339,7 @@ seed              seed written to the bitstream [1]
 parameterization  'moments' or 'log' ['moments']
 coarse_bits       bits per coarse level, 1 … 16 [6]
 max_bytes         bitstream budget (bytes) [none]
+fit               search of the perceptual fit: 'least-squares' or 'simplex' (slower) ['least-squares']
 
 The GIL is released while encoding.)doc");
 

@@ -26,6 +26,17 @@ def test_encode_array_equals_cli_bitstream(encoded):
     assert r.model_distance >= 0
 
 
+def test_encode_fit_method_equals_the_cli(cli, tmp_path):
+    src = tmp_path / "saw.bin"
+    cli("reference", "saw", "--device", "tpad", "-o", src)
+    for fit in ("least-squares", "simplex"):
+        out = tmp_path / f"saw-{fit}.texel"
+        cli("encode", src, "--device", "tpad", "--fit", fit, "-o", out)
+        assert texel.encode(str(src), device="tpad", fit=fit).bytes == out.read_bytes()
+    with pytest.raises(ValueError, match="fit is 'newton'"):
+        texel.encode(str(src), device="tpad", fit="newton")
+
+
 def test_decode_equals_cli(cli, encoded, tmp_path):
     _, stream = encoded
     for device in ("tpad", "generic"):
