@@ -23,8 +23,9 @@ def ticks_during(work):
 
 
 def test_reference_synthesis_releases_the_gil():
-    # ~0.5 s of synthesis; with the GIL held the main thread could not tick at all.
-    assert ticks_during(lambda: texel.reference("pink", length_mm=150)) > 20
+    # ~0.5 s of synthesis (4 m of pink noise on the tpad grid: 755,000 samples,
+    # chirp-z); with the GIL held the main thread could not tick at all.
+    assert ticks_during(lambda: texel.reference("pink", length_mm=4000)) > 20
 
 
 def test_encode_releases_the_gil():
