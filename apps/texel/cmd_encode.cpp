@@ -27,6 +27,8 @@ struct EncodeArgs {
   std::uint64_t seed = 1;
   std::string parameterization = "moments";
   std::string fit = "least-squares";
+  double weight_exponent = codec::PerceptualModel{}.weight_exponent;
+  double sensitivity_scale = codec::PerceptualModel{}.sensitivity_scale;
   unsigned coarse_bits = 6;
   std::optional<std::size_t> max_bytes;
   bool json = false;
@@ -42,6 +44,8 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   c.seed = a.seed;
   c.parameterization = parse_parameterization(a.parameterization, "--parameterization");
   c.fit_method = codec::parse_fit_method(a.fit, "--fit");
+  c.model.weight_exponent = a.weight_exponent;
+  c.model.sensitivity_scale = a.sensitivity_scale;
   c.coarse_bits = a.coarse_bits;
   c.max_bytes = a.max_bytes;
   return c;
@@ -228,6 +232,12 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
+  cmd->add_option("--weight-exponent", a->weight_exponent,
+                  "Perceptual model: exponent of a component's felt weight (1 = amplitude-weighted, the model before) [1.75]")
+      ->group(g);
+  cmd->add_option("--sensitivity-scale", a->sensitivity_scale,
+                  "Perceptual model: share of the threshold curve in the weighting, 0 … 1 (1 = the model before) [0.5]")
+      ->group(g);
   cmd->add_option("--fit", a->fit, "Search of the perceptual fit: least-squares | simplex (slower) [least-squares]")->group(g);
   cmd->add_option("--coarse-bits", a->coarse_bits, "Bits per coarse level, 1 … 16 [6]")->group(g);
   cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")
@@ -256,7 +266,8 @@ void register_encode(CLI::App& app) {
       if (cmd->count("--coarse-bits")) to.coarse_bits = a->coarse_bits;
       to.max_bytes = a->max_bytes;
       if (auto t = codec::transcode_file(a->inputs[0], signal_options(a->input), to)) {
-        for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit"})
+        for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit", "--weight-exponent",
+                                 "--sensitivity-scale"})
           if (cmd->count(flag))
             throw InvalidArgument(std::string(flag) + " applies to estimation; '" + a->inputs[0] +
                                   "' holds Texel parameters and is transcoded with its own (add --estimate to re-estimate it)");

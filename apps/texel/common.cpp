@@ -65,11 +65,18 @@ SignalOptions signal_options(const SignalArgs& a) {
 Signal load_input(const std::string& path, const SignalArgs& a) { return codec::load_signal(path, signal_options(a)); }
 
 std::string flag_of_field(std::string_view field) {
-  static const std::pair<std::string_view, std::string_view> flags[] = {
-      {"device", "--device"},           {"spacing", "--spacing"},           {"region", "--region"},
-      {"swipe_speed", "--swipe-speed"}, {"channel", "--channel"},           {"backend", "--backend"},
-      {"boundary", "--boundary"},       {"texel_length", "--texel-length"}, {"coarse_bits", "--coarse-bits"},
-      {"max_bytes", "--max-bytes"}};
+  static const std::pair<std::string_view, std::string_view> flags[] = {{"device", "--device"},
+                                                                        {"spacing", "--spacing"},
+                                                                        {"region", "--region"},
+                                                                        {"swipe_speed", "--swipe-speed"},
+                                                                        {"channel", "--channel"},
+                                                                        {"backend", "--backend"},
+                                                                        {"boundary", "--boundary"},
+                                                                        {"texel_length", "--texel-length"},
+                                                                        {"coarse_bits", "--coarse-bits"},
+                                                                        {"max_bytes", "--max-bytes"},
+                                                                        {"weight_exponent", "--weight-exponent"},
+                                                                        {"sensitivity_scale", "--sensitivity-scale"}};
   for (const auto& [f, flag] : flags)
     if (f == field) return std::string(flag);
   return std::string(field);  // a field with no flag (max_samples) keeps its library name

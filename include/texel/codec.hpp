@@ -68,6 +68,16 @@ struct PerceptualModel {
   double pitch_jnd_db = 1.0;       ///< just-noticeable pitch change, dB (≈ 25 % frequency)
   double noisiness_jnd_db = 1.0;   ///< just-noticeable change of spread, dB [modelling choice]
   double tie_weight = 0.01;        ///< weight of the physical tie-break terms (see docs/encoder.md)
+  /// Felt weight of a component (docs/encoder.md §2) [choice]: its
+  /// sensitivity-weighted amplitude per unit log-frequency raised to this
+  /// power. 1.75: between amplitude (1, the model before) and energy (2)
+  /// weighting, so the strongest components dominate the felt pitch.
+  double weight_exponent = 1.75;
+  /// How much of the threshold curve's frequency dependence (dB) the weight
+  /// keeps at the suprathreshold levels textures are felt at [choice]: 0.5
+  /// (equal-sensation contours flatten with level); 1 is the threshold curve
+  /// itself (the model before).
+  double sensitivity_scale = 0.5;
 };
 
 /// Relative vibrotactile threshold at temporal frequency f, dB above the most

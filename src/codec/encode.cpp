@@ -34,6 +34,10 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     throw FieldError("texel_length", "is " + num(cfg.texel_length.value()) + " mm; allowed: 0.001 … 65.535 mm");
   if (!(cfg.model.swipe_speed.value() > 0.0 && std::isfinite(cfg.model.swipe_speed.value())))
     throw FieldError("swipe_speed", "is " + num(cfg.model.swipe_speed.value()) + " mm/s; it must be > 0");
+  if (!(cfg.model.weight_exponent > 0.0 && cfg.model.weight_exponent <= 4.0))
+    throw FieldError("weight_exponent", "is " + num(cfg.model.weight_exponent) + "; allowed: > 0 … 4");
+  if (!(cfg.model.sensitivity_scale >= 0.0 && cfg.model.sensitivity_scale <= 1.0))
+    throw FieldError("sensitivity_scale", "is " + num(cfg.model.sensitivity_scale) + "; allowed: 0 … 1");
   if (cfg.coarse_bits < 1 || cfg.coarse_bits > 16)
     throw FieldError("coarse_bits", "is " + std::to_string(cfg.coarse_bits) + "; allowed: 1 … 16");
   const double len = static_cast<double>(n) * dx;

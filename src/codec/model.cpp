@@ -29,16 +29,19 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   thread_local std::vector<double> p;  // reused: the fit perceives hundreds of candidates
   power_spectrum(fine, p, m);
   const double v = model.swipe_speed.value();
-  // Per-bin frequency, dB and sensitivity depend only on (M, Δx, v): cache them.
+  // Per-bin frequency, dB and weight depend only on (M, Δx, v) and the
+  // model's weighting: cache them.
   struct Bins {
     std::size_t m = 0;
-    double dx = 0, v = 0, f_min = 0;
+    double dx = 0, v = 0, f_min = 0, exponent = 0, scale = 0;
     std::vector<double> f, d, gain;
   };
   thread_local Bins bins;
   const double f_lo = std::max(0.01, f_min_cpm);
-  if (bins.m != m || bins.dx != spacing_mm || bins.v != v || bins.f_min != f_lo) {
+  if (bins.m != m || bins.dx != spacing_mm || bins.v != v || bins.f_min != f_lo || bins.exponent != model.weight_exponent ||
+      bins.scale != model.sensitivity_scale) {
     bins.m = m, bins.dx = spacing_mm, bins.v = v, bins.f_min = f_lo;
+    bins.exponent = model.weight_exponent, bins.scale = model.sensitivity_scale;
     const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
     bins.f.assign(p.size(), 0.0);
     bins.d.assign(p.size(), 0.0);
@@ -47,8 +50,10 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
       const double f = static_cast<double>(i) * df;
       bins.f[i] = f;
       bins.d[i] = db_of(f);
-      // Sensitivity at f·v over sqrt(f): amplitude per unit log-frequency.
-      bins.gain[i] = f < f_lo ? 0.0 : std::pow(10.0, -threshold_db(Hertz(f * v)) / 20.0) / std::sqrt(f);
+      // Suprathreshold sensitivity at f·v over sqrt(f): amplitude per unit
+      // log-frequency, raised to the weight exponent (applied to √P below).
+      const double sensitivity = std::pow(10.0, -model.sensitivity_scale * threshold_db(Hertz(f * v)) / 20.0);
+      bins.gain[i] = f < f_lo ? 0.0 : std::pow(sensitivity / std::sqrt(f), model.weight_exponent);
     }
   }
   // Components more than `masked_db` below the strongest are not felt
@@ -62,7 +67,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   for (std::size_t i = 1; i < p.size(); ++i) {
     if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
     const double f = bins.f[i], d = bins.d[i];
-    const double w = std::sqrt(p[i]) * bins.gain[i];
+    const double w = (model.weight_exponent == 2.0 ? p[i] : std::pow(std::sqrt(p[i]), model.weight_exponent)) * bins.gain[i];
     sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
     sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
   }
