@@ -12,6 +12,7 @@
 #include <unistd.h>
 #include "../support/cli_run.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -120,35 +121,52 @@ TEST(ExperimentCli, GuidedExplorationStoresTwentyComparisonsPerReference) {
 TEST(ExperimentCli, KilledAtRandomMomentsAndResumedEqualsUninterrupted) {
   TempDir d("texel-exp-kill");
   const std::string proto = protocols + "texel-length.json";
-  // Reference: the uninterrupted run.
-  ASSERT_EQ(
-      run("experiment run " + proto + " --participant K1 --db " + d.at("ref.db") + " --simulate threshold=6mm --quiet").status,
-      0);
+  using Clock = std::chrono::steady_clock;
+  auto ms_since = [](Clock::time_point t) {
+    return static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t).count());
+  };
+  // Reference: the uninterrupted run, paced like the killed ones, and timed:
+  // kill moments are set from this build's own speed (an AddressSanitizer
+  // build starts and runs several times slower), never from fixed numbers.
+  const auto t_run = Clock::now();
+  ASSERT_EQ(run("experiment run " + proto + " --participant K1 --db " + d.at("ref.db") +
+                " --simulate threshold=6mm --pace 0.01 --quiet")
+                .status,
+            0);
+  const int run_ms = ms_since(t_run);
   ASSERT_EQ(run("experiment export --db " + d.at("ref.db") + " -o " + d.at("ref.csv")).status, 0);
   const auto expected = stable_rows(d.at("ref.csv"));
-
-  const std::string db = d.at("kill.db");
-  // Kill moments are spread over the run's life after start-up. Start-up is
-  // measured here, so a slow build (AddressSanitizer) still gets past it.
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t_start = Clock::now();
   (void)run("experiment status --db " + d.at("ref.db") + " --json");
-  const int startup_ms =
-      static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0).count());
+  const int startup_ms = std::min(ms_since(t_start), run_ms / 2);
+  // Each attempt lives past start-up and then at most an eighth of the
+  // run's work, so the run cannot finish before several kills.
+  const int work_ms = std::max(run_ms - startup_ms, 80);
   std::mt19937 rng(12345);
-  std::uniform_int_distribution<int> delay_ms(30 + startup_ms, 300 + 2 * startup_ms);
+  std::uniform_int_distribution<int> delay_ms(startup_ms + work_ms / 50, startup_ms + work_ms / 8);
+  const std::string db = d.at("kill.db");
   int kills = 0;
   // What a researcher does after a crash: resume the running session; start
   // one if the kill came before it existed; stop once it is finished (a kill
   // can land after the last commit, before the process exits).
+  int trials_done = 0;  // as of the last session_state()
   auto session_state = [&]() -> std::string {
     const CliRun s = run("experiment status --db " + db + " --json");
     if (s.status != 0) return "none";
     const auto j = nlohmann::json::parse(s.out.substr(s.out.find('{')));
-    return j["sessions"].empty() ? "none" : j["sessions"][0]["status"].get<std::string>();
+    if (j["sessions"].empty()) return "none";
+    trials_done = j["sessions"][0]["trials_done"].get<int>();
+    return j["sessions"][0]["status"].get<std::string>();
   };
+  // An attempt killed before it stored a trial (a slow start on a loaded
+  // machine) lengthens the next ones by half, so every run makes progress.
+  double stretch = 1.0;
+  int trials_before = -1;
   for (int attempt = 0; attempt < 60; ++attempt) {
     const std::string state = session_state();
     if (state == "finished") break;
+    if (attempt > 0 && trials_done <= trials_before) stretch = std::min(stretch * 1.5, 8.0);
+    trials_before = trials_done;
     const bool first = state == "none";
     const pid_t pid = ::fork();
     ASSERT_GE(pid, 0);
@@ -166,7 +184,7 @@ TEST(ExperimentCli, KilledAtRandomMomentsAndResumedEqualsUninterrupted) {
       ::execv(TEXEL_CLI, argv.data());
       ::_exit(127);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(stretch * delay_ms(rng))));
     int status = 0;
     if (::waitpid(pid, &status, WNOHANG) == pid) {
       ASSERT_TRUE(WIFEXITED(status));
