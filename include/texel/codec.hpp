@@ -3,6 +3,8 @@
 // (decoder).
 //
 // Encoder (docs/encoder.md has the model, its parameters and sources):
+//  0. Inputs without fine texture (constant per texel, as the renderer draws
+//     F = 0, or next to no power above the boundary) are a coarse profile.
 //  1. Split. The amplitude envelope is what changes more slowly than the
 //     fine/coarse boundary (1 mm): running maximum and minimum over a window
 //     of about two fine periods, smoothed by a moving average one boundary
@@ -10,12 +12,14 @@
 //     the texel centres become the coarse profile c_k with strengths C and F
 //     (rendering.md §7: e_k = 1 − C(1 − c_k), trough/peak = 1 − F).
 //  2. Fine part by analysis-by-synthesis. A perceptual model maps a signal to
-//     a felt pitch (sensitivity-weighted, amplitude-weighted mean frequency)
-//     and a felt noisiness (the weighted spread of log-frequency), at the
-//     swipe speed that turns cycles/mm into Hz. Candidate Texel textures are
-//     rendered with the library and compared with the input under the model;
-//     Nelder–Mead over (Central Pitch, Irregularity) minimises the distance,
-//     starting from the input's spectral centroid and spread.
+//     a felt pitch (the mean frequency weighted by suprathreshold
+//     sensitivity and amplitude, raised so the strongest components
+//     dominate) and a felt noisiness (the weighted spread of log-frequency),
+//     at the swipe speed that turns cycles/mm into Hz. Candidate Texel
+//     textures are rendered with the library and compared with the input
+//     under the model; least squares (Levenberg–Marquardt, or the simplex on
+//     request) over (Central Pitch, Irregularity) minimises the distance,
+//     from the best of a grid around the input's spectral centroid and spread.
 //  3. Inputs that are themselves fine-only Texel renderings are recognised
 //     (phase-continuous sinusoid, constant frequency per texel) and their
 //     texel length, Central Pitch and Irregularity are recovered from the
