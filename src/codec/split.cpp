@@ -4,6 +4,7 @@
 #include <cmath>
 #include <deque>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 #include "encoder_parts.hpp"
@@ -63,6 +64,15 @@ struct SplitScratch {
   std::deque<std::size_t> dq;
 };
 
+/// The interior samples [b, e) of texel k of length L: a sample on a texel
+/// boundary may round to either side, so it is left out (empty if the texel
+/// is under three samples long or beyond the input).
+std::pair<std::size_t, std::size_t> interior_samples(std::size_t k, double L, double dx, std::size_t n) {
+  const auto b = static_cast<std::size_t>(std::ceil((static_cast<double>(k) * L + dx) / dx));
+  const auto e = std::min(n, static_cast<std::size_t>(std::ceil((static_cast<double>(k + 1) * L - dx) / dx)));
+  return {b, e};
+}
+
 /// Within-texel variance, relative to the total, below which the input is
 /// constant over its texels (16-bit quantization adds ~10⁻¹¹ of full scale).
 constexpr double stepped_variance = 1e-6;
@@ -79,12 +89,10 @@ Split coarse_only_split(const std::vector<double>& a, double dx, const EncoderCo
       std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
   std::vector<double> e(k_count, 0.0);
   for (std::size_t k = 0; k < k_count; ++k) {
-    // Interior samples (a sample on a texel boundary may belong to either
-    // side), or the nearest one for texels under three samples long.
-    const double x0 = static_cast<double>(k) * L, x1 = x0 + L;
-    auto b = std::min(n - 1, static_cast<std::size_t>(std::ceil((x0 + dx) / dx)));
-    auto end = std::min(n, static_cast<std::size_t>(std::ceil((x1 - dx) / dx)));
-    if (end <= b) b = std::min(n - 1, static_cast<std::size_t>(std::lround((x0 + 0.5 * L) / dx))), end = b + 1;
+    // Interior samples, or the nearest one for texels under three samples long.
+    auto [b, end] = interior_samples(k, L, dx, n);
+    if (end <= b)
+      b = std::min(n - 1, static_cast<std::size_t>(std::lround((static_cast<double>(k) + 0.5) * L / dx))), end = b + 1;
     double m = 0.0;
     for (std::size_t i = b; i < end; ++i) m += a[i];
     e[k] = std::clamp(m / static_cast<double>(end - b), 0.0, 1.0);
@@ -163,13 +171,12 @@ std::optional<double> stepped_texel_length(const std::vector<double>& a, double 
   for (double L : lengths) {
     const auto texels = static_cast<std::size_t>(std::floor(static_cast<double>(n) * dx / L + 1e-9));
     if (texels < 4 || L < 4.0 * dx || (best && L <= *best)) continue;
-    // Interior samples of each texel only (a sample on a texel boundary may
-    // round to either side); the rest after the last whole texel is ignored.
+    // Interior samples of each texel only; the rest after the last whole
+    // texel is ignored.
     double within = 0.0, sum = 0.0, sum2 = 0.0;
     std::size_t count = 0;
     for (std::size_t k = 0; k < texels; ++k) {
-      const auto b = static_cast<std::size_t>(std::ceil((static_cast<double>(k) * L + dx) / dx));
-      const auto e = std::min(n, static_cast<std::size_t>(std::ceil((static_cast<double>(k + 1) * L - dx) / dx)));
+      const auto [b, e] = interior_samples(k, L, dx, n);
       if (e <= b) continue;
       double m = 0.0;
       for (std::size_t i = b; i < e; ++i) m += a[i];
