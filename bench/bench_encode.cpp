@@ -7,7 +7,9 @@
 // and over the two-scale maps, against the goals of issue #11 (10 ms and
 // 30 ms).
 //
-//   texel_bench_encode [--device NAME] [--repeat N] [--json PATH]
+//   texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME]
+//
+// --only keeps the maps whose name contains NAME (for profiling one map).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -55,7 +57,7 @@ struct Map {
 
 int main(int argc, char** argv) {
   std::string device_name = "tpad";
-  std::string json_path;
+  std::string json_path, only;
   int repeat = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -65,8 +67,10 @@ int main(int argc, char** argv) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--json" && i + 1 < argc) {
       json_path = argv[++i];
+    } else if (a == "--only" && i + 1 < argc) {
+      only = argv[++i];
     } else {
-      std::cerr << "usage: texel_bench_encode [--device NAME] [--repeat N] [--json PATH]\n";
+      std::cerr << "usage: texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME]\n";
       return 2;
     }
   }
@@ -85,10 +89,12 @@ int main(int argc, char** argv) {
 
   std::printf("encode time per map on %s (%lld samples), median of %d; baseline: rendering the same map\n", device_name.c_str(),
               static_cast<long long>(device.grid().count), repeat);
-  std::printf("%-22s %-10s %-9s %10s %10s %8s %9s\n", "map", "kind", "method", "render ms", "encode ms", "ratio", "distance");
+  std::printf("%-22s %-10s %-9s %10s %10s %8s %9s %6s %14s\n", "map", "kind", "method", "render ms", "encode ms", "ratio",
+              "distance", "evals", "P, I (dB)");
   nlohmann::json out = nlohmann::json::array();
   std::vector<double> fine_ms, two_scale_ms, other_ms;  // other: coarse-only or flat
   for (const Map& m : maps) {
+    if (m.name.find(only) == std::string::npos) continue;
     std::vector<double> a;
     const double render_ms = median_ms(repeat, [&] { a = m.render(); });
     const codec::Signal signal{a, device.spacing, m.name};
@@ -101,14 +107,18 @@ int main(int argc, char** argv) {
       (r.coarse ? two_scale_ms : fine_ms).push_back(encode_ms);
     else
       other_ms.push_back(encode_ms);
-    std::printf("%-22s %-10s %-9s %10.2f %10.2f %8.1f %9.3f\n", m.name.c_str(), kind, method, render_ms, encode_ms,
-                encode_ms / render_ms, r.model_distance);
+    std::printf("%-22s %-10s %-9s %10.2f %10.2f %8.1f %9.3f %6d %6.2f %7.2f\n", m.name.c_str(), kind, method, render_ms,
+                encode_ms, encode_ms / render_ms, r.model_distance, r.evaluations, r.spec.central_pitch.value(),
+                r.spec.irregularity.value());
     out.push_back({{"map", m.name},
                    {"kind", kind},
                    {"method", method},
                    {"render_ms", render_ms},
                    {"encode_ms", encode_ms},
                    {"model_distance", r.model_distance},
+                   {"evaluations", r.evaluations},
+                   {"central_pitch_db", r.spec.central_pitch.value()},
+                   {"irregularity_db", r.spec.irregularity.value()},
                    {"bytes", r.bytes.size()}});
   }
   const double fine_median = median(fine_ms), two_median = median(two_scale_ms);

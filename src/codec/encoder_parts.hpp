@@ -46,7 +46,7 @@ double shape_distance_db(const std::vector<double>& x, const std::vector<double>
 
 struct Split {
   std::vector<double> fine;  // zero-mean fine signal (envelope divided out)
-  double range = 0.0;        // relative envelope range (p98 − p2) / p98 at texel centres
+  double range = 0.0;        // relative envelope range (p98 − p2) / p98 at texel centres (automatic splits)
   std::size_t window = 0;    // running-extreme window, samples
   bool coarse = false;
   double C = 0.0;
@@ -63,6 +63,9 @@ enum class SplitMode { automatic, fine_only, two_scale, coarse_only };
 /// deriving it from the spectrum: candidates are analysed exactly like the input.
 Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode = SplitMode::automatic,
             std::size_t window = 0);
+/// The same into `out`, reusing its signal-sized buffer (the fit splits
+/// every two-scale candidate).
+void split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode, std::size_t window, Split& out);
 
 /// §1 step 0: the longest of `lengths` (mm) over whose texels the input is
 /// constant (a coarse profile without fine texture, as the renderer draws it

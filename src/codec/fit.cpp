@@ -40,7 +40,11 @@ Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) con
   thread_local std::vector<double> a;  // reused across candidates (no allocation per evaluation)
   a.resize(samples);
   t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(samples)}, 0, a);
-  if (two_scale) return perceive(split(a, dx, cfg, SplitMode::two_scale, two_scale->window).fine, dx, cfg.model, f_min);
+  if (two_scale) {
+    thread_local Split sp;  // reused, like `a`
+    split(a, dx, cfg, SplitMode::two_scale, two_scale->window, sp);
+    return perceive(sp.fine, dx, cfg.model, f_min);
+  }
   centre(a);
   return perceive(a, dx, cfg.model, f_min);
 }

@@ -16,6 +16,41 @@ namespace {
 /// Masking floor of the model, dB below the strongest spectral component.
 constexpr double masked_db = 50.0;
 
+/// x^e for x ≥ 0 over every bin of every candidate's spectrum: libm's pow
+/// was an eighth of an encode. An exponent with at most four binary digits
+/// after the point (the default 1.75 / 2 = 0.875 = ½ + ¼ + ⅛) is a product
+/// of integer powers and repeated square roots, exact to a few ulp; any
+/// other exponent falls back to pow.
+class DyadicPower {
+ public:
+  DyadicPower() = default;
+  explicit DyadicPower(double e) : e_(e) {
+    const double scaled = e * 16.0;
+    if (e >= 0.0 && e <= 8.0 && scaled == std::floor(scaled)) {
+      const auto bits = static_cast<unsigned>(scaled);
+      whole_ = bits >> 4;
+      fraction_ = bits & 15u;  // bit 3: x^½, bit 2: x^¼, bit 1: x^⅛, bit 0: x^1/16
+      dyadic_ = true;
+    }
+  }
+  double operator()(double x) const {
+    if (!dyadic_) return std::pow(x, e_);
+    double r = 1.0;
+    for (unsigned k = 0; k < whole_; ++k) r *= x;
+    double root = x;
+    for (unsigned bit = 8; bit != 0 && (fraction_ & ((bit << 1) - 1)) != 0; bit >>= 1) {
+      root = std::sqrt(root);
+      if (fraction_ & bit) r *= root;
+    }
+    return r;
+  }
+
+ private:
+  double e_ = 1.0;
+  unsigned whole_ = 1, fraction_ = 0;
+  bool dyadic_ = true;
+};
+
 }  // namespace
 
 double threshold_db(Hertz f) {
@@ -35,6 +70,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     std::size_t m = 0;
     double dx = 0, v = 0, f_min = 0, exponent = 0, scale = 0;
     std::vector<double> f, d, gain;
+    DyadicPower half_exponent;  // √P to the weight exponent: P to half of it
   };
   thread_local Bins bins;
   const double f_lo = std::max(0.01, f_min_cpm);
@@ -42,6 +78,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
       bins.scale != model.sensitivity_scale) {
     bins.m = m, bins.dx = spacing_mm, bins.v = v, bins.f_min = f_lo;
     bins.exponent = model.weight_exponent, bins.scale = model.sensitivity_scale;
+    bins.half_exponent = DyadicPower(0.5 * model.weight_exponent);
     const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
     bins.f.assign(p.size(), 0.0);
     bins.d.assign(p.size(), 0.0);
@@ -67,7 +104,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   for (std::size_t i = 1; i < p.size(); ++i) {
     if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
     const double f = bins.f[i], d = bins.d[i];
-    const double w = (model.weight_exponent == 2.0 ? p[i] : std::pow(std::sqrt(p[i]), model.weight_exponent)) * bins.gain[i];
+    const double w = bins.half_exponent(p[i]) * bins.gain[i];
     sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
     sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
   }

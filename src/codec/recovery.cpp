@@ -76,8 +76,10 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
   thread_local std::unique_ptr<texel::detail::RealFft> fft;
   if (!fft || fft->size() != m) fft = std::make_unique<texel::detail::RealFft>(m);
   std::vector<double> buf(m), fs, cs;
-  std::vector<std::complex<double>> spectrum(m / 2 + 1), grid_a(m / 2 + 1), grid_b(m / 2 + 1), geometric;
-  std::size_t geometric_len = 0;
+  std::vector<std::complex<double>> spectrum(m / 2 + 1), grid_a(m / 2 + 1), grid_b(m / 2 + 1);
+  // G_j(len) for the texel lengths in samples met so far (a texel spans
+  // ⌊L/dx⌋ or ⌈L/dx⌉ samples: two tables, not one per texel).
+  std::vector<std::pair<std::size_t, std::vector<std::complex<double>>>> geometric_tables;
   std::vector<std::size_t> minima;
   for (std::size_t k = 0; k < texels; ++k) {
     // Not a structured binding: clang 14 cannot capture one in the lambdas below.
@@ -140,17 +142,19 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
     const std::size_t j_top = std::min(m / 2, static_cast<std::size_t>(std::ceil((f_top + step) / df_grid)));
     // Per grid point, independent of the start phase: A_j = e^{2πi f_j δ}·
     // conj(X_j) and B_j = e^{4πi f_j δ}·G_j(len); rotations by recurrence.
-    if (geometric_len != len) {
-      geometric_len = len;
-      geometric.resize(m / 2 + 1);
+    auto table = std::find_if(geometric_tables.begin(), geometric_tables.end(), [&](const auto& t) { return t.first == len; });
+    if (table == geometric_tables.end()) {
+      std::vector<std::complex<double>> g(m / 2 + 1);
       for (std::size_t j = 0; j <= m / 2; ++j) {
         const double fq = static_cast<double>(j) * df_grid;
         const std::complex<double> ratio = std::polar(1.0, 4.0 * std::numbers::pi * fq * dx);
-        geometric[j] = std::abs(1.0 - ratio) < 1e-12
-                           ? std::complex<double>(static_cast<double>(len))
-                           : (1.0 - std::polar(1.0, 4.0 * std::numbers::pi * fq * dx * static_cast<double>(len))) / (1.0 - ratio);
+        g[j] = std::abs(1.0 - ratio) < 1e-12
+                   ? std::complex<double>(static_cast<double>(len))
+                   : (1.0 - std::polar(1.0, 4.0 * std::numbers::pi * fq * dx * static_cast<double>(len))) / (1.0 - ratio);
       }
+      table = geometric_tables.insert(geometric_tables.end(), {len, std::move(g)});
     }
+    const std::vector<std::complex<double>>& geometric = table->second;
     const std::complex<double> turn_delta = std::polar(1.0, 2.0 * std::numbers::pi * df_grid * delta);
     std::complex<double> rot = 1.0;
     for (std::size_t j = 0; j <= j_top; ++j, rot *= turn_delta) {
@@ -259,23 +263,17 @@ std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double 
   const double len = static_cast<double>(a.size()) * dx;
   // A rendering of L also fits every divisor of L, and a narrow distribution
   // almost fits longer lengths: take the longest length whose residual is
-  // close to the best one's (quantization noise sets that floor).
-  std::vector<Recovered> fits;
-  double best_rms = 1e9;
-  for (double L : lengths) {
-    if (len < 16.0 * L) continue;
-    fits.push_back(recover_frequencies(y, dx, L, band_max.value()));
-    best_rms = std::min(best_rms, fits.back().rms);
-  }
-  for (const Recovered& r : fits) {  // longest first
-    if (!(r.rms < recovery_rms && r.rms <= 2.0 * best_rms + recovery_floor)) continue;
+  // close to the best one's (quantization noise sets that floor). Longest
+  // first, so a length that fits at the floor is taken without trying its
+  // divisors: no shorter length can beat it by more than the floor.
+  auto accept = [&](const Recovered& r) -> std::optional<TexelRecovery> {
     const double L = r.L;
     const double lo = PitchDistributionConfig{}.band_min.value();
     // A renderer never draws below the band: mostly near-zero "frequencies"
     // are a stepped envelope (a coarse-only texture), not texels. (A texel
     // or two near a crest may fit low; the likelihood clamps them to the band.)
     const auto below = std::count_if(r.f.begin(), r.f.end(), [&](double v) { return v < 0.9 * lo; });
-    if (static_cast<double>(below) > 0.1 * static_cast<double>(r.f.size())) continue;
+    if (static_cast<double>(below) > 0.1 * static_cast<double>(r.f.size())) return std::nullopt;
     const auto [mu, sigma] = truncated_lognormal_mle(r.f, lo, band_max.value());
     TexelRecovery t;
     t.L = L;
@@ -290,7 +288,27 @@ std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double 
       t.i_db = db_of(m * std::sqrt(std::expm1(sigma * sigma)));
     }
     return t;
+  };
+  std::vector<Recovered> fits;
+  double best_rms = 1e9;
+  for (double L : lengths) {
+    if (len < 16.0 * L) continue;
+    fits.push_back(recover_frequencies(y, dx, L, band_max.value()));
+    best_rms = std::min(best_rms, fits.back().rms);
+    // At the floor, r.rms ≤ 2·best + floor holds whatever the shorter
+    // lengths give; it is the answer unless a longer length already passes
+    // (which the shorter lengths' residuals could still rule out).
+    if (fits.back().rms <= recovery_floor)
+      if (auto t = accept(fits.back())) {
+        bool longer_taken = false;
+        for (std::size_t j = 0; j + 1 < fits.size() && !longer_taken; ++j)
+          longer_taken = fits[j].rms < recovery_rms && fits[j].rms <= 2.0 * best_rms + recovery_floor && accept(fits[j]);
+        if (!longer_taken) return t;  // else the shorter lengths may still lower best_rms: go on
+      }
   }
+  for (const Recovered& r : fits)  // longest first
+    if (r.rms < recovery_rms && r.rms <= 2.0 * best_rms + recovery_floor)
+      if (auto t = accept(r)) return t;
   return std::nullopt;
 }
 

@@ -2,7 +2,6 @@
 // profile and strengths).
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <numeric>
 #include <utility>
 #include <vector>
@@ -19,25 +18,27 @@ constexpr double strength_snap = 0.02;
 
 // --- envelope tools ---------------------------------------------------------
 
-/// Running max (or min) over a centred window of w samples (monotonic deque,
-/// O(n)), into `out`.
+/// Running max (or min) over a centred window of w samples, into `out`: a
+/// monotonic queue of indices (O(n)); every index enters once, so an n-slot
+/// array with a moving head and tail holds it without wrapping.
 void running_extreme(const std::vector<double>& x, std::size_t w, bool max, std::vector<double>& out,
-                     std::deque<std::size_t>& dq) {
+                     std::vector<std::size_t>& queue) {
   const std::size_t n = x.size();
   const std::size_t half = w / 2;
   out.resize(n);
-  dq.clear();
+  queue.resize(n);
+  std::size_t head = 0, tail = 0;  // the queue is queue[head, tail)
   std::size_t next = 0;
-  auto better = [&](double a, double b) { return max ? a >= b : a <= b; };
+  auto better = [max](double a, double b) { return max ? a >= b : a <= b; };
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t hi = std::min(n - 1, i + half);
     for (; next <= hi; ++next) {
-      while (!dq.empty() && better(x[next], x[dq.back()])) dq.pop_back();
-      dq.push_back(next);
+      while (tail > head && better(x[next], x[queue[tail - 1]])) --tail;
+      queue[tail++] = next;
     }
     const std::size_t lo = i >= half ? i - half : 0;
-    while (dq.front() < lo) dq.pop_front();
-    out[i] = x[dq.front()];
+    while (queue[head] < lo) ++head;
+    out[i] = x[queue[head]];
   }
 }
 
@@ -61,7 +62,7 @@ void moving_average(const std::vector<double>& x, std::size_t w, std::vector<dou
 /// arithmetic (page faults).
 struct SplitScratch {
   std::vector<double> centred, spectrum, up_raw, up, slow_1, up_slow, lo_raw, lo, cum;
-  std::deque<std::size_t> dq;
+  std::vector<std::size_t> queue;
 };
 
 /// The interior samples [b, e) of texel k of length L: a sample on a texel
@@ -193,13 +194,25 @@ std::optional<double> stepped_texel_length(const std::vector<double>& a, double 
 }
 
 Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode, std::size_t window) {
+  Split s;
+  split(a, dx, cfg, mode, window, s);
+  return s;
+}
+
+void split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, SplitMode mode, std::size_t window, Split& s) {
+  // Start from a default Split, keeping the signal-sized buffer's storage.
+  std::vector<double> storage = std::move(s.fine);
+  s = Split{};
+  s.fine = std::move(storage);
   const std::size_t n = a.size();
   const double B = cfg.boundary.value();
   const double L = cfg.texel_length.value();
-  if (mode == SplitMode::coarse_only) return coarse_only_split(a, dx, cfg);
+  if (mode == SplitMode::coarse_only) {
+    s = coarse_only_split(a, dx, cfg);
+    return;
+  }
   if (mode == SplitMode::fine_only) {
     // No envelope to estimate: only the strengths (a flat surface has none).
-    Split s;
     if (n > 0 && std::all_of(a.begin(), a.end(), [&](double v) { return v == a[0]; })) {
       s.F = 0.0;
       s.C = 1.0 - std::clamp(a[0], 0.0, 1.0);
@@ -207,14 +220,13 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
     } else {
       fine_only_strengths(a, s);
     }
-    return s;
+    return;
   }
 
   // Window for the envelope: about two periods of the fine texture, so that
   // every window holds a peak and a trough. The fine frequency is the
   // power-weighted mean above the boundary when that band carries the
   // texture, else of the whole spectrum (a fine texture below the boundary).
-  Split s;
   thread_local SplitScratch sc;
   std::size_t w = window;
   if (w == 0) {
@@ -236,11 +248,14 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
       s.F = 0.0;
       s.C = 1.0 - std::clamp(a.empty() ? 1.0 : a[0], 0.0, 1.0);
       s.fine.assign(n, 0.0);
-      return s;
+      return;
     }
     // Next to nothing above the boundary: no fine texture, only coarse
     // features (whose layout touch resolves), e.g. a measured profile.
-    if (mode == SplitMode::automatic && hw < coarse_only_power * pw) return coarse_only_split(a, dx, cfg);
+    if (mode == SplitMode::automatic && hw < coarse_only_power * pw) {
+      s = coarse_only_split(a, dx, cfg);
+      return;
+    }
     const double fbar = hw >= 0.2 * pw ? hf / hw : pf / pw;
     w = static_cast<std::size_t>(std::max(1.0, std::round(2.0 / fbar / dx)));
   }
@@ -249,50 +264,53 @@ Split split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, S
   // the running extremes' steps; it barely attenuates coarse features (a
   // 5 mm period keeps 98 % of its amplitude).
   const auto smooth = std::max(w, static_cast<std::size_t>(std::round(0.5 * B / dx)));
-  running_extreme(a, w, true, sc.up_raw, sc.dq);
+  running_extreme(a, w, true, sc.up_raw, sc.queue);
   moving_average(sc.up_raw, smooth, sc.up, sc.cum);
   std::vector<double>& up = sc.up;
   // The decision coarse-or-not looks at the envelope low-passed at the
   // boundary proper (two passes of B): the envelope of a noise fluctuates
   // at the rate of its bandwidth, which is fine texture, not coarse layout.
-  const auto b_samples = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
-  moving_average(sc.up_raw, b_samples, sc.slow_1, sc.cum);
-  moving_average(sc.slow_1, b_samples, sc.up_slow, sc.cum);
+  // A forced two-scale split (the fit's candidates) decides nothing.
+  const bool decide = mode == SplitMode::automatic;
+  if (decide) {
+    const auto b_samples = std::max(w, static_cast<std::size_t>(std::round(B / dx)));
+    moving_average(sc.up_raw, b_samples, sc.slow_1, sc.cum);
+    moving_average(sc.slow_1, b_samples, sc.up_slow, sc.cum);
+  }
   const std::vector<double>& up_slow = sc.up_slow;
-  running_extreme(a, w, false, sc.lo_raw, sc.dq);
+  running_extreme(a, w, false, sc.lo_raw, sc.queue);
   moving_average(sc.lo_raw, smooth, sc.lo, sc.cum);
   const std::vector<double>& lo = sc.lo;
   for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
 
   const std::size_t k_count =
       std::max<std::size_t>(1, texel_count(Millimetres(static_cast<double>(n) * dx), cfg.texel_length, Fill::whole_texels));
-  std::vector<double> e(k_count), fk(k_count), e_slow(k_count);
+  std::vector<double> e(k_count), fk(k_count), e_slow(decide ? k_count : 0);
   for (std::size_t k = 0; k < k_count; ++k) {
     const double x = (static_cast<double>(k) + 0.5) * L;
     const auto i = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, std::round(x / dx))));
     e[k] = up[i];
-    e_slow[k] = std::clamp(up_slow[i], 1e-6, 1.0);
+    if (decide) e_slow[k] = std::clamp(up_slow[i], 1e-6, 1.0);
     fk[k] = std::clamp(1.0 - lo[i] / up[i], 0.0, 1.0);
   }
   s.F = std::clamp(percentile(fk, 0.5), 0.0, 1.0);
-  const double e_hi = percentile(e_slow, 0.98);
-  const double e_lo = percentile(e_slow, 0.02);
-  s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
-  std::vector<double> fine(n);
-  if (mode == SplitMode::fine_only || (mode == SplitMode::automatic && s.range < cfg.flat_envelope)) {
+  if (decide) {
+    const double e_hi = percentile(e_slow, 0.98);
+    const double e_lo = percentile(e_slow, 0.02);
+    s.range = e_hi > 0 ? (e_hi - e_lo) / e_hi : 0.0;
+  }
+  if (decide && s.range < cfg.flat_envelope) {
     fine_only_strengths(a, s);
-    return s;
   } else {
     s.coarse = true;
     const double e_min = *std::min_element(e.begin(), e.end());
     s.C = std::clamp(1.0 - e_min, 0.0, 1.0);
     s.c.resize(k_count);
     for (std::size_t k = 0; k < k_count; ++k) s.c[k] = s.C > 0 ? std::clamp((e[k] - e_min) / s.C, 0.0, 1.0) : 1.0;
-    for (std::size_t i = 0; i < n; ++i) fine[i] = a[i] / up[i];
-    centre(fine);
+    s.fine.resize(n);
+    for (std::size_t i = 0; i < n; ++i) s.fine[i] = a[i] / up[i];
+    centre(s.fine);
   }
-  s.fine = std::move(fine);
-  return s;
 }
 
 }  // namespace texel::codec::parts
