@@ -95,9 +95,17 @@ struct Fitter {
   const Split* two_scale = nullptr;  // the input's coarse estimate: candidates carry it and are split alike
   int evaluations = 0;
 
+  struct Evaluated {
+    double p_db, i_db;
+    std::optional<Percept> percept;
+  };
+  std::vector<Evaluated> memo;  // every point evaluated (a fit evaluates a few dozen)
+
   [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
+  std::optional<Percept> evaluate(double p_db, double i_db);
   /// Mean percept over two candidate draws (common random numbers); none if
-  /// (P, I) cannot be rendered. Counts one evaluation.
+  /// (P, I) cannot be rendered. Counts one evaluation unless (P, I) was
+  /// evaluated before.
   std::optional<Percept> percept(double p_db, double i_db);
   /// The model distance to the target (1e6 if not renderable).
   double operator()(double p_db, double i_db);

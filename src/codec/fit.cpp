@@ -51,7 +51,17 @@ Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) con
 
 /// Mean percept over two candidate draws (common random numbers: the same
 /// two seeds for every candidate, so the objective is smooth in P and I).
+/// A point evaluated before is not rendered again (the least-squares search
+/// starts from the grid's best point; identifiability revisits the fit).
 std::optional<Percept> Fitter::percept(double p_db, double i_db) {
+  for (const auto& [p, i, q] : memo)
+    if (p == p_db && i == i_db) return q;
+  std::optional<Percept> q = evaluate(p_db, i_db);
+  memo.push_back({p_db, i_db, q});
+  return q;
+}
+
+std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
   ++evaluations;
   Percept sum;
   constexpr std::array<std::uint64_t, 2> seeds{0x5EED0001, 0x5EED0002};
@@ -223,7 +233,7 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
                  double f_min, const Split* two_scale) {
   FineFit out;
   out.input = perceive(fine, dx, cfg.model, f_min);
-  Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale};
+  Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale, 0, {}};
   const Box box = fit_box(cfg, band_max);
   // Start from the physical centroid and spread of the fine spectrum, then
   // the best of a coarse grid around it (wide distributions make the
