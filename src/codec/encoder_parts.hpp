@@ -130,9 +130,10 @@ struct FineFit {
 
 /// §3 step 4: does a much narrower distribution feel different?
 void identifiability(Fitter& fit, const Box& box, FineFit& out);
-/// §3: the fine texture whose percept is closest to that of `fine`.
+/// §3: the fine texture whose percept is closest to that of `fine`; with
+/// `with_identifiability` false, its P and I only (step 4 skipped).
 FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg,
-                 double f_min = 0.0, const Split* two_scale = nullptr);
+                 double f_min = 0.0, const Split* two_scale = nullptr, bool with_identifiability = true);
 
 // --- recovery.cpp ----------------------------------------------------------------
 

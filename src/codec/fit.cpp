@@ -230,7 +230,7 @@ Box fit_box(const EncoderConfig& cfg, CyclesPerMm band_max) {
 }
 
 FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg,
-                 double f_min, const Split* two_scale) {
+                 double f_min, const Split* two_scale, bool with_identifiability) {
   FineFit out;
   out.input = perceive(fine, dx, cfg.model, f_min);
   Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale, 0, {}};
@@ -274,7 +274,7 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
   out.p_db = best[0];
   out.i_db = best[1];
   out.distance = best[2];
-  identifiability(fit, box, out);
+  if (with_identifiability) identifiability(fit, box, out);
   out.evaluations = fit.evaluations;
   return out;
 }
