@@ -83,7 +83,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   if (rec && has_fine) {
     FineFit r;
     r.input = perceive(sp.fine, dx, fit_cfg.model);
-    Fitter fitter{fit_cfg, r.input, dx, cand, band_max, 0.0, nullptr, 0, {}};
+    Fitter fitter{fit_cfg, r.input, dx, cand, band_max, 0.0, nullptr, 0, {}, 2};
     const Box box = fit_box(fit_cfg, band_max);
     r.p_db = std::clamp(rec->p_db, box.p_lo, box.p_hi);
     r.i_db = std::clamp(rec->i_db, box.i_lo, box.i_hi);
@@ -115,7 +115,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     const double shape = shape_distance_db(a, r, dx);
     if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
       sp = std::move(flat);
-      Fitter fitter{quick, flat_fit.input, dx, cand, band_max, 0.0, nullptr, 0, {}};
+      Fitter fitter{quick, flat_fit.input, dx, cand, band_max, 0.0, nullptr, 0, {}, 2};
       identifiability(fitter, fit_box(quick, band_max), flat_fit);
       flat_fit.evaluations += fitter.evaluations;
       fit = flat_fit;

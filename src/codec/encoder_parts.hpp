@@ -97,13 +97,15 @@ struct Fitter {
 
   struct Evaluated {
     double p_db, i_db;
+    int draws;
     std::optional<Percept> percept;
   };
   std::vector<Evaluated> memo;  // every point evaluated (a fit evaluates a few dozen)
+  int draws = 2;                // candidate draws per evaluation (1 or 2)
 
   [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
   std::optional<Percept> evaluate(double p_db, double i_db);
-  /// Mean percept over two candidate draws (common random numbers); none if
+  /// Mean percept over `draws` candidate draws (common random numbers); none if
   /// (P, I) cannot be rendered. Counts one evaluation unless (P, I) was
   /// evaluated before.
   std::optional<Percept> percept(double p_db, double i_db);

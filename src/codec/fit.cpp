@@ -54,10 +54,10 @@ Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) con
 /// A point evaluated before is not rendered again (the least-squares search
 /// starts from the grid's best point; identifiability revisits the fit).
 std::optional<Percept> Fitter::percept(double p_db, double i_db) {
-  for (const auto& [p, i, q] : memo)
-    if (p == p_db && i == i_db) return q;
+  for (const auto& [p, i, d, q] : memo)
+    if (p == p_db && i == i_db && d == draws) return q;
   std::optional<Percept> q = evaluate(p_db, i_db);
-  memo.push_back({p_db, i_db, q});
+  memo.push_back({p_db, i_db, draws, q});
   return q;
 }
 
@@ -65,13 +65,14 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
   ++evaluations;
   Percept sum;
   constexpr std::array<std::uint64_t, 2> seeds{0x5EED0001, 0x5EED0002};
+  const auto used = static_cast<double>(std::clamp(draws, 1, 2));
   try {
-    for (auto seed : seeds) {
-      const Percept q = render_percept(p_db, i_db, seed);
-      sum.pitch_db += q.pitch_db / seeds.size();
-      sum.noisiness_db += q.noisiness_db / seeds.size();
-      sum.mean_db += q.mean_db / seeds.size();
-      sum.spread_db += q.spread_db / seeds.size();
+    for (std::size_t d = 0; d < static_cast<std::size_t>(used); ++d) {
+      const Percept q = render_percept(p_db, i_db, seeds[d]);
+      sum.pitch_db += q.pitch_db / used;
+      sum.noisiness_db += q.noisiness_db / used;
+      sum.mean_db += q.mean_db / used;
+      sum.spread_db += q.spread_db / used;
     }
   } catch (const InvalidArgument&) {
     return std::nullopt;  // not renderable (e.g. too little of the distribution in the band)
@@ -233,7 +234,7 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
                  double f_min, const Split* two_scale, bool with_identifiability) {
   FineFit out;
   out.input = perceive(fine, dx, cfg.model, f_min);
-  Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale, 0, {}};
+  Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale, 0, {}, 2};
   const Box box = fit_box(cfg, band_max);
   // Start from the physical centroid and spread of the fine spectrum, then
   // the best of a coarse grid around it (wide distributions make the
@@ -245,7 +246,10 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
   // The best of a 3 × 3 grid around the start (±3 dB, ±8 dB): wide
   // distributions make the objective rough enough to trap a local search
   // far from the optimum.
+  // The grid only picks the basin: one draw per point is enough there and
+  // halves its cost; the search below compares points over both draws.
   auto grid_start = [&](double& p, double& i) {
+    fit.draws = 1;
     double best_v = fit(p, i);
     const double gp = p, gi = i;
     for (double dp : {-3.0, 0.0, 3.0})
@@ -255,6 +259,7 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
         const double v = fit(pp, ii);
         if (v < best_v) best_v = v, p = pp, i = ii;
       }
+    fit.draws = 2;
   };
   std::array<double, 3> best;
   if (cfg.fit_method == FitMethod::simplex) {
