@@ -1,11 +1,14 @@
 // The one place Texel talks to an FFT library (KISS FFT, float). Everything
-// else calls RealFft, so swapping the library touches only fft.cpp.
+// else calls RealFft, so swapping the library touches only fft.cpp; the
+// encoder's inner loop, which transforms a few dozen power-of-two-length
+// candidates per encode, calls Pow2RealFft (our own, double precision).
 #pragma once
 
 #include <complex>
 #include <cstddef>
 #include <memory>
 #include <span>
+#include <vector>
 
 namespace texel::detail {
 
@@ -28,6 +31,27 @@ class RealFft {
   struct Impl;
   std::size_t n_;
   std::unique_ptr<Impl> impl_;
+};
+
+/// Forward real FFT of a power-of-two length n ≥ 4, the same transform as
+/// RealFft in double precision: n/2 complex points by a radix-4 Stockham
+/// FFT (one radix-2 stage when log2(n/2) is odd) over split real and
+/// imaginary arrays, whose inner loops run over contiguous blocks the
+/// compiler vectorizes, then the real-input split. 3–4× KISS FFT's float
+/// transform at 2^15 (texel_bench_encode). Twiddles from libm: analysis
+/// only, never rendered bytes. Not thread-safe per object (scratch buffers).
+class Pow2RealFft {
+ public:
+  explicit Pow2RealFft(std::size_t n);
+  [[nodiscard]] std::size_t size() const { return n_; }
+  /// in.size() == size(); out.size() == size()/2 + 1.
+  void forward(std::span<const double> in, std::span<std::complex<double>> out);
+
+ private:
+  std::size_t n_;                           // real length
+  std::vector<double> tw_;                  // per radix-4 stage and p: w^p, w^2p, w^3p (re, im)
+  std::vector<double> sr_, si_;             // e^{−2πik/n}, k ≤ n/4: the real split's
+  std::vector<double> ar_, ai_, br_, bi_;   // ping-pong buffers
 };
 
 /// Smallest even length >= n whose only prime factors are 2, 3 and 5.

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
+#include <cstdint>
+#include <vector>
 #include <numbers>
 #include <set>
 
@@ -11,6 +14,7 @@
 #include "texel/error.hpp"
 #include "texel/spectrum.hpp"
 #include "texel/texture.hpp"
+#include "../../src/spectrum/fft.hpp"
 
 using namespace texel;
 
@@ -153,4 +157,43 @@ TEST(TexelLogCentroid, WithinHalfADecibelOfTheMedianForNarrowDistributions) {
     const SpectralReport r = analyse_spectrum(map, doc.device.spacing.value());
     EXPECT_NEAR(r.summary.log_centroid.value(), pitch, 0.5) << "pitch " << pitch;
   }
+}
+
+// The encoder's own power-of-two transform equals the DFT's definition
+// (X_k = Σ x_j e^{−2πi jk/n}) for every length from 4 to 2^11, both parities
+// of log2(n/2) (with and without the radix-2 stage), and KISS FFT's float
+// transform at the encoder's 2^15 to float precision.
+TEST(Pow2RealFft, EqualsTheDftAndKissFft) {
+  std::uint64_t state = 12345;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
+  };
+  for (std::size_t n = 4; n <= 2048; n *= 2) {
+    std::vector<double> x(n);
+    for (double& v : x) v = uniform();
+    texel::detail::Pow2RealFft fft(n);
+    std::vector<std::complex<double>> X(n / 2 + 1);
+    fft.forward(x, X);
+    double worst = 0.0, scale = 0.0;
+    for (std::size_t k = 0; k <= n / 2; ++k) {
+      std::complex<double> d = 0.0;
+      for (std::size_t j = 0; j < n; ++j)
+        d += x[j] * std::polar(1.0, -2.0 * std::numbers::pi * static_cast<double>((j * k) % n) / static_cast<double>(n));
+      worst = std::max(worst, std::abs(d - X[k]));
+      scale = std::max(scale, std::abs(d));
+    }
+    EXPECT_LT(worst, 1e-12 * scale * static_cast<double>(n)) << "n = " << n;
+  }
+  const std::size_t n = std::size_t{1} << 15;
+  std::vector<double> x(n);
+  for (std::size_t j = 0; j < n; ++j) x[j] = std::sin(0.01 * static_cast<double>(j) * static_cast<double>(j) / 100.0) + uniform();
+  std::vector<std::complex<double>> a(n / 2 + 1), b(n / 2 + 1);
+  texel::detail::Pow2RealFft(n).forward(x, a);
+  texel::detail::RealFft(n).forward(x, b);
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k <= n / 2; ++k) worst = std::max(worst, std::abs(a[k] - b[k])), scale = std::max(scale, std::abs(a[k]));
+  EXPECT_LT(worst, 1e-4 * scale);
+  EXPECT_THROW(texel::detail::Pow2RealFft(6), texel::InvalidArgument);
+  EXPECT_THROW(texel::detail::Pow2RealFft(2), texel::InvalidArgument);
 }
