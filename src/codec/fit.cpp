@@ -155,8 +155,9 @@ std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double
 /// average over the candidates' draw-to-draw roughness. Returns {P, I,
 /// distance} of the best point evaluated.
 std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p, double i) {
-  auto norm = [](const std::array<double, 4>& r) { return std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]); };
-  std::optional<std::array<double, 4>> r = fit.residuals(p, i);
+  using R = std::array<double, 4>;
+  auto norm = [](const R& r) { return std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]); };
+  std::optional<R> r = fit.residuals(p, i);
   if (!r) return {p, i, 1e6};
   double v = norm(*r);
   double lambda = 1e-3;
@@ -169,8 +170,10 @@ std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p,
     const auto ri = fit.residuals(p, i + hi);
     if (!rp || !ri) break;
     double a11 = 0, a12 = 0, a22 = 0, g1 = 0, g2 = 0;
+    std::array<R, 2> J{};  // J[0]: ∂r/∂P, J[1]: ∂r/∂I
     for (int k = 0; k < 4; ++k) {
       const double jp = ((*rp)[k] - (*r)[k]) / hp, ji = ((*ri)[k] - (*r)[k]) / hi;
+      J[0][k] = jp, J[1][k] = ji;
       a11 += jp * jp, a12 += jp * ji, a22 += ji * ji, g1 += jp * (*r)[k], g2 += ji * (*r)[k];
     }
     bool improved = false;
@@ -189,6 +192,12 @@ std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p,
       const double np = std::clamp(p + std::clamp(dp, -6.0, 6.0), box.p_lo, box.p_hi);
       const double ni = std::clamp(i + std::clamp(di, -12.0, 12.0), box.i_lo, box.i_hi);
       if (std::fabs(np - p) + std::fabs(ni - i) < 0.01) break;  // nothing left to move
+      // Converged, without rendering the step, when even the linear model
+      // predicts it gains less than the convergence threshold below (the
+      // last steps of a fit are hundredths of a dB: 3–4 renderings each).
+      R predicted = *r;
+      for (int k = 0; k < 4; ++k) predicted[k] += (np - p) * J[0][k] + (ni - i) * J[1][k];
+      if (v - norm(predicted) < 0.01 * v + 0.002) break;
       const auto rn = fit.residuals(np, ni);
       const double vn = rn ? norm(*rn) : 1e6;
       if (vn < v) {
