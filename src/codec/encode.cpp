@@ -103,11 +103,12 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     // coarse profile only if the input's envelope varies clearly more than
     // that of the best fine-only explanation.
     Split flat = split(a, dx, fit_cfg, SplitMode::fine_only);
-    EncoderConfig quick = fit_cfg;  // the check needs the neighbourhood, not the last 0.1 dB
+    // The check needs the neighbourhood, not the last 0.1 dB: a shorter
+    // search, P and I only (whether Irregularity is felt matters only if
+    // this explanation is kept; then the fit is finished below).
+    EncoderConfig quick = fit_cfg;
     quick.max_evaluations = fit_cfg.max_evaluations / 3;
-    // P and I only: whether Irregularity is felt matters only if this
-    // explanation is kept (then asked below).
-    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, quick, 0.0, nullptr, false);
+    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, quick, 0.0, nullptr, FitOptions{false, 2, std::nullopt});
     std::vector<double> r(n);
     fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
         .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, r);
@@ -115,10 +116,10 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     const double shape = shape_distance_db(a, r, dx);
     if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
       sp = std::move(flat);
-      Fitter fitter{quick, flat_fit.input, dx, cand, band_max, 0.0, nullptr, 0, {}, 2};
-      identifiability(fitter, fit_box(quick, band_max), flat_fit);
-      flat_fit.evaluations += fitter.evaluations;
-      fit = flat_fit;
+      const FitOptions finish{true, 8, std::array<double, 2>{flat_fit.p_db, flat_fit.i_db}};
+      fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg.fit_method == FitMethod::simplex ? quick : fit_cfg, 0.0, nullptr,
+                     fit_cfg.fit_method == FitMethod::simplex ? FitOptions{true, 8, std::nullopt} : finish);
+      fit.evaluations += flat_fit.evaluations;
     } else {
       fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg, 1.0 / cfg.boundary.value(), &sp);
       fit.evaluations += flat_fit.evaluations;

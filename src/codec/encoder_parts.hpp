@@ -132,10 +132,17 @@ struct FineFit {
 
 /// §3 step 4: does a much narrower distribution feel different?
 void identifiability(Fitter& fit, const Box& box, FineFit& out);
-/// §3: the fine texture whose percept is closest to that of `fine`; with
-/// `with_identifiability` false, its P and I only (step 4 skipped).
+/// How far fit_fine goes.
+struct FitOptions {
+  bool identifiability = true;  // §3 step 4 (else P and I only)
+  int iterations = 8;           // least-squares iterations at most
+  /// Start here instead of the grid around the spectrum's moments (a
+  /// refinement of an earlier, shorter fit).
+  std::optional<std::array<double, 2>> start;
+};
+/// §3: the fine texture whose percept is closest to that of `fine`.
 FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg,
-                 double f_min = 0.0, const Split* two_scale = nullptr, bool with_identifiability = true);
+                 double f_min = 0.0, const Split* two_scale = nullptr, const FitOptions& options = {});
 
 // --- recovery.cpp ----------------------------------------------------------------
 

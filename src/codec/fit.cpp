@@ -154,14 +154,13 @@ std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double
 /// Forward-difference Jacobian with steps wide enough (0.5 dB, 1 dB) to
 /// average over the candidates' draw-to-draw roughness. Returns {P, I,
 /// distance} of the best point evaluated.
-std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p, double i) {
+std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p, double i, int max_iterations) {
   using R = std::array<double, 4>;
   auto norm = [](const R& r) { return std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]); };
   std::optional<R> r = fit.residuals(p, i);
   if (!r) return {p, i, 1e6};
   double v = norm(*r);
   double lambda = 1e-3;
-  constexpr int max_iterations = 8;
   for (int iteration = 0; iteration < max_iterations && v > 0.02; ++iteration) {
     // Differences step inwards at the box's edges.
     const double hp = p + 0.5 <= box.p_hi ? 0.5 : -0.5;
@@ -240,7 +239,7 @@ Box fit_box(const EncoderConfig& cfg, CyclesPerMm band_max) {
 }
 
 FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, CyclesPerMm band_max, const EncoderConfig& cfg,
-                 double f_min, const Split* two_scale, bool with_identifiability) {
+                 double f_min, const Split* two_scale, const FitOptions& options) {
   FineFit out;
   out.input = perceive(fine, dx, cfg.model, f_min);
   Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale, 0, {}, 2};
@@ -270,11 +269,16 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
       }
     fit.draws = 2;
   };
+  if (options.start) {
+    p0 = std::clamp((*options.start)[0], box.p_lo, box.p_hi);
+    i0 = std::clamp((*options.start)[1], box.i_lo, box.i_hi);
+  } else {
+    grid_start(p0, i0);
+  }
   std::array<double, 3> best;
   if (cfg.fit_method == FitMethod::simplex) {
     // The encoder's search before least squares (kept as an option): needs
     // no smoothness, ~120 evaluations.
-    grid_start(p0, i0);
     best = nelder_mead(fit, box, p0, i0, 1.5, 4.0, cfg.max_evaluations / 2);
     best = nelder_mead(fit, box, best[0], best[1], 0.5, 2.0, cfg.max_evaluations / 2);  // restart: NM can stall
   } else {
@@ -282,13 +286,12 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
     // four residuals and a Texel texture's percept moves smoothly with
     // (P, I) at the scale of the difference steps, so Levenberg–Marquardt
     // converges in a few iterations where the simplex needs a hundred.
-    grid_start(p0, i0);
-    best = levenberg_marquardt(fit, box, p0, i0);
+    best = levenberg_marquardt(fit, box, p0, i0, options.iterations);
   }
   out.p_db = best[0];
   out.i_db = best[1];
   out.distance = best[2];
-  if (with_identifiability) identifiability(fit, box, out);
+  if (options.identifiability) identifiability(fit, box, out);
   out.evaluations = fit.evaluations;
   return out;
 }
