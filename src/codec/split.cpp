@@ -2,6 +2,7 @@
 // profile and strengths).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <utility>
 #include <vector>
@@ -18,43 +19,60 @@ constexpr double strength_snap = 0.02;
 
 // --- envelope tools ---------------------------------------------------------
 
-/// Running max (or min) over a centred window of w samples, into `out`: a
-/// monotonic queue of indices (O(n)); every index enters once, so an n-slot
-/// array with a moving head and tail holds it without wrapping.
-void running_extreme(const std::vector<double>& x, std::size_t w, bool max, std::vector<double>& out,
-                     std::vector<std::size_t>& queue) {
+/// Running max (or min) over a centred window of w samples (i − w/2 …
+/// i + w/2, shortened at the ends), into `out`: van Herk / Gil–Werman, three
+/// branch-free passes whatever the window (blocks of the window's span k:
+/// the prefix extreme within each block from the left, the suffix extreme
+/// from the right; a window covers the tail of one block and the head of
+/// the next). `g`, `h`: scratch.
+void running_extreme(const std::vector<double>& x, std::size_t w, bool max, std::vector<double>& out, std::vector<double>& g,
+                     std::vector<double>& h) {
   const std::size_t n = x.size();
   const std::size_t half = w / 2;
+  const std::size_t k = 2 * half + 1;  // the window's span
   out.resize(n);
-  queue.resize(n);
-  std::size_t head = 0, tail = 0;  // the queue is queue[head, tail)
-  std::size_t next = 0;
-  auto better = [max](double a, double b) { return max ? a >= b : a <= b; };
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t hi = std::min(n - 1, i + half);
-    for (; next <= hi; ++next) {
-      while (tail > head && better(x[next], x[queue[tail - 1]])) --tail;
-      queue[tail++] = next;
-    }
-    const std::size_t lo = i >= half ? i - half : 0;
-    while (queue[head] < lo) ++head;
-    out[i] = x[queue[head]];
+  if (n == 0) return;
+  // x padded with `half` neutral values on each side, to a whole number of blocks.
+  const double neutral = max ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+  const std::size_t padded = ((n + 2 * half + k - 1) / k) * k;
+  g.resize(padded);
+  h.resize(padded);
+  auto at = [&](std::size_t j) { return j >= half && j - half < n ? x[j - half] : neutral; };
+  auto pick = [max](double a, double b) { return max ? std::max(a, b) : std::min(a, b); };
+  for (std::size_t b = 0; b < padded; b += k) {
+    g[b] = at(b);
+    for (std::size_t j = b + 1; j < b + k; ++j) g[j] = pick(g[j - 1], at(j));
+    h[b + k - 1] = at(b + k - 1);
+    for (std::size_t j = b + k - 1; j-- > b;) h[j] = pick(h[j + 1], at(j));
   }
+  // Window of output i in padded coordinates: [i, i + k − 1].
+  for (std::size_t i = 0; i < n; ++i) out[i] = pick(h[i], g[i + k - 1]);
 }
 
 /// Centred moving average of w samples, windows shortened at the ends, into
-/// `out` (`cum`: scratch).
+/// `out` (`cum`: scratch). The interior (full windows) is its own loop,
+/// which the compiler vectorizes.
 void moving_average(const std::vector<double>& x, std::size_t w, std::vector<double>& out, std::vector<double>& cum) {
   const std::size_t n = x.size();
   const std::size_t half = w / 2;
-  cum.assign(n + 1, 0.0);
+  cum.resize(n + 1);
+  cum[0] = 0.0;
   for (std::size_t i = 0; i < n; ++i) cum[i + 1] = cum[i] + x[i];
   out.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  auto edge = [&](std::size_t i) {
     const std::size_t lo = i >= half ? i - half : 0;
     const std::size_t hi = std::min(n, i + half + 1);
     out[i] = (cum[hi] - cum[lo]) / static_cast<double>(hi - lo);
-  }
+  };
+  // Full windows: half ≤ i and i + half + 1 ≤ n.
+  const std::size_t first = std::min(n, half);
+  const std::size_t last = n >= half + 1 ? n - half : 0;  // one past the last full window
+  for (std::size_t i = 0; i < first; ++i) edge(i);
+  const auto span = static_cast<double>(2 * half + 1);
+  const double* c = cum.data();
+  double* o = out.data();
+  for (std::size_t i = first; i < last; ++i) o[i] = (c[i + half + 1] - c[i - half]) / span;
+  for (std::size_t i = std::max(first, last); i < n; ++i) edge(i);
 }
 
 /// Work buffers of split(), per thread: the fit splits every two-scale
@@ -62,7 +80,7 @@ void moving_average(const std::vector<double>& x, std::size_t w, std::vector<dou
 /// arithmetic (page faults).
 struct SplitScratch {
   std::vector<double> centred, spectrum, up_raw, up, slow_1, up_slow, lo_raw, lo, cum;
-  std::vector<std::size_t> queue;
+  std::vector<double> prefix, suffix;
 };
 
 /// The interior samples [b, e) of texel k of length L: a sample on a texel
@@ -264,7 +282,7 @@ void split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, Sp
   // the running extremes' steps; it barely attenuates coarse features (a
   // 5 mm period keeps 98 % of its amplitude).
   const auto smooth = std::max(w, static_cast<std::size_t>(std::round(0.5 * B / dx)));
-  running_extreme(a, w, true, sc.up_raw, sc.queue);
+  running_extreme(a, w, true, sc.up_raw, sc.prefix, sc.suffix);
   moving_average(sc.up_raw, smooth, sc.up, sc.cum);
   std::vector<double>& up = sc.up;
   // The decision coarse-or-not looks at the envelope low-passed at the
@@ -278,7 +296,7 @@ void split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, Sp
     moving_average(sc.slow_1, b_samples, sc.up_slow, sc.cum);
   }
   const std::vector<double>& up_slow = sc.up_slow;
-  running_extreme(a, w, false, sc.lo_raw, sc.queue);
+  running_extreme(a, w, false, sc.lo_raw, sc.prefix, sc.suffix);
   moving_average(sc.lo_raw, smooth, sc.lo, sc.cum);
   const std::vector<double>& lo = sc.lo;
   for (double& v : up) v = std::clamp(v, 1e-6, 1.0);
