@@ -1,5 +1,6 @@
 // §2 of docs/encoder.md: the perceptual model (threshold, percept, distance).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -65,17 +66,26 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   power_spectrum(fine, p, m);
   const double v = model.swipe_speed.value();
   // Per-bin frequency, dB and weight depend only on (M, Δx, v) and the
-  // model's weighting: cache them.
+  // model's weighting: cached, a few settings at once (an encode alternates
+  // between the whole band and the fine part's band above the boundary).
   struct Bins {
     std::size_t m = 0;
     double dx = 0, v = 0, f_min = 0, exponent = 0, scale = 0;
     std::vector<double> f, d, gain;
+    std::size_t first = 1;      // the first bin at or above f_min (gain > 0 from there)
     DyadicPower half_exponent;  // √P to the weight exponent: P to half of it
   };
-  thread_local Bins bins;
+  thread_local std::array<Bins, 4> cache;
+  thread_local std::size_t replace = 0;
   const double f_lo = std::max(0.01, f_min_cpm);
-  if (bins.m != m || bins.dx != spacing_mm || bins.v != v || bins.f_min != f_lo || bins.exponent != model.weight_exponent ||
-      bins.scale != model.sensitivity_scale) {
+  auto same = [&](const Bins& b) {
+    return b.m == m && b.dx == spacing_mm && b.v == v && b.f_min == f_lo && b.exponent == model.weight_exponent &&
+           b.scale == model.sensitivity_scale;
+  };
+  auto hit = std::find_if(cache.begin(), cache.end(), same);
+  if (hit == cache.end()) {
+    Bins& bins = cache[replace];
+    replace = (replace + 1) % cache.size();
     bins.m = m, bins.dx = spacing_mm, bins.v = v, bins.f_min = f_lo;
     bins.exponent = model.weight_exponent, bins.scale = model.sensitivity_scale;
     bins.half_exponent = DyadicPower(0.5 * model.weight_exponent);
@@ -83,6 +93,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     bins.f.assign(p.size(), 0.0);
     bins.d.assign(p.size(), 0.0);
     bins.gain.assign(p.size(), 0.0);
+    bins.first = p.size();
     for (std::size_t i = 1; i < p.size(); ++i) {
       const double f = static_cast<double>(i) * df;
       bins.f[i] = f;
@@ -91,17 +102,20 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
       // log-frequency, raised to the weight exponent (applied to √P below).
       const double sensitivity = std::pow(10.0, -model.sensitivity_scale * threshold_db(Hertz(f * v)) / 20.0);
       bins.gain[i] = f < f_lo ? 0.0 : std::pow(sensitivity / std::sqrt(f), model.weight_exponent);
+      if (bins.gain[i] > 0.0) bins.first = std::min(bins.first, i);
     }
+    hit = cache.begin() + static_cast<std::ptrdiff_t>(&bins - cache.data());
   }
+  const Bins& bins = *hit;
   // Components more than `masked_db` below the strongest are not felt
   // (and leakage and quantization noise stay out of the spread).
   double peak = 0.0;
-  for (std::size_t i = 1; i < p.size(); ++i)
+  for (std::size_t i = bins.first; i < p.size(); ++i)
     if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   double sw = 0, swf = 0, swd = 0, swdd = 0;  // perceptual weights
   double sp = 0, spf = 0, spd = 0, spdd = 0;  // physical (power) weights
-  for (std::size_t i = 1; i < p.size(); ++i) {
+  for (std::size_t i = bins.first; i < p.size(); ++i) {
     if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
     const double f = bins.f[i], d = bins.d[i];
     const double w = bins.half_exponent(p[i]) * bins.gain[i];
