@@ -196,8 +196,12 @@ Recovered recover_frequencies(const std::vector<double>& y, double dx, double L,
     search(phases);
     // The previous texel may have ended near a crest, where its end phase is
     // poorly determined: if this texel does not fit, let its start phase move
-    // a little (a few hundredths of a cycle) around the prediction.
-    if (k > 0 && best > 1e-6 * static_cast<double>(e - b)) {  // residual RMS above 1e-3
+    // a little (a few hundredths of a cycle) around the prediction — when the
+    // texels so far fit (residual RMS under 1e-3): an input whose texels
+    // already do not fit is no rendering, and the four extra searches per
+    // texel were most of the time spent rejecting it (e.g. a triangle wave).
+    const bool fitting_so_far = sse <= 1e-6 * static_cast<double>(used);
+    if (k > 0 && fitting_so_far && best > 1e-6 * static_cast<double>(e - b)) {  // residual RMS above 1e-3
       free_phase = true;
       search({phase - 0.03, phase - 0.01, phase + 0.01, phase + 0.03});
     }
