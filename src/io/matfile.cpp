@@ -1,5 +1,8 @@
 // MATLAB .mat files through libmatio (BSD-2, Debian's libmatio-dev): the only
-// translation unit that includes <matio.h>. Writing builds matio variables
+// translation unit that includes <matio.h>. libmatio is opened on first use
+// (dlopen, `matio()` below), not linked: it brings HDF5 and through it curl,
+// TLS and Kerberos, some thirty libraries whose loading was a third of every
+// texel command's start-up whether or not it touched a .mat file. Writing builds matio variables
 // from texel::mat values (copies: a map is at most a few hundred MB and the
 // copy keeps ownership simple); reading first lists every variable's header
 // (class, rank, dimensions; no data), checks the chosen one completely, and
@@ -27,6 +30,7 @@
 #include <unistd.h>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/shared_object.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -35,6 +39,39 @@ namespace fs = std::filesystem;
 using detail::num;
 
 namespace {
+
+// --- libmatio, opened on first use ---------------------------------------------
+
+#ifndef TEXEL_MATIO_SONAME
+#error "TEXEL_MATIO_SONAME (libmatio's shared object name) is set by src/CMakeLists.txt"
+#endif
+
+#define TEXEL_MATIO_FUNCTIONS(X)                                                                                    \
+  X(Mat_Open) X(Mat_Close) X(Mat_CreateVer) X(Mat_GetVersion) X(Mat_LogInitFunc) X(Mat_SizeOfClass) X(Mat_VarCreate) \
+      X(Mat_VarCreateStruct2) X(Mat_VarFree) X(Mat_VarReadData) X(Mat_VarReadNextInfo) X(Mat_VarSetCell)               \
+          X(Mat_VarSetStructFieldByName) X(Mat_VarWrite)
+
+/// The libmatio functions this file calls, resolved once from the shared
+/// object (the signatures <matio.h> declares).
+struct Matio {
+#define TEXEL_MATIO_POINTER(name) decltype(&::name) name = nullptr;
+  TEXEL_MATIO_FUNCTIONS(TEXEL_MATIO_POINTER)
+#undef TEXEL_MATIO_POINTER
+};
+
+/// libmatio, opened on the first .mat read or write; without it the rest of
+/// Texel works and .mat files are an IoError naming the library.
+const Matio& matio() {
+  static const Matio loaded = [] {
+    void* handle = detail::open_shared_object(TEXEL_MATIO_SONAME, "MATLAB .mat files");
+    Matio m;
+#define TEXEL_MATIO_RESOLVE(name) m.name = detail::shared_function<decltype(&::name)>(handle, TEXEL_MATIO_SONAME, #name);
+    TEXEL_MATIO_FUNCTIONS(TEXEL_MATIO_RESOLVE)
+#undef TEXEL_MATIO_RESOLVE
+    return m;
+  }();
+  return loaded;
+}
 
 // matio reports through a process-wide log function (stderr by default).
 // Route it into the last message of this thread so errors carry matio's
@@ -50,7 +87,7 @@ void matio_log(int level, char* message) {
 
 void init_matio_logging() {
   static std::once_flag once;
-  std::call_once(once, [] { Mat_LogInitFunc("texel", matio_log); });
+  std::call_once(once, [] { matio().Mat_LogInitFunc("texel", matio_log); });
 }
 
 std::string matio_reason() {
@@ -60,12 +97,12 @@ std::string matio_reason() {
 }
 
 struct VarFree {
-  void operator()(matvar_t* v) const { Mat_VarFree(v); }
+  void operator()(matvar_t* v) const { matio().Mat_VarFree(v); }
 };
 using VarPtr = std::unique_ptr<matvar_t, VarFree>;
 
 struct MatClose {
-  void operator()(mat_t* m) const { Mat_Close(m); }
+  void operator()(mat_t* m) const { matio().Mat_Close(m); }
 };
 using MatPtr = std::unique_ptr<mat_t, MatClose>;
 
@@ -123,7 +160,7 @@ class Builder {
                             std::to_string(m.cols) + " but holds " + std::to_string(m.data.size()) + " values");
     std::size_t dims[2] = {m.rows, m.cols};
     // matio copies `data` (no MAT_F_DONT_COPY_DATA); the const_cast is its C signature.
-    return check(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
+    return check(matio().Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
                                m.data.empty() ? nullptr : const_cast<double*>(m.data.data()), 0),
                  name);
   }
@@ -131,15 +168,15 @@ class Builder {
   VarPtr make(const char* name, const Text& t) const {
     std::vector<std::uint16_t> units = utf16(t.utf8);
     std::size_t dims[2] = {units.empty() ? 0u : 1u, units.size()};
-    return check(Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UINT16, 2, dims, units.empty() ? nullptr : units.data(), 0), name);
+    return check(matio().Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UINT16, 2, dims, units.empty() ? nullptr : units.data(), 0), name);
   }
 
   VarPtr make(const char* name, const StringColumn& c) const {
     std::size_t dims[2] = {c.values.size(), 1};
-    VarPtr cell = check(Mat_VarCreate(name, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), name);
+    VarPtr cell = check(matio().Mat_VarCreate(name, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), name);
     for (std::size_t i = 0; i < c.values.size(); ++i) {
       VarPtr element = make(static_cast<const char*>(nullptr), Text{c.values[i]});
-      Mat_VarSetCell(cell.get(), static_cast<int>(i), element.release());  // the cell owns it now
+      matio().Mat_VarSetCell(cell.get(), static_cast<int>(i), element.release());  // the cell owns it now
     }
     return cell;
   }
@@ -157,11 +194,11 @@ class Builder {
     }
     std::size_t dims[2] = {1, 1};
     names.push_back(nullptr);  // matio takes a null-terminated list
-    VarPtr var = check(Mat_VarCreateStruct2(name, 2, dims, names.data()), name);
+    VarPtr var = check(matio().Mat_VarCreateStruct2(name, 2, dims, names.data()), name);
     for (const auto& entry : s.fields) {  // not a structured binding: clang 14 cannot capture one
       const char* field = entry.first.c_str();
       VarPtr f = std::visit([&](const auto& v) { return make(field, v); }, entry.second);
-      Mat_VarSetStructFieldByName(var.get(), field, 0, f.release());  // the struct owns it now
+      matio().Mat_VarSetStructFieldByName(var.get(), field, 0, f.release());  // the struct owns it now
     }
     return var;
   }
@@ -470,14 +507,14 @@ class Reader {
       if (!(le || be) || (version != 0x0100 && version != 0x0200))
         throw FormatError("'" + path_ + "' is not a MATLAB v5/v7.3 .mat file (no version and byte-order mark at bytes 124-127)");
     }
-    mat_.reset(Mat_Open(path_.c_str(), MAT_ACC_RDONLY));
+    mat_.reset(matio().Mat_Open(path_.c_str(), MAT_ACC_RDONLY));
     if (!mat_) throw FormatError("'" + path_ + "' is not a MATLAB .mat file" + matio_reason());
-    version_ = Mat_GetVersion(mat_.get());
+    version_ = matio().Mat_GetVersion(mat_.get());
     if (version_ != MAT_FT_MAT5 && version_ != MAT_FT_MAT73)
       throw FormatError("'" + path_ + "' is a MATLAB v4 file; Texel reads v5 (-v7) and v7.3 .mat files");
     const std::size_t elements = version_ == MAT_FT_MAT5 ? v5_elements() : 0;
     constexpr std::size_t max_variables = 4096;
-    while (matvar_t* v = Mat_VarReadNextInfo(mat_.get())) {
+    while (matvar_t* v = matio().Mat_VarReadNextInfo(mat_.get())) {
       infos_.push_back(describe(v));
       if (infos_.size() > max_variables)
         throw FormatError("'" + path_ + "' holds more than " + std::to_string(max_variables) + " variables");
@@ -525,12 +562,12 @@ class Reader {
         throw FormatError(what + " declares " + info.shape + " elements but the file has only " + std::to_string(file_size_) +
                           " bytes");
     }
-    const std::size_t width = Mat_SizeOfClass(v->class_type);
+    const std::size_t width = matio().Mat_SizeOfClass(v->class_type);
     if (width == 0 || width > 8) throw FormatError(what + " has an unsupported element type");
     std::vector<unsigned char> raw(n * width);
     std::vector<int> start(static_cast<std::size_t>(v->rank), 0), stride(start.size(), 1), edge(start.size());
     for (std::size_t k = 0; k < edge.size(); ++k) edge[k] = static_cast<int>(v->dims[k]);
-    if (Mat_VarReadData(mat_.get(), const_cast<matvar_t*>(v), raw.data(), start.data(), stride.data(), edge.data()) != 0)
+    if (matio().Mat_VarReadData(mat_.get(), const_cast<matvar_t*>(v), raw.data(), start.data(), stride.data(), edge.data()) != 0)
       throw FormatError(what + " cannot be read (truncated or corrupt file)" + matio_reason());
     std::vector<double> out(n);
     auto convert = [&]<typename T>(T) {
@@ -664,17 +701,17 @@ void write_mat(const std::string& path, const std::vector<Variable>& variables, 
     // A fixed header (matio's default holds the platform and the time), so
     // the same map gives the same v5 bytes.
     const bool v73 = options.version == MatVersion::v73;
-    MatPtr mat(Mat_CreateVer(tmp.c_str(), v73 ? "MATLAB 7.3 MAT-file, written by Texel" : "MATLAB 5.0 MAT-file, written by Texel",
+    MatPtr mat(matio().Mat_CreateVer(tmp.c_str(), v73 ? "MATLAB 7.3 MAT-file, written by Texel" : "MATLAB 5.0 MAT-file, written by Texel",
                              v73 ? MAT_FT_MAT73 : MAT_FT_MAT5));
     if (!mat) throw IoError("cannot write '" + path + "': libmatio cannot create the file" + matio_reason());
     const Builder builder(path);
     const matio_compression compression = options.compress ? MAT_COMPRESSION_ZLIB : MAT_COMPRESSION_NONE;
     for (const Variable& var : variables) {
       VarPtr v = std::visit([&](const auto& value) { return builder.make(var.name.c_str(), value); }, var.value);
-      if (Mat_VarWrite(mat.get(), v.get(), compression) != 0)
+      if (matio().Mat_VarWrite(mat.get(), v.get(), compression) != 0)
         throw IoError("cannot write '" + path + "': libmatio failed on variable '" + var.name + "'" + matio_reason());
     }
-    if (Mat_Close(mat.release()) != 0)
+    if (matio().Mat_Close(mat.release()) != 0)
       throw IoError("cannot write '" + path + "': libmatio cannot close the file" + matio_reason());
     commit(tmp, path);
   } catch (...) {

@@ -18,6 +18,7 @@
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/serial_link.hpp"
+#include "texel/detail/shared_object.hpp"
 
 namespace texel {
 
@@ -200,8 +201,40 @@ class NullBackend final : public PacedBackend {
 
 // ------------------------------------------------------------- PortAudio
 
+// PortAudio is opened on first use (dlopen), not linked: it brings JACK and
+// ALSA, loaded by every texel command at start-up otherwise; only live
+// playback needs it.
+#ifndef TEXEL_PORTAUDIO_SONAME
+#error "TEXEL_PORTAUDIO_SONAME (PortAudio's shared object name) is set by src/CMakeLists.txt"
+#endif
+
+#define TEXEL_PORTAUDIO_FUNCTIONS(X)                                                                               \
+  X(Pa_CloseStream) X(Pa_GetDefaultOutputDevice) X(Pa_GetDeviceCount) X(Pa_GetDeviceInfo) X(Pa_GetErrorText)       \
+      X(Pa_GetHostApiInfo) X(Pa_Initialize) X(Pa_IsStreamStopped) X(Pa_OpenStream) X(Pa_StartStream) X(Pa_StopStream) \
+          X(Pa_Terminate)
+
+/// The PortAudio functions this file calls (the signatures <portaudio.h> declares).
+struct PortAudio {
+#define TEXEL_PORTAUDIO_POINTER(name) decltype(&::name) name = nullptr;
+  TEXEL_PORTAUDIO_FUNCTIONS(TEXEL_PORTAUDIO_POINTER)
+#undef TEXEL_PORTAUDIO_POINTER
+};
+
+/// PortAudio, opened when the first audio sink or device list is made.
+const PortAudio& portaudio() {
+  static const PortAudio loaded = [] {
+    void* handle = detail::open_shared_object(TEXEL_PORTAUDIO_SONAME, "audio output and device lists");
+    PortAudio pa;
+#define TEXEL_PORTAUDIO_RESOLVE(name) pa.name = detail::shared_function<decltype(&::name)>(handle, TEXEL_PORTAUDIO_SONAME, #name);
+    TEXEL_PORTAUDIO_FUNCTIONS(TEXEL_PORTAUDIO_RESOLVE)
+#undef TEXEL_PORTAUDIO_RESOLVE
+    return pa;
+  }();
+  return loaded;
+}
+
 void pa_check(PaError e, const std::string& what) {
-  if (e != paNoError) throw IoError("audio: " + what + ": " + Pa_GetErrorText(e));
+  if (e != paNoError) throw IoError("audio: " + what + ": " + portaudio().Pa_GetErrorText(e));
 }
 
 class PaSession {
@@ -213,7 +246,7 @@ class PaSession {
     const int saved = ::dup(2);
     std::FILE* devnull = std::fopen("/dev/null", "w");
     if (devnull && saved >= 0) ::dup2(::fileno(devnull), 2);
-    const PaError e = Pa_Initialize();
+    const PaError e = portaudio().Pa_Initialize();
     if (saved >= 0) {
       ::dup2(saved, 2);
       ::close(saved);
@@ -221,18 +254,18 @@ class PaSession {
     if (devnull) std::fclose(devnull);
     pa_check(e, "cannot initialise PortAudio");
   }
-  ~PaSession() { Pa_Terminate(); }
+  ~PaSession() { portaudio().Pa_Terminate(); }
   PaSession(const PaSession&) = delete;
   PaSession& operator=(const PaSession&) = delete;
 };
 
 std::vector<std::string> list_outputs() {
   std::vector<std::string> out;
-  const int n = Pa_GetDeviceCount();
+  const int n = portaudio().Pa_GetDeviceCount();
   for (int i = 0; i < n; ++i) {
-    const PaDeviceInfo* d = Pa_GetDeviceInfo(i);
+    const PaDeviceInfo* d = portaudio().Pa_GetDeviceInfo(i);
     if (!d || d->maxOutputChannels < 1) continue;
-    const PaHostApiInfo* h = Pa_GetHostApiInfo(d->hostApi);
+    const PaHostApiInfo* h = portaudio().Pa_GetHostApiInfo(d->hostApi);
     out.push_back(std::to_string(i) + ": " + d->name + " (" + (h ? h->name : "?") + ", " + std::to_string(d->maxOutputChannels) +
                   " ch, default " + detail::num(d->defaultSampleRate) + " Hz)");
   }
@@ -244,15 +277,15 @@ class AudioBackend final : public Backend {
   explicit AudioBackend(const AudioOptions& o) : options_(o) {
     PaDeviceIndex dev = paNoDevice;
     if (o.device.empty()) {
-      dev = Pa_GetDefaultOutputDevice();
+      dev = portaudio().Pa_GetDefaultOutputDevice();
     } else {
       char* end = nullptr;
       const long idx = std::strtol(o.device.c_str(), &end, 10);
-      if (end && *end == '\0' && idx >= 0 && idx < Pa_GetDeviceCount()) {
+      if (end && *end == '\0' && idx >= 0 && idx < portaudio().Pa_GetDeviceCount()) {
         dev = static_cast<PaDeviceIndex>(idx);
       } else {
-        for (int i = 0; i < Pa_GetDeviceCount(); ++i) {
-          const PaDeviceInfo* d = Pa_GetDeviceInfo(i);
+        for (int i = 0; i < portaudio().Pa_GetDeviceCount(); ++i) {
+          const PaDeviceInfo* d = portaudio().Pa_GetDeviceInfo(i);
           if (d && d->maxOutputChannels > 0 && std::string(d->name).find(o.device) != std::string::npos) {
             dev = i;
             break;
@@ -260,13 +293,13 @@ class AudioBackend final : public Backend {
         }
       }
     }
-    if (dev == paNoDevice || !Pa_GetDeviceInfo(dev) || Pa_GetDeviceInfo(dev)->maxOutputChannels < 1) {
+    if (dev == paNoDevice || !portaudio().Pa_GetDeviceInfo(dev) || portaudio().Pa_GetDeviceInfo(dev)->maxOutputChannels < 1) {
       std::string list;
       for (const auto& s : list_outputs()) list += (list.empty() ? "" : "; ") + s;
       throw IoError("audio: no output device '" + (o.device.empty() ? std::string("default") : o.device) +
                     "'; outputs: " + (list.empty() ? "none (use --backend null)" : list));
     }
-    const PaDeviceInfo* info = Pa_GetDeviceInfo(dev);
+    const PaDeviceInfo* info = portaudio().Pa_GetDeviceInfo(dev);
     device_name_ = info->name;
     PaStreamParameters p{};
     p.device = dev;
@@ -274,13 +307,13 @@ class AudioBackend final : public Backend {
     p.sampleFormat = paFloat32;
     p.suggestedLatency = o.latency_s > 0 ? o.latency_s : info->defaultLowOutputLatency;
     pa_check(
-        Pa_OpenStream(&stream_, nullptr, &p, o.rate_hz, static_cast<unsigned long>(o.block_frames), paClipOff,
+        portaudio().Pa_OpenStream(&stream_, nullptr, &p, o.rate_hz, static_cast<unsigned long>(o.block_frames), paClipOff,
                       &AudioBackend::callback, this),
         "cannot open '" + device_name_ + "' at " + detail::num(o.rate_hz) + " Hz, " + std::to_string(o.block_frames) + " frames");
   }
   ~AudioBackend() override {
     stop();
-    if (stream_) Pa_CloseStream(stream_);
+    if (stream_) portaudio().Pa_CloseStream(stream_);
   }
   [[nodiscard]] std::string describe() const override {
     return "audio '" + device_name_ + "', " + detail::num(options_.rate_hz) + " Hz, " + std::to_string(options_.block_frames) +
@@ -290,11 +323,11 @@ class AudioBackend final : public Backend {
  private:
   void do_start(Player& player) override {
     player_ = &player;
-    pa_check(Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
+    pa_check(portaudio().Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
   }
   // Pa_StopStream returns after the last callback has returned.
   void do_stop() noexcept override {
-    if (stream_ && Pa_IsStreamStopped(stream_) == 0) Pa_StopStream(stream_);
+    if (stream_ && portaudio().Pa_IsStreamStopped(stream_) == 0) portaudio().Pa_StopStream(stream_);
     player_ = nullptr;
   }
   // PortAudio's callback: calls only the real-time-safe process() and
