@@ -51,27 +51,9 @@ namespace {
       X(Mat_VarCreateStruct2) X(Mat_VarFree) X(Mat_VarReadData) X(Mat_VarReadNextInfo) X(Mat_VarSetCell)               \
           X(Mat_VarSetStructFieldByName) X(Mat_VarWrite)
 
-/// The libmatio functions this file calls, resolved once from the shared
-/// object (the signatures <matio.h> declares).
-struct Matio {
-#define TEXEL_MATIO_POINTER(name) decltype(&::name) name = nullptr;
-  TEXEL_MATIO_FUNCTIONS(TEXEL_MATIO_POINTER)
-#undef TEXEL_MATIO_POINTER
-};
-
-/// libmatio, opened on the first .mat read or write; without it the rest of
-/// Texel works and .mat files are an IoError naming the library.
-const Matio& matio() {
-  static const Matio loaded = [] {
-    void* handle = detail::open_shared_object(TEXEL_MATIO_SONAME, "MATLAB .mat files");
-    Matio m;
-#define TEXEL_MATIO_RESOLVE(name) m.name = detail::shared_function<decltype(&::name)>(handle, TEXEL_MATIO_SONAME, #name);
-    TEXEL_MATIO_FUNCTIONS(TEXEL_MATIO_RESOLVE)
-#undef TEXEL_MATIO_RESOLVE
-    return m;
-  }();
-  return loaded;
-}
+/// libmatio, opened on the first .mat read or write (`matio()`); without it
+/// the rest of Texel works and .mat files are an IoError naming the library.
+TEXEL_SHARED_LIBRARY(Matio, matio, TEXEL_MATIO_SONAME, "MATLAB .mat files", TEXEL_MATIO_FUNCTIONS)
 
 // matio reports through a process-wide log function (stderr by default).
 // Route it into the last message of this thread so errors carry matio's

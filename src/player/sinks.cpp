@@ -213,25 +213,10 @@ class NullBackend final : public PacedBackend {
       X(Pa_GetHostApiInfo) X(Pa_Initialize) X(Pa_IsStreamStopped) X(Pa_OpenStream) X(Pa_StartStream) X(Pa_StopStream) \
           X(Pa_Terminate)
 
-/// The PortAudio functions this file calls (the signatures <portaudio.h> declares).
-struct PortAudio {
-#define TEXEL_PORTAUDIO_POINTER(name) decltype(&::name) name = nullptr;
-  TEXEL_PORTAUDIO_FUNCTIONS(TEXEL_PORTAUDIO_POINTER)
-#undef TEXEL_PORTAUDIO_POINTER
-};
-
-/// PortAudio, opened when the first audio sink or device list is made.
-const PortAudio& portaudio() {
-  static const PortAudio loaded = [] {
-    void* handle = detail::open_shared_object(TEXEL_PORTAUDIO_SONAME, "audio output and device lists");
-    PortAudio pa;
-#define TEXEL_PORTAUDIO_RESOLVE(name) pa.name = detail::shared_function<decltype(&::name)>(handle, TEXEL_PORTAUDIO_SONAME, #name);
-    TEXEL_PORTAUDIO_FUNCTIONS(TEXEL_PORTAUDIO_RESOLVE)
-#undef TEXEL_PORTAUDIO_RESOLVE
-    return pa;
-  }();
-  return loaded;
-}
+/// PortAudio, opened when the first audio sink or device list is made
+/// (`portaudio()`).
+TEXEL_SHARED_LIBRARY(PortAudio, portaudio, TEXEL_PORTAUDIO_SONAME, "audio output and device lists",
+                     TEXEL_PORTAUDIO_FUNCTIONS)
 
 void pa_check(PaError e, const std::string& what) {
   if (e != paNoError) throw IoError("audio: " + what + ": " + portaudio().Pa_GetErrorText(e));

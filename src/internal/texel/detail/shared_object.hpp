@@ -26,3 +26,29 @@ F shared_function(void* handle, const char* soname, const char* name) {
 }
 
 }  // namespace texel::detail
+
+/// Defines `struct Type` with one pointer per function in LIST (an X-macro
+/// over the names the library's header declares) and `const Type& accessor()`,
+/// which opens SONAME and resolves them on its first call (thread-safe, once;
+/// a failure throws and the next call tries again). Use inside an unnamed
+/// namespace of the one file that calls the library:
+///   #define TEXEL_MATIO_FUNCTIONS(X) X(Mat_Open) X(Mat_Close)
+///   TEXEL_SHARED_LIBRARY(Matio, matio, "libmatio.so.11", "MATLAB .mat files", TEXEL_MATIO_FUNCTIONS)
+///   ... matio().Mat_Open(path, MAT_ACC_RDONLY) ...
+#define TEXEL_SHARED_LIBRARY_POINTER(name) decltype(&::name) name = nullptr;
+#define TEXEL_SHARED_LIBRARY_RESOLVE(name) \
+  loaded_.name = ::texel::detail::shared_function<decltype(&::name)>(handle_, soname_, #name);
+#define TEXEL_SHARED_LIBRARY(Type, accessor, SONAME, NEEDED_FOR, LIST)                 \
+  struct Type {                                                                        \
+    LIST(TEXEL_SHARED_LIBRARY_POINTER)                                                 \
+  };                                                                                   \
+  const Type& accessor() {                                                             \
+    static const Type loaded = [] {                                                    \
+      const char* soname_ = SONAME;                                                    \
+      void* handle_ = ::texel::detail::open_shared_object(soname_, NEEDED_FOR);        \
+      Type loaded_;                                                                    \
+      LIST(TEXEL_SHARED_LIBRARY_RESOLVE)                                               \
+      return loaded_;                                                                  \
+    }();                                                                               \
+    return loaded;                                                                     \
+  }
