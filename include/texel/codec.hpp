@@ -15,7 +15,9 @@
 //     a felt pitch (the mean frequency weighted by suprathreshold
 //     sensitivity and amplitude, raised so the strongest components
 //     dominate) and a felt noisiness (the weighted spread of log-frequency),
-//     at the swipe speed that turns cycles/mm into Hz. Candidate Texel
+//     at the swipe speed that turns cycles/mm into Hz; optionally through a
+//     display's frequency response (PerceptualModel::display, off by
+//     default: the stream is device independent). Candidate Texel
 //     textures are rendered with the library and compared with the input
 //     under the model; least squares (Levenberg–Marquardt, or the simplex on
 //     request) over (Central Pitch, Irregularity) minimises the distance,
