@@ -45,8 +45,8 @@ struct RegionLayout {
 /// every consumer behaves as before). A spatial frequency f (cycles/mm) felt
 /// at swipe speed v (mm/s) is the temporal frequency f·v (Hz).
 struct FrequencyResponse {
-  Hertz corner{0.0};  ///< −3 dB corner, Hz (> 0), or 0 = flat
-  int order = 1;      ///< roll-off 6·order dB/octave above the corner, 1 … 4
+  Hertz corner{0.0};   ///< −3 dB corner, Hz (> 0), or 0 = flat
+  int order = 1;       ///< roll-off 6·order dB/octave above the corner, 1 … 4
   std::string source;  ///< where the numbers come from, and how sure they are (free text)
 
   [[nodiscard]] bool flat() const { return !(corner.value() > 0.0); }

@@ -513,9 +513,9 @@ TEST_F(Cli, DisplayResponseReachesTheEncoderAndThePlayer) {
   EXPECT_EQ(m["display"]["order"].get<int>(), 1);
   expect_rejected({"encode", "m.bin", "--device", "tpad", "--display-response", "sideways"}, "--display-response");
   ASSERT_EQ(run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "-o", "limit.csv"}).status, 0);
-  ASSERT_EQ(run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "--response", "off", "-o", "off.csv"})
-                .status,
-            0);
+  ASSERT_EQ(
+      run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "--response", "off", "-o", "off.csv"}).status,
+      0);
   EXPECT_NE(slurp(dir / "limit.csv"), slurp(dir / "off.csv"));  // the tpad's response limit (3.98 kHz at 48 kHz) filtered
   expect_rejected({"swipe", "d.texel.json", "--response", "equalize", "-o", "x.csv"}, "--response");
 }

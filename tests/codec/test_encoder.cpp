@@ -276,12 +276,12 @@ TEST(DisplayInTheLoop, LowPassPullsFeltPitchTowardTheLowComponent) {
   const auto y = sines({{2.0, 0.25}, {8.0, 0.25}});
   const Percept a = perceive(y, dx, flat);
   const Percept b = perceive(y, dx, lowpass);
-  std::printf("two components 2 + 8 cpm: felt pitch %.2f dB flat, %.2f dB through tpad (components 3.01, 9.03 dB)\n",
-              a.pitch_db, b.pitch_db);
+  std::printf("two components 2 + 8 cpm: felt pitch %.2f dB flat, %.2f dB through tpad (components 3.01, 9.03 dB)\n", a.pitch_db,
+              b.pitch_db);
   // 3.67 dB flat, 3.22 dB through the tpad: toward the low component (asserted ≥ 0.25 dB)
   EXPECT_LT(b.pitch_db, a.pitch_db - 0.25);
   EXPECT_GT(b.pitch_db, 10.0 * std::log10(2.0) - 0.1);  // still not below the low component
-  EXPECT_EQ(b.mean_db, a.mean_db);  // the physical tie-break terms see the texture itself
+  EXPECT_EQ(b.mean_db, a.mean_db);                      // the physical tie-break terms see the texture itself
   EXPECT_EQ(b.spread_db, a.spread_db);
   // One component: felt at its own frequency through any display.
   for (const double f : {2.0, 8.0}) {

@@ -234,8 +234,8 @@ TEST(Device, FrequencyResponseIsAButterworthMagnitude) {
   r.corner = Hertz(400.0);
   r.order = 1;
   EXPECT_NEAR(r.gain_db(Hertz(400.0)), -3.0103, 1e-3);  // −3 dB at the corner
-  EXPECT_NEAR(r.gain(Hertz(40.0)), 1.0, 0.01);           // flat well below it
-  EXPECT_NEAR(r.gain_db(Hertz(4000.0)), -20.04, 0.01);   // 6 dB/octave, 20 dB/decade above
+  EXPECT_NEAR(r.gain(Hertz(40.0)), 1.0, 0.01);          // flat well below it
+  EXPECT_NEAR(r.gain_db(Hertz(4000.0)), -20.04, 0.01);  // 6 dB/octave, 20 dB/decade above
   EXPECT_NEAR(r.gain_db(r.frequency_at_db(20.0)), -20.0, 1e-9);
   r.order = 2;
   EXPECT_NEAR(r.gain_db(Hertz(4000.0)), -40.0, 0.01);
