@@ -76,9 +76,9 @@ void run(const PlayArgs& a) {
     if (!f.rate_hz) f.rate_hz = 1000.0;  // one frame per millisecond, like a position sensor
     if (bo.stream == SerialStream::drive && f.output == "vibration")
       f.output = "amplitude";  // a friction display takes amplitudes
-    config = player_config(f, 1000.0);
+    config = player_config(f, 1000.0, doc.device.response);
   } else {
-    config = player_config(a.finger, 48000.0);
+    config = player_config(a.finger, 48000.0, doc.device.response);
   }
   bo.rate_hz = config.rate_hz;
   const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);

@@ -46,7 +46,7 @@ void run(const SwipeArgs& a) {
   if (a.plot) check_writable(*a.plot);
 
   const Document doc = build_document(a.document, a.device, a.texture);
-  const PlayerConfig config = player_config(a.finger, 48000.0);
+  const PlayerConfig config = player_config(a.finger, 48000.0, doc.device.response);
   const Surface surface = prepare_surface(doc);
   const auto map = PlayerMap::from_surface(surface);
   double duration = 2.0;

@@ -28,10 +28,15 @@ void add_finger_options(CLI::App& cmd, FingerOptions& o) {
   cmd.add_option("--prediction", o.prediction_s,
                  "Latency compensation: predict the finger this far ahead (s) [0; TPaD tablet: 0.02]");
   cmd.add_option("--gain", o.gain, "Output gain, 0 … 1 [1]");
+  cmd.add_option("--response", o.response,
+                 "The display's frequency response (device profile): limit (never drive what the display attenuates by "
+                 "20 dB or more) or off [limit]");
 }
 
-PlayerConfig player_config(const FingerOptions& o, double default_rate_hz) {
+PlayerConfig player_config(const FingerOptions& o, double default_rate_hz, const FrequencyResponse& response) {
   PlayerConfig c;
+  c.response = response;
+  c.response_handling = parse_response_handling(o.response, "--response");
   c.rate_hz = o.rate_hz.value_or(default_rate_hz);
   c.mode = parse_output_mode(o.output, "--output");
   c.carrier_hz = o.carrier_hz;

@@ -27,6 +27,7 @@ struct FingerOptions {
   double carrier_hz = 250.0;
   double prediction_s = 0.0;
   double gain = 1.0;
+  std::string response = "limit";  ///< how the display's frequency response is respected: limit | off
 };
 
 void add_finger_options(CLI::App& cmd, FingerOptions& o);
@@ -34,8 +35,9 @@ void add_finger_options(CLI::App& cmd, FingerOptions& o);
 /// device and texture, in that order.
 void add_player_options(CLI::App& cmd, FingerOptions& finger, DeviceOptions& device, TextureOptions& texture);
 
-/// The player configuration the options describe (validated).
-PlayerConfig player_config(const FingerOptions& o, double default_rate_hz);
+/// The player configuration the options describe (validated); `response` is
+/// the display's (DeviceProfile::response of the document's device).
+PlayerConfig player_config(const FingerOptions& o, double default_rate_hz, const FrequencyResponse& response);
 /// The trace: the --trace file, or a simulated swipe over `surface_mm`
 /// sampled at 1 kHz. `duration_s` is the length asked for (or the trace's).
 std::vector<FingerSample> finger_trace(const FingerOptions& o, double surface_mm, double& duration_s);

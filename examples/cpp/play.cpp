@@ -45,6 +45,9 @@ int main(int argc, char** argv) try {
   texel::PlayerConfig config;
   config.rate_hz = 48000.0;
   config.mode = texel::OutputMode::vibration;  // zero-mean drive for a vibrotactile actuator
+  // The display's frequency response (as `texel swipe` takes it from the
+  // document's device): what the display attenuates by 20 dB or more is not driven.
+  config.response = texel::load_device("tpad").response;
   texel::Player player(config, texel::PlayerMap::from_surface(surface));
 
   // Off line the whole trace is known in advance: queue it (1,001 samples fit

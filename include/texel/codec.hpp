@@ -15,7 +15,9 @@
 //     a felt pitch (the mean frequency weighted by suprathreshold
 //     sensitivity and amplitude, raised so the strongest components
 //     dominate) and a felt noisiness (the weighted spread of log-frequency),
-//     at the swipe speed that turns cycles/mm into Hz. Candidate Texel
+//     at the swipe speed that turns cycles/mm into Hz; optionally through a
+//     display's frequency response (PerceptualModel::display, off by
+//     default: the stream is device independent). Candidate Texel
 //     textures are rendered with the library and compared with the input
 //     under the model; least squares (Levenberg–Marquardt, or the simplex on
 //     request) over (Central Pitch, Irregularity) minimises the distance,
@@ -82,7 +84,27 @@ struct PerceptualModel {
   /// (equal-sensation contours flatten with level); 1 is the threshold curve
   /// itself (the model before).
   double sensitivity_scale = 0.5;
+  /// The display between the texture and the finger (DeviceProfile::response,
+  /// docs/encoder.md §2 "The display in the loop"): what people feel through
+  /// a display is the displayed texture filtered by the display's response,
+  /// so each component's amplitude is weighted by |H(f·v)| at this model's
+  /// swipe speed v before the felt weights are formed. Default flat: no
+  /// display. `texel encode --device D` sets D's response; it is applied
+  /// with `--display-response device`.
+  FrequencyResponse display{};
+  /// Whether `display` is applied [choice] flat: the texture as drawn (the
+  /// model before); device: the model feels what the display reproduces.
+  /// Flat by default because the fit through a low-pass display loses the
+  /// established trends (docs/encoder.md §2, "The display in the loop").
+  enum class Display { device, flat } display_response = Display::flat;
 };
+
+std::string_view to_string(PerceptualModel::Display d);
+/// "device" or "flat"; errors name `field`.
+PerceptualModel::Display parse_display_response(std::string_view text, std::string_view field = "display_response");
+/// |H(f·v)| the model applies at spatial frequency f (cycles/mm): the display's
+/// gain at the model's swipe speed, or 1 when the display is flat or off.
+double display_gain(const PerceptualModel& model, CyclesPerMm f);
 
 /// Relative vibrotactile threshold at temporal frequency f, dB above the most
 /// sensitive frequency (0 dB at 250 Hz): a straight-line Pacinian U

@@ -35,6 +35,31 @@ struct RegionLayout {
   Millimetres length{0.0};
 };
 
+/// What a display reproduces of its drive signal, as a function of temporal
+/// frequency (docs/format.md "Device profiles", docs/encoder.md §2): a
+/// Butterworth-shaped low-pass |H(f)| = 1/√(1 + (f/corner)^(2·order)).
+/// An ultrasonic friction display's friction follows its drive envelope with
+/// the lag of a resonator driven at resonance (first order, corner f0/2Q);
+/// the squeeze film and the skin add more. corner 0 = flat (the default: a
+/// profile without "response" promises nothing about its bandwidth, and
+/// every consumer behaves as before). A spatial frequency f (cycles/mm) felt
+/// at swipe speed v (mm/s) is the temporal frequency f·v (Hz).
+struct FrequencyResponse {
+  Hertz corner{0.0};   ///< −3 dB corner, Hz (> 0), or 0 = flat
+  int order = 1;       ///< roll-off 6·order dB/octave above the corner, 1 … 4
+  std::string source;  ///< where the numbers come from, and how sure they are (free text)
+
+  [[nodiscard]] bool flat() const { return !(corner.value() > 0.0); }
+  /// |H(f)| in (0, 1]; 1 for a flat response.
+  [[nodiscard]] double gain(Hertz f) const;
+  /// 20·log10 |H(f)| (≤ 0 dB).
+  [[nodiscard]] double gain_db(Hertz f) const;
+  /// The frequency where |H| has fallen by `db` (> 0) dB; +∞ for a flat response.
+  [[nodiscard]] Hertz frequency_at_db(double db) const;
+};
+/// Throws InvalidArgument naming `field` (corner_hz, order).
+void validate(const FrequencyResponse& r, std::string_view field = "response");
+
 struct DeviceProfile {
   std::string name;  ///< e.g. "tpad"
   std::string description;
@@ -45,6 +70,10 @@ struct DeviceProfile {
   CyclesPerMm band_min{0.01};        ///< lowest renderable frequency
   CyclesPerMm band_max{0.0};         ///< 0 = Nyquist of the grid
   std::vector<RegionLayout> layout;  ///< named regions; empty = whole surface
+  /// The display's frequency response ("response" in the JSON; optional,
+  /// absent = flat). Rendering never uses it: a document's map is the same
+  /// bytes whatever the response. The encoder's model and the player do.
+  FrequencyResponse response;
 
   [[nodiscard]] Grid grid() const { return Grid{Millimetres(0.0), spacing, samples}; }
   [[nodiscard]] Millimetres length() const { return Millimetres(static_cast<double>(samples) * spacing.value()); }

@@ -42,6 +42,22 @@
 // Touch and lift fade the output in and out with a raised-cosine ramp of
 // touch_ramp_s (no click); a finger beyond the surface counts as lifted.
 //
+// The display's frequency response (PlayerConfig::response, from the device
+// profile; docs/format.md "Frequency response"). [choice] limit: the player
+// never drives content the display cannot reproduce: the map value under the
+// finger goes through a 2nd-order Butterworth low-pass at the frequency where
+// the display's response has fallen by response_limit_db (20 dB: a tenth of
+// the amplitude). The player runs in time, so this holds at whatever speed
+// the finger moves: a spatial frequency f at speed v is f·v Hz. Within the
+// display's pass band the filter costs at most 0.04 dB (first-order display:
+// the limit is 10× the corner); beyond it, drive the display would not turn
+// into friction is not sent (it would only load the amplifier and the
+// resonator). Skipped when the limit is above 0.45·rate (the output rate
+// already band-limits more) or the response is flat; off: as before.
+// Pre-emphasis (boosting within the pass band to flatten the display) is not
+// done: amplitudes live in [0, 1] with no headroom, and a boost would raise
+// the map's steps' overshoot and sensor noise with it.
+//
 // Lifetime. A Player is small (< 1 KiB: its queues' rings are allocated by
 // the constructor, i.e. at prepare) and can live on any stack. Whatever calls
 // process() from its own thread — a Backend (sinks.hpp) — is a PlayerDriver
@@ -67,6 +83,7 @@
 #include <string_view>
 #include <vector>
 
+#include "texel/device.hpp"
 #include "texel/finger.hpp"
 #include "texel/grid.hpp"
 #include "texel/spsc_queue.hpp"
@@ -103,6 +120,10 @@ class PlayerMap {
 };
 
 enum class OutputMode { amplitude, vibration, carrier };
+/// How the player respects the display's frequency response (see above). [choice] limit.
+enum class ResponseHandling { limit, off };
+std::string_view to_string(ResponseHandling h);
+ResponseHandling parse_response_handling(std::string_view text, std::string_view field = "response_handling");
 std::string_view to_string(OutputMode m);
 OutputMode parse_output_mode(std::string_view text, std::string_view field = "output");
 
@@ -122,7 +143,14 @@ struct PlayerConfig {
   /// 16 … 1,048,576 (default 4096: 4 s of a 1 kHz position sensor queued
   /// ahead). The ring (40 B per event) is allocated at prepare.
   std::size_t event_capacity = 4096;
+  /// The display's frequency response (DeviceProfile::response); flat (the
+  /// default) promises nothing, so nothing is limited.
+  FrequencyResponse response{};
+  ResponseHandling response_handling = ResponseHandling::limit;  ///< [choice] limit (see above)
+  double response_limit_db = 20.0;  ///< limit: attenuation (dB) at which the display no longer reproduces, 3 … 60
 };
+/// The low-pass corner (Hz) the player applies for `config`, or 0 for none.
+double response_limit_hz(const PlayerConfig& config);
 /// Throws InvalidArgument naming the field, the value and the allowed range.
 void validate(const PlayerConfig& config);
 
@@ -244,6 +272,13 @@ class Player {
       z2 = b2 * x - a2 * y;
       return y;
     }
+    /// Steady state for a constant input x (DC gain 1): no transient on touch-down.
+    void settle(double x) noexcept {
+      z2 = (b2 - a2) * x;
+      z1 = (b1 - a1) * x + z2;
+    }
+    /// RBJ cookbook low-pass, Q = 1/√2 (Butterworth): flat pass band, −3 dB at fc.
+    static Biquad lowpass(double fc, double rate) noexcept;
   };
 
   friend class PlayerAttachment;
@@ -275,6 +310,8 @@ class Player {
   double carrier_phase_ = 0.0;                           // cycles [0, 1)
   double dc_x1_ = 0.0, dc_y1_ = 0.0, dc_r_ = 0.0;
   Biquad lowpass_{};
+  Biquad display_lp_{};  // response limit (see above)
+  bool display_limit_ = false;
   std::uint64_t n_ = 0;
 };
 

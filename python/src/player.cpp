@@ -51,8 +51,11 @@ std::vector<FingerSample> trace_of(const py::object& t_s, const py::object& x_mm
   return trace;
 }
 
-PlayerConfig player_config(double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain) {
+PlayerConfig player_config(double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain,
+                           const std::string& response, const Document& doc) {
   PlayerConfig c;
+  c.response = doc.device.response;  // the display's, as `texel swipe` takes it
+  c.response_handling = parse_response_handling(response, "response");
   c.rate_hz = rate_hz;
   c.mode = parse_output_mode(output, "output");
   c.carrier_hz = carrier_hz;
@@ -80,7 +83,7 @@ py::tuple play(const PlayerMap& map, const PlayerConfig& config, const std::vect
 
 #define TEXEL_PLAYER_ARGS                                                                                                      \
   py::arg("rate_hz") = 48000.0, py::arg("output") = "vibration", py::arg("carrier_hz") = 250.0, py::arg("prediction_s") = 0.0, \
-  py::arg("gain") = 1.0
+  py::arg("gain") = 1.0, py::arg("response") = "limit"
 
 }  // namespace
 
@@ -118,9 +121,10 @@ lead_in_s   lifted time before the finger lands (s) [0])doc");
   m.def(
       "render_trace",
       [](const Document& doc, const py::object& t_s, const py::object& x_mm, const py::object& touch, double duration_s,
-         double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain) {
+         double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain,
+         const std::string& response) {
         const auto trace = trace_of(t_s, x_mm, touch);
-        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain);
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, doc);
         return play(*map_of(doc), c, trace, duration_s);
       },
       py::arg("document"), py::arg("t_s"), py::arg("x_mm"), py::arg("touch") = py::none(), py::kw_only(), py::arg("duration_s"),
@@ -135,14 +139,16 @@ output        'amplitude', 'vibration' (zero-mean, band-limited) or 'carrier' ['
 carrier_hz    carrier frequency for output='carrier' (Hz) [250]
 prediction_s  latency compensation look-ahead (s) [0]
 gain          output gain 0 … 1 [1]
+response      the device's frequency response: 'limit' (never drive what the display attenuates by 20 dB or more)
+              or 'off' ['limit']
 
 Returns (output, positions_mm): float32 arrays of one value per output sample. The GIL is released.)doc");
   m.def(
       "swipe",
       [](const Document& doc, double speed_mm_s, const std::string& pattern, std::optional<double> start_mm,
          std::optional<double> extent_mm, double turn_s, double duration_s, double rate_hz, const std::string& output,
-         double carrier_hz, double prediction_s, double gain) {
-        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain);
+         double carrier_hz, double prediction_s, double gain, const std::string& response) {
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, doc);
         if (!(std::isfinite(speed_mm_s) && speed_mm_s > 0))
           throw InvalidArgument("speed_mm_s is " + std::to_string(speed_mm_s) + "; it must be > 0 mm/s");
         if (!(std::isfinite(duration_s) && duration_s > 0 && duration_s <= 86400))

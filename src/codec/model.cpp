@@ -54,6 +54,19 @@ class DyadicPower {
 
 }  // namespace
 
+std::string_view to_string(PerceptualModel::Display d) { return d == PerceptualModel::Display::flat ? "flat" : "device"; }
+
+PerceptualModel::Display parse_display_response(std::string_view text, std::string_view field) {
+  if (text == "device") return PerceptualModel::Display::device;
+  if (text == "flat") return PerceptualModel::Display::flat;
+  throw FieldError(std::string(field), "is '" + std::string(text) + "'; allowed: device, flat");
+}
+
+double display_gain(const PerceptualModel& model, CyclesPerMm f) {
+  if (model.display_response == PerceptualModel::Display::flat) return 1.0;
+  return model.display.gain(Hertz(f.value() * model.swipe_speed.value()));
+}
+
 double threshold_db(Hertz f) {
   const double hz = std::max(f.value(), 1e-6);
   const double pacinian = 12.0 * std::fabs(std::log2(hz / 250.0));
@@ -65,62 +78,80 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   thread_local std::vector<double> p;  // reused: the fit perceives hundreds of candidates
   power_spectrum(fine, p, m);
   const double v = model.swipe_speed.value();
-  // Per-bin frequency, dB and weight depend only on (M, Δx, v) and the
-  // model's weighting: cached, a few settings at once (an encode alternates
-  // between the whole band and the fine part's band above the boundary).
+  // Per-bin frequency, dB, display gain and weight depend only on (M, Δx, v),
+  // the model's weighting and the display: cached, a few settings at once (an
+  // encode alternates between the whole band and the band above the boundary).
   struct Bins {
     std::size_t m = 0;
     double dx = 0, v = 0, f_min = 0, exponent = 0, scale = 0;
-    std::vector<double> f, d, gain;
+    double corner = 0;  // display response in force (0: flat or off)
+    int order = 0;
+    std::vector<double> f, d, gain, h2;
     std::size_t first = 1;      // the first bin at or above f_min (gain > 0 from there)
     DyadicPower half_exponent;  // √P to the weight exponent: P to half of it
   };
   thread_local std::array<Bins, 4> cache;
   thread_local std::size_t replace = 0;
   const double f_lo = std::max(0.01, f_min_cpm);
+  const bool display = model.display_response == PerceptualModel::Display::device && !model.display.flat();
+  const double corner = display ? model.display.corner.value() : 0.0;
+  const int order = display ? model.display.order : 0;
   auto same = [&](const Bins& b) {
     return b.m == m && b.dx == spacing_mm && b.v == v && b.f_min == f_lo && b.exponent == model.weight_exponent &&
-           b.scale == model.sensitivity_scale;
+           b.scale == model.sensitivity_scale && b.corner == corner && b.order == order;
   };
   auto hit = std::find_if(cache.begin(), cache.end(), same);
   if (hit == cache.end()) {
+    if (display) validate(model.display, "display");
     Bins& bins = cache[replace];
     replace = (replace + 1) % cache.size();
     bins.m = m, bins.dx = spacing_mm, bins.v = v, bins.f_min = f_lo;
     bins.exponent = model.weight_exponent, bins.scale = model.sensitivity_scale;
+    bins.corner = corner, bins.order = order;
     bins.half_exponent = DyadicPower(0.5 * model.weight_exponent);
     const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
     bins.f.assign(p.size(), 0.0);
     bins.d.assign(p.size(), 0.0);
     bins.gain.assign(p.size(), 0.0);
+    bins.h2.assign(p.size(), 1.0);
     bins.first = p.size();
     for (std::size_t i = 1; i < p.size(); ++i) {
       const double f = static_cast<double>(i) * df;
       bins.f[i] = f;
       bins.d[i] = db_of(f);
+      // The display passes |H(f·v)| of the component's amplitude: the felt
+      // component is the displayed one (flat: exactly 1, the model before).
+      const double h = display ? model.display.gain(Hertz(f * v)) : 1.0;
+      bins.h2[i] = h * h;
       // Suprathreshold sensitivity at f·v over sqrt(f): amplitude per unit
       // log-frequency, raised to the weight exponent (applied to √P below).
       const double sensitivity = std::pow(10.0, -model.sensitivity_scale * threshold_db(Hertz(f * v)) / 20.0);
-      bins.gain[i] = f < f_lo ? 0.0 : std::pow(sensitivity / std::sqrt(f), model.weight_exponent);
+      bins.gain[i] = f < f_lo ? 0.0 : std::pow(h * sensitivity / std::sqrt(f), model.weight_exponent);
       if (bins.gain[i] > 0.0) bins.first = std::min(bins.first, i);
     }
     hit = cache.begin() + static_cast<std::ptrdiff_t>(&bins - cache.data());
   }
   const Bins& bins = *hit;
   // Components more than `masked_db` below the strongest are not felt
-  // (and leakage and quantization noise stay out of the spread).
-  double peak = 0.0;
+  // (and leakage and quantization noise stay out of the spread). Felt: on
+  // the displayed spectrum P·|H|²; physical: on the texture's own spectrum P
+  // (the tie-break keeps the fit anchored to the texture where the display
+  // hides it). With a flat display the two masks are one, as before.
+  double peak = 0.0, peak_felt = 0.0;
   for (std::size_t i = bins.first; i < p.size(); ++i)
-    if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]);
+    if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]), peak_felt = std::max(peak_felt, p[i] * bins.h2[i]);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
+  const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
   double sw = 0, swf = 0, swd = 0, swdd = 0;  // perceptual weights
   double sp = 0, spf = 0, spd = 0, spdd = 0;  // physical (power) weights
   for (std::size_t i = bins.first; i < p.size(); ++i) {
-    if (!(p[i] > floor) || bins.gain[i] == 0.0) continue;
+    if (bins.gain[i] == 0.0) continue;
     const double f = bins.f[i], d = bins.d[i];
-    const double w = bins.half_exponent(p[i]) * bins.gain[i];
-    sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
-    sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+    if (p[i] * bins.h2[i] > floor_felt) {
+      const double w = bins.half_exponent(p[i]) * bins.gain[i];
+      sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
+    }
+    if (p[i] > floor) sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
   }
   if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
   Percept q;

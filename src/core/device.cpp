@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <utility>
 
 #include "texel/detail/format.hpp"
@@ -54,6 +55,30 @@ std::size_t bytes_per_sample(SampleFormat f) {
   return 0;
 }
 
+double FrequencyResponse::gain(Hertz f) const {
+  if (flat()) return 1.0;
+  const double r = std::fabs(f.value()) / corner.value();
+  return 1.0 / std::sqrt(1.0 + std::pow(r, 2.0 * order));
+}
+
+double FrequencyResponse::gain_db(Hertz f) const { return flat() ? 0.0 : 20.0 * std::log10(gain(f)); }
+
+Hertz FrequencyResponse::frequency_at_db(double db) const {
+  if (flat() || !(db > 0.0)) return Hertz(flat() ? std::numeric_limits<double>::infinity() : 0.0);
+  // |H|² = 1/(1 + r^2n) = 10^(−db/10)  ⇒  r = (10^(db/10) − 1)^(1/2n)
+  return Hertz(corner.value() * std::pow(std::pow(10.0, db / 10.0) - 1.0, 1.0 / (2.0 * order)));
+}
+
+void validate(const FrequencyResponse& r, std::string_view field) {
+  const std::string f(field);
+  if (r.corner.value() == 0.0) return;  // flat
+  if (!(std::isfinite(r.corner.value()) && r.corner.value() > 0.0 && r.corner.value() <= 1e6))
+    throw InvalidArgument(f + ".corner_hz is " + num(r.corner.value()) + "; allowed: > 0 … 1000000 Hz (omit " + f +
+                          " for a flat display)");
+  if (r.order < 1 || r.order > 4)
+    throw InvalidArgument(f + ".order is " + std::to_string(r.order) + "; allowed: 1 … 4 (6 dB/octave each)");
+}
+
 void validate(const DeviceProfile& p) {
   const std::string at = "device '" + p.name + "': ";
   if (p.name.empty()) throw InvalidArgument("device profile has an empty name");
@@ -82,6 +107,11 @@ void validate(const DeviceProfile& p) {
       throw InvalidArgument(at + "layout region '" + r.name + "' (" + num(r.start.value()) + " mm + " + num(r.length.value()) +
                             " mm) must lie inside 0 … " + num(p.length().value()) + " mm, in order, without overlap");
     prev_end = r.start.value() + r.length.value();
+  }
+  try {
+    validate(p.response);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(at + e.what());
   }
 }
 
@@ -113,6 +143,16 @@ DeviceProfile parse_device_profile(std::string_view json_text, std::string_view 
     } else {
       o.skip("layout");
     }
+    if (o.has("response")) {
+      // Optional; absent (or null) = flat, so older and user profiles load unchanged.
+      detail::JsonObject r(o.raw("response"), "response");
+      p.response.corner = Hertz(r.number("corner_hz", 1e-6, 1e6));
+      p.response.order = static_cast<int>(r.integer("order", 1, 4));
+      p.response.source = r.string_or("source", "");
+      r.finish();
+    } else {
+      o.skip("response");
+    }
     o.finish();
     validate(p);
     return p;
@@ -134,6 +174,15 @@ std::string device_profile_json(const DeviceProfile& p) {
   j["layout"] = nlohmann::ordered_json::array();
   for (const auto& r : p.layout)
     j["layout"].push_back({{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}});
+  // Written only when not flat: a profile without a response reads and
+  // writes the text it always had.
+  if (!p.response.flat()) {
+    nlohmann::ordered_json r;
+    r["corner_hz"] = p.response.corner.value();
+    r["order"] = p.response.order;
+    if (!p.response.source.empty()) r["source"] = p.response.source;
+    j["response"] = r;
+  }
   return j.dump(2) + "\n";
 }
 

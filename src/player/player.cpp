@@ -71,6 +71,14 @@ OutputMode parse_output_mode(std::string_view text, std::string_view field) {
   throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: amplitude, vibration, carrier");
 }
 
+std::string_view to_string(ResponseHandling h) { return h == ResponseHandling::off ? "off" : "limit"; }
+
+ResponseHandling parse_response_handling(std::string_view text, std::string_view field) {
+  if (text == "limit") return ResponseHandling::limit;
+  if (text == "off") return ResponseHandling::off;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: limit, off");
+}
+
 namespace {
 void check_range(std::string_view field, double v, double lo, double hi, std::string_view unit) {
   if (!(std::isfinite(v) && v >= lo && v <= hi))
@@ -90,9 +98,35 @@ void validate(const PlayerConfig& c) {
   check_range("crossfade_s", c.crossfade_s, 0.0005, 1.0, "s");
   check_range("highpass_hz", c.highpass_hz, 0.1, c.rate_hz / 4, "Hz");
   if (c.lowpass_hz != 0.0) check_range("lowpass_hz", c.lowpass_hz, 1.0, 0.45 * c.rate_hz, "Hz (0 = 0.4·rate)");
+  check_range("response_limit_db", c.response_limit_db, 3.0, 60.0, "dB");
+  try {
+    validate(c.response, "response");
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("player: " + std::string(e.what()));
+  }
   const std::size_t n = c.event_capacity;
   if (n < 16 || n > (std::size_t{1} << 20) || (n & (n - 1)) != 0)
     throw InvalidArgument("player: event_capacity is " + std::to_string(n) + "; allowed a power of two, 16 … 1048576");
+}
+
+double response_limit_hz(const PlayerConfig& c) {
+  if (c.response_handling == ResponseHandling::off || c.response.flat()) return 0.0;
+  const double f = c.response.frequency_at_db(c.response_limit_db).value();
+  return f <= 0.45 * c.rate_hz ? f : 0.0;
+}
+
+Player::Biquad Player::Biquad::lowpass(double fc, double rate) noexcept {
+  Biquad q;
+  const double w0 = 2.0 * std::numbers::pi * fc / rate;
+  const double alpha = std::sin(w0) / std::numbers::sqrt2;
+  const double cw = std::cos(w0);
+  const double a0 = 1.0 + alpha;
+  q.b0 = (1.0 - cw) / 2.0 / a0;
+  q.b1 = (1.0 - cw) / a0;
+  q.b2 = q.b0;
+  q.a1 = -2.0 * cw / a0;
+  q.a2 = (1.0 - alpha) / a0;
+  return q;
 }
 
 namespace {
@@ -131,17 +165,11 @@ Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
   gain_ = gain_target_ = config_.gain;
   carrier_inc_ = carrier_inc_target_ = config_.carrier_hz / rate;
   dc_r_ = std::exp(-2.0 * std::numbers::pi * config_.highpass_hz / rate);
-  // RBJ cookbook low-pass, Q = 1/√2 (Butterworth): flat pass band, −3 dB at fc.
-  const double fc = config_.lowpass_hz > 0 ? config_.lowpass_hz : 0.4 * rate;
-  const double w0 = 2.0 * std::numbers::pi * fc / rate;
-  const double alpha = std::sin(w0) / std::numbers::sqrt2;
-  const double cw = std::cos(w0);
-  const double a0 = 1.0 + alpha;
-  lowpass_.b0 = (1.0 - cw) / 2.0 / a0;
-  lowpass_.b1 = (1.0 - cw) / a0;
-  lowpass_.b2 = lowpass_.b0;
-  lowpass_.a1 = -2.0 * cw / a0;
-  lowpass_.a2 = (1.0 - alpha) / a0;
+  lowpass_ = Biquad::lowpass(config_.lowpass_hz > 0 ? config_.lowpass_hz : 0.4 * rate, rate);
+  if (const double limit = response_limit_hz(config_); limit > 0.0) {
+    display_lp_ = Biquad::lowpass(limit, rate);
+    display_limit_ = true;
+  }
 }
 
 Player::~Player() {
@@ -284,6 +312,14 @@ BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) no
     touch_level_ = touching ? std::min(1.0, touch_level_ + touch_step_) : std::max(0.0, touch_level_ - touch_step_);
     const double env = 0.5 - 0.5 * std::cos(std::numbers::pi * touch_level_);
 
+    // The display's response limit (see player.hpp): what it cannot
+    // reproduce is not driven. Starts settled on touch-down from rest.
+    if (display_limit_) {
+      if (was_silent && touching) display_lp_.settle(a);
+      a = display_lp_(a);
+      if (config_.mode == OutputMode::amplitude) a = std::clamp(a, 0.0, 1.0);  // the filter's overshoot at steps
+    }
+
     gain_ += gain_step;
     double y = 0.0;
     switch (config_.mode) {
@@ -299,8 +335,7 @@ BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) no
         if (was_silent && touching) {
           // Touch-down from rest: start the filters in their steady state for
           // the value under the finger, so landing does not thump.
-          lowpass_.z2 = (lowpass_.b2 - lowpass_.a2) * a;
-          lowpass_.z1 = (lowpass_.b1 - lowpass_.a1) * a + lowpass_.z2;
+          lowpass_.settle(a);
           dc_x1_ = a;
           dc_y1_ = 0.0;
         }

@@ -495,6 +495,31 @@ TEST_F(Cli, SwipeRecordingsEncodeBackToTheirParameters) {
   expect_rejected({"encode", "bad.csv"}, "time_s,position_mm,value");
 }
 
+// The device's frequency response (docs/format.md): the encoder's model
+// applies it with --display-response device; the player limits to it by
+// default (--response limit) and plays as before with --response off.
+TEST_F(Cli, DisplayResponseReachesTheEncoderAndThePlayer) {
+  write("d.texel.json", valid_document());
+  ASSERT_EQ(run({"render", "d.texel.json", "-o", "m.bin"}).status, 0);
+  const Result flat = run({"encode", "m.bin", "--device", "tpad", "--estimate", "--json"});
+  ASSERT_EQ(flat.status, 0) << flat.err;
+  EXPECT_EQ(nlohmann::json::parse(flat.out)["model"]["display_response"], "flat");
+  EXPECT_FALSE(nlohmann::json::parse(flat.out)["model"].contains("display"));
+  const Result dev = run({"encode", "m.bin", "--device", "tpad", "--display-response", "device", "--json"});
+  ASSERT_EQ(dev.status, 0) << dev.err;
+  const auto m = nlohmann::json::parse(dev.out)["model"];
+  EXPECT_EQ(m["display_response"], "device");
+  EXPECT_EQ(m["display"]["corner_hz"].get<double>(), 400.0);
+  EXPECT_EQ(m["display"]["order"].get<int>(), 1);
+  expect_rejected({"encode", "m.bin", "--device", "tpad", "--display-response", "sideways"}, "--display-response");
+  ASSERT_EQ(run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "-o", "limit.csv"}).status, 0);
+  ASSERT_EQ(
+      run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "--response", "off", "-o", "off.csv"}).status,
+      0);
+  EXPECT_NE(slurp(dir / "limit.csv"), slurp(dir / "off.csv"));  // the tpad's response limit (3.98 kHz at 48 kHz) filtered
+  expect_rejected({"swipe", "d.texel.json", "--response", "equalize", "-o", "x.csv"}, "--response");
+}
+
 TEST_F(Cli, EncodeTranscodesADocumentExactly) {
   ASSERT_EQ(run({"render", "--central-pitch", "8", "--irregularity", "0", "--texel-length", "0.5", "--seed", "3", "--device",
                  "tpad", "-o", "d.texel.json"})

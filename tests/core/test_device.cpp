@@ -5,6 +5,7 @@
 #include <rapidcheck/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -170,6 +171,9 @@ TEST(Device, ProfileJsonRoundTrips) {
     EXPECT_EQ(b.refresh.value(), a.refresh.value());
     EXPECT_EQ(b.band_min.value(), a.band_min.value());
     EXPECT_EQ(b.band_max.value(), a.band_max.value());
+    EXPECT_EQ(b.response.corner.value(), a.response.corner.value());
+    EXPECT_EQ(b.response.order, a.response.order);
+    EXPECT_EQ(b.response.source, a.response.source);
     ASSERT_EQ(b.layout.size(), a.layout.size());
     for (std::size_t i = 0; i < a.layout.size(); ++i) {
       EXPECT_EQ(b.layout[i].name, a.layout[i].name);
@@ -177,6 +181,79 @@ TEST(Device, ProfileJsonRoundTrips) {
       EXPECT_EQ(b.layout[i].length.value(), a.layout[i].length.value());
     }
   }
+}
+
+TEST(Device, FrequencyResponseIsOptionalAndValidated) {
+  // Missing: flat (old and user profiles keep loading), and the JSON a flat
+  // profile writes has no "response" (its text is unchanged).
+  const DeviceProfile flat = parse_device_profile(valid_profile, "test.json");
+  EXPECT_TRUE(flat.response.flat());
+  EXPECT_EQ(flat.response.gain(Hertz(5000.0)), 1.0);
+  EXPECT_EQ(device_profile_json(flat).find("response"), std::string::npos);
+  EXPECT_TRUE(parse_device_profile(with_field("response", "null"), "test.json").response.flat());
+  // Valid: corner and order, with a source; round trip.
+  const DeviceProfile lp =
+      parse_device_profile(with_field("response", R"({"corner_hz": 400, "order": 2, "source": "measured"})"), "test.json");
+  EXPECT_EQ(lp.response.corner.value(), 400.0);
+  EXPECT_EQ(lp.response.order, 2);
+  EXPECT_EQ(lp.response.source, "measured");
+  const DeviceProfile back = parse_device_profile(device_profile_json(lp), "round trip");
+  EXPECT_EQ(back.response.corner.value(), 400.0);
+  EXPECT_EQ(back.response.order, 2);
+  EXPECT_EQ(back.response.source, "measured");
+  // Invalid values name the field.
+  struct Case {
+    std::string value, expect;
+  };
+  const Case cases[] = {
+      {R"({"corner_hz": 0, "order": 1})", "response.corner_hz"},
+      {R"({"corner_hz": -5, "order": 1})", "response.corner_hz"},
+      {R"({"corner_hz": 2e6, "order": 1})", "response.corner_hz"},
+      {R"({"corner_hz": "fast", "order": 1})", "response.corner_hz"},
+      {R"({"order": 1})", "response.corner_hz is missing"},
+      {R"({"corner_hz": 400})", "response.order is missing"},
+      {R"({"corner_hz": 400, "order": 0})", "response.order"},
+      {R"({"corner_hz": 400, "order": 5})", "response.order"},
+      {R"({"corner_hz": 400, "order": 1.5})", "response.order"},
+      {R"({"corner_hz": 400, "order": 1, "q": 3})", "unknown key"},
+      {R"(400)", "response must be a JSON object"},
+  };
+  for (const auto& c : cases) {
+    const std::string msg = parse_error(with_field("response", c.value));
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.value << ": " << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+  }
+  DeviceProfile bad = flat;
+  bad.response.corner = Hertz(400.0);
+  bad.response.order = 7;
+  EXPECT_THROW(validate(bad), InvalidArgument);
+}
+
+TEST(Device, FrequencyResponseIsAButterworthMagnitude) {
+  FrequencyResponse r;
+  r.corner = Hertz(400.0);
+  r.order = 1;
+  EXPECT_NEAR(r.gain_db(Hertz(400.0)), -3.0103, 1e-3);  // −3 dB at the corner
+  EXPECT_NEAR(r.gain(Hertz(40.0)), 1.0, 0.01);          // flat well below it
+  EXPECT_NEAR(r.gain_db(Hertz(4000.0)), -20.04, 0.01);  // 6 dB/octave, 20 dB/decade above
+  EXPECT_NEAR(r.gain_db(r.frequency_at_db(20.0)), -20.0, 1e-9);
+  r.order = 2;
+  EXPECT_NEAR(r.gain_db(Hertz(4000.0)), -40.0, 0.01);
+  EXPECT_NEAR(r.gain_db(r.frequency_at_db(20.0)), -20.0, 1e-9);
+  EXPECT_TRUE(std::isinf(FrequencyResponse{}.frequency_at_db(20.0).value()));
+}
+
+TEST(Device, BuiltinResponses) {
+  // Ultrasonic friction displays are low-pass (docs/format.md, with sources
+  // in each profile); the generic profile promises nothing: flat.
+  for (const char* name : {"tpad", "tpad-tablet"}) {
+    const DeviceProfile d = load_device(name);
+    EXPECT_FALSE(d.response.flat()) << name;
+    EXPECT_GT(d.response.corner.value(), 50.0) << name;
+    EXPECT_LT(d.response.corner.value(), 2000.0) << name;
+    EXPECT_FALSE(d.response.source.empty()) << name << ": a response states where its numbers come from";
+  }
+  EXPECT_TRUE(load_device("generic").response.flat());
 }
 
 TEST(Encode, U16IsRoundOfAmplitudeTimes65535) {

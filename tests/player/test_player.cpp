@@ -313,6 +313,74 @@ TEST(Player, GainChangesAreRampedOverOneBlock) {
   EXPECT_NEAR(out.back(), 1.0f, 1e-5);
 }
 
+// The display's frequency response (player.hpp, [choice] limit): content the
+// display cannot reproduce is not driven; its pass band is untouched.
+TEST(Player, ResponseLimitAttenuatesWhatTheDisplayCannotReproduce) {
+  // Amplitude 0.4 around 0.5 of a sinusoid at f·v Hz; the output's amplitude
+  // at that frequency, measured after the touch-down.
+  auto gain = [](double f_hz, ResponseHandling h, OutputMode mode) {
+    const double f_cpm = f_hz / 100.0;  // at 100 mm/s
+    auto map = make_map(120, 0.001, [&](double x) { return 0.5 + 0.4 * std::sin(2 * pi * f_cpm * x); });
+    PlayerConfig c;
+    c.rate_hz = 48000;
+    c.mode = mode;
+    c.response.corner = Hertz(400.0);  // tpad: first order, 400 Hz → limit (20 dB down) at 3.98 kHz
+    c.response.order = 1;
+    c.response_handling = h;
+    const auto out = render_trace(*map, c, line(0.0, 0.6, 5.0, 100.0, 1000.0), 24000);
+    double s = 0, cc = 0;  // single-bin DFT over whole periods after 0.1 s
+    const std::size_t from = 4800, n = 19200;
+    for (std::size_t i = from; i < from + n; ++i) {
+      const double t = static_cast<double>(i) / c.rate_hz;
+      s += out[i] * std::sin(2 * pi * f_hz * t);
+      cc += out[i] * std::cos(2 * pi * f_hz * t);
+    }
+    return 2.0 * std::hypot(s, cc) / static_cast<double>(n) / 0.4;
+  };
+  EXPECT_NEAR(response_limit_hz([] {
+                PlayerConfig c;
+                c.response.corner = Hertz(400.0);
+                return c;
+              }()),
+              3980.0, 1.0);
+  for (OutputMode mode : {OutputMode::amplitude, OutputMode::vibration}) {
+    // Pass band (200 Hz, below the 400 Hz corner): within 0.1 dB of off.
+    const double pass = gain(200.0, ResponseHandling::limit, mode) / gain(200.0, ResponseHandling::off, mode);
+    EXPECT_NEAR(20 * std::log10(pass), 0.0, 0.1);
+    // At the corner: within 0.2 dB (the limit is ten times higher).
+    const double corner = gain(400.0, ResponseHandling::limit, mode) / gain(400.0, ResponseHandling::off, mode);
+    EXPECT_NEAR(20 * std::log10(corner), 0.0, 0.2);
+    // 12 kHz, where the display passes 3 %: the Butterworth at 3.98 kHz takes
+    // 19.2 dB off (asserted 15 … 23 dB).
+    const double stop = gain(12000.0, ResponseHandling::limit, mode) / gain(12000.0, ResponseHandling::off, mode);
+    EXPECT_LT(20 * std::log10(stop), -15.0);
+    EXPECT_GT(20 * std::log10(stop), -23.0);
+  }
+  // Amplitude output stays in [0, 1] (the filter's overshoot is clipped).
+  {
+    auto steps = make_map(120, 0.001, [](double x) { return std::fmod(x, 2.0) < 1.0 ? 0.0 : 1.0; });
+    PlayerConfig c;
+    c.response.corner = Hertz(400.0);
+    const auto out = render_trace(*steps, c, line(0.0, 0.5, 5.0, 100.0, 1000.0), 24000);
+    for (float y : out) ASSERT_TRUE(y >= 0.0f && y <= 1.0f) << y;
+  }
+  // Not applied when the limit is above 0.45·rate (the tpad's 8,333 Hz
+  // refresh: 3.98 kHz > 3.75 kHz), or for a flat response.
+  PlayerConfig slow;
+  slow.rate_hz = 8333;
+  slow.response.corner = Hertz(400.0);
+  EXPECT_EQ(response_limit_hz(slow), 0.0);
+  EXPECT_EQ(response_limit_hz(PlayerConfig{}), 0.0);
+  // Off and flat give the bytes of a player without a response.
+  auto map = make_map(50, 0.005, [](double x) { return 0.5 + 0.4 * std::sin(2 * pi * 30 * x); });
+  PlayerConfig plain;
+  PlayerConfig off = plain;
+  off.response.corner = Hertz(400.0);
+  off.response_handling = ResponseHandling::off;
+  const auto trace = line(0.0, 0.2, 5.0, 100.0, 1000.0);
+  EXPECT_EQ(render_trace(*map, plain, trace, 4800), render_trace(*map, off, trace, 4800));
+}
+
 TEST(Player, ConfigIsValidated) {
   PlayerConfig c;
   c.rate_hz = 10;
@@ -329,6 +397,18 @@ TEST(Player, ConfigIsValidated) {
     EXPECT_THROW(Player{c}, InvalidArgument) << n;
   }
   EXPECT_THROW(parse_output_mode("loud"), InvalidArgument);
+  c = {};
+  c.response_limit_db = 1.0;
+  EXPECT_THROW(validate(c), InvalidArgument);
+  c = {};
+  c.response.corner = Hertz(-3.0);
+  EXPECT_THROW(validate(c), InvalidArgument);
+  c = {};
+  c.response.corner = Hertz(400.0);
+  c.response.order = 0;
+  EXPECT_THROW(validate(c), InvalidArgument);
+  EXPECT_EQ(parse_response_handling("off"), ResponseHandling::off);
+  EXPECT_THROW(parse_response_handling("equalize"), InvalidArgument);
   EXPECT_THROW(PlayerMap(Grid{Millimetres(0), Millimetres(0.1), 3}, std::vector<float>(2)), InvalidArgument);
 }
 

@@ -29,6 +29,7 @@ def read_float_wav(path):
     (["--output", "amplitude", "--rate", 8333, "--speed", 150], dict(output="amplitude", rate_hz=8333, speed_mm_s=150)),
     (["--pattern", "back-and-forth", "--extent", 30, "--duration", 1.5, "--output", "carrier", "--carrier", 200],
      dict(pattern="back-and-forth", extent_mm=30, duration_s=1.5, output="carrier", carrier_hz=200)),
+    (["--output", "amplitude", "--response", "off"], dict(output="amplitude", response="off")),
 ])
 def test_swipe_equals_cli_wav(cli, tmp_path, flags, kwargs):
     doc = texel.document(central_pitch_db=5, seed=3)
@@ -73,3 +74,5 @@ def test_trace_errors():
         texel.render_trace(doc, [0.0, 0.2, 0.1], [0, 1, 2], duration_s=0.1)
     with pytest.raises(texel.InvalidArgument, match="output"):
         texel.swipe(doc, output="loud")
+    with pytest.raises(texel.InvalidArgument, match="response"):
+        texel.swipe(doc, response="equalize")

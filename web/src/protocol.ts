@@ -20,6 +20,8 @@ export interface DeviceProfile {
   band_min_cpm?: number;
   band_max_cpm?: number;
   layout?: { name: string; start_mm: number; length_mm: number }[];
+  /** The display's frequency response (docs/format.md); absent = flat. */
+  response?: { corner_hz: number; order: number; source?: string };
 }
 
 export interface ReferenceParam {
