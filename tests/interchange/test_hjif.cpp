@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/json_mutation.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/bitstream.hpp"
 #include "texel/codec.hpp"
@@ -23,6 +24,7 @@
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
 #include "texel/io.hpp"
+#include "texel/random.hpp"
 #include "texel/signal.hpp"
 #include "texel/surface.hpp"
 
@@ -433,6 +435,39 @@ TEST(Hjif, MalformedFilesAreRefusedWithOneLineNamingTheField) {
   hjif::ImportLimits small;
   small.max_keyframes = 2;
   EXPECT_THROW((void)hjif::parse_hjif(minimal().dump(), "x.hjif", small), FormatError);
+}
+
+// The fuzz target's contract over generated mutations of its seed corpus (the
+// GCC side of fuzz_hjif; docs/fuzzing.md): only texel::Error escapes, and an
+// accepted file samples to finite values.
+TEST(Hjif, MutatedFilesAreAcceptedOrRefusedWithATexelError) {
+  const std::string dir = std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_hjif/";
+  const CounterRng rng(12, 0);
+  std::size_t accepted = 0;
+  std::size_t refused = 0;
+  for (const char* seed : {"exported-friction.hjif", "hand-friction.hjif", "hand-temporal.hjif", "exported-two-regions.hjif"}) {
+    const std::string text = read_file(dir + seed);
+    for (std::uint64_t k = 0; k < 1500; ++k) {
+      std::string m = texel::test_support::mutate_json(text, rng, k);
+      if (k % 3 == 0) m = texel::test_support::mutate_json(m, rng, k + 1000000);
+      try {
+        (void)hjif::conformance_errors(m);
+        SignalOptions o;
+        o.swipe_speed = MmPerSecond(100.0);
+        o.spacing = Millimetres(0.05);
+        o.max_samples = 1 << 16;
+        const Signal s = decode_signal(std::as_bytes(std::span(m.data(), m.size())), SignalFormat::hjif, o, "m.hjif");
+        for (double a : s.samples) ASSERT_TRUE(a >= 0.0 && a <= 1.0) << seed << " mutation " << k;
+        ++accepted;
+      } catch (const Error&) {
+        ++refused;
+      } catch (const std::exception& e) {
+        FAIL() << seed << " mutation " << k << ": " << e.what();
+      }
+    }
+  }
+  EXPECT_GT(accepted, 0u);
+  EXPECT_GT(refused, 0u);
 }
 
 // --- glTF ----------------------------------------------------------------------
