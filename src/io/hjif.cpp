@@ -747,7 +747,7 @@ Exported export_hjif(const Document& doc, const ExportOptions& o) {
   if (perceptions.empty()) throw InvalidArgument("the document has no region with grid samples: nothing to export");
 
   // The document, compact, after the marker: exact parameters for Texel.
-  const std::string carried = json::parse(document_json(doc)).dump();
+  const std::string carried = ojson::parse(document_json(doc)).dump();
   std::string description = "Texel virtual texture on " + doc.device.name + " (" + std::to_string(doc.regions.size()) +
                             (doc.regions.size() == 1 ? " region" : " regions") + "), amplitude map within " +
                             num(o.tolerance) + " of full scale. texel-tolerance:" + num(o.tolerance) + " " +
@@ -827,10 +827,29 @@ std::vector<std::string> conformance_errors(std::string_view text) {
 
 std::vector<double> evaluate(const Experience& e, std::span<const double> x, std::optional<MmPerSecond> v) {
   std::vector<double> out(x.size(), 0.0);
+  // On ascending positions (every grid) each effect visits only the
+  // positions it covers; the total is bounded so that a file of many
+  // overlapping effects is refused rather than sampled for hours.
+  const bool ascending = std::is_sorted(x.begin(), x.end());
+  constexpr double max_work = 4294967296.0;  // 2^32 effect-samples
+  double work = 0.0;
   for (const Perception& p : e.perceptions) {
     const double k = ticks_per_mm(e, p, v);
-    for (const CurveEffect& c : p.effects)
-      for (std::size_t i = 0; i < x.size(); ++i) out[i] += curve_at(c, x[i] * k);
+    for (const CurveEffect& c : p.effects) {
+      std::size_t first = 0;
+      std::size_t last = x.size();
+      if (ascending && !c.keyframes.empty()) {
+        const double lo = (static_cast<double>(c.keyframes.front().position) - 1.0) / k;
+        const double hi = (static_cast<double>(c.keyframes.back().position) + 1.0) / k;
+        first = static_cast<std::size_t>(std::lower_bound(x.begin(), x.end(), lo) - x.begin());
+        last = static_cast<std::size_t>(std::upper_bound(x.begin(), x.end(), hi) - x.begin());
+      }
+      work += static_cast<double>(last - first);
+      if (work > max_work)
+        throw FormatError("the file's effects cover more than 2^32 samples in all on this grid (overlapping effects); "
+                          "it is not sampled");
+      for (std::size_t i = first; i < last; ++i) out[i] += curve_at(c, x[i] * k);
+    }
   }
   return out;
 }

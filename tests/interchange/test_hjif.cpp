@@ -188,11 +188,13 @@ TEST(Hjif, ExportIsConformantAndRoundTripsExactlyThroughTheCarriedParameters) {
       EXPECT_EQ(codec::transcode(*e.carried).bytes, codec::transcode(c.doc).bytes);
     }
     EXPECT_LE(max_error(e, c.doc), hjif::default_tolerance);
+    EXPECT_DOUBLE_EQ(max_error(hjif::parse_hjif(without_carried(x.json), c.name), c.doc), x.stats.max_error);
   }
 }
 
 TEST(Hjif, SamplesAloneReproduceTheMapWithinTheToleranceOnTpadAndGenericGrids) {
-  for (const char* device : {"tpad", "generic", "tpad-tablet"}) {
+  // tpad: the test above (the curves are the same with or without the carried document).
+  for (const char* device : {"generic", "tpad-tablet"}) {
     const DeviceProfile d = load_device(device);
     for (const Case& c : cases(d, std::string(device) == "tpad-tablet" ? -8.0 : 0.0)) {
       SCOPED_TRACE(std::string(device) + " " + c.name);
@@ -447,7 +449,7 @@ TEST(Hjif, MutatedFilesAreAcceptedOrRefusedWithATexelError) {
   std::size_t refused = 0;
   for (const char* seed : {"exported-friction.hjif", "hand-friction.hjif", "hand-temporal.hjif", "exported-two-regions.hjif"}) {
     const std::string text = read_file(dir + seed);
-    for (std::uint64_t k = 0; k < 1500; ++k) {
+    for (std::uint64_t k = 0; k < 600; ++k) {
       std::string m = texel::test_support::mutate_json(text, rng, k);
       if (k % 3 == 0) m = texel::test_support::mutate_json(m, rng, k + 1000000);
       try {
