@@ -235,6 +235,18 @@ TEST(Hjif, AWiderToleranceNeedsFewerKeyframesAndIsKept) {
   EXPECT_THROW((void)hjif::export_hjif(doc, bad), InvalidArgument);
 }
 
+TEST(Hjif, AGridOffTheTicksIsWrittenAtTheNearestTickAndStillMeetsTheTolerance) {
+  const DeviceProfile odd = with_grid(load_device("generic"), Millimetres(10.0), Millimetres(0.00471239));
+  const Document doc = make_document(odd, fine(10, -5, 0.25, 7));
+  const hjif::Exported x = hjif::export_hjif(doc, options());
+  EXPECT_FALSE(x.stats.grid_on_ticks);
+  EXPECT_EQ(x.stats.timescale, 48000u);
+  EXPECT_LE(x.stats.max_error, hjif::default_tolerance);
+  const hjif::Experience e = hjif::parse_hjif(without_carried(x.json));
+  EXPECT_LE(max_error(e, doc), hjif::default_tolerance);
+  EXPECT_TRUE(hjif::conformance_errors(x.json).empty());
+}
+
 TEST(Hjif, ModalityIsWrittenAsTheStandardSpellsIt) {
   const DeviceProfile tpad = load_device("tpad");
   hjif::ExportOptions o = options();
