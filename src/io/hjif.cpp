@@ -68,6 +68,24 @@ std::string list(const std::string_view (&set)[N]) {
   return s;
 }
 
+/// A value from the file, quoted for a one-line message: control characters
+/// escaped, at most 40 characters.
+std::string quote_value(std::string_view v) {
+  std::string out = "'";
+  for (std::size_t i = 0; i < v.size() && i < 40; ++i) {
+    const auto c = static_cast<unsigned char>(v[i]);
+    if (c < 0x20 || c == 0x7F) {
+      static constexpr char hex[] = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + (v.size() > 40 ? "…'" : "'");
+}
+
 bool is_spatial(std::string_view modality) { return modality == "Friction" || modality == "Vibrotactile Texture"; }
 
 // --- the walker: checks every known field, builds the Experience ------------
@@ -92,10 +110,10 @@ class Walker {
     if (!exp.version.empty()) check_version(exp.version);
     exp.profile = str(root, "", "profile", true).value_or("");
     if (!exp.profile.empty() && !one_of(exp.profile, kProfiles))
-      fail("profile", "is '" + exp.profile + "'; allowed: " + list(kProfiles));
+      fail("profile", "is " + quote_value(exp.profile) + "; allowed: " + list(kProfiles));
     exp.level = static_cast<int>(integer(root, "", "level", true, 1, 2).value_or(1));
     exp.date = str(root, "", "date", true).value_or("");
-    if (!exp.date.empty() && !valid_date(exp.date)) fail("date", "is '" + exp.date + "'; it must be an ISO 8601 date (YYYY-MM-DD…)");
+    if (!exp.date.empty() && !valid_date(exp.date)) fail("date", "is " + quote_value(exp.date) + "; it must be an ISO 8601 date (YYYY-MM-DD…)");
     exp.description = str(root, "", "description", true).value_or("");
     if (auto t = integer(root, "", "timescale", true, 1, std::numeric_limits<std::uint32_t>::max())) {
       exp.timescale = static_cast<std::uint32_t>(*t);
@@ -182,7 +200,7 @@ class Walker {
                                         const std::string_view (&set)[N]) {
     auto s = str(o, path, key, required);
     if (s && !one_of(*s, set)) {
-      fail(at(path, key), "is '" + *s + "'; allowed: " + list(set));
+      fail(at(path, key), "is " + quote_value(*s) + "; allowed: " + list(set));
       return std::nullopt;
     }
     return s;
@@ -240,10 +258,11 @@ class Walker {
   void check_version(const std::string& v) {
     static const std::regex re("^([0-9]{4})(-([0-9]+))?$");
     std::smatch m;
-    if (!std::regex_match(v, m, re)) return fail("version", "is '" + v + "'; it must be YYYY or YYYY-N (year of publication, amendment)");
-    if (std::stoi(m[1].str()) < 2023) fail("version", "is '" + v + "'; the year must be 2023 or later");
+    // Length first: std::regex matches recursively, so a long string could exhaust the stack.
+    if (v.size() > 16 || !std::regex_match(v, m, re)) return fail("version", "is " + quote_value(v) + "; it must be YYYY or YYYY-N (year of publication, amendment)");
+    if (std::stoi(m[1].str()) < 2023) fail("version", "is " + quote_value(v) + "; the year must be 2023 or later");
     if (m[3].matched && (m[3].str().size() > 4 || std::stoi(m[3].str()) <= 0))
-      fail("version", "is '" + v + "'; the amendment number must be > 0");
+      fail("version", "is " + quote_value(v) + "; the amendment number must be > 0");
   }
   static bool valid_date(const std::string& d) {
     static const std::regex re(
@@ -578,7 +597,7 @@ void check_carried_cost(const json& doc, std::size_t cap) {
   if (doc.is_object() && doc.contains("device") && doc["device"].is_string()) {
     const auto names = builtin_device_names();
     if (std::find(names.begin(), names.end(), doc["device"].get<std::string>()) == names.end())
-      throw FormatError("it names the device '" + doc["device"].get<std::string>() + "', which is not built in");
+      throw FormatError("it names the device " + quote_value(doc["device"].get<std::string>()) + ", which is not built in");
   }
   if (std::isfinite(min_spacing)) longest = std::max(longest, samples * min_spacing);
   const double c = static_cast<double>(cap);
@@ -593,7 +612,7 @@ std::string_view modality_name(Modality m) { return m == Modality::friction ? "F
 Modality parse_modality(std::string_view text, std::string_view field) {
   if (text == "friction") return Modality::friction;
   if (text == "vibrotactile-texture") return Modality::vibrotactile_texture;
-  throw FieldError(std::string(field), "is '" + std::string(text) + "'; allowed: friction, vibrotactile-texture");
+  throw FieldError(std::string(field), "is " + quote_value(text) + "; allowed: friction, vibrotactile-texture");
 }
 
 Exported export_hjif(const Document& doc, const ExportOptions& o) {
@@ -602,7 +621,7 @@ Exported export_hjif(const Document& doc, const ExportOptions& o) {
   const std::string date = today(o.date);
   {
     static const std::regex re("^[0-9]{4}-[01][0-9]-[0-3][0-9]$");
-    if (!std::regex_match(date, re)) throw FieldError("date", "is '" + date + "'; it must be YYYY-MM-DD");
+    if (date.size() != 10 || !std::regex_match(date, re)) throw FieldError("date", "is " + quote_value(date) + "; it must be YYYY-MM-DD");
   }
   const Surface surface = prepare_surface(doc);
   const Grid grid = surface.grid();

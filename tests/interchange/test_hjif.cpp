@@ -392,6 +392,8 @@ TEST(Hjif, MalformedFilesAreRefusedWithOneLineNamingTheField) {
   bad.push_back({"version", with([](json& j) { j["version"] = "2019"; }), "2023 or later"});
   bad.push_back({"profile", with([](json& j) { j["profile"] = "Deluxe"; }), "profile is 'Deluxe'"});
   bad.push_back({"date", with([](json& j) { j["date"] = "last tuesday"; }), "ISO 8601"});
+  bad.push_back({"control characters", with([](json& j) { j["version"] = "20\n23"; }), "'20\\x0a23'"});
+  bad.push_back({"long string", with([](json& j) { j["profile"] = std::string(100000, '7'); }), "7…'"});
   bad.push_back({"timescale", with([](json& j) { j["timescale"] = 96000; }), "at most 48000"});
   bad.push_back({"simple timescale", with([](json& j) { j["profile"] = "Simple Parametric"; j["timescale"] = 10000; }), "requires 1000"});
   bad.push_back({"simple modality", with([](json& j) { j["profile"] = "Simple Parametric"; }), "level 1 of the Simple Parametric"});
