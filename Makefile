@@ -58,7 +58,9 @@ demo: build web
 # set across GCC/clang, -O0/-O3 and SIMD widths.
 test: test-unit test-browser test-asan test-determinism
 
-test-unit: build
+# The glTF-Validator test (tests/interchange) runs Khronos' validator from
+# web/node_modules: the same one `npm ci` as the web build.
+test-unit: build web/node_modules/.package-lock.json
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 # End-to-end browser tests of Texel Studio: headless Debian chromium driven by
@@ -70,7 +72,7 @@ BROWSER_ENV = TEXEL_BIN=$(CURDIR)/$(BUILD)/bin/texel TEXEL_WEB=$(CURDIR)/$(WEB_O
 test-browser: build web
 	cd web && $(BROWSER_ENV) npm test --silent
 
-test-asan: deps
+test-asan: deps web/node_modules/.package-lock.json
 	@cmake --preset asan >/dev/null
 	@cmake --build build-asan -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp \

@@ -15,6 +15,7 @@ void register_spectrum(CLI::App& app);
 void register_atlas(CLI::App& app);
 void register_encode(CLI::App& app);
 void register_decode(CLI::App& app);
+void register_export(CLI::App& app);
 void register_swipe(CLI::App& app);
 void register_play(CLI::App& app);
 void register_controller(CLI::App& app);

@@ -77,7 +77,10 @@ std::string flag_of_field(std::string_view field) {
                                                                         {"max_bytes", "--max-bytes"},
                                                                         {"weight_exponent", "--weight-exponent"},
                                                                         {"sensitivity_scale", "--sensitivity-scale"},
-                                                                        {"display_response", "--display-response"}};
+                                                                        {"display_response", "--display-response"},
+                                                                        {"tolerance", "--tolerance"},
+                                                                        {"date", "--date"},
+                                                                        {"width", "--width"}};
   for (const auto& [f, flag] : flags)
     if (f == field) return std::string(flag);
   return std::string(field);  // a field with no flag (max_samples) keeps its library name

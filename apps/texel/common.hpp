@@ -55,7 +55,7 @@ void add_signal_options(CLI::App& cmd, SignalArgs& a);
 /// Help text of an input-signal argument: the formats load_signal reads.
 inline constexpr const char* kInputHelp =
     "Input: .bin (needs --device), .npy (--device or --spacing), .csv (position_mm,amplitude or time_s,value), "
-    ".wav (--swipe-speed), .mat, .texel.json, .texel (--device)";
+    ".wav (--swipe-speed), .mat, .texel.json, .texel (--device), .hjif (MPEG-I Haptics)";
 /// The library options the flags describe (throws InvalidArgument naming the flag).
 SignalOptions signal_options(const SignalArgs& a);
 /// Reads `path` through the one loader (codec::load_signal: every format, bitstreams too).

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   texel::cli::register_atlas(app);
   texel::cli::register_encode(app);
   texel::cli::register_decode(app);
+  texel::cli::register_export(app);
   texel::cli::register_swipe(app);
   texel::cli::register_play(app);
   texel::cli::register_controller(app);

@@ -44,12 +44,13 @@ enum class SignalFormat {
   mat,         ///< .mat: a MATLAB map (docs/format.md "MATLAB .mat"); file only
   document,    ///< .texel.json: rendered on its device (or on `device`)
   bitstream,   ///< .texel: decoded and rendered on `device`
+  hjif,        ///< .hjif: MPEG-I Haptics curves sampled on a grid (texel/interchange.hpp); temporal ones need `swipe_speed`
 };
 
-/// "device-map", "npy", "csv", "wav", "mat", "document", "bitstream".
+/// "device-map", "npy", "csv", "wav", "mat", "document", "bitstream", "hjif".
 std::string_view to_string(SignalFormat format);
 /// The format a path's extension names (.bin .npy .csv .wav .mat .texel.json
-/// .json .texel); throws InvalidArgument naming the extension and the allowed ones.
+/// .json .texel .hjif); throws InvalidArgument naming the extension and the allowed ones.
 SignalFormat signal_format_of(const std::string& path);
 
 /// What to do with a recording of more than one channel.

@@ -24,6 +24,7 @@
 #include "texel/codec.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
+#include "texel/interchange.hpp"
 #include "texel/surface.hpp"
 
 namespace texel::codec {
@@ -164,11 +165,22 @@ std::optional<Transcoded> transcode_file(const std::string& path, const SignalOp
     return std::nullopt;
   };
   const SignalFormat format = signal_format_of(path);
-  if (format != SignalFormat::document && format != SignalFormat::bitstream) return no("it holds samples, not Texel parameters");
+  if (format != SignalFormat::document && format != SignalFormat::bitstream && format != SignalFormat::hjif)
+    return no("it holds samples, not Texel parameters");
   if (signal.region) return no("a region of it was asked for");
   if (signal.spacing) return no("another sample spacing was asked for");
   if (format == SignalFormat::bitstream) return transcode(read_bitstream(path));
-  Document doc = load_document(path);
+  Document doc;
+  if (format == SignalFormat::hjif) {
+    // An MPEG-I Haptics file Texel exported carries its document: the same
+    // parameters, hence the same bitstream, as the document itself.
+    hjif::Experience e = hjif::load_hjif(path);
+    if (!e.carried)
+      return no(e.carried_rejected.empty() ? "it carries no Texel document, only samples" : e.carried_rejected);
+    doc = std::move(*e.carried);
+  } else {
+    doc = load_document(path);
+  }
   if (signal.device) doc.device = *signal.device;  // re-targeted, as `texel render DOC --device X`
   if (auto why = not_transcodable(doc)) return no(std::move(*why));
   return transcode(doc, options);

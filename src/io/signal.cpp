@@ -15,6 +15,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
+#include "texel/interchange.hpp"
 #include "texel/io.hpp"
 #include "texel/matfile.hpp"
 #include "texel/surface.hpp"
@@ -256,6 +257,64 @@ Signal render_document(Document doc, const SignalOptions& o, std::string_view or
   return s;
 }
 
+/// An MPEG-I Haptics file's curves sampled on a grid (docs/interchange.md
+/// "Import"): the given device's (re-gridded at `spacing`), else the carried
+/// Texel document's device, else a built-in device the file names as its
+/// reference device, else `spacing` (or, for temporal files, the channel's
+/// sampling rate at the swipe speed) from 0 to the last keyframe.
+Signal decode_hjif(std::string_view text, const SignalOptions& o, std::string_view origin) {
+  if (o.region && !o.region->name.empty())
+    throw FieldError("region", "'" + o.region->name + "' is a name; a part of " + in_quotes(origin) + " is chosen as START:END in mm");
+  hjif::ImportLimits limits;
+  limits.max_keyframes = std::min<std::size_t>(limits.max_keyframes, o.max_samples);
+  const hjif::Experience e = hjif::parse_hjif(text, origin, limits);
+  const bool temporal = !e.perceptions.front().spatial;
+  std::optional<MmPerSecond> v;
+  if (temporal) v = need_speed(o, origin);
+  std::optional<DeviceProfile> device = o.device;
+  std::string grid_from = device ? "device " + device->name : std::string();
+  if (!device && !o.spacing && e.carried) device = e.carried->device, grid_from = "its Texel document's device " + device->name;
+  if (!device && !o.spacing && e.perceptions.front().reference_device) {
+    const auto names = builtin_device_names();
+    const std::string& name = *e.perceptions.front().reference_device;
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      device = load_device(name), grid_from = "its reference device " + name;
+  }
+  Grid grid;
+  if (device) {
+    if (o.spacing) *device = with_grid(*device, std::nullopt, o.spacing);
+    grid = device->grid();
+  } else {
+    double h = 0.0;
+    if (o.spacing) {
+      h = o.spacing->value(), grid_from = "spacing " + num(h) + " mm";
+    } else if (temporal) {
+      const double rate = e.perceptions.front().frequency_sampling.value_or(e.timescale);
+      h = v->value() / rate, grid_from = num(rate) + " samples/s at " + num(v->value()) + " mm/s";
+    } else {
+      throw FieldError("device", "is required: " + in_quotes(origin) +
+                                     " names no built-in device and carries no Texel document; give a device or a spacing "
+                                     "to sample its curves on");
+    }
+    const double extent = hjif::extent_mm(e, v);
+    const double n = std::floor(extent / h + 1e-9) + 1.0;
+    if (!(n <= static_cast<double>(o.max_samples))) too_many(origin, static_cast<std::size_t>(std::min(n, 1e18)), o);
+    grid = Grid{Millimetres(0.0), Millimetres(h), static_cast<std::int64_t>(n)};
+  }
+  if (grid.count > 0 && static_cast<std::uint64_t>(grid.count) > o.max_samples)
+    too_many(origin, static_cast<std::size_t>(grid.count), o);
+  std::vector<double> x(static_cast<std::size_t>(grid.count));
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = grid.position(static_cast<std::int64_t>(i)).value();
+  Signal s;
+  s.samples = hjif::evaluate(e, x, v);
+  s.spacing = grid.spacing;
+  s.origin = grid.origin;
+  if (temporal) s.sample_rate = Hertz(v->value() / grid.spacing.value());  // scaled to full range, as recordings are
+  s.description = "MPEG-I haptics: " + std::to_string(e.perceptions.size()) + " " + e.perceptions.front().modality +
+                  (e.perceptions.size() == 1 ? " perception" : " perceptions") + " on " + grid_from;
+  return s;
+}
+
 /// Keeps the samples whose positions lie in [start, end).
 void apply_region(Signal& s, const SignalOptions::Region& r, std::string_view origin) {
   const double o = s.origin.value();
@@ -309,6 +368,7 @@ std::string_view to_string(SignalFormat f) {
     case SignalFormat::mat: return "mat";
     case SignalFormat::document: return "document";
     case SignalFormat::bitstream: return "bitstream";
+    case SignalFormat::hjif: return "hjif";
   }
   return "?";
 }
@@ -322,8 +382,9 @@ SignalFormat signal_format_of(const std::string& path) {
   if (ext == ".mat") return SignalFormat::mat;
   if (ext == ".texel.json" || ext == ".json") return SignalFormat::document;
   if (ext == ".texel") return SignalFormat::bitstream;
+  if (ext == ".hjif") return SignalFormat::hjif;
   throw InvalidArgument("input '" + path + "' has extension '" + ext +
-                        "'; allowed: .bin (device map), .npy, .csv (position or time), .wav, .mat, .texel.json, .texel");
+                        "'; allowed: .bin (device map), .npy, .csv (position or time), .wav, .mat, .texel.json, .texel, .hjif");
 }
 
 Recording decode_recording(std::span<const std::byte> bytes, const SignalOptions& o, std::string_view origin) {
@@ -370,6 +431,7 @@ Signal decode_signal(std::span<const std::byte> bytes, SignalFormat format, cons
       s = render_document(parse_document(text, origin), o, origin, span);
       break;
     }
+    case SignalFormat::hjif: s = decode_hjif(text, o, origin); break;
     case SignalFormat::mat:
       throw InvalidArgument(in_quotes(origin) + ": .mat maps are read from files only (libmatio opens by name)");
     case SignalFormat::bitstream:
@@ -414,6 +476,7 @@ Signal load_signal(const std::string& path, const SignalOptions& o) {
   const auto size = std::filesystem::file_size(path, ec);
   const std::uintmax_t limit = format == SignalFormat::csv        ? o.max_samples * 64 + 4096
                                : format == SignalFormat::document ? std::uintmax_t{64} << 20
+                               : format == SignalFormat::hjif     ? std::uintmax_t{256} << 20
                                                                   : o.max_samples * 8 + 65536;
   if (!ec && size > limit)
     throw FieldError("max_samples", "is " + std::to_string(o.max_samples) + "; " + in_quotes(path) + " has " +
