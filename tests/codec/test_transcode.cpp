@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/specs.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/codec.hpp"
 #include "texel/error.hpp"
@@ -31,12 +32,7 @@ std::vector<std::byte> decoded(const std::vector<std::byte>& bytes, const Device
 }
 
 TexelSpec fine(double pitch_db, double irregularity_db, double length_mm, std::uint64_t seed) {
-  TexelSpec s;
-  s.central_pitch = Decibels(pitch_db);
-  s.irregularity = Decibels(irregularity_db);
-  s.texel_length = Millimetres(length_mm);
-  s.seed = seed;
-  return s;
+  return test_support::fine_spec(pitch_db, irregularity_db, length_mm, seed);
 }
 
 TEST(Transcode, FineOnlyDocumentsDecodeToTheirOwnBytesOnEveryDevice) {

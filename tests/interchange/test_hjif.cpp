@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/json_mutation.hpp"
+#include "../support/specs.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/bitstream.hpp"
 #include "texel/codec.hpp"
@@ -35,12 +36,7 @@ using texel::test_support::TempDir;
 namespace {
 
 TexelSpec fine(double pitch_db, double irregularity_db, double length_mm, std::uint64_t seed) {
-  TexelSpec s;
-  s.central_pitch = Decibels(pitch_db);
-  s.irregularity = Decibels(irregularity_db);
-  s.texel_length = Millimetres(length_mm);
-  s.seed = seed;
-  return s;
+  return test_support::fine_spec(pitch_db, irregularity_db, length_mm, seed);
 }
 
 struct Case {
