@@ -14,9 +14,9 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -73,12 +73,16 @@ void transform_times(int repeat) {
   texel::detail::RealFft kiss(n);
   texel::detail::Pow2RealFft own(n);
   constexpr int calls = 100;
-  const double kiss_us = median_ms(repeat, [&] {
-                           for (int c = 0; c < calls; ++c) kiss.forward(x, out);
-                         }) * 1e3 / calls;
-  const double own_us = median_ms(repeat, [&] {
-                          for (int c = 0; c < calls; ++c) own.forward(x, out);
-                        }) * 1e3 / calls;
+  const double kiss_us = median_ms(repeat,
+                                   [&] {
+                                     for (int c = 0; c < calls; ++c) kiss.forward(x, out);
+                                   }) *
+                         1e3 / calls;
+  const double own_us = median_ms(repeat,
+                                  [&] {
+                                    for (int c = 0; c < calls; ++c) own.forward(x, out);
+                                  }) *
+                        1e3 / calls;
   std::printf("analysis transform, 2^15 real points: KISS FFT (float) %.1f us, Pow2RealFft (double) %.1f us (%.2fx faster)\n\n",
               kiss_us, own_us, kiss_us / own_us);
 }
@@ -137,7 +141,8 @@ int main(int argc, char** argv) {
     const codec::Signal signal{a, device.spacing, m.name};
     codec::EncodeResult r;
     double cpu_ms = 0.0;
-    const double encode_ms = median_ms(repeat, [&] { r = codec::encode(signal, codec::EncoderConfig{}); }, &cpu_ms);
+    const double encode_ms = median_ms(
+        repeat, [&] { r = codec::encode(signal, codec::EncoderConfig{}); }, &cpu_ms);
     const bool fine = r.spec.fine_strength > 0.0;
     const char* kind = r.coarse ? (fine ? "two-scale" : "coarse") : (fine ? "fine-only" : "flat");
     const char* method = r.texel_recovered ? "recovered" : (fine ? "fitted" : "no fine");
@@ -167,8 +172,9 @@ int main(int argc, char** argv) {
       "median encode: fine-only %.2f ms over %zu maps (goal < 10 ms: %s); two-scale %.2f ms over %zu maps (goal < 30 ms: %s)\n",
       fine_median, fine_ms.size(), fine_median < 10.0 ? "met" : "NOT met", two_median, two_scale_ms.size(),
       two_median < 30.0 ? "met" : "NOT met");
-  std::printf("median CPU time of the encoding thread: fine-only %.2f ms, two-scale %.2f ms (wall time above minus waiting for a core)\n",
-              median(fine_cpu), median(two_scale_cpu));
+  std::printf(
+      "median CPU time of the encoding thread: fine-only %.2f ms, two-scale %.2f ms (wall time above minus waiting for a core)\n",
+      median(fine_cpu), median(two_scale_cpu));
   std::printf("median encode of coarse-only and flat maps (no fine texture): %.2f ms over %zu maps\n", median(other_ms),
               other_ms.size());
   if (!json_path.empty()) {

@@ -42,8 +42,9 @@ Document input_document(const ExportArgs& a) {
 
 void register_export(CLI::App& app) {
   auto a = std::make_shared<ExportArgs>();
-  auto* cmd = app.add_subcommand("export", "Export a texture as MPEG-I Haptics (.hjif) or a glTF asset with an MPEG haptic "
-                                           "material (.gltf/.glb, written with the .hjif it references)");
+  auto* cmd = app.add_subcommand("export",
+                                 "Export a texture as MPEG-I Haptics (.hjif) or a glTF asset with an MPEG haptic "
+                                 "material (.gltf/.glb, written with the .hjif it references)");
   cmd->add_option("input", a->input, "Texture document (.texel.json) or bitstream (.texel, decoded on --device [tpad])")
       ->required();
   cmd->add_option("-o,--output", a->output, "Output: .hjif, .gltf or .glb")->required();
@@ -100,10 +101,10 @@ void register_export(CLI::App& app) {
       print_json(j);
       return;
     }
-    std::cout << a->input << " -> " << hjif_path << ": " << s.perceptions << " "
-              << hjif::modality_name(eo.modality) << (s.perceptions == 1 ? " perception, " : " perceptions, ") << s.keyframes
-              << " keyframes for " << s.samples << " samples, max error " << detail::num(s.max_error) << " (tolerance "
-              << detail::num(eo.tolerance) << "), " << h.json.size() << " bytes\n";
+    std::cout << a->input << " -> " << hjif_path << ": " << s.perceptions << " " << hjif::modality_name(eo.modality)
+              << (s.perceptions == 1 ? " perception, " : " perceptions, ") << s.keyframes << " keyframes for " << s.samples
+              << " samples, max error " << detail::num(s.max_error) << " (tolerance " << detail::num(eo.tolerance) << "), "
+              << h.json.size() << " bytes\n";
     if (ext != ".hjif") std::cout << "  " << a->output << ": " << asset_bytes << " bytes\n";
   });
 }

@@ -65,12 +65,12 @@ struct ExportOptions {
 /// What an export wrote and how well the samples reproduce the map.
 struct ExportStats {
   std::size_t perceptions = 0;
-  std::size_t keyframes = 0;       ///< over all perceptions
-  std::size_t samples = 0;         ///< grid samples covered by regions
-  std::uint32_t timescale = 0;     ///< ticks per millimetre
-  int amplitude_decimals = 0;      ///< decimals written per amplitude
-  double max_error = 0.0;          ///< max |curve − map| on the device grid, full scale
-  bool grid_on_ticks = true;       ///< every grid position is a whole number of ticks
+  std::size_t keyframes = 0;    ///< over all perceptions
+  std::size_t samples = 0;      ///< grid samples covered by regions
+  std::uint32_t timescale = 0;  ///< ticks per millimetre
+  int amplitude_decimals = 0;   ///< decimals written per amplitude
+  double max_error = 0.0;       ///< max |curve − map| on the device grid, full scale
+  bool grid_on_ticks = true;    ///< every grid position is a whole number of ticks
 };
 
 struct Exported {
@@ -99,12 +99,12 @@ struct CurveEffect {
 struct Perception {
   std::int64_t id = 0;
   std::string description;
-  std::string modality;         ///< as written, e.g. "Friction"
-  bool spatial = false;         ///< Friction / Vibrotactile Texture (else temporal Vibrotactile)
-  int unit_exponent = -3;       ///< spatial unit = 10^unit_exponent m [−3 when absent, choice]
-  double gain = 1.0;            ///< product of the channel gains applied
-  std::vector<CurveEffect> effects;  ///< every Curve effect of every channel and band
-  std::optional<std::string> reference_device;  ///< first reference device's name
+  std::string modality;                             ///< as written, e.g. "Friction"
+  bool spatial = false;                             ///< Friction / Vibrotactile Texture (else temporal Vibrotactile)
+  int unit_exponent = -3;                           ///< spatial unit = 10^unit_exponent m [−3 when absent, choice]
+  double gain = 1.0;                                ///< product of the channel gains applied
+  std::vector<CurveEffect> effects;                 ///< every Curve effect of every channel and band
+  std::optional<std::string> reference_device;      ///< first reference device's name
   std::optional<std::uint32_t> frequency_sampling;  ///< first channel's, if given
 };
 
@@ -115,9 +115,9 @@ struct Experience {
   int level = 1;
   std::string date;
   std::string description;
-  std::uint32_t timescale = 1000;    ///< ticks per second (temporal) / per spatial unit (spatial)
+  std::uint32_t timescale = 1000;       ///< ticks per second (temporal) / per spatial unit (spatial)
   std::vector<Perception> perceptions;  ///< the ones Texel can sample (spatial, or temporal vibrotactile)
-  std::vector<std::string> skipped;  ///< modalities present but not sampled (e.g. "Temperature")
+  std::vector<std::string> skipped;     ///< modalities present but not sampled (e.g. "Temperature")
   /// The Texel document carried in the description, when present, parsed and
   /// consistent with the curves (within the tolerance written beside it).
   std::optional<Document> carried;
@@ -127,10 +127,10 @@ struct Experience {
 
 /// Limits on what parse_hjif accepts (checked before anything that size is built).
 struct ImportLimits {
-  std::size_t max_bytes = std::size_t{256} << 20;        ///< text size
-  std::size_t max_depth = 32;                             ///< JSON nesting
-  std::size_t max_keyframes = std::size_t{1} << 24;       ///< over the whole file
-  std::size_t max_items = std::size_t{1} << 16;           ///< perceptions, channels, bands, effects (each array)
+  std::size_t max_bytes = std::size_t{256} << 20;    ///< text size
+  std::size_t max_depth = 32;                        ///< JSON nesting
+  std::size_t max_keyframes = std::size_t{1} << 24;  ///< over the whole file
+  std::size_t max_items = std::size_t{1} << 16;      ///< perceptions, channels, bands, effects (each array)
 };
 
 /// Parses and validates a .hjif text; `origin` names it in errors (FormatError,

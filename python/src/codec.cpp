@@ -461,8 +461,8 @@ modality  "friction" | "vibrotactile-texture";  date  YYYY-MM-DD (default: $SOUR
         const auto b = gltf::asset(doc, o, container == "glb" ? gltf::Container::glb : gltf::Container::gltf);
         return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
       },
-      py::arg("document"), py::kw_only(), py::arg("hjif_uri"), py::arg("container") = "gltf",
-      py::arg("modality") = "friction", py::arg("width_mm") = 25.0,
+      py::arg("document"), py::kw_only(), py::arg("hjif_uri"), py::arg("container") = "gltf", py::arg("modality") = "friction",
+      py::arg("width_mm") = 25.0,
       R"doc(A glTF 2.0 asset (bytes: .gltf text or .glb) of the display as a quad with the MPEG_haptic /
 MPEG_haptic_material extensions, referencing the .hjif at `hjif_uri` (write export_hjif's json there).)doc");
   m.def(

@@ -83,7 +83,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   if (rec && has_fine) {
     FineFit r;
     r.input = perceive(sp.fine, dx, fit_cfg.model);
-    Fitter fitter{fit_cfg, r.input, dx, cand, band_max, 0.0, nullptr, 0, {}, 2};
+    Fitter fitter(fit_cfg, r.input, dx, cand, band_max);
     const Box box = fit_box(fit_cfg, band_max);
     r.p_db = std::clamp(rec->p_db, box.p_lo, box.p_hi);
     r.i_db = std::clamp(rec->i_db, box.i_lo, box.i_hi);
@@ -104,11 +104,14 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     // that of the best fine-only explanation.
     Split flat = split(a, dx, fit_cfg, SplitMode::fine_only);
     // The check needs the neighbourhood, not the last 0.1 dB: a shorter
-    // search, P and I only (whether Irregularity is felt matters only if
-    // this explanation is kept; then the fit is finished below).
+    // search. The simplex's (a third of its budget) is the result if this
+    // explanation is kept; least squares runs two iterations, P and I only,
+    // and is finished below if it is kept.
     EncoderConfig quick = fit_cfg;
     quick.max_evaluations = fit_cfg.max_evaluations / 3;
-    FineFit flat_fit = fit_fine(flat.fine, dx, cand, band_max, quick, 0.0, nullptr, FitOptions{false, 2, std::nullopt});
+    const bool simplex = fit_cfg.fit_method == FitMethod::simplex;
+    FineFit flat_fit =
+        fit_fine(flat.fine, dx, cand, band_max, quick, 0.0, nullptr, simplex ? FitOptions{} : FitOptions{false, 2, std::nullopt});
     std::vector<double> r(n);
     fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
         .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, r);
@@ -116,10 +119,13 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     const double shape = shape_distance_db(a, r, dx);
     if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
       sp = std::move(flat);
-      const FitOptions finish{true, 8, std::array<double, 2>{flat_fit.p_db, flat_fit.i_db}};
-      fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg.fit_method == FitMethod::simplex ? quick : fit_cfg, 0.0, nullptr,
-                     fit_cfg.fit_method == FitMethod::simplex ? FitOptions{true, 8, std::nullopt} : finish);
-      fit.evaluations += flat_fit.evaluations;
+      if (simplex) {
+        fit = flat_fit;
+      } else {
+        fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg, 0.0, nullptr,
+                       FitOptions{true, 8, std::array<double, 2>{flat_fit.p_db, flat_fit.i_db}});
+        fit.evaluations += flat_fit.evaluations;
+      }
     } else {
       fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg, 1.0 / cfg.boundary.value(), &sp);
       fit.evaluations += flat_fit.evaluations;

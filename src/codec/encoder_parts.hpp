@@ -86,6 +86,16 @@ TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, Cy
 /// The objective: model distance between the target percept and candidate
 /// renderings of (P, I) on the input's grid, analysed like the input.
 struct Fitter {
+  Fitter(const EncoderConfig& config, const Percept& target_percept, double spacing_mm, std::size_t candidate_samples,
+         CyclesPerMm band_top, double band_bottom = 0.0, const Split* coarse_estimate = nullptr)
+      : cfg(config),
+        target(target_percept),
+        dx(spacing_mm),
+        samples(candidate_samples),
+        band_max(band_top),
+        f_min(band_bottom),
+        two_scale(coarse_estimate) {}
+
   const EncoderConfig& cfg;
   const Percept& target;
   double dx;

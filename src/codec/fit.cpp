@@ -242,7 +242,7 @@ FineFit fit_fine(const std::vector<double>& fine, double dx, std::size_t cand, C
                  double f_min, const Split* two_scale, const FitOptions& options) {
   FineFit out;
   out.input = perceive(fine, dx, cfg.model, f_min);
-  Fitter fit{cfg, out.input, dx, cand, band_max, f_min, two_scale, 0, {}, 2};
+  Fitter fit(cfg, out.input, dx, cand, band_max, f_min, two_scale);
   const Box box = fit_box(cfg, band_max);
   // Start from the physical centroid and spread of the fine spectrum, then
   // the best of a coarse grid around it (wide distributions make the

@@ -295,6 +295,7 @@ std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double 
   };
   std::vector<Recovered> fits;
   double best_rms = 1e9;
+  auto close_to_best = [&](const Recovered& r) { return r.rms < recovery_rms && r.rms <= 2.0 * best_rms + recovery_floor; };
   for (double L : lengths) {
     if (len < 16.0 * L) continue;
     fits.push_back(recover_frequencies(y, dx, L, band_max.value()));
@@ -306,12 +307,12 @@ std::optional<TexelRecovery> recover_texel(const std::vector<double>& a, double 
       if (auto t = accept(fits.back())) {
         bool longer_taken = false;
         for (std::size_t j = 0; j + 1 < fits.size() && !longer_taken; ++j)
-          longer_taken = fits[j].rms < recovery_rms && fits[j].rms <= 2.0 * best_rms + recovery_floor && accept(fits[j]);
+          longer_taken = close_to_best(fits[j]) && accept(fits[j]);
         if (!longer_taken) return t;  // else the shorter lengths may still lower best_rms: go on
       }
   }
   for (const Recovered& r : fits)  // longest first
-    if (r.rms < recovery_rms && r.rms <= 2.0 * best_rms + recovery_floor)
+    if (close_to_best(r))
       if (auto t = accept(r)) return t;
   return std::nullopt;
 }

@@ -68,7 +68,8 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   }
   if (!sc.fft || sc.fft->size() != m) sc.fft = std::make_unique<texel::detail::Pow2RealFft>(m);
   sc.buf.resize(m);
-  std::fill(sc.buf.begin() + static_cast<std::ptrdiff_t>(seg), sc.buf.end(), 0.0);  // the zero padding; [0, seg) is written per segment
+  std::fill(sc.buf.begin() + static_cast<std::ptrdiff_t>(seg), sc.buf.end(),
+            0.0);  // the zero padding; [0, seg) is written per segment
   sc.X.resize(m / 2 + 1);
   std::vector<double>& buf = sc.buf;
   std::vector<std::complex<double>>& X = sc.X;

@@ -175,8 +175,7 @@ std::optional<Transcoded> transcode_file(const std::string& path, const SignalOp
     // An MPEG-I Haptics file Texel exported carries its document: the same
     // parameters, hence the same bitstream, as the document itself.
     hjif::Experience e = hjif::load_hjif(path);
-    if (!e.carried)
-      return no(e.carried_rejected.empty() ? "it carries no Texel document, only samples" : e.carried_rejected);
+    if (!e.carried) return no(e.carried_rejected.empty() ? "it carries no Texel document, only samples" : e.carried_rejected);
     doc = std::move(*e.carried);
   } else {
     doc = load_document(path);

@@ -12,8 +12,8 @@ void* open_shared_object(const char* soname, std::string_view needed_for) {
   void* handle = dlopen(soname, RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* why = dlerror();
-    throw IoError(std::string(needed_for) + " need the shared library " + soname + ", which cannot be opened: " +
-                  (why != nullptr ? why : "unknown reason"));
+    throw IoError(std::string(needed_for) + " need the shared library " + soname +
+                  ", which cannot be opened: " + (why != nullptr ? why : "unknown reason"));
   }
   return handle;
 }

@@ -179,16 +179,20 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
     image = {{"name", "amplitude map"}, {"uri", "data:image/png;base64," + base64(png)}};
   }
   ojson accessors = ojson::array();
-  accessors.push_back({{"bufferView", 0}, {"byteOffset", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"},
-                       {"min", {0.0, 0.0, 0.0}}, {"max", {L, W, 0.0}}});
+  accessors.push_back({{"bufferView", 0},
+                       {"byteOffset", 0},
+                       {"componentType", 5126},
+                       {"count", 4},
+                       {"type", "VEC3"},
+                       {"min", {0.0, 0.0, 0.0}},
+                       {"max", {L, W, 0.0}}});
   accessors.push_back({{"bufferView", 0}, {"byteOffset", normals_at}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}});
   accessors.push_back({{"bufferView", 1}, {"byteOffset", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}});
   accessors.push_back({{"bufferView", 2}, {"byteOffset", 0}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}});
 
   ojson buffer{{"byteLength", container == Container::glb ? buf.size() : geometry_bytes}};
   if (container == Container::gltf)
-    buffer["uri"] = "data:application/octet-stream;base64," +
-                    base64(std::span<const std::byte>(buf.data(), geometry_bytes));
+    buffer["uri"] = "data:application/octet-stream;base64," + base64(std::span<const std::byte>(buf.data(), geometry_bytes));
 
   const std::string modality_key = o.modality == hjif::Modality::friction ? "friction" : "vibrotactileTexture";
   ojson material{{"name", "Texel texture"},
@@ -200,22 +204,25 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
       {"extensionsUsed", {"MPEG_media", "MPEG_haptic", "MPEG_haptic_material"}},
       {"extensions",
        {{"MPEG_media",
-         {{"media", ojson::array({ojson{{"name", "Texel texture"},
-                                        {"alternatives", ojson::array({ojson{{"uri", o.hjif_uri}, {"mimeType", "haptics/hjif"}}})}}})}}},
+         {{"media",
+           ojson::array({ojson{{"name", "Texel texture"},
+                               {"alternatives", ojson::array({ojson{{"uri", o.hjif_uri}, {"mimeType", "haptics/hjif"}}})}}})}}},
         {"MPEG_haptic", {{"hapticObjects", ojson::array({ojson{{"name", "Texel texture"}, {"mediaReference", {0}}}})}}},
         {"MPEG_haptic_material", {{"materials", ojson::array({std::move(material)})}}}}},
       {"scene", 0},
       {"scenes", ojson::array({ojson{{"name", "display"}, {"nodes", {0}}}})},
       {"nodes", ojson::array({ojson{{"name", doc.device.name}, {"mesh", 0}}})},
-      {"meshes", ojson::array({ojson{{"name", "display surface"},
-                                     {"primitives", ojson::array({ojson{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}},
-                                                                        {"indices", 3},
-                                                                        {"material", 0}}})},
-                                     {"extensions", {{"MPEG_haptic_material", {{"hapticMaterialIndex", 0}}}}}}})},
-      {"materials", ojson::array({ojson{{"name", "amplitude map"},
-                                        {"pbrMetallicRoughness",
-                                         {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}}},
-                                        {"doubleSided", true}}})},
+      {"meshes",
+       ojson::array({ojson{{"name", "display surface"},
+                           {"primitives", ojson::array({ojson{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}},
+                                                              {"indices", 3},
+                                                              {"material", 0}}})},
+                           {"extensions", {{"MPEG_haptic_material", {{"hapticMaterialIndex", 0}}}}}}})},
+      {"materials",
+       ojson::array({ojson{
+           {"name", "amplitude map"},
+           {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}}},
+           {"doubleSided", true}}})},
       {"textures", ojson::array({ojson{{"sampler", 0}, {"source", 0}}})},
       {"samplers", ojson::array({ojson{{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}})},
       {"images", ojson::array({std::move(image)})},

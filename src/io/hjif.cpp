@@ -34,10 +34,23 @@ using ojson = nlohmann::ordered_json;
 
 // --- the standard's vocabulary ---------------------------------------------
 
-constexpr std::string_view kModalities[] = {
-    "Pressure", "Acceleration",         "Velocity",  "Position", "Temperature", "Vibrotactile",
-    "Water",    "Wind",                 "Force",     "Electrotactile", "Vibrotactile Texture", "Stiffness",
-    "Friction", "Humidity",             "User-defined Temporal", "User-defined Spatial", "Other"};
+constexpr std::string_view kModalities[] = {"Pressure",
+                                            "Acceleration",
+                                            "Velocity",
+                                            "Position",
+                                            "Temperature",
+                                            "Vibrotactile",
+                                            "Water",
+                                            "Wind",
+                                            "Force",
+                                            "Electrotactile",
+                                            "Vibrotactile Texture",
+                                            "Stiffness",
+                                            "Friction",
+                                            "Humidity",
+                                            "User-defined Temporal",
+                                            "User-defined Spatial",
+                                            "Other"};
 constexpr std::string_view kBandTypes[] = {"Transient", "Curve", "VectorialWave", "WaveletWave"};
 constexpr std::string_view kCurveTypes[] = {"Unknown", "Cubic", "Linear", "Akima", "Bezier", "Bspline"};
 constexpr std::string_view kEffectTypes[] = {"Basis", "Reference", "Composite"};
@@ -113,7 +126,8 @@ class Walker {
       fail("profile", "is " + quote_value(exp.profile) + "; allowed: " + list(kProfiles));
     exp.level = static_cast<int>(integer(root, "", "level", true, 1, 2).value_or(1));
     exp.date = str(root, "", "date", true).value_or("");
-    if (!exp.date.empty() && !valid_date(exp.date)) fail("date", "is " + quote_value(exp.date) + "; it must be an ISO 8601 date (YYYY-MM-DD…)");
+    if (!exp.date.empty() && !valid_date(exp.date))
+      fail("date", "is " + quote_value(exp.date) + "; it must be an ISO 8601 date (YYYY-MM-DD…)");
     exp.description = str(root, "", "description", true).value_or("");
     if (auto t = integer(root, "", "timescale", true, 1, std::numeric_limits<std::uint32_t>::max())) {
       exp.timescale = static_cast<std::uint32_t>(*t);
@@ -153,7 +167,8 @@ class Walker {
       }
     }
     // Texel samples one kind: spatial perceptions if there are any, else temporal vibrotactile.
-    const bool any_spatial = std::any_of(exp.perceptions.begin(), exp.perceptions.end(), [](const Perception& p) { return p.spatial; });
+    const bool any_spatial =
+        std::any_of(exp.perceptions.begin(), exp.perceptions.end(), [](const Perception& p) { return p.spatial; });
     if (any_spatial) {
       for (const auto& p : exp.perceptions)
         if (!p.spatial) exp.skipped.push_back(p.modality);
@@ -167,9 +182,7 @@ class Walker {
   bool texel_limits_ = true;
   std::size_t keyframes_ = 0;
 
-  void fail(const std::string& path, const std::string& what) {
-    errors.push_back(path.empty() ? what : path + " " + what);
-  }
+  void fail(const std::string& path, const std::string& what) { errors.push_back(path.empty() ? what : path + " " + what); }
   static std::string at(const std::string& path, std::string_view key) {
     return path.empty() ? std::string(key) : path + "." + std::string(key);
   }
@@ -259,14 +272,16 @@ class Walker {
     static const std::regex re("^([0-9]{4})(-([0-9]+))?$");
     std::smatch m;
     // Length first: std::regex matches recursively, so a long string could exhaust the stack.
-    if (v.size() > 16 || !std::regex_match(v, m, re)) return fail("version", "is " + quote_value(v) + "; it must be YYYY or YYYY-N (year of publication, amendment)");
+    if (v.size() > 16 || !std::regex_match(v, m, re))
+      return fail("version", "is " + quote_value(v) + "; it must be YYYY or YYYY-N (year of publication, amendment)");
     if (std::stoi(m[1].str()) < 2023) fail("version", "is " + quote_value(v) + "; the year must be 2023 or later");
     if (m[3].matched && (m[3].str().size() > 4 || std::stoi(m[3].str()) <= 0))
       fail("version", "is " + quote_value(v) + "; the amendment number must be > 0");
   }
   static bool valid_date(const std::string& d) {
     static const std::regex re(
-        "^[+-]?[0-9]{4}(-[01][0-9](-[0-3][0-9](T[0-2][0-9]:[0-5][0-9](:[0-5][0-9](\\.[0-9]+)?)?(Z|[+-][0-2][0-9]:[0-5][0-9])?)?)?)?$");
+        "^[+-]?[0-9]{4}(-[01][0-9](-[0-3][0-9](T[0-2][0-9]:[0-5][0-9](:[0-5][0-9](\\.[0-9]+)?)?(Z|[+-][0-2][0-9]:[0-5][0-9])?)?)?"
+        ")?$");
     return d.size() <= 64 && std::regex_match(d, re);
   }
 
@@ -275,7 +290,8 @@ class Walker {
     if (!object(j, p)) return;
     Perception out;
     if (auto id = integer(j, p, "id", true, -kMaxPosition, kMaxPosition)) {
-      if (std::find(ids.begin(), ids.end(), *id) != ids.end()) fail(p + ".id", "is " + std::to_string(*id) + ", which another perception has");
+      if (std::find(ids.begin(), ids.end(), *id) != ids.end())
+        fail(p + ".id", "is " + std::to_string(*id) + ", which another perception has");
       ids.push_back(*id);
       out.id = *id;
     }
@@ -287,7 +303,8 @@ class Walker {
     if (modality) {
       out.modality = *modality;
       if (exp.profile == "Simple Parametric" && exp.level == 1 && !one_of(*modality, kSimpleLevel1))
-        fail(p + ".perception_modality", "is '" + *modality + "', which level 1 of the Simple Parametric profile does not allow (" +
+        fail(p + ".perception_modality", "is '" + *modality +
+                                             "', which level 1 of the Simple Parametric profile does not allow (" +
                                              list(kSimpleLevel1) + ")");
     }
     out.spatial = modality && is_spatial(*modality);
@@ -318,7 +335,8 @@ class Walker {
         const auto hi = number((*devs)[i], d, "maximum_frequency", false, 0, 1e9);
         const auto res = number((*devs)[i], d, "resonance_frequency", false, 0, 1e9);
         if (lo && hi && *hi < *lo) fail(d, "has maximum_frequency below minimum_frequency");
-        if (res && ((lo && *res < *lo) || (hi && *res > *hi))) fail(d + ".resonance_frequency", "lies outside the frequency range");
+        if (res && ((lo && *res < *lo) || (hi && *res > *hi)))
+          fail(d + ".resonance_frequency", "lies outside the frequency range");
       }
     }
     bool first_channel = true;
@@ -344,7 +362,8 @@ class Walker {
                const std::vector<std::int64_t>& library_ids, std::vector<std::int64_t>& ids, bool first) {
     if (!object(j, c)) return;
     if (auto id = integer(j, c, "id", true, -kMaxPosition, kMaxPosition)) {
-      if (std::find(ids.begin(), ids.end(), *id) != ids.end()) fail(c + ".id", "is " + std::to_string(*id) + ", which another channel has");
+      if (std::find(ids.begin(), ids.end(), *id) != ids.end())
+        fail(c + ".id", "is " + std::to_string(*id) + ", which another channel has");
       ids.push_back(*id);
     }
     str(j, c, "description", true);
@@ -385,10 +404,12 @@ class Walker {
     if (!object(j, b)) return;
     const auto type = enumerated(j, b, "band_type", true, kBandTypes);
     const auto curve = enumerated(j, b, "curve_type", false, kCurveTypes);
-    if (type && *type != "Curve" && curve) fail(b + ".curve_type", "is given for a '" + *type + "' band; only Curve bands have one");
+    if (type && *type != "Curve" && curve)
+      fail(b + ".curve_type", "is given for a '" + *type + "' band; only Curve bands have one");
     if (type && *type == "WaveletWave") {
       integer(j, b, "block_length", true, 1, kMaxPosition);
-      if (exp.profile == "Simple Parametric") fail(b + ".band_type", "is 'WaveletWave', which the Simple Parametric profile does not allow");
+      if (exp.profile == "Simple Parametric")
+        fail(b + ".band_type", "is 'WaveletWave', which the Simple Parametric profile does not allow");
     }
     const auto lo = integer(j, b, "lower_frequency_limit", true, 0, kMaxPosition);
     const auto hi = integer(j, b, "upper_frequency_limit", true, 0, kMaxPosition);
@@ -455,7 +476,8 @@ class Walker {
       integer(kf, k, "frequency_modulation", false, 0, kMaxPosition);
       if (rel) {
         if (*rel <= last && curve)
-          fail(k + ".relative_position", "is " + std::to_string(*rel) + ", not after the previous keyframe's " + std::to_string(last));
+          fail(k + ".relative_position",
+               "is " + std::to_string(*rel) + ", not after the previous keyframe's " + std::to_string(last));
         last = std::max(last, *rel);
       }
       if (curve && rel && amp && position) curve->keyframes.push_back(Keyframe{*position + *rel, *amp});
@@ -473,15 +495,19 @@ std::size_t nesting_depth(std::string_view t, std::size_t limit) {
   for (std::size_t i = 0; i < t.size(); ++i) {
     const char c = t[i];
     if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
       continue;
     }
-    if (c == '"') in_string = true;
+    if (c == '"')
+      in_string = true;
     else if (c == '[' || c == '{') {
       most = std::max(most, ++depth);
       if (most > limit) return most;
-    } else if ((c == ']' || c == '}') && depth > 0) --depth;
+    } else if ((c == ']' || c == '}') && depth > 0)
+      --depth;
   }
   return most;
 }
@@ -509,8 +535,10 @@ double pow10i(int k) {
 /// Ticks per millimetre of a perception (spatial) or per mm at the swipe speed (temporal).
 double ticks_per_mm(const Experience& e, const Perception& p, std::optional<MmPerSecond> v) {
   if (p.spatial) return static_cast<double>(e.timescale) / pow10i(p.unit_exponent + 3);
-  if (!v) throw FieldError("swipe_speed", "is required: the file's perceptions are temporal (Vibrotactile), and the swipe "
-                                          "speed (mm/s) turns their time into position");
+  if (!v)
+    throw FieldError("swipe_speed",
+                     "is required: the file's perceptions are temporal (Vibrotactile), and the swipe "
+                     "speed (mm/s) turns their time into position");
   return static_cast<double>(e.timescale) / v->value();
 }
 
@@ -522,7 +550,8 @@ double curve_at(const CurveEffect& c, double u) {
   if (k.empty() || u < static_cast<double>(k.front().position) - slack || u > static_cast<double>(k.back().position) + slack)
     return 0.0;
   // First keyframe with position > u.
-  auto hi = std::upper_bound(k.begin(), k.end(), u, [](double x, const Keyframe& f) { return x < static_cast<double>(f.position); });
+  auto hi =
+      std::upper_bound(k.begin(), k.end(), u, [](double x, const Keyframe& f) { return x < static_cast<double>(f.position); });
   if (hi == k.begin()) return k.front().amplitude;
   if (hi == k.end()) return k.back().amplitude;
   const Keyframe& a = *(hi - 1);
@@ -601,7 +630,8 @@ void check_carried_cost(const json& doc, std::size_t cap) {
   }
   if (std::isfinite(min_spacing)) longest = std::max(longest, samples * min_spacing);
   const double c = static_cast<double>(cap);
-  if (samples > c || (std::isfinite(min_spacing) && longest / min_spacing > c) || (std::isfinite(min_texel) && longest / min_texel > c))
+  if (samples > c || (std::isfinite(min_spacing) && longest / min_spacing > c) ||
+      (std::isfinite(min_texel) && longest / min_texel > c))
     throw FormatError("it asks for more than " + std::to_string(cap) + " samples or texels");
 }
 
@@ -621,7 +651,8 @@ Exported export_hjif(const Document& doc, const ExportOptions& o) {
   const std::string date = today(o.date);
   {
     static const std::regex re("^[0-9]{4}-[01][0-9]-[0-3][0-9]$");
-    if (date.size() != 10 || !std::regex_match(date, re)) throw FieldError("date", "is " + quote_value(date) + "; it must be YYYY-MM-DD");
+    if (date.size() != 10 || !std::regex_match(date, re))
+      throw FieldError("date", "is " + quote_value(date) + "; it must be YYYY-MM-DD");
   }
   const Surface surface = prepare_surface(doc);
   const Grid grid = surface.grid();
@@ -731,8 +762,8 @@ Exported export_hjif(const Document& doc, const ExportOptions& o) {
     ojson kfs = ojson::array();
     for (const Keyframe& k : curve.keyframes)
       kfs.push_back(ojson{{"relative_position", k.position - origin}, {"amplitude_modulation", k.amplitude}});
-    ojson effect{{"effect_type", "Basis"}, {"id", 0},           {"position", origin},
-                 {"phase", 0},             {"base_signal", "Sine"}, {"keyframes", std::move(kfs)}};
+    ojson effect{{"effect_type", "Basis"},     {"id", 0}, {"position", origin}, {"phase", 0}, {"base_signal", "Sine"},
+                 {"keyframes", std::move(kfs)}};
     const auto upper = static_cast<std::int64_t>(std::ceil(doc.device.band_top().value()));
     ojson band{{"band_type", "Curve"},
                {"curve_type", "Linear"},
@@ -768,9 +799,8 @@ Exported export_hjif(const Document& doc, const ExportOptions& o) {
   // The document, compact, after the marker: exact parameters for Texel.
   const std::string carried = ojson::parse(document_json(doc)).dump();
   std::string description = "Texel virtual texture on " + doc.device.name + " (" + std::to_string(doc.regions.size()) +
-                            (doc.regions.size() == 1 ? " region" : " regions") + "), amplitude map within " +
-                            num(o.tolerance) + " of full scale. texel-tolerance:" + num(o.tolerance) + " " +
-                            std::string(carried_marker) + carried;
+                            (doc.regions.size() == 1 ? " region" : " regions") + "), amplitude map within " + num(o.tolerance) +
+                            " of full scale. texel-tolerance:" + num(o.tolerance) + " " + std::string(carried_marker) + carried;
   ojson root{{"version", "2025"},
              {"profile", "Main"},
              {"level", 1},
@@ -793,8 +823,10 @@ Experience parse_hjif(std::string_view text, std::string_view origin, const Impo
   if (e.perceptions.empty()) {
     std::string found;
     for (const auto& m : e.skipped) found += (found.empty() ? "" : ", ") + m;
-    throw FormatError("'" + std::string(origin) + "' has no perception Texel can sample (Friction, Vibrotactile Texture, or "
-                      "Vibrotactile at a swipe speed)" + (found.empty() ? std::string() : "; it has: " + found));
+    throw FormatError("'" + std::string(origin) +
+                      "' has no perception Texel can sample (Friction, Vibrotactile Texture, or "
+                      "Vibrotactile at a swipe speed)" +
+                      (found.empty() ? std::string() : "; it has: " + found));
   }
   // The carried document, used only when its rendering agrees with the curves.
   const auto at = e.description.find(carried_marker);
@@ -865,8 +897,9 @@ std::vector<double> evaluate(const Experience& e, std::span<const double> x, std
       }
       work += static_cast<double>(last - first);
       if (work > max_work)
-        throw FormatError("the file's effects cover more than 2^32 samples in all on this grid (overlapping effects); "
-                          "it is not sampled");
+        throw FormatError(
+            "the file's effects cover more than 2^32 samples in all on this grid (overlapping effects); "
+            "it is not sampled");
       for (std::size_t i = first; i < last; ++i) out[i] += curve_at(c, x[i] * k);
     }
   }

@@ -46,10 +46,23 @@ namespace {
 #error "TEXEL_MATIO_SONAME (libmatio's shared object name) is set by src/CMakeLists.txt"
 #endif
 
-#define TEXEL_MATIO_FUNCTIONS(X)                                                                                    \
-  X(Mat_Open) X(Mat_Close) X(Mat_CreateVer) X(Mat_GetVersion) X(Mat_LogInitFunc) X(Mat_SizeOfClass) X(Mat_VarCreate) \
-      X(Mat_VarCreateStruct2) X(Mat_VarFree) X(Mat_VarReadData) X(Mat_VarReadNextInfo) X(Mat_VarSetCell)               \
-          X(Mat_VarSetStructFieldByName) X(Mat_VarWrite)
+// clang-format off
+#define TEXEL_MATIO_FUNCTIONS(X) \
+  X(Mat_Open) \
+  X(Mat_Close) \
+  X(Mat_CreateVer) \
+  X(Mat_GetVersion) \
+  X(Mat_LogInitFunc) \
+  X(Mat_SizeOfClass) \
+  X(Mat_VarCreate) \
+  X(Mat_VarCreateStruct2) \
+  X(Mat_VarFree) \
+  X(Mat_VarReadData) \
+  X(Mat_VarReadNextInfo) \
+  X(Mat_VarSetCell) \
+  X(Mat_VarSetStructFieldByName) \
+  X(Mat_VarWrite)
+// clang-format on
 
 /// libmatio, opened on the first .mat read or write (`matio()`); without it
 /// the rest of Texel works and .mat files are an IoError naming the library.
@@ -143,7 +156,7 @@ class Builder {
     std::size_t dims[2] = {m.rows, m.cols};
     // matio copies `data` (no MAT_F_DONT_COPY_DATA); the const_cast is its C signature.
     return check(matio().Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
-                               m.data.empty() ? nullptr : const_cast<double*>(m.data.data()), 0),
+                                       m.data.empty() ? nullptr : const_cast<double*>(m.data.data()), 0),
                  name);
   }
 
@@ -683,8 +696,9 @@ void write_mat(const std::string& path, const std::vector<Variable>& variables, 
     // A fixed header (matio's default holds the platform and the time), so
     // the same map gives the same v5 bytes.
     const bool v73 = options.version == MatVersion::v73;
-    MatPtr mat(matio().Mat_CreateVer(tmp.c_str(), v73 ? "MATLAB 7.3 MAT-file, written by Texel" : "MATLAB 5.0 MAT-file, written by Texel",
-                             v73 ? MAT_FT_MAT73 : MAT_FT_MAT5));
+    MatPtr mat(matio().Mat_CreateVer(tmp.c_str(),
+                                     v73 ? "MATLAB 7.3 MAT-file, written by Texel" : "MATLAB 5.0 MAT-file, written by Texel",
+                                     v73 ? MAT_FT_MAT73 : MAT_FT_MAT5));
     if (!mat) throw IoError("cannot write '" + path + "': libmatio cannot create the file" + matio_reason());
     const Builder builder(path);
     const matio_compression compression = options.compress ? MAT_COMPRESSION_ZLIB : MAT_COMPRESSION_NONE;

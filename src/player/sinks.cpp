@@ -15,10 +15,10 @@
 #include <unistd.h>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/shared_object.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/serial_link.hpp"
-#include "texel/detail/shared_object.hpp"
 
 namespace texel {
 
@@ -208,15 +208,25 @@ class NullBackend final : public PacedBackend {
 #error "TEXEL_PORTAUDIO_SONAME (PortAudio's shared object name) is set by src/CMakeLists.txt"
 #endif
 
-#define TEXEL_PORTAUDIO_FUNCTIONS(X)                                                                               \
-  X(Pa_CloseStream) X(Pa_GetDefaultOutputDevice) X(Pa_GetDeviceCount) X(Pa_GetDeviceInfo) X(Pa_GetErrorText)       \
-      X(Pa_GetHostApiInfo) X(Pa_Initialize) X(Pa_IsStreamStopped) X(Pa_OpenStream) X(Pa_StartStream) X(Pa_StopStream) \
-          X(Pa_Terminate)
+// clang-format off
+#define TEXEL_PORTAUDIO_FUNCTIONS(X) \
+  X(Pa_CloseStream) \
+  X(Pa_GetDefaultOutputDevice) \
+  X(Pa_GetDeviceCount) \
+  X(Pa_GetDeviceInfo) \
+  X(Pa_GetErrorText) \
+  X(Pa_GetHostApiInfo) \
+  X(Pa_Initialize) \
+  X(Pa_IsStreamStopped) \
+  X(Pa_OpenStream) \
+  X(Pa_StartStream) \
+  X(Pa_StopStream) \
+  X(Pa_Terminate)
+// clang-format on
 
 /// PortAudio, opened when the first audio sink or device list is made
 /// (`portaudio()`).
-TEXEL_SHARED_LIBRARY(PortAudio, portaudio, TEXEL_PORTAUDIO_SONAME, "audio output and device lists",
-                     TEXEL_PORTAUDIO_FUNCTIONS)
+TEXEL_SHARED_LIBRARY(PortAudio, portaudio, TEXEL_PORTAUDIO_SONAME, "audio output and device lists", TEXEL_PORTAUDIO_FUNCTIONS)
 
 void pa_check(PaError e, const std::string& what) {
   if (e != paNoError) throw IoError("audio: " + what + ": " + portaudio().Pa_GetErrorText(e));
@@ -293,7 +303,7 @@ class AudioBackend final : public Backend {
     p.suggestedLatency = o.latency_s > 0 ? o.latency_s : info->defaultLowOutputLatency;
     pa_check(
         portaudio().Pa_OpenStream(&stream_, nullptr, &p, o.rate_hz, static_cast<unsigned long>(o.block_frames), paClipOff,
-                      &AudioBackend::callback, this),
+                                  &AudioBackend::callback, this),
         "cannot open '" + device_name_ + "' at " + detail::num(o.rate_hz) + " Hz, " + std::to_string(o.block_frames) + " frames");
   }
   ~AudioBackend() override {

@@ -51,17 +51,15 @@ std::size_t fast_fft_length(std::size_t n) {
 namespace texel::detail {
 namespace {
 
+using Twiddles = Radix4Twiddles;
+
 /// The radix-4 butterflies of one twiddle set over a contiguous block of s
 /// (restrict parameters: the form the compiler vectorizes).
-struct Twiddles {
-  double w1r, w1i, w2r, w2i, w3r, w3i;
-};
-inline void radix4_block(std::size_t s, const double* __restrict a_r, const double* __restrict a_i,
-                         const double* __restrict b_r, const double* __restrict b_i, const double* __restrict c_r,
-                         const double* __restrict c_i, const double* __restrict d_r, const double* __restrict d_i,
-                         double* __restrict y0r, double* __restrict y0i, double* __restrict y1r, double* __restrict y1i,
-                         double* __restrict y2r, double* __restrict y2i, double* __restrict y3r, double* __restrict y3i,
-                         Twiddles w) {
+inline void radix4_block(std::size_t s, const double* __restrict a_r, const double* __restrict a_i, const double* __restrict b_r,
+                         const double* __restrict b_i, const double* __restrict c_r, const double* __restrict c_i,
+                         const double* __restrict d_r, const double* __restrict d_i, double* __restrict y0r,
+                         double* __restrict y0i, double* __restrict y1r, double* __restrict y1i, double* __restrict y2r,
+                         double* __restrict y2i, double* __restrict y3r, double* __restrict y3i, Twiddles w) {
   for (std::size_t q = 0; q < s; ++q) {
     const double apcr = a_r[q] + c_r[q], apci = a_i[q] + c_i[q], amcr = a_r[q] - c_r[q], amci = a_i[q] - c_i[q];
     const double bpdr = b_r[q] + d_r[q], bpdi = b_i[q] + d_i[q];
@@ -129,12 +127,11 @@ Pow2RealFft::Pow2RealFft(std::size_t n) : n_(n) {
   const std::size_t h = n / 2;
   // Per radix-4 stage (len = h, h/4, …), the twiddles of each p in order.
   for (std::size_t len = h; len >= 4; len /= 4)
-    for (std::size_t p = 0; p < len / 4; ++p)
-      for (std::size_t k = 1; k <= 3; ++k) {
-        const double t = 2.0 * M_PI * static_cast<double>(k * p) / static_cast<double>(len);
-        tw_.push_back(std::cos(t));
-        tw_.push_back(-std::sin(t));
-      }
+    for (std::size_t p = 0; p < len / 4; ++p) {
+      auto turn = [&](std::size_t k) { return 2.0 * M_PI * static_cast<double>(k * p) / static_cast<double>(len); };
+      tw_.push_back(
+          {std::cos(turn(1)), -std::sin(turn(1)), std::cos(turn(2)), -std::sin(turn(2)), std::cos(turn(3)), -std::sin(turn(3))});
+    }
   sr_.resize(h / 2 + 1), si_.resize(h / 2 + 1);
   for (std::size_t k = 0; k <= h / 2; ++k) {
     const double t = 2.0 * M_PI * static_cast<double>(k) / static_cast<double>(n);
@@ -154,8 +151,7 @@ void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<dou
   // natural order at the end.
   const StageFn stage = stage_fn();
   std::size_t len = h, s = 1;
-  static_assert(sizeof(Twiddles) == 6 * sizeof(double));
-  const auto* tw = reinterpret_cast<const Twiddles*>(tw_.data());
+  const Twiddles* tw = tw_.data();
   for (; len >= 4; len /= 4, s *= 4) {
     stage(xr, xi, yr, yi, len / 4, s, tw);
     tw += len / 4;

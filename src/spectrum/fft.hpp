@@ -40,6 +40,11 @@ class RealFft {
 /// compiler vectorizes, then the real-input split. 3–4× KISS FFT's float
 /// transform at 2^15 (texel_bench_encode). Twiddles from libm: analysis
 /// only, never rendered bytes. Not thread-safe per object (scratch buffers).
+/// The twiddles w^p, w^2p, w^3p (re, im) of one radix-4 butterfly set.
+struct Radix4Twiddles {
+  double w1r, w1i, w2r, w2i, w3r, w3i;
+};
+
 class Pow2RealFft {
  public:
   explicit Pow2RealFft(std::size_t n);
@@ -48,10 +53,10 @@ class Pow2RealFft {
   void forward(std::span<const double> in, std::span<std::complex<double>> out);
 
  private:
-  std::size_t n_;                           // real length
-  std::vector<double> tw_;                  // per radix-4 stage and p: w^p, w^2p, w^3p (re, im)
-  std::vector<double> sr_, si_;             // e^{−2πik/n}, k ≤ n/4: the real split's
-  std::vector<double> ar_, ai_, br_, bi_;   // ping-pong buffers
+  std::size_t n_;                          // real length
+  std::vector<Radix4Twiddles> tw_;         // per radix-4 stage and p
+  std::vector<double> sr_, si_;            // e^{−2πik/n}, k ≤ n/4: the real split's
+  std::vector<double> ar_, ai_, br_, bi_;  // ping-pong buffers
 };
 
 /// Smallest even length >= n whose only prime factors are 2, 3 and 5.

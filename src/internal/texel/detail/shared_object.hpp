@@ -38,17 +38,17 @@ F shared_function(void* handle, const char* soname, const char* name) {
 #define TEXEL_SHARED_LIBRARY_POINTER(name) decltype(&::name) name = nullptr;
 #define TEXEL_SHARED_LIBRARY_RESOLVE(name) \
   loaded_.name = ::texel::detail::shared_function<decltype(&::name)>(handle_, soname_, #name);
-#define TEXEL_SHARED_LIBRARY(Type, accessor, SONAME, NEEDED_FOR, LIST)                 \
-  struct Type {                                                                        \
-    LIST(TEXEL_SHARED_LIBRARY_POINTER)                                                 \
-  };                                                                                   \
-  const Type& accessor() {                                                             \
-    static const Type loaded = [] {                                                    \
-      const char* soname_ = SONAME;                                                    \
-      void* handle_ = ::texel::detail::open_shared_object(soname_, NEEDED_FOR);        \
-      Type loaded_;                                                                    \
-      LIST(TEXEL_SHARED_LIBRARY_RESOLVE)                                               \
-      return loaded_;                                                                  \
-    }();                                                                               \
-    return loaded;                                                                     \
+#define TEXEL_SHARED_LIBRARY(Type, accessor, SONAME, NEEDED_FOR, LIST)          \
+  struct Type {                                                                 \
+    LIST(TEXEL_SHARED_LIBRARY_POINTER)                                          \
+  };                                                                            \
+  const Type& accessor() {                                                      \
+    static const Type loaded = [] {                                             \
+      const char* soname_ = SONAME;                                             \
+      void* handle_ = ::texel::detail::open_shared_object(soname_, NEEDED_FOR); \
+      Type loaded_;                                                             \
+      LIST(TEXEL_SHARED_LIBRARY_RESOLVE)                                        \
+      return loaded_;                                                           \
+    }();                                                                        \
+    return loaded;                                                              \
   }
