@@ -2,6 +2,8 @@
 // src/internal/texel/detail/detfft.hpp for the method and its trade-off.
 #include "texel/detail/detfft.hpp"
 
+#include "texel/detail/scratch_file.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -238,78 +240,399 @@ std::size_t block_fft_size(std::size_t k, std::size_t n) {
 
 }  // namespace
 
-void sum_harmonics(const Harmonics& h, double origin, double spacing, std::int64_t index, std::span<double> out) {
-  const std::size_t k = h.amplitude.size();
-  const std::size_t n = out.size();
-  if (k == 0 || k != h.phase_cycles.size() || k > max_chirp_harmonics)
-    throw InvalidArgument("sum_harmonics: " + std::to_string(k) + " harmonics (" + std::to_string(h.phase_cycles.size()) +
-                          " phases); 1 to " + std::to_string(max_chirp_harmonics) + " are allowed");
-  if (n == 0) return;
-  const std::size_t m = block_fft_size(k, n);
-  const std::size_t block = std::min(m - k + 1, n);
-  const DetFft fft(m);
+namespace {
 
-  // Phase of harmonic first + j at sample t of a block starting at x0 (all in
-  // cycles, each reduced modulo 1 from exact products):
-  //   φ_j + (first + j)·f·(x0 + t·s) = A_j + B_t − C_(t−j), with θ = f·s and
-  //   A_j = φ_j + (first + j)·f·x0 + θ/2·j²,  B_t = θ/2·t² + first·θ·t,  C_d = θ/2·d².
-  const TwoDouble theta = multiply(h.fundamental, TwoDouble{spacing, 0.0});
-  const TwoDouble half_theta = wrap(TwoDouble{theta.hi * 0.5, theta.lo * 0.5});  // halving is exact
-  const TwoDouble first_theta = wrap(multiply(theta, TwoDouble{static_cast<double>(h.first), 0.0}));
+/// What every block of one chirp-z sum shares: sizes and the exact phase
+/// steps. Phase of harmonic first + j at sample t of a block starting at x0
+/// (all in cycles, each reduced modulo 1 from exact products):
+///   φ_j + (first + j)·f·(x0 + t·s) = A_j + B_t − C_(t−j), with θ = f·s and
+///   A_j = φ_j + (first + j)·f·x0 + θ/2·j²,  B_t = θ/2·t² + first·θ·t,  C_d = θ/2·d².
+struct ChirpPlan {
+  std::uint64_t first = 0;
+  TwoDouble fundamental;
+  std::size_t k = 0;      // harmonics
+  std::size_t m = 0;      // FFT size
+  std::size_t block = 0;  // output samples per block
+  TwoDouble half_theta;
+  TwoDouble first_theta;
+  double inv_m = 0.0;
 
-  // The kernel e^(−2πi·C_d) for d in (−K, B), circularly, scaled by 1/M
-  // (exact: a power of two) so that the inverse transform needs no scaling;
-  // shared by every block.
-  std::vector<double> vr(m, 0.0);
-  std::vector<double> vi(m, 0.0);
-  const double inv_m = 1.0 / static_cast<double>(m);
-  for (std::size_t d = 0; d < std::max(block, k); ++d) {
-    const double c = cycles_times(half_theta, static_cast<std::uint64_t>(d) * d);
-    const double re = detmath::cos_cycles(c) * inv_m;
-    const double im = -detmath::sin_cycles(c) * inv_m;
-    if (d < block) {
-      vr[d] = re;
-      vi[d] = im;
-    }
-    if (d >= 1 && d < k) {
-      vr[m - d] = re;
-      vi[m - d] = im;
+  ChirpPlan(std::uint64_t first_, TwoDouble f, std::size_t k_, std::size_t n, double spacing)
+      : first(first_), fundamental(f), k(k_), m(block_fft_size(k_, n)), block(std::min(m - k_ + 1, n)) {
+    const TwoDouble theta = multiply(f, TwoDouble{spacing, 0.0});
+    half_theta = wrap(TwoDouble{theta.hi * 0.5, theta.lo * 0.5});  // halving is exact
+    first_theta = wrap(multiply(theta, TwoDouble{static_cast<double>(first), 0.0}));
+    inv_m = 1.0 / static_cast<double>(m);  // exact: a power of two
+  }
+
+  /// The kernel e^(−2πi·C_d) for d in (−K, B), circularly (d at index d,
+  /// −d at m − d), scaled by 1/M so that the inverse transform needs no
+  /// scaling; 0 elsewhere. Shared by every block.
+  void kernel(std::size_t i0, std::span<double> re, std::span<double> im) const {
+    for (std::size_t x = 0; x < re.size(); ++x) {
+      const std::size_t i = i0 + x;
+      std::size_t d = 0;
+      if (i < block) {
+        d = i;
+      } else if (i + k > m) {
+        d = m - i;
+      } else {
+        re[x] = 0.0;
+        im[x] = 0.0;
+        continue;
+      }
+      const double c = cycles_times(half_theta, static_cast<std::uint64_t>(d) * d);
+      re[x] = detmath::cos_cycles(c) * inv_m;
+      im[x] = -detmath::sin_cycles(c) * inv_m;
     }
   }
-  fft.forward_to_bit_reversed(vr.data(), vi.data());
 
-  std::vector<double> ur(m);
-  std::vector<double> ui(m);
-  for (std::size_t m0 = 0; m0 < n; m0 += block) {
-    const std::size_t len = std::min(block, n - m0);
-    // x0 = origin + (index + m0)·spacing and f·x0 modulo 1, to ~106 bits.
+  /// f·x0 modulo 1 (to ~106 bits) for the block starting at sample m0,
+  /// x0 = origin + (index + m0)·spacing.
+  [[nodiscard]] TwoDouble alpha(double origin, double spacing, std::int64_t index, std::size_t m0) const {
     const auto i0 = static_cast<double>(index + static_cast<std::int64_t>(m0));  // exact below 2^53
     const TwoDouble p = two_product(i0, spacing);
     const TwoDouble s = two_sum(origin, p.hi);
     const TwoDouble x0 = two_sum(s.hi, s.lo + p.lo);  // s.hi may have cancelled to below p.lo
-    const TwoDouble alpha = wrap(multiply(h.fundamental, x0));
-    for (std::size_t j = 0; j < k; ++j) {
-      const double a =
-          h.phase_cycles[j] + cycles_times(alpha, h.first + j) + cycles_times(half_theta, static_cast<std::uint64_t>(j) * j);
-      ur[j] = h.amplitude[j] * detmath::cos_cycles(a);
-      ui[j] = h.amplitude[j] * detmath::sin_cycles(a);
+    return wrap(multiply(fundamental, x0));
+  }
+
+  /// The block's input u_j = a_j·e^(2πi·A_j) for j = j0 … from amplitudes
+  /// and phases (written over them: re over amplitude, im over phase).
+  void input(TwoDouble alpha, std::size_t j0, std::span<double> amplitude_re, std::span<double> phase_im) const {
+    for (std::size_t x = 0; x < amplitude_re.size(); ++x) {
+      const std::size_t j = j0 + x;
+      const double a = phase_im[x] + cycles_times(alpha, first + j) + cycles_times(half_theta, static_cast<std::uint64_t>(j) * j);
+      const double amp = amplitude_re[x];
+      amplitude_re[x] = amp * detmath::cos_cycles(a);
+      phase_im[x] = amp * detmath::sin_cycles(a);
+    }
+  }
+
+  /// y_t = Im(e^(2πi·B_t)·z_t) for t = t0 … into out.
+  void output(std::size_t t0, const double* zr, const double* zi, std::span<double> out) const {
+    for (std::size_t x = 0; x < out.size(); ++x) {
+      const std::size_t t = t0 + x;
+      const double b = cycles_times(half_theta, static_cast<std::uint64_t>(t) * t) + cycles_times(first_theta, t);
+      out[x] = detmath::sin_cycles(b) * zr[x] + detmath::cos_cycles(b) * zi[x];
+    }
+  }
+};
+
+/// The pointwise product u·v of the convolution, in place over u.
+void multiply_spectra(double* ur, double* ui, const double* vr, const double* vi, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double xr = ur[i];
+    const double xi = ui[i];
+    ur[i] = xr * vr[i] - xi * vi[i];
+    ui[i] = xr * vi[i] + xi * vr[i];
+  }
+}
+
+constexpr std::size_t input_run = 4096;  // harmonics asked of the source at once (in memory)
+
+/// The whole sum with every FFT array in memory (48 bytes per FFT point).
+void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin, double spacing, std::int64_t index,
+                   std::size_t n, const SampleSink& sink) {
+  const std::size_t m = plan.m;
+  const std::size_t k = plan.k;
+  const DetFft fft(m);
+  std::vector<double> vr(m);
+  std::vector<double> vi(m);
+  plan.kernel(0, vr, vi);
+  fft.forward_to_bit_reversed(vr.data(), vi.data());
+
+  std::vector<double> ur(m);
+  std::vector<double> ui(m);
+  std::vector<double> y(input_run);
+  for (std::size_t m0 = 0; m0 < n; m0 += plan.block) {
+    const std::size_t len = std::min(plan.block, n - m0);
+    const TwoDouble alpha = plan.alpha(origin, spacing, index, m0);
+    for (std::size_t j0 = 0; j0 < k; j0 += input_run) {
+      const std::span<double> re(ur.data() + j0, std::min(input_run, k - j0));
+      const std::span<double> im(ui.data() + j0, re.size());
+      h.fill(j0, re, im);
+      plan.input(alpha, j0, re, im);
     }
     std::fill(ur.begin() + static_cast<std::ptrdiff_t>(k), ur.end(), 0.0);
     std::fill(ui.begin() + static_cast<std::ptrdiff_t>(k), ui.end(), 0.0);
     fft.forward_to_bit_reversed(ur.data(), ui.data());
-    for (std::size_t i = 0; i < m; ++i) {
-      const double xr = ur[i];
-      const double xi = ui[i];
-      ur[i] = xr * vr[i] - xi * vi[i];
-      ui[i] = xr * vi[i] + xi * vr[i];
-    }
+    multiply_spectra(ur.data(), ui.data(), vr.data(), vi.data(), m);
     fft.inverse_from_bit_reversed(ur.data(), ui.data());
-    // y = Im(e^(2πi·B_t)·z_t).
-    for (std::size_t t = 0; t < len; ++t) {
-      const double b = cycles_times(half_theta, static_cast<std::uint64_t>(t) * t) + cycles_times(first_theta, t);
-      out[m0 + t] = detmath::sin_cycles(b) * ur[t] + detmath::cos_cycles(b) * ui[t];
+    for (std::size_t t0 = 0; t0 < len; t0 += input_run) {
+      const std::span<double> run(y.data(), std::min(input_run, len - t0));
+      plan.output(t0, ur.data() + t0, ui.data() + t0, run);
+      sink(m0 + t0, run);
     }
   }
+}
+
+// ------------------------------------------------------------ out of core
+//
+// An FFT of M = 2^p points kept in a scratch file, run with W = 2^w points
+// in memory. Stage q of the FFT (span h = 2^q) pairs indices that differ in
+// bit q only, with twiddle e^(−2πi·j/2h), j = index mod h. The stages of bits
+// below w act on contiguous blocks of W points, exactly as DetFft(W) does on
+// each block (its twiddles are the same fractions j/2h). The stages of bits
+// w … p−1 run in passes over groups of R = 2^r rows of C = W/R contiguous
+// points (rows 2^lo apart): such a group is closed under the butterflies of
+// bits lo … lo + r − 1, so a pass loads each group once, runs its stages in
+// the in-memory order (decimation in frequency: high bits first; in time:
+// low bits first) and writes it back. Every butterfly is the same IEEE
+// operations on the same values as in memory, so the bits are the same.
+
+struct DiskArray {
+  std::uint64_t re = 0;  // element offsets in the scratch file
+  std::uint64_t im = 0;
+};
+
+class OutOfCore {
+ public:
+  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points)
+      : file_(file),
+        m_(m),
+        w_(w_points),
+        fft_(w_points),
+        re_(w_points),
+        im_(w_points),
+        re2_(w_points),
+        im2_(w_points),
+        twiddle_c_(w_points),
+        twiddle_s_(w_points) {
+    while ((std::size_t{1} << p_) < m_) ++p_;
+    while ((std::size_t{1} << wbits_) < w_) ++wbits_;
+    const int c_min = std::min(9, wbits_ - 1);  // rows of at least 4 KiB where W allows
+    r_max_ = wbits_ - c_min;
+  }
+
+  [[nodiscard]] std::size_t work() const { return w_; }
+
+  /// Writes the M points a chunk at a time: fill(i0, re, im) for W points.
+  template <class Fill>
+  void write(DiskArray a, Fill&& fill) {
+    for (std::size_t i0 = 0; i0 < m_; i0 += w_) {
+      fill(i0, std::span<double>(re_), std::span<double>(im_));
+      file_.write(a.re + i0, re_);
+      file_.write(a.im + i0, im_);
+    }
+  }
+
+  /// The stages of bits w … p−1 of decimation in frequency (high bits first).
+  void dif_top(DiskArray a) {
+    for (int hi = p_; hi > wbits_;) {
+      const int lo = std::max(wbits_, hi - r_max_);
+      pass(a, lo, hi, false);
+      hi = lo;
+    }
+  }
+
+  /// The stages of bits w … p−1 of decimation in time (low bits first).
+  void dit_top(DiskArray a) {
+    for (int lo = wbits_; lo < p_;) {
+      const int hi = std::min(p_, lo + r_max_);
+      pass(a, lo, hi, true);
+      lo = hi;
+    }
+  }
+
+  /// For each block of W contiguous points: fn(i0, re, im) in memory.
+  template <class Fn>
+  void blocks(DiskArray a, Fn&& fn) {
+    for (std::size_t i0 = 0; i0 < m_; i0 += w_) {
+      file_.read(a.re + i0, re_);
+      file_.read(a.im + i0, im_);
+      fn(i0, re_.data(), im_.data());
+      file_.write(a.re + i0, re_);
+      file_.write(a.im + i0, im_);
+    }
+  }
+
+  [[nodiscard]] const DetFft& block_fft() const { return fft_; }
+  /// A second pair of W-point buffers, free for blocks()' callers.
+  [[nodiscard]] double* spare_re() { return re2_.data(); }
+  [[nodiscard]] double* spare_im() { return im2_.data(); }
+
+ private:
+  void pass(DiskArray a, int lo, int hi, bool inverse) {
+    const std::size_t rows = std::size_t{1} << (hi - lo);
+    const std::size_t cols = w_ / rows;
+    const std::size_t stride = std::size_t{1} << lo;
+    const std::size_t mids = stride / cols;
+    const std::size_t highs = m_ >> hi;
+    // Twiddles of stage q (span h = 2^q) at offset (2^(q−lo) − 1)·C: for
+    // row t' < 2^(q−lo) and column u, j = t'·2^lo + mid·C + u (the index's
+    // bits below q); the same for every group with this `mid`.
+    for (std::size_t mid = 0; mid < mids; ++mid) {
+      for (int q = lo; q < hi; ++q) {
+        const std::size_t s = std::size_t{1} << (q - lo);
+        double* c = twiddle_c_.data() + (s - 1) * cols;
+        double* sn = twiddle_s_.data() + (s - 1) * cols;
+        for (std::size_t t = 0; t < s; ++t)
+          for (std::size_t u = 0; u < cols; ++u) {
+            const std::size_t j = t * stride + mid * cols + u;
+            const double x = std::ldexp(static_cast<double>(j), -(q + 1));  // j/2h, exact
+            c[t * cols + u] = detmath::cos_cycles(x);
+            sn[t * cols + u] = -detmath::sin_cycles(x);
+          }
+      }
+      for (std::size_t hp = 0; hp < highs; ++hp) {
+        const std::uint64_t base = (static_cast<std::uint64_t>(hp) << hi) + mid * cols;
+        for (std::size_t t = 0; t < rows; ++t) {
+          file_.read(a.re + base + t * stride, std::span<double>(re_.data() + t * cols, cols));
+          file_.read(a.im + base + t * stride, std::span<double>(im_.data() + t * cols, cols));
+        }
+        for (int step = 0; step < hi - lo; ++step) {
+          const int q = inverse ? lo + step : hi - 1 - step;
+          const std::size_t s = std::size_t{1} << (q - lo);
+          const double* c = twiddle_c_.data() + (s - 1) * cols;
+          const double* sn = twiddle_s_.data() + (s - 1) * cols;
+          for (std::size_t t = 0; t < rows; ++t) {
+            if ((t & s) != 0) continue;
+            const std::size_t tw = (t & (s - 1)) * cols;
+            butterflies(re_.data() + t * cols, im_.data() + t * cols, re_.data() + (t + s) * cols, im_.data() + (t + s) * cols,
+                        c + tw, sn + tw, cols, inverse);
+          }
+        }
+        for (std::size_t t = 0; t < rows; ++t) {
+          file_.write(a.re + base + t * stride, std::span<const double>(re_.data() + t * cols, cols));
+          file_.write(a.im + base + t * stride, std::span<const double>(im_.data() + t * cols, cols));
+        }
+      }
+    }
+  }
+
+  /// dif_stage's / dit_stage's butterfly, element for element.
+  static void butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n,
+                          bool inverse) {
+    if (!inverse) {
+      for (std::size_t j = 0; j < n; ++j) {
+        const double wr = c[j];
+        const double wi = s[j];
+        const double xr = ar[j];
+        const double xi = ai[j];
+        const double yr = br[j];
+        const double yi = bi[j];
+        ar[j] = xr + yr;
+        ai[j] = xi + yi;
+        const double dr = xr - yr;
+        const double di = xi - yi;
+        br[j] = dr * wr - di * wi;
+        bi[j] = dr * wi + di * wr;
+      }
+      return;
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+      const double wr = c[j];
+      const double wi = s[j];
+      const double yr = br[j];
+      const double yi = bi[j];
+      const double tr = yr * wr + yi * wi;
+      const double ti = yi * wr - yr * wi;
+      const double xr = ar[j];
+      const double xi = ai[j];
+      ar[j] = xr + tr;
+      ai[j] = xi + ti;
+      br[j] = xr - tr;
+      bi[j] = xi - ti;
+    }
+  }
+
+  ScratchFile& file_;
+  std::size_t m_;
+  std::size_t w_;
+  int p_ = 0;
+  int wbits_ = 0;
+  int r_max_ = 1;
+  DetFft fft_;
+  std::vector<double> re_, im_, re2_, im2_;
+  std::vector<double> twiddle_c_, twiddle_s_;
+};
+
+/// The whole sum with the FFT arrays in a scratch file and W points in memory.
+void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double origin, double spacing, std::int64_t index,
+                     std::size_t n, const SampleSink& sink, std::size_t w) {
+  const std::size_t m = plan.m;
+  const std::size_t k = plan.k;
+  ScratchFile file("chirp-z synthesis");
+  const DiskArray u{0, m};
+  const DiskArray v{2 * static_cast<std::uint64_t>(m), 3 * static_cast<std::uint64_t>(m)};
+  OutOfCore ooc(file, m, w);
+  const DetFft& fft = ooc.block_fft();
+
+  ooc.write(v, [&](std::size_t i0, std::span<double> re, std::span<double> im) { plan.kernel(i0, re, im); });
+  ooc.dif_top(v);
+  ooc.blocks(v, [&](std::size_t, double* re, double* im) { fft.forward_to_bit_reversed(re, im); });
+
+  for (std::size_t m0 = 0; m0 < n; m0 += plan.block) {
+    const std::size_t len = std::min(plan.block, n - m0);
+    const TwoDouble alpha = plan.alpha(origin, spacing, index, m0);
+    ooc.write(u, [&](std::size_t i0, std::span<double> re, std::span<double> im) {
+      const std::size_t live = i0 < k ? std::min(re.size(), k - i0) : 0;
+      if (live > 0) {
+        h.fill(i0, re.first(live), im.first(live));
+        plan.input(alpha, i0, re.first(live), im.first(live));
+      }
+      std::fill(re.begin() + static_cast<std::ptrdiff_t>(live), re.end(), 0.0);
+      std::fill(im.begin() + static_cast<std::ptrdiff_t>(live), im.end(), 0.0);
+    });
+    ooc.dif_top(u);
+    // The stages below w of the forward transform, the product and the
+    // stages below w of the inverse all act within a block: one pass.
+    ooc.blocks(u, [&](std::size_t i0, double* re, double* im) {
+      fft.forward_to_bit_reversed(re, im);
+      file.read(v.re + i0, std::span<double>(ooc.spare_re(), w));
+      file.read(v.im + i0, std::span<double>(ooc.spare_im(), w));
+      multiply_spectra(re, im, ooc.spare_re(), ooc.spare_im(), w);
+      fft.inverse_from_bit_reversed(re, im);
+    });
+    ooc.dit_top(u);
+    for (std::size_t t0 = 0; t0 < len; t0 += w) {
+      const std::size_t run = std::min(w, len - t0);
+      const std::span<double> zr(ooc.spare_re(), run);
+      const std::span<double> zi(ooc.spare_im(), run);
+      file.read(u.re + t0, zr);
+      file.read(u.im + t0, zi);
+      plan.output(t0, zr.data(), zi.data(), zr);  // y_t overwrites z_t element by element
+      sink(m0 + t0, zr);
+    }
+  }
+}
+
+}  // namespace
+
+void sum_harmonics(const HarmonicSource& h, double origin, double spacing, std::int64_t index, std::size_t samples,
+                   const SampleSink& sink, const ChirpMemory& memory) {
+  const std::size_t k = h.count;
+  if (k == 0 || k > max_chirp_harmonics || !h.fill)
+    throw InvalidArgument("sum_harmonics: " + std::to_string(k) + " harmonics; 1 to " + std::to_string(max_chirp_harmonics) +
+                          " are allowed");
+  const std::size_t budget = memory.fft_points;
+  if (budget < 4 || (budget & (budget - 1)) != 0)
+    throw InvalidArgument("sum_harmonics: a memory of " + std::to_string(budget) + " FFT points; it must be a power of two >= 4");
+  if (samples == 0) return;
+  const ChirpPlan plan(h.first, h.fundamental, k, samples, spacing);
+  if (plan.m <= budget)
+    sum_in_memory(plan, h, origin, spacing, index, samples, sink);
+  else
+    sum_out_of_core(plan, h, origin, spacing, index, samples, sink, budget / 2);
+}
+
+void sum_harmonics(const Harmonics& h, double origin, double spacing, std::int64_t index, std::span<double> out) {
+  const std::size_t k = h.amplitude.size();
+  if (k == 0 || k != h.phase_cycles.size() || k > max_chirp_harmonics)
+    throw InvalidArgument("sum_harmonics: " + std::to_string(k) + " harmonics (" + std::to_string(h.phase_cycles.size()) +
+                          " phases); 1 to " + std::to_string(max_chirp_harmonics) + " are allowed");
+  const HarmonicSource source{h.first, h.fundamental, k, [&](std::size_t j0, std::span<double> a, std::span<double> p) {
+                                std::copy_n(h.amplitude.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
+                                std::copy_n(h.phase_cycles.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
+                              }};
+  // The whole output is in memory already: so may the FFT be.
+  sum_harmonics(
+      source, origin, spacing, index, out.size(),
+      [&](std::size_t m0, std::span<const double> y) {
+        std::copy(y.begin(), y.end(), out.begin() + static_cast<std::ptrdiff_t>(m0));
+      },
+      ChirpMemory{std::size_t{1} << 26});
 }
 
 }  // namespace texel::detail

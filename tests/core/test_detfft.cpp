@@ -4,10 +4,13 @@
 // -O0/-O3, any SIMD width, sanitizers).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "texel/detail/detfft.hpp"
@@ -218,4 +221,82 @@ TEST(ChirpZ, RefusesEmptyMismatchedOrTooManyHarmonics) {
   EXPECT_THROW(sum_harmonics(Harmonics{1, {1.0, 0.0}, one, two}, 0.0, 0.1, 0, out), InvalidArgument);
   const std::vector<double> many(max_chirp_harmonics + 1, 0.0);
   EXPECT_THROW(sum_harmonics(Harmonics{1, {1.0, 0.0}, many, many}, 0.0, 0.1, 0, out), InvalidArgument);
+}
+
+TEST(ChirpZ, StreamedAndOutOfCoreGiveTheInMemoryBits) {
+  // The streamed form with every FFT size below, at and above the memory
+  // budget (out of core on a scratch file, in one pass or several for the
+  // stages above the budget, one output block or many) gives the span form's
+  // bits exactly. The budget only moves where the arrays live.
+  const std::vector<Case> cases{
+      {1, 1, 1, 0, 10.0, 0.0, 0.01, 0, false},
+      {300, 1000, 5, 0, 5.3, 0.0, 0.0053, 0, false},
+      {2000, 2500, 1, 0, 26.5, -50.88, 0.0053, 9600, false},
+      {50, 20000, 1, 1.0, 0, 0.0, 0.0053, 0, true},
+      {700, 5000, 400, 0, 101.76, 0.00123, 0.0053, -3, false},
+      {4000, 9000, 3, 0, 47.7, 0.0, 0.0053, 0, false},
+  };
+  for (const Case& c : cases) {
+    std::vector<double> amp, phase;
+    const Harmonics h = series(c, amp, phase);
+    std::vector<double> expected(c.samples);
+    sum_harmonics(h, c.origin, c.spacing, c.index, expected);
+    std::size_t runs = 0;
+    const HarmonicSource source{h.first, h.fundamental, c.harmonics,
+                                [&](std::size_t j0, std::span<double> a, std::span<double> p) {
+                                  ASSERT_EQ(a.size(), p.size());
+                                  ASSERT_LE(j0 + a.size(), c.harmonics);
+                                  std::copy_n(amp.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
+                                  std::copy_n(phase.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
+                                  ++runs;
+                                }};
+    for (std::size_t budget : {std::size_t{32}, std::size_t{4096}, std::size_t{1} << 17}) {
+      std::vector<double> got(c.samples, std::nan(""));
+      std::size_t next = 0;
+      sum_harmonics(
+          source, c.origin, c.spacing, c.index, c.samples,
+          [&](std::size_t m0, std::span<const double> y) {
+            ASSERT_EQ(m0, next) << "samples arrive in order";
+            std::copy(y.begin(), y.end(), got.begin() + static_cast<std::ptrdiff_t>(m0));
+            next += y.size();
+          },
+          ChirpMemory{budget});
+      EXPECT_EQ(next, c.samples);
+      EXPECT_EQ(digest(got), digest(expected)) << c.harmonics << " harmonics × " << c.samples << " samples, budget " << budget;
+    }
+    EXPECT_GT(runs, 0u);
+  }
+  std::vector<double> out(4);
+  const HarmonicSource none{1, {1.0, 0.0}, 3, nullptr};
+  EXPECT_THROW(sum_harmonics(none, 0.0, 0.1, 0, 4, [](std::size_t, std::span<const double>) {}), InvalidArgument);
+  const HarmonicSource one{1, {1.0, 0.0}, 1, [](std::size_t, std::span<double> a, std::span<double> p) {
+                             a[0] = 1.0;
+                             p[0] = 0.0;
+                           }};
+  EXPECT_THROW(sum_harmonics(
+                   one, 0.0, 0.1, 0, 4, [](std::size_t, std::span<const double>) {}, ChirpMemory{48}),
+               InvalidArgument);
+}
+
+TEST(ChirpZ, AScratchFileThatCannotBeCreatedIsAClearError) {
+  const char* old = std::getenv("TMPDIR");
+  const std::string saved = old != nullptr ? old : "";
+  ::setenv("TMPDIR", "/nonexistent-texel-dir", 1);
+  std::vector<double> amp(500, 1.0), phase(500, 0.0);
+  const HarmonicSource source{1, {1.0, 0.0}, amp.size(), [&](std::size_t j0, std::span<double> a, std::span<double> p) {
+                                std::copy_n(amp.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
+                                std::copy_n(phase.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
+                              }};
+  try {
+    sum_harmonics(
+        source, 0.0, 0.001, 0, 1000, [](std::size_t, std::span<const double>) {}, ChirpMemory{64});
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-texel-dir"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("TMPDIR"), std::string::npos) << e.what();
+  }
+  if (old != nullptr)
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
 }

@@ -26,6 +26,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -108,5 +109,40 @@ inline constexpr std::size_t max_chirp_harmonics = std::size_t{1} << 22;
 /// Requires 1 <= amplitude.size() == phase_cycles.size() <=
 /// max_chirp_harmonics, first + amplitude.size() < 2^52, |index| + out.size() < 2^52.
 void sum_harmonics(const Harmonics& h, double origin, double spacing, std::int64_t index, std::span<double> out);
+
+/// Harmonics supplied in runs, for sums too large to hold: fill(j0,
+/// amplitude, phase) writes the amplitudes and phases (cycles) of harmonics
+/// first + j0 … first + j0 + amplitude.size() − 1 (amplitude.size() ==
+/// phase.size()). It is called once per run per output block, so it must
+/// give the same values every time.
+struct HarmonicSource {
+  std::uint64_t first = 0;  ///< harmonic number of element 0 (< 2^52)
+  TwoDouble fundamental;    ///< cycles per mm
+  std::size_t count = 0;    ///< harmonics first … first + count − 1
+  std::function<void(std::size_t j0, std::span<double> amplitude, std::span<double> phase)> fill;
+};
+
+/// Receives the samples of sum_harmonics in order: sink(m0, y) is samples
+/// m0 … m0 + y.size() − 1.
+using SampleSink = std::function<void(std::size_t m0, std::span<const double> y)>;
+
+/// How much memory the chirp-z synthesis may use. An FFT of up to
+/// `fft_points` points runs in memory (48 bytes per point); a larger one
+/// runs out of core on a ScratchFile ($TMPDIR; 32 bytes per FFT point on
+/// disk) with about 32 bytes × fft_points of memory, streaming the FFT's
+/// stages in passes. Where the arrays live never changes a bit of the
+/// result: every butterfly is the in-memory FFT's, with the same twiddles.
+struct ChirpMemory {
+  std::size_t fft_points = std::size_t{1} << 17;  ///< a power of two >= 4 (6 MiB in memory)
+};
+
+/// The same sum as above, streamed: the harmonics come from `h.fill` and the
+/// `samples` results go to `sink` in blocks, so memory is bounded by
+/// `memory` whatever the number of harmonics or samples. Bit-identical to
+/// the span form for the same harmonics.
+/// Throws InvalidArgument as the span form; IoError if a scratch file is
+/// needed and cannot be written.
+void sum_harmonics(const HarmonicSource& h, double origin, double spacing, std::int64_t index, std::size_t samples,
+                   const SampleSink& sink, const ChirpMemory& memory = {});
 
 }  // namespace texel::detail
