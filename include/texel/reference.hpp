@@ -32,8 +32,9 @@
 //  - `chirp_z` (version 3, the default): noise and waveforms, whose
 //    components are harmonics of one fundamental, go through Bluestein's
 //    chirp-z transform on Texel's own deterministic FFT (detfft), in
-//    O((samples + harmonics)·log) time and O(samples + harmonics) memory:
-//    4 m of full-band white noise at 5 µm in about half a second and 77 MB.
+//    O((samples + harmonics)·log) time and bounded memory (ReferenceMemory:
+//    FFTs and prepared samples beyond it go to a scratch file, with the same
+//    bits): 4 m of full-band white noise at 5 µm in about half a second.
 //    Sums of sinusoids (at most 256 arbitrary frequencies) stay direct.
 //  - `direct` (version 2): every component summed at every sample with
 //    detmath::sin_cycles, O(samples × components): about 3 s for 400 mm of
@@ -47,8 +48,10 @@
 // gaps a = 0; pulses 0.5 − 0.5·cos over one 5 mm period) and are not rescaled.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -61,6 +64,11 @@
 #include "texel/units.hpp"
 
 namespace texel {
+
+namespace detail {
+class ScratchFile;
+struct NoiseBand;
+}  // namespace detail
 
 /// A parameter value: a number, a list of numbers, or a word from a choice.
 using ReferenceValue = std::variant<double, std::vector<double>, std::string>;
@@ -149,6 +157,20 @@ struct ReferenceFeature {
   Millimetres length;
 };
 
+/// How much memory preparing a reference may use. Where the data lives
+/// never changes a bit of the result; these bound the process's memory
+/// whatever the texture's length (docs/algorithm.md "Reference textures").
+struct ReferenceMemory {
+  /// Chirp-z FFTs of up to this many points run in memory (48 bytes per
+  /// point); larger ones run out of core on a scratch file in $TMPDIR (32
+  /// bytes per point on disk, about 32 bytes × fft_points in memory). A
+  /// power of two >= 4.
+  std::size_t fft_points = std::size_t{1} << 17;
+  /// Up to this many prepared samples are kept in memory (8 bytes each);
+  /// more go to a scratch file and are read back as they are rendered.
+  std::size_t cached_samples = std::size_t{1} << 19;
+};
+
 /// A reference prepared for a grid: an immutable Texture.
 class ReferenceTexture final : public Texture {
  public:
@@ -159,41 +181,55 @@ class ReferenceTexture final : public Texture {
   /// from them. Rendering on another grid takes those samples where a
   /// position coincides with one and evaluates the same function of x
   /// directly elsewhere, with the same scale (values clamped to [0, 1]).
-  /// Validates; throws InvalidArgument. Allocates.
-  ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling);
+  /// `memory` bounds the memory used (not the bytes rendered).
+  /// Validates; throws InvalidArgument (IoError if a scratch file is needed
+  /// and cannot be written). Allocates.
+  ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling, const ReferenceMemory& memory = {});
 
   [[nodiscard]] Millimetres length() const override { return length_; }
   void render(const Grid& grid, std::int64_t first, std::span<double> out) const override;
   [[nodiscard]] std::string describe() const override;
 
   [[nodiscard]] const ReferenceSpec& spec() const { return spec_; }
-  /// Sinusoidal components (signal-defined references); empty otherwise.
-  [[nodiscard]] const std::vector<ReferenceComponent>& components() const { return components_; }
+  /// Sinusoidal components (signal-defined references), ascending in
+  /// frequency; empty otherwise. A noise's components are drawn again on
+  /// every call (K of them for a band holding K harmonics; not kept).
+  [[nodiscard]] std::vector<ReferenceComponent> components() const;
   /// Patches or pulses (amplitude-defined references); empty otherwise.
   [[nodiscard]] const std::vector<ReferenceFeature>& features() const { return features_; }
   /// The gaps between consecutive features, in spatial order.
   [[nodiscard]] std::vector<Millimetres> gaps() const;
   /// max|y| over the prepared grid's samples (1 for amplitude-defined references).
   [[nodiscard]] double peak() const { return peak_; }
+  /// True when the prepared samples live in a scratch file (more than
+  /// ReferenceMemory::cached_samples of them).
+  [[nodiscard]] bool samples_in_scratch_file() const { return scratch_ != nullptr; }
   /// Slow, obviously-correct single-sample evaluation (tests).
   [[nodiscard]] double amplitude_at(Millimetres x) const;
 
  private:
   enum class Shape { sum, patch, pulse };
   void evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const;
+  /// Prepared samples [i, i + out.size()) (indices from cache_first_).
+  void read_samples(std::size_t i, std::span<double> out) const;
 
   ReferenceSpec spec_;
   Millimetres length_;
   Shape shape_ = Shape::sum;
-  std::vector<ReferenceComponent> components_;
+  std::vector<ReferenceComponent> components_;      // sums of sinusoids and waveforms
+  std::shared_ptr<const detail::NoiseBand> noise_;  // noise: drawn on demand instead
   std::vector<ReferenceFeature> features_;
   double peak_ = 1.0;
   double scale_ = 0.5;  // 0.5 / peak
   // Samples on the prepared grid (global indices cache_first_ …), reused when
-  // the same grid renders again (the usual case: Surface::render).
+  // the same grid renders again (the usual case: Surface::render): in
+  // cache_, or in scratch_ when there are more than
+  // ReferenceMemory::cached_samples.
   Grid grid_;
   std::int64_t cache_first_ = 0;
+  std::size_t cache_count_ = 0;
   std::vector<double> cache_;
+  std::shared_ptr<const detail::ScratchFile> scratch_;
 };
 
 /// The reference's amplitudes on samples [0, grid.count) of `grid` (origin

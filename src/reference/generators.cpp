@@ -8,15 +8,72 @@
 #include "texel/detail/detfft.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detail/lanes.hpp"
+#include "texel/detail/scratch_file.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
 #include "texel/reference.hpp"
 
 namespace texel {
+
+/// A noise band's components, drawn on demand: component k (a harmonic k/P
+/// of the texture length P) has the target gain at k/P times a Rayleigh
+/// magnitude, and a uniform phase, from CounterRng counters 2k and 2k + 1.
+/// A pure function of k, so a band of millions of harmonics need not be
+/// kept: the synthesis and every later use draw the same values again.
+struct detail::NoiseBand {
+  bool band_pass = false;
+  double centre = 0.0;    // band-pass: f_c (cpm)
+  double q = 0.0;         // band-pass: 1/(2ζ)
+  double exponent = 0.0;  // colours: amplitude ∝ f^exponent (0: white)
+  double period = 1.0;    // the texture's length P (mm)
+  CounterRng rng;
+  std::uint64_t first = 1;  // harmonics first … last
+  std::uint64_t last = 0;
+
+  [[nodiscard]] ReferenceComponent component(std::uint64_t k) const {
+    const double f = static_cast<double>(k) / period;
+    double gain = 1.0;
+    if (band_pass) {
+      const double d = f / centre - centre / f;
+      gain = 1.0 / std::sqrt(1.0 + q * q * d * d);
+    } else if (exponent != 0.0) {
+      gain = detmath::exp(exponent * detmath::log(f));
+    }
+    const double u = rng.uniform(2 * k);
+    const double magnitude = std::sqrt(-2.0 * detmath::log(u));  // Rayleigh, σ = 1
+    return {CyclesPerMm(f), gain * magnitude, rng.uniform(2 * k + 1)};
+  }
+  [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(last - first + 1); }
+};
+
 namespace {
 
 using detail::num;
+
+/// The components of a reference a run at a time, ascending: the stored ones
+/// (sums of sinusoids, waveforms) at once, a noise's drawn in runs.
+struct ComponentRuns {
+  const std::vector<ReferenceComponent>& stored;
+  const detail::NoiseBand* noise;
+
+  template <class Fn>
+  void operator()(Fn&& fn) const {
+    if (noise == nullptr) {
+      fn(std::span<const ReferenceComponent>(stored));
+      return;
+    }
+    constexpr std::size_t run = 4096;
+    std::vector<ReferenceComponent> buffer;
+    buffer.reserve(std::min(run, noise->count()));
+    for (std::uint64_t k0 = noise->first; k0 <= noise->last; k0 += run) {
+      const std::uint64_t k1 = std::min<std::uint64_t>(noise->last, k0 + run - 1);
+      buffer.clear();
+      for (std::uint64_t k = k0; k <= k1; ++k) buffer.push_back(noise->component(k));
+      fn(std::span<const ReferenceComponent>(buffer));
+    }
+  }
+};
 
 // ------------------------------------------------------------ synthesis kernel
 //
@@ -73,14 +130,16 @@ AccumulateKernel accumulate_kernel() {
   return kernel;
 }
 
-/// Σ_k a_k·sin(2π(φ_k + f_k·x)) at grid samples [first, first + out.size()).
-void synthesize(const std::vector<ReferenceComponent>& comps, const Grid& grid, std::int64_t first, std::span<double> out) {
+/// out[m] += Σ_k a_k·sin(2π(φ_k + f_k·x_m)) at grid samples [first, first +
+/// out.size()), components in the order given. Accumulating run after run
+/// into the same `out` gives the bits of one pass over all of them.
+void accumulate(std::span<const ReferenceComponent> comps, const Grid& grid, std::int64_t first, std::span<double> out) {
   constexpr std::size_t chunk = 2048;  // accumulator stays in L1 across components
-  std::vector<double> acc(chunk + max_lanes);
+  std::vector<double> acc(chunk + max_lanes, 0.0);
   const AccumulateKernel accumulate_component = accumulate_kernel();
   for (std::size_t i = 0; i < out.size(); i += chunk) {
     const std::size_t len = std::min(chunk, out.size() - i);
-    std::fill(acc.begin(), acc.end(), 0.0);
+    std::copy_n(out.begin() + static_cast<std::ptrdiff_t>(i), len, acc.begin());
     const double base = static_cast<double>(first + static_cast<std::int64_t>(i));
     for (const auto& c : comps)
       accumulate_component(base, grid.origin.value(), grid.spacing.value(), c.frequency.value(), c.amplitude, c.phase_cycles,
@@ -98,21 +157,42 @@ struct HarmonicLayout {
   std::vector<std::uint64_t> number;  // ascending, one per component
 };
 
-/// The same sum as synthesize() on samples [first, first + out.size()) of
-/// `grid`, by chirp-z transform (detfft): components laid out densely from
-/// the lowest harmonic to the highest, absent ones at amplitude 0.
-void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const HarmonicLayout& layout, const Grid& grid,
-                          std::int64_t first, std::span<double> out) {
+/// The same sum as accumulate() from zero on `count` samples from `first`
+/// of `grid`, by chirp-z transform (detfft), samples to `sink`: a noise's
+/// harmonics drawn as the transform asks for them, a waveform's laid out
+/// densely from the lowest harmonic to the highest, absent ones at
+/// amplitude 0.
+void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const HarmonicLayout& layout,
+                          const detail::NoiseBand* noise, const Grid& grid, std::int64_t first, std::size_t count,
+                          const detail::SampleSink& sink, const ReferenceMemory& memory) {
+  const detail::ChirpMemory chirp{memory.fft_points};
+  if (noise != nullptr) {
+    const detail::HarmonicSource source{noise->first, layout.fundamental, noise->count(),
+                                        [noise](std::size_t j0, std::span<double> amplitude, std::span<double> phase) {
+                                          for (std::size_t x = 0; x < amplitude.size(); ++x) {
+                                            const ReferenceComponent c = noise->component(noise->first + j0 + x);
+                                            amplitude[x] = c.amplitude;
+                                            phase[x] = c.phase_cycles;
+                                          }
+                                        }};
+    detail::sum_harmonics(source, grid.origin.value(), grid.spacing.value(), first, count, sink, chirp);
+    return;
+  }
   const std::uint64_t lowest = layout.number.front();
-  const auto count = static_cast<std::size_t>(layout.number.back() - lowest + 1);
-  std::vector<double> amplitude(count, 0.0);
-  std::vector<double> phase(count, 0.0);
+  const auto harmonics = static_cast<std::size_t>(layout.number.back() - lowest + 1);
+  std::vector<double> amplitude(harmonics, 0.0);
+  std::vector<double> phase(harmonics, 0.0);
   for (std::size_t i = 0; i < comps.size(); ++i) {
     const auto j = static_cast<std::size_t>(layout.number[i] - lowest);
     amplitude[j] = comps[i].amplitude;
     phase[j] = comps[i].phase_cycles;
   }
-  detail::sum_harmonics({lowest, layout.fundamental, amplitude, phase}, grid.origin.value(), grid.spacing.value(), first, out);
+  const detail::HarmonicSource source{lowest, layout.fundamental, harmonics,
+                                      [&](std::size_t j0, std::span<double> a, std::span<double> p) {
+                                        std::copy_n(amplitude.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
+                                        std::copy_n(phase.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
+                                      }};
+  detail::sum_harmonics(source, grid.origin.value(), grid.spacing.value(), first, count, sink, chirp);
 }
 
 // ------------------------------------------------------------ parameters
@@ -126,12 +206,6 @@ std::string word(const ReferenceSpec& s, const char* key) { return std::get<std:
 /// The band's upper edge: band_max (0 = Nyquist), never at or above Nyquist.
 double band_top(double band_max, double nyquist) { return band_max > 0.0 && band_max < nyquist ? band_max : nyquist; }
 
-/// Rayleigh magnitude (σ = 1) and uniform phase of noise component k.
-std::pair<double, double> noise_draw(const CounterRng& rng, std::uint64_t k) {
-  const double u = rng.uniform(2 * k);
-  return {std::sqrt(-2.0 * detmath::log(u)), rng.uniform(2 * k + 1)};
-}
-
 /// Harmonics k/P of the texture length P inside [lo, hi), hi exclusive.
 std::pair<std::uint64_t, std::uint64_t> harmonic_range(double lo, double hi, double period) {
   const double kmin = std::max(1.0, std::ceil(lo * period - 1e-9));
@@ -142,54 +216,37 @@ std::pair<std::uint64_t, std::uint64_t> harmonic_range(double lo, double hi, dou
 
 std::string field(const ReferenceSpec& s, const std::string& key) { return "reference '" + s.name + "' parameter " + key; }
 
-std::vector<ReferenceComponent> noise_components(const ReferenceSpec& s, const std::string& family, double period, double nyquist,
-                                                 HarmonicLayout& layout) {
-  std::vector<ReferenceComponent> comps;
-  const CounterRng rng(s.seed, Stream::reference);
+detail::NoiseBand noise_band(const ReferenceSpec& s, const std::string& family, double period, double nyquist) {
+  detail::NoiseBand band{.rng = CounterRng(s.seed, Stream::reference)};
+  band.period = period;
   double lo = 0.0;
   double hi = 0.0;
-  double fc = 0.0;
-  double q = 0.0;
-  double exponent = 0.0;
   if (family == "band-pass noise") {
-    fc = number(s, "centre_cpm");
-    q = 1.0 / (2.0 * number(s, "zeta"));
+    band.band_pass = true;
+    band.centre = number(s, "centre_cpm");
+    band.q = 1.0 / (2.0 * number(s, "zeta"));
     lo = number(s, "band_min_cpm");
     hi = band_top(number(s, "band_max_cpm"), nyquist);
   } else {
     lo = number(s, "band_min_cpm");
     hi = band_top(number(s, "band_max_cpm"), nyquist);
-    exponent = number(s, "slope_db_per_decade") / 20.0;  // amplitude ∝ f^(slope/20)
+    band.exponent = number(s, "slope_db_per_decade") / 20.0;  // amplitude ∝ f^(slope/20)
   }
   const auto [k0, k1] = harmonic_range(lo, hi, period);
   if (k1 < k0)
     throw InvalidArgument("reference '" + s.name + "': the band " + num(lo) + " … " + num(hi) + " cpm holds no harmonic of the " +
                           num(period) + " mm texture (spacing " + num(1.0 / period) +
                           " cpm); widen the band or lengthen the texture");
-  // The chirp-z synthesis's FFTs grow with the harmonic count (48 to 200
-  // bytes per harmonic); the direct one's time grows with its square.
+  // The chirp-z synthesis's FFT (in memory or on disk) grows with the
+  // harmonic count; the direct one's time grows with its square.
   if (s.synthesis == ReferenceSynthesis::chirp_z && k1 - k0 + 1 > detail::max_chirp_harmonics)
     throw InvalidArgument("reference '" + s.name + "': the band " + num(lo) + " … " + num(hi) + " cpm holds " +
                           std::to_string(k1 - k0 + 1) + " harmonics of the " + num(period) + " mm texture; at most " +
                           std::to_string(detail::max_chirp_harmonics) +
                           " (narrow the band, shorten the texture or coarsen the grid)");
-  comps.reserve(k1 - k0 + 1);
-  layout.fundamental = detail::reciprocal(period);
-  layout.number.reserve(k1 - k0 + 1);
-  for (std::uint64_t k = k0; k <= k1; ++k) {
-    const double f = static_cast<double>(k) / period;
-    double gain = 1.0;
-    if (family == "band-pass noise") {
-      const double d = f / fc - fc / f;
-      gain = 1.0 / std::sqrt(1.0 + q * q * d * d);
-    } else if (exponent != 0.0) {
-      gain = detmath::exp(exponent * detmath::log(f));
-    }
-    const auto [mag, phase] = noise_draw(rng, k);
-    comps.push_back({CyclesPerMm(f), gain * mag, phase});
-    layout.number.push_back(k);
-  }
-  return comps;
+  band.first = k0;
+  band.last = k1;
+  return band;
 }
 
 std::vector<ReferenceComponent> sine_components(const ReferenceSpec& s, double nyquist) {
@@ -326,7 +383,8 @@ std::vector<ReferenceFeature> pulse_features(const ReferenceSpec& s, double leng
 
 }  // namespace
 
-ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling)
+ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length, const Sampling& sampling,
+                                   const ReferenceMemory& memory)
     : spec_(spec), length_(length), grid_(sampling.grid) {
   const Grid& grid = sampling.grid;
   validate(spec_);
@@ -334,12 +392,16 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     throw InvalidArgument("reference length is " + num(length.value()) + " mm; it must be > 0");
   if (!(std::isfinite(grid.spacing.value()) && grid.spacing.value() > 0.0 && std::isfinite(grid.origin.value())))
     throw InvalidArgument("reference grid spacing is " + num(grid.spacing.value()) + " mm; it must be > 0");
+  if (memory.fft_points < 4 || (memory.fft_points & (memory.fft_points - 1)) != 0)
+    throw InvalidArgument("reference memory: fft_points is " + std::to_string(memory.fft_points) +
+                          "; it must be a power of two >= 4");
   const ReferenceInfo& info = reference_info(spec_.name);
   const double nyquist = grid.nyquist().value();
   const double L = length.value();
   HarmonicLayout layout;
   if (info.family == "band-pass noise" || info.family == "colour of noise") {
-    components_ = noise_components(spec_, info.family, L, nyquist, layout);
+    noise_ = std::make_shared<const detail::NoiseBand>(noise_band(spec_, info.family, L, nyquist));
+    layout.fundamental = detail::reciprocal(L);
   } else if (info.family == "sum of sinusoids") {
     components_ = sine_components(spec_, nyquist);
   } else if (info.family == "shaped waveform") {
@@ -363,29 +425,90 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
   while (b > a && !(grid.position(b - 1).value() < L)) --b;
   while (grid.position(b).value() < L) ++b;
   cache_first_ = a;
-  cache_.resize(static_cast<std::size_t>(b - a));
-  if (shape_ == Shape::sum) {
-    if (spec_.synthesis == ReferenceSynthesis::chirp_z && !layout.number.empty())
-      synthesize_harmonics(components_, layout, grid, a, cache_);
+  cache_count_ = static_cast<std::size_t>(b - a);
+
+  // Where the samples go: cache_, or a scratch file beyond the budget (the
+  // bits are the same either way; only the memory differs).
+  std::shared_ptr<detail::ScratchFile> file;
+  if (cache_count_ > memory.cached_samples)
+    file = std::make_shared<detail::ScratchFile>("reference '" + spec_.name + "'");
+  else
+    cache_.resize(cache_count_);
+  const auto store = [&](std::size_t i, std::span<const double> y) {
+    if (file)
+      file->write(i, y);
     else
-      synthesize(components_, grid, a, cache_);
+      std::copy(y.begin(), y.end(), cache_.begin() + static_cast<std::ptrdiff_t>(i));
+  };
+  const auto load = [&](std::size_t i, std::span<double> y) {
+    if (file)
+      file->read(i, y);
+    else
+      std::copy_n(cache_.begin() + static_cast<std::ptrdiff_t>(i), y.size(), y.begin());
+  };
+  constexpr std::size_t block = std::size_t{1} << 14;  // samples per step when not in one piece
+  std::vector<double> buffer(std::min(block, cache_count_));
+
+  if (shape_ == Shape::sum) {
     double peak = 0.0;
-    for (double y : cache_) peak = std::max(peak, std::abs(y));
+    const auto keep = [&](std::size_t i, std::span<const double> y) {
+      for (double v : y) peak = std::max(peak, std::abs(v));
+      store(i, y);
+    };
+    if (spec_.synthesis == ReferenceSynthesis::chirp_z && (noise_ || !layout.number.empty())) {
+      synthesize_harmonics(components_, layout, noise_.get(), grid, a, cache_count_, keep, memory);
+    } else {
+      const ComponentRuns runs{components_, noise_.get()};
+      for (std::size_t i = 0; i < cache_count_; i += block) {
+        const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
+        std::fill(y.begin(), y.end(), 0.0);
+        runs([&](std::span<const ReferenceComponent> comps) { accumulate(comps, grid, a + static_cast<std::int64_t>(i), y); });
+        keep(i, y);
+      }
+    }
     peak_ = peak > 0.0 ? peak : 1.0;
     scale_ = 0.5 / peak_;
-    for (double& y : cache_) {
-      const double v = 0.5 + scale_ * y;
-      y = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+    for (std::size_t i = 0; i < cache_count_; i += block) {
+      const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
+      load(i, y);
+      for (double& v : y) {
+        const double u = 0.5 + scale_ * v;
+        v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+      }
+      store(i, y);
     }
   } else {
-    evaluate(grid, a, cache_);
+    for (std::size_t i = 0; i < cache_count_; i += block) {
+      const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
+      evaluate(grid, a + static_cast<std::int64_t>(i), y);
+      store(i, y);
+    }
   }
+  scratch_ = std::move(file);
+}
+
+std::vector<ReferenceComponent> ReferenceTexture::components() const {
+  if (!noise_) return components_;
+  std::vector<ReferenceComponent> all;
+  all.reserve(noise_->count());
+  ComponentRuns{components_,
+                noise_.get()}([&](std::span<const ReferenceComponent> run) { all.insert(all.end(), run.begin(), run.end()); });
+  return all;
+}
+
+void ReferenceTexture::read_samples(std::size_t i, std::span<double> out) const {
+  if (scratch_)
+    scratch_->read(i, out);
+  else
+    std::copy_n(cache_.begin() + static_cast<std::ptrdiff_t>(i), out.size(), out.begin());
 }
 
 void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const {
   const double L = length_.value();
   if (shape_ == Shape::sum) {
-    synthesize(components_, grid, first, out);
+    std::fill(out.begin(), out.end(), 0.0);
+    ComponentRuns{components_,
+                  noise_.get()}([&](std::span<const ReferenceComponent> comps) { accumulate(comps, grid, first, out); });
     for (std::size_t i = 0; i < out.size(); ++i) {
       const double x = grid.position(first + static_cast<std::int64_t>(i)).value();
       const double v = 0.5 + scale_ * out[i];
@@ -420,14 +543,16 @@ void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<
 
 void ReferenceTexture::render(const Grid& grid, std::int64_t first, std::span<double> out) const {
   const auto n = static_cast<std::int64_t>(out.size());
-  const std::int64_t cache_end = cache_first_ + static_cast<std::int64_t>(cache_.size());
+  const std::int64_t cache_end = cache_first_ + static_cast<std::int64_t>(cache_count_);
   if (grid.origin.value() == grid_.origin.value() && grid.spacing.value() == grid_.spacing.value()) {
     // The prepared grid: its samples inside [0, L) are the cache, the others
     // at rest. (Never re-synthesised: a window's bytes are the whole's.)
     const std::int64_t a = std::clamp(cache_first_ - first, std::int64_t{0}, n);
     const std::int64_t b = std::clamp(cache_end - first, a, n);
     std::fill(out.begin(), out.begin() + a, 0.0);
-    if (b > a) std::copy_n(cache_.begin() + (first + a - cache_first_), b - a, out.begin() + a);
+    if (b > a)
+      read_samples(static_cast<std::size_t>(first + a - cache_first_),
+                   out.subspan(static_cast<std::size_t>(a), static_cast<std::size_t>(b - a)));
     std::fill(out.begin() + b, out.end(), 0.0);
     return;
   }
@@ -436,21 +561,21 @@ void ReferenceTexture::render(const Grid& grid, std::int64_t first, std::span<do
   // of other positions are evaluated directly.
   const double o = grid_.origin.value();
   const double sp = grid_.spacing.value();
-  const auto cached = [&](double x) -> const double* {
+  const auto cached = [&](double x) -> std::int64_t {  // the prepared sample at x, or −1
     const double r = std::round((x - o) / sp);
-    if (!(r >= static_cast<double>(cache_first_) - 1.0 && r <= static_cast<double>(cache_end))) return nullptr;
+    if (!(r >= static_cast<double>(cache_first_) - 1.0 && r <= static_cast<double>(cache_end))) return -1;
     const auto i = static_cast<std::int64_t>(r);
     for (std::int64_t j = std::max(i - 1, cache_first_); j <= std::min(i + 1, cache_end - 1); ++j)
-      if (grid_.position(j).value() == x) return &cache_[static_cast<std::size_t>(j - cache_first_)];
-    return nullptr;
+      if (grid_.position(j).value() == x) return j - cache_first_;
+    return -1;
   };
   std::int64_t i = 0;
   while (i < n) {
     std::int64_t j = i;
-    const double* hit = nullptr;
-    while (j < n && (hit = cached(grid.position(first + j).value())) == nullptr) ++j;
+    std::int64_t hit = -1;
+    while (j < n && (hit = cached(grid.position(first + j).value())) < 0) ++j;
     if (j > i) evaluate(grid, first + i, out.subspan(static_cast<std::size_t>(i), static_cast<std::size_t>(j - i)));
-    if (j < n) out[static_cast<std::size_t>(j)] = *hit;
+    if (j < n) read_samples(static_cast<std::size_t>(hit), out.subspan(static_cast<std::size_t>(j), 1));
     i = j + 1;
   }
 }
@@ -461,7 +586,9 @@ double ReferenceTexture::amplitude_at(Millimetres x) const {
   if (!(x_mm >= 0.0 && x_mm < L)) return 0.0;
   if (shape_ == Shape::sum) {
     double y = 0.0;
-    for (const auto& c : components_) y = y + c.amplitude * detmath::sin_cycles(c.phase_cycles + c.frequency.value() * x_mm);
+    ComponentRuns{components_, noise_.get()}([&](std::span<const ReferenceComponent> run) {
+      for (const auto& c : run) y = y + c.amplitude * detmath::sin_cycles(c.phase_cycles + c.frequency.value() * x_mm);
+    });
     const double v = 0.5 + scale_ * y;
     return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
   }
