@@ -4,6 +4,8 @@ peak resident memory of `texel render` writing 10^7 uint16 samples (20 MB) to
 a .bin, next to `dd` writing the same number of bytes, measured in the same
 run. Texel's file is fsync'ed before it is renamed into place (a file that
 appears is on disk), so dd is timed both without and with conv=fsync.
+Then reference generation at growing lengths (5 µm samples, uint16), each
+beside dd writing the same bytes: peak memory must stay flat with length.
 
 usage: render_to_file.py TEXEL [SAMPLES] [RUNS]
 """
@@ -57,6 +59,32 @@ def main():
     print("(peak MiB is the child's ru_maxrss, which includes the forking Python's ~12 MiB before exec)")
     print(f"goal: peak < 32 MiB: {'met' if peak < 32 else 'NOT met'} ({peak:.1f}); "
           f"within 4× of dd conv=fsync: {'met' if render <= 4 * base else 'NOT met'} ({render / base:.1f}×)")
+    references(texel, max(1, runs // 2))
+
+
+def references(texel, runs):
+    """texel reference NAME --length L --spacing 0.005 beside dd of the same bytes."""
+    spacing = 0.005
+    rows = []
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "ref.bin")
+        dd_out = os.path.join(d, "dd.bin")
+        for name, length in [("white", 400), ("white", 4000), ("white", 20000), ("pink", 4000), ("square", 4000),
+                             ("patch-4.6", 4000)]:
+            cmd = [texel, "reference", name, "--device", "tpad", "--length", str(length), "--spacing", str(spacing),
+                   "-o", out]
+            rs = [measure(cmd) for _ in range(runs)]
+            size = os.path.getsize(out)
+            dd = [measure(["dd", "if=/dev/zero", f"of={dd_out}", f"bs={size}", "count=1", "conv=fsync", "status=none"])
+                  for _ in range(runs)]
+            rows.append((name, length, size, statistics.median(w for w, _ in rs), max(m for _, m in rs),
+                         statistics.median(w for w, _ in dd)))
+    print(f"\nReference generation to .bin (tpad format, {spacing} mm spacing), median of {runs}")
+    print(f"{'reference':12s} {'length mm':>10s} {'bytes':>11s} {'wall ms':>9s} {'peak MiB':>9s} {'dd fsync ms':>12s} {'× dd':>7s}")
+    for name, length, size, wall, peak, dd in rows:
+        print(f"{name:12s} {length:10d} {size:11,d} {wall * 1e3:9.1f} {peak:9.1f} {dd * 1e3:12.1f} {wall / dd:6.1f}×")
+    worst = max(r[4] for r in rows)
+    print(f"goal: peak < 32 MiB at every length: {'met' if worst < 32 else 'NOT met'} ({worst:.1f} MiB at most)")
 
 
 if __name__ == "__main__":
