@@ -145,24 +145,33 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Samp
   const double L = spec.texel_length.value();
   const std::size_t n = texel_count(length, spec.texel_length, spec.fill);
   end_mm_ = spec.fill == Fill::whole_texels ? static_cast<double>(n) * L : length.value();
-  const std::vector<double> coarse = sample_at_texel_centres(spec.coarse, spec.texel_length, n);
+  // A constant coarse profile (every fine-only texture) is one value, not a
+  // per-texel array: the same clamped value sample_at_texel_centres gives.
+  const auto* constant = std::get_if<ConstantProfile>(&spec.coarse);
+  const std::vector<double> coarse =
+      constant != nullptr ? std::vector<double>{} : sample_at_texel_centres(spec.coarse, spec.texel_length, n);
+  const double constant_c =
+      constant == nullptr ? 0.0 : (constant->value < 0.0 ? 0.0 : (constant->value > 1.0 ? 1.0 : constant->value));
 
-  texels_.resize(n);
-  offset_.resize(n);
-  gain_.resize(n);
+  // Filled in one pass (reserve, not resize: no zeroing pass over memory
+  // that is written at once; at 10^5–10^7 texels the first touch of these
+  // arrays is most of the preparation's time).
+  texels_.reserve(n);
+  offset_.reserve(n);
+  gain_.reserve(n);
   const CounterRng phase_rng(spec.seed, Stream::phase);
   double phase = phase_rng.uniform(0);
   const double C = spec.coarse_strength;
   const double F = spec.fine_strength;
   for (std::size_t k = 0; k < n; ++k) {
-    Texel& t = texels_[k];
+    Texel& t = texels_.emplace_back();
     t.start = Millimetres(static_cast<double>(k) * L);
     t.frequency = CyclesPerMm(distribution_.draw(spec.seed, k));
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
-    t.envelope = 1.0 - C * (1.0 - coarse[k]);
-    offset_[k] = t.envelope - t.envelope * F * 0.5;
-    gain_[k] = t.envelope * F * 0.5;
+    t.envelope = 1.0 - C * (1.0 - (constant != nullptr ? constant_c : coarse[k]));
+    offset_.push_back(t.envelope - t.envelope * F * 0.5);
+    gain_.push_back(t.envelope * F * 0.5);
     // Continuous phase: the next texel starts where this one ends. Keep the
     // phase in [0, 1) cycles so precision does not decay along the surface.
     const double next = phase + t.frequency.value() * L;

@@ -81,8 +81,8 @@ TEST(ReferenceMemory, ScratchFilesNeverChangeTheBytes) {
     double spacing;
   };
   const std::vector<Case> cases{
-      {spec("white", 7), 200.0, 0.005},       {spec("bandpass-f4-z0.5", 2), 120.0, 0.0053},
-      {spec("blue", 3), 90.0, 0.0053},        {direct_pink, 12.0, 0.0053},
+      {spec("white", 7), 100.0, 0.005},       {spec("bandpass-f4-z0.5", 2), 60.0, 0.0053},
+      {spec("blue", 3), 50.0, 0.0053},        {direct_pink, 12.0, 0.0053},
       {spec("square"), 101.76, 0.0053},       {spec("4sin"), 60.0, 0.0053},
       {spec("patch-4.6", 5), 101.76, 0.0053}, {spec("pulse-b"), 101.76, 0.0053},
   };
