@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "texel/player.hpp"
 #include "texel/studio/server.hpp"
 #include "texel/studio/service.hpp"
 
@@ -72,6 +73,7 @@ void run(const StudioArgs& a) {
   so.backend = a.backend;
   so.audio_device = a.audio_device;
   so.response = a.response;
+  (void)parse_response_handling(a.response, "--response");  // named as the flag (the service says "response")
   so.protocols_dir = a.protocols.empty() ? default_protocols_dir() : a.protocols;
   studio::Service service(so);  // declared first: the server, destroyed before it, drops its clients first
 
