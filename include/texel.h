@@ -236,12 +236,31 @@ typedef enum texel_output_mode {
   TEXEL_OUTPUT_CARRIER = 2    /* a(x)·sin(2π·carrier_hz·t) */
 } texel_output_mode;
 
+/* How the player respects the display's frequency response (the device
+ * profile's "response", docs/format.md "Frequency response"). LIMIT: a
+ * 2nd-order Butterworth low-pass at the frequency where the display is
+ * response_limit_db down, so the player never drives what the display cannot
+ * reproduce (tpad: first order at 400 Hz, limited at 3.98 kHz; skipped when
+ * that is above 0.45·rate_hz, e.g. at the tpad's 8333 Hz refresh; a flat
+ * profile such as generic is never limited). OFF: played flat. */
+typedef enum texel_response_handling {
+  TEXEL_RESPONSE_LIMIT = 0, /* [choice], the default */
+  TEXEL_RESPONSE_OFF = 1
+} texel_response_handling;
+
+/* Start from texel_player_config_default(). Fields are only ever appended
+ * (this header has no struct_size field): a program must be compiled against
+ * the texel.h of the library it links (docs/c-api.md "Extending structs"). */
 typedef struct texel_player_config {
   double rate_hz;         /* output rate, 100 … 384000 [48000]; tpad: 8333 */
   texel_output_mode mode; /* [AMPLITUDE] */
   double gain;            /* 0 … 1 [1] */
   double carrier_hz;      /* carrier mode: 0 … rate/2 [250] */
   double prediction_s;    /* latency compensation look-ahead, 0 … 0.1 s [0] */
+  /* Appended after 0.1.0. The response itself is the device's of each
+   * surface given to texel_player_set_surface. */
+  texel_response_handling response_handling; /* [LIMIT] */
+  double response_limit_db;                  /* LIMIT: the display's attenuation where driving stops, 3 … 60 dB [20] */
 } texel_player_config;
 
 texel_player_config texel_player_config_default(void);
@@ -250,8 +269,11 @@ texel_player_config texel_player_config_default(void);
  * texel_player_set_surface. */
 texel_status texel_player_create(const texel_player_config* config, texel_player** out);
 /* Control thread: renders the surface's whole map into a new player map and
- * swaps it in (process crossfades to it). Allocates; frees maps process has
- * retired. The surface may be destroyed afterwards. */
+ * swaps it in (process crossfades to it). The map carries the frequency
+ * response of the surface's device, which the player respects from the swap
+ * on (config.response_handling); surfaces of different devices may follow
+ * one another. Allocates; frees maps process has retired. The surface may be
+ * destroyed afterwards. */
 texel_status texel_player_set_surface(texel_player* player, const texel_surface* surface);
 /* Control thread: queues one finger sample (time-ordered; t_s on the
  * player's clock, 0 = first output sample; x_mm in device coordinates;

@@ -271,6 +271,7 @@ struct RunArgs {
   bool resume = false;
   std::string backend = "null";
   std::string audio_device;
+  std::string response = "limit";
   bool json = false;
   bool quiet = false;
 };
@@ -285,6 +286,7 @@ void run(const RunArgs& a) {
   ex::PresenterOptions po;
   po.backend = a.backend;
   po.audio_device = a.audio_device;
+  po.response_handling = parse_response_handling(a.response, "--response");
   ex::Presenter presenter(po);
   const bool existed = std::filesystem::exists(a.db);
   std::optional<ex::Store> opened;
@@ -371,6 +373,7 @@ void run(const RunArgs& a) {
   j["finished"] = finished;
   j["trials"] = session.trials_done();
   j["backend"] = presenter.describe();
+  j["response"] = std::string(to_string(po.response_handling));
   j["blocks_processed"] = s.blocks;
   j["worst_block_ms"] = s.worst_block_s * 1e3;
   j["worst_block_fraction"] = presenter.block_period_s() > 0 ? s.worst_block_s / presenter.block_period_s() : 0.0;
@@ -521,6 +524,9 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_flag("--resume", a->resume, "Continue the participant's unfinished session of this protocol");
   run_cmd->add_option("--backend", a->backend, "Stimulus output: null (no hardware), audio (PortAudio) or serial:PATH [null]");
   run_cmd->add_option("--audio-device", a->audio_device, "PortAudio output: index or name substring [default output]");
+  run_cmd->add_option("--response", a->response,
+                      "The stimuli's display frequency response (the protocol's device profile): limit (never drive "
+                      "what the display attenuates by 20 dB or more) or off [limit]");
   run_cmd->add_flag("--json", a->json, "Print the run summary as JSON");
   run_cmd->add_flag("--quiet", a->quiet, "No progress or summary text");
   run_cmd->callback([a] { run(*a); });

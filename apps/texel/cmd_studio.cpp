@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "texel/player.hpp"
 #include "texel/studio/server.hpp"
 #include "texel/studio/service.hpp"
 
@@ -38,6 +39,7 @@ struct StudioArgs {
   std::string db = "texel-studio.db";
   std::string backend = "null";
   std::string audio_device;
+  std::string response = "limit";
   std::string web;
   std::string protocols;
   bool open = false;
@@ -70,6 +72,8 @@ void run(const StudioArgs& a) {
   so.db_path = a.db;
   so.backend = a.backend;
   so.audio_device = a.audio_device;
+  so.response = a.response;
+  (void)parse_response_handling(a.response, "--response");  // named as the flag (the service says "response")
   so.protocols_dir = a.protocols.empty() ? default_protocols_dir() : a.protocols;
   studio::Service service(so);  // declared first: the server, destroyed before it, drops its clients first
 
@@ -106,6 +110,10 @@ void register_studio(CLI::App& app) {
   cmd->add_option("--db", args->db, "experiment store (SQLite; created on first use)")->capture_default_str();
   cmd->add_option("--backend", args->backend, "null, audio or serial:PATH")->capture_default_str();
   cmd->add_option("--audio-device", args->audio_device, "PortAudio output device for --backend audio (index or name)");
+  cmd->add_option("--response", args->response,
+                  "The shown document's display frequency response (device profile): limit (never drive what the "
+                  "display attenuates by 20 dB or more) or off")
+      ->capture_default_str();
   cmd->add_option("--web", args->web, "the built front end (default: <texel dir>/../web, built by make demo)");
   cmd->add_option("--protocols", args->protocols,
                   "directory of shipped protocols (default: the source tree's examples/protocols)");

@@ -54,6 +54,17 @@
 // into friction is not sent (it would only load the amplifier and the
 // resonator). Skipped when the limit is above 0.45·rate (the output rate
 // already band-limits more) or the response is flat; off: as before.
+// The response travels with the map: a map made for a device
+// (PlayerMap::from_document, or a response given to the constructor) carries
+// that device's response, and the player respects it in place of
+// PlayerConfig::response while the map plays, so one player can show
+// documents of different displays (the experiments' Presenter, the C API's
+// texel_player_set_surface). process() recomputes the limit filter's
+// coefficients (a few sin/cos/pow, no allocation) at the instant it takes
+// the new map; the filter keeps its state (limit → limit) or starts settled
+// on the value under the finger (none → limit). During that map's crossfade
+// the outgoing map is limited by the incoming display's response too — it
+// lasts crossfade_s (20 ms) and fades out anyway.
 // Pre-emphasis (boosting within the pass band to flatten the display) is not
 // done: amplitudes live in [0, 1] with no headroom, and a boost would raise
 // the map's steps' overshoot and sensor noise with it.
@@ -79,6 +90,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -92,20 +104,33 @@ namespace texel {
 
 class Surface;
 class Texture;
+struct Document;
 
 /// An immutable amplitude map on a uniform grid, in device coordinates (mm).
 class PlayerMap {
  public:
   /// `values` holds one amplitude in [0, 1] per grid sample; grid.count must
-  /// equal values.size() and be >= 1. Throws InvalidArgument otherwise.
-  PlayerMap(Grid grid, std::vector<float> values);
-  /// The whole device map of a surface, all regions (gaps at rest).
-  static std::unique_ptr<const PlayerMap> from_surface(const Surface& surface);
+  /// equal values.size() and be >= 1. `response`: the frequency response of
+  /// the display the map is for (its DeviceProfile::response); while this map
+  /// plays the player respects it in place of PlayerConfig::response (see
+  /// above); absent = the config's. Throws InvalidArgument otherwise or for
+  /// an invalid response.
+  PlayerMap(Grid grid, std::vector<float> values, std::optional<FrequencyResponse> response = std::nullopt);
+  /// The whole device map of a surface, all regions (gaps at rest), carrying
+  /// `response` (absent: the player's config decides).
+  static std::unique_ptr<const PlayerMap> from_surface(const Surface& surface,
+                                                       std::optional<FrequencyResponse> response = std::nullopt);
+  /// The whole map of a document on its device, carrying the device's
+  /// frequency response (doc.device.response): what the experiments'
+  /// Presenter, the studio's Feel-it and the C API play.
+  static std::unique_ptr<const PlayerMap> from_document(const Document& doc);
   /// A single texture laid on `grid` (texture coordinates = grid positions).
   static std::unique_ptr<const PlayerMap> from_texture(const Texture& texture, const Grid& grid);
 
   [[nodiscard]] const Grid& grid() const { return grid_; }
   [[nodiscard]] std::span<const float> values() const { return values_; }
+  /// The display's response this map carries, if any (see the constructor).
+  [[nodiscard]] const std::optional<FrequencyResponse>& response() const { return response_; }
   /// Linear interpolation between grid samples; positions beyond the ends
   /// take the nearest end value (the caller decides what "off the surface"
   /// means). Real-time safe.
@@ -116,6 +141,7 @@ class PlayerMap {
  private:
   Grid grid_;
   std::vector<float> values_;
+  std::optional<FrequencyResponse> response_;
   double inv_spacing_ = 0.0;
 };
 
@@ -151,6 +177,9 @@ struct PlayerConfig {
 };
 /// The low-pass corner (Hz) the player applies for `config`, or 0 for none.
 double response_limit_hz(const PlayerConfig& config);
+/// The same for a map that carries `response` (PlayerMap::response) under
+/// `config`'s handling, limit and rate. Real-time safe (arithmetic only).
+double response_limit_hz(const PlayerConfig& config, const FrequencyResponse& response) noexcept;
 /// Throws InvalidArgument naming the field, the value and the allowed range.
 void validate(const PlayerConfig& config);
 
@@ -284,6 +313,7 @@ class Player {
   friend class PlayerAttachment;
 
   void take_events(double tau) noexcept;
+  void use_response_of(const PlayerMap* map) noexcept;
   double finger_position(double tau) noexcept;
 
   PlayerConfig config_;
@@ -312,6 +342,8 @@ class Player {
   Biquad lowpass_{};
   Biquad display_lp_{};  // response limit (see above)
   bool display_limit_ = false;
+  bool display_settle_ = false;    // limit just switched on: start settled
+  double display_limit_hz_ = 0.0;  // the limit in force (0: none)
   std::uint64_t n_ = 0;
 };
 

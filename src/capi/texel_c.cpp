@@ -558,6 +558,8 @@ texel_player_config texel_player_config_default(void) {
   p.gain = c.gain;
   p.carrier_hz = c.carrier_hz;
   p.prediction_s = c.prediction_s;
+  p.response_handling = TEXEL_RESPONSE_LIMIT;
+  p.response_limit_db = c.response_limit_db;
   return p;
 }
 
@@ -577,6 +579,14 @@ texel_status texel_player_create(const texel_player_config* config, texel_player
     pc.gain = c.gain;
     pc.carrier_hz = c.carrier_hz;
     pc.prediction_s = c.prediction_s;
+    switch (enum_value(c.response_handling)) {
+      case TEXEL_RESPONSE_LIMIT: pc.response_handling = texel::ResponseHandling::limit; break;
+      case TEXEL_RESPONSE_OFF: pc.response_handling = texel::ResponseHandling::off; break;
+      default:
+        throw InvalidArgument("response_handling is " + std::to_string(enum_value(c.response_handling)) +
+                              "; allowed: TEXEL_RESPONSE_LIMIT (0), TEXEL_RESPONSE_OFF (1)");
+    }
+    pc.response_limit_db = c.response_limit_db;
     // The library's extrapolation window must cover the look-ahead.
     pc.extrapolate_s = std::max(pc.extrapolate_s, std::isfinite(c.prediction_s) ? c.prediction_s : 0.0);
     texel::validate(pc);
@@ -588,7 +598,8 @@ texel_status texel_player_set_surface(texel_player* player, const texel_surface*
   return guarded([&] {
     texel_player& p = need(player, "player");
     const texel_surface& s = need(surface, "surface");
-    p.player.set_map(texel::PlayerMap::from_surface(s.surface));
+    // The map carries the surface's device response (player.hpp).
+    p.player.set_map(texel::PlayerMap::from_surface(s.surface, s.device.response));
   });
 }
 

@@ -48,6 +48,8 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
     bo.block_frames = options_.block_frames;
     bo.audio_device = options_.audio_device;
   }
+  config.response_handling = options_.response_handling;
+  config.response_limit_db = options_.response_limit_db;
   bo.rate_hz = config.rate_hz;
   player_ = std::make_unique<Player>(config);
   const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
@@ -71,8 +73,8 @@ void Presenter::show(const std::string& document_json) {
   // noise reference takes ~0.1 s to synthesise; copying its map, 0.1 ms).
   auto it = std::find_if(cache_.begin(), cache_.end(), [&](const auto& e) { return e.first == document_json; });
   if (it == cache_.end()) {
-    const Surface surface = prepare_surface(parse_document(document_json, "stimulus"));
-    cache_.emplace_front(document_json, PlayerMap::from_surface(surface));
+    // The map carries the document's device response (presenter.hpp).
+    cache_.emplace_front(document_json, PlayerMap::from_document(parse_document(document_json, "stimulus")));
     if (cache_.size() > cache_size) cache_.pop_back();
     it = cache_.begin();
   } else {
@@ -80,18 +82,24 @@ void Presenter::show(const std::string& document_json) {
     it = cache_.begin();
   }
   const PlayerMap& m = *it->second;
-  player_->set_map(std::make_unique<const PlayerMap>(m.grid(), std::vector<float>(m.values().begin(), m.values().end())));
+  last_response_ = m.response();
+  player_->set_map(
+      std::make_unique<const PlayerMap>(m.grid(), std::vector<float>(m.values().begin(), m.values().end()), m.response()));
   ++shown_;
 }
 
 void Presenter::show(std::unique_ptr<const PlayerMap> map) {
+  if (map) last_response_ = map->response();
   player_->set_map(std::move(map));
   ++shown_;
 }
 
 void Presenter::blank() {
   // A one-sample map at rest: the finger is off it, so the player fades out.
-  player_->set_map(std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f}));
+  // It carries the last stimulus's display response, so what fades out
+  // during the crossfade is still limited as that display needs.
+  player_->set_map(
+      std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f}, last_response_));
 }
 
 void Presenter::pump() {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "texel/detail/format.hpp"
+#include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/surface.hpp"
 #include "texel/texture.hpp"
@@ -17,18 +18,30 @@ using detail::num;
 
 // ------------------------------------------------------------------ PlayerMap
 
-PlayerMap::PlayerMap(Grid grid, std::vector<float> values) : grid_(grid), values_(std::move(values)) {
+PlayerMap::PlayerMap(Grid grid, std::vector<float> values, std::optional<FrequencyResponse> response)
+    : grid_(grid), values_(std::move(values)), response_(std::move(response)) {
   if (grid_.count < 1 || static_cast<std::size_t>(grid_.count) != values_.size())
     throw InvalidArgument("player map: grid has " + std::to_string(grid_.count) + " samples but " +
                           std::to_string(values_.size()) + " values were given; they must match and be >= 1");
   if (!(std::isfinite(grid_.spacing.value()) && grid_.spacing.value() > 0))
     throw InvalidArgument("player map: spacing_mm is " + num(grid_.spacing.value()) + "; it must be a finite number > 0");
+  if (response_) {
+    try {
+      validate(*response_, "response");
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument("player map: " + std::string(e.what()));
+    }
+  }
   inv_spacing_ = 1.0 / grid_.spacing.value();
 }
 
-std::unique_ptr<const PlayerMap> PlayerMap::from_surface(const Surface& surface) {
+std::unique_ptr<const PlayerMap> PlayerMap::from_surface(const Surface& surface, std::optional<FrequencyResponse> response) {
   const std::vector<double> map = surface.render();
-  return std::make_unique<const PlayerMap>(surface.grid(), std::vector<float>(map.begin(), map.end()));
+  return std::make_unique<const PlayerMap>(surface.grid(), std::vector<float>(map.begin(), map.end()), std::move(response));
+}
+
+std::unique_ptr<const PlayerMap> PlayerMap::from_document(const Document& doc) {
+  return from_surface(prepare_surface(doc), doc.device.response);
 }
 
 std::unique_ptr<const PlayerMap> PlayerMap::from_texture(const Texture& texture, const Grid& grid) {
@@ -109,11 +122,13 @@ void validate(const PlayerConfig& c) {
     throw InvalidArgument("player: event_capacity is " + std::to_string(n) + "; allowed a power of two, 16 … 1048576");
 }
 
-double response_limit_hz(const PlayerConfig& c) {
-  if (c.response_handling == ResponseHandling::off || c.response.flat()) return 0.0;
-  const double f = c.response.frequency_at_db(c.response_limit_db).value();
+double response_limit_hz(const PlayerConfig& c, const FrequencyResponse& r) noexcept {
+  if (c.response_handling == ResponseHandling::off || r.flat()) return 0.0;
+  const double f = r.frequency_at_db(c.response_limit_db).value();
   return f <= 0.45 * c.rate_hz ? f : 0.0;
 }
+
+double response_limit_hz(const PlayerConfig& c) { return response_limit_hz(c, c.response); }
 
 Player::Biquad Player::Biquad::lowpass(double fc, double rate) noexcept {
   Biquad q;
@@ -166,10 +181,31 @@ Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
   carrier_inc_ = carrier_inc_target_ = config_.carrier_hz / rate;
   dc_r_ = std::exp(-2.0 * std::numbers::pi * config_.highpass_hz / rate);
   lowpass_ = Biquad::lowpass(config_.lowpass_hz > 0 ? config_.lowpass_hz : 0.4 * rate, rate);
-  if (const double limit = response_limit_hz(config_); limit > 0.0) {
-    display_lp_ = Biquad::lowpass(limit, rate);
-    display_limit_ = true;
+  use_response_of(current_);
+  display_settle_ = false;  // the first touch-down settles the filter anyway
+}
+
+// The response limit for the map now playing (player.hpp): the map's own
+// response if it carries one, else the config's. Real-time safe: arithmetic
+// on members only; nothing changes while the limit stays the same, so maps
+// of one display never disturb the filter.
+void Player::use_response_of(const PlayerMap* map) noexcept {
+  const FrequencyResponse& r = map && map->response() ? *map->response() : config_.response;
+  const double limit = response_limit_hz(config_, r);
+  if (limit == display_limit_hz_) return;
+  display_limit_hz_ = limit;
+  if (!(limit > 0.0)) {
+    display_limit_ = false;
+    return;
   }
+  const Biquad q = Biquad::lowpass(limit, config_.rate_hz);
+  display_lp_.b0 = q.b0;
+  display_lp_.b1 = q.b1;
+  display_lp_.b2 = q.b2;
+  display_lp_.a1 = q.a1;
+  display_lp_.a2 = q.a2;
+  if (!display_limit_) display_settle_ = true;  // stale state: start settled on the next value
+  display_limit_ = true;
 }
 
 Player::~Player() {
@@ -271,6 +307,7 @@ BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) no
       current_ = next;
       crossfading_ = true;
       fade_pos_ = 0.0;
+      use_response_of(current_);
     }
   }
 
@@ -315,7 +352,10 @@ BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) no
     // The display's response limit (see player.hpp): what it cannot
     // reproduce is not driven. Starts settled on touch-down from rest.
     if (display_limit_) {
-      if (was_silent && touching) display_lp_.settle(a);
+      if ((was_silent && touching) || display_settle_) {
+        display_lp_.settle(a);
+        display_settle_ = false;
+      }
       a = display_lp_(a);
       if (config_.mode == OutputMode::amplitude) a = std::clamp(a, 0.0, 1.0);  // the filter's overshoot at steps
     }

@@ -283,6 +283,7 @@ struct Service::Impl {
     po.backend = options.backend;
     po.audio_device = options.audio_device;
     po.finger = ex::FingerSource::external;
+    po.response_handling = parse_response_handling(options.response, "response");
     presenter = std::make_unique<ex::Presenter>(po);
     hello = make_hello();
     design_worker = std::thread([this] { run_design_lane(); });
@@ -709,7 +710,8 @@ struct Service::Impl {
   void feel_select(Client& c, const Job& job) {
     const Fields f(job.msg, job.type, {"document"});
     // Rendered here, outside feel_mutex: finger samples keep flowing meanwhile.
-    auto map = PlayerMap::from_surface(prepare_surface(document_of(f.object("document"), "document")));
+    // The map carries the document's device response (presenter.hpp).
+    auto map = PlayerMap::from_document(document_of(f.object("document"), "document"));
     {
       std::lock_guard lock(feel_mutex);
       presenter->show(std::move(map));

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <iostream>
 #include <limits>
 #include <memory>
 #include <string>
@@ -680,6 +681,88 @@ TEST(CApi, PlayerConfigDefaults) {
   EXPECT_EQ(c.gain, l.gain);
   EXPECT_EQ(c.carrier_hz, l.carrier_hz);
   EXPECT_EQ(c.prediction_s, l.prediction_s);
+  EXPECT_EQ(c.response_handling, TEXEL_RESPONSE_LIMIT);
+  EXPECT_EQ(c.response_limit_db, l.response_limit_db);
+}
+
+// The display's frequency response reaches the C player through the
+// surface's device (texel.h, docs/format.md "Frequency response"): a tpad
+// surface is limited where the tpad cannot reproduce (first order at 400 Hz,
+// limited from 3.98 kHz), a generic (flat) one is not, and OFF plays flat.
+namespace response {
+
+// One sinusoid of `cpm` cycles/mm over the whole of `device`.
+Surf sine_surface(const char* device, double cpm) {
+  const std::string json = std::string(R"({"format": "texel-document", "version": 3, "device": ")") + device +
+                           R"(", "regions": [{"name": "all", "start_mm": 0, "texture": {"kind": "reference",
+                           "name": "2sin", "params": {"frequencies_cpm": [)" +
+                           std::to_string(cpm) + "]}}}]}";
+  texel_document* d = nullptr;
+  EXPECT_EQ(texel_document_parse(json.data(), json.size(), &d), TEXEL_OK) << texel_last_error();
+  const Doc doc(d);
+  texel_surface* s = nullptr;
+  EXPECT_EQ(texel_surface_create(d, &s), TEXEL_OK) << texel_last_error();
+  return Surf(s);
+}
+
+// Plays `surfaces` in turn (0.15 s each, at most three: the finger stays on
+// the 100 mm surface) under a finger swiping at 200 mm/s from 5 mm (50 cpm →
+// 10 kHz, 1 cpm → 200 Hz) at 48 kHz, vibration output; returns the RMS of
+// each one's last 0.1 s (after the crossfade).
+std::vector<double> swipe_rms(texel_response_handling h, const std::vector<const texel_surface*>& surfaces) {
+  texel_player_config c = texel_player_config_default();
+  c.rate_hz = 48000;
+  c.mode = TEXEL_OUTPUT_VIBRATION;
+  c.response_handling = h;
+  texel_player* raw = nullptr;
+  EXPECT_EQ(texel_player_create(&c, &raw), TEXEL_OK) << texel_last_error();
+  const Play player(raw);
+  std::vector<double> rms;
+  std::vector<float> out(64);
+  double pushed = 0.0;
+  for (const texel_surface* s : surfaces) {
+    EXPECT_EQ(texel_player_set_surface(raw, s), TEXEL_OK) << texel_last_error();
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (int block = 0; block < 113; ++block) {  // 0.15 s
+      const double now = static_cast<double>(texel_player_samples(raw)) / c.rate_hz;
+      for (; pushed <= now + 0.01; pushed += 0.001) EXPECT_EQ(texel_player_push(raw, pushed, 5.0 + 200.0 * pushed, 1), TEXEL_OK);
+      EXPECT_EQ(texel_player_process(raw, out.data(), out.size(), nullptr), TEXEL_OK);
+      if (block < 38) continue;  // 0.05 s: touch-down / crossfade
+      for (float v : out) sum += static_cast<double>(v) * v;
+      n += out.size();
+    }
+    rms.push_back(std::sqrt(sum / static_cast<double>(n)));
+  }
+  return rms;
+}
+
+double db(double ratio) { return 20.0 * std::log10(ratio); }
+
+}  // namespace response
+
+TEST(CApi, PlayerRespectsTheSurfaceDeviceResponse) {
+  using response::db;
+  using response::swipe_rms;
+  const Surf tpad_high = response::sine_surface("tpad", 50.0);
+  const Surf tpad_low = response::sine_surface("tpad", 1.0);
+  const Surf generic_high = response::sine_surface("generic", 50.0);
+  const auto limit = swipe_rms(TEXEL_RESPONSE_LIMIT, {tpad_high.get(), tpad_low.get()});
+  const auto off = swipe_rms(TEXEL_RESPONSE_OFF, {tpad_high.get(), tpad_low.get()});
+  std::cout << "rms 10 kHz: limit " << limit[0] << ", off " << off[0] << "; 200 Hz: limit " << limit[1] << ", off " << off[1]
+            << "\n";
+  EXPECT_GT(off[0], 0.1);
+  EXPECT_GT(off[1], 0.1);
+  EXPECT_LT(db(limit[0] / off[0]), -12.0);       // the 2nd-order Butterworth at 3.98 kHz: −16 dB at 10 kHz
+  EXPECT_NEAR(db(limit[1] / off[1]), 0.0, 0.5);  // pass band untouched
+  // The response follows each surface's device in one player: flat generic,
+  // then the tpad, then generic again.
+  const auto mixed = swipe_rms(TEXEL_RESPONSE_LIMIT, {generic_high.get(), tpad_high.get(), generic_high.get()});
+  std::cout << "rms 10 kHz: generic " << mixed[0] << ", tpad " << mixed[1] << ", generic " << mixed[2] << "\n";
+  EXPECT_GT(mixed[0], 0.1);
+  EXPECT_GT(mixed[2], 0.1);
+  EXPECT_LT(db(mixed[1] / mixed[0]), -12.0);
+  EXPECT_NEAR(db(mixed[2] / mixed[0]), 0.0, 0.5);
 }
 
 TEST(CApi, PlayerPlaysTheMapUnderAFinger) {
@@ -770,6 +853,10 @@ TEST(CApi, PlayerErrors) {
       {[](texel_player_config& x) { x.carrier_hz = -1; }, "carrier_hz"},
       {[](texel_player_config& x) { x.prediction_s = 1; }, "prediction_s"},
       {[](texel_player_config& x) { x.prediction_s = nan_v; }, "prediction_s"},
+      {[](texel_player_config& x) { x.response_handling = static_cast<texel_response_handling>(2); }, "response_handling"},
+      {[](texel_player_config& x) { x.response_handling = static_cast<texel_response_handling>(-1); }, "response_handling"},
+      {[](texel_player_config& x) { x.response_limit_db = 1; }, "response_limit_db"},
+      {[](texel_player_config& x) { x.response_limit_db = nan_v; }, "response_limit_db"},
   };
   for (const Case& k : cases) {
     c = texel_player_config_default();

@@ -75,22 +75,28 @@ TEST(CApiAlloc, CountingAllocatorWorks) {
 TEST(CApiAlloc, ProcessAllocatesNothing) {
   texel_params params = texel_params_default();
   texel_surface* surface = nullptr;
+  texel_surface* flat = nullptr;
   ASSERT_EQ(texel_surface_from_params("tpad", &params, &surface), TEXEL_OK);
+  ASSERT_EQ(texel_surface_from_params("generic", &params, &flat), TEXEL_OK);
+  // 48 kHz: the tpad's response limit (3.98 kHz, below 0.45·rate) runs in
+  // process(), and swapping in the generic (flat) surface and back switches
+  // it off and on there (TEXEL_RESPONSE_LIMIT, the default).
   texel_player_config config = texel_player_config_default();
-  config.rate_hz = 8333;
+  config.rate_hz = 48000;
   config.mode = TEXEL_OUTPUT_VIBRATION;
+  ASSERT_EQ(config.response_handling, TEXEL_RESPONSE_LIMIT);
   texel_player* player = nullptr;
   ASSERT_EQ(texel_player_create(&config, &player), TEXEL_OK);
   ASSERT_EQ(texel_player_set_surface(player, surface), TEXEL_OK);
 
-  std::vector<float> out(64), pos(64);
+  std::vector<float> out(384), pos(384);  // 8 ms at 48 kHz: the 8 finger samples pushed per block
   double t = 0.0;
   for (int block = 0; block < 2000; ++block) {
     // Control side: finger samples every block, a new map now and then.
     for (int k = 0; k < 8; ++k, t += 1.0 / 1000.0)
       ASSERT_EQ(texel_player_push(player, t, 5.0 + 40.0 * std::abs(std::sin(t)), block % 300 < 250), TEXEL_OK);
-    if (block % 500 == 250) {
-      ASSERT_EQ(texel_player_set_surface(player, surface), TEXEL_OK);
+    if (block % 250 == 125) {
+      ASSERT_EQ(texel_player_set_surface(player, block % 500 == 125 ? flat : surface), TEXEL_OK);
     }
     if (block % 100 == 0) {
       ASSERT_EQ(texel_player_collect(player, nullptr), TEXEL_OK);
@@ -109,6 +115,7 @@ TEST(CApiAlloc, ProcessAllocatesNothing) {
   EXPECT_EQ(counted_allocations.load(), 0u);
   texel_player_destroy(player);
   texel_surface_destroy(surface);
+  texel_surface_destroy(flat);
 }
 
 TEST(CApiAlloc, OutOfMemoryIsAStatus) {

@@ -243,6 +243,19 @@ static void test_player(void) {
   c.rate_hz = NAN;
   CHECK_STATUS(texel_player_create(&c, &player), TEXEL_INVALID_ARGUMENT);
   CHECK_STATUS(texel_player_create(NULL, &player), TEXEL_INVALID_ARGUMENT);
+  /* The response fields appended after 0.1.0: defaults, OFF, bad values. */
+  c = texel_player_config_default();
+  CHECK(c.response_handling == TEXEL_RESPONSE_LIMIT && c.response_limit_db == 20.0);
+  c.response_handling = TEXEL_RESPONSE_OFF;
+  CHECK_STATUS(texel_player_create(&c, &player), TEXEL_OK);
+  texel_player_destroy(player);
+  c.response_handling = (texel_response_handling)5;
+  CHECK_STATUS(texel_player_create(&c, &player), TEXEL_INVALID_ARGUMENT);
+  CHECK(player == NULL && strstr(texel_last_error(), "response_handling") != NULL);
+  c = texel_player_config_default();
+  c.response_limit_db = 100.0;
+  CHECK_STATUS(texel_player_create(&c, &player), TEXEL_INVALID_ARGUMENT);
+  CHECK(player == NULL && strstr(texel_last_error(), "response_limit_db") != NULL);
 }
 
 int main(void) {

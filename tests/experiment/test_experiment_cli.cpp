@@ -69,6 +69,7 @@ TEST(ExperimentCli, TexelLengthSimulatedExportAnalyze) {
   ASSERT_EQ(r.status, 0) << r.out;
   const auto summary = nlohmann::json::parse(r.out.substr(r.out.find('{')));
   EXPECT_TRUE(summary["finished"].get<bool>());
+  EXPECT_EQ(summary["response"], "limit");  // the protocol device's response, respected by default
   const int trials = summary["trials"].get<int>();
   EXPECT_GT(trials, 10);
 
@@ -299,6 +300,9 @@ TEST(ExperimentCli, BadInputIsOneLineExitTwoAndTouchesNothing) {
       run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db + " --resume --simulate default"));
   one_line_2(run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db +
                  " --backend laser --simulate default"));
+  one_line_2(run("experiment run " + protocols + "texel-length.json --participant S01 --db " + db +
+                 " --response equalize --simulate default"));
+  EXPECT_FALSE(fs::exists(db));
   one_line_2(run("experiment export --db " + d.at("missing.db") + " -o " + d.at("x.csv")));
   EXPECT_FALSE(fs::exists(d.at("x.csv")));
   // A corrupt database is refused and left byte-identical.

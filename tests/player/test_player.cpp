@@ -381,6 +381,51 @@ TEST(Player, ResponseLimitAttenuatesWhatTheDisplayCannotReproduce) {
   EXPECT_EQ(render_trace(*map, plain, trace, 4800), render_trace(*map, off, trace, 4800));
 }
 
+// A map made for a device carries its response (PlayerMap::from_document):
+// the player respects it in place of the config's, and switches at the swap.
+TEST(Player, ResponseTravelsWithTheMap) {
+  FrequencyResponse tpad;
+  tpad.corner = Hertz(400.0);
+  auto wave = [](double x) { return 0.5 + 0.4 * std::sin(2 * pi * 100 * x); };  // 10 kHz at 100 mm/s
+  auto base = make_map(60, 0.001, wave);
+  const auto with = [&](std::optional<FrequencyResponse> r) {
+    return std::make_unique<const PlayerMap>(base->grid(), std::vector<float>(base->values().begin(), base->values().end()),
+                                             std::move(r));
+  };
+  const auto trace = line(0.0, 0.3, 5.0, 100.0, 1000.0);
+  PlayerConfig config_tpad;
+  config_tpad.mode = OutputMode::vibration;
+  config_tpad.response = tpad;
+  PlayerConfig config_flat = config_tpad;
+  config_flat.response = {};
+  // The map's response in place of the config's: the same bytes both ways.
+  EXPECT_EQ(render_trace(*with(tpad), config_flat, trace, 9600), render_trace(*base, config_tpad, trace, 9600));
+  EXPECT_EQ(render_trace(*with(FrequencyResponse{}), config_tpad, trace, 9600), render_trace(*base, config_flat, trace, 9600));
+  // Off ignores it.
+  PlayerConfig off = config_flat;
+  off.response_handling = ResponseHandling::off;
+  EXPECT_EQ(render_trace(*with(tpad), off, trace, 9600), render_trace(*base, config_flat, trace, 9600));
+  EXPECT_THROW(with(FrequencyResponse{Hertz(-1.0), 1, {}}), InvalidArgument);
+
+  // Swapped while playing: flat → tpad → flat, 0.1 s each, RMS of the last 0.06 s of each.
+  Player p(config_flat, with(FrequencyResponse{}));
+  for (const auto& s : trace) ASSERT_TRUE(p.push(s));
+  std::vector<double> rms;
+  std::vector<float> out(4800);
+  for (int k = 0; k < 3; ++k) {
+    if (k > 0) p.set_map(with(k == 1 ? std::optional(tpad) : std::optional(FrequencyResponse{})));
+    p.process(std::span(out).first(1920));
+    p.process(std::span(out).subspan(1920, 2880));
+    double sum = 0;
+    for (std::size_t i = 1920; i < out.size(); ++i) sum += static_cast<double>(out[i]) * out[i];
+    rms.push_back(std::sqrt(sum / 2880.0));
+  }
+  EXPECT_GT(rms[0], 0.1);
+  EXPECT_LT(20 * std::log10(rms[1] / rms[0]), -12.0);  // the 3.98 kHz Butterworth at 10 kHz: −16 dB
+  EXPECT_NEAR(20 * std::log10(rms[2] / rms[0]), 0.0, 0.5);
+  p.collect();
+}
+
 TEST(Player, ConfigIsValidated) {
   PlayerConfig c;
   c.rate_hz = 10;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <new>
+#include <optional>
 #include <thread>
 
 #include "texel/player.hpp"
@@ -87,11 +88,16 @@ TEST(PlayerAlloc, QueuesAllocateAtPrepareOnly) {
 TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
   constexpr std::uint64_t blocks = 1000000;
   constexpr std::size_t frames = 64;
-  auto make = [](double level) {
+  // Maps carrying no response (the config's), a flat one and the tpad's in
+  // turn, so process() also switches its response limit off and on.
+  auto make = [](double level, std::uint64_t k = 0) {
     std::vector<float> v(19200);
     for (std::size_t i = 0; i < v.size(); ++i)
       v[i] = static_cast<float>(level * (0.5 + 0.5 * std::sin(0.05 * static_cast<double>(i))));
-    return std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, std::move(v));
+    std::optional<FrequencyResponse> r;
+    if (k % 3 == 1) r = FrequencyResponse{};
+    if (k % 3 == 2) r = FrequencyResponse{Hertz(300.0), 2, "a second-order display"};
+    return std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, std::move(v), std::move(r));
   };
   for (OutputMode mode : {OutputMode::vibration, OutputMode::carrier, OutputMode::amplitude}) {
     PlayerConfig c;
@@ -113,7 +119,7 @@ TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
         const double now = static_cast<double>(done.load(std::memory_order_relaxed)) * frames / c.rate_hz;
         while (t < now + 0.05 && player.push({t, 50 + 40 * std::sin(2 * t), std::fmod(t, 0.5) < 0.45})) t += 0.001;
         if (++k % 4 == 0) player.set_gain(0.5 + 0.5 * std::sin(t));
-        player.set_map(make(0.3 + 0.7 * std::fabs(std::sin(t))));  // allocates here, on the control thread
+        player.set_map(make(0.3 + 0.7 * std::fabs(std::sin(t)), swaps));  // allocates here, on the control thread
         ++swaps;
         player.collect();
         std::this_thread::yield();

@@ -17,6 +17,7 @@
 
 #include "../support/temp_dir.hpp"
 #include "base64.hpp"
+#include "texel/error.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/studio/service.hpp"
@@ -319,6 +320,19 @@ TEST(Service, MatchImportExport) {
       EXPECT_EQ(i["kind"], "signal");
     }
   }
+}
+
+// Feel-it respects the shown document's display response (texel studio
+// --response; the Presenter's tests measure it): the option is validated.
+TEST(Service, ResponseOptionIsValidated) {
+  texel::test_support::TempDir dir("studio");
+  ServiceOptions o = options(dir.at("db"));
+  o.response = "equalize";
+  EXPECT_THROW(Service{o}, texel::InvalidArgument);
+  o.response = "off";
+  Service s(o);
+  Client c(s);
+  EXPECT_EQ(c.ask({{"type", "feel.select"}, {"document", tpad_document()}})["type"], "feel.selected");
 }
 
 TEST(Service, FeelMovesReachThePlayer) {

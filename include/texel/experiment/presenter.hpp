@@ -18,6 +18,15 @@
 // lead, so the player interpolates towards it instead of extrapolating; pump()
 // then feeds nothing and only frees retired maps.
 //
+// The display's frequency response (player.hpp, docs/format.md "Frequency
+// response"): every stimulus carries its document's device response
+// (PlayerMap::from_document), so the one player respects the response of
+// the device each document is for — in a session the protocol's device, in
+// the studio the designed document's — switching at the map swap without
+// rebuilding the player. response_handling [choice] limit (off: as before,
+// flat). With a serial display the player streams at 1 kHz, below any
+// built-in profile's limit (tpad: 3.98 kHz), so nothing is filtered there.
+//
 // Trade-off: one control thread, no callback into the engine; the real-time
 // side is the player's (no allocation, locks or I/O).
 #pragma once
@@ -46,6 +55,11 @@ struct PresenterOptions {
   /// External finger: a sample is due this long after it arrives (s), 0 … 0.1.
   /// Longer hides network jitter, shorter feels more direct.
   double finger_lead_s = 0.005;
+  /// How the player respects each stimulus's display response (see the
+  /// banner). [choice] limit; off plays flat.
+  ResponseHandling response_handling = ResponseHandling::limit;
+  /// limit: attenuation (dB) at which the display no longer reproduces, 3 … 60 [20].
+  double response_limit_db = 20.0;
 };
 
 class Presenter {
@@ -58,8 +72,9 @@ class Presenter {
 
   /// Plays the texture document (a Texel document as JSON text).
   void show(const std::string& document_json);
-  /// Plays a map prepared by the caller (PlayerMap::from_surface), so a
-  /// front end shared by several threads can render outside its lock.
+  /// Plays a map prepared by the caller (PlayerMap::from_document, which
+  /// carries the device's response), so a front end shared by several
+  /// threads can render outside its lock.
   void show(std::unique_ptr<const PlayerMap> map);
   /// Silence (between trials, during the working-memory matrix).
   void blank();
@@ -89,7 +104,8 @@ class Presenter {
   PresenterOptions options_;
   std::unique_ptr<Player> player_;
   std::unique_ptr<Backend> backend_;
-  double next_finger_s_ = 0.0;  // simulated: next sample's time; external: newest sample's time
+  std::optional<FrequencyResponse> last_response_;  // of the last map shown (blank() keeps it)
+  double next_finger_s_ = 0.0;                      // simulated: next sample's time; external: newest sample's time
   double period_s_ = 0.0;
   std::size_t shown_ = 0;
   bool running_ = false;

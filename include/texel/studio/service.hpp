@@ -29,9 +29,13 @@
 namespace texel::studio {
 
 struct ServiceOptions {
-  std::string db_path = "texel-studio.db";   ///< experiment store (created on first use)
-  std::string backend = "null";              ///< "null", "audio" or "serial:PATH"
-  std::string audio_device;                  ///< PortAudio device for "audio" (index or name substring)
+  std::string db_path = "texel-studio.db";  ///< experiment store (created on first use)
+  std::string backend = "null";             ///< "null", "audio" or "serial:PATH"
+  std::string audio_device;                 ///< PortAudio device for "audio" (index or name substring)
+  /// Feel-it and participant screens: how the player respects the shown
+  /// document's display response, "limit" ([choice], the default) or "off"
+  /// (experiment/presenter.hpp, docs/format.md "Frequency response").
+  std::string response = "limit";
   std::string protocols_dir;                 ///< shipped protocols offered in the experimenter view ("" = none)
   std::size_t max_message_bytes = 4u << 20;  ///< larger messages are refused
   double max_messages_per_s = 2000.0;        ///< per client, token bucket (burst = one second's worth)
