@@ -84,54 +84,55 @@ namespace {
 constexpr std::size_t leaf = 2048;
 constexpr std::size_t max_size = std::size_t{1} << 26;
 
-/// One decimation-in-frequency stage over re/im[0, n): butterflies of span h
-/// with twiddles (c, s)[j] = e^(−2πi·j/2h), j < h (contiguous, so the loop
-/// vectorizes; lanes perform the scalar operations, so bits do not change).
-void dif_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
-  for (std::size_t base = 0; base < n; base += 2 * h) {
-    double* ar = re + base;
-    double* ai = im + base;
-    double* br = ar + h;
-    double* bi = ai + h;
-    for (std::size_t j = 0; j < h; ++j) {
-      const double wr = c[j];
-      const double wi = s[j];
-      const double xr = ar[j];
-      const double xi = ai[j];
-      const double yr = br[j];
-      const double yi = bi[j];
-      ar[j] = xr + yr;
-      ai[j] = xi + yi;
-      const double dr = xr - yr;
-      const double di = xi - yi;
-      br[j] = dr * wr - di * wi;
-      bi[j] = dr * wi + di * wr;
-    }
+/// n decimation-in-frequency butterflies (a, b)[j] with twiddles (c, s)[j]
+/// (contiguous, so the loop vectorizes; lanes perform the scalar operations,
+/// so bits do not change). Shared by the in-memory and out-of-core FFTs.
+void dif_butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n) {
+  for (std::size_t j = 0; j < n; ++j) {
+    const double wr = c[j];
+    const double wi = s[j];
+    const double xr = ar[j];
+    const double xi = ai[j];
+    const double yr = br[j];
+    const double yi = bi[j];
+    ar[j] = xr + yr;
+    ai[j] = xi + yi;
+    const double dr = xr - yr;
+    const double di = xi - yi;
+    br[j] = dr * wr - di * wi;
+    bi[j] = dr * wi + di * wr;
   }
 }
 
-/// One decimation-in-time stage with the conjugate twiddles (the inverse).
-void dit_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
-  for (std::size_t base = 0; base < n; base += 2 * h) {
-    double* ar = re + base;
-    double* ai = im + base;
-    double* br = ar + h;
-    double* bi = ai + h;
-    for (std::size_t j = 0; j < h; ++j) {
-      const double wr = c[j];
-      const double wi = s[j];
-      const double yr = br[j];
-      const double yi = bi[j];
-      const double tr = yr * wr + yi * wi;
-      const double ti = yi * wr - yr * wi;
-      const double xr = ar[j];
-      const double xi = ai[j];
-      ar[j] = xr + tr;
-      ai[j] = xi + ti;
-      br[j] = xr - tr;
-      bi[j] = xi - ti;
-    }
+/// The same for decimation in time with the conjugate twiddles (the inverse).
+void dit_butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n) {
+  for (std::size_t j = 0; j < n; ++j) {
+    const double wr = c[j];
+    const double wi = s[j];
+    const double yr = br[j];
+    const double yi = bi[j];
+    const double tr = yr * wr + yi * wi;
+    const double ti = yi * wr - yr * wi;
+    const double xr = ar[j];
+    const double xi = ai[j];
+    ar[j] = xr + tr;
+    ai[j] = xi + ti;
+    br[j] = xr - tr;
+    bi[j] = xi - ti;
   }
+}
+
+/// One decimation-in-frequency stage over re/im[0, n): butterflies of span h
+/// with twiddles (c, s)[j] = e^(−2πi·j/2h), j < h.
+void dif_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
+  for (std::size_t base = 0; base < n; base += 2 * h)
+    dif_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
+}
+
+/// One decimation-in-time stage (the inverse).
+void dit_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
+  for (std::size_t base = 0; base < n; base += 2 * h)
+    dit_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
 }
 
 }  // namespace
@@ -489,8 +490,14 @@ class OutOfCore {
           for (std::size_t t = 0; t < rows; ++t) {
             if ((t & s) != 0) continue;
             const std::size_t tw = (t & (s - 1)) * cols;
-            butterflies(re_.data() + t * cols, im_.data() + t * cols, re_.data() + (t + s) * cols, im_.data() + (t + s) * cols,
-                        c + tw, sn + tw, cols, inverse);
+            double* ar = re_.data() + t * cols;
+            double* ai = im_.data() + t * cols;
+            double* br = re_.data() + (t + s) * cols;
+            double* bi = im_.data() + (t + s) * cols;
+            if (inverse)
+              dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
+            else
+              dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
           }
         }
         for (std::size_t t = 0; t < rows; ++t) {
@@ -498,42 +505,6 @@ class OutOfCore {
           file_.write(a.im + base + t * stride, std::span<const double>(im_.data() + t * cols, cols));
         }
       }
-    }
-  }
-
-  /// dif_stage's / dit_stage's butterfly, element for element.
-  static void butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n,
-                          bool inverse) {
-    if (!inverse) {
-      for (std::size_t j = 0; j < n; ++j) {
-        const double wr = c[j];
-        const double wi = s[j];
-        const double xr = ar[j];
-        const double xi = ai[j];
-        const double yr = br[j];
-        const double yi = bi[j];
-        ar[j] = xr + yr;
-        ai[j] = xi + yi;
-        const double dr = xr - yr;
-        const double di = xi - yi;
-        br[j] = dr * wr - di * wi;
-        bi[j] = dr * wi + di * wr;
-      }
-      return;
-    }
-    for (std::size_t j = 0; j < n; ++j) {
-      const double wr = c[j];
-      const double wi = s[j];
-      const double yr = br[j];
-      const double yi = bi[j];
-      const double tr = yr * wr + yi * wi;
-      const double ti = yi * wr - yr * wi;
-      const double xr = ar[j];
-      const double xi = ai[j];
-      ar[j] = xr + tr;
-      ai[j] = xi + ti;
-      br[j] = xr - tr;
-      bi[j] = xi - ti;
     }
   }
 
