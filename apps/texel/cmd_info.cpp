@@ -49,7 +49,7 @@ ordered document_info(const Document& doc, const std::string& path) {
         {"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}, {"texture", r.texture->describe()}};
     if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
       const auto& s = t->spec();
-      rj["texels"] = t->texels().size();
+      rj["texels"] = t->texel_count();
       rj["central_pitch_db"] = s.central_pitch.value();
       rj["irregularity_db"] = s.irregularity.value();
       rj["texel_length_mm"] = s.texel_length.value();

@@ -63,14 +63,19 @@ nlohmann::ordered_json summary(const Document& doc, const Surface& surface, doub
     rj["length_mm"] = r.length.value();
     rj["texture"] = r.texture->describe();
     if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
-      const auto& tx = t->texels();
+      // Two passes over the texels in runs (bounded memory at any length).
+      const std::size_t n = t->texel_count();
       double m = 0.0, s2 = 0.0;
-      for (const auto& x : tx) m += x.frequency.value();
-      m /= static_cast<double>(std::max<std::size_t>(tx.size(), 1));
-      for (const auto& x : tx) s2 += (x.frequency.value() - m) * (x.frequency.value() - m);
-      rj["texels"] = tx.size();
+      t->for_each_texels([&](std::size_t, std::span<const Texel> run) {
+        for (const auto& x : run) m += x.frequency.value();
+      });
+      m /= static_cast<double>(std::max<std::size_t>(n, 1));
+      t->for_each_texels([&](std::size_t, std::span<const Texel> run) {
+        for (const auto& x : run) s2 += (x.frequency.value() - m) * (x.frequency.value() - m);
+      });
+      rj["texels"] = n;
       rj["frequency_mean_cpm"] = m;
-      rj["frequency_sd_cpm"] = tx.size() > 1 ? std::sqrt(s2 / static_cast<double>(tx.size() - 1)) : 0.0;
+      rj["frequency_sd_cpm"] = n > 1 ? std::sqrt(s2 / static_cast<double>(n - 1)) : 0.0;
       rj["band_mass"] = t->distribution().band_mass();
     }
     j["regions"].push_back(rj);

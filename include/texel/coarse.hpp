@@ -7,6 +7,7 @@
 // uniformly sampled signal (used to turn a reference texture into a profile).
 #pragma once
 
+#include <span>
 #include <string>
 #include <utility>
 #include <variant>
@@ -45,6 +46,10 @@ void validate(const CoarseProfile& profile);
 /// c at each texel centre (k + 0.5)·L for k in [0, count). Throws
 /// InvalidArgument when a ValuesProfile is shorter than `count`.
 std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t count);
+/// The same values for texels first … first + c.size() − 1, into c (bit for
+/// bit the whole's). The profile must be valid and a ValuesProfile long
+/// enough (the whole-count form checks both).
+void sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t first, std::span<double> c);
 /// Human-readable kind ("constant", "sine", ...).
 std::string kind_name(const CoarseProfile& profile);
 /// Reads a CSV of position_mm,value rows (an optional header line is allowed).

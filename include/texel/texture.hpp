@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -96,19 +97,33 @@ struct Texel {
   double envelope;        ///< e_k = 1 − C·(1 − c_k)
 };
 
+namespace detail {
+struct TexelListOnce;
+}  // namespace detail
+
 class TexelTexture final : public Texture {
  public:
   /// Prepares `spec` over [0, length) for `sampling` (its band top bounds the
   /// pitch distribution when spec.band_max is 0). Validates; throws
   /// InvalidArgument. Allocates.
-  TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling);
+  /// `keep`: texels kept whole up to this count (kept_texels; a longer
+  /// texture is checkpointed, see below). It moves memory, never a bit.
+  TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling, std::size_t keep = kept_texels);
 
   [[nodiscard]] Millimetres length() const override { return length_; }
   void render(const Grid& grid, std::int64_t first, std::span<double> out) const override;
   [[nodiscard]] std::string describe() const override;
 
   [[nodiscard]] const TexelSpec& spec() const { return spec_; }
-  [[nodiscard]] const std::vector<Texel>& texels() const { return texels_; }
+  /// Every texel. A texture of more than kept_texels texels keeps only
+  /// checkpoints, so the first call draws them all (and keeps them): prefer
+  /// texel_count() and for_each_texels() there.
+  [[nodiscard]] const std::vector<Texel>& texels() const;
+  /// The number of texels.
+  [[nodiscard]] std::size_t texel_count() const { return count_; }
+  /// Calls fn(first index, std::span<const Texel>) on every texel in
+  /// ascending runs, in bounded memory whatever the count.
+  void for_each_texels(const std::function<void(std::size_t, std::span<const Texel>)>& fn) const;
   [[nodiscard]] const PitchDistribution& distribution() const { return distribution_; }
   /// End of the textured span: texel count · L, or the length with a partial final texel.
   [[nodiscard]] Millimetres textured_end() const { return Millimetres(end_mm_); }
@@ -123,13 +138,37 @@ class TexelTexture final : public Texture {
   /// that k·L computed in floating point lands in texel k (1 picometre).
   static constexpr double boundary_tolerance_mm = 1e-9;
 
+  /// Up to this many texels are kept whole (48 bytes each); a longer
+  /// texture keeps the phase every checkpoint_stride texels and draws the
+  /// texels a window needs as it renders (the same values, bit for bit), so
+  /// its memory is bounded whatever its length.
+  static constexpr std::size_t kept_texels = std::size_t{1} << 17;
+  static constexpr std::size_t checkpoint_stride = 1024;
+
  private:
+  /// Texels and their envelope terms for indices [first, first + count).
+  struct TexelRun {
+    std::size_t first = 0;
+    std::vector<Texel> texels;
+    std::vector<double> offset;  // e_k·(1 − F/2)
+    std::vector<double> gain;    // e_k·F/2
+  };
+  /// Draws texels [first, first + count) into `run`, starting from `phase`
+  /// (the continuous phase entering texel `first`); returns the phase
+  /// entering texel first + count.
+  double draw(std::size_t first, std::size_t count, double phase, TexelRun& run) const;
+  /// The run of checkpoint block `block` (lazy mode).
+  void draw_block(std::size_t block, TexelRun& run) const;
+  /// Texel k's run: the kept one, or `scratch` drawn for k's block.
+  const TexelRun& run_of(std::size_t k, TexelRun& scratch) const;
+
   TexelSpec spec_;
   Millimetres length_;
   PitchDistribution distribution_;
-  std::vector<Texel> texels_;
-  std::vector<double> offset_;  // e_k·(1 − F/2)
-  std::vector<double> gain_;    // e_k·F/2
+  std::size_t count_ = 0;
+  TexelRun kept_;                               // every texel (count_ <= kept_texels)
+  std::vector<double> checkpoint_phase_;        // else: the phase entering texel c·checkpoint_stride
+  std::shared_ptr<detail::TexelListOnce> all_;  // texels() of a checkpointed texture, drawn once
   double end_mm_ = 0.0;
 };
 

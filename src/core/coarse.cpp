@@ -92,9 +92,18 @@ std::string kind_name(const CoarseProfile& profile) {
 
 std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t count) {
   validate(profile);
+  if (const auto* v = std::get_if<ValuesProfile>(&profile); v != nullptr && v->values.size() < count)
+    throw InvalidArgument("coarse.values has " + std::to_string(v->values.size()) + " values but the texture has " +
+                          std::to_string(count) + " texels; give one value per texel");
   std::vector<double> c(count);
+  sample_at_texel_centres(profile, texel_length, 0, c);
+  return c;
+}
+
+void sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t first, std::span<double> c) {
   const double L = texel_length.value();
-  auto centre = [L](std::size_t k) { return (static_cast<double>(k) + 0.5) * L; };
+  const std::size_t count = c.size();
+  auto centre = [L, first](std::size_t i) { return (static_cast<double>(first + i) + 0.5) * L; };
   if (const auto* k = std::get_if<ConstantProfile>(&profile)) {
     std::fill(c.begin(), c.end(), k->value);
   } else if (const auto* s = std::get_if<SineProfile>(&profile)) {
@@ -103,10 +112,7 @@ std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millim
       c[i] = 0.5 + 0.5 * detmath::sin_cycles(cycles);
     }
   } else if (const auto* v = std::get_if<ValuesProfile>(&profile)) {
-    if (v->values.size() < count)
-      throw InvalidArgument("coarse.values has " + std::to_string(v->values.size()) + " values but the texture has " +
-                            std::to_string(count) + " texels; give one value per texel");
-    std::copy_n(v->values.begin(), count, c.begin());
+    std::copy_n(v->values.begin() + static_cast<std::ptrdiff_t>(first), count, c.begin());
   } else if (const auto* p = std::get_if<PointsProfile>(&profile)) {
     for (std::size_t i = 0; i < count; ++i) c[i] = interpolate_points(p->points, centre(i));
   } else if (const auto* sp = std::get_if<SampledProfile>(&profile)) {
@@ -114,7 +120,6 @@ std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millim
   }
   // sin_cycles may overshoot 1 by an ulp; keep c in [0, 1] exactly.
   for (double& x : c) x = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
-  return c;
 }
 
 PointsProfile read_profile_csv(const std::string& path) {

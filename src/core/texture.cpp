@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 
 #include "texel/detail/format.hpp"
 #include "texel/detail/lanes.hpp"
@@ -127,7 +128,7 @@ std::size_t texel_count(Millimetres length, Millimetres texel_length, Fill fill)
   return static_cast<std::size_t>(std::max(n, 0.0));
 }
 
-TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling)
+TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling, std::size_t keep)
     : spec_(spec), length_(length), distribution_([&] {
         validate(spec);
         if (!(std::isfinite(length.value()) && length.value() > 0.0))
@@ -143,48 +144,120 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Samp
         return PitchDistribution(c);
       }()) {
   const double L = spec.texel_length.value();
-  const std::size_t n = texel_count(length, spec.texel_length, spec.fill);
-  end_mm_ = spec.fill == Fill::whole_texels ? static_cast<double>(n) * L : length.value();
+  count_ = texel::texel_count(length, spec.texel_length, spec.fill);
+  end_mm_ = spec.fill == Fill::whole_texels ? static_cast<double>(count_) * L : length.value();
+  if (const auto* v = std::get_if<ValuesProfile>(&spec.coarse); v != nullptr && v->values.size() < count_)
+    throw InvalidArgument("coarse.values has " + std::to_string(v->values.size()) + " values but the texture has " +
+                          std::to_string(count_) + " texels; give one value per texel");
+  const double phase0 = CounterRng(spec.seed, Stream::phase).uniform(0);
+  if (count_ <= keep) {
+    (void)draw(0, count_, phase0, kept_);
+    return;
+  }
+  // Checkpoints only: the phase entering every checkpoint_stride-th texel,
+  // from the same recurrence the whole texture runs (so a block drawn from
+  // its checkpoint has the whole's bits).
+  checkpoint_phase_.reserve((count_ + checkpoint_stride - 1) / checkpoint_stride);
+  all_ = std::make_shared<detail::TexelListOnce>();
+  TexelRun run;
+  double phase = phase0;
+  for (std::size_t k0 = 0; k0 < count_; k0 += checkpoint_stride) {
+    checkpoint_phase_.push_back(phase);
+    phase = draw(k0, std::min(checkpoint_stride, count_ - k0), phase, run);
+  }
+}
+
+double TexelTexture::draw(std::size_t first, std::size_t count, double phase, TexelRun& run) const {
+  const TexelSpec& spec = spec_;
+  const double L = spec.texel_length.value();
   // A constant coarse profile (every fine-only texture) is one value, not a
   // per-texel array: the same clamped value sample_at_texel_centres gives.
   const auto* constant = std::get_if<ConstantProfile>(&spec.coarse);
-  const std::vector<double> coarse =
-      constant != nullptr ? std::vector<double>{} : sample_at_texel_centres(spec.coarse, spec.texel_length, n);
+  std::vector<double> coarse;
+  if (constant == nullptr) {
+    coarse.resize(count);
+    sample_at_texel_centres(spec.coarse, spec.texel_length, first, coarse);
+  }
   const double constant_c =
       constant == nullptr ? 0.0 : (constant->value < 0.0 ? 0.0 : (constant->value > 1.0 ? 1.0 : constant->value));
-
-  // Filled in one pass (reserve, not resize: no zeroing pass over memory
-  // that is written at once; at 10^5–10^7 texels the first touch of these
-  // arrays is most of the preparation's time).
-  texels_.reserve(n);
-  offset_.reserve(n);
-  gain_.reserve(n);
+  // Filled in one pass (no zeroing pass over memory that is written at once:
+  // at 10^5 texels the first touch of these arrays is most of the time).
+  run.first = first;
+  run.texels.clear();
+  run.offset.clear();
+  run.gain.clear();
+  run.texels.reserve(count);
+  run.offset.reserve(count);
+  run.gain.reserve(count);
   const CounterRng phase_rng(spec.seed, Stream::phase);
-  double phase = phase_rng.uniform(0);
   const double C = spec.coarse_strength;
   const double F = spec.fine_strength;
-  for (std::size_t k = 0; k < n; ++k) {
-    Texel& t = texels_.emplace_back();
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t k = first + i;
+    Texel& t = run.texels.emplace_back();
     t.start = Millimetres(static_cast<double>(k) * L);
     t.frequency = CyclesPerMm(distribution_.draw(spec.seed, k));
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
-    t.envelope = 1.0 - C * (1.0 - (constant != nullptr ? constant_c : coarse[k]));
-    offset_.push_back(t.envelope - t.envelope * F * 0.5);
-    gain_.push_back(t.envelope * F * 0.5);
+    t.envelope = 1.0 - C * (1.0 - (constant != nullptr ? constant_c : coarse[i]));
+    run.offset.push_back(t.envelope - t.envelope * F * 0.5);
+    run.gain.push_back(t.envelope * F * 0.5);
     // Continuous phase: the next texel starts where this one ends. Keep the
     // phase in [0, 1) cycles so precision does not decay along the surface.
     const double next = phase + t.frequency.value() * L;
     phase = next - detmath::floor_exact(next);
+  }
+  return phase;
+}
+
+void TexelTexture::draw_block(std::size_t block, TexelRun& run) const {
+  const std::size_t first = block * checkpoint_stride;
+  (void)draw(first, std::min(checkpoint_stride, count_ - first), checkpoint_phase_[block], run);
+}
+
+const TexelTexture::TexelRun& TexelTexture::run_of(std::size_t k, TexelRun& scratch) const {
+  if (checkpoint_phase_.empty()) return kept_;
+  if (scratch.texels.empty() || k < scratch.first || k >= scratch.first + scratch.texels.size())
+    draw_block(k / checkpoint_stride, scratch);
+  return scratch;
+}
+
+namespace detail {
+/// Every texel of a checkpointed texture, drawn on the first texels() call.
+struct TexelListOnce {
+  std::once_flag once;
+  std::vector<Texel> texels;
+};
+}  // namespace detail
+
+const std::vector<Texel>& TexelTexture::texels() const {
+  if (checkpoint_phase_.empty()) return kept_.texels;
+  std::call_once(all_->once, [&] {
+    all_->texels.reserve(count_);
+    for_each_texels(
+        [&](std::size_t, std::span<const Texel> run) { all_->texels.insert(all_->texels.end(), run.begin(), run.end()); });
+  });
+  return all_->texels;
+}
+
+void TexelTexture::for_each_texels(const std::function<void(std::size_t, std::span<const Texel>)>& fn) const {
+  if (checkpoint_phase_.empty()) {
+    if (count_ > 0) fn(0, kept_.texels);
+    return;
+  }
+  TexelRun run;
+  for (std::size_t b = 0; b < checkpoint_phase_.size(); ++b) {
+    draw_block(b, run);
+    fn(run.first, run.texels);
   }
 }
 
 std::int64_t TexelTexture::texel_at(Millimetres at) const {
   const double x = at.value();
   const double shifted = x + boundary_tolerance_mm;
-  if (!(shifted >= 0.0) || !(x < end_mm_ - boundary_tolerance_mm) || texels_.empty()) return -1;
+  if (!(shifted >= 0.0) || !(x < end_mm_ - boundary_tolerance_mm) || count_ == 0) return -1;
   const double k = std::floor(shifted / spec_.texel_length.value());
-  const auto n = static_cast<double>(texels_.size());
+  const auto n = static_cast<double>(count_);
   if (k >= n) return -1;
   return static_cast<std::int64_t>(k);
 }
@@ -193,16 +266,19 @@ double TexelTexture::amplitude_at(Millimetres at) const {
   const double x = at.value();
   const std::int64_t k = texel_at(at);
   if (k < 0) return 0.0;
-  const auto i = static_cast<std::size_t>(k);
-  const Texel& t = texels_[i];
+  TexelRun scratch;
+  const TexelRun& run = run_of(static_cast<std::size_t>(k), scratch);
+  const std::size_t i = static_cast<std::size_t>(k) - run.first;
+  const Texel& t = run.texels[i];
   const double u = t.phase_cycles + t.frequency.value() * (x - t.start.value());
-  return offset_[i] + gain_[i] * detmath::sin_cycles(u);
+  return run.offset[i] + run.gain[i] * detmath::sin_cycles(u);
 }
 
 void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double> out) const {
   const auto n = static_cast<std::int64_t>(out.size());
   const double L = spec_.texel_length.value();
-  const auto texel_total = static_cast<double>(texels_.size());
+  const auto texel_total = static_cast<double>(count_);
+  TexelRun scratch;  // a checkpointed texture's texels, a block at a time
   const RunKernel kernel = run_kernel();
   // texel_at(grid.position(first + j)), inlined: the same tests in the same
   // order, with floor_exact (exact here: the quotient is at most ~1e12 texels)
@@ -210,7 +286,7 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
   auto texel_of = [&](std::int64_t j) -> std::int64_t {
     const double x = grid.position(first + j).value();
     const double shifted = x + boundary_tolerance_mm;
-    if (!(shifted >= 0.0) || !(x < end_mm_ - boundary_tolerance_mm) || texels_.empty()) return -1;
+    if (!(shifted >= 0.0) || !(x < end_mm_ - boundary_tolerance_mm) || count_ == 0) return -1;
     const double k = detmath::floor_exact(shifted / L);
     return k >= texel_total ? -1 : static_cast<std::int64_t>(k);
   };
@@ -233,8 +309,9 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
     std::int64_t next = -1;
     while (end < n && (next = texel_of(end)) == k) ++end;
     // Long runs go in pieces so the kernel's index stays a 32-bit int.
-    const auto ik = static_cast<std::size_t>(k);
-    const Texel& t = texels_[ik];
+    const TexelRun& texels = run_of(static_cast<std::size_t>(k), scratch);
+    const std::size_t ik = static_cast<std::size_t>(k) - texels.first;
+    const Texel& t = texels.texels[ik];
     for (std::int64_t a = j; a < end;) {
       const std::int64_t len = std::min<std::int64_t>(end - a, 1 << 30);
       const Run run{static_cast<double>(first + a),
@@ -243,8 +320,8 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
                     t.start.value(),
                     t.frequency.value(),
                     t.phase_cycles,
-                    offset_[ik],
-                    gain_[ik]};
+                    texels.offset[ik],
+                    texels.gain[ik]};
       kernel(run, out.data() + a, static_cast<std::int32_t>(len));
       a += len;
     }

@@ -169,7 +169,7 @@ DesignView design_view(const Document& doc, const DesignOptions& options) {
   if (samples.size() >= 4) v.spectrum = spectrum_view(samples, v.grid.spacing.value(), options.spectrum_points);
 
   if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
-    v.texels = t->texels().size();
+    v.texels = t->texel_count();
     v.histogram = histogram_of(*t, options.histogram_bins);
     v.central_pitch_cpm = to_cpm(t->spec().central_pitch).value();
     v.irregularity_cpm = to_cpm(t->spec().irregularity).value();
