@@ -59,7 +59,38 @@ def main():
     print("(peak MiB is the child's ru_maxrss, which includes the forking Python's ~12 MiB before exec)")
     print(f"goal: peak < 32 MiB: {'met' if peak < 32 else 'NOT met'} ({peak:.1f}); "
           f"within 4× of dd conv=fsync: {'met' if render <= 4 * base else 'NOT met'} ({render / base:.1f}×)")
+    lengths(texel, samples, max(1, runs // 2))
     references(texel, max(1, runs // 2))
+
+
+def lengths(texel, samples, runs):
+    """texel render and texel decode at 0.1×, 1× and 10× the samples, beside dd of the same bytes: memory stays flat."""
+    spacing = 0.0053
+    rows = []
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "map.bin")
+        dd_out = os.path.join(d, "dd.bin")
+        doc = os.path.join(d, "d.texel.json")
+        stream = os.path.join(d, "d.texel")
+        subprocess.run([texel, "render", "--central-pitch", "8", "--seed", "3", "--device", "tpad", "-o", doc], check=True,
+                       stdout=subprocess.DEVNULL)
+        subprocess.run([texel, "encode", doc, "-o", stream], check=True, stdout=subprocess.DEVNULL)
+        for n in (samples // 10, samples, samples * 10):
+            length = f"{n * spacing:.4f}"
+            for name, cmd in (("render", [texel, "render", "--device", "tpad", "--length", length, "--seed", "3", "-o", out]),
+                              ("decode", [texel, "decode", stream, "--device", "tpad", "--length", length, "-o", out])):
+                rs = [measure(cmd) for _ in range(runs)]
+                size = os.path.getsize(out)
+                dd = [measure(["dd", "if=/dev/zero", f"of={dd_out}", "bs=1M", f"count={size}", "iflag=count_bytes",
+                               "conv=fsync", "status=none"]) for _ in range(runs)]
+                rows.append((name, n, size, statistics.median(w for w, _ in rs), max(m for _, m in rs),
+                             statistics.median(w for w, _ in dd)))
+    print(f"\nRender and decode at growing lengths (tpad, uint16), median of {runs}")
+    print(f"{'command':8s} {'samples':>13s} {'bytes':>13s} {'wall ms':>9s} {'peak MiB':>9s} {'dd fsync ms':>12s} {'× dd':>7s}")
+    for name, n, size, wall, peak, dd in rows:
+        print(f"{name:8s} {n:13,d} {size:13,d} {wall * 1e3:9.1f} {peak:9.1f} {dd * 1e3:12.1f} {wall / dd:6.1f}×")
+    worst = max(r[4] for r in rows)
+    print(f"goal: peak < 32 MiB at every length: {'met' if worst < 32 else 'NOT met'} ({worst:.1f} MiB at most)")
 
 
 def references(texel, runs):
@@ -75,8 +106,8 @@ def references(texel, runs):
                    "-o", out]
             rs = [measure(cmd) for _ in range(runs)]
             size = os.path.getsize(out)
-            dd = [measure(["dd", "if=/dev/zero", f"of={dd_out}", f"bs={size}", "count=1", "conv=fsync", "status=none"])
-                  for _ in range(runs)]
+            dd = [measure(["dd", "if=/dev/zero", f"of={dd_out}", "bs=1M", f"count={size}", "iflag=count_bytes", "conv=fsync",
+                           "status=none"]) for _ in range(runs)]
             rows.append((name, length, size, statistics.median(w for w, _ in rs), max(m for _, m in rs),
                          statistics.median(w for w, _ in dd)))
     print(f"\nReference generation to .bin (tpad format, {spacing} mm spacing), median of {runs}")
