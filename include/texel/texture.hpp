@@ -148,19 +148,24 @@ class TexelTexture final : public Texture {
  private:
   /// Texels and their envelope terms for indices [first, first + count).
   struct TexelRun {
+    std::uint64_t owner = 0;  // the texture (id_) whose texels these are
     std::size_t first = 0;
     std::vector<Texel> texels;
     std::vector<double> offset;  // e_k·(1 − F/2)
     std::vector<double> gain;    // e_k·F/2
+    std::vector<double> coarse;  // work: c_k of the run
   };
+
   /// Draws texels [first, first + count) into `run`, starting from `phase`
   /// (the continuous phase entering texel `first`); returns the phase
   /// entering texel first + count.
   double draw(std::size_t first, std::size_t count, double phase, TexelRun& run) const;
   /// The run of checkpoint block `block` (lazy mode).
   void draw_block(std::size_t block, TexelRun& run) const;
-  /// Texel k's run: the kept one, or `scratch` drawn for k's block.
-  const TexelRun& run_of(std::size_t k, TexelRun& scratch) const;
+  /// Texel k's run: the kept one, or this thread's block of a checkpointed
+  /// texture (kept from one window to the next: no redrawing and no
+  /// allocation per window). Valid until the thread draws another block.
+  const TexelRun& run_of(std::size_t k) const;
 
   TexelSpec spec_;
   Millimetres length_;
@@ -170,6 +175,7 @@ class TexelTexture final : public Texture {
   std::vector<double> checkpoint_phase_;        // else: the phase entering texel c·checkpoint_stride
   std::shared_ptr<detail::TexelListOnce> all_;  // texels() of a checkpointed texture, drawn once
   double end_mm_ = 0.0;
+  std::uint64_t id_ = 0;  // unique per prepared texture (copies share it: same texels)
 };
 
 /// Number of texels a span of `length` holds under `fill`.

@@ -1,6 +1,7 @@
 #include "texel/texture.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -144,6 +145,8 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Samp
         return PitchDistribution(c);
       }()) {
   const double L = spec.texel_length.value();
+  static std::atomic<std::uint64_t> next_id{1};
+  id_ = next_id.fetch_add(1, std::memory_order_relaxed);
   count_ = texel::texel_count(length, spec.texel_length, spec.fill);
   end_mm_ = spec.fill == Fill::whole_texels ? static_cast<double>(count_) * L : length.value();
   if (const auto* v = std::get_if<ValuesProfile>(&spec.coarse); v != nullptr && v->values.size() < count_)
@@ -152,6 +155,7 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Samp
   const double phase0 = CounterRng(spec.seed, Stream::phase).uniform(0);
   if (count_ <= keep) {
     (void)draw(0, count_, phase0, kept_);
+    std::vector<double>().swap(kept_.coarse);  // work space, not kept
     return;
   }
   // Checkpoints only: the phase entering every checkpoint_stride-th texel,
@@ -173,7 +177,7 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
   // A constant coarse profile (every fine-only texture) is one value, not a
   // per-texel array: the same clamped value sample_at_texel_centres gives.
   const auto* constant = std::get_if<ConstantProfile>(&spec.coarse);
-  std::vector<double> coarse;
+  std::vector<double>& coarse = run.coarse;
   if (constant == nullptr) {
     coarse.resize(count);
     sample_at_texel_centres(spec.coarse, spec.texel_length, first, coarse);
@@ -215,11 +219,15 @@ void TexelTexture::draw_block(std::size_t block, TexelRun& run) const {
   (void)draw(first, std::min(checkpoint_stride, count_ - first), checkpoint_phase_[block], run);
 }
 
-const TexelTexture::TexelRun& TexelTexture::run_of(std::size_t k, TexelRun& scratch) const {
+const TexelTexture::TexelRun& TexelTexture::run_of(std::size_t k) const {
   if (checkpoint_phase_.empty()) return kept_;
-  if (scratch.texels.empty() || k < scratch.first || k >= scratch.first + scratch.texels.size())
-    draw_block(k / checkpoint_stride, scratch);
-  return scratch;
+  thread_local TexelRun block;
+  if (block.owner != id_ || k < block.first || k >= block.first + block.texels.size()) {
+    block.owner = 0;  // not valid until drawn (draw may throw on allocation)
+    draw_block(k / checkpoint_stride, block);
+    block.owner = id_;
+  }
+  return block;
 }
 
 namespace detail {
@@ -266,8 +274,7 @@ double TexelTexture::amplitude_at(Millimetres at) const {
   const double x = at.value();
   const std::int64_t k = texel_at(at);
   if (k < 0) return 0.0;
-  TexelRun scratch;
-  const TexelRun& run = run_of(static_cast<std::size_t>(k), scratch);
+  const TexelRun& run = run_of(static_cast<std::size_t>(k));
   const std::size_t i = static_cast<std::size_t>(k) - run.first;
   const Texel& t = run.texels[i];
   const double u = t.phase_cycles + t.frequency.value() * (x - t.start.value());
@@ -278,7 +285,6 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
   const auto n = static_cast<std::int64_t>(out.size());
   const double L = spec_.texel_length.value();
   const auto texel_total = static_cast<double>(count_);
-  TexelRun scratch;  // a checkpointed texture's texels, a block at a time
   const RunKernel kernel = run_kernel();
   // texel_at(grid.position(first + j)), inlined: the same tests in the same
   // order, with floor_exact (exact here: the quotient is at most ~1e12 texels)
@@ -309,7 +315,7 @@ void TexelTexture::render(const Grid& grid, std::int64_t first, std::span<double
     std::int64_t next = -1;
     while (end < n && (next = texel_of(end)) == k) ++end;
     // Long runs go in pieces so the kernel's index stays a 32-bit int.
-    const TexelRun& texels = run_of(static_cast<std::size_t>(k), scratch);
+    const TexelRun& texels = run_of(static_cast<std::size_t>(k));
     const std::size_t ik = static_cast<std::size_t>(k) - texels.first;
     const Texel& t = texels.texels[ik];
     for (std::int64_t a = j; a < end;) {
