@@ -2,7 +2,6 @@
 // phase every checkpoint_stride texels is kept and windows draw the texels
 // they need. That moves memory, never a bit of what renders.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -16,19 +15,14 @@
 #include "texel/surface.hpp"
 #include "texel/texture.hpp"
 
+#include "../support/memory.hpp"
+
 using namespace texel;
 
 namespace {
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
-long peak_rss_kib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return u.ru_maxrss;
-}
+using test_support::peak_rss_kib;
+using test_support::same_bits;
 
 }  // namespace
 

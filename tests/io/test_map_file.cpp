@@ -2,7 +2,6 @@
 // byte the whole-map writers' output, appears atomically, and rendering a
 // long map to it keeps memory bounded by a chunk, not by the map.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
 #include <cstdio>
 #include <cstring>
@@ -11,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "../support/memory.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
@@ -101,11 +101,7 @@ TEST(MapFile, FailureLeavesNothingAndOtherExtensionsAreRefused) {
   EXPECT_EQ(slurp(dir.at("old.bin")), "old");
 }
 
-long peak_rss_kib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return u.ru_maxrss;
-}
+using test_support::peak_rss_kib;
 
 TEST(MapFile, LongMapsStreamInBoundedMemory) {
   // 10^7 samples (50 m at 5 µm, 200,000 texels): rendered whole, the map

@@ -2,7 +2,6 @@
 // move to scratch files beyond ReferenceMemory's budget, and that changes
 // where the data lives, never a byte of what renders.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -18,6 +17,8 @@
 #include "texel/map_file.hpp"
 #include "texel/reference.hpp"
 #include "texel/surface.hpp"
+
+#include "../support/memory.hpp"
 
 using namespace texel;
 
@@ -56,15 +57,8 @@ Rendered render(const ReferenceSpec& s, double length, const Grid& grid, const R
   return r;
 }
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
-long peak_rss_kib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return u.ru_maxrss;
-}
+using test_support::peak_rss_kib;
+using test_support::same_bits;
 
 }  // namespace
 
