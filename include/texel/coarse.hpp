@@ -43,6 +43,9 @@ using CoarseProfile = std::variant<ConstantProfile, SineProfile, ValuesProfile, 
 
 /// Throws InvalidArgument (naming the field) if the profile is malformed.
 void validate(const CoarseProfile& profile);
+/// Throws InvalidArgument when a ValuesProfile holds fewer than `count`
+/// values (one per texel); other profiles cover any count.
+void check_texel_values(const CoarseProfile& profile, std::size_t count);
 /// c at each texel centre (k + 0.5)·L for k in [0, count). Throws
 /// InvalidArgument when a ValuesProfile is shorter than `count`.
 std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t count);

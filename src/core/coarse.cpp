@@ -90,11 +90,15 @@ std::string kind_name(const CoarseProfile& profile) {
   return std::visit(Namer{}, profile);
 }
 
-std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t count) {
-  validate(profile);
+void check_texel_values(const CoarseProfile& profile, std::size_t count) {
   if (const auto* v = std::get_if<ValuesProfile>(&profile); v != nullptr && v->values.size() < count)
     throw InvalidArgument("coarse.values has " + std::to_string(v->values.size()) + " values but the texture has " +
                           std::to_string(count) + " texels; give one value per texel");
+}
+
+std::vector<double> sample_at_texel_centres(const CoarseProfile& profile, Millimetres texel_length, std::size_t count) {
+  validate(profile);
+  check_texel_values(profile, count);
   std::vector<double> c(count);
   sample_at_texel_centres(profile, texel_length, 0, c);
   return c;

@@ -588,18 +588,21 @@ void sum_harmonics(const HarmonicSource& h, double origin, double spacing, std::
     sum_out_of_core(plan, h, origin, spacing, index, samples, sink, budget / 2);
 }
 
+HarmonicSource harmonic_source(const Harmonics& h) {
+  return {h.first, h.fundamental, h.amplitude.size(), [h](std::size_t j0, std::span<double> a, std::span<double> p) {
+            std::copy_n(h.amplitude.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
+            std::copy_n(h.phase_cycles.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
+          }};
+}
+
 void sum_harmonics(const Harmonics& h, double origin, double spacing, std::int64_t index, std::span<double> out) {
   const std::size_t k = h.amplitude.size();
   if (k == 0 || k != h.phase_cycles.size() || k > max_chirp_harmonics)
     throw InvalidArgument("sum_harmonics: " + std::to_string(k) + " harmonics (" + std::to_string(h.phase_cycles.size()) +
                           " phases); 1 to " + std::to_string(max_chirp_harmonics) + " are allowed");
-  const HarmonicSource source{h.first, h.fundamental, k, [&](std::size_t j0, std::span<double> a, std::span<double> p) {
-                                std::copy_n(h.amplitude.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
-                                std::copy_n(h.phase_cycles.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
-                              }};
   // The whole output is in memory already: so may the FFT be.
   sum_harmonics(
-      source, origin, spacing, index, out.size(),
+      harmonic_source(h), origin, spacing, index, out.size(),
       [&](std::size_t m0, std::span<const double> y) {
         std::copy(y.begin(), y.end(), out.begin() + static_cast<std::ptrdiff_t>(m0));
       },

@@ -149,9 +149,7 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Samp
   id_ = next_id.fetch_add(1, std::memory_order_relaxed);
   count_ = texel::texel_count(length, spec.texel_length, spec.fill);
   end_mm_ = spec.fill == Fill::whole_texels ? static_cast<double>(count_) * L : length.value();
-  if (const auto* v = std::get_if<ValuesProfile>(&spec.coarse); v != nullptr && v->values.size() < count_)
-    throw InvalidArgument("coarse.values has " + std::to_string(v->values.size()) + " values but the texture has " +
-                          std::to_string(count_) + " texels; give one value per texel");
+  check_texel_values(spec.coarse, count_);
   const double phase0 = CounterRng(spec.seed, Stream::phase).uniform(0);
   if (count_ <= keep) {
     (void)draw(0, count_, phase0, kept_);
@@ -176,14 +174,10 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
   const double L = spec.texel_length.value();
   // A constant coarse profile (every fine-only texture) is one value, not a
   // per-texel array: the same clamped value sample_at_texel_centres gives.
-  const auto* constant = std::get_if<ConstantProfile>(&spec.coarse);
+  const bool constant = std::holds_alternative<ConstantProfile>(spec.coarse);
   std::vector<double>& coarse = run.coarse;
-  if (constant == nullptr) {
-    coarse.resize(count);
-    sample_at_texel_centres(spec.coarse, spec.texel_length, first, coarse);
-  }
-  const double constant_c =
-      constant == nullptr ? 0.0 : (constant->value < 0.0 ? 0.0 : (constant->value > 1.0 ? 1.0 : constant->value));
+  coarse.resize(constant ? 1 : count);
+  sample_at_texel_centres(spec.coarse, spec.texel_length, first, coarse);
   // Filled in one pass (no zeroing pass over memory that is written at once:
   // at 10^5 texels the first touch of these arrays is most of the time).
   run.first = first;
@@ -203,7 +197,7 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
     t.frequency = CyclesPerMm(distribution_.draw(spec.seed, k));
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
-    t.envelope = 1.0 - C * (1.0 - (constant != nullptr ? constant_c : coarse[i]));
+    t.envelope = 1.0 - C * (1.0 - coarse[constant ? 0 : i]);
     run.offset.push_back(t.envelope - t.envelope * F * 0.5);
     run.gain.push_back(t.envelope * F * 0.5);
     // Continuous phase: the next texel starts where this one ends. Keep the

@@ -187,12 +187,8 @@ void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const Ha
     amplitude[j] = comps[i].amplitude;
     phase[j] = comps[i].phase_cycles;
   }
-  const detail::HarmonicSource source{lowest, layout.fundamental, harmonics,
-                                      [&](std::size_t j0, std::span<double> a, std::span<double> p) {
-                                        std::copy_n(amplitude.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
-                                        std::copy_n(phase.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
-                                      }};
-  detail::sum_harmonics(source, grid.origin.value(), grid.spacing.value(), first, count, sink, chirp);
+  detail::sum_harmonics(detail::harmonic_source({lowest, layout.fundamental, amplitude, phase}), grid.origin.value(),
+                        grid.spacing.value(), first, count, sink, chirp);
 }
 
 // ------------------------------------------------------------ parameters
@@ -434,17 +430,12 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     file = std::make_shared<detail::ScratchFile>("reference '" + spec_.name + "'");
   else
     cache_.resize(cache_count_);
+  scratch_ = file;  // read_samples reads back what store wrote
   const auto store = [&](std::size_t i, std::span<const double> y) {
     if (file)
       file->write(i, y);
     else
       std::copy(y.begin(), y.end(), cache_.begin() + static_cast<std::ptrdiff_t>(i));
-  };
-  const auto load = [&](std::size_t i, std::span<double> y) {
-    if (file)
-      file->read(i, y);
-    else
-      std::copy_n(cache_.begin() + static_cast<std::ptrdiff_t>(i), y.size(), y.begin());
   };
   constexpr std::size_t block = std::size_t{1} << 14;  // samples per step when not in one piece
   std::vector<double> buffer(std::min(block, cache_count_));
@@ -470,7 +461,7 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     scale_ = 0.5 / peak_;
     for (std::size_t i = 0; i < cache_count_; i += block) {
       const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
-      load(i, y);
+      read_samples(i, y);
       for (double& v : y) {
         const double u = 0.5 + scale_ * v;
         v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
@@ -484,7 +475,6 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
       store(i, y);
     }
   }
-  scratch_ = std::move(file);
 }
 
 std::vector<ReferenceComponent> ReferenceTexture::components() const {

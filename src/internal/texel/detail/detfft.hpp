@@ -122,6 +122,9 @@ struct HarmonicSource {
   std::function<void(std::size_t j0, std::span<double> amplitude, std::span<double> phase)> fill;
 };
 
+/// A source reading the spans of `h` (which must outlive it).
+HarmonicSource harmonic_source(const Harmonics& h);
+
 /// Receives the samples of sum_harmonics in order: sink(m0, y) is samples
 /// m0 … m0 + y.size() − 1.
 using SampleSink = std::function<void(std::size_t m0, std::span<const double> y)>;
