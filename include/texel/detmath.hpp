@@ -59,6 +59,83 @@ template <class T>
   return r * p;
 }
 
+/// fdlibm's split of ln 2: the high part has trailing zero bits, so k·ln2_hi
+/// is exact for |k| < 2^11.
+inline constexpr double ln2_hi = 6.93147180369123816490e-01;
+inline constexpr double ln2_lo = 1.90821492927058770002e-10;
+inline constexpr double inv_ln2 = 1.44269504088896338700e+00;
+
+/// exp's reduction and polynomial, generic over the value type like
+/// sin_cycles_generic (the scalar exp and the lane-wise texel draws share
+/// this one definition): x = k·ln2 + r with k = round_even(x/ln2) and
+/// |r| <= ln2/2, then e^r by Taylor to r^14 (error < 1e-18). Returns e^r in
+/// [0.70, 1.42] and sets `k`; e^x = e^r·2^k (scale_pow2). For finite x in
+/// exp's range (-745.13 … 709.78).
+template <class T>
+[[gnu::always_inline]] constexpr T exp_reduced_generic(T x, T& k) {
+  constexpr double magic = 6755399441055744.0;  // round_even's 1.5 * 2^52
+  k = ((x * inv_ln2) + magic) - magic;
+  const T r = (x - k * ln2_hi) - k * ln2_lo;
+  T p = 1.0 / 87178291200.0 * r + 1.0 / 6227020800.0;  // 1/14!, 1/13!
+  p = p * r + 1.0 / 479001600.0;
+  p = p * r + 1.0 / 39916800.0;
+  p = p * r + 1.0 / 3628800.0;
+  p = p * r + 1.0 / 362880.0;
+  p = p * r + 1.0 / 40320.0;
+  p = p * r + 1.0 / 5040.0;
+  p = p * r + 1.0 / 720.0;
+  p = p * r + 1.0 / 120.0;
+  p = p * r + 1.0 / 24.0;
+  p = p * r + 1.0 / 6.0;
+  p = p * r + 0.5;
+  p = p * r + 1.0;
+  p = p * r + 1.0;
+  return p;
+}
+
+/// 2^k for k in [-1022, 1023], exactly (a normal double built from its
+/// exponent bits).
+constexpr double pow2(int k) { return std::bit_cast<double>(static_cast<std::uint64_t>(k + 1023) << 52); }
+
+/// p·2^k rounded once, for p in [0.5, 2) and k in [-1076, 1024]: what
+/// std::ldexp(p, k) returns, bit for bit, without the library call. Where
+/// 2^k is a normal double the product is exact, or (a subnormal result)
+/// rounded once from the exact value, as ldexp rounds; beyond, the first
+/// factor gives an exact normal product and only the second rounds.
+constexpr double scale_pow2(double p, int k) {
+  if (k >= -1022 && k <= 1023) return p * pow2(k);
+  return k > 0 ? (p * pow2(k - 1023)) * pow2(1023) : (p * pow2(k + 1022)) * pow2(-1022);
+}
+
+/// Wichura's AS241 (PPND16) central branch, for |q| <= 0.425 where
+/// q = p − 1/2: Φ⁻¹(p) = q·num(r)/den(r), r = 0.180625 − q². Generic over
+/// the value type; normal_quantile uses it for that branch.
+template <class T>
+[[gnu::always_inline]] constexpr T normal_quantile_central_generic(T q) {
+  const T r = 0.180625 - q * q;
+  const T num = (((((((2.5090809287301226727e+3 * r + 3.3430575583588128105e+4) * r + 6.7265770927008700853e+4) * r +
+                     4.5921953931549871457e+4) *
+                        r +
+                    1.3731693765509461125e+4) *
+                       r +
+                   1.9715909503065514427e+3) *
+                      r +
+                  1.3314166789178437745e+2) *
+                     r +
+                 3.3871328727963666080e+0);
+  const T den = (((((((5.2264952788528545610e+3 * r + 2.8729085735721942674e+4) * r + 3.9307895800092710610e+4) * r +
+                     2.1213794301586595867e+4) *
+                        r +
+                    5.3941960214247511077e+3) *
+                       r +
+                   6.8718700749205790830e+2) *
+                      r +
+                  4.2313330701600911252e+1) *
+                     r +
+                 1.0);
+  return q * num / den;
+}
+
 /// sin(2π·u) for any |u| < 2^50 cycles.
 constexpr double sin_cycles(double u) { return sin_cycles_generic(u); }
 

@@ -8,11 +8,6 @@
 namespace texel::detmath {
 namespace {
 
-// fdlibm's split of ln 2: the high part has trailing zero bits, so k·ln2_hi
-// is exact for |k| < 2^11.
-constexpr double ln2_hi = 6.93147180369123816490e-01;
-constexpr double ln2_lo = 1.90821492927058770002e-10;
-constexpr double inv_ln2 = 1.44269504088896338700e+00;
 constexpr double ln10 = 2.30258509299404568402;
 
 }  // namespace
@@ -58,26 +53,11 @@ double exp(double x) {
   if (std::isnan(x)) return x;
   if (x > 709.782712893384) return std::numeric_limits<double>::infinity();
   if (x < -745.1332191019412) return 0.0;
-  // x = k·ln2 + r, |r| <= ln2/2; e^r by Taylor to r^14 (error < 1e-18).
-  const double k = round_even(x * inv_ln2);
-  const double r = (x - k * ln2_hi) - k * ln2_lo;
-  double p = 1.0 / 87178291200.0;  // 1/14!
-  p = p * r + 1.0 / 6227020800.0;
-  p = p * r + 1.0 / 479001600.0;
-  p = p * r + 1.0 / 39916800.0;
-  p = p * r + 1.0 / 3628800.0;
-  p = p * r + 1.0 / 362880.0;
-  p = p * r + 1.0 / 40320.0;
-  p = p * r + 1.0 / 5040.0;
-  p = p * r + 1.0 / 720.0;
-  p = p * r + 1.0 / 120.0;
-  p = p * r + 1.0 / 24.0;
-  p = p * r + 1.0 / 6.0;
-  p = p * r + 0.5;
-  p = p * r + 1.0;
-  p = p * r + 1.0;
-  // Scaling by a power of two is exact (ldexp is an IEEE-exact operation).
-  return std::ldexp(p, static_cast<int>(k));
+  double k = 0.0;
+  const double p = exp_reduced_generic(x, k);
+  // Scaling by a power of two is exact (or rounded once into the subnormals),
+  // as std::ldexp does it; scale_pow2 is that without the library call.
+  return scale_pow2(p, static_cast<int>(k));
 }
 
 double pow10(double x) { return exp(x * ln10); }
@@ -90,30 +70,7 @@ double normal_quantile(double p) {
   }
   // Wichura, Algorithm AS241 (PPND16), Applied Statistics 37 (1988) 477–484.
   const double q = p - 0.5;
-  if (std::fabs(q) <= 0.425) {
-    const double r = 0.180625 - q * q;
-    const double num = (((((((2.5090809287301226727e+3 * r + 3.3430575583588128105e+4) * r + 6.7265770927008700853e+4) * r +
-                            4.5921953931549871457e+4) *
-                               r +
-                           1.3731693765509461125e+4) *
-                              r +
-                          1.9715909503065514427e+3) *
-                             r +
-                         1.3314166789178437745e+2) *
-                            r +
-                        3.3871328727963666080e+0);
-    const double den = (((((((5.2264952788528545610e+3 * r + 2.8729085735721942674e+4) * r + 3.9307895800092710610e+4) * r +
-                            2.1213794301586595867e+4) *
-                               r +
-                           5.3941960214247511077e+3) *
-                              r +
-                          6.8718700749205790830e+2) *
-                             r +
-                         4.2313330701600911252e+1) *
-                            r +
-                        1.0);
-    return q * num / den;
-  }
+  if (std::fabs(q) <= 0.425) return normal_quantile_central_generic(q);
   double r = q < 0.0 ? p : 1.0 - p;
   r = std::sqrt(-log(r));  // sqrt is correctly rounded by IEEE-754
   double value = 0.0;

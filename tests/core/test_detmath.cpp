@@ -8,10 +8,12 @@
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
+#include <bit>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "texel/detmath.hpp"
 #include "texel/random.hpp"
@@ -68,6 +70,98 @@ TEST(Detmath, ExpWithinTwoUlpOfTheCLibrary) {
   EXPECT_EQ(dm::exp(1000.0), std::numeric_limits<double>::infinity());
   EXPECT_EQ(dm::exp(-1000.0), 0.0);
   EXPECT_TRUE(std::isnan(dm::exp(std::numeric_limits<double>::quiet_NaN())));
+}
+
+namespace {
+
+/// detmath::exp as it was written before scale_pow2: the same reduction and
+/// polynomial, scaled by std::ldexp. The reference the new scaling must
+/// reproduce bit for bit.
+double exp_with_ldexp(double x) {
+  if (std::isnan(x)) return x;
+  if (x > 709.782712893384) return std::numeric_limits<double>::infinity();
+  if (x < -745.1332191019412) return 0.0;
+  const double k = dm::round_even(x * 1.44269504088896338700e+00);
+  const double r = (x - k * 6.93147180369123816490e-01) - k * 1.90821492927058770002e-10;
+  double p = 1.0 / 87178291200.0;
+  for (double c : {1.0 / 6227020800.0, 1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0, 1.0 / 362880.0, 1.0 / 40320.0,
+                   1.0 / 5040.0, 1.0 / 720.0, 1.0 / 120.0, 1.0 / 24.0, 1.0 / 6.0, 0.5, 1.0, 1.0})
+    p = p * r + c;
+  return std::ldexp(p, static_cast<int>(k));
+}
+
+std::uint64_t bits_of(double v) { return std::bit_cast<std::uint64_t>(v); }
+
+}  // namespace
+
+TEST(Detmath, ScalePow2IsLdexpForEveryExponent) {
+  // Every exponent exp can produce, with mantissas across [0.5, 2) and its
+  // edges: normal, subnormal (rounded once, ties to even), zero and overflow
+  // results all equal std::ldexp's.
+  Sweep s;
+  std::vector<double> mantissas = {0.5,
+                                   0.7071067811865476,
+                                   1.0,
+                                   1.4142135623730951,
+                                   std::nextafter(2.0, 0.0),
+                                   std::nextafter(1.0, 0.0),
+                                   std::nextafter(1.0, 2.0),
+                                   1.5,
+                                   0.75,
+                                   1.0000000000000004};
+  for (int i = 0; i < 200; ++i) mantissas.push_back(s(0.5, 2.0));
+  for (int k = -1076; k <= 1024; ++k)
+    for (double p : mantissas)
+      ASSERT_EQ(bits_of(dm::scale_pow2(p, k)), bits_of(std::ldexp(p, k))) << "p = " << p << ", k = " << k;
+  for (int k = -1022; k <= 1023; ++k) ASSERT_EQ(dm::pow2(k), std::ldexp(1.0, k)) << k;
+}
+
+TEST(Detmath, ExpIsBitIdenticalToTheLdexpFormula) {
+  // The exact power-of-two scaling changed how exp multiplies by 2^k, never
+  // a bit of what it returns: against the former formula over the whole
+  // range, densely where the result is subnormal or overflows, and at the
+  // thresholds, zeros, infinities and NaN.
+  Sweep s;
+  std::vector<double> xs = {0.0,
+                            -0.0,
+                            1.0,
+                            -1.0,
+                            1e-300,
+                            -1e-300,
+                            4.9406564584124654e-324,
+                            709.782712893384,
+                            std::nextafter(709.782712893384, 0.0),
+                            std::nextafter(709.782712893384, 1000.0),
+                            709.782712893383973096,
+                            -745.1332191019412,
+                            std::nextafter(-745.1332191019412, 0.0),
+                            std::nextafter(-745.1332191019412, -1000.0),
+                            -708.3964185322641,  // ~ the smallest normal result
+                            -744.4400719213812,  // ~ the smallest subnormal
+                            std::numeric_limits<double>::infinity(),
+                            -std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::max(),
+                            std::numeric_limits<double>::lowest()};
+  for (int i = 0; i < 1000000; ++i) xs.push_back(s(-746.0, 711.0));
+  for (int i = 0; i < 200000; ++i) xs.push_back(s(-745.2, -707.0));  // subnormal and near-subnormal results
+  for (int i = 0; i < 100000; ++i) xs.push_back(s(708.0, 709.8));    // k = 1022 … 1024, overflow
+  for (int i = 0; i < 100000; ++i) xs.push_back(s(-1e-6, 1e-6));
+  // Whole multiples of ln 2 and their neighbours, where k changes.
+  for (int k = -1076; k <= 1025; ++k) {
+    const double x = k * 0.6931471805599453;
+    xs.insert(xs.end(), {x, std::nextafter(x, -1e9), std::nextafter(x, 1e9), x + 0.34657359027997264, x - 0.34657359027997264});
+  }
+  for (double x : xs) {
+    const double got = dm::exp(x), want = exp_with_ldexp(x);
+    if (std::isnan(want)) {
+      ASSERT_TRUE(std::isnan(got)) << "x = " << x;
+      continue;
+    }
+    ASSERT_EQ(bits_of(got), bits_of(want)) << "x = " << x;
+  }
+  EXPECT_TRUE(std::isnan(dm::exp(std::numeric_limits<double>::quiet_NaN())));
+  EXPECT_GT(dm::exp(-745.0), 0.0);  // a subnormal result, not flushed
+  EXPECT_LT(dm::exp(-745.0), std::numeric_limits<double>::min());
 }
 
 TEST(Detmath, LogWithinTwoUlpOfTheCLibrary) {
