@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -49,6 +50,10 @@ class PitchDistribution {
 
   /// Frequency (cpm) of draw `index` for `seed`: a pure function.
   [[nodiscard]] double draw(std::uint64_t seed, std::uint64_t index) const;
+  /// out[i] = draw(seed, first + i), bit for bit, for a run of draws: the
+  /// usual first attempts computed a vector of texels at a time, the rare
+  /// ones (a tail of the normal quantile, a redraw) by draw itself.
+  void draw(std::uint64_t seed, std::uint64_t first, std::span<double> out) const;
 
   [[nodiscard]] double mu() const { return mu_; }        ///< mean of ln f
   [[nodiscard]] double sigma() const { return sigma_; }  ///< standard deviation of ln f

@@ -1,8 +1,10 @@
 #include "texel/distribution.hpp"
 
 #include <cmath>
+#include <cstring>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/lanes.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 
@@ -20,6 +22,84 @@ double cpm_of(double db) { return detmath::exp(db * ln10_over_10); }
 void require_finite(double v, std::string_view field, std::string_view unit) {
   if (!std::isfinite(v))
     throw InvalidArgument(std::string(field) + " is " + num(v) + " " + std::string(unit) + "; it must be a finite number");
+}
+
+// ------------------------------------------------------------ lane-wise draws
+//
+// The first attempt of W texels' draws at once: u from the counter (integer
+// work, scalar), z = Φ⁻¹(u) by AS241's central branch, f = exp(mu + sigma·z)
+// by exp's reduction and polynomial, each lane doing exactly the scalar
+// operations in the same order (detmath's *_generic definitions, shared
+// with the scalar functions; -ffp-contract=off) — the pattern and reasoning
+// of the render kernel (texture.cpp, above render_lanes). Scalar fallbacks
+// take the rare branches: a tail of Φ⁻¹ (|u − 1/2| > 0.425) is the scalar
+// normal_quantile, and a lane whose exponent leaves 2^k's normal range or
+// whose frequency falls outside the band (a redraw, or a clamp) is marked
+// for PitchDistribution::draw, which starts again from attempt 0 and so
+// returns the same bits. The exp's ldexp becomes an exact multiplication by
+// 2^k, built from k's bits: k + (1.5·2^52 + 1023) holds k + 1023 in its low
+// mantissa bits (exact, |k| < 2^11), and shifted left by 52 they are 2^k's
+// exponent field.
+struct DrawBatch {
+  CounterRng rng;
+  std::uint64_t first;  // index of out[0]
+  double mu, sigma, lo, hi;
+};
+
+// Marks a lane for the scalar draw (a frequency is never negative).
+constexpr double scalar_draw = -1.0;
+
+template <int W>
+[[gnu::always_inline]] inline void draw_lanes(const DrawBatch& b, double* out, std::size_t count) {
+  using V = typename detail::Lanes<W>::type;
+  using U = typename detail::Lanes<W>::u64;
+  constexpr double magic = 6755399441055744.0;  // 1.5 * 2^52
+  for (std::size_t i = 0; i < count; i += W) {
+    const std::size_t live = std::min<std::size_t>(W, count - i);
+    V u{};
+    for (std::size_t l = 0; l < live; ++l) u[l] = b.rng.uniform((b.first + i + l) * PitchDistribution::max_attempts);
+    for (std::size_t l = live; l < W; ++l) u[l] = 0.5;  // idle lanes: any value in the central branch
+    const V q = u - 0.5;
+    V z = detmath::normal_quantile_central_generic(q);
+    for (std::size_t l = 0; l < live; ++l)
+      if (!(q[l] >= -0.425 && q[l] <= 0.425)) z[l] = detmath::normal_quantile(u[l]);
+    const V t = b.mu + b.sigma * z;
+    V k;
+    const V p = detmath::exp_reduced_generic(t, k);
+    U two_k;
+    V biased = k + (magic + 1023.0);
+    std::memcpy(&two_k, &biased, sizeof two_k);
+    two_k <<= 52;
+    V scale;
+    std::memcpy(&scale, &two_k, sizeof scale);
+    const V f = p * scale;
+    for (std::size_t l = 0; l < live; ++l) {
+      // exp's own tests (NaN, overflow, underflow), then 2^k normal.
+      const bool exact = t[l] <= 709.782712893384 && t[l] >= -745.1332191019412 && k[l] >= -1022.0 && k[l] <= 1023.0;
+      const bool in_band = f[l] >= b.lo && f[l] <= b.hi;
+      out[i + l] = exact && in_band ? f[l] : scalar_draw;
+    }
+  }
+}
+
+using DrawKernel = void (*)(const DrawBatch&, double*, std::size_t);
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void draw_avx512(const DrawBatch& b, double* out, std::size_t n) { draw_lanes<8>(b, out, n); }
+__attribute__((target("avx2"))) void draw_avx2(const DrawBatch& b, double* out, std::size_t n) { draw_lanes<4>(b, out, n); }
+#endif
+void draw_generic(const DrawBatch& b, double* out, std::size_t n) { draw_lanes<2>(b, out, n); }
+
+/// The widest kernel this CPU runs (detail::simd_lanes), chosen once.
+DrawKernel draw_kernel() {
+  static const DrawKernel kernel = [] {
+#if defined(__x86_64__) || defined(__i386__)
+    if (detail::simd_lanes() == 8) return &draw_avx512;
+    if (detail::simd_lanes() == 4) return &draw_avx2;
+#endif
+    return &draw_generic;
+  }();
+  return kernel;
 }
 
 }  // namespace
@@ -121,6 +201,19 @@ double PitchDistribution::draw(std::uint64_t seed, std::uint64_t index) const {
   }
   f = f < lo ? lo : (f > hi ? hi : f);
   return quantize(f);
+}
+
+void PitchDistribution::draw(std::uint64_t seed, std::uint64_t first, std::span<double> out) const {
+  const DrawBatch batch{
+      CounterRng(seed, Stream::frequency), first, mu_, sigma_, config_.band_min.value(), config_.band_max.value()};
+  draw_kernel()(batch, out.data(), out.size());
+  const bool quantized = config_.quantization_db > 0.0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (out[i] == scalar_draw)
+      out[i] = draw(seed, first + i);
+    else if (quantized)
+      out[i] = quantize(out[i]);  // draw's clamp is the identity for an in-band value
+  }
 }
 
 }  // namespace texel

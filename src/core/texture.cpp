@@ -190,11 +190,15 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
   const CounterRng phase_rng(spec.seed, Stream::phase);
   const double C = spec.coarse_strength;
   const double F = spec.fine_strength;
+  // Frequencies a batch at a time (lane-wise, the same bits as one by one).
+  constexpr std::size_t batch = 256;
+  double frequency[batch];
   for (std::size_t i = 0; i < count; ++i) {
     const std::size_t k = first + i;
+    if (i % batch == 0) distribution_.draw(spec.seed, k, std::span<double>(frequency, std::min(batch, count - i)));
     Texel& t = run.texels.emplace_back();
     t.start = Millimetres(static_cast<double>(k) * L);
-    t.frequency = CyclesPerMm(distribution_.draw(spec.seed, k));
+    t.frequency = CyclesPerMm(frequency[i % batch]);
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
     t.envelope = 1.0 - C * (1.0 - coarse[constant ? 0 : i]);

@@ -19,6 +19,7 @@
 #include <rapidcheck/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -255,6 +256,45 @@ TEST(PitchDistribution, DrawIsAPureFunctionOfSeedAndIndex) {
   // exp(mu + sigma·Φ⁻¹(0.13143070512329408)).
   // Φ⁻¹ from mpmath at 30 digits: -1.11965358775361904313.
   EXPECT_NEAR(d.draw(1, 0), std::exp(d.mu() + d.sigma() * -1.11965358775361904313), 1e-13);
+}
+
+TEST(PitchDistribution, RunsOfDrawsAreTheScalarDrawsBitForBit) {
+  // The lane-wise run draw(seed, first, out) against draw(seed, k) one by
+  // one: narrow and wide distributions (tails of the normal quantile, many
+  // redraws), clamping, quantization, zero spread, a band holding little of
+  // the distribution, and runs that start and end off the lane width.
+  std::vector<PitchDistributionConfig> configs;
+  configs.push_back(config(10.0, -5.0));
+  configs.push_back(config(10.0, 10.0));  // wide: redraws at the band top
+  auto clamp = config(10.0, 12.0);
+  clamp.out_of_band = OutOfBand::clamp;
+  configs.push_back(clamp);
+  auto quantized = config(10.0, 10.0);
+  quantized.quantization_db = 1.5;
+  configs.push_back(quantized);
+  configs.push_back(config(6.0, 0.0, Parameterization::log));  // sigma = 0
+  configs.push_back(config(6.0, 8.0, Parameterization::log));
+  auto narrow_band = config(0.0, 0.0, Parameterization::log);
+  narrow_band.irregularity = Decibels(12.0);
+  narrow_band.band_min = CyclesPerMm(0.9);
+  narrow_band.band_max = CyclesPerMm(1.2);  // ~3% of the mass: most first attempts redraw
+  configs.push_back(narrow_band);
+  auto tiny = config(-30.0, -30.0);
+  tiny.band_min = CyclesPerMm(1e-4);
+  configs.push_back(tiny);
+  for (std::size_t c = 0; c < configs.size(); ++c) {
+    const PitchDistribution d(configs[c]);
+    for (const auto& [first, count] : std::vector<std::pair<std::uint64_t, std::size_t>>{
+             {0, 1}, {0, 7}, {3, 13}, {1000, 4096}, {(std::uint64_t{1} << 36) + 5, 1001}}) {
+      for (std::uint64_t seed : {1u, 7u, 12345u}) {
+        std::vector<double> run(count, -7.0);
+        d.draw(seed, first, run);
+        for (std::size_t i = 0; i < count; ++i)
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(run[i]), std::bit_cast<std::uint64_t>(d.draw(seed, first + i)))
+              << "config " << c << " seed " << seed << " draw " << first + i;
+      }
+    }
+  }
 }
 
 class Quantized : public ::testing::TestWithParam<double> {};

@@ -10,14 +10,16 @@
 
 namespace texel::detail {
 
-// W doubles in one vector register (`type`), and the W-lane int32, uint16 and
-// float vectors the encoders convert through. Spelled out per width: GCC
-// drops vector_size on a type that depends on a template parameter.
+// W doubles in one vector register (`type`), the W-lane uint64 vector of
+// their bits, and the W-lane int32, uint16 and float vectors the encoders
+// convert through. Spelled out per width: GCC drops vector_size on a type
+// that depends on a template parameter.
 template <int W>
 struct Lanes;
 template <>
 struct Lanes<2> {
   using type = double __attribute__((vector_size(16)));
+  using u64 = std::uint64_t __attribute__((vector_size(16)));
   using i32 = std::int32_t __attribute__((vector_size(8)));
   using u16 = std::uint16_t __attribute__((vector_size(4)));
   using f32 = float __attribute__((vector_size(8)));
@@ -25,6 +27,7 @@ struct Lanes<2> {
 template <>
 struct Lanes<4> {
   using type = double __attribute__((vector_size(32)));
+  using u64 = std::uint64_t __attribute__((vector_size(32)));
   using i32 = std::int32_t __attribute__((vector_size(16)));
   using u16 = std::uint16_t __attribute__((vector_size(8)));
   using f32 = float __attribute__((vector_size(16)));
@@ -32,6 +35,7 @@ struct Lanes<4> {
 template <>
 struct Lanes<8> {
   using type = double __attribute__((vector_size(64)));
+  using u64 = std::uint64_t __attribute__((vector_size(64)));
   using i32 = std::int32_t __attribute__((vector_size(32)));
   using u16 = std::uint16_t __attribute__((vector_size(16)));
   using f32 = float __attribute__((vector_size(32)));
