@@ -29,9 +29,18 @@ std::optional<MapFileKind> map_file_kind(const std::string& path);
 
 struct MapFileOptions {
   std::size_t chunk_samples = std::size_t{1} << 16;  ///< samples rendered per chunk (> 0) [65536]
+  /// Threads rendering and encoding chunks: 0 = automatic (the hardware's
+  /// threads, at most max_auto_threads), 1 = the calling thread alone [0].
+  /// The bytes written and the stats never depend on it.
+  unsigned threads = 0;
+  static constexpr unsigned max_auto_threads = 4;
   /// Called after each chunk with the fraction written (0 … 1]; may be empty.
   std::function<void(double)> progress;
 };
+
+/// The threads write_map uses for `requested` (MapFileOptions::threads):
+/// itself when > 0, else the hardware's, between 1 and max_auto_threads.
+unsigned map_file_threads(unsigned requested);
 
 /// What write_map wrote.
 struct MapFileStats {
@@ -43,6 +52,13 @@ struct MapFileStats {
 /// Renders `surface` chunk by chunk into `path` (kind by extension; .bin in
 /// `format`). Throws InvalidArgument for another extension, IoError when the
 /// file cannot be written (nothing is left behind).
+///
+/// With several threads, worker threads render and encode chunks ahead (at
+/// most two chunks per thread in memory) while the calling thread writes
+/// them strictly in order and calls `progress`; an exception in a worker
+/// stops the others and is rethrown here, with no file left behind.
+/// `surface` is rendered concurrently (Surface::render is safe to call from
+/// several threads on a prepared surface).
 MapFileStats write_map(const std::string& path, const Surface& surface, SampleFormat format, const MapFileOptions& options = {});
 
 }  // namespace texel

@@ -156,15 +156,20 @@ class TexelTexture final : public Texture {
     std::vector<double> coarse;  // work: c_k of the run
   };
 
+  struct BlockCache;
+
   /// Draws texels [first, first + count) into `run`, starting from `phase`
   /// (the continuous phase entering texel `first`); returns the phase
   /// entering texel first + count.
   double draw(std::size_t first, std::size_t count, double phase, TexelRun& run) const;
+  /// That phase alone: draw's frequencies and recurrence, keeping nothing.
+  double advance(std::size_t first, std::size_t count, double phase) const;
   /// The run of checkpoint block `block` (lazy mode).
   void draw_block(std::size_t block, TexelRun& run) const;
   /// Texel k's run: the kept one, or this thread's block of a checkpointed
-  /// texture (kept from one window to the next: no redrawing and no
-  /// allocation per window). Valid until the thread draws another block.
+  /// texture (kept from one window to the next, and shared with the other
+  /// threads through blocks_: no redrawing and no allocation per window).
+  /// Valid until the thread asks for another block.
   const TexelRun& run_of(std::size_t k) const;
 
   TexelSpec spec_;
@@ -174,6 +179,7 @@ class TexelTexture final : public Texture {
   TexelRun kept_;                               // every texel (count_ <= kept_texels)
   std::vector<double> checkpoint_phase_;        // else: the phase entering texel c·checkpoint_stride
   std::shared_ptr<detail::TexelListOnce> all_;  // texels() of a checkpointed texture, drawn once
+  std::shared_ptr<BlockCache> blocks_;          // its recently drawn blocks, shared by threads
   double end_mm_ = 0.0;
   std::uint64_t id_ = 0;  // unique per prepared texture (copies share it: same texels)
 };

@@ -161,12 +161,38 @@ TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Samp
   // its checkpoint has the whole's bits).
   checkpoint_phase_.reserve((count_ + checkpoint_stride - 1) / checkpoint_stride);
   all_ = std::make_shared<detail::TexelListOnce>();
-  TexelRun run;
+  blocks_ = std::make_shared<BlockCache>();
   double phase = phase0;
   for (std::size_t k0 = 0; k0 < count_; k0 += checkpoint_stride) {
     checkpoint_phase_.push_back(phase);
-    phase = draw(k0, std::min(checkpoint_stride, count_ - k0), phase, run);
+    phase = advance(k0, std::min(checkpoint_stride, count_ - k0), phase);
   }
+}
+
+namespace {
+/// The phase recurrence: texel k starts at `phase` (in [0, 1) cycles), the
+/// next starts where it ends, kept in [0, 1) so precision does not decay
+/// along the surface. draw and advance share it: the same bits.
+[[gnu::always_inline]] inline double phase_after(double phase, double frequency, double L) {
+  const double next = phase + frequency * L;
+  return next - detmath::floor_exact(next);
+}
+}  // namespace
+
+double TexelTexture::advance(std::size_t first, std::size_t count, double phase) const {
+  const double L = spec_.texel_length.value();
+  const CounterRng phase_rng(spec_.seed, Stream::phase);
+  constexpr std::size_t batch = 256;
+  double frequency[batch];
+  for (std::size_t i0 = 0; i0 < count; i0 += batch) {
+    const std::size_t n = std::min(batch, count - i0);
+    distribution_.draw(spec_.seed, first + i0, std::span<double>(frequency, n));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (spec_.phase == PhaseMode::reset) phase = phase_rng.uniform(first + i0 + i + 1);
+      phase = phase_after(phase, frequency[i], L);
+    }
+  }
+  return phase;
 }
 
 double TexelTexture::draw(std::size_t first, std::size_t count, double phase, TexelRun& run) const {
@@ -204,10 +230,7 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
     t.envelope = 1.0 - C * (1.0 - coarse[constant ? 0 : i]);
     run.offset.push_back(t.envelope - t.envelope * F * 0.5);
     run.gain.push_back(t.envelope * F * 0.5);
-    // Continuous phase: the next texel starts where this one ends. Keep the
-    // phase in [0, 1) cycles so precision does not decay along the surface.
-    const double next = phase + t.frequency.value() * L;
-    phase = next - detmath::floor_exact(next);
+    phase = phase_after(phase, t.frequency.value(), L);
   }
   return phase;
 }
@@ -217,15 +240,67 @@ void TexelTexture::draw_block(std::size_t block, TexelRun& run) const {
   (void)draw(first, std::min(checkpoint_stride, count_ - first), checkpoint_phase_[block], run);
 }
 
+/// The blocks of a checkpointed texture drawn most recently, shared by every
+/// thread that renders it, so that a block two threads' windows share (the
+/// end of one chunk of write_map and the start of the next) is drawn once.
+/// A block is shared read-only once drawn; one whose only holder is the cache
+/// is recycled for the next block drawn (no allocation once warm). Drawing
+/// happens outside the lock; two threads that miss the same block at the
+/// same moment both draw it (the same bits) and the first kept wins.
+struct TexelTexture::BlockCache {
+  static constexpr std::size_t capacity = 16;  // ~70 KB each
+
+  std::mutex mutex;
+  std::vector<std::shared_ptr<TexelRun>> recent;  // most recently used first
+
+  std::shared_ptr<const TexelRun> get(const TexelTexture& texture, std::size_t block) {
+    const std::size_t first = block * checkpoint_stride;
+    std::shared_ptr<TexelRun> run;
+    {
+      const std::lock_guard lock(mutex);
+      if (auto hit = find(first); hit != recent.end()) {
+        std::rotate(recent.begin(), hit, hit + 1);
+        return recent.front();
+      }
+      // Recycle the least recently used block if nobody else holds it (a
+      // holder gets its reference under this lock, so none can appear).
+      if (recent.size() >= capacity && recent.back().use_count() == 1) {
+        // The last holder's release (its reference count's decrement) comes
+        // before our writes to the block.
+        std::atomic_thread_fence(std::memory_order_acquire);
+        run = std::move(recent.back());
+        recent.pop_back();
+      }
+    }
+    if (!run) run = std::make_shared<TexelRun>();
+    run->owner = 0;  // not valid until drawn (draw may throw on allocation)
+    texture.draw_block(block, *run);
+    run->owner = texture.id_;
+    const std::lock_guard lock(mutex);
+    if (auto hit = find(first); hit != recent.end()) {  // drawn meanwhile by another thread
+      std::rotate(recent.begin(), hit, hit + 1);
+      return recent.front();
+    }
+    recent.insert(recent.begin(), std::move(run));
+    if (recent.size() > capacity) recent.pop_back();
+    return recent.front();
+  }
+
+ private:
+  std::vector<std::shared_ptr<TexelRun>>::iterator find(std::size_t first) {
+    return std::find_if(recent.begin(), recent.end(), [&](const auto& r) { return r->first == first; });
+  }
+};
+
 const TexelTexture::TexelRun& TexelTexture::run_of(std::size_t k) const {
   if (checkpoint_phase_.empty()) return kept_;
-  thread_local TexelRun block;
-  if (block.owner != id_ || k < block.first || k >= block.first + block.texels.size()) {
-    block.owner = 0;  // not valid until drawn (draw may throw on allocation)
-    draw_block(k / checkpoint_stride, block);
-    block.owner = id_;
-  }
-  return block;
+  // This thread's current block, kept from one window to the next (no lock
+  // while the texels of one block render). Another texture's block (ids are
+  // never reused) or another block goes back to the texture's cache.
+  thread_local std::shared_ptr<const TexelRun> block;
+  if (!block || block->owner != id_ || k < block->first || k >= block->first + block->texels.size())
+    block = blocks_->get(*this, k / checkpoint_stride);
+  return *block;
 }
 
 namespace detail {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "texel/device.hpp"
@@ -90,6 +91,39 @@ TEST(TexelCheckpoints, CheckpointedTexturesRenderTheKeptBytes) {
     EXPECT_EQ(seen, kept.texel_count());
     EXPECT_EQ(lazy.texels()[seen - 1].phase_cycles, kept.texels()[seen - 1].phase_cycles);
   }
+}
+
+TEST(TexelCheckpoints, ThreadsRenderingOneTextureAtOnceGetTheSameBytes) {
+  // Eight threads render interleaved windows of one checkpointed texture at
+  // the same time, again and again, sharing its block cache: the windows
+  // straddle blocks, so threads want the same block at once, and more
+  // threads than cores are preempted while they hold a block the others
+  // cycle past. Every window equals the single-threaded render of the whole.
+  const Grid grid{Millimetres(0.0), Millimetres(0.001), 1'000'000};
+  TexelSpec spec;
+  spec.seed = 21;
+  spec.texel_length = Millimetres(0.01);  // 100,000 texels in 98 blocks, 10 samples each
+  spec.coarse_strength = 0.5;
+  spec.coarse = SineProfile{Millimetres(3.0), 0.0};
+  const TexelTexture lazy(spec, grid.length(), Sampling{grid}, 0);
+  const TexelTexture kept(spec, grid.length(), Sampling{grid}, std::size_t(-1));
+  std::vector<double> want(static_cast<std::size_t>(grid.count));
+  kept.render(grid, 0, want);
+  constexpr std::size_t window = 24'999;
+  constexpr unsigned threads = 8;
+  std::vector<std::vector<double>> got(threads, std::vector<double>(want.size(), -1.0));
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      for (unsigned pass = 0; pass < 12; ++pass)  // a different share of the windows each pass
+        for (std::size_t w = (t + pass) % threads; w * window < want.size(); w += threads) {
+          const std::size_t first = w * window;
+          lazy.render(grid, static_cast<std::int64_t>(first),
+                      std::span<double>(got[t].data() + first, std::min(window, want.size() - first)));
+        }
+    });
+  for (auto& t : pool) t.join();
+  for (unsigned t = 0; t < threads; ++t) EXPECT_TRUE(same_bits(got[t], want)) << "thread " << t;
 }
 
 TEST(TexelCheckpoints, MillionsOfTexelsRenderInBoundedMemory) {

@@ -3,6 +3,8 @@
 // long map to it keeps memory bounded by a chunk, not by the map.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +18,8 @@
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/map_file.hpp"
+#include "texel/reference.hpp"
+#include "texel/texture.hpp"
 
 namespace {
 
@@ -95,10 +99,135 @@ TEST(MapFile, FailureLeavesNothingAndOtherExtensionsAreRefused) {
   o.progress = [](double f) {
     if (f > 0.5) throw IoError("disk full (simulated)");
   };
-  EXPECT_THROW((void)write_map(dir.at("new.bin"), surface, doc.device.format, o), IoError);
-  EXPECT_THROW((void)write_map(dir.at("old.bin"), surface, doc.device.format, o), IoError);
-  EXPECT_EQ(dir.listing(), (std::set<std::string>{"old.bin"}));
-  EXPECT_EQ(slurp(dir.at("old.bin")), "old");
+  for (unsigned threads : {1u, 3u}) {  // the caller's exception with workers running, too
+    o.threads = threads;
+    EXPECT_THROW((void)write_map(dir.at("new.bin"), surface, doc.device.format, o), IoError);
+    EXPECT_THROW((void)write_map(dir.at("old.bin"), surface, doc.device.format, o), IoError);
+    EXPECT_EQ(dir.listing(), (std::set<std::string>{"old.bin"}));
+    EXPECT_EQ(slurp(dir.at("old.bin")), "old");
+  }
+}
+
+/// A texture whose render throws for windows that reach `fail_at`, and
+/// counts the windows it was asked for: a failing worker.
+class FailingTexture final : public Texture {
+ public:
+  FailingTexture(Millimetres length, std::int64_t fail_at) : length_(length), fail_at_(fail_at) {}
+  [[nodiscard]] Millimetres length() const override { return length_; }
+  void render(const Grid&, std::int64_t first, std::span<double> out) const override {
+    calls_.fetch_add(1);
+    if (first + static_cast<std::int64_t>(out.size()) > fail_at_) throw IoError("scratch file unreadable (simulated)");
+    std::fill(out.begin(), out.end(), 0.25);
+  }
+  [[nodiscard]] std::string describe() const override { return "failing"; }
+  [[nodiscard]] int calls() const { return calls_.load(); }
+
+ private:
+  Millimetres length_;
+  std::int64_t fail_at_;
+  mutable std::atomic<int> calls_{0};
+};
+
+TEST(MapFile, ThreadCountNeverChangesTheBytesOrTheStats) {
+  // The same file and the same mean_amplitude from 1, 2, 3 and 8 threads,
+  // for every format: a two-scale tpad map, a checkpointed texture (more
+  // than kept_texels texels, whose blocks the threads share) and a surface
+  // of two regions, a reference whose prepared samples live in a scratch
+  // file (pread by every thread) beside a Texel texture.
+  TempDir dir("mapfile");
+  std::vector<std::pair<std::string, Surface>> surfaces;
+  surfaces.emplace_back("tpad two-scale", prepare_surface(study(load_device("tpad"))));
+  {
+    DeviceProfile d = load_device("generic");
+    d.samples = 600'000;  // 3 m at 5 µm
+    TexelSpec s;
+    s.central_pitch = Decibels(12.0);
+    s.texel_length = Millimetres(0.02);  // 150,000 texels: checkpointed
+    s.coarse_strength = 0.3;
+    s.coarse = SineProfile{Millimetres(40.0), 10.0};
+    s.seed = 4;
+    const Surface surface = prepare_surface(make_document(d, s));
+    const auto* t = dynamic_cast<const TexelTexture*>(surface.regions().at(0).texture.get());
+    ASSERT_NE(t, nullptr);
+    ASSERT_GT(t->texel_count(), TexelTexture::kept_texels);
+    surfaces.emplace_back("checkpointed", surface);
+  }
+  {
+    const Grid grid{Millimetres(0.0), Millimetres(0.005), 200'000};
+    ReferenceSpec white;
+    white.name = "white";
+    white.seed = 3;
+    // Prepared for the grid the region sees (origin at its left edge), so
+    // rendering reads the prepared samples back from the scratch file.
+    const Sampling sampling{Grid{Millimetres(-50.0), grid.spacing, 0}};
+    auto reference = std::make_shared<const ReferenceTexture>(white, Millimetres(400.0), sampling, ReferenceMemory{4096, 1000});
+    ASSERT_TRUE(reference->samples_in_scratch_file());
+    TexelSpec s;
+    s.seed = 5;
+    auto texel = prepare(s, Millimetres(500.0), Sampling{Grid{Millimetres(-480.0), grid.spacing, 0}});
+    surfaces.emplace_back("reference + texel", Surface(grid, {Region{"ref", Millimetres(50.0), Millimetres(400.0), reference},
+                                                              Region{"texel", Millimetres(480.0), Millimetres(500.0), texel}}));
+  }
+  for (const auto& [name, surface] : surfaces) {
+    for (const char* file : {"m.bin", "m.npy", "m.csv"}) {
+      for (std::size_t chunk : {std::size_t{777}, std::size_t{1} << 14}) {
+        MapFileOptions o;
+        o.chunk_samples = chunk;
+        o.threads = 1;
+        const MapFileStats one = write_map(dir.at(file), surface, SampleFormat::u16le, o);
+        const std::string want = slurp(dir.at(file));
+        for (unsigned threads : {2u, 3u, 8u}) {
+          o.threads = threads;
+          double last = 0.0;
+          o.progress = [&](double f) {
+            EXPECT_GT(f, last);  // in order, from the calling thread
+            last = f;
+          };
+          const MapFileStats many = write_map(dir.at(file), surface, SampleFormat::u16le, o);
+          EXPECT_TRUE(slurp(dir.at(file)) == want) << name << " " << file << " chunk " << chunk << " threads " << threads;
+          EXPECT_EQ(many.mean_amplitude, one.mean_amplitude) << name << " " << file << " threads " << threads;
+          EXPECT_EQ(many.bytes, one.bytes);
+          EXPECT_EQ(last, 1.0);
+        }
+      }
+    }
+  }
+}
+
+TEST(MapFile, AWorkerExceptionStopsTheOthersAndLeavesNoFile) {
+  // A window past sample 300,000 throws in whichever worker renders it: the
+  // error reaches the caller, the workers stop (far fewer windows than the
+  // map's are rendered), and neither a new file nor a temporary remains; an
+  // existing file keeps its bytes.
+  TempDir dir("mapfile");
+  const std::int64_t samples = 10'000'000;
+  const Grid grid{Millimetres(0.0), Millimetres(0.005), samples};
+  { std::ofstream(dir.at("old.bin")) << "old"; }
+  for (unsigned threads : {1u, 2u, 4u}) {
+    for (const char* file : {"new.bin", "old.bin", "new.csv"}) {
+      auto texture = std::make_shared<const FailingTexture>(grid.length(), 300'000);
+      const Surface surface(grid, {Region{"r", Millimetres(0.0), grid.length(), texture}});
+      MapFileOptions o;
+      o.chunk_samples = 1000;
+      o.threads = threads;
+      try {
+        (void)write_map(dir.at(file), surface, SampleFormat::u16le, o);
+        ADD_FAILURE() << "no exception with " << threads << " threads";
+      } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find("simulated"), std::string::npos) << e.what();
+      }
+      EXPECT_LT(texture->calls(), 300 + 2 * 8 * static_cast<int>(threads)) << threads << " threads rendered on";
+      EXPECT_EQ(dir.listing(), (std::set<std::string>{"old.bin"})) << file << ", " << threads << " threads";
+      EXPECT_EQ(slurp(dir.at("old.bin")), "old");
+    }
+  }
+}
+
+TEST(MapFile, ThreadsAreAutomaticUpToAFewOrAsAsked) {
+  EXPECT_GE(map_file_threads(0), 1u);
+  EXPECT_LE(map_file_threads(0), MapFileOptions::max_auto_threads);
+  EXPECT_EQ(map_file_threads(1), 1u);
+  EXPECT_EQ(map_file_threads(6), 6u);
 }
 
 using test_support::peak_rss_kib;
