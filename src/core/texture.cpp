@@ -61,7 +61,15 @@ template <int W>
     block(a);
     std::memcpy(out + m, &a, sizeof a);
   }
-  if (m < count) {  // a short final block computes every lane, stores the live ones
+  if (m == count) return;
+  if (count >= W) {
+    // The last W samples again, overlapping the previous block: a sample's
+    // value is a function of its index alone, so the overlap is rewritten
+    // with the same bits, and the store is one whole vector.
+    for (int l = 0; l < W; ++l) index[l] = run.base + static_cast<double>(count - W + l);
+    block(a);
+    std::memcpy(out + count - W, &a, sizeof a);
+  } else {  // a run shorter than a vector computes every lane, stores the live ones
     block(a);
     std::memcpy(out + m, &a, static_cast<std::size_t>(count - m) * sizeof(double));
   }
