@@ -37,7 +37,9 @@ class Texture {
   /// Length of the textured span (mm); positions beyond it are at rest.
   [[nodiscard]] virtual Millimetres length() const = 0;
   /// Amplitudes at grid positions first, first+1, ... (grid positions are in
-  /// the texture's own coordinates). Same values whatever the window.
+  /// the texture's own coordinates). Same values whatever the window. Writes
+  /// every element of `out` (0 at rest). Safe to call from several threads
+  /// at once.
   virtual void render(const Grid& grid, std::int64_t first, std::span<double> out) const = 0;
   /// Short human-readable description, e.g. "texel P=10 dB I=-5 dB L=0.25 mm".
   [[nodiscard]] virtual std::string describe() const = 0;

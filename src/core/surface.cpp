@@ -35,8 +35,10 @@ Surface::Surface(Grid grid, std::vector<Region> regions) : grid_(grid), regions_
 }
 
 void Surface::render(std::int64_t first, std::span<double> out) const {
-  std::fill(out.begin(), out.end(), 0.0);
   const auto n = static_cast<std::int64_t>(out.size());
+  // Samples in no region are at rest: zero the gaps between the regions'
+  // windows only (a texture's render writes every sample of its window).
+  std::int64_t rest = first;  // samples [first, rest) are written
   for (const Region& r : regions_) {
     // Samples i with start <= position(i) < start + length belong to r.
     const double end_mm = r.start.value() + r.length.value();
@@ -55,8 +57,11 @@ void Surface::render(std::int64_t first, std::span<double> out) const {
     while (b < first + n && inside(b)) ++b;
     // The region's texture sees positions from its own origin.
     const Grid local{grid_.origin - r.start, grid_.spacing, grid_.count};
+    if (a > rest) std::fill(out.begin() + (rest - first), out.begin() + (a - first), 0.0);
     r.texture->render(local, a, out.subspan(static_cast<std::size_t>(a - first), static_cast<std::size_t>(b - a)));
+    rest = std::max(rest, b);  // regions may share a sample within their 1e-9 mm tolerance
   }
+  std::fill(out.begin() + (rest - first), out.end(), 0.0);
 }
 
 std::vector<double> Surface::render() const {

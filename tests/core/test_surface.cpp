@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "texel/device.hpp"
 #include "texel/error.hpp"
@@ -69,6 +70,29 @@ TEST(Surface, SamplesInNoRegionAreAtRest) {
   double inside = 0.0;
   for (std::size_t i = 300; i < 700; ++i) inside += map[i];
   EXPECT_GT(inside / 400.0, 0.2);
+}
+
+TEST(Surface, EveryWindowZeroesItsSamplesAtRestWhateverTheBufferHeld) {
+  // Render zeroes only the gaps between regions (no pass over the whole
+  // window): windows into a buffer of garbage, starting and ending in gaps,
+  // in regions and across both, equal the whole map, gaps included.
+  const Grid g{Millimetres(0.0), Millimetres(0.01), 1000};  // 10 mm
+  const Surface s(g, {Region{"a", Millimetres(1.0), Millimetres(2.0), texture(10.0, 1, 2.0, g)},
+                      Region{"b", Millimetres(3.0), Millimetres(1.5), texture(12.0, 2, 1.5, g)},
+                      Region{"c", Millimetres(6.0), Millimetres(3.0), texture(8.0, 3, 3.0, g)}});
+  const auto whole = s.render();
+  for (std::size_t first : {0, 50, 100, 250, 299, 300, 420, 500, 598, 950}) {
+    for (std::size_t len : {1, 7, 60, 333, 1000}) {
+      if (first + len > whole.size()) continue;
+      std::vector<double> win(len, std::nan(""));
+      s.render(static_cast<std::int64_t>(first), win);
+      ASSERT_EQ(std::memcmp(win.data(), whole.data() + first, len * sizeof(double)), 0) << first << " + " << len;
+    }
+  }
+  const Surface empty(g, {});
+  std::vector<double> win(100, 0.5);
+  empty.render(10, win);
+  for (double v : win) ASSERT_EQ(v, 0.0);
 }
 
 TEST(Surface, RejectsOverlappingAndOutOfRangeRegions) {
