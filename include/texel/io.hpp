@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
@@ -43,6 +44,9 @@ class AtomicFile {
   std::string path_;
   std::string tmp_;
   int fd_ = -1;
+  std::uint64_t written_ = 0;  // bytes written so far
+  std::uint64_t kicked_ = 0;   // bytes whose write-back has been started
+  static constexpr std::uint64_t writeback_step = std::uint64_t{8} << 20;
 };
 
 /// Throws IoError if `path`'s directory does not exist or is not writable,
