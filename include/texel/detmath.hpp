@@ -136,6 +136,70 @@ template <class T>
   return q * num / den;
 }
 
+/// log's core for positive, finite, normal x, generic over the value type T
+/// and the matching 64-bit word type U (double and std::uint64_t, or GCC/clang
+/// vectors of them, every lane doing the scalar operations): x = m·2^e with
+/// m in [√½, √2), exactly, from the bits; log m = 2·atanh(s), s = (m−1)/(m+1),
+/// |s| <= 0.1716, by the odd series to s^23. `e_offset` is added to e (the
+/// scalar log's pre-scaling of subnormals). All exponent arithmetic is on
+/// small whole numbers, exact in double.
+template <class T, class U>
+[[gnu::always_inline]] constexpr T log_normal_generic(T x, double e_offset = 0.0) {
+  const U bits = std::bit_cast<U>(x);
+  const U biased = (bits >> 52) & 0x7FFULL;
+  T m = std::bit_cast<T>((bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL);  // [1, 2)
+  // The biased exponent as a double, exactly: 2^52 + biased, less 2^52.
+  T de = std::bit_cast<T>(biased | 0x4330000000000000ULL) - 4503599627370496.0;
+  de = de + (e_offset - 1023.0);
+  // m above √2: halve it and count one more power of two. (Selects on the
+  // comparison itself: a vector mask kept in a variable is slow to build.)
+  de = m > 1.4142135623730951 ? de + 1.0 : de;
+  m = m > 1.4142135623730951 ? m * 0.5 : m;
+  const T s = (m - 1.0) / (m + 1.0);
+  const T s2 = s * s;
+  T p = 1.0 / 23.0 * s2 + 1.0 / 21.0;
+  p = p * s2 + 1.0 / 19.0;
+  p = p * s2 + 1.0 / 17.0;
+  p = p * s2 + 1.0 / 15.0;
+  p = p * s2 + 1.0 / 13.0;
+  p = p * s2 + 1.0 / 11.0;
+  p = p * s2 + 1.0 / 9.0;
+  p = p * s2 + 1.0 / 7.0;
+  p = p * s2 + 1.0 / 5.0;
+  p = p * s2 + 1.0 / 3.0;
+  const T log_m = 2.0 * s + 2.0 * s * s2 * p;
+  return de * ln2_hi + (log_m + de * ln2_lo);
+}
+
+/// AS241's first tail branch, for |q| > 0.425 where r = √(−log(min(p, 1−p)))
+/// is at most 5: the magnitude of Φ⁻¹(p), num(r − 1.6)/den(r − 1.6). Generic
+/// over the value type; normal_quantile uses it for that branch.
+template <class T>
+[[gnu::always_inline]] constexpr T normal_quantile_tail_generic(T r) {
+  r = r - 1.6;
+  const T num = (((((((7.74545014278341407640e-4 * r + 2.27238449892691845833e-2) * r + 2.41780725177450611770e-1) * r +
+                     1.27045825245236838258e+0) *
+                        r +
+                    3.64784832476320460504e+0) *
+                       r +
+                   5.76949722146069140550e+0) *
+                      r +
+                  4.63033784615654529590e+0) *
+                     r +
+                 1.42343711074968357734e+0);
+  const T den = (((((((1.05075007164441684324e-9 * r + 5.47593808499534494600e-4) * r + 1.51986665636164571966e-2) * r +
+                     1.48103976427480074590e-1) *
+                        r +
+                    6.89767334985100004550e-1) *
+                       r +
+                   1.67638483018380384940e+0) *
+                      r +
+                  2.05319162663775882187e+0) *
+                     r +
+                 1.0);
+  return num / den;
+}
+
 /// sin(2π·u) for any |u| < 2^50 cycles.
 constexpr double sin_cycles(double u) { return sin_cycles_generic(u); }
 

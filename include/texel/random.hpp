@@ -23,8 +23,11 @@
 
 namespace texel {
 
-/// The SplitMix64 output function (a bijection on 64-bit words).
-constexpr std::uint64_t mix64(std::uint64_t z) {
+/// The SplitMix64 output function (a bijection on 64-bit words), generic
+/// over the word type: std::uint64_t, or a GCC/clang vector of them whose
+/// every lane does the scalar operations (modular, so exactly the same).
+template <class U>
+[[gnu::always_inline]] constexpr U mix64_generic(U z) {
   z ^= z >> 30;
   z *= 0xBF58476D1CE4E5B9ULL;
   z ^= z >> 27;
@@ -32,6 +35,9 @@ constexpr std::uint64_t mix64(std::uint64_t z) {
   z ^= z >> 31;
   return z;
 }
+
+/// The SplitMix64 output function (a bijection on 64-bit words).
+constexpr std::uint64_t mix64(std::uint64_t z) { return mix64_generic(z); }
 
 /// High 64 bits of the 128-bit product a·b, portably.
 constexpr std::uint64_t mul_high(std::uint64_t a, std::uint64_t b) {
@@ -59,8 +65,12 @@ class CounterRng {
   constexpr CounterRng(std::uint64_t seed, Stream stream) : CounterRng(seed, static_cast<std::uint64_t>(stream)) {}
 
   /// 64 random bits for this counter.
-  [[nodiscard]] constexpr std::uint64_t bits(std::uint64_t counter) const {
-    return mix64(key_ + (counter + 1) * 0x9E3779B97F4A7C15ULL);
+  [[nodiscard]] constexpr std::uint64_t bits(std::uint64_t counter) const { return bits_generic(counter); }
+  /// bits(), generic over the counter type like mix64_generic: a vector of
+  /// counters gives each lane's bits.
+  template <class U>
+  [[nodiscard]] [[gnu::always_inline]] constexpr U bits_generic(U counter) const {
+    return mix64_generic(key_ + (counter + 1) * 0x9E3779B97F4A7C15ULL);
   }
   /// Uniform in the open interval (0, 1), 53-bit resolution.
   [[nodiscard]] constexpr double uniform(std::uint64_t counter) const {

@@ -16,37 +16,9 @@ double log(double x) {
   if (std::isnan(x) || x < 0.0) return std::numeric_limits<double>::quiet_NaN();
   if (x == 0.0) return -std::numeric_limits<double>::infinity();
   if (std::isinf(x)) return x;
-  // Decompose x = m·2^e with m in [sqrt(1/2), sqrt(2)), exactly, via the bits.
-  int e = 0;
-  std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
-  if ((bits >> 52) == 0) {  // subnormal: scale into the normal range first
-    x *= 0x1.0p54;
-    e -= 54;
-    bits = std::bit_cast<std::uint64_t>(x);
-  }
-  e += static_cast<int>((bits >> 52) & 0x7FF) - 1023;
-  double m = std::bit_cast<double>((bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL);  // [1, 2)
-  if (m > 1.4142135623730951) {
-    m *= 0.5;
-    e += 1;
-  }
-  // log m = 2·atanh(s), s = (m−1)/(m+1), |s| <= 0.1716: odd series to s^23.
-  const double s = (m - 1.0) / (m + 1.0);
-  const double s2 = s * s;
-  double p = 1.0 / 23.0;
-  p = p * s2 + 1.0 / 21.0;
-  p = p * s2 + 1.0 / 19.0;
-  p = p * s2 + 1.0 / 17.0;
-  p = p * s2 + 1.0 / 15.0;
-  p = p * s2 + 1.0 / 13.0;
-  p = p * s2 + 1.0 / 11.0;
-  p = p * s2 + 1.0 / 9.0;
-  p = p * s2 + 1.0 / 7.0;
-  p = p * s2 + 1.0 / 5.0;
-  p = p * s2 + 1.0 / 3.0;
-  const double log_m = 2.0 * s + 2.0 * s * s2 * p;
-  const double de = static_cast<double>(e);
-  return de * ln2_hi + (log_m + de * ln2_lo);
+  if ((std::bit_cast<std::uint64_t>(x) >> 52) == 0)  // subnormal: scale into the normal range first
+    return log_normal_generic<double, std::uint64_t>(x * 0x1.0p54, -54.0);
+  return log_normal_generic<double, std::uint64_t>(x);
 }
 
 double exp(double x) {
@@ -75,28 +47,7 @@ double normal_quantile(double p) {
   r = std::sqrt(-log(r));  // sqrt is correctly rounded by IEEE-754
   double value = 0.0;
   if (r <= 5.0) {
-    r -= 1.6;
-    const double num = (((((((7.74545014278341407640e-4 * r + 2.27238449892691845833e-2) * r + 2.41780725177450611770e-1) * r +
-                            1.27045825245236838258e+0) *
-                               r +
-                           3.64784832476320460504e+0) *
-                              r +
-                          5.76949722146069140550e+0) *
-                             r +
-                         4.63033784615654529590e+0) *
-                            r +
-                        1.42343711074968357734e+0);
-    const double den = (((((((1.05075007164441684324e-9 * r + 5.47593808499534494600e-4) * r + 1.51986665636164571966e-2) * r +
-                            1.48103976427480074590e-1) *
-                               r +
-                           6.89767334985100004550e-1) *
-                              r +
-                          1.67638483018380384940e+0) *
-                             r +
-                         2.05319162663775882187e+0) *
-                            r +
-                        1.0);
-    value = num / den;
+    value = normal_quantile_tail_generic(r);
   } else {
     r -= 5.0;
     const double num = (((((((2.01033439929228813265e-7 * r + 2.71155556874348757815e-5) * r + 1.24266094738807843860e-3) * r +

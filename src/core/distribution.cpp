@@ -1,5 +1,7 @@
 #include "texel/distribution.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 
@@ -26,59 +28,86 @@ void require_finite(double v, std::string_view field, std::string_view unit) {
 
 // ------------------------------------------------------------ lane-wise draws
 //
-// The first attempt of W texels' draws at once: u from the counter (integer
-// work, scalar), z = Φ⁻¹(u) by AS241's central branch, f = exp(mu + sigma·z)
-// by exp's reduction and polynomial, each lane doing exactly the scalar
-// operations in the same order (detmath's *_generic definitions, shared
-// with the scalar functions; -ffp-contract=off) — the pattern and reasoning
-// of the render kernel (texture.cpp, above render_lanes). Scalar fallbacks
-// take the rare branches: a tail of Φ⁻¹ (|u − 1/2| > 0.425) is the scalar
-// normal_quantile, and a lane whose exponent leaves 2^k's normal range or
-// whose frequency falls outside the band (a redraw, or a clamp) is marked
-// for PitchDistribution::draw, which starts again from attempt 0 and so
-// returns the same bits. The exp's ldexp becomes an exact multiplication by
-// 2^k, built from k's bits: k + (1.5·2^52 + 1023) holds k + 1023 in its low
-// mantissa bits (exact, |k| < 2^11), and shifted left by 52 they are 2^k's
-// exponent field.
+// The first attempt of W texels' draws at once, each lane doing exactly the
+// scalar operations in the same order — the pattern and reasoning of the
+// render kernel (texture.cpp, above render_lanes): the counter's bits
+// (CounterRng::bits_generic, modular integer arithmetic), the uniform, the
+// normal quantile (AS241's central branch and its first tail, through
+// detmath's generic definitions, which the scalar functions share) and
+// exp(mu + sigma·z), in IEEE double with -ffp-contract=off. Every lane
+// computes both branches and a select keeps the one the scalar code takes.
+// A lane the kernel cannot finish exactly is marked for
+// PitchDistribution::draw, which starts again from attempt 0 and so returns
+// the same bits: AS241's far tail (r > 5, p < 1.4e-11), an exponent k
+// outside 2^k's normal range, or a frequency outside the band (a redraw, or
+// a clamp). Some steps differ in form from the scalar code but not in
+// value, being exact: the uniform's 53-bit integer converted to double in
+// two 32-bit halves (each exact, their sum exact below 2^53); log's and
+// exp's exponents moved between integers and doubles through 2^52's bits
+// (exact below 2^51); ldexp as a multiplication by 2^k built from k's bits
+// (detmath::scale_pow2); square roots, correctly rounded either way.
+// tests/core/test_distribution.cpp compares runs with the scalar draw bit
+// for bit.
 struct DrawBatch {
   CounterRng rng;
   std::uint64_t first;  // index of out[0]
   double mu, sigma, lo, hi;
 };
 
-// Marks a lane for the scalar draw (a frequency is never negative).
-constexpr double scalar_draw = -1.0;
+// A negative value marks a lane for the scalar draw (a frequency never is).
 
 template <int W>
 [[gnu::always_inline]] inline void draw_lanes(const DrawBatch& b, double* out, std::size_t count) {
   using V = typename detail::Lanes<W>::type;
   using U = typename detail::Lanes<W>::u64;
-  constexpr double magic = 6755399441055744.0;  // 1.5 * 2^52
+  constexpr std::uint64_t two52_bits = 0x4330000000000000ULL;  // 2^52: n | two52_bits is 2^52 + n for n < 2^52
+  constexpr double two52 = 4503599627370496.0;
+  U lane{};
+  for (int l = 0; l < W; ++l) lane[l] = static_cast<std::uint64_t>(l);
   for (std::size_t i = 0; i < count; i += W) {
-    const std::size_t live = std::min<std::size_t>(W, count - i);
-    V u{};
-    for (std::size_t l = 0; l < live; ++l) u[l] = b.rng.uniform((b.first + i + l) * PitchDistribution::max_attempts);
-    for (std::size_t l = live; l < W; ++l) u[l] = 0.5;  // idle lanes: any value in the central branch
+    // u = ((bits >> 11) + 0.5)·2^-53, never 1 (CounterRng::uniform).
+    const U index = lane + (b.first + i);
+    const U word = b.rng.bits_generic(index * PitchDistribution::max_attempts) >> 11;
+    const V whole = (std::bit_cast<V>((word >> 32) | two52_bits) - two52) * 4294967296.0 +
+                    (std::bit_cast<V>((word & 0xFFFFFFFFULL) | two52_bits) - two52);
+    V u = (whole + 0.5) * 0x1.0p-53;
+    u = u < 1.0 ? u : V{} + 0x1.fffffffffffffp-1;
+    // z = Φ⁻¹(u) (detmath::normal_quantile's branches; |q| <= 0.425 is
+    // fabs(q) <= 0.425, q never NaN). Selects test the comparisons directly:
+    // vector masks kept in variables and combined are built lane by lane.
     const V q = u - 0.5;
-    V z = detmath::normal_quantile_central_generic(q);
-    for (std::size_t l = 0; l < live; ++l)
-      if (!(q[l] >= -0.425 && q[l] <= 0.425)) z[l] = detmath::normal_quantile(u[l]);
+    const V abs_q = q < 0.0 ? -q : q;
+    V r = q < 0.0 ? u : 1.0 - u;
+    r = -detmath::log_normal_generic<V, U>(r);
+    {
+      // Lane by lane through memory, where the compiler vectorizes it (no
+      // errno here); indexing the vector itself would split it into lanes.
+      alignas(sizeof(V)) double lanes[W];
+      std::memcpy(lanes, &r, sizeof r);
+      for (int l = 0; l < W; ++l) lanes[l] = std::sqrt(lanes[l]);  // correctly rounded
+      std::memcpy(&r, lanes, sizeof r);
+    }
+    V z = detmath::normal_quantile_tail_generic(r);
+    z = q < 0.0 ? -z : z;
+    z = abs_q <= 0.425 ? detmath::normal_quantile_central_generic(q) : z;
+    const V far = abs_q <= 0.425 ? V{} : r;  // r > 5: AS241's far tail, left to the scalar draw
+    // f = exp(t), t = mu + sigma·z (detmath::exp's reduction and scaling).
     const V t = b.mu + b.sigma * z;
     V k;
     const V p = detmath::exp_reduced_generic(t, k);
-    U two_k;
-    V biased = k + (magic + 1023.0);
-    std::memcpy(&two_k, &biased, sizeof two_k);
-    two_k <<= 52;
-    V scale;
-    std::memcpy(&scale, &two_k, sizeof scale);
-    const V f = p * scale;
-    for (std::size_t l = 0; l < live; ++l) {
-      // exp's own tests (NaN, overflow, underflow), then 2^k normal.
-      const bool exact = t[l] <= 709.782712893384 && t[l] >= -745.1332191019412 && k[l] >= -1022.0 && k[l] <= 1023.0;
-      const bool in_band = f[l] >= b.lo && f[l] <= b.hi;
-      out[i + l] = exact && in_band ? f[l] : scalar_draw;
-    }
+    const U biased = std::bit_cast<U>(k + (two52 + 1023.0));  // low bits: k + 1023
+    V f = p * std::bit_cast<V>(biased << 52);
+    // 2^k normal (k in [-1022, 1023] puts t inside exp's thresholds,
+    // -745.13 … 709.78, and a NaN t fails it), the near tail, the band:
+    // else a negative mark for the scalar draw. (Each test its own mark: GCC
+    // 12 merges selects with one common value into a mask it builds lane by
+    // lane.)
+    f = k >= -1022.0 ? f : V{} - 1.0;
+    f = k <= 1023.0 ? f : V{} - 2.0;
+    f = far <= 5.0 ? f : V{} - 3.0;
+    f = f >= b.lo ? f : V{} - 4.0;
+    f = f <= b.hi ? f : V{} - 5.0;
+    std::memcpy(out + i, &f, std::min<std::size_t>(W, count - i) * sizeof(double));
   }
 }
 
@@ -88,16 +117,17 @@ using DrawKernel = void (*)(const DrawBatch&, double*, std::size_t);
 __attribute__((target("avx512f"))) void draw_avx512(const DrawBatch& b, double* out, std::size_t n) { draw_lanes<8>(b, out, n); }
 __attribute__((target("avx2"))) void draw_avx2(const DrawBatch& b, double* out, std::size_t n) { draw_lanes<4>(b, out, n); }
 #endif
-void draw_generic(const DrawBatch& b, double* out, std::size_t n) { draw_lanes<2>(b, out, n); }
 
-/// The widest kernel this CPU runs (detail::simd_lanes), chosen once.
+/// The widest kernel this CPU runs (detail::simd_lanes), chosen once; none
+/// below AVX2, where two lanes computing every branch are slower than the
+/// scalar draw computing one.
 DrawKernel draw_kernel() {
-  static const DrawKernel kernel = [] {
+  static const DrawKernel kernel = []() -> DrawKernel {
 #if defined(__x86_64__) || defined(__i386__)
     if (detail::simd_lanes() == 8) return &draw_avx512;
     if (detail::simd_lanes() == 4) return &draw_avx2;
 #endif
-    return &draw_generic;
+    return nullptr;
   }();
   return kernel;
 }
@@ -206,10 +236,15 @@ double PitchDistribution::draw(std::uint64_t seed, std::uint64_t index) const {
 void PitchDistribution::draw(std::uint64_t seed, std::uint64_t first, std::span<double> out) const {
   const DrawBatch batch{
       CounterRng(seed, Stream::frequency), first, mu_, sigma_, config_.band_min.value(), config_.band_max.value()};
-  draw_kernel()(batch, out.data(), out.size());
+  const DrawKernel kernel = draw_kernel();
+  if (kernel == nullptr) {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = draw(seed, first + i);
+    return;
+  }
+  kernel(batch, out.data(), out.size());
   const bool quantized = config_.quantization_db > 0.0;
   for (std::size_t i = 0; i < out.size(); ++i) {
-    if (out[i] == scalar_draw)
+    if (out[i] < 0.0)
       out[i] = draw(seed, first + i);
     else if (quantized)
       out[i] = quantize(out[i]);  // draw's clamp is the identity for an in-band value

@@ -12,6 +12,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
 #include <vector>
 
@@ -162,6 +163,119 @@ TEST(Detmath, ExpIsBitIdenticalToTheLdexpFormula) {
   EXPECT_TRUE(std::isnan(dm::exp(std::numeric_limits<double>::quiet_NaN())));
   EXPECT_GT(dm::exp(-745.0), 0.0);  // a subnormal result, not flushed
   EXPECT_LT(dm::exp(-745.0), std::numeric_limits<double>::min());
+}
+
+namespace {
+
+/// detmath::log as it was written before its core became
+/// log_normal_generic (shared with the lane-wise draws): the reference.
+double log_before_generic(double x) {
+  if (std::isnan(x) || x < 0.0) return std::numeric_limits<double>::quiet_NaN();
+  if (x == 0.0) return -std::numeric_limits<double>::infinity();
+  if (std::isinf(x)) return x;
+  int e = 0;
+  std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+  if ((bits >> 52) == 0) {
+    x *= 0x1.0p54;
+    e -= 54;
+    bits = std::bit_cast<std::uint64_t>(x);
+  }
+  e += static_cast<int>((bits >> 52) & 0x7FF) - 1023;
+  double m = std::bit_cast<double>((bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL);
+  if (m > 1.4142135623730951) {
+    m *= 0.5;
+    e += 1;
+  }
+  const double s = (m - 1.0) / (m + 1.0);
+  const double s2 = s * s;
+  double p = 1.0 / 23.0;
+  for (double c :
+       {1.0 / 21.0, 1.0 / 19.0, 1.0 / 17.0, 1.0 / 15.0, 1.0 / 13.0, 1.0 / 11.0, 1.0 / 9.0, 1.0 / 7.0, 1.0 / 5.0, 1.0 / 3.0})
+    p = p * s2 + c;
+  const double log_m = 2.0 * s + 2.0 * s * s2 * p;
+  const double de = static_cast<double>(e);
+  return de * 6.93147180369123816490e-01 + (log_m + de * 1.90821492927058770002e-10);
+}
+
+/// A polynomial in r by Horner's rule, highest coefficient first.
+double horner(std::initializer_list<double> c, double r) {
+  auto it = c.begin();
+  double p = *it++;
+  for (; it != c.end(); ++it) p = p * r + *it;
+  return p;
+}
+
+/// detmath::normal_quantile as it was written before its branches became
+/// generic definitions (AS241, PPND16): the reference.
+double normal_quantile_before_generic(double p) {
+  if (!(p > 0.0 && p < 1.0)) return std::numeric_limits<double>::quiet_NaN();
+  const double q = p - 0.5;
+  if (std::fabs(q) <= 0.425) {
+    const double r = 0.180625 - q * q;
+    const double num =
+        horner({2.5090809287301226727e+3, 3.3430575583588128105e+4, 6.7265770927008700853e+4, 4.5921953931549871457e+4,
+                1.3731693765509461125e+4, 1.9715909503065514427e+3, 1.3314166789178437745e+2, 3.3871328727963666080e+0},
+               r);
+    const double den =
+        horner({5.2264952788528545610e+3, 2.8729085735721942674e+4, 3.9307895800092710610e+4, 2.1213794301586595867e+4,
+                5.3941960214247511077e+3, 6.8718700749205790830e+2, 4.2313330701600911252e+1, 1.0},
+               r);
+    return q * num / den;
+  }
+  double r = q < 0.0 ? p : 1.0 - p;
+  r = std::sqrt(-log_before_generic(r));
+  double value = 0.0;
+  if (r <= 5.0) {
+    r -= 1.6;
+    value = horner({7.74545014278341407640e-4, 2.27238449892691845833e-2, 2.41780725177450611770e-1, 1.27045825245236838258e+0,
+                    3.64784832476320460504e+0, 5.76949722146069140550e+0, 4.63033784615654529590e+0, 1.42343711074968357734e+0},
+                   r) /
+            horner({1.05075007164441684324e-9, 5.47593808499534494600e-4, 1.51986665636164571966e-2, 1.48103976427480074590e-1,
+                    6.89767334985100004550e-1, 1.67638483018380384940e+0, 2.05319162663775882187e+0, 1.0},
+                   r);
+  } else {
+    r -= 5.0;
+    value = horner({2.01033439929228813265e-7, 2.71155556874348757815e-5, 1.24266094738807843860e-3, 2.65321895265761230930e-2,
+                    2.96560571828504891230e-1, 1.78482653991729133580e+0, 5.46378491116411436990e+0, 6.65790464350110377720e+0},
+                   r) /
+            horner({2.04426310338993978564e-15, 1.42151175831644588870e-7, 1.84631831751005468180e-5, 7.86869131145613259100e-4,
+                    1.48753612908506148525e-2, 1.36929880922735805310e-1, 5.99832206555887937690e-1, 1.0},
+                   r);
+  }
+  return q < 0.0 ? -value : value;
+}
+
+}  // namespace
+
+TEST(Detmath, LogAndNormalQuantileAreBitIdenticalToTheirFormerCode) {
+  // Their cores became generic definitions shared with the lane-wise draws;
+  // not a bit of what they return changed: over the whole positive range
+  // (subnormals included) and, for the quantile, both tails densely.
+  Sweep s;
+  std::vector<double> xs = {1.0,
+                            0.5,
+                            2.0,
+                            1.4142135623730951,
+                            1.4142135623730954,
+                            4.9406564584124654e-324,
+                            1e-310,
+                            std::numeric_limits<double>::min(),
+                            std::numeric_limits<double>::max(),
+                            0x1.0p-54,
+                            0x1.0p-53};
+  for (int i = 0; i < 300000; ++i) xs.push_back(std::ldexp(s(0.5, 1.0), static_cast<int>(s(-1074, 1024))));
+  for (int i = 0; i < 100000; ++i) xs.push_back(s(0.0, 1.0));
+  for (double x : xs) ASSERT_EQ(bits_of(dm::log(x)), bits_of(log_before_generic(x))) << "x = " << x;
+  std::vector<double> ps = {
+      0.5, 0.075, 0.925, 0.07499999999999996, 0.925000000000000003, 0x1.0p-54, 1.0 - 0x1.0p-53, 1e-300, 1.3e-11, 1.5e-11, 1e-12};
+  for (int i = 0; i < 300000; ++i) ps.push_back(s(0.0, 1.0));
+  for (int i = 0; i < 100000; ++i) ps.push_back(std::ldexp(s(0.5, 1.0), static_cast<int>(s(-60, -3))));        // lower tail
+  for (int i = 0; i < 100000; ++i) ps.push_back(1.0 - std::ldexp(s(0.5, 1.0), static_cast<int>(s(-53, -3))));  // upper tail
+  for (double p : ps) {
+    if (p > 0.0 && p < 1.0) {
+      ASSERT_EQ(bits_of(dm::normal_quantile(p)), bits_of(normal_quantile_before_generic(p))) << "p = " << p;
+    }
+  }
 }
 
 TEST(Detmath, LogWithinTwoUlpOfTheCLibrary) {
