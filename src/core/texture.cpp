@@ -46,6 +46,7 @@ template <int W>
   using V = typename detail::Lanes<W>::type;
   V index;
   for (int l = 0; l < W; ++l) index[l] = run.base + static_cast<double>(l);
+  const V first_index = index;
   // One block of W samples into `a`; the index steps by W (integers below
   // 2^53 are exact, so lane l holds base + m + l exactly).
   auto block = [&](V& a) {
@@ -65,8 +66,9 @@ template <int W>
   if (count >= W) {
     // The last W samples again, overlapping the previous block: a sample's
     // value is a function of its index alone, so the overlap is rewritten
-    // with the same bits, and the store is one whole vector.
-    for (int l = 0; l < W; ++l) index[l] = run.base + static_cast<double>(count - W + l);
+    // with the same bits, and the store is one whole vector. (Whole numbers
+    // below 2^53: base + l + (count − W) is exact in any order.)
+    index = first_index + static_cast<double>(count - W);
     block(a);
     std::memcpy(out + count - W, &a, sizeof a);
   } else {  // a run shorter than a vector computes every lane, stores the live ones
