@@ -53,12 +53,12 @@ struct MapFileStats {
 /// `format`). Throws InvalidArgument for another extension, IoError when the
 /// file cannot be written (nothing is left behind).
 ///
-/// With several threads, worker threads render and encode chunks ahead (at
-/// most two chunks per thread in memory) while the calling thread writes
-/// them strictly in order and calls `progress`; an exception in a worker
-/// stops the others and is rethrown here, with no file left behind.
-/// `surface` is rendered concurrently (Surface::render is safe to call from
-/// several threads on a prepared surface).
+/// With several threads, chunks are rendered and encoded by that many
+/// threads, the calling thread among them (at most two chunks per thread in
+/// memory); the calling thread writes them strictly in order and calls
+/// `progress`. An exception in any thread stops the others and is rethrown
+/// here, with no file left behind. `surface` is rendered concurrently
+/// (Texture::render is safe to call from several threads).
 MapFileStats write_map(const std::string& path, const Surface& surface, SampleFormat format, const MapFileOptions& options = {});
 
 }  // namespace texel

@@ -89,19 +89,22 @@ struct ChunkMaker {
   }
 };
 
-/// Worker threads that make chunks 0 … count−1 ahead of the calling thread,
-/// which takes them strictly in order (take), writes them and gives each
-/// back (give_back). A chunk lives in slot index mod slots until it is given
-/// back, so at most `slots` chunks are in memory whatever the map's length.
-/// A worker's exception stops the others and is rethrown by take; the
-/// destructor (normal end, or the caller's own exception) stops the workers
-/// and joins them before the slots go.
+/// Chunks 0 … count−1 made by `threads` threads, the calling thread among
+/// them, and taken by the calling thread strictly in order (take), written,
+/// and given back (give_back). A chunk lives in slot index mod slots until it
+/// is given back, so at most `slots` chunks are in memory whatever the map's
+/// length. While the chunk it wants is still being made, the calling thread
+/// makes the next chunk nobody has started (so `threads` threads, not one
+/// more, share the cores, and the caller rarely sleeps). A worker's exception
+/// stops the others and is rethrown by take; the destructor (normal end, or
+/// an exception in the calling thread) stops the workers and joins them
+/// before the slots go.
 class ChunkPipeline {
  public:
-  ChunkPipeline(const ChunkMaker& make, std::size_t count, unsigned workers)
-      : make_(make), count_(count), slots_(2 * static_cast<std::size_t>(workers)), made_(slots_.size(), false) {
+  ChunkPipeline(const ChunkMaker& make, std::size_t count, unsigned threads)
+      : make_(make), count_(count), slots_(2 * static_cast<std::size_t>(threads)), made_(slots_.size(), false) {
     try {
-      for (unsigned w = 0; w < workers; ++w) threads_.emplace_back([this] { work(); });
+      for (unsigned w = 1; w < threads; ++w) workers_.emplace_back([this] { work(); });
     } catch (...) {
       stop();
       throw;
@@ -114,47 +117,67 @@ class ChunkPipeline {
   /// Chunk `index`, once made (the caller takes 0, 1, 2, … in order).
   const Chunk& take(std::size_t index) {
     std::unique_lock lock(mutex_);
-    made_cv_.wait(lock, [&] { return error_ || made_[index % slots_.size()]; });
-    if (error_) std::rethrow_exception(error_);
-    return slots_[index % slots_.size()];
+    for (;;) {
+      if (error_) std::rethrow_exception(error_);
+      if (made_[slot(index)]) return slots_[slot(index)];
+      if (startable()) {
+        const std::size_t mine = next_++;
+        lock.unlock();
+        make_(mine, slots_[slot(mine)]);  // throws past take: the destructor stops the workers
+        lock.lock();
+        made_[slot(mine)] = true;
+        continue;
+      }
+      awaited_ = index;
+      made_cv_.wait(lock);
+      awaited_ = none;
+    }
   }
   /// Chunk `index` is written: its slot may take chunk index + slots.
   void give_back(std::size_t index) {
     {
       const std::lock_guard lock(mutex_);
-      made_[index % slots_.size()] = false;
+      made_[slot(index)] = false;
       given_back_ = index + 1;
     }
-    free_cv_.notify_all();
+    free_cv_.notify_one();
   }
 
  private:
+  static constexpr std::size_t none = ~std::size_t{0};
+
+  [[nodiscard]] std::size_t slot(std::size_t index) const { return index % slots_.size(); }
+  /// A chunk nobody has started, with a free slot (under the lock).
+  [[nodiscard]] bool startable() const { return next_ < count_ && next_ < given_back_ + slots_.size(); }
+
   void work() {
     for (;;) {
       std::size_t index = 0;
       {
         std::unique_lock lock(mutex_);
-        free_cv_.wait(lock, [&] { return stopping_ || next_ >= count_ || next_ < given_back_ + slots_.size(); });
+        free_cv_.wait(lock, [&] { return stopping_ || next_ >= count_ || startable(); });
         if (stopping_ || next_ >= count_) return;
         index = next_++;
       }
       try {
-        make_(index, slots_[index % slots_.size()]);
+        make_(index, slots_[slot(index)]);
       } catch (...) {
         {
           const std::lock_guard lock(mutex_);
           if (!error_) error_ = std::current_exception();
           stopping_ = true;
         }
-        made_cv_.notify_all();
+        made_cv_.notify_one();
         free_cv_.notify_all();
         return;
       }
+      bool wake = false;
       {
         const std::lock_guard lock(mutex_);
-        made_[index % slots_.size()] = true;
+        made_[slot(index)] = true;
+        wake = awaited_ == index;  // the caller sleeps until this very chunk
       }
-      made_cv_.notify_all();
+      if (wake) made_cv_.notify_one();
     }
   }
 
@@ -164,22 +187,23 @@ class ChunkPipeline {
       stopping_ = true;
     }
     free_cv_.notify_all();
-    for (auto& t : threads_) t.join();
-    threads_.clear();
+    for (auto& t : workers_) t.join();
+    workers_.clear();
   }
 
   const ChunkMaker& make_;
   const std::size_t count_;
   std::vector<Chunk> slots_;
   std::vector<bool> made_;      // per slot: holds its chunk, not yet given back
-  std::size_t next_ = 0;        // the next chunk a worker makes
+  std::size_t next_ = 0;        // the next chunk nobody has started
   std::size_t given_back_ = 0;  // chunks the caller has written
+  std::size_t awaited_ = none;  // the chunk the caller sleeps for
   bool stopping_ = false;
   std::exception_ptr error_;
   std::mutex mutex_;
   std::condition_variable made_cv_;  // the caller waits for a chunk
   std::condition_variable free_cv_;  // workers wait for a slot
-  std::vector<std::thread> threads_;
+  std::vector<std::thread> workers_;
 };
 
 }  // namespace
