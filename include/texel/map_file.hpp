@@ -39,7 +39,8 @@ struct MapFileOptions {
 };
 
 /// The threads write_map uses for `requested` (MapFileOptions::threads):
-/// itself when > 0, else the hardware's, between 1 and max_auto_threads.
+/// itself when > 0, else the processors this process may run on (Linux: its
+/// affinity mask; elsewhere the hardware's), between 1 and max_auto_threads.
 unsigned map_file_threads(unsigned requested);
 
 /// What write_map wrote.

@@ -11,6 +11,10 @@
 #include <thread>
 #include <vector>
 
+#if defined(__linux__)
+#include <sched.h>
+#endif
+
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -218,7 +222,14 @@ std::optional<MapFileKind> map_file_kind(const std::string& path) {
 
 unsigned map_file_threads(unsigned requested) {
   if (requested > 0) return requested;
-  return std::clamp(std::thread::hardware_concurrency(), 1u, MapFileOptions::max_auto_threads);
+  unsigned cores = std::thread::hardware_concurrency();
+#if defined(__linux__)
+  // The processors this process may run on (taskset, a container's cpuset),
+  // which can be fewer than the machine's.
+  cpu_set_t set;
+  if (::sched_getaffinity(0, sizeof set, &set) == 0) cores = static_cast<unsigned>(CPU_COUNT(&set));
+#endif
+  return std::clamp(cores, 1u, MapFileOptions::max_auto_threads);
 }
 
 MapFileStats write_map(const std::string& path, const Surface& surface, SampleFormat format, const MapFileOptions& options) {
