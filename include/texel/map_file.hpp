@@ -29,9 +29,10 @@ std::optional<MapFileKind> map_file_kind(const std::string& path);
 
 struct MapFileOptions {
   std::size_t chunk_samples = std::size_t{1} << 16;  ///< samples rendered per chunk (> 0) [65536]
-  /// Threads rendering and encoding chunks: 0 = automatic (the hardware's
-  /// threads, at most max_auto_threads), 1 = the calling thread alone [0].
-  /// The bytes written and the stats never depend on it.
+  /// Threads rendering and encoding chunks, the calling thread among them:
+  /// 0 = automatic (map_file_threads: the processors the process may run
+  /// on, at most max_auto_threads), 1 = the calling thread alone [0]. The
+  /// bytes written and the stats never depend on it.
   unsigned threads = 0;
   static constexpr unsigned max_auto_threads = 4;
   /// Called after each chunk with the fraction written (0 … 1]; may be empty.
