@@ -145,11 +145,15 @@ template <class T>
 /// small whole numbers, exact in double.
 template <class T, class U>
 [[gnu::always_inline]] constexpr T log_normal_generic(T x, double e_offset = 0.0) {
-  const U bits = std::bit_cast<U>(x);
+  // __builtin_bit_cast, not std::bit_cast: a builtin is never a call, and a
+  // vector passed to a function compiled for another instruction set (the
+  // lane-wise kernels are AVX2/AVX-512 functions) changes its calling
+  // convention; unoptimized builds would make that call.
+  const U bits = __builtin_bit_cast(U, x);
   const U biased = (bits >> 52) & 0x7FFULL;
-  T m = std::bit_cast<T>((bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL);  // [1, 2)
+  T m = __builtin_bit_cast(T, (bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL);  // [1, 2)
   // The biased exponent as a double, exactly: 2^52 + biased, less 2^52.
-  T de = std::bit_cast<T>(biased | 0x4330000000000000ULL) - 4503599627370496.0;
+  T de = __builtin_bit_cast(T, biased | 0x4330000000000000ULL) - 4503599627370496.0;
   de = de + (e_offset - 1023.0);
   // m above √2: halve it and count one more power of two. (Selects on the
   // comparison itself: a vector mask kept in a variable is slow to build.)

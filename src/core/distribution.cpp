@@ -68,8 +68,9 @@ template <int W>
     // u = ((bits >> 11) + 0.5)·2^-53, never 1 (CounterRng::uniform).
     const U index = lane + (b.first + i);
     const U word = b.rng.bits_generic(index * PitchDistribution::max_attempts) >> 11;
-    const V whole = (std::bit_cast<V>((word >> 32) | two52_bits) - two52) * 4294967296.0 +
-                    (std::bit_cast<V>((word & 0xFFFFFFFFULL) | two52_bits) - two52);
+    // (__builtin_bit_cast: never a call, see detmath::log_normal_generic.)
+    const V whole = (__builtin_bit_cast(V, (word >> 32) | two52_bits) - two52) * 4294967296.0 +
+                    (__builtin_bit_cast(V, (word & 0xFFFFFFFFULL) | two52_bits) - two52);
     V u = (whole + 0.5) * 0x1.0p-53;
     u = u < 1.0 ? u : V{} + 0x1.fffffffffffffp-1;
     // z = Φ⁻¹(u) (detmath::normal_quantile's branches; |q| <= 0.425 is
@@ -95,8 +96,8 @@ template <int W>
     const V t = b.mu + b.sigma * z;
     V k;
     const V p = detmath::exp_reduced_generic(t, k);
-    const U biased = std::bit_cast<U>(k + (two52 + 1023.0));  // low bits: k + 1023
-    V f = p * std::bit_cast<V>(biased << 52);
+    const U biased = __builtin_bit_cast(U, k + (two52 + 1023.0));  // low bits: k + 1023
+    V f = p * __builtin_bit_cast(V, biased << 52);
     // 2^k normal (k in [-1022, 1023] puts t inside exp's thresholds,
     // -745.13 … 709.78, and a NaN t fails it), the near tail, the band:
     // else a negative mark for the scalar draw. (Each test its own mark: GCC
