@@ -83,11 +83,11 @@ TexelSpec fine_spec(double p_db, double i_db, const EncoderConfig& cfg, CyclesPe
 TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, Millimetres length,
                           std::uint64_t seed = 0x5EED0001);
 
-/// The objective: model distance between the target percept and candidate
-/// renderings of (P, I) on the input's grid, analysed like the input.
 /// The fit's residuals (Fitter::residuals).
 using Residuals = std::array<double, 6>;
 
+/// The objective: model distance between the target percept and candidate
+/// renderings of (P, I) on the input's grid, analysed like the input.
 struct Fitter {
   Fitter(const EncoderConfig& config, const Percept& target_percept, double spacing_mm, std::size_t candidate_samples,
          CyclesPerMm band_top, double band_bottom = 0.0, const Split* coarse_estimate = nullptr)
