@@ -141,8 +141,11 @@ int main(int argc, char** argv) {
     const codec::Signal signal{a, device.spacing, m.name};
     codec::EncodeResult r;
     double cpu_ms = 0.0;
+    // As `texel encode --device D` encodes: D's frequency response in the model's loop.
+    codec::EncoderConfig cfg;
+    cfg.model.display = device.response;
     const double encode_ms = median_ms(
-        repeat, [&] { r = codec::encode(signal, codec::EncoderConfig{}); }, &cpu_ms);
+        repeat, [&] { r = codec::encode(signal, cfg); }, &cpu_ms);
     const bool fine = r.spec.fine_strength > 0.0;
     const char* kind = r.coarse ? (fine ? "two-scale" : "coarse") : (fine ? "fine-only" : "flat");
     const char* method = r.texel_recovered ? "recovered" : (fine ? "fitted" : "no fine");

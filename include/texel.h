@@ -207,8 +207,10 @@ texel_status texel_encode_with(const double* amplitudes, size_t count, double sp
  * recordings (need swipe_speed_mm_s > 0: the finger speed that turns time
  * into position), a *.texel.json document or a .texel bitstream (rendered on
  * `device`, or on the document's own). `device` may be NULL (name or path
- * otherwise, as texel_device_lookup); swipe_speed_mm_s 0 = none, > 0 also
- * sets the perceptual model's speed (as `texel encode --swipe-speed`). */
+ * otherwise, as texel_device_lookup; its frequency response is in the
+ * perceptual model's loop, as `texel encode --device`); swipe_speed_mm_s 0 =
+ * none, > 0 also sets the perceptual model's speed (as `texel encode
+ * --swipe-speed`). */
 texel_status texel_encode_file(const char* path, const char* device, double swipe_speed_mm_s, const texel_encode_options* options,
                                texel_encode_result** out);
 

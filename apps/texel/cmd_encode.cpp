@@ -30,6 +30,7 @@ struct EncodeArgs {
   double weight_exponent = codec::PerceptualModel{}.weight_exponent;
   double sensitivity_scale = codec::PerceptualModel{}.sensitivity_scale;
   std::string display_response = std::string(codec::to_string(codec::PerceptualModel{}.display_response));
+  double drawn_weight = codec::PerceptualModel{}.drawn_weight;
   unsigned coarse_bits = 6;
   std::optional<std::size_t> max_bytes;
   bool json = false;
@@ -47,9 +48,10 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   c.fit_method = codec::parse_fit_method(a.fit, "--fit");
   c.model.weight_exponent = a.weight_exponent;
   c.model.sensitivity_scale = a.sensitivity_scale;
-  // The display in the model's loop: the --device's frequency response,
-  // applied with --display-response device (docs/encoder.md §2).
+  // The display in the model's loop: the --device's frequency response
+  // (--display-response device, the default; docs/encoder.md §2).
   c.model.display_response = codec::parse_display_response(a.display_response, "display_response");
+  c.model.drawn_weight = a.drawn_weight;
   if (a.input.device) c.model.display = load_device(*a.input.device).response;
   c.coarse_bits = a.coarse_bits;
   c.max_bytes = a.max_bytes;
@@ -100,8 +102,10 @@ nlohmann::ordered_json result_json(const std::string& input, const Signal& sig, 
   m["evaluations"] = r.evaluations;
   m["fit"] = std::string(codec::to_string(cfg.fit_method));
   m["display_response"] = std::string(codec::to_string(cfg.model.display_response));
-  if (cfg.model.display_response == codec::PerceptualModel::Display::device && !cfg.model.display.flat())
+  if (codec::display_in_loop(cfg.model)) {
     m["display"] = {{"corner_hz", cfg.model.display.corner.value()}, {"order", cfg.model.display.order}};
+    m["drawn_weight"] = cfg.model.drawn_weight;
+  }
   j["model"] = m;
   nlohmann::ordered_json z;
   z["bitstream_bytes"] = r.bytes.size();
@@ -247,8 +251,12 @@ void register_encode(CLI::App& app) {
                   "Perceptual model: share of the threshold curve in the weighting, 0 … 1 (1 = the model before) [0.5]")
       ->group(g);
   cmd->add_option("--display-response", a->display_response,
-                  "Perceptual model: flat (the texture as drawn) or device (as the --device's frequency response "
-                  "passes it at the swipe speed) [flat]")
+                  "Perceptual model: device (felt as the --device's frequency response passes it at the swipe speed) or "
+                  "flat (the texture as drawn) [device]")
+      ->group(g);
+  cmd->add_option("--drawn-weight", a->drawn_weight,
+                  "Perceptual model: weight of the texture as drawn beside the displayed one in the fit, >= 0 (0 = the "
+                  "display alone) [1]")
       ->group(g);
   cmd->add_option("--fit", a->fit, "Search of the perceptual fit: least-squares | simplex (slower) [least-squares]")->group(g);
   cmd->add_option("--coarse-bits", a->coarse_bits, "Bits per coarse level, 1 … 16 [6]")->group(g);
@@ -279,7 +287,7 @@ void register_encode(CLI::App& app) {
       to.max_bytes = a->max_bytes;
       if (auto t = codec::transcode_file(a->inputs[0], signal_options(a->input), to)) {
         for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit", "--weight-exponent",
-                                 "--sensitivity-scale", "--display-response"})
+                                 "--sensitivity-scale", "--display-response", "--drawn-weight"})
           if (cmd->count(flag))
             throw InvalidArgument(std::string(flag) + " applies to estimation; '" + a->inputs[0] +
                                   "' holds Texel parameters and is transcoded with its own (add --estimate to re-estimate it)");

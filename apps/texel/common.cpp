@@ -78,6 +78,7 @@ std::string flag_of_field(std::string_view field) {
                                                                         {"weight_exponent", "--weight-exponent"},
                                                                         {"sensitivity_scale", "--sensitivity-scale"},
                                                                         {"display_response", "--display-response"},
+                                                                        {"drawn_weight", "--drawn-weight"},
                                                                         {"tolerance", "--tolerance"},
                                                                         {"date", "--date"},
                                                                         {"width", "--width"}};

@@ -15,9 +15,10 @@
 //     a felt pitch (the mean frequency weighted by suprathreshold
 //     sensitivity and amplitude, raised so the strongest components
 //     dominate) and a felt noisiness (the weighted spread of log-frequency),
-//     at the swipe speed that turns cycles/mm into Hz; optionally through a
-//     display's frequency response (PerceptualModel::display, off by
-//     default: the stream is device independent). Candidate Texel
+//     at the swipe speed that turns cycles/mm into Hz, through the display's
+//     frequency response (PerceptualModel::display: the device's, from the
+//     front doors), the fit anchored by the texture as drawn (the stream is
+//     device independent and the response an estimate). Candidate Texel
 //     textures are rendered with the library and compared with the input
 //     under the model; least squares (Levenberg–Marquardt, or the simplex on
 //     request) over (Central Pitch, Irregularity) minimises the distance,
@@ -89,14 +90,21 @@ struct PerceptualModel {
   /// a display is the displayed texture filtered by the display's response,
   /// so each component's amplitude is weighted by |H(f·v)| at this model's
   /// swipe speed v before the felt weights are formed. Default flat: no
-  /// display. `texel encode --device D` sets D's response; it is applied
-  /// with `--display-response device`.
+  /// display. `texel encode --device D` and Python `encode(device=D)` set D's
+  /// response.
   FrequencyResponse display{};
-  /// Whether `display` is applied [choice] flat: the texture as drawn (the
-  /// model before); device: the model feels what the display reproduces.
-  /// Flat by default because the fit through a low-pass display loses the
-  /// established trends (docs/encoder.md §2, "The display in the loop").
-  enum class Display { device, flat } display_response = Display::flat;
+  /// Whether `display` is in the loop [choice] device: the model feels what
+  /// the display reproduces (felt pitch and noisiness through it); flat: the
+  /// texture as drawn (the model before; also what a flat `display` gives).
+  enum class Display { device, flat } display_response = Display::device;
+  /// With a display in the loop, the fit also matches the texture as drawn
+  /// (its felt pitch and noisiness without the display), weighted by this
+  /// [choice] 1: the stream is device independent and the display's response
+  /// is an estimate, so a texture must feel right through the display and
+  /// as drawn; where the display hides a difference, the drawn texture
+  /// decides (docs/encoder.md §2). 0: the display alone. Unused without a
+  /// display in the loop. >= 0.
+  double drawn_weight = 1.0;
 };
 
 std::string_view to_string(PerceptualModel::Display d);
@@ -105,6 +113,9 @@ PerceptualModel::Display parse_display_response(std::string_view text, std::stri
 /// |H(f·v)| the model applies at spatial frequency f (cycles/mm): the display's
 /// gain at the model's swipe speed, or 1 when the display is flat or off.
 double display_gain(const PerceptualModel& model, CyclesPerMm f);
+/// A display is in the model's loop: display_response is device and the
+/// display is not flat.
+bool display_in_loop(const PerceptualModel& model);
 
 /// Relative vibrotactile threshold at temporal frequency f, dB above the most
 /// sensitive frequency (0 dB at 250 Hz): a straight-line Pacinian U
@@ -118,17 +129,27 @@ struct Percept {
   double noisiness_db = 0.0;  ///< felt spread of log-frequency, dB
   double mean_db = 0.0;       ///< physical: power-weighted mean frequency, dB re 1 cpm
   double spread_db = 0.0;     ///< physical: power-weighted SD of 10·log10 f, dB
+  /// Felt pitch and noisiness of the texture as drawn (without the display);
+  /// equal to pitch_db and noisiness_db when no display is in the loop.
+  double drawn_pitch_db = 0.0;
+  double drawn_noisiness_db = 0.0;
 };
 
 /// A percept as named fields, the names every front door reports it under
-/// (pitch_db, noisiness_db, centroid_db, spread_db).
-std::array<std::pair<const char*, double>, 4> fields(const Percept& p);
+/// (pitch_db, noisiness_db, centroid_db, spread_db, drawn_pitch_db,
+/// drawn_noisiness_db).
+std::array<std::pair<const char*, double>, 6> fields(const Percept& p);
 
 /// Percept of a zero-mean fine signal sampled every `spacing_mm`, from its
 /// content above `f_min_cpm` (and above 0.01 cpm).
 Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm = 0.0);
-/// Model distance in JND units (plus the small physical tie-break).
+/// Model distance in JND units (plus the small physical tie-break): how
+/// different the two feel (through the display when one is in the loop).
 double distance(const Percept& a, const Percept& b, const PerceptualModel& model);
+/// What the fit minimises: distance() plus, with a display in the loop, the
+/// difference of the textures as drawn weighted by drawn_weight (JND units).
+/// Equal to distance() without a display in the loop.
+double fit_distance(const Percept& a, const Percept& b, const PerceptualModel& model);
 
 // --- encoder ----------------------------------------------------------------
 

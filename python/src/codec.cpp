@@ -308,8 +308,8 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       "encode",
       [](const py::object& source, const py::object& device, std::optional<double> spacing_mm,
          std::optional<double> swipe_speed_mm_s, double boundary_mm, double texel_length_mm, std::uint64_t seed,
-         const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes,
-         const std::string& fit) {
+         const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes, const std::string& fit,
+         const std::string& display_response, double drawn_weight) {
         codec::EncoderConfig c;
         if (swipe_speed_mm_s) c.model.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
         c.boundary = Millimetres(boundary_mm);
@@ -319,6 +319,15 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
         c.coarse_bits = coarse_bits;
         c.max_bytes = max_bytes;
         c.fit_method = codec::parse_fit_method(fit, "fit");
+        // The display in the model's loop is the device's, as `texel encode
+        // --device`: the given one, or for an array the tpad it defaults to.
+        c.model.display_response = codec::parse_display_response(display_response, "display_response");
+        c.model.drawn_weight = drawn_weight;
+        const bool path = py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__");
+        if (!device.is_none())
+          c.model.display = device_of(device, std::nullopt, std::nullopt).response;
+        else if (!path)
+          c.model.display = load_device("tpad").response;
         const codec::Signal signal = signal_of(source, device, spacing_mm, swipe_speed_mm_s);
         py::gil_scoped_release release;
         return codec::encode(signal, c);
@@ -326,7 +335,8 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       py::arg("source"), py::kw_only(), py::arg("device") = py::none(), py::arg("spacing_mm") = py::none(),
       py::arg("swipe_speed_mm_s") = py::none(), py::arg("boundary_mm") = 1.0, py::arg("texel_length_mm") = 0.25,
       py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("coarse_bits") = 6u,
-      py::arg("max_bytes") = py::none(), py::arg("fit") = "least-squares",
+      py::arg("max_bytes") = py::none(), py::arg("fit") = "least-squares", py::arg("display_response") = "device",
+      py::arg("drawn_weight") = codec::PerceptualModel{}.drawn_weight,
       R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
 
 source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array: float amplitudes
@@ -341,6 +351,11 @@ parameterization  'moments' or 'log' ['moments']
 coarse_bits       bits per coarse level, 1 … 16 [6]
 max_bytes         bitstream budget (bytes) [none]
 fit               search of the perceptual fit: 'least-squares' or 'simplex' (slower) ['least-squares']
+display_response  'device': the model feels the texture through the device's frequency response (the
+                  given device's; for an array, the tpad it defaults to; a path without `device`
+                  has none), or 'flat': as drawn ['device']
+drawn_weight      weight of the texture as drawn beside the displayed one in the fit (0: the display
+                  alone) [1]
 
 The GIL is released while encoding.)doc");
 

@@ -183,7 +183,8 @@ def load_signal(path: _Path, *, device: Optional[_Device] = None, spacing_mm: Op
 def encode(source: Union[_Path, _Array], *, device: Optional[_Device] = None, spacing_mm: Optional[float] = None,
            swipe_speed_mm_s: Optional[float] = None, boundary_mm: float = 1.0, texel_length_mm: float = 0.25,
            seed: int = 1, parameterization: str = "moments", coarse_bits: int = 6,
-           max_bytes: Optional[int] = None, fit: str = "least-squares") -> EncodeResult: ...
+           max_bytes: Optional[int] = None, fit: str = "least-squares",
+           display_response: Literal["device", "flat"] = "device", drawn_weight: float = 1.0) -> EncodeResult: ...
 
 # ---------------------------------------------------------------- spectrum
 class Spectrum:

@@ -38,6 +38,8 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     throw FieldError("weight_exponent", "is " + num(cfg.model.weight_exponent) + "; allowed: > 0 … 4");
   if (!(cfg.model.sensitivity_scale >= 0.0 && cfg.model.sensitivity_scale <= 1.0))
     throw FieldError("sensitivity_scale", "is " + num(cfg.model.sensitivity_scale) + "; allowed: 0 … 1");
+  if (!(cfg.model.drawn_weight >= 0.0 && cfg.model.drawn_weight <= 100.0))
+    throw FieldError("drawn_weight", "is " + num(cfg.model.drawn_weight) + "; allowed: 0 … 100");
   if (cfg.coarse_bits < 1 || cfg.coarse_bits > 16)
     throw FieldError("coarse_bits", "is " + std::to_string(cfg.coarse_bits) + "; allowed: 1 … 16");
   const double len = static_cast<double>(n) * dx;

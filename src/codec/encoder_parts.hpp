@@ -83,6 +83,9 @@ TexelSpec fine_spec(double p_db, double i_db, const EncoderConfig& cfg, CyclesPe
 TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, CyclesPerMm band_max, Millimetres length,
                           std::uint64_t seed = 0x5EED0001);
 
+/// The fit's residuals (Fitter::residuals).
+using Residuals = std::array<double, 6>;
+
 /// The objective: model distance between the target percept and candidate
 /// renderings of (P, I) on the input's grid, analysed like the input.
 struct Fitter {
@@ -119,11 +122,14 @@ struct Fitter {
   /// (P, I) cannot be rendered. Counts one evaluation unless (P, I) was
   /// evaluated before.
   std::optional<Percept> percept(double p_db, double i_db);
-  /// The model distance to the target (1e6 if not renderable).
+  /// The fit's objective, fit_distance to the target (1e6 if not renderable).
   double operator()(double p_db, double i_db);
-  /// The distance's terms (pitch and noisiness in JND, the tie-break terms
-  /// weighted): their norm is operator()'s value.
-  std::optional<std::array<double, 4>> residuals(double p_db, double i_db);
+  /// The felt distance to the target, distance() (1e6 if not renderable).
+  double felt(double p_db, double i_db);
+  /// The objective's terms (pitch and noisiness in JND, the tie-break terms
+  /// weighted, the drawn texture's pitch and noisiness weighted): their norm
+  /// is operator()'s value.
+  std::optional<Residuals> residuals(double p_db, double i_db);
 };
 
 struct Box {

@@ -73,6 +73,8 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
       sum.noisiness_db += q.noisiness_db / used;
       sum.mean_db += q.mean_db / used;
       sum.spread_db += q.spread_db / used;
+      sum.drawn_pitch_db += q.drawn_pitch_db / used;
+      sum.drawn_noisiness_db += q.drawn_noisiness_db / used;
     }
   } catch (const InvalidArgument&) {
     return std::nullopt;  // not renderable (e.g. too little of the distribution in the band)
@@ -82,18 +84,29 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
 
 double Fitter::operator()(double p_db, double i_db) {
   const std::optional<Percept> q = percept(p_db, i_db);
+  return q ? fit_distance(target, *q, cfg.model) : 1e6;
+}
+
+double Fitter::felt(double p_db, double i_db) {
+  const std::optional<Percept> q = percept(p_db, i_db);
   return q ? distance(target, *q, cfg.model) : 1e6;
 }
 
-std::optional<std::array<double, 4>> Fitter::residuals(double p_db, double i_db) {
+std::optional<Residuals> Fitter::residuals(double p_db, double i_db) {
   const std::optional<Percept> q = percept(p_db, i_db);
   if (!q) return std::nullopt;
   const PerceptualModel& m = cfg.model;
   const double tie = std::sqrt(m.tie_weight);
-  // |r| is distance(target, q): the model's distance as a sum of squares.
-  return std::array<double, 4>{(q->pitch_db - target.pitch_db) / m.pitch_jnd_db,
-                               (q->noisiness_db - target.noisiness_db) / m.noisiness_jnd_db, tie * (q->mean_db - target.mean_db),
-                               tie * (q->spread_db - target.spread_db)};
+  // Without a display in the loop the drawn terms are 0 (exactly: the sums
+  // below are then the model's distance as before, bit for bit).
+  const double w = display_in_loop(m) ? m.drawn_weight : 0.0;
+  // |r| is fit_distance(target, q): the fit's objective as a sum of squares.
+  return Residuals{(q->pitch_db - target.pitch_db) / m.pitch_jnd_db,
+                   (q->noisiness_db - target.noisiness_db) / m.noisiness_jnd_db,
+                   tie * (q->mean_db - target.mean_db),
+                   tie * (q->spread_db - target.spread_db),
+                   w * (q->drawn_pitch_db - target.drawn_pitch_db) / m.pitch_jnd_db,
+                   w * (q->drawn_noisiness_db - target.drawn_noisiness_db) / m.noisiness_jnd_db};
 }
 
 namespace {
@@ -155,8 +168,12 @@ std::array<double, 3> nelder_mead(Fitter& fit, const Box& box, double p0, double
 /// average over the candidates' draw-to-draw roughness. Returns {P, I,
 /// distance} of the best point evaluated.
 std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p, double i, int max_iterations) {
-  using R = std::array<double, 4>;
-  auto norm = [](const R& r) { return std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]); };
+  using R = Residuals;
+  auto norm = [](const R& r) {
+    double sum = 0.0;
+    for (const double x : r) sum += x * x;
+    return std::sqrt(sum);
+  };
   std::optional<R> r = fit.residuals(p, i);
   if (!r) return {p, i, 1e6};
   double v = norm(*r);
@@ -170,7 +187,7 @@ std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p,
     if (!rp || !ri) break;
     double a11 = 0, a12 = 0, a22 = 0, g1 = 0, g2 = 0;
     std::array<R, 2> J{};  // J[0]: ∂r/∂P, J[1]: ∂r/∂I
-    for (int k = 0; k < 4; ++k) {
+    for (std::size_t k = 0; k < R{}.size(); ++k) {
       const double jp = ((*rp)[k] - (*r)[k]) / hp, ji = ((*ri)[k] - (*r)[k]) / hi;
       J[0][k] = jp, J[1][k] = ji;
       a11 += jp * jp, a12 += jp * ji, a22 += ji * ji, g1 += jp * (*r)[k], g2 += ji * (*r)[k];
@@ -195,7 +212,7 @@ std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p,
       // predicts it gains less than the convergence threshold below (the
       // last steps of a fit are hundredths of a dB: 3–4 renderings each).
       R predicted = *r;
-      for (int k = 0; k < 4; ++k) predicted[k] += (np - p) * J[0][k] + (ni - i) * J[1][k];
+      for (std::size_t k = 0; k < R{}.size(); ++k) predicted[k] += (np - p) * J[0][k] + (ni - i) * J[1][k];
       if (v - norm(predicted) < 0.01 * v + 0.002) break;
       const auto rn = fit.residuals(np, ni);
       const double vn = rn ? norm(*rn) : 1e6;
@@ -215,10 +232,12 @@ std::array<double, 3> levenberg_marquardt(Fitter& fit, const Box& box, double p,
 
 }  // namespace
 
-/// Identifiability: does a much narrower distribution feel different?
+/// Identifiability: does a much narrower distribution feel different (by
+/// the felt distance: through the display when one is in the loop)?
 void identifiability(Fitter& fit, const Box& box, FineFit& out) {
   const double narrower = std::max(box.i_lo, out.i_db - 6.0);
-  if (fit(out.p_db, narrower) - out.distance < 0.5) {
+  const double here = fit.felt(out.p_db, out.i_db);
+  if (fit.felt(out.p_db, narrower) - here < 0.5) {
     out.identifiable = false;
     // The widest distribution (1 dB steps up from the estimate) that still
     // feels the same, by bisection: the distance grows with the spread.
@@ -226,7 +245,7 @@ void identifiability(Fitter& fit, const Box& box, FineFit& out) {
     int same = 0, differs = steps + 1;  // `same` steps feel the same; `differs` (if ≤ steps) does not
     while (differs - same > 1) {
       const int mid = (same + differs) / 2;
-      (fit(out.p_db, out.i_db + mid) - out.distance >= 0.5 ? differs : same) = mid;
+      (fit.felt(out.p_db, out.i_db + mid) - here >= 0.5 ? differs : same) = mid;
     }
     out.bound_db = out.i_db + same;
   }

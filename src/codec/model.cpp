@@ -67,6 +67,10 @@ double display_gain(const PerceptualModel& model, CyclesPerMm f) {
   return model.display.gain(Hertz(f.value() * model.swipe_speed.value()));
 }
 
+bool display_in_loop(const PerceptualModel& model) {
+  return model.display_response == PerceptualModel::Display::device && !model.display.flat();
+}
+
 double threshold_db(Hertz f) {
   const double hz = std::max(f.value(), 1e-6);
   const double pacinian = 12.0 * std::fabs(std::log2(hz / 250.0));
@@ -87,13 +91,14 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     double corner = 0;  // display response in force (0: flat or off)
     int order = 0;
     std::vector<double> f, d, gain, h2;
-    std::size_t first = 1;      // the first bin at or above f_min (gain > 0 from there)
-    DyadicPower half_exponent;  // √P to the weight exponent: P to half of it
+    std::vector<double> gain_drawn;  // the weights without the display (empty: no display)
+    std::size_t first = 1;           // the first bin at or above f_min (gain > 0 from there)
+    DyadicPower half_exponent;       // √P to the weight exponent: P to half of it
   };
   thread_local std::array<Bins, 4> cache;
   thread_local std::size_t replace = 0;
   const double f_lo = std::max(0.01, f_min_cpm);
-  const bool display = model.display_response == PerceptualModel::Display::device && !model.display.flat();
+  const bool display = display_in_loop(model);
   const double corner = display ? model.display.corner.value() : 0.0;
   const int order = display ? model.display.order : 0;
   auto same = [&](const Bins& b) {
@@ -114,6 +119,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     bins.d.assign(p.size(), 0.0);
     bins.gain.assign(p.size(), 0.0);
     bins.h2.assign(p.size(), 1.0);
+    bins.gain_drawn.assign(display ? p.size() : 0, 0.0);
     bins.first = p.size();
     for (std::size_t i = 1; i < p.size(); ++i) {
       const double f = static_cast<double>(i) * df;
@@ -127,6 +133,7 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
       // log-frequency, raised to the weight exponent (applied to √P below).
       const double sensitivity = std::pow(10.0, -model.sensitivity_scale * threshold_db(Hertz(f * v)) / 20.0);
       bins.gain[i] = f < f_lo ? 0.0 : std::pow(h * sensitivity / std::sqrt(f), model.weight_exponent);
+      if (display) bins.gain_drawn[i] = f < f_lo ? 0.0 : std::pow(sensitivity / std::sqrt(f), model.weight_exponent);
       if (bins.gain[i] > 0.0) bins.first = std::min(bins.first, i);
     }
     hit = cache.begin() + static_cast<std::ptrdiff_t>(&bins - cache.data());
@@ -142,16 +149,25 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     if (bins.gain[i] > 0.0) peak = std::max(peak, p[i]), peak_felt = std::max(peak_felt, p[i] * bins.h2[i]);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
-  double sw = 0, swf = 0, swd = 0, swdd = 0;  // perceptual weights
-  double sp = 0, spf = 0, spd = 0, spdd = 0;  // physical (power) weights
+  double sw = 0, swf = 0, swd = 0, swdd = 0;      // perceptual weights
+  double sp = 0, spf = 0, spd = 0, spdd = 0;      // physical (power) weights
+  double sw0 = 0, swf0 = 0, swd0 = 0, swdd0 = 0;  // perceptual weights of the texture as drawn (display in the loop)
+  const bool drawn = !bins.gain_drawn.empty();
   for (std::size_t i = bins.first; i < p.size(); ++i) {
     if (bins.gain[i] == 0.0) continue;
     const double f = bins.f[i], d = bins.d[i];
-    if (p[i] * bins.h2[i] > floor_felt) {
-      const double w = bins.half_exponent(p[i]) * bins.gain[i];
+    const double amplitude = bins.half_exponent(p[i]);  // √P to the weight exponent
+    if (p[i] > floor && p[i] * bins.h2[i] > floor_felt) {
+      const double w = amplitude * bins.gain[i];
       sw += w, swf += w * f, swd += w * d, swdd += w * d * d;
     }
-    if (p[i] > floor) sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+    if (p[i] > floor) {
+      sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+      if (drawn) {  // felt as drawn: masked on the texture's own spectrum
+        const double w = amplitude * bins.gain_drawn[i];
+        sw0 += w, swf0 += w * f, swd0 += w * d, swdd0 += w * d * d;
+      }
+    }
   }
   if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
   Percept q;
@@ -161,6 +177,13 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
   q.mean_db = db_of(spf / sp);
   const double pd = spd / sp;
   q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  q.drawn_pitch_db = q.pitch_db;
+  q.drawn_noisiness_db = q.noisiness_db;
+  if (drawn && sw0 > 0.0) {
+    q.drawn_pitch_db = db_of(swf0 / sw0);
+    const double md0 = swd0 / sw0;
+    q.drawn_noisiness_db = std::sqrt(std::max(0.0, swdd0 / sw0 - md0 * md0));
+  }
   return q;
 }
 
@@ -170,6 +193,14 @@ double distance(const Percept& a, const Percept& b, const PerceptualModel& model
   const double dm = a.mean_db - b.mean_db;
   const double ds = a.spread_db - b.spread_db;
   return std::sqrt(dp * dp + dn * dn + model.tie_weight * (dm * dm + ds * ds));
+}
+
+double fit_distance(const Percept& a, const Percept& b, const PerceptualModel& model) {
+  const double d = distance(a, b, model);
+  if (!display_in_loop(model) || model.drawn_weight == 0.0) return d;
+  const double dp = model.drawn_weight * (a.drawn_pitch_db - b.drawn_pitch_db) / model.pitch_jnd_db;
+  const double dn = model.drawn_weight * (a.drawn_noisiness_db - b.drawn_noisiness_db) / model.noisiness_jnd_db;
+  return std::sqrt(d * d + dp * dp + dn * dn);
 }
 
 }  // namespace texel::codec

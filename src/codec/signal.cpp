@@ -51,8 +51,13 @@ Bitstream read_bitstream(const std::string& path) {
   return parse_bitstream(std::as_bytes(std::span(bytes.data(), bytes.size())));
 }
 
-std::array<std::pair<const char*, double>, 4> fields(const Percept& p) {
-  return {{{"pitch_db", p.pitch_db}, {"noisiness_db", p.noisiness_db}, {"centroid_db", p.mean_db}, {"spread_db", p.spread_db}}};
+std::array<std::pair<const char*, double>, 6> fields(const Percept& p) {
+  return {{{"pitch_db", p.pitch_db},
+           {"noisiness_db", p.noisiness_db},
+           {"centroid_db", p.mean_db},
+           {"spread_db", p.spread_db},
+           {"drawn_pitch_db", p.drawn_pitch_db},
+           {"drawn_noisiness_db", p.drawn_noisiness_db}}};
 }
 
 Signal encoder_signal(const texel::Signal& s) { return Signal{s.samples, s.spacing, s.description}; }

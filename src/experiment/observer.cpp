@@ -147,7 +147,9 @@ MatchPoint perceptual_target(const std::string& reference_name, const std::strin
   signal.amplitude = surface.render();
   signal.spacing = profile.spacing;
   signal.description = "reference " + reference_name + " on " + profile.name;
-  const codec::EncodeResult r = codec::encode(signal, codec::EncoderConfig{});
+  codec::EncoderConfig cfg;  // as `texel encode --device`: the display's response in the model's loop
+  cfg.model.display = profile.response;
+  const codec::EncodeResult r = codec::encode(signal, cfg);
   return {r.spec.central_pitch.value(), r.spec.irregularity.value()};
 }
 

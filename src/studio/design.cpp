@@ -203,7 +203,9 @@ MatchView match_region(const Document& doc, const MatchOptions& options) {
   codec::Signal signal{target, surface.grid().spacing, "studio " + region_label(doc, options.region)};
 
   MatchView m;
-  m.result = codec::encode(signal, options.encoder);
+  codec::EncoderConfig encoder = options.encoder;  // the document's display in the model's loop unless given one
+  if (encoder.model.display.flat()) encoder.model.display = doc.device.response;
+  m.result = codec::encode(signal, encoder);
   m.into = into;
   m.document = doc;
   RegionSpec& dst = m.document.regions[into];
@@ -259,7 +261,9 @@ ImportResult import_file(std::string_view name, std::span<const std::byte> bytes
   } catch (const Error& e) {
     throw FormatError(e.what());  // the studio reports every bad upload as a format problem
   }
-  out.encoded = codec::encode(signal, options.encoder);
+  codec::EncoderConfig encoder = options.encoder;  // the device's display in the model's loop unless given one
+  if (encoder.model.display.flat()) encoder.model.display = options.device.response;
+  out.encoded = codec::encode(signal, encoder);
   out.document = codec::decode_document(out.encoded->bitstream, options.device);
   return out;
 }

@@ -496,22 +496,32 @@ TEST_F(Cli, SwipeRecordingsEncodeBackToTheirParameters) {
 }
 
 // The device's frequency response (docs/format.md): the encoder's model
-// applies it with --display-response device; the player limits to it by
-// default (--response limit) and plays as before with --response off.
+// feels through it by default (--display-response device, anchored by the
+// texture as drawn: --drawn-weight) and as drawn with --display-response
+// flat; the player limits to it by default (--response limit) and plays as
+// before with --response off.
 TEST_F(Cli, DisplayResponseReachesTheEncoderAndThePlayer) {
   write("d.texel.json", valid_document());
   ASSERT_EQ(run({"render", "d.texel.json", "-o", "m.bin"}).status, 0);
-  const Result flat = run({"encode", "m.bin", "--device", "tpad", "--estimate", "--json"});
-  ASSERT_EQ(flat.status, 0) << flat.err;
-  EXPECT_EQ(nlohmann::json::parse(flat.out)["model"]["display_response"], "flat");
-  EXPECT_FALSE(nlohmann::json::parse(flat.out)["model"].contains("display"));
-  const Result dev = run({"encode", "m.bin", "--device", "tpad", "--display-response", "device", "--json"});
+  const Result dev = run({"encode", "m.bin", "--device", "tpad", "--json"});
   ASSERT_EQ(dev.status, 0) << dev.err;
   const auto m = nlohmann::json::parse(dev.out)["model"];
   EXPECT_EQ(m["display_response"], "device");
   EXPECT_EQ(m["display"]["corner_hz"].get<double>(), 400.0);
   EXPECT_EQ(m["display"]["order"].get<int>(), 1);
+  EXPECT_EQ(m["drawn_weight"].get<double>(), 1.0);
+  EXPECT_TRUE(m["input"].contains("drawn_pitch_db"));
+  const Result flat = run({"encode", "m.bin", "--device", "tpad", "--display-response", "flat", "--json"});
+  ASSERT_EQ(flat.status, 0) << flat.err;
+  EXPECT_EQ(nlohmann::json::parse(flat.out)["model"]["display_response"], "flat");
+  EXPECT_FALSE(nlohmann::json::parse(flat.out)["model"].contains("display"));
+  // generic is flat: nothing in the loop whatever the switch.
+  ASSERT_EQ(run({"render", "d.texel.json", "--device", "generic", "-o", "g.npy"}).status, 0);
+  const Result generic = run({"encode", "g.npy", "--device", "generic", "--json"});
+  ASSERT_EQ(generic.status, 0) << generic.err;
+  EXPECT_FALSE(nlohmann::json::parse(generic.out)["model"].contains("display"));
   expect_rejected({"encode", "m.bin", "--device", "tpad", "--display-response", "sideways"}, "--display-response");
+  expect_rejected({"encode", "m.bin", "--device", "tpad", "--drawn-weight", "-1"}, "--drawn-weight");
   ASSERT_EQ(run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "-o", "limit.csv"}).status, 0);
   ASSERT_EQ(
       run({"swipe", "d.texel.json", "--duration", "0.2", "--output", "amplitude", "--response", "off", "-o", "off.csv"}).status,

@@ -68,24 +68,30 @@ TEST(Encoder, CoarseRoundTrip) {
   s.coarse_strength = 0.6;
   s.fine_strength = 0.5;
   s.coarse = SineProfile{Millimetres(5.0), 0.0};
-  const EncodeResult r = encode(render_signal(s), EncoderConfig{});
-  ASSERT_TRUE(r.coarse);
-  EXPECT_NEAR(r.spec.coarse_strength, 0.6, 0.05);  // the issue's tolerance
-  EXPECT_NEAR(r.spec.fine_strength, 0.5, 0.05);
-  const std::size_t n = 400;
-  const auto truth = sample_at_texel_centres(s.coarse, s.texel_length, n);
-  const auto got = sample_at_texel_centres(r.spec.coarse, s.texel_length, n);
-  double ma = 0, mb = 0;
-  for (std::size_t k = 0; k < n; ++k) ma += truth[k], mb += got[k];
-  ma /= n, mb /= n;
-  double sab = 0, saa = 0, sbb = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    sab += (truth[k] - ma) * (got[k] - mb);
-    saa += (truth[k] - ma) * (truth[k] - ma);
-    sbb += (got[k] - mb) * (got[k] - mb);
+  // As drawn, and through the tpad's response as `texel encode --device tpad` encodes.
+  EncoderConfig through_tpad;
+  through_tpad.model.display = load_device("tpad").response;
+  for (const EncoderConfig& cfg : {EncoderConfig{}, through_tpad}) {
+    SCOPED_TRACE(display_in_loop(cfg.model) ? "through the tpad" : "as drawn");
+    const EncodeResult r = encode(render_signal(s), cfg);
+    ASSERT_TRUE(r.coarse);
+    EXPECT_NEAR(r.spec.coarse_strength, 0.6, 0.05);  // the issue's tolerance
+    EXPECT_NEAR(r.spec.fine_strength, 0.5, 0.05);
+    const std::size_t n = 400;
+    const auto truth = sample_at_texel_centres(s.coarse, s.texel_length, n);
+    const auto got = sample_at_texel_centres(r.spec.coarse, s.texel_length, n);
+    double ma = 0, mb = 0;
+    for (std::size_t k = 0; k < n; ++k) ma += truth[k], mb += got[k];
+    ma /= n, mb /= n;
+    double sab = 0, saa = 0, sbb = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      sab += (truth[k] - ma) * (got[k] - mb);
+      saa += (truth[k] - ma) * (truth[k] - ma);
+      sbb += (got[k] - mb) * (got[k] - mb);
+    }
+    EXPECT_GT(sab / std::sqrt(saa * sbb), 0.95);  // the issue's tolerance
+    EXPECT_NEAR(r.spec.central_pitch.value(), 10.0, 0.5);
   }
-  EXPECT_GT(sab / std::sqrt(saa * sbb), 0.95);  // the issue's tolerance
-  EXPECT_NEAR(r.spec.central_pitch.value(), 10.0, 0.5);
 }
 
 // Coarse-only maps (C > 0, F = 0; issue #11 item 4) encode as a coarse
@@ -179,55 +185,68 @@ TEST(Encoder, BitBudgetIsHonoured) {
   EXPECT_THROW((void)encode(render_signal(s), cfg), InvalidArgument);
 }
 
-TEST(EncoderTrends, SumsOfSinusoidsRiseWithTheirComponents) {
+// The trends hold as the texture is drawn (no display in the model's loop)
+// and through the tpad's frequency response, as `texel encode --device tpad`
+// encodes by default (docs/encoder.md §2, "The display in the loop").
+class EncoderTrends : public ::testing::TestWithParam<const char*> {
+ protected:
+  static EncoderConfig config() {
+    EncoderConfig cfg;
+    if (std::string(GetParam()) == "tpad") cfg.model.display = load_device("tpad").response;
+    return cfg;
+  }
+  static double pitch(const std::string& name) { return encode_reference(name, config()).spec.central_pitch.value(); }
+};
+
+INSTANTIATE_TEST_SUITE_P(Display, EncoderTrends, ::testing::Values("drawn", "tpad"),
+                         [](const auto& info) { return std::string(info.param); });
+
+TEST_P(EncoderTrends, SumsOfSinusoidsRiseWithTheirComponents) {
   // Felt pitch ≈ amplitude-weighted mean frequency: 4.25, 5.7, 7 cpm (plus sensitivity weighting).
-  const double p2 = encode_reference("2sin").spec.central_pitch.value();
-  const double p3 = encode_reference("3sin").spec.central_pitch.value();
-  const double p4 = encode_reference("4sin").spec.central_pitch.value();
+  const double p2 = pitch("2sin");
+  const double p3 = pitch("3sin");
+  const double p4 = pitch("4sin");
   EXPECT_LT(p2, p3);
   EXPECT_LT(p3, p4);
 }
 
-TEST(EncoderTrends, PinkBelowWhiteAndBlue) {
-  const double pink = encode_reference("pink").spec.central_pitch.value();
-  EXPECT_LT(pink, encode_reference("white").spec.central_pitch.value());
-  EXPECT_LT(pink, encode_reference("blue").spec.central_pitch.value());
+TEST_P(EncoderTrends, PinkBelowWhiteAndBlue) {
+  const double pink = pitch("pink");
+  EXPECT_LT(pink, pitch("white"));
+  EXPECT_LT(pink, pitch("blue"));
 }
 
-TEST(EncoderTrends, WaveformsNearTheirFundamental) {
+TEST_P(EncoderTrends, WaveformsNearTheirFundamental) {
   // People feel a shaped waveform near its fundamental (1 cpm = 0 dB; 100 Hz
   // at 100 mm/s), whose component is the strongest; docs/encoder.md §2.
   // Within 2.5 dB of it (a third of an octave up), below the lowest sum of
   // sinusoids (2sin: components at 2.5 and 6 cpm, 4 and 7.8 dB), and pulled
   // up in the order of the harmonics' strength (tri 1/k², square 1/k on odd
   // k, saw 1/k on every k).
-  const double tri = encode_reference("tri").spec.central_pitch.value();
-  const double square = encode_reference("square").spec.central_pitch.value();
-  const double saw = encode_reference("saw").spec.central_pitch.value();
-  const double two_sines = encode_reference("2sin").spec.central_pitch.value();
+  const double tri = pitch("tri");
+  const double square = pitch("square");
+  const double saw = pitch("saw");
+  const double two_sines = pitch("2sin");
   for (const double p : {tri, square, saw}) {
     EXPECT_NEAR(p, 0.0, 2.5);
     EXPECT_LT(p, two_sines - 1.0);
   }
   EXPECT_LT(tri, square);
   EXPECT_LT(square, saw);
-  // The model before (amplitude weighting, threshold sensitivity) put square
-  // and saw at 4.7 and 5.7 dB: its switches still reproduce that.
+  // The model before (amplitude weighting, threshold sensitivity, no display)
+  // put square and saw at 4.7 and 5.7 dB: its switches still reproduce that.
   EncoderConfig before;
   before.model.weight_exponent = 1.0;
   before.model.sensitivity_scale = 1.0;
-  const DeviceProfile d = load_device("tpad");
-  ReferenceSpec rs;
-  rs.name = "square";
-  EXPECT_GT(encode(codec::Signal{render_reference(rs, d.grid()), d.spacing, "square"}, before).spec.central_pitch.value(), 4.0);
+  EXPECT_GT(encode_reference("square", before).spec.central_pitch.value(), 4.0);
 }
 
-TEST(EncoderTrends, BandPassPitchFollowsCentreAndIrregularityFollowsZeta) {
+TEST_P(EncoderTrends, BandPassPitchFollowsCentreAndIrregularityFollowsZeta) {
   std::map<std::string, EncodeResult> r;
   for (const char* f : {"1", "4", "20"})
     for (const char* z : {"0.05", "0.5", "5"}) {
       const std::string name = std::string("bandpass-f") + f + "-z" + z;
-      r[name] = encode_reference(name);
+      r[name] = encode_reference(name, config());
     }
   auto P = [&](const char* f, const char* z) { return r[std::string("bandpass-f") + f + "-z" + z].spec.central_pitch.value(); };
   auto I = [&](const char* f, const char* z) { return r[std::string("bandpass-f") + f + "-z" + z].spec.irregularity.value(); };
@@ -312,9 +331,9 @@ TEST(DisplayInTheLoop, LowPassPullsFeltPitchTowardTheLowComponent) {
 }
 
 // What is felt through the tpad (the model's percept of the references, no
-// fit): every established trend holds, and the shaped waveforms stay near
-// their fundamental. (The fit through the display does not keep them yet:
-// docs/encoder.md §2, "The display in the loop"; hence [choice] flat.)
+// fit): the established trends hold, and the shaped waveforms stay near
+// their fundamental. (The fit keeps them too, anchored by the texture as
+// drawn: EncoderTrends/tpad above.)
 TEST(DisplayInTheLoop, FeltTrendsHoldThroughTheTpad) {
   PerceptualModel m;
   m.display = load_device("tpad").response;
@@ -370,6 +389,72 @@ TEST(DisplayInTheLoop, FeltTrendsHoldThroughTheTpad) {
     EXPECT_LT(N(f, "0.05"), N(f, "0.5")) << f;
     EXPECT_LT(N(f, "0.5"), N(f, "5")) << f;
   }
+}
+
+// The fit through a display is anchored by the texture as drawn
+// (PerceptualModel::drawn_weight): the drawn terms are the flat model's
+// percept, bit for bit; they enter only the fit's objective, never the felt
+// distance; without a display the encoder is the model without one, bit for
+// bit; and a display never uncovers what the texture itself masks.
+TEST(DisplayInTheLoop, TheFitIsAnchoredByTheTextureAsDrawn) {
+  const DeviceProfile d = load_device("tpad");
+  const double dx = d.spacing.value();
+  PerceptualModel flat;
+  PerceptualModel tpad;
+  tpad.display = d.response;
+  EXPECT_TRUE(display_in_loop(tpad));
+  EXPECT_FALSE(display_in_loop(flat));  // the default display is flat: nothing in the loop
+  const auto y = sines({{2.0, 0.25}, {8.0, 0.25}});
+  const Percept as_drawn = perceive(y, dx, flat);
+  const Percept through = perceive(y, dx, tpad);
+  EXPECT_EQ(through.drawn_pitch_db, as_drawn.pitch_db);
+  EXPECT_EQ(through.drawn_noisiness_db, as_drawn.noisiness_db);
+  EXPECT_EQ(as_drawn.drawn_pitch_db, as_drawn.pitch_db);
+  // fit_distance adds the drawn difference only with a display in the loop.
+  const Percept other = perceive(sines({{3.0, 0.25}, {8.0, 0.25}}), dx, tpad);
+  EXPECT_GT(fit_distance(through, other, tpad), distance(through, other, tpad));
+  PerceptualModel alone = tpad;
+  alone.drawn_weight = 0.0;
+  EXPECT_EQ(fit_distance(through, other, alone), distance(through, other, alone));
+  EXPECT_EQ(fit_distance(as_drawn, other, flat), distance(as_drawn, other, flat));
+
+  // Without a display in the loop (flat display, or display_response flat)
+  // the encoder is the one before: same bytes, same distance.
+  EncoderConfig none;
+  EncoderConfig off;
+  off.model.display = d.response;
+  off.model.display_response = PerceptualModel::Display::flat;
+  for (const char* name : {"2sin", "pink"}) {
+    const EncodeResult a = encode_reference(name, none);
+    const EncodeResult b = encode_reference(name, off);
+    EXPECT_EQ(a.bytes, b.bytes) << name;
+    EXPECT_EQ(a.model_distance, b.model_distance) << name;
+  }
+  // Through the display the drawn anchor changes the fit (drawn_weight 0 is
+  // the display alone: pink then fits a narrow distribution near 60 cpm,
+  // docs/encoder.md §2), and the reported distance is the felt one.
+  EncoderConfig anchored;
+  anchored.model.display = d.response;
+  EncoderConfig display_alone = anchored;
+  display_alone.model.drawn_weight = 0.0;
+  const EncodeResult pa = encode_reference("pink", anchored);
+  const EncodeResult pd = encode_reference("pink", display_alone);
+  EXPECT_NE(pa.bytes, pd.bytes);
+  EXPECT_LT(pa.spec.central_pitch.value(), encode_reference("white", anchored).spec.central_pitch.value());
+  EXPECT_DOUBLE_EQ(pa.model_distance, distance(pa.input, pa.decoded, anchored.model));
+
+  // A Texel rendering decoded with its recovered parameters feels like
+  // itself through the display too: a display attenuates and never uncovers
+  // leakage the texture masks (it read 0.43 JND when the felt mask was set
+  // on the displayed spectrum alone).
+  TexelSpec s;
+  s.seed = 1;
+  const EncodeResult r = encode(render_signal(s), anchored);
+  EXPECT_TRUE(r.texel_recovered);
+  EXPECT_LT(r.model_distance, 0.1);
+  EncoderConfig bad = anchored;
+  bad.model.drawn_weight = -1.0;
+  EXPECT_THROW((void)encode(render_signal(s), bad), InvalidArgument);
 }
 
 TEST(Encoder, PerceptualModelShape) {

@@ -21,7 +21,7 @@ def test_encode_array_equals_cli_bitstream(encoded):
     r = texel.encode(m)
     assert r.bytes == out.read_bytes()
     assert texel.encode(str(src), device="tpad").bytes == out.read_bytes()
-    assert set(r.percept) == {"pitch_db", "noisiness_db", "centroid_db", "spread_db"}
+    assert set(r.percept) == {"pitch_db", "noisiness_db", "centroid_db", "spread_db", "drawn_pitch_db", "drawn_noisiness_db"}
     assert r.spec["texel_length_mm"] == pytest.approx(0.25)
     assert r.model_distance >= 0
 
@@ -35,6 +35,25 @@ def test_encode_fit_method_equals_the_cli(cli, tmp_path):
         assert texel.encode(str(src), device="tpad", fit=fit).bytes == out.read_bytes()
     with pytest.raises(ValueError, match="fit is 'newton'"):
         texel.encode(str(src), device="tpad", fit="newton")
+
+
+def test_encode_display_in_the_loop_equals_the_cli(cli, tmp_path):
+    # The device's frequency response is in the model's loop by default, as
+    # `texel encode --device tpad`; 'flat' and drawn_weight as their flags.
+    src = tmp_path / "pink.bin"
+    cli("reference", "pink", "--device", "tpad", "-o", src)
+    streams = {}
+    for flags in ((), ("--display-response", "flat"), ("--drawn-weight", "0")):
+        out = tmp_path / f"pink{len(streams)}.texel"
+        cli("encode", src, "--device", "tpad", *flags, "-o", out)
+        streams[flags] = out.read_bytes()
+    assert texel.encode(str(src), device="tpad").bytes == streams[()]
+    assert texel.encode(np.fromfile(src, dtype="<u2")).bytes == streams[()]  # an array defaults to the tpad
+    assert texel.encode(str(src), device="tpad", display_response="flat").bytes == streams[("--display-response", "flat")]
+    assert texel.encode(str(src), device="tpad", drawn_weight=0).bytes == streams[("--drawn-weight", "0")]
+    assert len(set(streams.values())) == 3
+    with pytest.raises(ValueError, match="drawn_weight is -1"):
+        texel.encode(str(src), device="tpad", drawn_weight=-1)
 
 
 def test_decode_equals_cli(cli, encoded, tmp_path):

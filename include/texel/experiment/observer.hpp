@@ -94,7 +94,8 @@ class Matcher {
 /// The (Central Pitch, Irregularity) of the reference called `reference_name`
 /// (texel reference --list) under the encoder's perceptual model: the
 /// reference is rendered on `device` (a built-in name or a profile path) and
-/// encoded with texel::codec::encode. Nothing is cached. Throws
+/// encoded with texel::codec::encode as `texel encode --device` does (the
+/// device's frequency response in the model's loop). Nothing is cached. Throws
 /// InvalidArgument for an unknown reference or device. Takes about a second.
 MatchPoint perceptual_target(const std::string& reference_name, const std::string& device = "tpad");
 

@@ -96,6 +96,8 @@ struct MatchOptions {
   /// Region that receives the match; none = the last region other than
   /// `region` (the studies' right half), or `region` itself if it is alone.
   std::optional<std::size_t> into;
+  /// The encoder's settings; a flat model.display takes the document's
+  /// device's response (in the loop as `texel encode --device` puts it).
   codec::EncoderConfig encoder;
   std::size_t spectrum_points = 2048;
 };
@@ -125,7 +127,7 @@ ImportKind import_kind(std::string_view name);
 struct ImportOptions {
   DeviceProfile device = load_device("tpad");  ///< decodes bitstreams, reads .bin, receives encodings
   MmPerSecond swipe_speed{100.0};              ///< for time recordings (.wav, time/value .csv)
-  codec::EncoderConfig encoder;
+  codec::EncoderConfig encoder;                ///< a flat model.display takes `device`'s response
 };
 
 struct ImportResult {
