@@ -2,13 +2,13 @@
 // src/internal/texel/detail/detfft.hpp for the method and its trade-off.
 #include "texel/detail/detfft.hpp"
 
+#include "texel/detail/detfft_kernels.hpp"
 #include "texel/detail/scratch_file.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
-#include "texel/detmath.hpp"
 #include "texel/error.hpp"
 
 namespace texel::detail {
@@ -36,22 +36,10 @@ TwoDouble multiply(TwoDouble a, TwoDouble b) {
   return quick_two_sum(p.hi, p.lo + (a.hi * b.lo + a.lo * b.hi));
 }
 
-/// x minus its nearest integer, in [−1/2, 1/2]: exact for every finite double
-/// (x − floor(x) is not: −1e-17 − (−1) rounds to 1).
-double wrap(double x) { return x - std::round(x); }
-
 /// a modulo 1, to ~106 bits: integer multiples of it then stay small.
-TwoDouble wrap(TwoDouble a) { return two_sum(wrap(a.hi), a.lo); }
-
-/// c·q modulo 1 (in [−1/2, 1/2]) for a two-double c with |c.hi| <= 1/2 and
-/// an integer q < 2^53: the product's high part is exact (two_product) and
-/// reduced exactly, its low part is below one cycle, so the phase keeps
-/// about 1e-16 cycle whatever q.
-double cycles_times(TwoDouble c, std::uint64_t q) {
-  const auto qd = static_cast<double>(q);
-  const TwoDouble p = two_product(c.hi, qd);
-  return wrap(wrap(p.hi) + (p.lo + c.lo * qd));
-}
+/// (wrap_cycles(x) = x − round(x) is exact for every finite double; x −
+/// floor(x) is not: −1e-17 − (−1) rounds to 1.)
+TwoDouble wrap(TwoDouble a) { return two_sum(wrap_cycles(a.hi), a.lo); }
 
 }  // namespace
 
@@ -84,60 +72,9 @@ namespace {
 constexpr std::size_t leaf = 2048;
 constexpr std::size_t max_size = std::size_t{1} << 26;
 
-/// n decimation-in-frequency butterflies (a, b)[j] with twiddles (c, s)[j]
-/// (contiguous, so the loop vectorizes; lanes perform the scalar operations,
-/// so bits do not change). Shared by the in-memory and out-of-core FFTs.
-void dif_butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n) {
-  for (std::size_t j = 0; j < n; ++j) {
-    const double wr = c[j];
-    const double wi = s[j];
-    const double xr = ar[j];
-    const double xi = ai[j];
-    const double yr = br[j];
-    const double yi = bi[j];
-    ar[j] = xr + yr;
-    ai[j] = xi + yi;
-    const double dr = xr - yr;
-    const double di = xi - yi;
-    br[j] = dr * wr - di * wi;
-    bi[j] = dr * wi + di * wr;
-  }
-}
-
-/// The same for decimation in time with the conjugate twiddles (the inverse).
-void dit_butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n) {
-  for (std::size_t j = 0; j < n; ++j) {
-    const double wr = c[j];
-    const double wi = s[j];
-    const double yr = br[j];
-    const double yi = bi[j];
-    const double tr = yr * wr + yi * wi;
-    const double ti = yi * wr - yr * wi;
-    const double xr = ar[j];
-    const double xi = ai[j];
-    ar[j] = xr + tr;
-    ai[j] = xi + ti;
-    br[j] = xr - tr;
-    bi[j] = xi - ti;
-  }
-}
-
-/// One decimation-in-frequency stage over re/im[0, n): butterflies of span h
-/// with twiddles (c, s)[j] = e^(−2πi·j/2h), j < h.
-void dif_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
-  for (std::size_t base = 0; base < n; base += 2 * h)
-    dif_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
-}
-
-/// One decimation-in-time stage (the inverse).
-void dit_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
-  for (std::size_t base = 0; base < n; base += 2 * h)
-    dit_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
-}
-
 }  // namespace
 
-DetFft::DetFft(std::size_t n) : n_(n) {
+DetFft::DetFft(std::size_t n, int lanes) : n_(n), kernels_(&fft_kernels(lanes)) {
   if (n < 1 || n > max_size || (n & (n - 1)) != 0)
     throw InvalidArgument("FFT size is " + std::to_string(n) + "; it must be a power of two from 1 to 2^26");
   while ((std::size_t{1} << bits_) < n) ++bits_;
@@ -149,11 +86,7 @@ DetFft::DetFft(std::size_t n) : n_(n) {
   sin_.resize(n - 1);
   const std::size_t top = n / 2 - 1;
   const double inv = 1.0 / static_cast<double>(n);  // exact: n is a power of two
-  for (std::size_t t = 0; t < n / 2; ++t) {
-    const double u = static_cast<double>(t) * inv;  // exact
-    cos_[top + t] = detmath::cos_cycles(u);
-    sin_[top + t] = -detmath::sin_cycles(u);
-  }
+  kernels_->twiddles(0.0, inv, n / 2, cos_.data() + top, sin_.data() + top);
   for (std::size_t h = n / 4; h >= 1; h /= 2)
     for (std::size_t j = 0; j < h; ++j) {
       cos_[h - 1 + j] = cos_[top + j * (n / (2 * h))];
@@ -170,12 +103,12 @@ std::size_t DetFft::bit_reverse(std::size_t i) const {
 void DetFft::dif(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    dif_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
+    kernels_->dif_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
     dif(re, im, n / 2);
     dif(re + n / 2, im + n / 2, n / 2);
     return;
   }
-  for (std::size_t h = n / 2; h >= 1; h /= 2) dif_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
+  for (std::size_t h = n / 2; h >= 1; h /= 2) kernels_->dif_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
 }
 
 void DetFft::dit(double* re, double* im, std::size_t n) const {
@@ -183,10 +116,10 @@ void DetFft::dit(double* re, double* im, std::size_t n) const {
   if (n > leaf) {
     dit(re, im, n / 2);
     dit(re + n / 2, im + n / 2, n / 2);
-    dit_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
+    kernels_->dit_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
     return;
   }
-  for (std::size_t h = 1; h < n; h *= 2) dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
+  for (std::size_t h = 1; h < n; h *= 2) kernels_->dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
 }
 
 void DetFft::forward_to_bit_reversed(double* re, double* im) const { dif(re, im, n_); }
@@ -249,43 +182,34 @@ namespace {
 ///   φ_j + (first + j)·f·(x0 + t·s) = A_j + B_t − C_(t−j), with θ = f·s and
 ///   A_j = φ_j + (first + j)·f·x0 + θ/2·j²,  B_t = θ/2·t² + first·θ·t,  C_d = θ/2·d².
 struct ChirpPlan {
-  std::uint64_t first = 0;
   TwoDouble fundamental;
   std::size_t k = 0;      // harmonics
   std::size_t m = 0;      // FFT size
   std::size_t block = 0;  // output samples per block
-  TwoDouble half_theta;
-  TwoDouble first_theta;
-  double inv_m = 0.0;
+  ChirpPhases phases;     // θ/2, first·θ, first, 1/M
+  const FftKernels* kernels = nullptr;
 
-  ChirpPlan(std::uint64_t first_, TwoDouble f, std::size_t k_, std::size_t n, double spacing)
-      : first(first_), fundamental(f), k(k_), m(block_fft_size(k_, n)), block(std::min(m - k_ + 1, n)) {
+  ChirpPlan(std::uint64_t first, TwoDouble f, std::size_t k_, std::size_t n, double spacing, int lanes)
+      : fundamental(f), k(k_), m(block_fft_size(k_, n)), block(std::min(m - k_ + 1, n)), kernels(&fft_kernels(lanes)) {
     const TwoDouble theta = multiply(f, TwoDouble{spacing, 0.0});
-    half_theta = wrap(TwoDouble{theta.hi * 0.5, theta.lo * 0.5});  // halving is exact
-    first_theta = wrap(multiply(theta, TwoDouble{static_cast<double>(first), 0.0}));
-    inv_m = 1.0 / static_cast<double>(m);  // exact: a power of two
+    phases.half_theta = wrap(TwoDouble{theta.hi * 0.5, theta.lo * 0.5});  // halving is exact
+    phases.first_theta = wrap(multiply(theta, TwoDouble{static_cast<double>(first), 0.0}));
+    phases.first = static_cast<double>(first);    // exact below 2^52
+    phases.inv_m = 1.0 / static_cast<double>(m);  // exact: a power of two
   }
 
   /// The kernel e^(−2πi·C_d) for d in (−K, B), circularly (d at index d,
   /// −d at m − d), scaled by 1/M so that the inverse transform needs no
   /// scaling; 0 elsewhere. Shared by every block.
   void kernel(std::size_t i0, std::span<double> re, std::span<double> im) const {
-    for (std::size_t x = 0; x < re.size(); ++x) {
-      const std::size_t i = i0 + x;
-      std::size_t d = 0;
-      if (i < block) {
-        d = i;
-      } else if (i + k > m) {
-        d = m - i;
-      } else {
-        re[x] = 0.0;
-        im[x] = 0.0;
-        continue;
-      }
-      const double c = cycles_times(half_theta, static_cast<std::uint64_t>(d) * d);
-      re[x] = detmath::cos_cycles(c) * inv_m;
-      im[x] = -detmath::sin_cycles(c) * inv_m;
-    }
+    const std::size_t end = i0 + re.size();
+    const std::size_t a = std::clamp(block, i0, end);     // [i0, a): d = i
+    const std::size_t b = std::clamp(m - k + 1, a, end);  // [a, b): 0; [b, end): d = m − i
+    if (a > i0) kernels->chirp_kernel(phases, static_cast<double>(i0), 1.0, a - i0, re.data(), im.data());
+    std::fill(re.begin() + static_cast<std::ptrdiff_t>(a - i0), re.begin() + static_cast<std::ptrdiff_t>(b - i0), 0.0);
+    std::fill(im.begin() + static_cast<std::ptrdiff_t>(a - i0), im.begin() + static_cast<std::ptrdiff_t>(b - i0), 0.0);
+    if (end > b)
+      kernels->chirp_kernel(phases, static_cast<double>(m - b), -1.0, end - b, re.data() + (b - i0), im.data() + (b - i0));
   }
 
   /// f·x0 modulo 1 (to ~106 bits) for the block starting at sample m0,
@@ -301,34 +225,14 @@ struct ChirpPlan {
   /// The block's input u_j = a_j·e^(2πi·A_j) for j = j0 … from amplitudes
   /// and phases (written over them: re over amplitude, im over phase).
   void input(TwoDouble alpha, std::size_t j0, std::span<double> amplitude_re, std::span<double> phase_im) const {
-    for (std::size_t x = 0; x < amplitude_re.size(); ++x) {
-      const std::size_t j = j0 + x;
-      const double a = phase_im[x] + cycles_times(alpha, first + j) + cycles_times(half_theta, static_cast<std::uint64_t>(j) * j);
-      const double amp = amplitude_re[x];
-      amplitude_re[x] = amp * detmath::cos_cycles(a);
-      phase_im[x] = amp * detmath::sin_cycles(a);
-    }
+    kernels->chirp_input(phases, alpha, static_cast<double>(j0), amplitude_re.size(), amplitude_re.data(), phase_im.data());
   }
 
   /// y_t = Im(e^(2πi·B_t)·z_t) for t = t0 … into out.
   void output(std::size_t t0, const double* zr, const double* zi, std::span<double> out) const {
-    for (std::size_t x = 0; x < out.size(); ++x) {
-      const std::size_t t = t0 + x;
-      const double b = cycles_times(half_theta, static_cast<std::uint64_t>(t) * t) + cycles_times(first_theta, t);
-      out[x] = detmath::sin_cycles(b) * zr[x] + detmath::cos_cycles(b) * zi[x];
-    }
+    kernels->chirp_output(phases, static_cast<double>(t0), out.size(), zr, zi, out.data());
   }
 };
-
-/// The pointwise product u·v of the convolution, in place over u.
-void multiply_spectra(double* ur, double* ui, const double* vr, const double* vi, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const double xr = ur[i];
-    const double xi = ui[i];
-    ur[i] = xr * vr[i] - xi * vi[i];
-    ui[i] = xr * vi[i] + xi * vr[i];
-  }
-}
 
 constexpr std::size_t input_run = 4096;  // harmonics asked of the source at once (in memory)
 
@@ -337,7 +241,7 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
                    std::size_t n, const SampleSink& sink) {
   const std::size_t m = plan.m;
   const std::size_t k = plan.k;
-  const DetFft fft(m);
+  const DetFft fft(m, plan.kernels->lanes);
   std::vector<double> vr(m);
   std::vector<double> vi(m);
   plan.kernel(0, vr, vi);
@@ -358,7 +262,7 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
     std::fill(ur.begin() + static_cast<std::ptrdiff_t>(k), ur.end(), 0.0);
     std::fill(ui.begin() + static_cast<std::ptrdiff_t>(k), ui.end(), 0.0);
     fft.forward_to_bit_reversed(ur.data(), ui.data());
-    multiply_spectra(ur.data(), ui.data(), vr.data(), vi.data(), m);
+    plan.kernels->multiply_spectra(ur.data(), ui.data(), vr.data(), vi.data(), m);
     fft.inverse_from_bit_reversed(ur.data(), ui.data());
     for (std::size_t t0 = 0; t0 < len; t0 += input_run) {
       const std::span<double> run(y.data(), std::min(input_run, len - t0));
@@ -389,11 +293,12 @@ struct DiskArray {
 
 class OutOfCore {
  public:
-  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points)
+  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points, const FftKernels& kernels)
       : file_(file),
         m_(m),
         w_(w_points),
-        fft_(w_points),
+        kernels_(kernels),
+        fft_(w_points, kernels.lanes),
         re_(w_points),
         im_(w_points),
         re2_(w_points),
@@ -468,13 +373,9 @@ class OutOfCore {
         const std::size_t s = std::size_t{1} << (q - lo);
         double* c = twiddle_c_.data() + (s - 1) * cols;
         double* sn = twiddle_s_.data() + (s - 1) * cols;
+        const double inv_2h = std::ldexp(1.0, -(q + 1));  // j/2h is exact
         for (std::size_t t = 0; t < s; ++t)
-          for (std::size_t u = 0; u < cols; ++u) {
-            const std::size_t j = t * stride + mid * cols + u;
-            const double x = std::ldexp(static_cast<double>(j), -(q + 1));  // j/2h, exact
-            c[t * cols + u] = detmath::cos_cycles(x);
-            sn[t * cols + u] = -detmath::sin_cycles(x);
-          }
+          kernels_.twiddles(static_cast<double>(t * stride + mid * cols), inv_2h, cols, c + t * cols, sn + t * cols);
       }
       for (std::size_t hp = 0; hp < highs; ++hp) {
         const std::uint64_t base = (static_cast<std::uint64_t>(hp) << hi) + mid * cols;
@@ -495,9 +396,9 @@ class OutOfCore {
             double* br = re_.data() + (t + s) * cols;
             double* bi = im_.data() + (t + s) * cols;
             if (inverse)
-              dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
+              kernels_.dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
             else
-              dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
+              kernels_.dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
           }
         }
         for (std::size_t t = 0; t < rows; ++t) {
@@ -514,6 +415,7 @@ class OutOfCore {
   int p_ = 0;
   int wbits_ = 0;
   int r_max_ = 1;
+  const FftKernels& kernels_;
   DetFft fft_;
   std::vector<double> re_, im_, re2_, im2_;
   std::vector<double> twiddle_c_, twiddle_s_;
@@ -527,7 +429,7 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
   ScratchFile file("chirp-z synthesis");
   const DiskArray u{0, m};
   const DiskArray v{2 * static_cast<std::uint64_t>(m), 3 * static_cast<std::uint64_t>(m)};
-  OutOfCore ooc(file, m, w);
+  OutOfCore ooc(file, m, w, *plan.kernels);
   const DetFft& fft = ooc.block_fft();
 
   ooc.write(v, [&](std::size_t i0, std::span<double> re, std::span<double> im) { plan.kernel(i0, re, im); });
@@ -553,7 +455,7 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
       fft.forward_to_bit_reversed(re, im);
       file.read(v.re + i0, std::span<double>(ooc.spare_re(), w));
       file.read(v.im + i0, std::span<double>(ooc.spare_im(), w));
-      multiply_spectra(re, im, ooc.spare_re(), ooc.spare_im(), w);
+      plan.kernels->multiply_spectra(re, im, ooc.spare_re(), ooc.spare_im(), w);
       fft.inverse_from_bit_reversed(re, im);
     });
     ooc.dit_top(u);
@@ -581,7 +483,7 @@ void sum_harmonics(const HarmonicSource& h, double origin, double spacing, std::
   if (budget < 4 || (budget & (budget - 1)) != 0)
     throw InvalidArgument("sum_harmonics: a memory of " + std::to_string(budget) + " FFT points; it must be a power of two >= 4");
   if (samples == 0) return;
-  const ChirpPlan plan(h.first, h.fundamental, k, samples, spacing);
+  const ChirpPlan plan(h.first, h.fundamental, k, samples, spacing, memory.lanes);
   if (plan.m <= budget)
     sum_in_memory(plan, h, origin, spacing, index, samples, sink);
   else

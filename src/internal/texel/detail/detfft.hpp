@@ -11,9 +11,12 @@
 // forward (natural order in, bit-reversed out) and Cooley–Tukey decimation in
 // time inverse (bit-reversed in, natural out), so a convolution never
 // permutes; `forward`/`inverse` add the permutation for callers that need the
-// natural order. Trade-off: radix 2 and split re/im arrays are slower than a
-// tuned library (pocketfft, FFTW) by a small factor, in exchange for bits
-// that depend on nothing but this file and detmath.
+// natural order. The loops (butterflies, twiddles, the chirps' phases and
+// sines below) run in explicit SIMD lanes (detfft_kernels.hpp), every lane
+// doing the scalar operations in the same order, so the width never changes
+// a bit. Trade-off: radix 2 and split re/im arrays are slower than a tuned
+// library (pocketfft, FFTW) by a small factor, in exchange for bits that
+// depend on nothing but these files and detmath.
 //
 // sum_harmonics evaluates a sum of harmonics of one fundamental on a uniform
 // grid, the whole of a reference noise or waveform, with Bluestein's chirp-z
@@ -49,13 +52,18 @@ TwoDouble two_product(double a, double b);
 /// 1 / d as a two-double (d > 0).
 TwoDouble reciprocal(double d);
 
+struct FftKernels;
+
 /// A deterministic complex FFT of size n = 2^p, 1 <= n <= 2^26.
 class DetFft {
  public:
   /// Prepares the twiddles e^(−2πi·t/n), t < n/2, laid out per stage (n − 1
-  /// complex values).
-  /// Throws InvalidArgument if n is not a power of two in range.
-  explicit DetFft(std::size_t n);
+  /// complex values). `lanes` picks the SIMD width of its loops
+  /// (detfft_kernels.hpp: 0 = the widest this CPU runs, 1 = the scalar
+  /// reference); the bits are the same for every width.
+  /// Throws InvalidArgument if n is not a power of two in range, or for a
+  /// width this CPU does not run.
+  explicit DetFft(std::size_t n, int lanes = 0);
 
   [[nodiscard]] std::size_t size() const { return n_; }
 
@@ -79,6 +87,7 @@ class DetFft {
 
   std::size_t n_ = 1;
   int bits_ = 0;
+  const FftKernels* kernels_ = nullptr;
   // Twiddles e^(−2πi·j/2h) of every stage h (1, 2, 4 … n/2), j < h, stage h
   // at offset h − 1: n − 1 values, contiguous per stage.
   std::vector<double> cos_;
@@ -137,6 +146,9 @@ using SampleSink = std::function<void(std::size_t m0, std::span<const double> y)
 /// result: every butterfly is the in-memory FFT's, with the same twiddles.
 struct ChirpMemory {
   std::size_t fft_points = std::size_t{1} << 17;  ///< a power of two >= 4 (6 MiB in memory)
+  /// The SIMD width of the loops: 0 = the widest this CPU runs, 1 = the
+  /// scalar reference (tests), 2, 4 or 8. Never changes a bit.
+  int lanes = 0;
 };
 
 /// The same sum as above, streamed: the harmonics come from `h.fill` and the
