@@ -3,6 +3,7 @@
 #include "texel/detail/detfft.hpp"
 
 #include "texel/detail/detfft_kernels.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detail/scratch_file.hpp"
 
 #include <algorithm>
@@ -285,49 +286,65 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
 // the in-memory order (decimation in frequency: high bits first; in time:
 // low bits first) and writes it back. Every butterfly is the same IEEE
 // operations on the same values as in memory, so the bits are the same.
+//
+// The groups of a pass, and the blocks, are independent of each other: each
+// worker thread (parallel.hpp) takes a contiguous share of them into its own
+// W-point buffers. The first pass of a forward transform takes its points
+// from the function that defines them (the kernel, the chirped harmonics)
+// rather than from the file, so an input is never written to be read back.
 
 struct DiskArray {
   std::uint64_t re = 0;  // element offsets in the scratch file
   std::uint64_t im = 0;
 };
 
+/// Runs of an array's points read from the file.
+struct FileRuns {
+  const ScratchFile& file;
+  DiskArray a;
+  void operator()(std::size_t i0, std::span<double> re, std::span<double> im) const {
+    file.read(a.re + i0, re);
+    file.read(a.im + i0, im);
+  }
+};
+
 class OutOfCore {
  public:
-  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points, const FftKernels& kernels)
-      : file_(file),
-        m_(m),
-        w_(w_points),
-        kernels_(kernels),
-        fft_(w_points, kernels.lanes),
-        re_(w_points),
-        im_(w_points),
-        re2_(w_points),
-        im2_(w_points),
-        twiddle_c_(w_points),
-        twiddle_s_(w_points) {
+  /// One worker's memory: 6 arrays of W points (48 bytes per point).
+  struct Workspace {
+    explicit Workspace(std::size_t w) : re(w), im(w), re2(w), im2(w), twiddle_c(w), twiddle_s(w) {}
+    std::vector<double> re, im;    // the group or block at hand
+    std::vector<double> re2, im2;  // free for blocks()' and outputs' callers
+    std::vector<double> twiddle_c, twiddle_s;
+    std::size_t twiddle_mid = 0;  // the group column the twiddles are for
+    bool twiddles_valid = false;
+  };
+
+  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points, const FftKernels& kernels, int workers)
+      : file_(file), m_(m), w_(w_points), kernels_(kernels), fft_(w_points, kernels.lanes) {
     while ((std::size_t{1} << p_) < m_) ++p_;
     while ((std::size_t{1} << wbits_) < w_) ++wbits_;
     const int c_min = std::min(9, wbits_ - 1);  // rows of at least 4 KiB where W allows
     r_max_ = wbits_ - c_min;
+    workspaces_.reserve(static_cast<std::size_t>(std::max(1, workers)));
+    for (int i = 0; i < std::max(1, workers); ++i) workspaces_.emplace_back(w_points);
   }
 
-  [[nodiscard]] std::size_t work() const { return w_; }
+  [[nodiscard]] int workers() const { return static_cast<int>(workspaces_.size()); }
+  [[nodiscard]] Workspace& workspace(std::size_t worker) { return workspaces_[worker]; }
 
-  /// Writes the M points a chunk at a time: fill(i0, re, im) for W points.
+  /// The stages of bits w … p−1 of decimation in frequency (high bits
+  /// first) of the array whose points fill(i0, re, im) defines (runs of
+  /// contiguous points, any order, from any worker): the first pass takes
+  /// them from `fill`, the others from the file.
   template <class Fill>
-  void write(DiskArray a, Fill&& fill) {
-    for (std::size_t i0 = 0; i0 < m_; i0 += w_) {
-      fill(i0, std::span<double>(re_), std::span<double>(im_));
-      file_.write(a.re + i0, re_);
-      file_.write(a.im + i0, im_);
-    }
-  }
-
-  /// The stages of bits w … p−1 of decimation in frequency (high bits first).
-  void dif_top(DiskArray a) {
+  void dif_top(DiskArray a, const Fill& fill) {
     for (int hi = p_; hi > wbits_;) {
       const int lo = std::max(wbits_, hi - r_max_);
-      pass(a, lo, hi, false);
+      if (hi == p_)
+        pass(a, lo, hi, false, fill);
+      else
+        pass(a, lo, hi, false, FileRuns{file_, a});
       hi = lo;
     }
   }
@@ -336,77 +353,85 @@ class OutOfCore {
   void dit_top(DiskArray a) {
     for (int lo = wbits_; lo < p_;) {
       const int hi = std::min(p_, lo + r_max_);
-      pass(a, lo, hi, true);
+      pass(a, lo, hi, true, FileRuns{file_, a});
       lo = hi;
     }
   }
 
-  /// For each block of W contiguous points: fn(i0, re, im) in memory.
+  /// For each block of W contiguous points, on some worker: the block read
+  /// into its workspace's re/im, fn(workspace, i0), written back.
   template <class Fn>
-  void blocks(DiskArray a, Fn&& fn) {
-    for (std::size_t i0 = 0; i0 < m_; i0 += w_) {
-      file_.read(a.re + i0, re_);
-      file_.read(a.im + i0, im_);
-      fn(i0, re_.data(), im_.data());
-      file_.write(a.re + i0, re_);
-      file_.write(a.im + i0, im_);
-    }
+  void blocks(DiskArray a, const Fn& fn) {
+    parallel_tasks(workers(), m_ / w_, [&](std::size_t worker, std::size_t task) {
+      Workspace& ws = workspaces_[worker];
+      const std::uint64_t i0 = task * w_;
+      file_.read(a.re + i0, ws.re);
+      file_.read(a.im + i0, ws.im);
+      fn(ws, static_cast<std::size_t>(i0));
+      file_.write(a.re + i0, ws.re);
+      file_.write(a.im + i0, ws.im);
+    });
   }
 
   [[nodiscard]] const DetFft& block_fft() const { return fft_; }
-  /// A second pair of W-point buffers, free for blocks()' callers.
-  [[nodiscard]] double* spare_re() { return re2_.data(); }
-  [[nodiscard]] double* spare_im() { return im2_.data(); }
 
  private:
-  void pass(DiskArray a, int lo, int hi, bool inverse) {
+  template <class Load>
+  void pass(DiskArray a, int lo, int hi, bool inverse, const Load& load) {
     const std::size_t rows = std::size_t{1} << (hi - lo);
     const std::size_t cols = w_ / rows;
     const std::size_t stride = std::size_t{1} << lo;
     const std::size_t mids = stride / cols;
     const std::size_t highs = m_ >> hi;
-    // Twiddles of stage q (span h = 2^q) at offset (2^(q−lo) − 1)·C: for
-    // row t' < 2^(q−lo) and column u, j = t'·2^lo + mid·C + u (the index's
-    // bits below q); the same for every group with this `mid`.
-    for (std::size_t mid = 0; mid < mids; ++mid) {
-      for (int q = lo; q < hi; ++q) {
-        const std::size_t s = std::size_t{1} << (q - lo);
-        double* c = twiddle_c_.data() + (s - 1) * cols;
-        double* sn = twiddle_s_.data() + (s - 1) * cols;
-        const double inv_2h = std::ldexp(1.0, -(q + 1));  // j/2h is exact
-        for (std::size_t t = 0; t < s; ++t)
-          kernels_.twiddles(static_cast<double>(t * stride + mid * cols), inv_2h, cols, c + t * cols, sn + t * cols);
-      }
-      for (std::size_t hp = 0; hp < highs; ++hp) {
-        const std::uint64_t base = (static_cast<std::uint64_t>(hp) << hi) + mid * cols;
-        for (std::size_t t = 0; t < rows; ++t) {
-          file_.read(a.re + base + t * stride, std::span<double>(re_.data() + t * cols, cols));
-          file_.read(a.im + base + t * stride, std::span<double>(im_.data() + t * cols, cols));
-        }
-        for (int step = 0; step < hi - lo; ++step) {
-          const int q = inverse ? lo + step : hi - 1 - step;
+    for (Workspace& ws : workspaces_) ws.twiddles_valid = false;
+    // Groups in the order (mid, high), shared out contiguously: a worker
+    // recomputes its twiddles only when `mid` changes.
+    parallel_tasks(workers(), mids * highs, [&](std::size_t worker, std::size_t task) {
+      Workspace& ws = workspaces_[worker];
+      const std::size_t mid = task / highs;
+      const std::size_t hp = task % highs;
+      if (!ws.twiddles_valid || ws.twiddle_mid != mid) {
+        // Twiddles of stage q (span h = 2^q) at offset (2^(q−lo) − 1)·C: for
+        // row t' < 2^(q−lo) and column u, j = t'·2^lo + mid·C + u (the index's
+        // bits below q); the same for every group with this `mid`.
+        for (int q = lo; q < hi; ++q) {
           const std::size_t s = std::size_t{1} << (q - lo);
-          const double* c = twiddle_c_.data() + (s - 1) * cols;
-          const double* sn = twiddle_s_.data() + (s - 1) * cols;
-          for (std::size_t t = 0; t < rows; ++t) {
-            if ((t & s) != 0) continue;
-            const std::size_t tw = (t & (s - 1)) * cols;
-            double* ar = re_.data() + t * cols;
-            double* ai = im_.data() + t * cols;
-            double* br = re_.data() + (t + s) * cols;
-            double* bi = im_.data() + (t + s) * cols;
-            if (inverse)
-              kernels_.dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
-            else
-              kernels_.dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
-          }
+          double* c = ws.twiddle_c.data() + (s - 1) * cols;
+          double* sn = ws.twiddle_s.data() + (s - 1) * cols;
+          const double inv_2h = std::ldexp(1.0, -(q + 1));  // j/2h is exact
+          for (std::size_t t = 0; t < s; ++t)
+            kernels_.twiddles(static_cast<double>(t * stride + mid * cols), inv_2h, cols, c + t * cols, sn + t * cols);
         }
+        ws.twiddle_mid = mid;
+        ws.twiddles_valid = true;
+      }
+      const std::size_t base = (hp << hi) + mid * cols;
+      for (std::size_t t = 0; t < rows; ++t)
+        load(base + t * stride, std::span<double>(ws.re.data() + t * cols, cols),
+             std::span<double>(ws.im.data() + t * cols, cols));
+      for (int step = 0; step < hi - lo; ++step) {
+        const int q = inverse ? lo + step : hi - 1 - step;
+        const std::size_t s = std::size_t{1} << (q - lo);
+        const double* c = ws.twiddle_c.data() + (s - 1) * cols;
+        const double* sn = ws.twiddle_s.data() + (s - 1) * cols;
         for (std::size_t t = 0; t < rows; ++t) {
-          file_.write(a.re + base + t * stride, std::span<const double>(re_.data() + t * cols, cols));
-          file_.write(a.im + base + t * stride, std::span<const double>(im_.data() + t * cols, cols));
+          if ((t & s) != 0) continue;
+          const std::size_t tw = (t & (s - 1)) * cols;
+          double* ar = ws.re.data() + t * cols;
+          double* ai = ws.im.data() + t * cols;
+          double* br = ws.re.data() + (t + s) * cols;
+          double* bi = ws.im.data() + (t + s) * cols;
+          if (inverse)
+            kernels_.dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
+          else
+            kernels_.dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
         }
       }
-    }
+      for (std::size_t t = 0; t < rows; ++t) {
+        file_.write(a.re + base + t * stride, std::span<const double>(ws.re.data() + t * cols, cols));
+        file_.write(a.im + base + t * stride, std::span<const double>(ws.im.data() + t * cols, cols));
+      }
+    });
   }
 
   ScratchFile& file_;
@@ -417,29 +442,28 @@ class OutOfCore {
   int r_max_ = 1;
   const FftKernels& kernels_;
   DetFft fft_;
-  std::vector<double> re_, im_, re2_, im2_;
-  std::vector<double> twiddle_c_, twiddle_s_;
+  std::vector<Workspace> workspaces_;
 };
 
-/// The whole sum with the FFT arrays in a scratch file and W points in memory.
+/// The whole sum with the FFT arrays in a scratch file and W points in
+/// memory per worker.
 void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double origin, double spacing, std::int64_t index,
-                     std::size_t n, const SampleSink& sink, std::size_t w) {
+                     std::size_t n, const SampleSink& sink, std::size_t w, int workers) {
   const std::size_t m = plan.m;
   const std::size_t k = plan.k;
   ScratchFile file("chirp-z synthesis");
   const DiskArray u{0, m};
   const DiskArray v{2 * static_cast<std::uint64_t>(m), 3 * static_cast<std::uint64_t>(m)};
-  OutOfCore ooc(file, m, w, *plan.kernels);
+  OutOfCore ooc(file, m, w, *plan.kernels, workers);
   const DetFft& fft = ooc.block_fft();
 
-  ooc.write(v, [&](std::size_t i0, std::span<double> re, std::span<double> im) { plan.kernel(i0, re, im); });
-  ooc.dif_top(v);
-  ooc.blocks(v, [&](std::size_t, double* re, double* im) { fft.forward_to_bit_reversed(re, im); });
+  ooc.dif_top(v, [&](std::size_t i0, std::span<double> re, std::span<double> im) { plan.kernel(i0, re, im); });
+  ooc.blocks(v, [&](OutOfCore::Workspace& ws, std::size_t) { fft.forward_to_bit_reversed(ws.re.data(), ws.im.data()); });
 
   for (std::size_t m0 = 0; m0 < n; m0 += plan.block) {
     const std::size_t len = std::min(plan.block, n - m0);
     const TwoDouble alpha = plan.alpha(origin, spacing, index, m0);
-    ooc.write(u, [&](std::size_t i0, std::span<double> re, std::span<double> im) {
+    ooc.dif_top(u, [&](std::size_t i0, std::span<double> re, std::span<double> im) {
       const std::size_t live = i0 < k ? std::min(re.size(), k - i0) : 0;
       if (live > 0) {
         h.fill(i0, re.first(live), im.first(live));
@@ -448,25 +472,32 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
       std::fill(re.begin() + static_cast<std::ptrdiff_t>(live), re.end(), 0.0);
       std::fill(im.begin() + static_cast<std::ptrdiff_t>(live), im.end(), 0.0);
     });
-    ooc.dif_top(u);
     // The stages below w of the forward transform, the product and the
     // stages below w of the inverse all act within a block: one pass.
-    ooc.blocks(u, [&](std::size_t i0, double* re, double* im) {
-      fft.forward_to_bit_reversed(re, im);
-      file.read(v.re + i0, std::span<double>(ooc.spare_re(), w));
-      file.read(v.im + i0, std::span<double>(ooc.spare_im(), w));
-      plan.kernels->multiply_spectra(re, im, ooc.spare_re(), ooc.spare_im(), w);
-      fft.inverse_from_bit_reversed(re, im);
+    ooc.blocks(u, [&](OutOfCore::Workspace& ws, std::size_t i0) {
+      fft.forward_to_bit_reversed(ws.re.data(), ws.im.data());
+      file.read(v.re + i0, ws.re2);
+      file.read(v.im + i0, ws.im2);
+      plan.kernels->multiply_spectra(ws.re.data(), ws.im.data(), ws.re2.data(), ws.im2.data(), w);
+      fft.inverse_from_bit_reversed(ws.re.data(), ws.im.data());
     });
     ooc.dit_top(u);
-    for (std::size_t t0 = 0; t0 < len; t0 += w) {
-      const std::size_t run = std::min(w, len - t0);
-      const std::span<double> zr(ooc.spare_re(), run);
-      const std::span<double> zi(ooc.spare_im(), run);
-      file.read(u.re + t0, zr);
-      file.read(u.im + t0, zi);
-      plan.output(t0, zr.data(), zi.data(), zr);  // y_t overwrites z_t element by element
-      sink(m0 + t0, zr);
+    // Outputs W at a time, one run per worker, handed to the sink in order.
+    const auto runs = static_cast<std::size_t>(ooc.workers());
+    for (std::size_t t0 = 0; t0 < len; t0 += runs * w) {
+      const std::size_t count = std::min(runs, (len - t0 + w - 1) / w);
+      const auto run_of = [&](std::size_t r) { return std::min(w, len - (t0 + r * w)); };
+      parallel_tasks(ooc.workers(), count, [&](std::size_t worker, std::size_t r) {  // run r on worker r
+        OutOfCore::Workspace& ws = ooc.workspace(worker);
+        const std::size_t at = t0 + r * w;
+        const std::span<double> zr(ws.re2.data(), run_of(r));
+        const std::span<double> zi(ws.im2.data(), zr.size());
+        file.read(u.re + at, zr);
+        file.read(u.im + at, zi);
+        plan.output(at, zr.data(), zi.data(), zr);  // y_t overwrites z_t element by element
+      });
+      for (std::size_t r = 0; r < count; ++r)
+        sink(m0 + t0 + r * w, std::span<const double>(ooc.workspace(r).re2.data(), run_of(r)));
     }
   }
 }
@@ -487,7 +518,8 @@ void sum_harmonics(const HarmonicSource& h, double origin, double spacing, std::
   if (plan.m <= budget)
     sum_in_memory(plan, h, origin, spacing, index, samples, sink);
   else
-    sum_out_of_core(plan, h, origin, spacing, index, samples, sink, budget / 2);
+    sum_out_of_core(plan, h, origin, spacing, index, samples, sink, budget / 2,
+                    memory.threads > 0 ? memory.threads : worker_threads());
 }
 
 HarmonicSource harmonic_source(const Harmonics& h) {

@@ -5,15 +5,18 @@
 // whole chirp-z sums through each width, in memory and out of core.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "texel/detail/detfft.hpp"
 #include "texel/detail/detfft_kernels.hpp"
 #include "texel/detail/lanes.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
 
@@ -207,4 +210,88 @@ TEST(DetFftKernels, TransformsAndChirpZSumsAreTheScalarBitsAtEveryWidth) {
       }
     }
   }
+}
+
+TEST(DetFftKernels, ThreadCountsGiveTheOneThreadBits) {
+  // Out of core the groups of a pass, the blocks and the output runs are
+  // shared among workers; every count gives the bits of one thread, and
+  // the source may be called concurrently (here it checks its arguments).
+  struct Case {
+    std::size_t harmonics, samples;
+    double period;
+  };
+  for (const Case& c : {Case{301, 1003, 5.3}, Case{2003, 25001, 26.5}, Case{4001, 9003, 47.7}}) {
+    const std::vector<double> amp = values(c.harmonics, 41, 0.0, 2.0), phase = values(c.harmonics, 42, 0.0, 1.0);
+    std::atomic<int> bad = 0;
+    const HarmonicSource source{2, reciprocal(c.period), c.harmonics,
+                                [&](std::size_t j0, std::span<double> a, std::span<double> p) {
+                                  if (a.size() != p.size() || j0 + a.size() > c.harmonics) ++bad;
+                                  std::copy_n(amp.begin() + static_cast<std::ptrdiff_t>(j0), a.size(), a.begin());
+                                  std::copy_n(phase.begin() + static_cast<std::ptrdiff_t>(j0), p.size(), p.begin());
+                                }};
+    for (std::size_t budget : {std::size_t{32}, std::size_t{1024}, std::size_t{4096}}) {
+      std::vector<double> expected;
+      for (int threads : {1, 2, 3, 5}) {
+        std::vector<double> y(c.samples, std::nan(""));
+        std::size_t next = 0;
+        sum_harmonics(
+            source, 0.0, 0.0053, 0, c.samples,
+            [&](std::size_t m0, std::span<const double> v) {
+              ASSERT_EQ(m0, next) << "samples arrive in order";
+              std::copy(v.begin(), v.end(), y.begin() + static_cast<std::ptrdiff_t>(m0));
+              next += v.size();
+            },
+            ChirpMemory{budget, 0, threads});
+        EXPECT_EQ(next, c.samples);
+        if (threads == 1)
+          expected = y;
+        else
+          EXPECT_TRUE(same_bits(y, expected))
+              << c.harmonics << " harmonics × " << c.samples << " samples, budget " << budget << ", " << threads << " threads";
+      }
+    }
+    EXPECT_EQ(bad.load(), 0);
+  }
+}
+
+TEST(DetFftKernels, AWorkerThreadsErrorReachesTheCaller) {
+  // A source that fails on one run, whichever worker draws it: the error
+  // comes out of sum_harmonics, after every thread has been joined.
+  const HarmonicSource failing{1, {1.0 / 64.0, 0.0}, 3000, [](std::size_t j0, std::span<double> a, std::span<double> p) {
+                                 if (j0 >= 2000) throw IoError("source failed at " + std::to_string(j0));
+                                 std::fill(a.begin(), a.end(), 1.0);
+                                 std::fill(p.begin(), p.end(), 0.0);
+                               }};
+  for (int threads : {1, 2, 4})
+    EXPECT_THROW(sum_harmonics(
+                     failing, 0.0, 0.005, 0, 5000, [](std::size_t, std::span<const double>) {}, ChirpMemory{256, 0, threads}),
+                 IoError)
+        << threads << " threads";
+}
+
+TEST(ParallelTasks, EveryTaskOnceInContiguousSharesAndErrorsRethrown) {
+  for (int workers : {1, 2, 3, 8})
+    for (std::size_t tasks : {0u, 1u, 2u, 7u, 64u}) {
+      std::vector<std::atomic<int>> runs(tasks);
+      std::vector<std::size_t> worker_of(tasks);
+      parallel_tasks(workers, tasks, [&](std::size_t worker, std::size_t task) {
+        ++runs[task];
+        worker_of[task] = worker;
+      });
+      for (std::size_t t = 0; t < tasks; ++t) {
+        EXPECT_EQ(runs[t].load(), 1) << workers << " workers, task " << t;
+        if (t > 0) {
+          EXPECT_GE(worker_of[t], worker_of[t - 1]);  // contiguous shares, in worker order
+        }
+        if (tasks <= static_cast<std::size_t>(workers)) {
+          EXPECT_EQ(worker_of[t], t);
+        }
+      }
+    }
+  EXPECT_THROW(parallel_tasks(2, 10,
+                              [](std::size_t, std::size_t task) {
+                                if (task == 7) throw InvalidArgument("task 7");
+                              }),
+               InvalidArgument);
+  EXPECT_GE(worker_threads(), 1);
 }

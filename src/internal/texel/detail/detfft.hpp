@@ -123,7 +123,9 @@ void sum_harmonics(const Harmonics& h, double origin, double spacing, std::int64
 /// amplitude, phase) writes the amplitudes and phases (cycles) of harmonics
 /// first + j0 … first + j0 + amplitude.size() − 1 (amplitude.size() ==
 /// phase.size()). It is called once per run per output block, so it must
-/// give the same values every time.
+/// give the same values every time; out of core the runs come in any order
+/// and from several threads at once, so it must be safe to call
+/// concurrently (a pure function of j0 is).
 struct HarmonicSource {
   std::uint64_t first = 0;  ///< harmonic number of element 0 (< 2^52)
   TwoDouble fundamental;    ///< cycles per mm
@@ -141,7 +143,8 @@ using SampleSink = std::function<void(std::size_t m0, std::span<const double> y)
 /// How much memory the chirp-z synthesis may use. An FFT of up to
 /// `fft_points` points runs in memory (48 bytes per point); a larger one
 /// runs out of core on a ScratchFile ($TMPDIR; 32 bytes per FFT point on
-/// disk) with about 32 bytes × fft_points of memory, streaming the FFT's
+/// disk) with about 32 bytes × fft_points of memory, plus 24 bytes ×
+/// fft_points for each worker thread beyond the first, streaming the FFT's
 /// stages in passes. Where the arrays live never changes a bit of the
 /// result: every butterfly is the in-memory FFT's, with the same twiddles.
 struct ChirpMemory {
@@ -149,6 +152,9 @@ struct ChirpMemory {
   /// The SIMD width of the loops: 0 = the widest this CPU runs, 1 = the
   /// scalar reference (tests), 2, 4 or 8. Never changes a bit.
   int lanes = 0;
+  /// Worker threads of an out-of-core sum (parallel.hpp), each with its
+  /// own W-point buffers: 0 = detail::worker_threads(). Never changes a bit.
+  int threads = 0;
 };
 
 /// The same sum as above, streamed: the harmonics come from `h.fill` and the
