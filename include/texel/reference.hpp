@@ -210,7 +210,8 @@ class ReferenceTexture final : public Texture {
  private:
   enum class Shape { sum, patch, pulse };
   void evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const;
-  /// Prepared samples [i, i + out.size()) (indices from cache_first_).
+  /// Prepared samples [i, i + out.size()) (indices from cache_first_), as
+  /// amplitudes (a sum is kept as synthesised and mapped here).
   void read_samples(std::size_t i, std::span<double> out) const;
 
   ReferenceSpec spec_;

@@ -457,17 +457,10 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
         keep(i, y);
       }
     }
+    // The sums are kept as synthesised; read_samples maps them to amplitude
+    // (no second pass over a scratch file).
     peak_ = peak > 0.0 ? peak : 1.0;
     scale_ = 0.5 / peak_;
-    for (std::size_t i = 0; i < cache_count_; i += block) {
-      const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
-      read_samples(i, y);
-      for (double& v : y) {
-        const double u = 0.5 + scale_ * v;
-        v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-      }
-      store(i, y);
-    }
   } else {
     for (std::size_t i = 0; i < cache_count_; i += block) {
       const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
@@ -491,6 +484,11 @@ void ReferenceTexture::read_samples(std::size_t i, std::span<double> out) const 
     scratch_->read(i, out);
   else
     std::copy_n(cache_.begin() + static_cast<std::ptrdiff_t>(i), out.size(), out.begin());
+  if (shape_ != Shape::sum) return;
+  for (double& v : out) {  // a sum as synthesised, to amplitude (as evaluate does)
+    const double u = 0.5 + scale_ * v;
+    v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+  }
 }
 
 void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const {
