@@ -308,6 +308,16 @@ struct FileRuns {
   }
 };
 
+/// Runs of an array's points written back to the file.
+struct FileWrites {
+  ScratchFile& file;
+  DiskArray a;
+  void operator()(std::size_t i0, std::span<double> re, std::span<double> im) const {
+    file.write(a.re + i0, re);
+    file.write(a.im + i0, im);
+  }
+};
+
 class OutOfCore {
  public:
   /// One worker's memory: 6 arrays of W points (48 bytes per point).
@@ -342,18 +352,24 @@ class OutOfCore {
     for (int hi = p_; hi > wbits_;) {
       const int lo = std::max(wbits_, hi - r_max_);
       if (hi == p_)
-        pass(a, lo, hi, false, fill);
+        pass(lo, hi, false, fill, FileWrites{file_, a});
       else
-        pass(a, lo, hi, false, FileRuns{file_, a});
+        pass(lo, hi, false, FileRuns{file_, a}, FileWrites{file_, a});
       hi = lo;
     }
   }
 
-  /// The stages of bits w … p−1 of decimation in time (low bits first).
-  void dit_top(DiskArray a) {
+  /// The stages of bits w … p−1 of decimation in time (low bits first); the
+  /// last pass hands each run of finished points to take(i0, re, im) (any
+  /// order, from any worker) instead of writing it back.
+  template <class Take>
+  void dit_top(DiskArray a, const Take& take) {
     for (int lo = wbits_; lo < p_;) {
       const int hi = std::min(p_, lo + r_max_);
-      pass(a, lo, hi, true, FileRuns{file_, a});
+      if (hi == p_)
+        pass(lo, hi, true, FileRuns{file_, a}, take);
+      else
+        pass(lo, hi, true, FileRuns{file_, a}, FileWrites{file_, a});
       lo = hi;
     }
   }
@@ -376,8 +392,10 @@ class OutOfCore {
   [[nodiscard]] const DetFft& block_fft() const { return fft_; }
 
  private:
-  template <class Load>
-  void pass(DiskArray a, int lo, int hi, bool inverse, const Load& load) {
+  /// The stages of bits lo … hi−1 over every group: its rows come from
+  /// load(i0, re, im) and go to save(i0, re, im).
+  template <class Load, class Save>
+  void pass(int lo, int hi, bool inverse, const Load& load, const Save& save) {
     const std::size_t rows = std::size_t{1} << (hi - lo);
     const std::size_t cols = w_ / rows;
     const std::size_t stride = std::size_t{1} << lo;
@@ -427,10 +445,9 @@ class OutOfCore {
             kernels_.dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
         }
       }
-      for (std::size_t t = 0; t < rows; ++t) {
-        file_.write(a.re + base + t * stride, std::span<const double>(ws.re.data() + t * cols, cols));
-        file_.write(a.im + base + t * stride, std::span<const double>(ws.im.data() + t * cols, cols));
-      }
+      for (std::size_t t = 0; t < rows; ++t)
+        save(base + t * stride, std::span<double>(ws.re.data() + t * cols, cols),
+             std::span<double>(ws.im.data() + t * cols, cols));
     });
   }
 
@@ -481,23 +498,19 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
       plan.kernels->multiply_spectra(ws.re.data(), ws.im.data(), ws.re2.data(), ws.im2.data(), w);
       fft.inverse_from_bit_reversed(ws.re.data(), ws.im.data());
     });
-    ooc.dit_top(u);
-    // Outputs W at a time, one run per worker, handed to the sink in order.
-    const auto runs = static_cast<std::size_t>(ooc.workers());
-    for (std::size_t t0 = 0; t0 < len; t0 += runs * w) {
-      const std::size_t count = std::min(runs, (len - t0 + w - 1) / w);
-      const auto run_of = [&](std::size_t r) { return std::min(w, len - (t0 + r * w)); };
-      parallel_tasks(ooc.workers(), count, [&](std::size_t worker, std::size_t r) {  // run r on worker r
-        OutOfCore::Workspace& ws = ooc.workspace(worker);
-        const std::size_t at = t0 + r * w;
-        const std::span<double> zr(ws.re2.data(), run_of(r));
-        const std::span<double> zi(ws.im2.data(), zr.size());
-        file.read(u.re + at, zr);
-        file.read(u.im + at, zi);
-        plan.output(at, zr.data(), zi.data(), zr);  // y_t overwrites z_t element by element
-      });
-      for (std::size_t r = 0; r < count; ++r)
-        sink(m0 + t0 + r * w, std::span<const double>(ooc.workspace(r).re2.data(), run_of(r)));
+    // The last pass turns z_t into y_t where t < len and writes y alone
+    // over u.re; the points beyond are never read again.
+    ooc.dit_top(u, [&](std::size_t i0, std::span<double> zr, std::span<double> zi) {
+      if (i0 >= len) return;
+      const std::span<double> y = zr.first(std::min(zr.size(), len - i0));
+      plan.output(i0, zr.data(), zi.data(), y);  // y_t overwrites z_t element by element
+      file.write(u.re + i0, y);
+    });
+    const std::span<double> y(ooc.workspace(0).re2);
+    for (std::size_t t0 = 0; t0 < len; t0 += w) {
+      const std::span<double> run = y.first(std::min(w, len - t0));
+      file.read(u.re + t0, run);
+      sink(m0 + t0, run);
     }
   }
 }
