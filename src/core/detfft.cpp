@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 #include "texel/error.hpp"
@@ -322,10 +323,20 @@ class OutOfCore {
  public:
   /// One worker's memory: 6 arrays of W points (48 bytes per point).
   struct Workspace {
-    explicit Workspace(std::size_t w) : re(w), im(w), re2(w), im2(w), twiddle_c(w), twiddle_s(w) {}
-    std::vector<double> re, im;    // the group or block at hand
-    std::vector<double> re2, im2;  // free for blocks()' and outputs' callers
-    std::vector<double> twiddle_c, twiddle_s;
+    // Not zeroed: every point is written before it is read, and the pages
+    // are first touched by the worker that uses them.
+    explicit Workspace(std::size_t w)
+        : memory(new double[6 * w]),
+          re(memory.get(), w),
+          im(memory.get() + w, w),
+          re2(memory.get() + 2 * w, w),
+          im2(memory.get() + 3 * w, w),
+          twiddle_c(memory.get() + 4 * w, w),
+          twiddle_s(memory.get() + 5 * w, w) {}
+    std::unique_ptr<double[]> memory;
+    std::span<double> re, im;    // the group or block at hand
+    std::span<double> re2, im2;  // free for blocks()' and outputs' callers
+    std::span<double> twiddle_c, twiddle_s;
     std::size_t twiddle_mid = 0;  // the group column the twiddles are for
     bool twiddles_valid = false;
   };
