@@ -482,6 +482,11 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
   ScratchFile file("chirp-z synthesis");
   const DiskArray u{0, m};
   const DiskArray v{2 * static_cast<std::uint64_t>(m), 3 * static_cast<std::uint64_t>(m)};
+  // With several blocks the source's amplitudes and phases are drawn once,
+  // for the first, and read back for the others (a noise draws each with a
+  // logarithm or more; reading it back costs a copy).
+  const bool several_blocks = plan.block < n;
+  const DiskArray drawn{4 * static_cast<std::uint64_t>(m), 4 * static_cast<std::uint64_t>(m) + k};
   OutOfCore ooc(file, m, w, *plan.kernels, workers);
   const DetFft& fft = ooc.block_fft();
 
@@ -494,8 +499,15 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
     ooc.dif_top(u, [&](std::size_t i0, std::span<double> re, std::span<double> im) {
       const std::size_t live = i0 < k ? std::min(re.size(), k - i0) : 0;
       if (live > 0) {
-        h.fill(i0, re.first(live), im.first(live));
-        plan.input(alpha, i0, re.first(live), im.first(live));
+        const std::span<double> amplitude = re.first(live);
+        const std::span<double> phase = im.first(live);
+        if (m0 == 0) {
+          h.fill(i0, amplitude, phase);
+          if (several_blocks) FileWrites{file, drawn}(i0, amplitude, phase);
+        } else {
+          FileRuns{file, drawn}(i0, amplitude, phase);
+        }
+        plan.input(alpha, i0, amplitude, phase);
       }
       std::fill(re.begin() + static_cast<std::ptrdiff_t>(live), re.end(), 0.0);
       std::fill(im.begin() + static_cast<std::ptrdiff_t>(live), im.end(), 0.0);
