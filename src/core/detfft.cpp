@@ -102,26 +102,30 @@ std::size_t DetFft::bit_reverse(std::size_t i) const {
   return r;
 }
 
+// The stages run two at a time (spans h and h/2 in one sweep over quads of
+// points: the same butterflies, half the loads and stores).
 void DetFft::dif(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    kernels_->dif_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
-    dif(re, im, n / 2);
-    dif(re + n / 2, im + n / 2, n / 2);
+    kernels_->dif_two_stages(re, im, n, n / 2, cos_.data(), sin_.data());
+    for (std::size_t i = 0; i < n; i += n / 4) dif(re + i, im + i, n / 4);
     return;
   }
-  for (std::size_t h = n / 2; h >= 1; h /= 2) kernels_->dif_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
+  std::size_t h = n / 2;
+  for (; h >= 2; h /= 4) kernels_->dif_two_stages(re, im, n, h, cos_.data(), sin_.data());
+  if (h == 1) kernels_->dif_stage(re, im, n, 1, cos_.data(), sin_.data());
 }
 
 void DetFft::dit(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    dit(re, im, n / 2);
-    dit(re + n / 2, im + n / 2, n / 2);
-    kernels_->dit_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
+    for (std::size_t i = 0; i < n; i += n / 4) dit(re + i, im + i, n / 4);
+    kernels_->dit_two_stages(re, im, n, n / 2, cos_.data(), sin_.data());
     return;
   }
-  for (std::size_t h = 1; h < n; h *= 2) kernels_->dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
+  std::size_t h = 1;  // the next span
+  for (; 2 * h < n; h *= 4) kernels_->dit_two_stages(re, im, n, 2 * h, cos_.data(), sin_.data());
+  if (h < n) kernels_->dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
 }
 
 void DetFft::forward_to_bit_reversed(double* re, double* im) const { dif(re, im, n_); }

@@ -73,6 +73,16 @@ void reference_dit_stage(double* re, double* im, std::size_t n, std::size_t h, c
     reference_dit_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
 }
 
+void reference_dif_two_stages(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
+  reference_dif_stage(re, im, n, h, c + h - 1, s + h - 1);
+  reference_dif_stage(re, im, n, h / 2, c + h / 2 - 1, s + h / 2 - 1);
+}
+
+void reference_dit_two_stages(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
+  reference_dit_stage(re, im, n, h / 2, c + h / 2 - 1, s + h / 2 - 1);
+  reference_dit_stage(re, im, n, h, c + h - 1, s + h - 1);
+}
+
 void reference_multiply_spectra(double* ur, double* ui, const double* vr, const double* vi, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const double xr = ur[i];
@@ -275,6 +285,62 @@ template <int W, bool Dif>
     butterflies_lanes<W, Dif>(re + base, im + base, re + base + h, im + base + h, c, s, h);
 }
 
+// Two stages in one sweep: span h and span q = h/2 (decimation in frequency:
+// h first; in time: q first) on the quads (base + j, + q, + h, + h + q) of
+// each group of 2h points. Every butterfly is a single stage's, on the same
+// values, in an order that keeps each one after the butterflies it reads
+// from; the quads only save the loads and stores of a second sweep.
+template <int W, bool Dif>
+[[gnu::always_inline]] inline void two_stages_lanes(double* re, double* im, std::size_t n, std::size_t h, const double* c,
+                                                    const double* s) {
+  using V = Vec<W>;
+  const std::size_t q = h / 2;
+  if (q < static_cast<std::size_t>(W)) {
+    const std::size_t first = Dif ? h : q;
+    const std::size_t second = Dif ? q : h;
+    stage_lanes<W, Dif>(re, im, n, first, c + first - 1, s + first - 1);
+    stage_lanes<W, Dif>(re, im, n, second, c + second - 1, s + second - 1);
+    return;
+  }
+  const double* ch = c + h - 1;
+  const double* sh = s + h - 1;
+  const double* cq = c + q - 1;
+  const double* sq = s + q - 1;
+  for (std::size_t base = 0; base < n; base += 2 * h) {
+    double* r = re + base;
+    double* i = im + base;
+    for (std::size_t j = 0; j < q; j += W) {  // q is a multiple of W
+      V r0 = load<V>(r + j);
+      V i0 = load<V>(i + j);
+      V r1 = load<V>(r + j + q);
+      V i1 = load<V>(i + j + q);
+      V r2 = load<V>(r + j + h);
+      V i2 = load<V>(i + j + h);
+      V r3 = load<V>(r + j + h + q);
+      V i3 = load<V>(i + j + h + q);
+      if constexpr (Dif) {
+        dif_values(r0, i0, r2, i2, load<V>(ch + j), load<V>(sh + j));
+        dif_values(r1, i1, r3, i3, load<V>(ch + j + q), load<V>(sh + j + q));
+        dif_values(r0, i0, r1, i1, load<V>(cq + j), load<V>(sq + j));
+        dif_values(r2, i2, r3, i3, load<V>(cq + j), load<V>(sq + j));
+      } else {
+        dit_values(r0, i0, r1, i1, load<V>(cq + j), load<V>(sq + j));
+        dit_values(r2, i2, r3, i3, load<V>(cq + j), load<V>(sq + j));
+        dit_values(r0, i0, r2, i2, load<V>(ch + j), load<V>(sh + j));
+        dit_values(r1, i1, r3, i3, load<V>(ch + j + q), load<V>(sh + j + q));
+      }
+      store(r + j, r0);
+      store(i + j, i0);
+      store(r + j + q, r1);
+      store(i + j + q, i1);
+      store(r + j + h, r2);
+      store(i + j + h, i2);
+      store(r + j + h + q, r3);
+      store(i + j + h + q, i3);
+    }
+  }
+}
+
 // Element x of each loop below, for T = a lane vector (x, x + 1, …) or double.
 
 template <class T>
@@ -365,46 +431,54 @@ template <int W>
 // One table per width: the same templates compiled for each instruction set
 // (GCC drops a target attribute from a template, so each width's entry
 // points are spelled out by this macro).
-#define TEXEL_FFT_KERNELS(W, ATTRIBUTE)                                                                                     \
-  ATTRIBUTE void dif_butterflies_##W(double* ar, double* ai, double* br, double* bi, const double* c, const double* s,      \
-                                     std::size_t n) {                                                                       \
-    butterflies_lanes<W, true>(ar, ai, br, bi, c, s, n);                                                                    \
-  }                                                                                                                         \
-  ATTRIBUTE void dit_butterflies_##W(double* ar, double* ai, double* br, double* bi, const double* c, const double* s,      \
-                                     std::size_t n) {                                                                       \
-    butterflies_lanes<W, false>(ar, ai, br, bi, c, s, n);                                                                   \
-  }                                                                                                                         \
-  ATTRIBUTE void dif_stage_##W(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {    \
-    stage_lanes<W, true>(re, im, n, h, c, s);                                                                               \
-  }                                                                                                                         \
-  ATTRIBUTE void dit_stage_##W(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {    \
-    stage_lanes<W, false>(re, im, n, h, c, s);                                                                              \
-  }                                                                                                                         \
-  ATTRIBUTE void multiply_spectra_##W(double* ur, double* ui, const double* vr, const double* vi, std::size_t n) {          \
-    multiply_lanes<W>(ur, ui, vr, vi, n);                                                                                   \
-  }                                                                                                                         \
-  ATTRIBUTE void twiddles_##W(double j0, double scale, std::size_t n, double* c, double* s) {                               \
-    twiddles_lanes<W>(j0, scale, n, c, s);                                                                                  \
-  }                                                                                                                         \
-  ATTRIBUTE void chirp_kernel_##W(const ChirpPhases& p, double d0, double step, std::size_t n, double* re, double* im) {    \
-    chirp_kernel_lanes<W>(p, d0, step, n, re, im);                                                                          \
-  }                                                                                                                         \
-  ATTRIBUTE void chirp_input_##W(const ChirpPhases& p, TwoDouble alpha, double j0, std::size_t n, double* re, double* im) { \
-    chirp_input_lanes<W>(p, alpha, j0, n, re, im);                                                                          \
-  }                                                                                                                         \
-  ATTRIBUTE void chirp_output_##W(const ChirpPhases& p, double t0, std::size_t n, const double* zr, const double* zi,       \
-                                  double* out) {                                                                            \
-    chirp_output_lanes<W>(p, t0, n, zr, zi, out);                                                                           \
-  }                                                                                                                         \
-  const FftKernels kernels_##W{W,                                                                                           \
-                               &dif_butterflies_##W,                                                                        \
-                               &dit_butterflies_##W,                                                                        \
-                               &dif_stage_##W,                                                                              \
-                               &dit_stage_##W,                                                                              \
-                               &multiply_spectra_##W,                                                                       \
-                               &twiddles_##W,                                                                               \
-                               &chirp_kernel_##W,                                                                           \
-                               &chirp_input_##W,                                                                            \
+#define TEXEL_FFT_KERNELS(W, ATTRIBUTE)                                                                                       \
+  ATTRIBUTE void dif_butterflies_##W(double* ar, double* ai, double* br, double* bi, const double* c, const double* s,        \
+                                     std::size_t n) {                                                                         \
+    butterflies_lanes<W, true>(ar, ai, br, bi, c, s, n);                                                                      \
+  }                                                                                                                           \
+  ATTRIBUTE void dit_butterflies_##W(double* ar, double* ai, double* br, double* bi, const double* c, const double* s,        \
+                                     std::size_t n) {                                                                         \
+    butterflies_lanes<W, false>(ar, ai, br, bi, c, s, n);                                                                     \
+  }                                                                                                                           \
+  ATTRIBUTE void dif_stage_##W(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {      \
+    stage_lanes<W, true>(re, im, n, h, c, s);                                                                                 \
+  }                                                                                                                           \
+  ATTRIBUTE void dit_stage_##W(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {      \
+    stage_lanes<W, false>(re, im, n, h, c, s);                                                                                \
+  }                                                                                                                           \
+  ATTRIBUTE void dif_two_stages_##W(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) { \
+    two_stages_lanes<W, true>(re, im, n, h, c, s);                                                                            \
+  }                                                                                                                           \
+  ATTRIBUTE void dit_two_stages_##W(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) { \
+    two_stages_lanes<W, false>(re, im, n, h, c, s);                                                                           \
+  }                                                                                                                           \
+  ATTRIBUTE void multiply_spectra_##W(double* ur, double* ui, const double* vr, const double* vi, std::size_t n) {            \
+    multiply_lanes<W>(ur, ui, vr, vi, n);                                                                                     \
+  }                                                                                                                           \
+  ATTRIBUTE void twiddles_##W(double j0, double scale, std::size_t n, double* c, double* s) {                                 \
+    twiddles_lanes<W>(j0, scale, n, c, s);                                                                                    \
+  }                                                                                                                           \
+  ATTRIBUTE void chirp_kernel_##W(const ChirpPhases& p, double d0, double step, std::size_t n, double* re, double* im) {      \
+    chirp_kernel_lanes<W>(p, d0, step, n, re, im);                                                                            \
+  }                                                                                                                           \
+  ATTRIBUTE void chirp_input_##W(const ChirpPhases& p, TwoDouble alpha, double j0, std::size_t n, double* re, double* im) {   \
+    chirp_input_lanes<W>(p, alpha, j0, n, re, im);                                                                            \
+  }                                                                                                                           \
+  ATTRIBUTE void chirp_output_##W(const ChirpPhases& p, double t0, std::size_t n, const double* zr, const double* zi,         \
+                                  double* out) {                                                                              \
+    chirp_output_lanes<W>(p, t0, n, zr, zi, out);                                                                             \
+  }                                                                                                                           \
+  const FftKernels kernels_##W{W,                                                                                             \
+                               &dif_butterflies_##W,                                                                          \
+                               &dit_butterflies_##W,                                                                          \
+                               &dif_stage_##W,                                                                                \
+                               &dit_stage_##W,                                                                                \
+                               &dif_two_stages_##W,                                                                           \
+                               &dit_two_stages_##W,                                                                           \
+                               &multiply_spectra_##W,                                                                         \
+                               &twiddles_##W,                                                                                 \
+                               &chirp_kernel_##W,                                                                             \
+                               &chirp_input_##W,                                                                              \
                                &chirp_output_##W};
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -419,6 +493,8 @@ const FftKernels kernels_1{1,
                            &reference_dit_butterflies,
                            &reference_dif_stage,
                            &reference_dit_stage,
+                           &reference_dif_two_stages,
+                           &reference_dit_two_stages,
                            &reference_multiply_spectra,
                            &reference_twiddles,
                            &reference_chirp_kernel,

@@ -166,6 +166,22 @@ TEST(DetFftKernels, EveryWidthGivesTheScalarBits) {
           EXPECT_TRUE(same_bits(a, b)) << (dif ? "dif" : "dit") << " stage, " << w << " lanes, n = " << n << ", h = " << h;
         }
       }
+      // Two stages in one sweep (spans h and h/2), twiddles from a whole table.
+      const std::vector<double> ct = values(n, 7), st = values(n, 8);
+      for (std::size_t h = 2; h < n; h *= 2) {
+        for (bool dif : {true, false}) {
+          std::vector<double> a = values(2 * n, 9), b = a;
+          (dif ? ref.dif_two_stages : ref.dit_two_stages)(a.data(), a.data() + n, n, h, ct.data(), st.data());
+          (dif ? k.dif_two_stages : k.dit_two_stages)(b.data(), b.data() + n, n, h, ct.data(), st.data());
+          EXPECT_TRUE(same_bits(a, b)) << (dif ? "dif" : "dit") << " two stages, " << w << " lanes, n = " << n << ", h = " << h;
+          // … and the bits of its two single stages.
+          std::vector<double> c2 = values(2 * n, 9);
+          const std::size_t g1 = dif ? h : h / 2, g2 = dif ? h / 2 : h;
+          (dif ? k.dif_stage : k.dit_stage)(c2.data(), c2.data() + n, n, g1, ct.data() + g1 - 1, st.data() + g1 - 1);
+          (dif ? k.dif_stage : k.dit_stage)(c2.data(), c2.data() + n, n, g2, ct.data() + g2 - 1, st.data() + g2 - 1);
+          EXPECT_TRUE(same_bits(b, c2)) << (dif ? "dif" : "dit") << " two stages vs one by one, n = " << n << ", h = " << h;
+        }
+      }
     }
   }
   EXPECT_THROW((void)fft_kernels(3), InvalidArgument);

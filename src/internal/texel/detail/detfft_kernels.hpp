@@ -85,6 +85,12 @@ struct FftKernels {
   void (*dif_stage)(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s);
   /// The same for decimation in time.
   void (*dit_stage)(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s);
+  /// The stages of spans h and h/2 (h >= 2; n a multiple of 2h) in one sweep,
+  /// decimation in frequency (h, then h/2), with the twiddles of span g at
+  /// (c, s) + g − 1: the bits of the two dif_stage calls.
+  void (*dif_two_stages)(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s);
+  /// The same in time: span h/2, then h.
+  void (*dit_two_stages)(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s);
   /// u ← u·v, complex, pointwise.
   void (*multiply_spectra)(double* ur, double* ui, const double* vr, const double* vi, std::size_t n);
   /// c[x] = cos_cycles(u), s[x] = −sin_cycles(u), u = (j0 + x)·scale; j0 a
