@@ -491,6 +491,7 @@ void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double orig
   // logarithm or more; reading it back costs a copy).
   const bool several_blocks = plan.block < n;
   const DiskArray drawn{4 * static_cast<std::uint64_t>(m), 4 * static_cast<std::uint64_t>(m) + k};
+  file.reserve(4 * static_cast<std::uint64_t>(m) + (several_blocks ? 2 * k : 0));
   OutOfCore ooc(file, m, w, *plan.kernels, workers);
   const DetFft& fft = ooc.block_fft();
 

@@ -426,10 +426,12 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
   // Where the samples go: cache_, or a scratch file beyond the budget (the
   // bits are the same either way; only the memory differs).
   std::shared_ptr<detail::ScratchFile> file;
-  if (cache_count_ > memory.cached_samples)
+  if (cache_count_ > memory.cached_samples) {
     file = std::make_shared<detail::ScratchFile>("reference '" + spec_.name + "'");
-  else
+    file->reserve(cache_count_);
+  } else {
     cache_.resize(cache_count_);
+  }
   scratch_ = file;  // read_samples reads back what store wrote
   const auto store = [&](std::size_t i, std::span<const double> y) {
     if (file)
