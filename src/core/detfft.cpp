@@ -285,7 +285,7 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
 // bit q only, with twiddle e^(−2πi·j/2h), j = index mod h. The stages of bits
 // below w act on contiguous blocks of W points, exactly as DetFft(W) does on
 // each block (its twiddles are the same fractions j/2h). The stages of bits
-// w … p−1 run in passes over groups of R = 2^r rows of C = W/R contiguous
+// w … p−1 run in passes over groups of R = 2^r rows of C = 2W/R contiguous
 // points (rows 2^lo apart): such a group is closed under the butterflies of
 // bits lo … lo + r − 1, so a pass loads each group once, runs its stages in
 // the in-memory order (decimation in frequency: high bits first; in time:
@@ -294,9 +294,12 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
 //
 // The groups of a pass, and the blocks, are independent of each other: each
 // worker thread (parallel.hpp) takes a contiguous share of them into its own
-// W-point buffers. The first pass of a forward transform takes its points
-// from the function that defines them (the kernel, the chirped harmonics)
-// rather than from the file, so an input is never written to be read back.
+// buffers (two blocks' worth, which a group fills: the longer its rows, the
+// fewer and larger the reads and writes). The first pass of a forward
+// transform takes its points from the function that defines them (the
+// kernel, the chirped harmonics) rather than from the file, so an input is
+// never written to be read back; the last pass of an inverse one hands its
+// points on rather than writing them back.
 
 struct DiskArray {
   std::uint64_t re = 0;  // element offsets in the scratch file
@@ -328,29 +331,30 @@ class OutOfCore {
   /// One worker's memory: 6 arrays of W points (48 bytes per point).
   struct Workspace {
     // Not zeroed: every point is written before it is read, and the pages
-    // are first touched by the worker that uses them.
+    // are first touched by the worker that uses them. re2 follows re and
+    // im2 follows im, so a pass's group of 2W points is (re, im) doubled.
     explicit Workspace(std::size_t w)
         : memory(new double[6 * w]),
           re(memory.get(), w),
-          im(memory.get() + w, w),
-          re2(memory.get() + 2 * w, w),
+          re2(memory.get() + w, w),
+          im(memory.get() + 2 * w, w),
           im2(memory.get() + 3 * w, w),
           twiddle_c(memory.get() + 4 * w, w),
           twiddle_s(memory.get() + 5 * w, w) {}
     std::unique_ptr<double[]> memory;
-    std::span<double> re, im;    // the group or block at hand
-    std::span<double> re2, im2;  // free for blocks()' and outputs' callers
-    std::span<double> twiddle_c, twiddle_s;
-    std::size_t twiddle_mid = 0;  // the group column the twiddles are for
-    bool twiddles_valid = false;
+    std::span<double> re, re2;  // a block at hand; a second one free for blocks()' callers
+    std::span<double> im, im2;
+    std::span<double> twiddle_c, twiddle_s;  // one stage of a pass
   };
 
   OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points, const FftKernels& kernels, int workers)
       : file_(file), m_(m), w_(w_points), kernels_(kernels), fft_(w_points, kernels.lanes) {
     while ((std::size_t{1} << p_) < m_) ++p_;
     while ((std::size_t{1} << wbits_) < w_) ++wbits_;
-    const int c_min = std::min(9, wbits_ - 1);  // rows of at least 4 KiB where W allows
-    r_max_ = wbits_ - c_min;
+    // A pass's group is 2W points (2^(w+1)): rows of at least 4 KiB where
+    // that allows.
+    const int c_min = std::min(9, wbits_);
+    r_max_ = wbits_ + 1 - c_min;
     workspaces_.reserve(static_cast<std::size_t>(std::max(1, workers)));
     for (int i = 0; i < std::max(1, workers); ++i) workspaces_.emplace_back(w_points);
   }
@@ -412,48 +416,36 @@ class OutOfCore {
   template <class Load, class Save>
   void pass(int lo, int hi, bool inverse, const Load& load, const Save& save) {
     const std::size_t rows = std::size_t{1} << (hi - lo);
-    const std::size_t cols = w_ / rows;
+    const std::size_t cols = 2 * w_ / rows;  // a group is 2W points
     const std::size_t stride = std::size_t{1} << lo;
     const std::size_t mids = stride / cols;
     const std::size_t highs = m_ >> hi;
-    for (Workspace& ws : workspaces_) ws.twiddles_valid = false;
-    // Groups in the order (mid, high), shared out contiguously: a worker
-    // recomputes its twiddles only when `mid` changes.
     parallel_tasks(workers(), mids * highs, [&](std::size_t worker, std::size_t task) {
       Workspace& ws = workspaces_[worker];
+      double* re = ws.re.data();
+      double* im = ws.im.data();
       const std::size_t mid = task / highs;
-      const std::size_t hp = task % highs;
-      if (!ws.twiddles_valid || ws.twiddle_mid != mid) {
-        // Twiddles of stage q (span h = 2^q) at offset (2^(q−lo) − 1)·C: for
-        // row t' < 2^(q−lo) and column u, j = t'·2^lo + mid·C + u (the index's
-        // bits below q); the same for every group with this `mid`.
-        for (int q = lo; q < hi; ++q) {
-          const std::size_t s = std::size_t{1} << (q - lo);
-          double* c = ws.twiddle_c.data() + (s - 1) * cols;
-          double* sn = ws.twiddle_s.data() + (s - 1) * cols;
-          const double inv_2h = std::ldexp(1.0, -(q + 1));  // j/2h is exact
-          for (std::size_t t = 0; t < s; ++t)
-            kernels_.twiddles(static_cast<double>(t * stride + mid * cols), inv_2h, cols, c + t * cols, sn + t * cols);
-        }
-        ws.twiddle_mid = mid;
-        ws.twiddles_valid = true;
-      }
-      const std::size_t base = (hp << hi) + mid * cols;
+      const std::size_t base = ((task % highs) << hi) + mid * cols;
       for (std::size_t t = 0; t < rows; ++t)
-        load(base + t * stride, std::span<double>(ws.re.data() + t * cols, cols),
-             std::span<double>(ws.im.data() + t * cols, cols));
+        load(base + t * stride, std::span<double>(re + t * cols, cols), std::span<double>(im + t * cols, cols));
       for (int step = 0; step < hi - lo; ++step) {
         const int q = inverse ? lo + step : hi - 1 - step;
+        // Stage q (span h = 2^q) pairs rows t and t + s, s = 2^(q−lo); row
+        // t' < s and column u have j = t'·2^lo + mid·C + u (the index's bits
+        // below q) and twiddle e^(−2πi·j/2h): s·C <= W of them.
         const std::size_t s = std::size_t{1} << (q - lo);
-        const double* c = ws.twiddle_c.data() + (s - 1) * cols;
-        const double* sn = ws.twiddle_s.data() + (s - 1) * cols;
+        double* c = ws.twiddle_c.data();
+        double* sn = ws.twiddle_s.data();
+        const double inv_2h = std::ldexp(1.0, -(q + 1));  // j/2h is exact
+        for (std::size_t t = 0; t < s; ++t)
+          kernels_.twiddles(static_cast<double>(t * stride + mid * cols), inv_2h, cols, c + t * cols, sn + t * cols);
         for (std::size_t t = 0; t < rows; ++t) {
           if ((t & s) != 0) continue;
           const std::size_t tw = (t & (s - 1)) * cols;
-          double* ar = ws.re.data() + t * cols;
-          double* ai = ws.im.data() + t * cols;
-          double* br = ws.re.data() + (t + s) * cols;
-          double* bi = ws.im.data() + (t + s) * cols;
+          double* ar = re + t * cols;
+          double* ai = im + t * cols;
+          double* br = re + (t + s) * cols;
+          double* bi = im + (t + s) * cols;
           if (inverse)
             kernels_.dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
           else
@@ -461,8 +453,7 @@ class OutOfCore {
         }
       }
       for (std::size_t t = 0; t < rows; ++t)
-        save(base + t * stride, std::span<double>(ws.re.data() + t * cols, cols),
-             std::span<double>(ws.im.data() + t * cols, cols));
+        save(base + t * stride, std::span<double>(re + t * cols, cols), std::span<double>(im + t * cols, cols));
     });
   }
 
