@@ -169,6 +169,11 @@ struct ReferenceMemory {
   /// Up to this many prepared samples are kept in memory (8 bytes each);
   /// more go to a scratch file and are read back as they are rendered.
   std::size_t cached_samples = std::size_t{1} << 19;
+  /// Worker threads of the synthesis, each with buffers of its own (an
+  /// out-of-core FFT's worker about 24 bytes × fft_points): 0 = the
+  /// TEXEL_THREADS environment variable, else 2 where the machine has two
+  /// hardware threads. Never changes a bit.
+  int threads = 0;
 };
 
 /// A reference prepared for a grid: an immutable Texture.

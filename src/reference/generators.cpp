@@ -8,6 +8,7 @@
 #include "texel/detail/detfft.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detail/lanes.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detail/scratch_file.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
@@ -148,6 +149,10 @@ void accumulate(std::span<const ReferenceComponent> comps, const Grid& grid, std
   }
 }
 
+/// Component-samples (sines) of a direct sum worth a second thread: about
+/// 4 ms of work; below it a thread start costs more than it saves.
+constexpr double direct_work_per_thread = 1 << 22;
+
 /// Components that are harmonics of one fundamental (noise: of 1/length;
 /// waveforms: of fundamental_cpm), with each component's harmonic number:
 /// what the chirp-z synthesis needs besides amplitudes and phases. Empty for
@@ -165,7 +170,7 @@ struct HarmonicLayout {
 void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const HarmonicLayout& layout,
                           const detail::NoiseBand* noise, const Grid& grid, std::int64_t first, std::size_t count,
                           const detail::SampleSink& sink, const ReferenceMemory& memory) {
-  const detail::ChirpMemory chirp{memory.fft_points};
+  const detail::ChirpMemory chirp{memory.fft_points, 0, memory.threads};
   if (noise != nullptr) {
     const detail::HarmonicSource source{noise->first, layout.fundamental, noise->count(),
                                         [noise](std::size_t j0, std::span<double> amplitude, std::span<double> phase) {
@@ -440,7 +445,6 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
       std::copy(y.begin(), y.end(), cache_.begin() + static_cast<std::ptrdiff_t>(i));
   };
   constexpr std::size_t block = std::size_t{1} << 14;  // samples per step when not in one piece
-  std::vector<double> buffer(std::min(block, cache_count_));
 
   if (shape_ == Shape::sum) {
     double peak = 0.0;
@@ -451,19 +455,32 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     if (spec_.synthesis == ReferenceSynthesis::chirp_z && (noise_ || !layout.number.empty())) {
       synthesize_harmonics(components_, layout, noise_.get(), grid, a, cache_count_, keep, memory);
     } else {
+      // Directly: each block of samples sums every component in the same
+      // order wherever it runs, so long sums share the blocks among workers
+      // (each with its buffer and its peak; the maximum is order-free).
       const ComponentRuns runs{components_, noise_.get()};
-      for (std::size_t i = 0; i < cache_count_; i += block) {
-        const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
-        std::fill(y.begin(), y.end(), 0.0);
+      const std::size_t blocks = (cache_count_ + block - 1) / block;
+      const double work = static_cast<double>(noise_ ? noise_->count() : components_.size()) * static_cast<double>(cache_count_);
+      const int workers = work < direct_work_per_thread ? 1 : (memory.threads > 0 ? memory.threads : detail::worker_threads());
+      const std::size_t team = std::min(static_cast<std::size_t>(workers), blocks);
+      std::vector<std::vector<double>> buffers(team);
+      std::vector<double> peaks(team, 0.0);
+      detail::parallel_tasks(static_cast<int>(team), blocks, [&](std::size_t worker, std::size_t task) {
+        const std::size_t i = task * block;
+        std::vector<double>& y = buffers[worker];
+        y.assign(std::min(block, cache_count_ - i), 0.0);
         runs([&](std::span<const ReferenceComponent> comps) { accumulate(comps, grid, a + static_cast<std::int64_t>(i), y); });
-        keep(i, y);
-      }
+        for (double v : y) peaks[worker] = std::max(peaks[worker], std::abs(v));
+        store(i, y);  // distinct samples: safe from any worker
+      });
+      for (double p : peaks) peak = std::max(peak, p);
     }
     // The sums are kept as synthesised; read_samples maps them to amplitude
     // (no second pass over a scratch file).
     peak_ = peak > 0.0 ? peak : 1.0;
     scale_ = 0.5 / peak_;
   } else {
+    std::vector<double> buffer(std::min(block, cache_count_));
     for (std::size_t i = 0; i < cache_count_; i += block) {
       const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
       evaluate(grid, a + static_cast<std::int64_t>(i), y);
