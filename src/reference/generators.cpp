@@ -455,20 +455,24 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     if (spec_.synthesis == ReferenceSynthesis::chirp_z && (noise_ || !layout.number.empty())) {
       synthesize_harmonics(components_, layout, noise_.get(), grid, a, cache_count_, keep, memory);
     } else {
-      // Directly: each block of samples sums every component in the same
-      // order wherever it runs, so long sums share the blocks among workers
-      // (each with its buffer and its peak; the maximum is order-free).
+      // Directly: each run of samples sums every component in the same
+      // order wherever it runs (the bits do not depend on how the samples
+      // are cut), so long sums share runs among workers, short enough to
+      // even out (a run draws a noise's components again: ~1e-3 of its
+      // sines); each worker has its buffer and its peak, and the maximum of
+      // the peaks is order-free.
       const ComponentRuns runs{components_, noise_.get()};
-      const std::size_t blocks = (cache_count_ + block - 1) / block;
       const double work = static_cast<double>(noise_ ? noise_->count() : components_.size()) * static_cast<double>(cache_count_);
       const int workers = work < direct_work_per_thread ? 1 : (memory.threads > 0 ? memory.threads : detail::worker_threads());
-      const std::size_t team = std::min(static_cast<std::size_t>(workers), blocks);
+      const std::size_t step = workers > 1 ? std::size_t{1} << 12 : block;
+      const std::size_t tasks = (cache_count_ + step - 1) / step;
+      const std::size_t team = std::min(static_cast<std::size_t>(workers), tasks);
       std::vector<std::vector<double>> buffers(team);
       std::vector<double> peaks(team, 0.0);
-      detail::parallel_tasks(static_cast<int>(team), blocks, [&](std::size_t worker, std::size_t task) {
-        const std::size_t i = task * block;
+      detail::parallel_tasks(static_cast<int>(team), tasks, [&](std::size_t worker, std::size_t task) {
+        const std::size_t i = task * step;
         std::vector<double>& y = buffers[worker];
-        y.assign(std::min(block, cache_count_ - i), 0.0);
+        y.assign(std::min(step, cache_count_ - i), 0.0);
         runs([&](std::span<const ReferenceComponent> comps) { accumulate(comps, grid, a + static_cast<std::int64_t>(i), y); });
         for (double v : y) peaks[worker] = std::max(peaks[worker], std::abs(v));
         store(i, y);  // distinct samples: safe from any worker
