@@ -25,6 +25,9 @@
 // phase is reduced modulo one cycle from exact integer products and
 // double-double factors, so the result is as accurate as the direct sum
 // (about 1e-13 of the peak at 10^6 harmonics) and bit-identical everywhere.
+// Out of core, the independent parts (groups of a pass, blocks) run on
+// worker threads (parallel.hpp) with buffers of their own; which thread
+// does what never changes a bit.
 #pragma once
 
 #include <cstddef>
