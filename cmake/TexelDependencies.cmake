@@ -47,6 +47,7 @@ function(texel_find_dependencies component missing_var)
     set(for_build ON)
   endif()
   if(component STREQUAL "core")
+    # std::thread (write_map's chunk workers, the reference synthesis's workers).
     _texel_package(libc6-dev Threads_FOUND Threads)
     if(for_build)
       _texel_package(nlohmann-json3-dev nlohmann_json_FOUND nlohmann_json 3.10)

@@ -2,13 +2,15 @@
 // src/internal/texel/detail/detfft.hpp for the method and its trade-off.
 #include "texel/detail/detfft.hpp"
 
+#include "texel/detail/detfft_kernels.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detail/scratch_file.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 
-#include "texel/detmath.hpp"
 #include "texel/error.hpp"
 
 namespace texel::detail {
@@ -36,22 +38,10 @@ TwoDouble multiply(TwoDouble a, TwoDouble b) {
   return quick_two_sum(p.hi, p.lo + (a.hi * b.lo + a.lo * b.hi));
 }
 
-/// x minus its nearest integer, in [−1/2, 1/2]: exact for every finite double
-/// (x − floor(x) is not: −1e-17 − (−1) rounds to 1).
-double wrap(double x) { return x - std::round(x); }
-
 /// a modulo 1, to ~106 bits: integer multiples of it then stay small.
-TwoDouble wrap(TwoDouble a) { return two_sum(wrap(a.hi), a.lo); }
-
-/// c·q modulo 1 (in [−1/2, 1/2]) for a two-double c with |c.hi| <= 1/2 and
-/// an integer q < 2^53: the product's high part is exact (two_product) and
-/// reduced exactly, its low part is below one cycle, so the phase keeps
-/// about 1e-16 cycle whatever q.
-double cycles_times(TwoDouble c, std::uint64_t q) {
-  const auto qd = static_cast<double>(q);
-  const TwoDouble p = two_product(c.hi, qd);
-  return wrap(wrap(p.hi) + (p.lo + c.lo * qd));
-}
+/// (wrap_cycles(x) = x − round(x) is exact for every finite double; x −
+/// floor(x) is not: −1e-17 − (−1) rounds to 1.)
+TwoDouble wrap(TwoDouble a) { return two_sum(wrap_cycles(a.hi), a.lo); }
 
 }  // namespace
 
@@ -84,60 +74,9 @@ namespace {
 constexpr std::size_t leaf = 2048;
 constexpr std::size_t max_size = std::size_t{1} << 26;
 
-/// n decimation-in-frequency butterflies (a, b)[j] with twiddles (c, s)[j]
-/// (contiguous, so the loop vectorizes; lanes perform the scalar operations,
-/// so bits do not change). Shared by the in-memory and out-of-core FFTs.
-void dif_butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n) {
-  for (std::size_t j = 0; j < n; ++j) {
-    const double wr = c[j];
-    const double wi = s[j];
-    const double xr = ar[j];
-    const double xi = ai[j];
-    const double yr = br[j];
-    const double yi = bi[j];
-    ar[j] = xr + yr;
-    ai[j] = xi + yi;
-    const double dr = xr - yr;
-    const double di = xi - yi;
-    br[j] = dr * wr - di * wi;
-    bi[j] = dr * wi + di * wr;
-  }
-}
-
-/// The same for decimation in time with the conjugate twiddles (the inverse).
-void dit_butterflies(double* ar, double* ai, double* br, double* bi, const double* c, const double* s, std::size_t n) {
-  for (std::size_t j = 0; j < n; ++j) {
-    const double wr = c[j];
-    const double wi = s[j];
-    const double yr = br[j];
-    const double yi = bi[j];
-    const double tr = yr * wr + yi * wi;
-    const double ti = yi * wr - yr * wi;
-    const double xr = ar[j];
-    const double xi = ai[j];
-    ar[j] = xr + tr;
-    ai[j] = xi + ti;
-    br[j] = xr - tr;
-    bi[j] = xi - ti;
-  }
-}
-
-/// One decimation-in-frequency stage over re/im[0, n): butterflies of span h
-/// with twiddles (c, s)[j] = e^(−2πi·j/2h), j < h.
-void dif_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
-  for (std::size_t base = 0; base < n; base += 2 * h)
-    dif_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
-}
-
-/// One decimation-in-time stage (the inverse).
-void dit_stage(double* re, double* im, std::size_t n, std::size_t h, const double* c, const double* s) {
-  for (std::size_t base = 0; base < n; base += 2 * h)
-    dit_butterflies(re + base, im + base, re + base + h, im + base + h, c, s, h);
-}
-
 }  // namespace
 
-DetFft::DetFft(std::size_t n) : n_(n) {
+DetFft::DetFft(std::size_t n, int lanes) : n_(n), kernels_(&fft_kernels(lanes)) {
   if (n < 1 || n > max_size || (n & (n - 1)) != 0)
     throw InvalidArgument("FFT size is " + std::to_string(n) + "; it must be a power of two from 1 to 2^26");
   while ((std::size_t{1} << bits_) < n) ++bits_;
@@ -149,11 +88,7 @@ DetFft::DetFft(std::size_t n) : n_(n) {
   sin_.resize(n - 1);
   const std::size_t top = n / 2 - 1;
   const double inv = 1.0 / static_cast<double>(n);  // exact: n is a power of two
-  for (std::size_t t = 0; t < n / 2; ++t) {
-    const double u = static_cast<double>(t) * inv;  // exact
-    cos_[top + t] = detmath::cos_cycles(u);
-    sin_[top + t] = -detmath::sin_cycles(u);
-  }
+  kernels_->twiddles(0.0, inv, n / 2, cos_.data() + top, sin_.data() + top);
   for (std::size_t h = n / 4; h >= 1; h /= 2)
     for (std::size_t j = 0; j < h; ++j) {
       cos_[h - 1 + j] = cos_[top + j * (n / (2 * h))];
@@ -167,26 +102,30 @@ std::size_t DetFft::bit_reverse(std::size_t i) const {
   return r;
 }
 
+// The stages run two at a time (spans h and h/2 in one sweep over quads of
+// points: the same butterflies, half the loads and stores).
 void DetFft::dif(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    dif_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
-    dif(re, im, n / 2);
-    dif(re + n / 2, im + n / 2, n / 2);
+    kernels_->dif_two_stages(re, im, n, n / 2, cos_.data(), sin_.data());
+    for (std::size_t i = 0; i < n; i += n / 4) dif(re + i, im + i, n / 4);
     return;
   }
-  for (std::size_t h = n / 2; h >= 1; h /= 2) dif_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
+  std::size_t h = n / 2;
+  for (; h >= 2; h /= 4) kernels_->dif_two_stages(re, im, n, h, cos_.data(), sin_.data());
+  if (h == 1) kernels_->dif_stage(re, im, n, 1, cos_.data(), sin_.data());
 }
 
 void DetFft::dit(double* re, double* im, std::size_t n) const {
   if (n < 2) return;
   if (n > leaf) {
-    dit(re, im, n / 2);
-    dit(re + n / 2, im + n / 2, n / 2);
-    dit_stage(re, im, n, n / 2, cos_.data() + n / 2 - 1, sin_.data() + n / 2 - 1);
+    for (std::size_t i = 0; i < n; i += n / 4) dit(re + i, im + i, n / 4);
+    kernels_->dit_two_stages(re, im, n, n / 2, cos_.data(), sin_.data());
     return;
   }
-  for (std::size_t h = 1; h < n; h *= 2) dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
+  std::size_t h = 1;  // the next span
+  for (; 2 * h < n; h *= 4) kernels_->dit_two_stages(re, im, n, 2 * h, cos_.data(), sin_.data());
+  if (h < n) kernels_->dit_stage(re, im, n, h, cos_.data() + h - 1, sin_.data() + h - 1);
 }
 
 void DetFft::forward_to_bit_reversed(double* re, double* im) const { dif(re, im, n_); }
@@ -249,43 +188,34 @@ namespace {
 ///   φ_j + (first + j)·f·(x0 + t·s) = A_j + B_t − C_(t−j), with θ = f·s and
 ///   A_j = φ_j + (first + j)·f·x0 + θ/2·j²,  B_t = θ/2·t² + first·θ·t,  C_d = θ/2·d².
 struct ChirpPlan {
-  std::uint64_t first = 0;
   TwoDouble fundamental;
   std::size_t k = 0;      // harmonics
   std::size_t m = 0;      // FFT size
   std::size_t block = 0;  // output samples per block
-  TwoDouble half_theta;
-  TwoDouble first_theta;
-  double inv_m = 0.0;
+  ChirpPhases phases;     // θ/2, first·θ, first, 1/M
+  const FftKernels* kernels = nullptr;
 
-  ChirpPlan(std::uint64_t first_, TwoDouble f, std::size_t k_, std::size_t n, double spacing)
-      : first(first_), fundamental(f), k(k_), m(block_fft_size(k_, n)), block(std::min(m - k_ + 1, n)) {
+  ChirpPlan(std::uint64_t first, TwoDouble f, std::size_t k_, std::size_t n, double spacing, int lanes)
+      : fundamental(f), k(k_), m(block_fft_size(k_, n)), block(std::min(m - k_ + 1, n)), kernels(&fft_kernels(lanes)) {
     const TwoDouble theta = multiply(f, TwoDouble{spacing, 0.0});
-    half_theta = wrap(TwoDouble{theta.hi * 0.5, theta.lo * 0.5});  // halving is exact
-    first_theta = wrap(multiply(theta, TwoDouble{static_cast<double>(first), 0.0}));
-    inv_m = 1.0 / static_cast<double>(m);  // exact: a power of two
+    phases.half_theta = wrap(TwoDouble{theta.hi * 0.5, theta.lo * 0.5});  // halving is exact
+    phases.first_theta = wrap(multiply(theta, TwoDouble{static_cast<double>(first), 0.0}));
+    phases.first = static_cast<double>(first);    // exact below 2^52
+    phases.inv_m = 1.0 / static_cast<double>(m);  // exact: a power of two
   }
 
   /// The kernel e^(−2πi·C_d) for d in (−K, B), circularly (d at index d,
   /// −d at m − d), scaled by 1/M so that the inverse transform needs no
   /// scaling; 0 elsewhere. Shared by every block.
   void kernel(std::size_t i0, std::span<double> re, std::span<double> im) const {
-    for (std::size_t x = 0; x < re.size(); ++x) {
-      const std::size_t i = i0 + x;
-      std::size_t d = 0;
-      if (i < block) {
-        d = i;
-      } else if (i + k > m) {
-        d = m - i;
-      } else {
-        re[x] = 0.0;
-        im[x] = 0.0;
-        continue;
-      }
-      const double c = cycles_times(half_theta, static_cast<std::uint64_t>(d) * d);
-      re[x] = detmath::cos_cycles(c) * inv_m;
-      im[x] = -detmath::sin_cycles(c) * inv_m;
-    }
+    const std::size_t end = i0 + re.size();
+    const std::size_t a = std::clamp(block, i0, end);     // [i0, a): d = i
+    const std::size_t b = std::clamp(m - k + 1, a, end);  // [a, b): 0; [b, end): d = m − i
+    if (a > i0) kernels->chirp_kernel(phases, static_cast<double>(i0), 1.0, a - i0, re.data(), im.data());
+    std::fill(re.begin() + static_cast<std::ptrdiff_t>(a - i0), re.begin() + static_cast<std::ptrdiff_t>(b - i0), 0.0);
+    std::fill(im.begin() + static_cast<std::ptrdiff_t>(a - i0), im.begin() + static_cast<std::ptrdiff_t>(b - i0), 0.0);
+    if (end > b)
+      kernels->chirp_kernel(phases, static_cast<double>(m - b), -1.0, end - b, re.data() + (b - i0), im.data() + (b - i0));
   }
 
   /// f·x0 modulo 1 (to ~106 bits) for the block starting at sample m0,
@@ -301,34 +231,14 @@ struct ChirpPlan {
   /// The block's input u_j = a_j·e^(2πi·A_j) for j = j0 … from amplitudes
   /// and phases (written over them: re over amplitude, im over phase).
   void input(TwoDouble alpha, std::size_t j0, std::span<double> amplitude_re, std::span<double> phase_im) const {
-    for (std::size_t x = 0; x < amplitude_re.size(); ++x) {
-      const std::size_t j = j0 + x;
-      const double a = phase_im[x] + cycles_times(alpha, first + j) + cycles_times(half_theta, static_cast<std::uint64_t>(j) * j);
-      const double amp = amplitude_re[x];
-      amplitude_re[x] = amp * detmath::cos_cycles(a);
-      phase_im[x] = amp * detmath::sin_cycles(a);
-    }
+    kernels->chirp_input(phases, alpha, static_cast<double>(j0), amplitude_re.size(), amplitude_re.data(), phase_im.data());
   }
 
   /// y_t = Im(e^(2πi·B_t)·z_t) for t = t0 … into out.
   void output(std::size_t t0, const double* zr, const double* zi, std::span<double> out) const {
-    for (std::size_t x = 0; x < out.size(); ++x) {
-      const std::size_t t = t0 + x;
-      const double b = cycles_times(half_theta, static_cast<std::uint64_t>(t) * t) + cycles_times(first_theta, t);
-      out[x] = detmath::sin_cycles(b) * zr[x] + detmath::cos_cycles(b) * zi[x];
-    }
+    kernels->chirp_output(phases, static_cast<double>(t0), out.size(), zr, zi, out.data());
   }
 };
-
-/// The pointwise product u·v of the convolution, in place over u.
-void multiply_spectra(double* ur, double* ui, const double* vr, const double* vi, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const double xr = ur[i];
-    const double xi = ui[i];
-    ur[i] = xr * vr[i] - xi * vi[i];
-    ui[i] = xr * vi[i] + xi * vr[i];
-  }
-}
 
 constexpr std::size_t input_run = 4096;  // harmonics asked of the source at once (in memory)
 
@@ -337,7 +247,7 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
                    std::size_t n, const SampleSink& sink) {
   const std::size_t m = plan.m;
   const std::size_t k = plan.k;
-  const DetFft fft(m);
+  const DetFft fft(m, plan.kernels->lanes);
   std::vector<double> vr(m);
   std::vector<double> vi(m);
   plan.kernel(0, vr, vi);
@@ -358,7 +268,7 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
     std::fill(ur.begin() + static_cast<std::ptrdiff_t>(k), ur.end(), 0.0);
     std::fill(ui.begin() + static_cast<std::ptrdiff_t>(k), ui.end(), 0.0);
     fft.forward_to_bit_reversed(ur.data(), ui.data());
-    multiply_spectra(ur.data(), ui.data(), vr.data(), vi.data(), m);
+    plan.kernels->multiply_spectra(ur.data(), ui.data(), vr.data(), vi.data(), m);
     fft.inverse_from_bit_reversed(ur.data(), ui.data());
     for (std::size_t t0 = 0; t0 < len; t0 += input_run) {
       const std::span<double> run(y.data(), std::min(input_run, len - t0));
@@ -375,137 +285,176 @@ void sum_in_memory(const ChirpPlan& plan, const HarmonicSource& h, double origin
 // bit q only, with twiddle e^(−2πi·j/2h), j = index mod h. The stages of bits
 // below w act on contiguous blocks of W points, exactly as DetFft(W) does on
 // each block (its twiddles are the same fractions j/2h). The stages of bits
-// w … p−1 run in passes over groups of R = 2^r rows of C = W/R contiguous
+// w … p−1 run in passes over groups of R = 2^r rows of C = 2W/R contiguous
 // points (rows 2^lo apart): such a group is closed under the butterflies of
 // bits lo … lo + r − 1, so a pass loads each group once, runs its stages in
 // the in-memory order (decimation in frequency: high bits first; in time:
 // low bits first) and writes it back. Every butterfly is the same IEEE
 // operations on the same values as in memory, so the bits are the same.
+//
+// The groups of a pass, and the blocks, are independent of each other: each
+// worker thread (parallel.hpp) takes a contiguous share of them into its own
+// buffers (two blocks' worth, which a group fills: the longer its rows, the
+// fewer and larger the reads and writes). The first pass of a forward
+// transform takes its points from the function that defines them (the
+// kernel, the chirped harmonics) rather than from the file, so an input is
+// never written to be read back; the last pass of an inverse one hands its
+// points on rather than writing them back.
 
 struct DiskArray {
   std::uint64_t re = 0;  // element offsets in the scratch file
   std::uint64_t im = 0;
 };
 
+/// Runs of an array's points read from the file.
+struct FileRuns {
+  const ScratchFile& file;
+  DiskArray a;
+  void operator()(std::size_t i0, std::span<double> re, std::span<double> im) const {
+    file.read(a.re + i0, re);
+    file.read(a.im + i0, im);
+  }
+};
+
+/// Runs of an array's points written back to the file.
+struct FileWrites {
+  ScratchFile& file;
+  DiskArray a;
+  void operator()(std::size_t i0, std::span<double> re, std::span<double> im) const {
+    file.write(a.re + i0, re);
+    file.write(a.im + i0, im);
+  }
+};
+
 class OutOfCore {
  public:
-  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points)
-      : file_(file),
-        m_(m),
-        w_(w_points),
-        fft_(w_points),
-        re_(w_points),
-        im_(w_points),
-        re2_(w_points),
-        im2_(w_points),
-        twiddle_c_(w_points),
-        twiddle_s_(w_points) {
+  /// One worker's memory: 6 arrays of W points (48 bytes per point).
+  struct Workspace {
+    // Not zeroed: every point is written before it is read, and the pages
+    // are first touched by the worker that uses them. re2 follows re and
+    // im2 follows im, so a pass's group of 2W points is (re, im) doubled.
+    explicit Workspace(std::size_t w)
+        : memory(new double[6 * w]),
+          re(memory.get(), w),
+          re2(memory.get() + w, w),
+          im(memory.get() + 2 * w, w),
+          im2(memory.get() + 3 * w, w),
+          twiddle_c(memory.get() + 4 * w, w),
+          twiddle_s(memory.get() + 5 * w, w) {}
+    std::unique_ptr<double[]> memory;
+    std::span<double> re, re2;  // a block at hand; a second one free for blocks()' callers
+    std::span<double> im, im2;
+    std::span<double> twiddle_c, twiddle_s;  // one stage of a pass
+  };
+
+  OutOfCore(ScratchFile& file, std::size_t m, std::size_t w_points, const FftKernels& kernels, int workers)
+      : file_(file), m_(m), w_(w_points), kernels_(kernels), fft_(w_points, kernels.lanes) {
     while ((std::size_t{1} << p_) < m_) ++p_;
     while ((std::size_t{1} << wbits_) < w_) ++wbits_;
-    const int c_min = std::min(9, wbits_ - 1);  // rows of at least 4 KiB where W allows
-    r_max_ = wbits_ - c_min;
+    // A pass's group is 2W points (2^(w+1)): rows of at least 4 KiB where
+    // that allows.
+    const int c_min = std::min(9, wbits_);
+    r_max_ = wbits_ + 1 - c_min;
+    workspaces_.reserve(static_cast<std::size_t>(std::max(1, workers)));
+    for (int i = 0; i < std::max(1, workers); ++i) workspaces_.emplace_back(w_points);
   }
 
-  [[nodiscard]] std::size_t work() const { return w_; }
+  [[nodiscard]] int workers() const { return static_cast<int>(workspaces_.size()); }
+  [[nodiscard]] Workspace& workspace(std::size_t worker) { return workspaces_[worker]; }
 
-  /// Writes the M points a chunk at a time: fill(i0, re, im) for W points.
+  /// The stages of bits w … p−1 of decimation in frequency (high bits
+  /// first) of the array whose points fill(i0, re, im) defines (runs of
+  /// contiguous points, any order, from any worker): the first pass takes
+  /// them from `fill`, the others from the file.
   template <class Fill>
-  void write(DiskArray a, Fill&& fill) {
-    for (std::size_t i0 = 0; i0 < m_; i0 += w_) {
-      fill(i0, std::span<double>(re_), std::span<double>(im_));
-      file_.write(a.re + i0, re_);
-      file_.write(a.im + i0, im_);
-    }
-  }
-
-  /// The stages of bits w … p−1 of decimation in frequency (high bits first).
-  void dif_top(DiskArray a) {
+  void dif_top(DiskArray a, const Fill& fill) {
     for (int hi = p_; hi > wbits_;) {
       const int lo = std::max(wbits_, hi - r_max_);
-      pass(a, lo, hi, false);
+      if (hi == p_)
+        pass(lo, hi, false, fill, FileWrites{file_, a});
+      else
+        pass(lo, hi, false, FileRuns{file_, a}, FileWrites{file_, a});
       hi = lo;
     }
   }
 
-  /// The stages of bits w … p−1 of decimation in time (low bits first).
-  void dit_top(DiskArray a) {
+  /// The stages of bits w … p−1 of decimation in time (low bits first); the
+  /// last pass hands each run of finished points to take(i0, re, im) (any
+  /// order, from any worker) instead of writing it back.
+  template <class Take>
+  void dit_top(DiskArray a, const Take& take) {
     for (int lo = wbits_; lo < p_;) {
       const int hi = std::min(p_, lo + r_max_);
-      pass(a, lo, hi, true);
+      if (hi == p_)
+        pass(lo, hi, true, FileRuns{file_, a}, take);
+      else
+        pass(lo, hi, true, FileRuns{file_, a}, FileWrites{file_, a});
       lo = hi;
     }
   }
 
-  /// For each block of W contiguous points: fn(i0, re, im) in memory.
+  /// For each block of W contiguous points, on some worker: the block read
+  /// into its workspace's re/im, fn(workspace, i0), written back.
   template <class Fn>
-  void blocks(DiskArray a, Fn&& fn) {
-    for (std::size_t i0 = 0; i0 < m_; i0 += w_) {
-      file_.read(a.re + i0, re_);
-      file_.read(a.im + i0, im_);
-      fn(i0, re_.data(), im_.data());
-      file_.write(a.re + i0, re_);
-      file_.write(a.im + i0, im_);
-    }
+  void blocks(DiskArray a, const Fn& fn) {
+    parallel_tasks(workers(), m_ / w_, [&](std::size_t worker, std::size_t task) {
+      Workspace& ws = workspaces_[worker];
+      const std::uint64_t i0 = task * w_;
+      file_.read(a.re + i0, ws.re);
+      file_.read(a.im + i0, ws.im);
+      fn(ws, static_cast<std::size_t>(i0));
+      file_.write(a.re + i0, ws.re);
+      file_.write(a.im + i0, ws.im);
+    });
   }
 
   [[nodiscard]] const DetFft& block_fft() const { return fft_; }
-  /// A second pair of W-point buffers, free for blocks()' callers.
-  [[nodiscard]] double* spare_re() { return re2_.data(); }
-  [[nodiscard]] double* spare_im() { return im2_.data(); }
 
  private:
-  void pass(DiskArray a, int lo, int hi, bool inverse) {
+  /// The stages of bits lo … hi−1 over every group: its rows come from
+  /// load(i0, re, im) and go to save(i0, re, im).
+  template <class Load, class Save>
+  void pass(int lo, int hi, bool inverse, const Load& load, const Save& save) {
     const std::size_t rows = std::size_t{1} << (hi - lo);
-    const std::size_t cols = w_ / rows;
+    const std::size_t cols = 2 * w_ / rows;  // a group is 2W points
     const std::size_t stride = std::size_t{1} << lo;
     const std::size_t mids = stride / cols;
     const std::size_t highs = m_ >> hi;
-    // Twiddles of stage q (span h = 2^q) at offset (2^(q−lo) − 1)·C: for
-    // row t' < 2^(q−lo) and column u, j = t'·2^lo + mid·C + u (the index's
-    // bits below q); the same for every group with this `mid`.
-    for (std::size_t mid = 0; mid < mids; ++mid) {
-      for (int q = lo; q < hi; ++q) {
+    parallel_tasks(workers(), mids * highs, [&](std::size_t worker, std::size_t task) {
+      Workspace& ws = workspaces_[worker];
+      double* re = ws.re.data();
+      double* im = ws.im.data();
+      const std::size_t mid = task / highs;
+      const std::size_t base = ((task % highs) << hi) + mid * cols;
+      for (std::size_t t = 0; t < rows; ++t)
+        load(base + t * stride, std::span<double>(re + t * cols, cols), std::span<double>(im + t * cols, cols));
+      for (int step = 0; step < hi - lo; ++step) {
+        const int q = inverse ? lo + step : hi - 1 - step;
+        // Stage q (span h = 2^q) pairs rows t and t + s, s = 2^(q−lo); row
+        // t' < s and column u have j = t'·2^lo + mid·C + u (the index's bits
+        // below q) and twiddle e^(−2πi·j/2h): s·C <= W of them.
         const std::size_t s = std::size_t{1} << (q - lo);
-        double* c = twiddle_c_.data() + (s - 1) * cols;
-        double* sn = twiddle_s_.data() + (s - 1) * cols;
+        double* c = ws.twiddle_c.data();
+        double* sn = ws.twiddle_s.data();
+        const double inv_2h = std::ldexp(1.0, -(q + 1));  // j/2h is exact
         for (std::size_t t = 0; t < s; ++t)
-          for (std::size_t u = 0; u < cols; ++u) {
-            const std::size_t j = t * stride + mid * cols + u;
-            const double x = std::ldexp(static_cast<double>(j), -(q + 1));  // j/2h, exact
-            c[t * cols + u] = detmath::cos_cycles(x);
-            sn[t * cols + u] = -detmath::sin_cycles(x);
-          }
-      }
-      for (std::size_t hp = 0; hp < highs; ++hp) {
-        const std::uint64_t base = (static_cast<std::uint64_t>(hp) << hi) + mid * cols;
+          kernels_.twiddles(static_cast<double>(t * stride + mid * cols), inv_2h, cols, c + t * cols, sn + t * cols);
         for (std::size_t t = 0; t < rows; ++t) {
-          file_.read(a.re + base + t * stride, std::span<double>(re_.data() + t * cols, cols));
-          file_.read(a.im + base + t * stride, std::span<double>(im_.data() + t * cols, cols));
-        }
-        for (int step = 0; step < hi - lo; ++step) {
-          const int q = inverse ? lo + step : hi - 1 - step;
-          const std::size_t s = std::size_t{1} << (q - lo);
-          const double* c = twiddle_c_.data() + (s - 1) * cols;
-          const double* sn = twiddle_s_.data() + (s - 1) * cols;
-          for (std::size_t t = 0; t < rows; ++t) {
-            if ((t & s) != 0) continue;
-            const std::size_t tw = (t & (s - 1)) * cols;
-            double* ar = re_.data() + t * cols;
-            double* ai = im_.data() + t * cols;
-            double* br = re_.data() + (t + s) * cols;
-            double* bi = im_.data() + (t + s) * cols;
-            if (inverse)
-              dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
-            else
-              dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
-          }
-        }
-        for (std::size_t t = 0; t < rows; ++t) {
-          file_.write(a.re + base + t * stride, std::span<const double>(re_.data() + t * cols, cols));
-          file_.write(a.im + base + t * stride, std::span<const double>(im_.data() + t * cols, cols));
+          if ((t & s) != 0) continue;
+          const std::size_t tw = (t & (s - 1)) * cols;
+          double* ar = re + t * cols;
+          double* ai = im + t * cols;
+          double* br = re + (t + s) * cols;
+          double* bi = im + (t + s) * cols;
+          if (inverse)
+            kernels_.dit_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
+          else
+            kernels_.dif_butterflies(ar, ai, br, bi, c + tw, sn + tw, cols);
         }
       }
-    }
+      for (std::size_t t = 0; t < rows; ++t)
+        save(base + t * stride, std::span<double>(re + t * cols, cols), std::span<double>(im + t * cols, cols));
+    });
   }
 
   ScratchFile& file_;
@@ -514,57 +463,73 @@ class OutOfCore {
   int p_ = 0;
   int wbits_ = 0;
   int r_max_ = 1;
+  const FftKernels& kernels_;
   DetFft fft_;
-  std::vector<double> re_, im_, re2_, im2_;
-  std::vector<double> twiddle_c_, twiddle_s_;
+  std::vector<Workspace> workspaces_;
 };
 
-/// The whole sum with the FFT arrays in a scratch file and W points in memory.
+/// The whole sum with the FFT arrays in a scratch file and W points in
+/// memory per worker.
 void sum_out_of_core(const ChirpPlan& plan, const HarmonicSource& h, double origin, double spacing, std::int64_t index,
-                     std::size_t n, const SampleSink& sink, std::size_t w) {
+                     std::size_t n, const SampleSink& sink, std::size_t w, int workers) {
   const std::size_t m = plan.m;
   const std::size_t k = plan.k;
   ScratchFile file("chirp-z synthesis");
   const DiskArray u{0, m};
   const DiskArray v{2 * static_cast<std::uint64_t>(m), 3 * static_cast<std::uint64_t>(m)};
-  OutOfCore ooc(file, m, w);
+  // With several blocks the source's amplitudes and phases are drawn once,
+  // for the first, and read back for the others (a noise draws each with a
+  // logarithm or more; reading it back costs a copy).
+  const bool several_blocks = plan.block < n;
+  const DiskArray drawn{4 * static_cast<std::uint64_t>(m), 4 * static_cast<std::uint64_t>(m) + k};
+  file.reserve(4 * static_cast<std::uint64_t>(m) + (several_blocks ? 2 * k : 0));
+  OutOfCore ooc(file, m, w, *plan.kernels, workers);
   const DetFft& fft = ooc.block_fft();
 
-  ooc.write(v, [&](std::size_t i0, std::span<double> re, std::span<double> im) { plan.kernel(i0, re, im); });
-  ooc.dif_top(v);
-  ooc.blocks(v, [&](std::size_t, double* re, double* im) { fft.forward_to_bit_reversed(re, im); });
+  ooc.dif_top(v, [&](std::size_t i0, std::span<double> re, std::span<double> im) { plan.kernel(i0, re, im); });
+  ooc.blocks(v, [&](OutOfCore::Workspace& ws, std::size_t) { fft.forward_to_bit_reversed(ws.re.data(), ws.im.data()); });
 
   for (std::size_t m0 = 0; m0 < n; m0 += plan.block) {
     const std::size_t len = std::min(plan.block, n - m0);
     const TwoDouble alpha = plan.alpha(origin, spacing, index, m0);
-    ooc.write(u, [&](std::size_t i0, std::span<double> re, std::span<double> im) {
+    ooc.dif_top(u, [&](std::size_t i0, std::span<double> re, std::span<double> im) {
       const std::size_t live = i0 < k ? std::min(re.size(), k - i0) : 0;
       if (live > 0) {
-        h.fill(i0, re.first(live), im.first(live));
-        plan.input(alpha, i0, re.first(live), im.first(live));
+        const std::span<double> amplitude = re.first(live);
+        const std::span<double> phase = im.first(live);
+        if (m0 == 0) {
+          h.fill(i0, amplitude, phase);
+          if (several_blocks) FileWrites{file, drawn}(i0, amplitude, phase);
+        } else {
+          FileRuns{file, drawn}(i0, amplitude, phase);
+        }
+        plan.input(alpha, i0, amplitude, phase);
       }
       std::fill(re.begin() + static_cast<std::ptrdiff_t>(live), re.end(), 0.0);
       std::fill(im.begin() + static_cast<std::ptrdiff_t>(live), im.end(), 0.0);
     });
-    ooc.dif_top(u);
     // The stages below w of the forward transform, the product and the
     // stages below w of the inverse all act within a block: one pass.
-    ooc.blocks(u, [&](std::size_t i0, double* re, double* im) {
-      fft.forward_to_bit_reversed(re, im);
-      file.read(v.re + i0, std::span<double>(ooc.spare_re(), w));
-      file.read(v.im + i0, std::span<double>(ooc.spare_im(), w));
-      multiply_spectra(re, im, ooc.spare_re(), ooc.spare_im(), w);
-      fft.inverse_from_bit_reversed(re, im);
+    ooc.blocks(u, [&](OutOfCore::Workspace& ws, std::size_t i0) {
+      fft.forward_to_bit_reversed(ws.re.data(), ws.im.data());
+      file.read(v.re + i0, ws.re2);
+      file.read(v.im + i0, ws.im2);
+      plan.kernels->multiply_spectra(ws.re.data(), ws.im.data(), ws.re2.data(), ws.im2.data(), w);
+      fft.inverse_from_bit_reversed(ws.re.data(), ws.im.data());
     });
-    ooc.dit_top(u);
+    // The last pass turns z_t into y_t where t < len and writes y alone
+    // over u.re; the points beyond are never read again.
+    ooc.dit_top(u, [&](std::size_t i0, std::span<double> zr, std::span<double> zi) {
+      if (i0 >= len) return;
+      const std::span<double> y = zr.first(std::min(zr.size(), len - i0));
+      plan.output(i0, zr.data(), zi.data(), y);  // y_t overwrites z_t element by element
+      file.write(u.re + i0, y);
+    });
+    const std::span<double> y(ooc.workspace(0).re2);
     for (std::size_t t0 = 0; t0 < len; t0 += w) {
-      const std::size_t run = std::min(w, len - t0);
-      const std::span<double> zr(ooc.spare_re(), run);
-      const std::span<double> zi(ooc.spare_im(), run);
-      file.read(u.re + t0, zr);
-      file.read(u.im + t0, zi);
-      plan.output(t0, zr.data(), zi.data(), zr);  // y_t overwrites z_t element by element
-      sink(m0 + t0, zr);
+      const std::span<double> run = y.first(std::min(w, len - t0));
+      file.read(u.re + t0, run);
+      sink(m0 + t0, run);
     }
   }
 }
@@ -581,11 +546,12 @@ void sum_harmonics(const HarmonicSource& h, double origin, double spacing, std::
   if (budget < 4 || (budget & (budget - 1)) != 0)
     throw InvalidArgument("sum_harmonics: a memory of " + std::to_string(budget) + " FFT points; it must be a power of two >= 4");
   if (samples == 0) return;
-  const ChirpPlan plan(h.first, h.fundamental, k, samples, spacing);
+  const ChirpPlan plan(h.first, h.fundamental, k, samples, spacing, memory.lanes);
   if (plan.m <= budget)
     sum_in_memory(plan, h, origin, spacing, index, samples, sink);
   else
-    sum_out_of_core(plan, h, origin, spacing, index, samples, sink, budget / 2);
+    sum_out_of_core(plan, h, origin, spacing, index, samples, sink, budget / 2,
+                    memory.threads > 0 ? memory.threads : worker_threads());
 }
 
 HarmonicSource harmonic_source(const Harmonics& h) {

@@ -40,6 +40,14 @@ ScratchFile::~ScratchFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
+void ScratchFile::reserve(std::uint64_t elements) {
+#ifdef __linux__
+  if (elements > 0) (void)::fallocate(fd_, 0, 0, static_cast<off_t>(elements * sizeof(double)));
+#else
+  (void)elements;
+#endif
+}
+
 void ScratchFile::write(std::uint64_t offset, std::span<const double> data) {
   const auto* p = reinterpret_cast<const char*>(data.data());
   std::size_t left = data.size_bytes();

@@ -8,6 +8,7 @@
 #include "texel/detail/detfft.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detail/lanes.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detail/scratch_file.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
@@ -148,6 +149,10 @@ void accumulate(std::span<const ReferenceComponent> comps, const Grid& grid, std
   }
 }
 
+/// Component-samples (sines) of a direct sum worth a second thread: about
+/// 4 ms of work; below it a thread start costs more than it saves.
+constexpr double direct_work_per_thread = 1 << 22;
+
 /// Components that are harmonics of one fundamental (noise: of 1/length;
 /// waveforms: of fundamental_cpm), with each component's harmonic number:
 /// what the chirp-z synthesis needs besides amplitudes and phases. Empty for
@@ -165,7 +170,7 @@ struct HarmonicLayout {
 void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const HarmonicLayout& layout,
                           const detail::NoiseBand* noise, const Grid& grid, std::int64_t first, std::size_t count,
                           const detail::SampleSink& sink, const ReferenceMemory& memory) {
-  const detail::ChirpMemory chirp{memory.fft_points};
+  const detail::ChirpMemory chirp{memory.fft_points, 0, memory.threads};
   if (noise != nullptr) {
     const detail::HarmonicSource source{noise->first, layout.fundamental, noise->count(),
                                         [noise](std::size_t j0, std::span<double> amplitude, std::span<double> phase) {
@@ -426,10 +431,12 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
   // Where the samples go: cache_, or a scratch file beyond the budget (the
   // bits are the same either way; only the memory differs).
   std::shared_ptr<detail::ScratchFile> file;
-  if (cache_count_ > memory.cached_samples)
+  if (cache_count_ > memory.cached_samples) {
     file = std::make_shared<detail::ScratchFile>("reference '" + spec_.name + "'");
-  else
+    file->reserve(cache_count_);
+  } else {
     cache_.resize(cache_count_);
+  }
   scratch_ = file;  // read_samples reads back what store wrote
   const auto store = [&](std::size_t i, std::span<const double> y) {
     if (file)
@@ -438,7 +445,6 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
       std::copy(y.begin(), y.end(), cache_.begin() + static_cast<std::ptrdiff_t>(i));
   };
   constexpr std::size_t block = std::size_t{1} << 14;  // samples per step when not in one piece
-  std::vector<double> buffer(std::min(block, cache_count_));
 
   if (shape_ == Shape::sum) {
     double peak = 0.0;
@@ -449,26 +455,36 @@ ReferenceTexture::ReferenceTexture(const ReferenceSpec& spec, Millimetres length
     if (spec_.synthesis == ReferenceSynthesis::chirp_z && (noise_ || !layout.number.empty())) {
       synthesize_harmonics(components_, layout, noise_.get(), grid, a, cache_count_, keep, memory);
     } else {
+      // Directly: each run of samples sums every component in the same
+      // order wherever it runs (the bits do not depend on how the samples
+      // are cut), so long sums share runs among workers, short enough to
+      // even out (a run draws a noise's components again: ~1e-3 of its
+      // sines); each worker has its buffer and its peak, and the maximum of
+      // the peaks is order-free.
       const ComponentRuns runs{components_, noise_.get()};
-      for (std::size_t i = 0; i < cache_count_; i += block) {
-        const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
-        std::fill(y.begin(), y.end(), 0.0);
+      const double work = static_cast<double>(noise_ ? noise_->count() : components_.size()) * static_cast<double>(cache_count_);
+      const int workers = work < direct_work_per_thread ? 1 : (memory.threads > 0 ? memory.threads : detail::worker_threads());
+      const std::size_t step = workers > 1 ? std::size_t{1} << 12 : block;
+      const std::size_t tasks = (cache_count_ + step - 1) / step;
+      const std::size_t team = std::min(static_cast<std::size_t>(workers), tasks);
+      std::vector<std::vector<double>> buffers(team);
+      std::vector<double> peaks(team, 0.0);
+      detail::parallel_tasks(static_cast<int>(team), tasks, [&](std::size_t worker, std::size_t task) {
+        const std::size_t i = task * step;
+        std::vector<double>& y = buffers[worker];
+        y.assign(std::min(step, cache_count_ - i), 0.0);
         runs([&](std::span<const ReferenceComponent> comps) { accumulate(comps, grid, a + static_cast<std::int64_t>(i), y); });
-        keep(i, y);
-      }
+        for (double v : y) peaks[worker] = std::max(peaks[worker], std::abs(v));
+        store(i, y);  // distinct samples: safe from any worker
+      });
+      for (double p : peaks) peak = std::max(peak, p);
     }
+    // The sums are kept as synthesised; read_samples maps them to amplitude
+    // (no second pass over a scratch file).
     peak_ = peak > 0.0 ? peak : 1.0;
     scale_ = 0.5 / peak_;
-    for (std::size_t i = 0; i < cache_count_; i += block) {
-      const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
-      read_samples(i, y);
-      for (double& v : y) {
-        const double u = 0.5 + scale_ * v;
-        v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-      }
-      store(i, y);
-    }
   } else {
+    std::vector<double> buffer(std::min(block, cache_count_));
     for (std::size_t i = 0; i < cache_count_; i += block) {
       const std::span<double> y(buffer.data(), std::min(block, cache_count_ - i));
       evaluate(grid, a + static_cast<std::int64_t>(i), y);
@@ -491,6 +507,11 @@ void ReferenceTexture::read_samples(std::size_t i, std::span<double> out) const 
     scratch_->read(i, out);
   else
     std::copy_n(cache_.begin() + static_cast<std::ptrdiff_t>(i), out.size(), out.begin());
+  if (shape_ != Shape::sum) return;
+  for (double& v : out) {  // a sum as synthesised, to amplitude (as evaluate does)
+    const double u = 0.5 + scale_ * v;
+    v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+  }
 }
 
 void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -241,7 +242,7 @@ TEST(ChirpZ, StreamedAndOutOfCoreGiveTheInMemoryBits) {
     const Harmonics h = series(c, amp, phase);
     std::vector<double> expected(c.samples);
     sum_harmonics(h, c.origin, c.spacing, c.index, expected);
-    std::size_t runs = 0;
+    std::atomic<std::size_t> runs = 0;  // the source is called from every worker thread
     const HarmonicSource source{h.first, h.fundamental, c.harmonics,
                                 [&](std::size_t j0, std::span<double> a, std::span<double> p) {
                                   ASSERT_EQ(a.size(), p.size());

@@ -133,3 +133,38 @@ TEST(ReferenceMemory, FourMetresOfWhiteNoiseStreamInBoundedMemory) {
   EXPECT_EQ(0, std::memcmp(bytes.data() + 654'321 * bytes_per_sample(d.format), enc.data(), enc.size()));
   std::filesystem::remove_all(dir);
 }
+
+TEST(ReferenceMemory, ThreadCountsNeverChangeTheBytes) {
+  // Worker threads share out the chirp-z passes and blocks (in memory and
+  // out of core) and the direct sum's sample blocks; 1, 2 and 3 of them give
+  // the same bits.
+  ReferenceSpec direct_pink = spec("pink", 4);
+  direct_pink.synthesis = ReferenceSynthesis::direct;  // version 2, long enough to be shared out
+  direct_pink.params["band_max_cpm"] = 5.0;
+  struct Case {
+    ReferenceSpec spec;
+    double length;
+    double spacing;
+    std::size_t fft_points;
+  };
+  const std::vector<Case> cases{
+      {spec("white", 7), 100.0, 0.005, 4096},
+      {spec("bandpass-f4-z0.5", 2), 60.0, 0.0053, 1024},
+      {spec("white", 9), 30.0, 0.0053, std::size_t{1} << 17},
+      {direct_pink, 100.0, 0.0053, 4096},
+      {spec("square"), 101.76, 0.0053, 4096},
+  };
+  for (const Case& c : cases) {
+    const Grid grid{Millimetres(0.0), Millimetres(c.spacing), static_cast<std::int64_t>(c.length / c.spacing) + 3};
+    std::vector<double> expected;
+    for (int threads : {1, 2, 3}) {
+      const ReferenceTexture t(c.spec, Millimetres(c.length), Sampling{grid}, ReferenceMemory{c.fft_points, 1000, threads});
+      std::vector<double> out(static_cast<std::size_t>(grid.count));
+      t.render(grid, 0, out);
+      if (threads == 1)
+        expected = out;
+      else
+        EXPECT_TRUE(same_bits(out, expected)) << c.spec.name << ", " << threads << " threads";
+    }
+  }
+}

@@ -11,9 +11,12 @@
 // forward (natural order in, bit-reversed out) and Cooley–Tukey decimation in
 // time inverse (bit-reversed in, natural out), so a convolution never
 // permutes; `forward`/`inverse` add the permutation for callers that need the
-// natural order. Trade-off: radix 2 and split re/im arrays are slower than a
-// tuned library (pocketfft, FFTW) by a small factor, in exchange for bits
-// that depend on nothing but this file and detmath.
+// natural order. The loops (butterflies, twiddles, the chirps' phases and
+// sines below) run in explicit SIMD lanes (detfft_kernels.hpp), every lane
+// doing the scalar operations in the same order, so the width never changes
+// a bit. Trade-off: radix 2 and split re/im arrays are slower than a tuned
+// library (pocketfft, FFTW) by a small factor, in exchange for bits that
+// depend on nothing but these files and detmath.
 //
 // sum_harmonics evaluates a sum of harmonics of one fundamental on a uniform
 // grid, the whole of a reference noise or waveform, with Bluestein's chirp-z
@@ -22,6 +25,9 @@
 // phase is reduced modulo one cycle from exact integer products and
 // double-double factors, so the result is as accurate as the direct sum
 // (about 1e-13 of the peak at 10^6 harmonics) and bit-identical everywhere.
+// Out of core, the independent parts (groups of a pass, blocks) run on
+// worker threads (parallel.hpp) with buffers of their own; which thread
+// does what never changes a bit.
 #pragma once
 
 #include <cstddef>
@@ -49,13 +55,18 @@ TwoDouble two_product(double a, double b);
 /// 1 / d as a two-double (d > 0).
 TwoDouble reciprocal(double d);
 
+struct FftKernels;
+
 /// A deterministic complex FFT of size n = 2^p, 1 <= n <= 2^26.
 class DetFft {
  public:
   /// Prepares the twiddles e^(−2πi·t/n), t < n/2, laid out per stage (n − 1
-  /// complex values).
-  /// Throws InvalidArgument if n is not a power of two in range.
-  explicit DetFft(std::size_t n);
+  /// complex values). `lanes` picks the SIMD width of its loops
+  /// (detfft_kernels.hpp: 0 = the widest this CPU runs, 1 = the scalar
+  /// reference); the bits are the same for every width.
+  /// Throws InvalidArgument if n is not a power of two in range, or for a
+  /// width this CPU does not run.
+  explicit DetFft(std::size_t n, int lanes = 0);
 
   [[nodiscard]] std::size_t size() const { return n_; }
 
@@ -79,6 +90,7 @@ class DetFft {
 
   std::size_t n_ = 1;
   int bits_ = 0;
+  const FftKernels* kernels_ = nullptr;
   // Twiddles e^(−2πi·j/2h) of every stage h (1, 2, 4 … n/2), j < h, stage h
   // at offset h − 1: n − 1 values, contiguous per stage.
   std::vector<double> cos_;
@@ -114,7 +126,9 @@ void sum_harmonics(const Harmonics& h, double origin, double spacing, std::int64
 /// amplitude, phase) writes the amplitudes and phases (cycles) of harmonics
 /// first + j0 … first + j0 + amplitude.size() − 1 (amplitude.size() ==
 /// phase.size()). It is called once per run per output block, so it must
-/// give the same values every time.
+/// give the same values every time; out of core the runs come in any order
+/// and from several threads at once, so it must be safe to call
+/// concurrently (a pure function of j0 is).
 struct HarmonicSource {
   std::uint64_t first = 0;  ///< harmonic number of element 0 (< 2^52)
   TwoDouble fundamental;    ///< cycles per mm
@@ -132,11 +146,18 @@ using SampleSink = std::function<void(std::size_t m0, std::span<const double> y)
 /// How much memory the chirp-z synthesis may use. An FFT of up to
 /// `fft_points` points runs in memory (48 bytes per point); a larger one
 /// runs out of core on a ScratchFile ($TMPDIR; 32 bytes per FFT point on
-/// disk) with about 32 bytes × fft_points of memory, streaming the FFT's
+/// disk) with about 32 bytes × fft_points of memory, plus 24 bytes ×
+/// fft_points for each worker thread beyond the first, streaming the FFT's
 /// stages in passes. Where the arrays live never changes a bit of the
 /// result: every butterfly is the in-memory FFT's, with the same twiddles.
 struct ChirpMemory {
   std::size_t fft_points = std::size_t{1} << 17;  ///< a power of two >= 4 (6 MiB in memory)
+  /// The SIMD width of the loops: 0 = the widest this CPU runs, 1 = the
+  /// scalar reference (tests), 2, 4 or 8. Never changes a bit.
+  int lanes = 0;
+  /// Worker threads of an out-of-core sum (parallel.hpp), each with its
+  /// own W-point buffers: 0 = detail::worker_threads(). Never changes a bit.
+  int threads = 0;
 };
 
 /// The same sum as above, streamed: the harmonics come from `h.fill` and the

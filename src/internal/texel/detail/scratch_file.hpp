@@ -27,6 +27,11 @@ class ScratchFile {
   ScratchFile(const ScratchFile&) = delete;
   ScratchFile& operator=(const ScratchFile&) = delete;
 
+  /// Allocates room for `elements` doubles up front where the file system
+  /// can (Linux fallocate; the first writes of a page then cost about half
+  /// as much); best effort: a file system that cannot simply grows as
+  /// written, and a full disk is still reported by write().
+  void reserve(std::uint64_t elements);
   /// Writes `data` at element `offset` (doubles), growing the file as
   /// needed. Throws IoError (e.g. the disk is full).
   void write(std::uint64_t offset, std::span<const double> data);
