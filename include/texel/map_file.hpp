@@ -30,8 +30,9 @@ std::optional<MapFileKind> map_file_kind(const std::string& path);
 struct MapFileOptions {
   std::size_t chunk_samples = std::size_t{1} << 16;  ///< samples rendered per chunk (> 0) [65536]
   /// Threads rendering and encoding chunks, the calling thread among them:
-  /// 0 = automatic (map_file_threads: the processors the process may run
-  /// on, at most max_auto_threads), 1 = the calling thread alone [0]. The
+  /// 0 = automatic (map_file_threads: TEXEL_THREADS if set, else the
+  /// processors the process may run on, at most max_auto_threads), 1 = the
+  /// calling thread alone [0]. The
   /// bytes written and the stats never depend on it.
   unsigned threads = 0;
   static constexpr unsigned max_auto_threads = 4;
@@ -40,8 +41,9 @@ struct MapFileOptions {
 };
 
 /// The threads write_map uses for `requested` (MapFileOptions::threads):
-/// itself when > 0, else the processors this process may run on (Linux: its
-/// affinity mask; elsewhere the hardware's), between 1 and max_auto_threads.
+/// itself when > 0, else TEXEL_THREADS if set, else the processors this
+/// process may run on (Linux: its affinity mask; elsewhere the hardware's),
+/// between 1 and max_auto_threads.
 unsigned map_file_threads(unsigned requested);
 
 /// What write_map wrote.

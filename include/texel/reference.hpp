@@ -172,8 +172,8 @@ struct ReferenceMemory {
   std::size_t cached_samples = std::size_t{1} << 19;
   /// Worker threads of the synthesis, each with buffers of its own (an
   /// out-of-core FFT's worker about 24 bytes × fft_points): 0 = the
-  /// TEXEL_THREADS environment variable, else 2 where the machine has two
-  /// hardware threads. Never changes a bit.
+  /// TEXEL_THREADS environment variable, else the processors the process
+  /// may run on, at most 2. Never changes a bit.
   int threads = 0;
 };
 

@@ -11,10 +11,7 @@
 #include <thread>
 #include <vector>
 
-#if defined(__linux__)
-#include <sched.h>
-#endif
-
+#include "texel/detail/parallel.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -222,14 +219,7 @@ std::optional<MapFileKind> map_file_kind(const std::string& path) {
 
 unsigned map_file_threads(unsigned requested) {
   if (requested > 0) return requested;
-  unsigned cores = std::thread::hardware_concurrency();
-#if defined(__linux__)
-  // The processors this process may run on (taskset, a container's cpuset),
-  // which can be fewer than the machine's.
-  cpu_set_t set;
-  if (::sched_getaffinity(0, sizeof set, &set) == 0) cores = static_cast<unsigned>(CPU_COUNT(&set));
-#endif
-  return std::clamp(cores, 1u, MapFileOptions::max_auto_threads);
+  return static_cast<unsigned>(detail::worker_threads(static_cast<int>(MapFileOptions::max_auto_threads)));
 }
 
 MapFileStats write_map(const std::string& path, const Surface& surface, SampleFormat format, const MapFileOptions& options) {

@@ -1,5 +1,6 @@
-// Fork–join over a few threads for the bit-exact synthesis (detfft's
-// out-of-core passes). Internal to Texel.
+// Fork–join over a few threads for bit-exact work (detfft's out-of-core
+// passes, the direct reference sum), and the one thread-count policy of the
+// library (write_map's chunks too). Internal to Texel.
 //
 // Only work whose results do not depend on where or in which order it runs
 // is spread: independent butterfly groups, blocks, runs of output samples,
@@ -19,11 +20,14 @@
 
 namespace texel::detail {
 
-/// How many threads the synthesis may use, chosen once: TEXEL_THREADS (a
-/// number >= 1) if set, else 2 where the machine runs two or more threads at
-/// once, else 1. Two, not all of them: every worker holds its own buffers
-/// (detfft.hpp's ChirpMemory), and the memory bound is per worker.
-int worker_threads();
+/// The processors this process may run on (Linux: its affinity mask, so
+/// taskset and a container's cpuset count; elsewhere the hardware's), >= 1.
+int available_processors();
+/// How many threads a bit-exact job may spread over: TEXEL_THREADS (a number
+/// >= 1, read once) if set, else available_processors() up to `cap`. Every
+/// worker holds its own buffers, so callers cap by memory: the reference
+/// synthesis at 2 (detfft.hpp's ChirpMemory), write_map's chunks at 4.
+int worker_threads(int cap = 2);
 
 /// Runs fn(worker, task) for every task in [0, tasks): worker i < workers
 /// takes the tasks [tasks·i/n, tasks·(i+1)/n) in order (n = min(workers,
