@@ -510,7 +510,7 @@ texel_status texel_encode_file(const char* path, const char* device, double swip
     if (swipe_speed_mm_s > 0.0) lo.swipe_speed = texel::MmPerSecond(swipe_speed_mm_s);
     texel::codec::EncoderConfig config = options ? config_of(*options) : texel::codec::EncoderConfig{};
     if (lo.swipe_speed) config.model.swipe_speed = *lo.swipe_speed;  // as texel encode --swipe-speed
-    if (lo.device) config.model.display = lo.device->response;        // as texel encode --device
+    if (lo.device) config.model.display = lo.device->response;       // as texel encode --device
     const texel::Signal signal = texel::codec::load_signal(path, lo);
     return encoded(texel::codec::encoder_signal(signal), config);
   });
