@@ -196,6 +196,13 @@ void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const Ha
                         grid.spacing.value(), first, count, sink, chirp);
 }
 
+/// A synthesised sum y as amplitude: 0.5 + scale·y, clamped to [0, 1]
+/// (references.md [choice]; scale = 0.5 / max|y|).
+double amplitude_of(double scale, double y) {
+  const double v = 0.5 + scale * y;
+  return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+}
+
 // ------------------------------------------------------------ parameters
 
 double number(const ReferenceSpec& s, const char* key) { return std::get<double>(reference_value(s, key)); }
@@ -508,10 +515,7 @@ void ReferenceTexture::read_samples(std::size_t i, std::span<double> out) const 
   else
     std::copy_n(cache_.begin() + static_cast<std::ptrdiff_t>(i), out.size(), out.begin());
   if (shape_ != Shape::sum) return;
-  for (double& v : out) {  // a sum as synthesised, to amplitude (as evaluate does)
-    const double u = 0.5 + scale_ * v;
-    v = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-  }
+  for (double& v : out) v = amplitude_of(scale_, v);  // a sum as synthesised, to amplitude
 }
 
 void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<double> out) const {
@@ -522,8 +526,7 @@ void ReferenceTexture::evaluate(const Grid& grid, std::int64_t first, std::span<
                   noise_.get()}([&](std::span<const ReferenceComponent> comps) { accumulate(comps, grid, first, out); });
     for (std::size_t i = 0; i < out.size(); ++i) {
       const double x = grid.position(first + static_cast<std::int64_t>(i)).value();
-      const double v = 0.5 + scale_ * out[i];
-      out[i] = !(x >= 0.0 && x < L) ? 0.0 : (v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v));
+      out[i] = !(x >= 0.0 && x < L) ? 0.0 : amplitude_of(scale_, out[i]);
     }
     return;
   }
@@ -600,8 +603,7 @@ double ReferenceTexture::amplitude_at(Millimetres x) const {
     ComponentRuns{components_, noise_.get()}([&](std::span<const ReferenceComponent> run) {
       for (const auto& c : run) y = y + c.amplitude * detmath::sin_cycles(c.phase_cycles + c.frequency.value() * x_mm);
     });
-    const double v = 0.5 + scale_ * y;
-    return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+    return amplitude_of(scale_, y);
   }
   for (const auto& f : features_) {
     const double t = x_mm - f.start.value();
