@@ -1,0 +1,248 @@
+// Experiment messages (FIFO lane, one session at a time): thin calls into the
+// experiment engine's step-wise API (experiment/runner.hpp) and its store;
+// every rule of a study lives there.
+#include <algorithm>
+#include <filesystem>
+
+#include "messages.hpp"
+#include "texel/error.hpp"
+
+namespace texel::studio::detail {
+
+namespace {
+
+namespace ex = texel::experiment;
+
+ex::Store& the_store(State& s) {
+  if (!s.store) s.store.emplace(ex::Store::open(s.options.db_path, ex::StoreMode::read_write));
+  return *s.store;
+}
+
+struct Shipped {
+  std::string file;
+  ex::Protocol protocol;
+};
+
+std::vector<Shipped> shipped_protocols(const State& s) {
+  std::vector<Shipped> out;
+  if (s.options.protocols_dir.empty()) return out;
+  std::error_code ec;
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(s.options.protocols_dir, ec))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& p : files) {
+    try {
+      out.push_back({p.filename().string(), ex::load_protocol(p.string())});
+    } catch (const Error&) {
+      // A broken shipped file is the CLI's to report (texel experiment validate), not a client's.
+    }
+  }
+  return out;
+}
+
+ojson session_json(const State& s) {
+  const ex::SessionInfo& i = s.active->info;
+  return ojson{{"id", i.id},
+               {"participant", i.participant},
+               {"protocol", i.protocol},
+               {"study", i.study},
+               {"simulated", !s.active->simulate.empty()}};
+}
+
+ojson progress_json(const State& s) {
+  return ojson{{"done", s.active->session.trials_done()}, {"planned", s.active->session.trials_planned()}};
+}
+
+// What participant screens may see of a question: the engine's view without
+// the stimulus documents (their parameters would give the odd one away),
+// unless the question asks to draw the maps (visual practice).
+ojson participant_question(const ex::Question& q) {
+  ojson j = q.to_json();
+  if (!q.show_maps)
+    for (auto& st : j["stimuli"]) st.erase("document");
+  return j;
+}
+
+// The state participant screens show: the question, finished or idle.
+ojson current_state(const State& s, const json& id) {
+  if (!s.active) return reply("experiment.idle", id);
+  ojson r = reply(s.active->session.finished() ? "experiment.finished" : "experiment.question", id);
+  r["session"] = session_json(s);
+  r["progress"] = progress_json(s);
+  if (!s.active->session.finished()) r["question"] = participant_question(s.active->session.question());
+  return r;
+}
+
+const ex::Question& current_question(const State& s, const Fields& f, const std::string& type) {
+  if (!s.active) throw Reject{"not_found", type + ": no session is running; start one in the experimenter view"};
+  if (s.active->session.finished()) throw Reject{"conflict", type + ": the session is finished"};
+  const ex::Question& q = s.active->session.question();
+  const std::int64_t trial = f.integer("trial", 0, 1 << 30);
+  if (trial != q.trial)
+    throw Reject{"conflict", type + ": trial " + std::to_string(trial) + " is not the current trial (" + std::to_string(q.trial) +
+                                 "); ask experiment.current"};
+  return q;
+}
+
+void show_stimulus(State& s, const std::string& document_json_text) {
+  std::lock_guard lock(s.feel_mutex);
+  s.presenter->show(document_json_text);
+}
+
+void new_trial(State& s) {
+  std::lock_guard lock(s.feel_mutex);
+  s.presenter->blank();
+  s.trace.clear();
+}
+
+std::optional<ex::Protocol> chosen_protocol(const State& s, const json& p) {
+  if (p.is_string()) {
+    std::optional<ex::Protocol> found;  // the last file of that name, as the list shows them
+    for (auto& sh : shipped_protocols(s))
+      if (sh.protocol.name == p.get_ref<const std::string&>()) found = std::move(sh.protocol);
+    if (found) return found;
+    throw Reject{"not_found", "experiment.start: protocol " + clipped(p.get<std::string>()) +
+                                  " is not a shipped protocol (see experiment.list)"};
+  }
+  if (p.is_object()) {
+    if (p.contains("device") && p["device"].is_string())
+      require_builtin_device(p["device"].get<std::string>(), "experiment.start: protocol.device must be a built-in device");
+    return ex::parse_protocol(p.dump(), "protocol");
+  }
+  throw Reject{"bad_message", std::string("experiment.start: protocol must be a name or an object, got ") + p.type_name()};
+}
+
+}  // namespace
+
+void on_experiment_list(State& s, Client& c, const Job& job) {
+  ojson r = reply("experiment.list", job.id);
+  r["protocols"] = ojson::array();
+  for (const auto& sh : shipped_protocols(s))
+    r["protocols"].push_back({{"name", sh.protocol.name},
+                              {"file", sh.file},
+                              {"study", sh.protocol.study},
+                              {"title", sh.protocol.title},
+                              {"description", sh.protocol.description},
+                              {"trials_planned", sh.protocol.planned_trials()}});
+  r["sessions"] = ojson::array();
+  for (const auto& i : the_store(s).sessions())
+    r["sessions"].push_back({{"id", i.id},
+                             {"participant", i.participant},
+                             {"protocol", i.protocol},
+                             {"study", i.study},
+                             {"status", i.status},
+                             {"finished", i.status == "finished"},
+                             {"simulated", !i.simulate.empty()},
+                             {"trials_done", i.trials_done},
+                             {"trials_planned", i.trials_planned},
+                             {"created_at", i.created_at},
+                             {"updated_at", i.updated_at}});
+  r["active"] = s.active ? session_json(s) : ojson(nullptr);
+  send(c, r);
+}
+
+void on_experiment_start(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const json& p = f.raw("protocol");
+  ex::OpenOptions o;
+  o.participant = f.string("participant", 32);
+  o.resume = f.boolean("resume", false);
+  if (f.has("simulate")) o.simulate = f.string("simulate", max_name_chars);
+  const std::optional<ex::Protocol> protocol = chosen_protocol(s, p);
+  if (s.active && !s.active->session.finished()) {
+    if (s.active->info.participant != o.participant || s.active->info.protocol != protocol->name || !o.resume)
+      throw Reject{"conflict", "experiment.start: session " + std::to_string(s.active->info.id) + " (participant " +
+                                   s.active->info.participant + ", " + s.active->info.protocol +
+                                   ") is running; stop it first (experiment.stop)"};
+  } else {
+    s.active.reset();
+    ex::Store& st = the_store(s);
+    const bool unfinished = st.unfinished_session(o.participant, protocol->name).has_value();
+    if (unfinished && !o.resume)
+      throw Reject{"conflict", "experiment.start: participant " + clipped(o.participant) + " has an unfinished " +
+                                   protocol->name + " session; resume it (resume: true)"};
+    if (!unfinished && o.resume)
+      throw Reject{"not_found", "experiment.start: participant " + clipped(o.participant) + " has no unfinished " +
+                                    protocol->name + " session to resume"};
+    try {
+      s.active.emplace(ex::open_session(st, *protocol, o));
+    } catch (const InvalidArgument&) {
+      throw;
+    } catch (const FormatError&) {
+      throw;
+    } catch (const IoError&) {
+      throw;
+    } catch (const Error& e) {  // another process is writing this session
+      throw Reject{"conflict", std::string("experiment.start: ") + e.what()};
+    }
+    new_trial(s);
+  }
+  ojson r = reply("experiment.started", job.id);
+  r["session"] = session_json(s);
+  r["progress"] = progress_json(s);
+  r["resumed"] = o.resume;
+  send(c, r);
+}
+
+void on_experiment_current(State& s, Client& c, const Job& job) { send(c, current_state(s, job.id)); }
+
+void on_experiment_select(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const ex::Question& q = current_question(s, f, job.type);
+  if (q.stimuli.empty()) throw Reject{"invalid", "experiment.select: this question has no stimuli"};
+  const auto i = static_cast<std::size_t>(f.integer("stimulus", 0, static_cast<std::int64_t>(q.stimuli.size()) - 1));
+  show_stimulus(s, q.stimuli[i].document_json);
+  ojson r = reply("experiment.selected", job.id);
+  r["trial"] = q.trial;
+  r["stimulus"] = i;
+  r["label"] = q.stimuli[i].label;
+  send(c, r);
+}
+
+void on_experiment_preview(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const ex::Question& q = current_question(s, f, job.type);
+  if (q.sliders.size() != 2) throw Reject{"invalid", "experiment.preview: this question has no sliders"};
+  const double sp = f.number("slider_p", q.sliders[0].min, q.sliders[0].max);
+  const double si = f.number("slider_i", q.sliders[1].min, q.sliders[1].max);
+  show_stimulus(s, s.active->session.preview_document(sp, si));
+  ojson r = reply("experiment.selected", job.id);
+  r["trial"] = q.trial;
+  r["slider_p"] = sp;
+  r["slider_i"] = si;
+  send(c, r);
+}
+
+void on_experiment_answer(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  (void)current_question(s, f, job.type);
+  ex::Response response;
+  if (f.boolean("simulated", false)) {
+    if (s.active->simulate.empty())
+      throw Reject{"invalid", "experiment.answer: simulated answers need a session started with 'simulate'"};
+    response = ex::simulated_participant(*s.active).respond(s.active->session);
+  } else {
+    response = ex::Response::from_json(f.object("response"));
+  }
+  if (!response.swipe_mean_speed_mm_s) {
+    std::lock_guard lock(s.feel_mutex);
+    const SwipeMeasures m = swipe_measures(s.trace);
+    if (m.intervals > 0) {
+      response.swipe_mean_speed_mm_s = m.mean_speed_mm_s;
+      response.swipe_sd_speed_mm_s = m.sd_speed_mm_s;
+      response.directional_proportion = m.directional_proportion;
+    }
+  }
+  (void)ex::record(the_store(s), *s.active, response);  // committed before the next question goes out
+  new_trial(s);
+  send(c, current_state(s, job.id));
+}
+
+void on_experiment_stop(State& s, Client& c, const Job& job) {
+  s.active.reset();
+  new_trial(s);
+  send(c, reply("experiment.idle", job.id));
+}
+
+}  // namespace texel::studio::detail

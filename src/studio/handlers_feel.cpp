@@ -1,0 +1,74 @@
+// "Feel it" messages: the one Presenter (external finger) shared by all
+// clients. feel.select swaps a document's map in (design lane, latest wins);
+// feel.move and feel.state are answered before handle() returns.
+#include "messages.hpp"
+#include "texel/player.hpp"
+
+namespace texel::studio::detail {
+
+void on_feel_select(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  // Rendered here, outside feel_mutex: finger samples keep flowing meanwhile.
+  // The map carries the document's device response (presenter.hpp).
+  auto map = PlayerMap::from_document(document_of(s, f.object("document"), "document"));
+  {
+    std::lock_guard lock(s.feel_mutex);
+    s.presenter->show(std::move(map));
+  }
+  send(c, reply("feel.selected", job.id));
+}
+
+void on_feel_move(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const std::int64_t seq = f.integer("seq", 0, std::int64_t{1} << 53);
+  const double x = f.number("x_mm", -max_abs_mm, max_abs_mm);
+  const bool touch = f.boolean("touch", true);
+  std::optional<FingerSample> sample;
+  {
+    std::lock_guard lock(s.feel_mutex);
+    sample = s.presenter->push_finger(x, touch);
+    if (sample) {
+      s.finger_client = c.id;
+      s.finger_x = x;
+      s.finger_down = touch;
+      if (s.trace.size() < max_trace_samples) s.trace.push_back(*sample);
+    }
+    s.presenter->pump();
+  }
+  if (!sample) throw Reject{"busy", "the player's finger queue is full; send fewer positions"};
+  ojson r = reply("feel.ack", job.id);
+  r["seq"] = seq;
+  r["t_s"] = sample->t_s;
+  send(c, r);
+}
+
+void on_feel_state(State& s, Client& c, const Job& job) {
+  BackendStats st;
+  std::string backend, error;
+  {
+    std::lock_guard lock(s.feel_mutex);
+    s.presenter->pump();
+    st = s.presenter->stats();
+    backend = s.presenter->describe();
+    error = s.presenter->error();
+  }
+  ojson r = reply("feel.state", job.id);
+  r["position_mm"] = st.position_mm;
+  r["touching"] = st.touching;
+  r["blocks"] = st.blocks;
+  r["peak"] = st.peak;
+  r["underruns"] = st.underruns;
+  r["backend"] = backend;
+  r["error"] = error;
+  send(c, r);
+}
+
+void lift_finger(State& s, std::uint64_t client) {
+  std::lock_guard lock(s.feel_mutex);
+  if (s.finger_client == client && s.finger_down) {
+    (void)s.presenter->push_finger(s.finger_x, false);
+    s.finger_down = false;
+  }
+}
+
+}  // namespace texel::studio::detail

@@ -1,0 +1,176 @@
+// The studio's message table and what its handlers share (internal to
+// texel_studio; docs/studio.md "Messages", docs/schema/studio-messages.schema.json).
+//
+// One row per client message type: {type, lane, allowed keys, handler}. The
+// service (service.cpp) routes by it, refuses unknown types and keys from it,
+// and tests/studio checks it against the JSON Schema the front end's message
+// types are generated from. Handlers live in files by concern:
+// handlers_design.cpp (hello, design), handlers_codec.cpp (match, import,
+// export), handlers_feel.cpp (feel.*), handlers_experiment.cpp (experiment.*).
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "texel/document.hpp"
+#include "texel/experiment/presenter.hpp"
+#include "texel/experiment/runner.hpp"
+#include "texel/finger.hpp"
+#include "texel/studio/design.hpp"
+#include "texel/studio/handler.hpp"
+#include "texel/studio/service.hpp"
+
+namespace texel::studio::detail {
+
+using json = nlohmann::json;
+using ojson = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+inline constexpr std::size_t max_queued_jobs = 64;  // per client, both lanes
+inline constexpr std::size_t max_nesting = 64;      // JSON depth
+inline constexpr std::size_t max_id_chars = 64;
+inline constexpr std::size_t max_name_chars = 255;          // file names, participant codes, protocol names
+inline constexpr std::size_t max_trace_samples = 1u << 18;  // finger samples kept per trial for swipe measures
+inline constexpr double max_abs_mm = 1e6;
+
+/// A refused message: the error code and one line naming field, value, allowed.
+struct Reject {
+  std::string code;
+  std::string message;
+};
+
+/// A client-supplied text in an error message: quoted, at most 64 characters.
+std::string clipped(std::string_view s);
+
+/// Typed reads of one message's keys, each a one-line Reject naming the key
+/// (unknown keys are refused from the table before a handler runs).
+class Fields {
+ public:
+  Fields(const json& msg, std::string type) : msg_(msg), type_(std::move(type)) {}
+  [[nodiscard]] bool has(const char* key) const { return msg_.contains(key) && !msg_[key].is_null(); }
+  [[nodiscard]] const json& raw(const char* key) const;
+  [[nodiscard]] const json& object(const char* key) const;
+  [[nodiscard]] double number(const char* key, double lo, double hi) const;
+  [[nodiscard]] std::int64_t integer(const char* key, std::int64_t lo, std::int64_t hi) const;
+  [[nodiscard]] bool boolean(const char* key, bool fallback) const;
+  [[nodiscard]] std::string string(const char* key, std::size_t max_chars) const;
+
+ private:
+  [[nodiscard]] Reject wrong(const char* key, const char* want, const json& v) const;
+  const json& msg_;
+  std::string type_;
+};
+
+/// One client message on its way to a handler.
+struct Job {
+  std::string type;
+  json msg;
+  json id;
+  Clock::time_point received;
+};
+
+/// A connected browser: its sink, rate bucket and queued work.
+struct Client {
+  std::uint64_t id = 0;
+  Sink sink;
+  std::mutex send_mutex;  // held while the sink runs; disconnect() waits on it
+  bool open = true;       // guarded by send_mutex
+  // Guarded by the service's lane mutex:
+  double tokens = 0.0;
+  Clock::time_point refilled = Clock::now();
+  std::map<std::string, std::pair<std::uint64_t, Job>> slots;  // design lane: type → (order, newest job)
+  std::size_t fifo_jobs = 0;
+};
+
+/// What the handlers share: the options, the display (one Presenter behind
+/// feel_mutex) and the experiment session (touched by the FIFO worker only).
+struct State {
+  ServiceOptions options;
+  ojson hello;
+
+  std::mutex feel_mutex;
+  std::unique_ptr<experiment::Presenter> presenter;
+  std::uint64_t finger_client = 0;  // who touched last (lifted on disconnect)
+  double finger_x = 0.0;
+  bool finger_down = false;
+  std::vector<FingerSample> trace;  // finger samples of the current trial (swipe measures)
+
+  std::optional<experiment::Store> store;
+  std::optional<experiment::ActiveSession> active;
+};
+
+inline double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// ------------------------------------------------------------------ replies
+void send(Client& c, const ojson& reply);
+ojson reply(const char* type, const json& id);
+
+// ------------------------------------------------ helpers of several handlers
+/// A client's document: built-in devices only, map and texel count capped.
+Document document_of(const State& s, const json& j, const std::string& where);
+/// An optional region index key (0 … 1023).
+std::optional<std::size_t> region_field(const Fields& f, const char* key);
+/// Throws a Reject unless `name` is a built-in device.
+void require_builtin_device(std::string_view name, const std::string& what);
+/// {frequency_cpm, magnitude_db} of a plotted spectrum.
+ojson spectrum_json(const SpectrumView& s);
+/// Lower-case hex of bytes (encoded bitstreams).
+std::string hex(std::span<const std::byte> bytes);
+/// The hello reply without its id (built once).
+ojson make_hello(const State& s);
+/// Lifts the finger if `client` was the one touching.
+void lift_finger(State& s, std::uint64_t client);
+
+// -------------------------------------------------------------------- table
+/// When a message is handled: before handle() returns; on the design lane
+/// (one slot per client and type, latest wins); on the FIFO lane, in order.
+enum class Lane { now, design, fifo };
+
+using Handler = void (*)(State&, Client&, const Job&);
+
+struct MessageSpec {
+  std::string_view type;
+  Lane lane;
+  std::initializer_list<std::string_view> keys;  ///< allowed besides type and id
+  Handler handler;
+};
+
+/// Every client message type, in the order error messages list them.
+std::span<const MessageSpec> message_table();
+/// The row of `type`, or nullptr.
+const MessageSpec* find_message(std::string_view type);
+/// Refuses keys of `msg` that the row does not allow (one line naming them).
+void check_keys(const MessageSpec& spec, const json& msg);
+
+// Handlers, by file.
+void on_hello(State&, Client&, const Job&);
+void on_design(State&, Client&, const Job&);
+void on_match(State&, Client&, const Job&);
+void on_import(State&, Client&, const Job&);
+void on_export(State&, Client&, const Job&);
+void on_feel_select(State&, Client&, const Job&);
+void on_feel_move(State&, Client&, const Job&);
+void on_feel_state(State&, Client&, const Job&);
+void on_experiment_list(State&, Client&, const Job&);
+void on_experiment_start(State&, Client&, const Job&);
+void on_experiment_current(State&, Client&, const Job&);
+void on_experiment_select(State&, Client&, const Job&);
+void on_experiment_preview(State&, Client&, const Job&);
+void on_experiment_answer(State&, Client&, const Job&);
+void on_experiment_stop(State&, Client&, const Job&);
+
+}  // namespace texel::studio::detail
