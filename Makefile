@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD := build
 PY := /usr/bin/python3
 
-.PHONY: all deps configure build python web demo test test-unit test-browser test-asan test-determinism bench fuzz format clean
+.PHONY: all deps configure build python web web-test demo test test-unit test-browser test-asan test-determinism bench fuzz format clean
 
 all: build
 
@@ -27,15 +27,22 @@ python: configure
 # installs exactly the committed lockfile from the npm registry; nothing else
 # is downloaded (the browser tests drive Debian's chromium).
 WEB_OUT := $(BUILD)/web
-WEB_SRC := $(shell find web -path web/node_modules -prune -o -path web/tests -prune -o -type f -print 2>/dev/null)
+WEB_SRC := $(shell find web -path web/node_modules -prune -o -path web/tests -prune -o -path web/src/generated -prune -o -type f -print 2>/dev/null)
 
 web: $(WEB_OUT)/index.html
 
 web/node_modules/.package-lock.json: web/package-lock.json | deps
 	cd web && npm ci --no-audit --no-fund --loglevel=error
 
-$(WEB_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC)
+$(WEB_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json
 	cd web && TEXEL_WEB_OUT=$(CURDIR)/$(WEB_OUT) npm run --silent build
+
+# The test build: the same front end plus the browser tests' hooks
+# (window.__texelStats); only the browser tests and the latency bench serve it.
+WEB_TEST_OUT := $(BUILD)/web-test
+web-test: $(WEB_TEST_OUT)/index.html
+$(WEB_TEST_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json
+	cd web && TEXEL_WEB_OUT=$(CURDIR)/$(WEB_TEST_OUT) npm run --silent build:test
 
 # The studies (issue #8): a simulated cohort of 8 participants through every
 # shipped protocol (free exploration before the quantization test that uses
@@ -66,10 +73,10 @@ test-unit: build web/node_modules/.package-lock.json
 # End-to-end browser tests of Texel Studio: headless Debian chromium driven by
 # playwright-core against `texel studio` on loopback. Screenshots and the
 # measured latencies land in build/browser-artifacts/.
-BROWSER_ENV = TEXEL_BIN=$(CURDIR)/$(BUILD)/bin/texel TEXEL_WEB=$(CURDIR)/$(WEB_OUT) \
+BROWSER_ENV = TEXEL_BIN=$(CURDIR)/$(BUILD)/bin/texel TEXEL_WEB=$(CURDIR)/$(WEB_TEST_OUT) TEXEL_WEB_PROD=$(CURDIR)/$(WEB_OUT) \
   TEXEL_ARTIFACTS=$(CURDIR)/$(BUILD)/browser-artifacts TEXEL_PROTOCOLS=$(CURDIR)/examples/protocols
 
-test-browser: build web
+test-browser: build web web-test
 	cd web && $(BROWSER_ENV) npm test --silent
 
 test-asan: deps web/node_modules/.package-lock.json
@@ -82,7 +89,7 @@ test-asan: deps web/node_modules/.package-lock.json
 test-determinism: build
 	bash tests/determinism/cross_build.sh
 
-bench: build web
+bench: build web web-test
 	$(BUILD)/bin/texel_bench --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json

@@ -7,19 +7,9 @@ import { h, decodeF32, download, base64ToBytes, bytesToBase64, fmt, stats, check
 import { MapPlot, HistogramPlot, SpectrumPlot } from './plots';
 import { FeelStrip } from './feel';
 import { hearIt } from './audio';
-import type {
-  CoarseProfile,
-  DesignReply,
-  DeviceProfile,
-  FileReply,
-  HelloReply,
-  ImportReply,
-  MatchReply,
-  RegionDoc,
-  Spectrum,
-  TexelTexture,
-  TextureDocument,
-} from './protocol';
+import { Store } from './store';
+import type { CoarseProfile, RegionDoc, TexelTexture, TextureDocument } from './document';
+import type { DesignReply, DeviceProfile, ExportRequest, HelloReply, Spectrum } from './generated/messages';
 
 interface TexelParams {
   central_pitch_db: number;
@@ -50,6 +40,8 @@ interface DesignerState {
   texel: TexelParams;
   /** Keys of an imported texel texture the controls do not show (kept as they are). */
   extra: Record<string, unknown>;
+  /** The last match's target and matched spectra, drawn over the spectrum. */
+  overlays: { target?: Spectrum; match?: Spectrum };
 }
 
 const defaults = (): TexelParams => ({
@@ -71,7 +63,7 @@ const defaults = (): TexelParams => ({
 let hello: HelloReply | null = null;
 
 export async function getHello(): Promise<HelloReply> {
-  if (!hello) hello = await studio().call<HelloReply>('hello', {}, 15000);
+  if (!hello) hello = await studio().call('hello', {}, 15000);
   return hello;
 }
 
@@ -80,9 +72,10 @@ function deviceProfile(dev: string | DeviceProfile): DeviceProfile | undefined {
   return hello?.devices.find((d) => d.name === dev);
 }
 
-function deviceLength(dev: string | DeviceProfile): number {
+/** The device's length (mm) from its profile (the server's hello); NaN while unknown. */
+export function deviceLength(dev: string | DeviceProfile): number {
   const p = deviceProfile(dev);
-  return p ? p.samples * p.spacing_mm : 101.76;
+  return p ? p.samples * p.spacing_mm : NaN;
 }
 
 function halves(dev: string | DeviceProfile): { left: [number, number]; right: [number, number] } {
@@ -159,6 +152,7 @@ function stateFromDocument(doc: TextureDocument, prev: DesignerState): DesignerS
   return s;
 }
 
+/** Puts a texel texture into `s` (a fresh copy: its texel and extra are replaced). */
 function applyTexel(s: DesignerState, t: TexelTexture): void {
   const known = new Set([
     'kind', 'central_pitch_db', 'irregularity_db', 'texel_length_mm', 'seed', 'parameterization',
@@ -166,7 +160,7 @@ function applyTexel(s: DesignerState, t: TexelTexture): void {
   ]);
   s.extra = {};
   for (const [k, v] of Object.entries(t)) if (!known.has(k)) s.extra[k] = v;
-  const p = s.texel;
+  const p = (s.texel = { ...s.texel });
   p.central_pitch_db = t.central_pitch_db;
   p.irregularity_db = t.irregularity_db;
   p.texel_length_mm = t.texel_length_mm;
@@ -243,7 +237,8 @@ function select(id: string, label: string, options: [string, string][], value: s
 // ---------------------------------------------------------------- page
 
 export function mountDesigner(root: HTMLElement): void {
-  const s: DesignerState = {
+  // The page's one state: controls write it, render() (below) reads it.
+  const store = new Store<DesignerState>({
     device: 'tpad',
     split: false,
     reference: '4sin',
@@ -251,13 +246,14 @@ export function mountDesigner(root: HTMLElement): void {
     reference_version: 3,
     texel: defaults(),
     extra: {},
-  };
+    overlays: {},
+  });
+  const setTexel = (p: Partial<TexelParams>) => store.update((st) => ({ texel: { ...st.texel, ...p } }));
   const client = studio();
 
   const mapPlot = new MapPlot();
   const hist = new HistogramPlot();
   const spec = new SpectrumPlot();
-  let overlays: { target?: Spectrum; match?: Spectrum } = {};
   let lastSpectrum: Spectrum | null = null;
   let lastSelectedKey = '';
   let stripActiveUntil = 0;
@@ -274,13 +270,14 @@ export function mountDesigner(root: HTMLElement): void {
   let gen = 0;
   let drawnGen = 0;
   const t0s: { g: number; t0: number }[] = [];
-  const strip = new FeelStrip({ length_mm: 101.76, onEnter: () => {
+  // Its length comes from the device's profile (hello) and each design reply's grid.
+  const strip = new FeelStrip({ length_mm: NaN, onEnter: () => {
     stripActiveUntil = performance.now() + 30000;
     void selectForFeel();
   } });
 
   async function selectForFeel(): Promise<void> {
-    const doc = buildDocument(s);
+    const doc = buildDocument(store.get());
     const key = JSON.stringify(doc);
     if (key === lastSelectedKey) return;
     lastSelectedKey = key;
@@ -299,13 +296,14 @@ export function mountDesigner(root: HTMLElement): void {
 
   async function design(): Promise<void> {
     const g = ++gen;
-    const t0 = performance.now();
-    t0s.push({ g, t0 });
-    if (t0s.length > 500) t0s.splice(0, t0s.length - 500);
-    stats.designsSent++;
+    if (__TEXEL_TEST_HOOKS__) {
+      t0s.push({ g, t0: performance.now() });
+      if (t0s.length > 500) t0s.splice(0, t0s.length - 500);
+    }
+    if (__TEXEL_TEST_HOOKS__) stats.designsSent++;
     let reply: DesignReply | null;
     try {
-      reply = await client.request<DesignReply>('design', { document: buildDocument(s) }, { lane: 'design', timeoutMs: 60000 });
+      reply = await client.request('design', { document: buildDocument(store.get()) }, { lane: 'design', timeoutMs: 60000 });
     } catch (e) {
       if (e instanceof StudioError && e.code === 'superseded') return;
       if (g >= drawnGen) showError(e);
@@ -315,14 +313,16 @@ export function mountDesigner(root: HTMLElement): void {
     drawnGen = g;
     draw(reply);
     await Promise.resolve(); // uPlot commits its redraw in a microtask queued by setData
-    const t1 = performance.now();
-    for (let i = t0s.length - 1; i >= 0; i--)
-      if (t0s[i].g <= g) {
-        stats.sliderToRedrawMs.push(t1 - t0s[i].t0);
-        t0s.splice(i, 1);
-      }
-    if (stats.sliderToRedrawMs.length > 5000) stats.sliderToRedrawMs.splice(0, 1000);
-    stats.designsDrawn++;
+    if (__TEXEL_TEST_HOOKS__) {
+      const t1 = performance.now();
+      for (let i = t0s.length - 1; i >= 0; i--)
+        if (t0s[i].g <= g) {
+          stats.sliderToRedrawMs.push(t1 - t0s[i].t0);
+          t0s.splice(i, 1);
+        }
+      if (stats.sliderToRedrawMs.length > 5000) stats.sliderToRedrawMs.splice(0, 1000);
+      stats.designsDrawn++;
+    }
     if (performance.now() < stripActiveUntil) void selectForFeel();
   }
 
@@ -332,14 +332,15 @@ export function mountDesigner(root: HTMLElement): void {
     const values = decodeF32(r.map_f32);
     const analysed = [...r.regions].reverse().find((x) => x.kind === 'texel') ?? r.regions[r.regions.length - 1];
     mapPlot.setMap(r.grid.origin_mm, r.grid.spacing_mm, values, r.regions, analysed ? analysed.start_mm + Math.min(3, analysed.length_mm / 2) : undefined);
-    stats.lastMapChecksum = checksum(values);
+    if (__TEXEL_TEST_HOOKS__) stats.lastMapChecksum = checksum(values);
     hearIt.setMap(values, r.grid.origin_mm, r.grid.spacing_mm);
     if (r.histogram) {
       hist.set(r.histogram.edges_cpm, r.histogram.counts, r.histogram.pdf);
-      stats.lastHistChecksum = checksum(r.histogram.counts.concat(r.histogram.edges_cpm));
+      if (__TEXEL_TEST_HOOKS__) stats.lastHistChecksum = checksum(r.histogram.counts.concat(r.histogram.edges_cpm));
     }
     if (r.spectrum) {
       lastSpectrum = r.spectrum;
+      const overlays = store.get().overlays;
       spec.set(r.spectrum, overlays.target, overlays.match);
     }
     if (r.encoded && r.encoded.bytes !== null) {
@@ -348,7 +349,7 @@ export function mountDesigner(root: HTMLElement): void {
       const hex = r.encoded.hex ?? '';
       hexEl.textContent = hex.length > 72 ? `${hex.slice(0, 72)}…` : hex;
       hexEl.title = hex;
-      stats.lastEncodedBytes = r.encoded.bytes;
+      if (__TEXEL_TEST_HOOKS__) stats.lastEncodedBytes = r.encoded.bytes;
     } else {
       bytesEl.textContent = r.encoded?.error ? 'not encodable' : '–';
       bytesEl.dataset.bytes = '';
@@ -359,51 +360,35 @@ export function mountDesigner(root: HTMLElement): void {
     texelsEl.textContent = r.texels !== undefined ? `${r.texels} texels` : '';
     elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
     strip.setLength(r.grid.count * r.grid.spacing_mm);
-    root.dataset.designs = String(stats.designsDrawn + 1);
   }
 
-  const changed = () => void design();
-
-  // --- controls
-  const t = s.texel;
-  const pitch = slider('central-pitch', 'Central Pitch', -10, 19.5, 0.1, t.central_pitch_db, 'dB re 1 cycle/mm', (v) => ((t.central_pitch_db = v), changed()), pitchCpm);
-  const irr = slider('irregularity', 'Irregularity', -30, 20, 0.1, t.irregularity_db, 'dB', (v) => ((t.irregularity_db = v), changed()), irrCpm);
-  const length = slider('texel-length', 'Texel length', 0.05, 10, 0.01, t.texel_length_mm, 'mm', (v) => ((t.texel_length_mm = v), changed()));
+  // --- controls: each writes the store; render() shows the store in them
+  const t = store.get().texel;
+  const pitch = slider('central-pitch', 'Central Pitch', -10, 19.5, 0.1, t.central_pitch_db, 'dB re 1 cycle/mm', (v) => setTexel({ central_pitch_db: v }), pitchCpm);
+  const irr = slider('irregularity', 'Irregularity', -30, 20, 0.1, t.irregularity_db, 'dB', (v) => setTexel({ irregularity_db: v }), irrCpm);
+  const length = slider('texel-length', 'Texel length', 0.05, 10, 0.01, t.texel_length_mm, 'mm', (v) => setTexel({ texel_length_mm: v }));
   const seedIn = h('input', { type: 'number', id: 'seed', min: 0, step: 1, value: t.seed, 'data-testid': 'seed', class: 'num' }) as HTMLInputElement;
-  seedIn.addEventListener('change', () => {
-    t.seed = Math.max(0, Math.floor(Number(seedIn.value) || 0));
-    changed();
-  });
-  const newDraw = h('button', { type: 'button', 'data-testid': 'new-draw', onclick: () => {
-    t.seed = Math.floor(Math.random() * 2 ** 31);
-    seedIn.value = String(t.seed);
-    changed();
-  } }, 'New draw');
+  seedIn.addEventListener('change', () => setTexel({ seed: Math.max(0, Math.floor(Number(seedIn.value) || 0)) }));
+  const newDraw = h('button', { type: 'button', 'data-testid': 'new-draw', onclick: () => setTexel({ seed: Math.floor(Math.random() * 2 ** 31) }) }, 'New draw');
   const param = select('parameterization', 'Parameterization', [['moments', 'moments (mean, SD)'], ['log', 'log (lognormal μ, σ)']], t.parameterization, (v) => {
-    t.parameterization = v as 'moments' | 'log';
-    if (v === 'log' && t.irregularity_db < 0) {
-      t.irregularity_db = 0;
-      irr.set(0);
-    }
-    changed();
+    const irregularity = v === 'log' && store.get().texel.irregularity_db < 0 ? { irregularity_db: 0 } : {};
+    setTexel({ parameterization: v as 'moments' | 'log', ...irregularity });
   });
-  const quant = slider('quantization', 'Quantization', 0, 20, 0.5, t.quantization_db, 'dB, 0 = off', (v) => ((t.quantization_db = v), changed()));
-  const cStrength = slider('coarse-strength', 'Coarse strength C', 0, 1, 0.01, t.coarse_strength, '0…1', (v) => ((t.coarse_strength = v), changed()));
-  const fStrength = slider('fine-strength', 'Fine strength F', 0, 1, 0.01, t.fine_strength, '0…1', (v) => ((t.fine_strength = v), changed()));
+  const quant = slider('quantization', 'Quantization', 0, 20, 0.5, t.quantization_db, 'dB, 0 = off', (v) => setTexel({ quantization_db: v }));
+  const cStrength = slider('coarse-strength', 'Coarse strength C', 0, 1, 0.01, t.coarse_strength, '0…1', (v) => setTexel({ coarse_strength: v }));
+  const fStrength = slider('fine-strength', 'Fine strength F', 0, 1, 0.01, t.fine_strength, '0…1', (v) => setTexel({ fine_strength: v }));
 
-  const constVal = slider('coarse-value', 'Constant value', 0, 1, 0.01, t.coarse_value, '0…1', (v) => ((t.coarse_value = v), changed()));
-  const sinePeriod = slider('sine-period', 'Sine period', 0.5, 50, 0.1, t.sine_period_mm, 'mm', (v) => ((t.sine_period_mm = v), changed()));
-  const sinePhase = slider('sine-phase', 'Sine phase', 0, 360, 1, t.sine_phase_deg, 'degrees', (v) => ((t.sine_phase_deg = v), changed()));
+  const constVal = slider('coarse-value', 'Constant value', 0, 1, 0.01, t.coarse_value, '0…1', (v) => setTexel({ coarse_value: v }));
+  const sinePeriod = slider('sine-period', 'Sine period', 0.5, 50, 0.1, t.sine_period_mm, 'mm', (v) => setTexel({ sine_period_mm: v }));
+  const sinePhase = slider('sine-phase', 'Sine phase', 0, 360, 1, t.sine_phase_deg, 'degrees', (v) => setTexel({ sine_phase_deg: v }));
   const pointsInfo = h('p', { class: 'hint', 'data-testid': 'points-info' });
   const drawBtn = h('button', { type: 'button', 'aria-pressed': 'false', 'data-testid': 'draw-coarse' }, 'Draw on the map') as HTMLButtonElement;
   const coarseSel = select('coarse-kind', 'Coarse profile', [['constant', 'constant'], ['sine', 'sine'], ['points', 'drawn on the map']], t.coarse, (v) => {
-    t.coarse = v as TexelParams['coarse'];
-    setDrawMode(v === 'points' && !t.points.length);
-    showCoarse();
-    changed();
+    setDrawMode(v === 'points' && !store.get().texel.points.length);
+    setTexel({ coarse: v as TexelParams['coarse'] });
   });
   const coarseParams = h('div', { class: 'coarse-params' });
-  function showCoarse(): void {
+  function showCoarse(t: TexelParams): void {
     coarseParams.replaceChildren();
     if (t.coarse === 'constant') coarseParams.append(constVal.row);
     else if (t.coarse === 'sine') coarseParams.append(sinePeriod.row, sinePhase.row);
@@ -420,6 +405,7 @@ export function mountDesigner(root: HTMLElement): void {
   }
   drawBtn.addEventListener('click', () => setDrawMode(!mapPlot.drawMode));
   mapPlot.onDrawn = (pts) => {
+    const s = store.get();
     const hv = halves(s.device);
     const start = s.split ? hv.right[0] : 0;
     const len = s.split ? hv.right[1] : deviceLength(s.device);
@@ -433,37 +419,18 @@ export function mountDesigner(root: HTMLElement): void {
       showError('Draw over the rendering (the texel region) to set its coarse profile.');
       return;
     }
-    t.points = out;
-    t.coarse = 'points';
-    coarseSel.el.value = 'points';
-    if (t.coarse_strength === 0) {
-      // C = 0 would hide the profile: show it at full strength.
-      t.coarse_strength = 1;
-      cStrength.set(1);
-    }
-    showCoarse();
     setDrawMode(false);
-    changed();
+    // C = 0 would hide the profile: show it at full strength.
+    setTexel({ points: out, coarse: 'points', ...(s.texel.coarse_strength === 0 ? { coarse_strength: 1 } : {}) });
   };
 
   // device, regions, reference
-  const deviceSel = select('device', 'Device', [['tpad', 'tpad']], 'tpad', (v) => {
-    s.device = v;
-    changed();
-  });
-  const splitSel = select('regions', 'Regions', [['single', 'single texture'], ['split', 'reference left, rendering right']], 'single', (v) => {
-    s.split = v === 'split';
-    matchBtn.disabled = !s.split;
-    refRow.hidden = !s.split;
-    overlays = {};
-    changed();
-  });
-  const refSel = select('reference', 'Reference', [['4sin', '4sin']], s.reference, (v) => {
-    s.reference = v;
-    s.reference_version = 3; // a reference chosen here is a new one
-    overlays = {};
-    changed();
-  });
+  const deviceSel = select('device', 'Device', [['tpad', 'tpad']], 'tpad', (v) => store.update({ device: v }));
+  const splitSel = select('regions', 'Regions', [['single', 'single texture'], ['split', 'reference left, rendering right']], 'single', (v) =>
+    store.update({ split: v === 'split', overlays: {} }),
+  );
+  // A reference chosen here is a new one (format version 3).
+  const refSel = select('reference', 'Reference', [['4sin', '4sin']], store.get().reference, (v) => store.update({ reference: v, reference_version: 3, overlays: {} }));
   const refRow = refSel.row;
   refRow.hidden = true;
 
@@ -474,19 +441,19 @@ export function mountDesigner(root: HTMLElement): void {
     matchInfo.textContent = 'encoding…';
     try {
       // Region 0 is the reference on the left; the service puts the match into the last Texel region.
-      const r = await client.call<MatchReply>('match', { document: buildDocument(s), region: 0 }, 120000);
-      const reg = r.region as RegionDoc;
-      if (reg?.texture?.kind === 'texel') applyTexel(s, reg.texture);
-      syncControls();
-      overlays = { target: r.target_spectrum, match: r.match_spectrum };
-      if (lastSpectrum) spec.set(lastSpectrum, overlays.target, overlays.match);
-      matchInfo.textContent = `matched in ${r.encoded?.bytes} bytes${r.model_distance !== undefined ? `, model distance ${fmt(r.model_distance, 2)}` : ''}`;
-      changed();
+      const r = await client.call('match', { document: buildDocument(store.get()), region: 0 }, 120000);
+      const reg = r.region as unknown as RegionDoc;
+      matchInfo.textContent = `matched in ${r.encoded.bytes} bytes, model distance ${fmt(r.model_distance, 2)}`;
+      store.update((st) => {
+        const ns: DesignerState = { ...st, overlays: { target: r.target_spectrum, match: r.match_spectrum } };
+        if (reg?.texture?.kind === 'texel') applyTexel(ns, reg.texture);
+        return ns;
+      });
     } catch (e) {
       matchInfo.textContent = '';
       showError(e);
     } finally {
-      matchBtn.disabled = !s.split;
+      matchBtn.disabled = !store.get().split;
     }
   });
 
@@ -494,7 +461,9 @@ export function mountDesigner(root: HTMLElement): void {
     return Math.round(v * 1e4) / 1e4;
   }
 
-  function syncControls(): void {
+  /** Shows the store's state in every control (the only way controls change). */
+  function render(s: DesignerState, prev: DesignerState): void {
+    const t = s.texel;
     pitch.set(shown(t.central_pitch_db));
     irr.set(shown(t.irregularity_db));
     length.set(shown(t.texel_length_mm));
@@ -515,8 +484,11 @@ export function mountDesigner(root: HTMLElement): void {
       deviceSel.el.value = s.device;
     }
     refSel.el.value = s.reference;
-    showCoarse();
+    showCoarse(t);
+    if (s.overlays !== prev.overlays && lastSpectrum) spec.set(lastSpectrum, s.overlays.target, s.overlays.match);
+    void design();
   }
+  store.subscribe(render);
 
   // --- import / export, drag and drop
   const fileIn = h('input', { type: 'file', id: 'import-file', 'data-testid': 'import-file', accept: '.json,.texel,.bin,.npy,.csv,.wav', class: 'visually-hidden' }) as HTMLInputElement;
@@ -528,23 +500,19 @@ export function mountDesigner(root: HTMLElement): void {
     status.textContent = `importing ${f.name}…`;
     try {
       const bytes = new Uint8Array(await f.arrayBuffer());
-      const dev = typeof s.device === 'string' ? s.device : s.device.name;
-      const r = await client.call<ImportReply>('import', { name: f.name, data_base64: bytesToBase64(bytes), device: dev }, 120000);
-      // The controls hold on to s.texel: update it in place.
-      const ns = stateFromDocument(r.document, s);
-      Object.assign(s.texel, ns.texel);
-      Object.assign(s, ns, { texel: s.texel });
-      syncControls();
+      const device = store.get().device;
+      const dev = typeof device === 'string' ? device : device.name;
+      const r = await client.call('import', { name: f.name, data_base64: bytesToBase64(bytes), device: dev }, 120000);
       status.textContent = `imported ${f.name}`;
       status.dataset.imported = f.name;
-      changed();
+      store.update(stateFromDocument(r.document as TextureDocument, store.get()));
     } catch (e) {
       showError(e);
     }
   }
-  async function exportAs(as: string): Promise<void> {
+  async function exportAs(as: ExportRequest['as']): Promise<void> {
     try {
-      const r = await client.call<FileReply>('export', { document: buildDocument(s), as }, 60000);
+      const r = await client.call('export', { document: buildDocument(store.get()), as }, 60000);
       download(r.name, r.mime, base64ToBytes(r.data_base64));
     } catch (e) {
       showError(e);
@@ -608,16 +576,18 @@ export function mountDesigner(root: HTMLElement): void {
     h('div', { class: 'two' }, h('div', {}, h('h2', {}, 'Texel frequencies'), hist.el), h('div', {}, h('h2', {}, 'Spectrum'), spec.el)),
   );
   root.replaceChildren(h('div', { class: 'designer' }, controls, plots), status, dropHint);
-  showCoarse();
+  showCoarse(store.get().texel);
 
   void getHello()
     .then((hi) => {
+      const s = store.get();
       deviceSel.el.replaceChildren(...hi.devices.map((d) => h('option', { value: d.name, title: d.description ?? '' }, d.name)));
       deviceSel.el.value = typeof s.device === 'string' ? s.device : s.device.name;
       refSel.el.replaceChildren(...hi.references.map((r) => h('option', { value: r.name, title: r.description ?? '' }, r.name)));
       refSel.el.value = s.reference;
+      strip.setLength(deviceLength(s.device));
       root.dataset.ready = 'true';
-      changed();
+      void design();
     })
     .catch(showError);
 }

@@ -5,7 +5,7 @@
 
 import { studio } from './ws';
 import { h } from './util';
-import type { ListReply, SessionInfo } from './protocol';
+import type { ExperimentListReply, ExperimentStartRequest, StoredSession } from './generated/messages';
 
 export function mountExperimenter(root: HTMLElement): void {
   const client = studio();
@@ -27,7 +27,7 @@ export function mountExperimenter(root: HTMLElement): void {
     status.classList.remove('error');
     status.textContent = `starting ${protocol} for ${code}…`;
     try {
-      const body: Record<string, unknown> = { protocol, participant: code };
+      const body: Omit<ExperimentStartRequest, 'type' | 'id'> = { protocol, participant: code };
       if (resumeIt) body.resume = true;
       if (sim) body.simulate = sim;
       await client.call('experiment.start', body, 120000);
@@ -76,8 +76,8 @@ export function mountExperimenter(root: HTMLElement): void {
     simulateBtn.textContent = simulating ? 'Pause the simulation' : 'Run the simulated participant';
     while (simulating && document.body.contains(root)) {
       try {
-        const cur = await client.call<{ type: string; question?: { trial: number } }>('experiment.current', {}, 30000);
-        if (cur.type !== 'experiment.question' || !cur.question) break;
+        const cur = await client.call('experiment.current', {}, 30000);
+        if (cur.type !== 'experiment.question') break;
         await client.call('experiment.answer', { trial: cur.question.trial, simulated: true }, 60000);
       } catch (e) {
         status.textContent = e instanceof Error ? e.message : String(e);
@@ -89,7 +89,7 @@ export function mountExperimenter(root: HTMLElement): void {
     await refresh();
   });
 
-  function row(s: SessionInfo): HTMLElement {
+  function row(s: StoredSession): HTMLElement {
     const resumeBtn = s.finished
       ? h('span', {}, '')
       : h('button', { type: 'button', 'aria-label': `Resume session ${s.id} (${s.participant}, ${s.protocol})`, onclick: () => void start(s.protocol, s.participant, true, '') }, 'Resume');
@@ -106,9 +106,9 @@ export function mountExperimenter(root: HTMLElement): void {
   }
 
   async function refresh(): Promise<void> {
-    let l: ListReply;
+    let l: ExperimentListReply;
     try {
-      l = await client.call<ListReply>('experiment.list', {}, 15000);
+      l = await client.call('experiment.list', {}, 15000);
     } catch (e) {
       status.textContent = e instanceof Error ? e.message : String(e);
       return;
@@ -131,8 +131,8 @@ export function mountExperimenter(root: HTMLElement): void {
     if (l.active) {
       let progress = '';
       try {
-        const cur = await client.call<{ type: string; progress?: { done: number; planned: number } }>('experiment.current', {}, 15000);
-        if (cur.progress)
+        const cur = await client.call('experiment.current', {}, 15000);
+        if (cur.type !== 'experiment.idle')
           progress = cur.progress.planned > 0 ? `${cur.progress.done} / ${cur.progress.planned} trials` : `${cur.progress.done} trials (adaptive)`;
         const finished = cur.type === 'experiment.finished';
         if (finished) {
@@ -145,7 +145,7 @@ export function mountExperimenter(root: HTMLElement): void {
       } catch {
         /* list is enough */
       }
-      const simulated = (l.active as { simulated?: boolean }).simulated === true;
+      const simulated = l.active.simulated;
       const key = JSON.stringify([l.active.id, l.active.participant, l.active.protocol, progress, simulated]);
       if (active.dataset.key !== key) {
         active.dataset.key = key;

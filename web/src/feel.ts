@@ -12,47 +12,12 @@
 import { studio } from './ws';
 import { h, stats, fmt } from './util';
 import { hearIt } from './audio';
-import type { FeelState } from './protocol';
+import FeelWorker from './feel-worker?worker';
+import type { FingerSample, FromFeelWorker } from './feel-worker';
+import type { FeelStateReply } from './generated/messages';
 
-// Finger samples travel on their own WebSocket, owned by a small worker:
-// the worker sends each sample the moment it is posted and time-stamps the
-// feel.ack as it arrives, whatever the page's main thread is doing (after a
-// pointer event Chromium renders a frame first, which would otherwise add up
-// to a frame to every measured ack). Times are absolute (timeOrigin + now),
-// so the page's and the worker's clocks agree.
-const FEEL_WORKER = `
-let ws = null, url = '', sent = new Map(), waiting = null;
-function send(m) {
-  if (sent.size > 4096) sent.clear();
-  sent.set(m.seq, m.t0);
-  ws.send(JSON.stringify({ type: 'feel.move', seq: m.seq, x_mm: m.x_mm, touch: m.touch }));
-}
-function connect() {
-  ws = new WebSocket(url);
-  // While connecting, only the newest sample is kept (it is where the finger is now).
-  ws.onopen = () => { if (waiting) { const m = waiting; waiting = null; send(m); } };
-  ws.onmessage = (e) => {
-    const t = performance.timeOrigin + performance.now();
-    let m; try { m = JSON.parse(e.data); } catch { return; }
-    if (m.type === 'feel.ack') {
-      const t0 = sent.get(m.seq); sent.delete(m.seq);
-      postMessage({ ack: m.seq, ms: t0 === undefined ? null : t - t0 });
-    } else if (m.type === 'error') postMessage({ error: m.message });
-  };
-  ws.onclose = () => { ws = null; setTimeout(connect, 500); };
-}
-onmessage = (e) => {
-  const m = e.data;
-  if (m.url) { url = m.url; connect(); return; }
-  if (!ws || ws.readyState !== 1) {
-    if (waiting) postMessage({ dropped: waiting.seq });
-    waiting = m;
-    return;
-  }
-  send(m);
-};
-`;
-
+// Finger samples travel on their own WebSocket, owned by a small worker
+// (feel-worker.ts, bundled by Vite as a module of its own).
 let seq = 0;
 let worker: Worker | null | undefined;
 const sentAt = new Map<number, number>(); // fallback path (no Worker): main-thread times
@@ -61,15 +26,14 @@ let ackInstalled = false;
 export function feelWorker(): Worker | null {
   if (worker !== undefined) return worker;
   try {
-    const w = new Worker(URL.createObjectURL(new Blob([FEEL_WORKER], { type: 'text/javascript' })));
-    const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
-    w.postMessage({ url: `${proto}//${location.host}/ws` });
-    w.onmessage = (e: MessageEvent) => {
-      const m = e.data as { ack?: number; ms?: number | null; dropped?: number };
-      if (m.ack !== undefined) {
+    const w = new FeelWorker();
+    w.onmessage = (e: MessageEvent<FromFeelWorker>) => {
+      if (!__TEXEL_TEST_HOOKS__) return;
+      const m = e.data;
+      if ('ack' in m) {
         stats.feelAcks++;
         if (typeof m.ms === 'number') pushAck(m.ms);
-      } else if (m.dropped !== undefined) stats.feelMovesSent--;
+      } else if ('dropped' in m) stats.feelMovesSent--;
     };
     worker = w;
   } catch {
@@ -79,6 +43,7 @@ export function feelWorker(): Worker | null {
 }
 
 function pushAck(ms: number): void {
+  if (!__TEXEL_TEST_HOOKS__) return;
   stats.pointerToAckMs.push(ms);
   if (stats.pointerToAckMs.length > 5000) stats.pointerToAckMs.splice(0, 1000);
 }
@@ -87,11 +52,10 @@ function installAck(): void {
   if (ackInstalled) return;
   ackInstalled = true;
   studio().on('feel.ack', (m) => {
-    const s = Number((m as { seq?: number }).seq);
-    const t0 = sentAt.get(s);
-    stats.feelAcks++;
+    const t0 = sentAt.get(m.seq);
+    if (__TEXEL_TEST_HOOKS__) stats.feelAcks++;
     if (t0 !== undefined) {
-      sentAt.delete(s);
+      sentAt.delete(m.seq);
       pushAck(performance.now() - t0);
     }
   });
@@ -101,13 +65,14 @@ export function sendMove(x_mm: number, touch: boolean): void {
   const s = ++seq;
   const w = feelWorker();
   if (w) {
-    w.postMessage({ seq: s, x_mm, touch, t0: performance.timeOrigin + performance.now() });
-    stats.feelMovesSent++;
+    const sample: FingerSample = { seq: s, x_mm, touch, t0: performance.timeOrigin + performance.now() };
+    w.postMessage(sample);
+    if (__TEXEL_TEST_HOOKS__) stats.feelMovesSent++;
   } else {
     installAck();
     if (sentAt.size > 2000) sentAt.clear();
     sentAt.set(s, performance.now());
-    if (studio().send('feel.move', { seq: s, x_mm, touch })) stats.feelMovesSent++;
+    if (studio().send('feel.move', { seq: s, x_mm, touch }) && __TEXEL_TEST_HOOKS__) stats.feelMovesSent++;
   }
   hearIt.pointer(x_mm, touch);
 }
@@ -144,7 +109,7 @@ export class FeelStrip {
         role: 'slider',
         'aria-label': opts.label ?? 'Feel it: the display. Move the pointer or a finger over it, or use the arrow keys',
         'aria-valuemin': 0,
-        'aria-valuemax': Math.round(this.length_mm),
+        'aria-valuemax': Number.isFinite(this.length_mm) ? Math.round(this.length_mm) : undefined,
         'aria-valuenow': 0,
         'data-testid': 'feel-strip',
       },
@@ -178,6 +143,7 @@ export class FeelStrip {
   }
 
   private move(x: number, touch: boolean): void {
+    if (!Number.isFinite(x)) return; // the device's length is not known yet (hello)
     this.lastX = x;
     // A transform, not `left`: the marker moves on the compositor without a
     // layout or paint, so the frame after a pointer event is cheap and the
@@ -245,7 +211,7 @@ export class FeelStrip {
       }
       if (studio().state !== 'open') return;
       try {
-        const st = await studio().request<FeelState>('feel.state', {}, { lane: 'feel.state', timeoutMs: 2000 });
+        const st = await studio().request('feel.state', {}, { lane: 'feel.state', timeoutMs: 2000 });
         if (!st) return;
         this.showState(st);
       } catch {
@@ -254,7 +220,7 @@ export class FeelStrip {
     }, 100);
   }
 
-  private showState(st: FeelState): void {
+  private showState(st: FeelStateReply): void {
     const p = st.position_mm;
     if (p === null || p === undefined || !Number.isFinite(p)) {
       this.posText.textContent = '–';

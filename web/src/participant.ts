@@ -13,7 +13,7 @@ import { studio, StudioError } from './ws';
 import { h, isoNow, decodeF32 } from './util';
 import { FeelStrip } from './feel';
 import { getHello } from './designer';
-import type { CurrentReply, DesignReply, Question, QuestionReply, ResponseJson, TrialEvent } from './protocol';
+import type { ExperimentQuestionReply, Question, Replies, Response, TrialEvent } from './generated/messages';
 
 const niceChoice: Record<string, string> = { unsure: 'Unsure', same: 'Same', different: 'Different' };
 
@@ -70,13 +70,13 @@ export function mountParticipant(root: HTMLElement): void {
   const alive = () => document.body.contains(root) && !!root.querySelector('.participant');
 
   const screen = h('div', { class: 'participant-screen' });
-  const strip = new FeelStrip({ length_mm: 101.76, label: 'Feel the selected texture here: move a finger or the pointer along the strip' });
+  const strip = new FeelStrip({ length_mm: NaN, label: 'Feel the selected texture here: move a finger or the pointer along the strip' });
   root.replaceChildren(h('div', { class: 'participant' }, screen));
 
   async function load(): Promise<void> {
     if (idleTimer) clearTimeout(idleTimer);
     try {
-      const cur = await client.call<CurrentReply>('experiment.current', {}, 60000);
+      const cur = await client.call('experiment.current', {}, 60000);
       show(cur);
     } catch (e) {
       screen.replaceChildren(h('p', { class: 'status error', role: 'alert' }, e instanceof Error ? e.message : String(e)));
@@ -84,7 +84,7 @@ export function mountParticipant(root: HTMLElement): void {
     }
   }
 
-  function show(cur: CurrentReply): void {
+  function show(cur: Replies['experiment.current']): void {
     root.dataset.state = cur.type;
     if (cur.type === 'experiment.question') void renderQuestion(cur);
     else if (cur.type === 'experiment.finished') {
@@ -95,7 +95,7 @@ export function mountParticipant(root: HTMLElement): void {
     }
   }
 
-  async function renderQuestion(reply: QuestionReply): Promise<void> {
+  async function renderQuestion(reply: ExperimentQuestionReply): Promise<void> {
     const q: Question = reply.question;
     const shownPerf = performance.now();
     const shownAt = isoNow();
@@ -199,7 +199,7 @@ export function mountParticipant(root: HTMLElement): void {
             maps.append(h('div', {}, h('span', {}, s.label), c));
             if (!s.document) continue;
             try {
-              const r = await client.call<DesignReply>('design', { document: s.document }, 60000);
+              const r = await client.call('design', { document: s.document }, 60000);
               drawMiniMap(c, decodeF32(r.map_f32));
             } catch {
               /* maps are an aid only */
@@ -296,7 +296,7 @@ export function mountParticipant(root: HTMLElement): void {
       submit.textContent = 'Saving…';
       const answeredPerf = performance.now();
       ev('answer', answer.choice ?? (answer.rating !== undefined ? String(answer.rating) : 'sliders'));
-      const response: ResponseJson = {
+      const response: Response = {
         ...answer,
         rt_ms: Math.round((answeredPerf - shownPerf) * 10) / 10,
         shown_at: shownAt,
@@ -304,7 +304,7 @@ export function mountParticipant(root: HTMLElement): void {
         events,
       };
       try {
-        const next = await client.call<CurrentReply>('experiment.answer', { trial: q.trial, response }, 60000);
+        const next = await client.call('experiment.answer', { trial: q.trial, response }, 60000);
         clearTimers();
         show(next);
       } catch (e) {

@@ -6,7 +6,7 @@
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import { h } from './util';
-import type { Spectrum } from './protocol';
+import type { Spectrum } from './generated/messages';
 
 function widthOf(el: HTMLElement, fallback: number): number {
   return Math.max(200, Math.floor(el.clientWidth || fallback));

@@ -73,7 +73,12 @@ export function quantile(xs: number[], p: number): number {
   return s[lo] + (s[hi] - s[lo]) * (pos - lo);
 }
 
-/** Test and diagnostics hook: small counters and timing samples (see README in tests/e2e). */
+/**
+ * Test hook, built only in the test build (__TEXEL_TEST_HOOKS__, env.d.ts):
+ * small counters and timing samples the browser tests read as
+ * window.__texelStats. Every write sits behind `if (__TEXEL_TEST_HOOKS__)`,
+ * so the production bundle has none of it.
+ */
 export interface TexelStats {
   designsSent: number;
   designsDrawn: number;
@@ -97,7 +102,7 @@ export const stats: TexelStats = {
   lastMapChecksum: null,
   lastHistChecksum: null,
 };
-(window as unknown as { __texelStats: TexelStats }).__texelStats = stats;
+if (__TEXEL_TEST_HOOKS__) (window as unknown as { __texelStats: TexelStats }).__texelStats = stats;
 
 /** A cheap order-sensitive checksum so tests can tell that a plotted series changed. */
 export function checksum(xs: ArrayLike<number>): number {

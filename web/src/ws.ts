@@ -6,8 +6,13 @@
 // `design` jobs (latest wins), so an older request may never get a reply.
 // Requests sent with a `lane` are therefore settled as superseded (resolved
 // with null) as soon as a reply to a *newer* request of the same lane arrives.
+//
+// Types. Requests, their bodies and their replies are the ones generated from
+// docs/schema/studio-messages.schema.json (generated/messages.ts): a key the
+// schema does not list, or a reply field it does not have, fails tsc. The
+// same client runs in the page and in the feel worker (feel-worker.ts).
 
-import type { ErrorReply } from './protocol';
+import type { Body, Replies, RequestType, ServerMessage, ServerMessages } from './generated/messages';
 
 export class StudioError extends Error {
   constructor(
@@ -19,11 +24,10 @@ export class StudioError extends Error {
   }
 }
 
-type Reply = { type: string; id?: number | string; [k: string]: unknown };
-type Listener = (msg: Reply) => void;
+type Listener = (msg: ServerMessage) => void;
 
 interface Pending {
-  resolve: (v: Reply | null) => void;
+  resolve: (v: ServerMessage | null) => void;
   reject: (e: Error) => void;
   lane?: string;
   timer?: ReturnType<typeof setTimeout>;
@@ -85,9 +89,9 @@ export class StudioClient {
 
   private receive(data: unknown): void {
     if (typeof data !== 'string') return;
-    let msg: Reply;
+    let msg: ServerMessage;
     try {
-      msg = JSON.parse(data) as Reply;
+      msg = JSON.parse(data) as ServerMessage;
     } catch {
       return;
     }
@@ -105,16 +109,13 @@ export class StudioClient {
           }
       }
       if (msg.type === 'error') {
-        const e = msg as unknown as ErrorReply;
-        p.reject(new StudioError(e.code, e.message));
+        p.reject(new StudioError(msg.code, msg.message));
       } else {
         p.resolve(msg);
       }
     }
     const ls = this.listeners.get(msg.type);
     if (ls) for (const l of ls) l(msg);
-    const any = this.listeners.get('*');
-    if (any) for (const l of any) l(msg);
   }
 
   /** Resolves when the socket is open. */
@@ -124,11 +125,11 @@ export class StudioClient {
   }
 
   /** Sends a request and resolves with its reply (null if superseded in its lane). */
-  async request<T = Reply>(type: string, body: Record<string, unknown> = {}, opts: RequestOptions = {}): Promise<T | null> {
+  async request<K extends RequestType>(type: K, body: Body<K>, opts: RequestOptions = {}): Promise<Replies[K] | null> {
     await this.ready();
     const id = this.nextId++;
-    return new Promise<T | null>((resolve, reject) => {
-      const p: Pending = { resolve: resolve as (v: Reply | null) => void, reject, lane: opts.lane };
+    return new Promise<Replies[K] | null>((resolve, reject) => {
+      const p: Pending = { resolve: resolve as (v: ServerMessage | null) => void, reject, lane: opts.lane };
       if (opts.timeoutMs)
         p.timer = setTimeout(() => {
           this.pending.delete(id);
@@ -140,24 +141,24 @@ export class StudioClient {
   }
 
   /** Like request() but for replies that must arrive (throws when superseded). */
-  async call<T = Reply>(type: string, body: Record<string, unknown> = {}, timeoutMs = 60000): Promise<T> {
-    const r = await this.request<T>(type, body, { timeoutMs });
+  async call<K extends RequestType>(type: K, body: Body<K>, timeoutMs = 60000): Promise<Replies[K]> {
+    const r = await this.request(type, body, { timeoutMs });
     if (r === null) throw new StudioError('superseded', `${type} was superseded`);
     return r;
   }
 
   /** Fire and forget; dropped while disconnected (finger samples are perishable). */
-  send(type: string, body: Record<string, unknown> = {}): boolean {
+  send<K extends RequestType>(type: K, body: Body<K>): boolean {
     if (!this.ws || this.state !== 'open') return false;
     this.ws.send(JSON.stringify({ type, ...body }));
     return true;
   }
 
-  on(type: string, l: Listener): () => void {
+  on<K extends keyof ServerMessages>(type: K, l: (msg: ServerMessages[K]) => void): () => void {
     let s = this.listeners.get(type);
     if (!s) this.listeners.set(type, (s = new Set()));
-    s.add(l);
-    return () => s!.delete(l);
+    s.add(l as Listener);
+    return () => s!.delete(l as Listener);
   }
 
   onState(l: (s: ConnectionState) => void): () => void {
@@ -168,11 +169,14 @@ export class StudioClient {
 
 let client: StudioClient | null = null;
 
+/** /ws of the serving origin (the page's, or the worker's: the same). */
+export function studioUrl(): string {
+  const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
+  return `${proto}//${location.host}/ws`;
+}
+
 /** The page's client, connected to /ws of the serving origin. */
 export function studio(): StudioClient {
-  if (!client) {
-    const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
-    client = new StudioClient(`${proto}//${location.host}/ws`);
-  }
+  if (!client) client = new StudioClient(studioUrl());
   return client;
 }

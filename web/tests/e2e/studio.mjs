@@ -6,7 +6,7 @@
 //
 // Environment (paths relative to web/ unless absolute):
 //   TEXEL_BIN        texel binary            (default ../build/bin/texel)
-//   TEXEL_WEB        built front end         (default ../build/web)
+//   TEXEL_WEB        test build of the front end (default ../build/web-test)
 //   TEXEL_ARTIFACTS  screenshots, latency    (default ../build/browser-artifacts)
 //   TEXEL_PROTOCOLS  shipped protocols       (default ../examples/protocols)
 //   TEXEL_CHROMIUM   browser executable      (default /usr/bin/chromium)
@@ -26,7 +26,7 @@ const fromWeb = (p) => resolve(webDir, p);
 
 export const paths = {
   bin: fromWeb(process.env.TEXEL_BIN ?? '../build/bin/texel'),
-  web: fromWeb(process.env.TEXEL_WEB ?? '../build/web'),
+  web: fromWeb(process.env.TEXEL_WEB ?? '../build/web-test'),
   artifacts: fromWeb(process.env.TEXEL_ARTIFACTS ?? '../build/browser-artifacts'),
   protocols: fromWeb(process.env.TEXEL_PROTOCOLS ?? '../examples/protocols'),
   chromium: process.env.TEXEL_CHROMIUM ?? '/usr/bin/chromium',
