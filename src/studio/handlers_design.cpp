@@ -97,7 +97,9 @@ Document document_of(const State& s, const json& j, const std::string& where) {
   }
   if (device && j.contains("device_grid") && j["device_grid"].is_object()) {
     const json& g = j["device_grid"];
-    auto opt = [&](const char* k) { return g.contains(k) && g[k].is_number() ? std::optional(g[k].get<double>()) : std::nullopt; };
+    auto opt = [&](const char* k) {
+      return g.contains(k) && g[k].is_number() ? std::optional(g[k].get<double>()) : std::nullopt;
+    };
     device = with_grid(*device, millimetres(opt("length_mm")), millimetres(opt("spacing_mm")));
   }
   if (device) check_cost(s, j, *device, where);

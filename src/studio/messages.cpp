@@ -91,7 +91,8 @@ std::int64_t Fields::integer(const char* key, std::int64_t lo, std::int64_t hi) 
   const bool fits = v.is_number_unsigned() ? v.get<std::uint64_t>() <= static_cast<std::uint64_t>(hi) : true;
   const std::int64_t i = fits ? v.get<std::int64_t>() : hi;
   if (!fits || i < lo || i > hi)
-    throw Reject{"invalid", type_ + ": " + key + " is " + v.dump() + "; allowed: " + std::to_string(lo) + " … " + std::to_string(hi)};
+    throw Reject{"invalid",
+                 type_ + ": " + key + " is " + v.dump() + "; allowed: " + std::to_string(lo) + " … " + std::to_string(hi)};
   return i;
 }
 

@@ -111,9 +111,7 @@ struct State {
   std::optional<experiment::ActiveSession> active;
 };
 
-inline double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+inline double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // ------------------------------------------------------------------ replies
 void send(Client& c, const ojson& reply);

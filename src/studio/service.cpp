@@ -194,16 +194,12 @@ struct Service::Impl {
       if (!spec) unknown_type(type);
       Job job{std::move(type), std::move(msg), id, Clock::now()};
       switch (spec->lane) {
-        case Lane::now:
-          run(state, *c, job);
-          break;
+        case Lane::now: run(state, *c, job); break;
         case Lane::design:
           check_keys(*spec, job.msg);
           enqueue_design_lane(c, std::move(job));
           break;
-        case Lane::fifo:
-          enqueue_fifo(c, std::move(job));
-          break;
+        case Lane::fifo: enqueue_fifo(c, std::move(job)); break;
       }
     });
   }

@@ -129,6 +129,7 @@ TEST(StudioMessages, RepliesHaveTheSchemasKeys) {
     for (const auto& [k, v] : r.items())
       if (k != "type" && k != "id") keys.insert(k);
     for (const auto& k : keys) EXPECT_TRUE(keys_of(def).count(k)) << type << " sends " << k << ", not in the schema";
-    for (const auto& k : def.value("required", json::array())) EXPECT_TRUE(r.contains(k.get<std::string>())) << type << " lacks " << k;
+    for (const auto& k : def.value("required", json::array()))
+      EXPECT_TRUE(r.contains(k.get<std::string>())) << type << " lacks " << k;
   }
 }
