@@ -12,7 +12,8 @@
 import { studio, StudioError } from './ws';
 import { h, isoNow, decodeF32 } from './util';
 import { FeelStrip } from './feel';
-import { getHello } from './designer';
+import { getHello, deviceLength } from './designer';
+import { Store } from './store';
 import type { ExperimentQuestionReply, Question, Replies, Response, TrialEvent } from './generated/messages';
 
 const niceChoice: Record<string, string> = { unsure: 'Unsure', same: 'Same', different: 'Different' };
@@ -102,7 +103,6 @@ export function mountParticipant(root: HTMLElement): void {
     const events: TrialEvent[] = [];
     const ev = (kind: string, detail: string) => events.push({ t_s: (performance.now() - shownPerf) / 1000, kind, detail, at: isoNow() });
     ev('show', `trial ${q.trial}`);
-    let timedOut = false;
     const timers: ReturnType<typeof setTimeout>[] = [];
     const clearTimers = () => timers.forEach((t) => clearTimeout(t));
 
@@ -110,13 +110,20 @@ export function mountParticipant(root: HTMLElement): void {
       const hi = await getHello();
       const dev = q.stimuli.find((x) => x.document)?.document?.device ?? 'tpad';
       const p = typeof dev === 'object' ? dev : hi.devices.find((d) => d.name === dev);
-      if (p) strip.setLength(p.samples * p.spacing_mm);
+      if (p) strip.setLength(deviceLength(p));
     } catch {
       /* keep the default length */
     }
 
-    // ---- answer state
-    const answer: { choice?: string; rating?: number; confidence?: number; digit?: number; slider_p?: number; slider_i?: number } = {};
+    // ---- the trial's one state: inputs write it, render() enables Submit from it
+    type Answer = Pick<Response, 'choice' | 'rating' | 'confidence' | 'digit' | 'slider_p' | 'slider_i'>;
+    const trial = new Store<{ answer: Answer; inputsReady: boolean; timedOut: boolean; saving: boolean }>({
+      answer: {},
+      inputsReady: q.phases.length === 0,
+      timedOut: false,
+      saving: false,
+    });
+    const setAnswer = (p: Answer) => trial.update((t) => ({ answer: { ...t.answer, ...p } }));
     const submit = h('button', { type: 'button', class: 'big primary submit', 'data-testid': 'submit', disabled: true }, 'Submit') as HTMLButtonElement;
     const needs = {
       choice: q.choices.length > 0,
@@ -125,15 +132,15 @@ export function mountParticipant(root: HTMLElement): void {
       digit: q.recall_cell >= -1, // -1: the recall question indicates all cells (control matrix); -2: none
       sliders: q.sliders.length >= 2,
     };
-    let inputsReady = q.phases.length === 0;
-    const update = () => {
+    trial.subscribe(({ answer, inputsReady, saving }) => {
       submit.disabled =
+        saving ||
         !inputsReady ||
         (needs.choice && answer.choice === undefined) ||
         (needs.rating && answer.rating === undefined) ||
         (needs.confidence && answer.confidence === undefined) ||
         (needs.digit && answer.digit === undefined);
-    };
+    });
 
     // ---- stimuli
     const stimulusButtons = q.stimuli.map((s, i) => {
@@ -142,7 +149,7 @@ export function mountParticipant(root: HTMLElement): void {
       return b;
     });
     async function selectStimulus(i: number): Promise<void> {
-      if (timedOut) return;
+      if (trial.get().timedOut) return;
       stimulusButtons.forEach((b, k) => b.setAttribute('aria-pressed', String(k === i)));
       ev('select', q.stimuli[i]?.label ?? String(i));
       try {
@@ -174,7 +181,7 @@ export function mountParticipant(root: HTMLElement): void {
         const left = Math.max(0, (end - performance.now()) / 1000);
         countdown.textContent = `${Math.ceil(left)} s left to feel`;
         if (left <= 0) {
-          timedOut = true;
+          trial.update({ timedOut: true });
           ev('timeout', `${q.time_limit_s} s`);
           stimulusButtons.forEach((b) => (b.disabled = true));
           countdown.textContent = 'Time is up: please answer.';
@@ -215,9 +222,7 @@ export function mountParticipant(root: HTMLElement): void {
 
     // ---- answer inputs
     if (needs.sliders) {
-      const vals = q.sliders.map((s) => s.start);
-      answer.slider_p = vals[0];
-      answer.slider_i = vals[1];
+      setAnswer({ slider_p: q.sliders[0].start, slider_i: q.sliders[1].start });
       let inFlight = false;
       let again = false;
       const preview = async () => {
@@ -227,7 +232,8 @@ export function mountParticipant(root: HTMLElement): void {
         }
         inFlight = true;
         try {
-          await client.call('experiment.preview', { trial: q.trial, slider_p: vals[0], slider_i: vals[1] }, 30000);
+          const { slider_p, slider_i } = trial.get().answer;
+          await client.call('experiment.preview', { trial: q.trial, slider_p: slider_p!, slider_i: slider_i! }, 30000);
         } catch (e) {
           msg.textContent = e instanceof Error ? e.message : String(e);
         }
@@ -241,9 +247,7 @@ export function mountParticipant(root: HTMLElement): void {
         const id = `slider-${s.name}`;
         const input = h('input', { type: 'range', id, min: s.min, max: s.max, step: (s.max - s.min) / 200, value: s.start, class: 'big-slider', 'data-testid': id }) as HTMLInputElement;
         input.addEventListener('input', () => {
-          vals[k] = Number(input.value);
-          if (k === 0) answer.slider_p = vals[0];
-          else answer.slider_i = vals[1];
+          setAnswer(k === 0 ? { slider_p: Number(input.value) } : { slider_i: Number(input.value) });
           void preview();
         });
         input.addEventListener('change', () => ev('slider', `${s.name}=${input.value}`));
@@ -252,9 +256,8 @@ export function mountParticipant(root: HTMLElement): void {
     }
     if (needs.choice) {
       const g = radioGroup('Your answer', q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? c })), (v) => {
-        answer.choice = v;
         ev('choice', v);
-        update();
+        setAnswer({ choice: v });
       }, 'choices');
       answerArea.append(g.el);
     }
@@ -263,9 +266,8 @@ export function mountParticipant(root: HTMLElement): void {
       const opts = [];
       for (let v = lo; v <= hi; v++) opts.push({ value: String(v), text: String(v) });
       const g = radioGroup(`Similarity from ${lo} (different) to ${hi} (the same)`, opts, (v) => {
-        answer.rating = Number(v);
         ev('rating', v);
-        update();
+        setAnswer({ rating: Number(v) });
       }, 'rating');
       answerArea.append(h('p', { class: 'scale-label' }, `${lo} = very different … ${hi} = identical`), g.el);
     }
@@ -275,16 +277,14 @@ export function mountParticipant(root: HTMLElement): void {
       const opts = [];
       for (let v = 1; v <= 9; v++) opts.push({ value: String(v), text: String(v) });
       const g = radioGroup(`Digit ${where}`, opts, (v) => {
-        answer.digit = Number(v);
-        update();
+        setAnswer({ digit: Number(v) });
       }, 'digit');
       answerArea.append(h('p', { class: 'prompt' }, `Which digit was ${where} of the matrix?`), g.el);
     }
     if (q.confidence) {
       const opts = [1, 2, 3, 4, 5].map((v) => ({ value: String(v), text: String(v) }));
       const g = radioGroup('Confidence from 1 (guess) to 5 (certain)', opts, (v) => {
-        answer.confidence = Number(v);
-        update();
+        setAnswer({ confidence: Number(v) });
       }, 'confidence');
       answerArea.append(h('p', { class: 'scale-label' }, 'How confident are you? 1 = guess … 5 = certain'), g.el);
     }
@@ -292,8 +292,9 @@ export function mountParticipant(root: HTMLElement): void {
 
     submit.addEventListener('click', async () => {
       if (submit.disabled) return;
-      submit.disabled = true;
+      trial.update({ saving: true });
       submit.textContent = 'Saving…';
+      const answer = trial.get().answer;
       const answeredPerf = performance.now();
       ev('answer', answer.choice ?? (answer.rating !== undefined ? String(answer.rating) : 'sliders'));
       const response: Response = {
@@ -315,13 +316,13 @@ export function mountParticipant(root: HTMLElement): void {
           // A stale trial or a lost connection: show what the engine holds now.
           setTimeout(() => alive() && void load(), 500);
         } else {
-          update();
+          trial.update({ saving: false });
         }
       }
     });
 
     screen.replaceChildren(h('div', { class: 'question', 'data-task': q.task, 'data-trial': q.trial, 'aria-describedby': q.prompt ? 'prompt' : undefined }, ...parts.filter((p): p is HTMLElement => !!p)));
-    update();
+    trial.update({});
 
     // ---- timed phases (working memory): stimulus, matrix, stimulus, then the questions
     if (q.phases.length) {
@@ -331,8 +332,7 @@ export function mountParticipant(root: HTMLElement): void {
         if (k >= q.phases.length) {
           phaseArea.replaceChildren(h('p', {}, 'Now answer the questions.'));
           answerArea.hidden = false;
-          inputsReady = true;
-          update();
+          trial.update({ inputsReady: true });
           return;
         }
         const ph = q.phases[k];
