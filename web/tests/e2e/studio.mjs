@@ -14,10 +14,10 @@
 //                    firefox.test.mjs only, driven by puppeteer-core over
 //                    WebDriver BiDi)
 
-import { spawn } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync, existsSync } from 'node:fs';
+import { spawn, spawnSync } from 'node:child_process';
+import { mkdirSync, mkdtempSync, rmSync, existsSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
+import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
@@ -252,21 +252,45 @@ export async function launchFirefox({ hardTimeoutMs = 600_000 } = {}) {
 /**
  * Runs `fn({studio, browser, page, context})` against a fresh server and browser and
  * always tears both down. Page errors and console errors are collected in `errors`.
+ * Every WebSocket frame the pages send and receive is recorded and, once the
+ * flow passed, checked against docs/schema/studio-messages.schema.json
+ * (tests/check_messages.py; the frames stay in the artifacts as ws-*.jsonl).
  */
 export async function withStudio(fn, { contextOptions = {} } = {}) {
   const studio = await startStudio();
+  const frames = [];
   let browser;
+  let result;
   try {
     browser = await launchBrowser();
     const context = await browser.newContext({ viewport: { width: 1280, height: 900 }, acceptDownloads: true, ...contextOptions });
+    context.on('page', (p) =>
+      p.on('websocket', (ws) => {
+        ws.on('framesent', (f) => typeof f.payload === 'string' && frames.push({ dir: 'sent', text: f.payload }));
+        ws.on('framereceived', (f) => typeof f.payload === 'string' && frames.push({ dir: 'received', text: f.payload }));
+      }),
+    );
     const page = await context.newPage();
     const errors = [];
     page.on('pageerror', (e) => errors.push(String(e)));
-    return await fn({ studio, browser, context, page, errors });
+    result = await fn({ studio, browser, context, page, errors });
   } finally {
     await browser?.close().catch(() => {});
     await studio.stop();
   }
+  checkFrames(frames);
+  return result;
+}
+
+let flows = 0;
+/** Validates recorded frames with python3-jsonschema against the message schema; throws naming the first mismatches. */
+export function checkFrames(frames) {
+  mkdirSync(paths.artifacts, { recursive: true });
+  const file = join(paths.artifacts, `ws-${basename(process.argv[1] ?? 'flow', '.test.mjs')}-${++flows}.jsonl`);
+  writeFileSync(file, frames.map((f) => JSON.stringify(f)).join('\n') + '\n');
+  const r = spawnSync('/usr/bin/python3', [join(webDir, 'tests', 'check_messages.py'), resolve(webDir, '..'), file], { encoding: 'utf8' });
+  if (r.status !== 0) throw new Error(`messages not as docs/schema/studio-messages.schema.json says (${file}):\n${r.stdout}${r.stderr}`);
+  return r.stdout;
 }
 
 export function artifact(name) {
