@@ -1,0 +1,75 @@
+/* texel_decode — the map a .texel bitstream stands for on a device
+ * (docs/matlab.md).
+ *
+ *   [map, info] = texel_decode(bitstream, 'device', 'tpad')   % uint8 bytes
+ *   [map, info] = texel_decode('rough.texel', 'output', 'native')
+ *
+ * The first argument is the bitstream (a uint8 vector, e.g. texel_encode's
+ * result.bitstream) or the path of a .texel file. Options: device ['tpad'],
+ * output ('amplitude' | 'u16' | 'native', as texel_render). The map equals
+ * `texel decode FILE --device D -o map.bin` byte for byte. */
+#include "texel_mex.h"
+
+struct decode_args {
+  char* device;
+  enum tm_output output;
+};
+
+static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+  struct decode_args* a = (struct decode_args*)ctx;
+  if (tm_is(name, "device"))
+    a->device = tm_text(fn, name, v);
+  else if (tm_is(name, "output"))
+    a->output = tm_output_of(fn, v);
+  else
+    return 0;
+  return 1;
+}
+
+/* The bytes of a file, in mxMalloc memory. */
+static uint8_t* read_file(const char* fn, const char* path, size_t* size) {
+  FILE* f = fopen(path, "rb");
+  uint8_t* bytes = NULL;
+  size_t cap = 0, n = 0, got;
+  if (!f) mexErrMsgIdAndTxt("texel:ioError", "cannot read '%s'", path);
+  do {
+    if (n == cap) {
+      cap = cap ? cap * 2 : 4096;
+      bytes = (uint8_t*)mxRealloc(bytes, cap);
+    }
+    got = fread(bytes + n, 1, cap - n, f);
+    n += got;
+  } while (got > 0);
+  if (ferror(f)) {
+    fclose(f);
+    mexErrMsgIdAndTxt("texel:ioError", "%s: cannot read '%s'", fn, path);
+  }
+  fclose(f);
+  *size = n;
+  return bytes;
+}
+
+void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
+  static const char fn[] = "texel_decode";
+  struct decode_args a;
+  texel_document* doc = NULL;
+  const uint8_t* bytes;
+  size_t size;
+  const char* device;
+  if (nlhs > 2) tm_usage(fn, "returns at most [map, info]");
+  if (nrhs < 1) tm_usage(fn, "give the bitstream (uint8) or a .texel path first");
+  memset(&a, 0, sizeof a);
+  if (mxIsChar(prhs[0])) {
+    bytes = read_file(fn, tm_text(fn, "the path", prhs[0]), &size);
+  } else if (mxIsUint8(prhs[0]) && !mxIsComplex(prhs[0])) {
+    bytes = (const uint8_t*)mxGetData(prhs[0]);
+    size = mxGetNumberOfElements(prhs[0]);
+  } else {
+    tm_usage(fn, "the bitstream must be uint8 bytes or the path of a .texel file");
+    return;
+  }
+  tm_options(fn, nrhs, prhs, 1, take, &a, "device, output");
+  device = a.device ? a.device : "tpad";
+  tm_check(texel_decode(bytes, size, device, &doc));
+  tm_render_document(doc, device, a.output, nlhs, plhs);
+}

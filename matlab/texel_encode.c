@@ -1,0 +1,101 @@
+/* texel_encode — Texel parameters and a .texel bitstream for a map or a
+ * recording (docs/matlab.md).
+ *
+ *   r = texel_encode(amplitude, 'spacing_mm', 0.005)      % a map in memory
+ *   r = texel_encode('scan.mat')                          % any file `texel encode` reads
+ *   r = texel_encode('map.bin', 'device', 'tpad')
+ *
+ * Options (texel.h's texel_encode_options; defaults as `texel encode`):
+ *   spacing_mm        sample spacing of an array input, mm (required for arrays)
+ *   device            a file's device (needed for .bin; its response joins the model)
+ *   swipe_speed_mm_s  finger speed: time recordings to position, and the model's speed
+ *   boundary_mm [1], texel_length_mm [0.25], parameterization ['moments'],
+ *   seed [1], coarse_bits [6], max_bytes [0 = none], recover_texel [true]
+ * r holds the decoded parameters (central_pitch_db, irregularity_db, ...,
+ * as texel_render takes them), has_coarse_profile, distance_jnd and
+ * bitstream (uint8 column: the .texel file `texel encode -o` writes). */
+#include "texel_mex.h"
+
+struct encode_args {
+  texel_encode_options options;
+  double spacing_mm;
+  int has_spacing;
+  double swipe_speed_mm_s;
+  char* device;
+};
+
+static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+  struct encode_args* a = (struct encode_args*)ctx;
+  texel_encode_options* o = &a->options;
+  if (tm_is(name, "spacing_mm")) {
+    a->spacing_mm = tm_scalar(fn, name, v);
+    a->has_spacing = 1;
+  } else if (tm_is(name, "device"))
+    a->device = tm_text(fn, name, v);
+  else if (tm_is(name, "swipe_speed_mm_s"))
+    a->swipe_speed_mm_s = tm_scalar(fn, name, v);
+  else if (tm_is(name, "boundary_mm"))
+    o->boundary_mm = tm_scalar(fn, name, v);
+  else if (tm_is(name, "texel_length_mm"))
+    o->texel_length_mm = tm_scalar(fn, name, v);
+  else if (tm_is(name, "parameterization"))
+    o->parameterization = tm_parameterization(fn, v);
+  else if (tm_is(name, "seed"))
+    o->seed = tm_count(fn, name, v);
+  else if (tm_is(name, "coarse_bits")) {
+    const uint64_t bits = tm_count(fn, name, v);
+    o->coarse_bits = bits > 1000 ? 1000u : (unsigned)bits; /* out of range either way: libtexel names it */
+  } else if (tm_is(name, "max_bytes"))
+    o->max_bytes = (size_t)tm_count(fn, name, v);
+  else if (tm_is(name, "recover_texel"))
+    o->recover_texel = tm_scalar(fn, name, v) != 0.0;
+  else
+    return 0;
+  return 1;
+}
+
+void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
+  static const char fn[] = "texel_encode";
+  struct encode_args a;
+  texel_encode_result* result = NULL;
+  texel_params params;
+  int has_profile = 0;
+  double jnd = 0.0;
+  size_t nbytes = 0;
+  mxArray* bitstream = NULL;
+  texel_status st;
+  mxArray* r;
+  if (nlhs > 1) tm_usage(fn, "returns one struct");
+  if (nrhs < 1) tm_usage(fn, "give the map (a numeric vector) or a file path first");
+  memset(&a, 0, sizeof a);
+  a.options = texel_encode_options_default();
+  tm_options(fn, nrhs, prhs, 1, take, &a,
+             "spacing_mm, device, swipe_speed_mm_s, boundary_mm, texel_length_mm, parameterization, seed, coarse_bits, "
+             "max_bytes, recover_texel");
+  if (mxIsChar(prhs[0])) {
+    char* path = tm_text(fn, "the path", prhs[0]);
+    if (a.has_spacing) tm_usage(fn, "spacing_mm is for arrays; a file carries its own spacing");
+    st = texel_encode_file(path, a.device, a.swipe_speed_mm_s, &a.options, &result);
+  } else {
+    size_t count = 0;
+    double* amplitude = tm_vector(fn, "the map", prhs[0], &count);
+    if (!a.has_spacing) tm_usage(fn, "an array needs 'spacing_mm' (the distance between its samples, mm)");
+    if (a.device || a.swipe_speed_mm_s != 0.0) tm_usage(fn, "device and swipe_speed_mm_s are for files; an array is a map");
+    st = texel_encode_with(amplitude, count, a.spacing_mm, &a.options, &result);
+  }
+  if (st == TEXEL_OK) st = texel_encode_result_params(result, &params, &has_profile);
+  if (st == TEXEL_OK) st = texel_encode_result_distance(result, &jnd);
+  if (st == TEXEL_OK) st = texel_encode_result_bytes(result, NULL, 0, &nbytes);
+  if (st == TEXEL_OK) {
+    bitstream = mxCreateNumericMatrix(nbytes, 1, mxUINT8_CLASS, mxREAL);
+    st = texel_encode_result_bytes(result, (uint8_t*)mxGetData(bitstream), nbytes, NULL);
+  }
+  if (st != TEXEL_OK) tm_keep_error();
+  texel_encode_result_destroy(result);
+  if (st != TEXEL_OK) tm_raise(st);
+  r = tm_params_struct(&params);
+  tm_set(r, "has_coarse_profile", mxCreateLogicalScalar(has_profile != 0));
+  tm_set_scalar(r, "distance_jnd", jnd);
+  tm_set(r, "bitstream", bitstream);
+  plhs[0] = r;
+}

@@ -1,0 +1,49 @@
+/* texel_reference — one of Texel's reference textures on a device
+ * (docs/matlab.md; `texel reference --list` names them).
+ *
+ *   [map, info] = texel_reference('pink', 'seed', 3, 'device', 'tpad', 'output', 'native')
+ *
+ * Options: seed [1], device ['tpad'], output ('amplitude' | 'u16' | 'native',
+ * as texel_render). The map equals `texel reference NAME --seed S --device D
+ * -o map.bin` byte for byte; info as texel_render's, with name and seed. */
+#include "texel_mex.h"
+
+struct reference_args {
+  uint64_t seed;
+  char* device;
+  enum tm_output output;
+};
+
+static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+  struct reference_args* a = (struct reference_args*)ctx;
+  if (tm_is(name, "seed"))
+    a->seed = tm_count(fn, name, v);
+  else if (tm_is(name, "device"))
+    a->device = tm_text(fn, name, v);
+  else if (tm_is(name, "output"))
+    a->output = tm_output_of(fn, v);
+  else
+    return 0;
+  return 1;
+}
+
+void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
+  static const char fn[] = "texel_reference";
+  struct reference_args a;
+  texel_document* doc = NULL;
+  char* name;
+  const char* device;
+  if (nlhs > 2) tm_usage(fn, "returns at most [map, info]");
+  if (nrhs < 1) tm_usage(fn, "give the reference's name first, e.g. texel_reference('pink')");
+  memset(&a, 0, sizeof a);
+  a.seed = 1;
+  name = tm_text(fn, "the reference name", prhs[0]);
+  tm_options(fn, nrhs, prhs, 1, take, &a, "seed, device, output");
+  device = a.device ? a.device : "tpad";
+  tm_check(texel_document_from_reference(device, name, a.seed, &doc));
+  tm_render_document(doc, device, a.output, nlhs, plhs);
+  if (nlhs > 1) {
+    tm_set_text(plhs[1], "name", name);
+    tm_set(plhs[1], "seed", tm_uint64(a.seed));
+  }
+}

@@ -1,0 +1,88 @@
+/* texel_render — a Texel texture's map on a device (docs/matlab.md).
+ *
+ *   [map, info] = texel_render('central_pitch_db', 10, 'irregularity_db', -5, ...
+ *                              'texel_length_mm', 0.25, 'seed', 7, 'device', 'tpad')
+ *   [map, info] = texel_render('document', 'brick.texel.json')
+ *
+ * Options (texel.h's texel_params; defaults as `texel render`):
+ *   device                 name or profile path ['tpad']
+ *   central_pitch_db       dB re 1 cycle/mm [10]     irregularity_db   dB [-5]
+ *   texel_length_mm        mm [0.25]                 seed              [1]
+ *   parameterization       'moments' | 'log'         quantization_db   0 … 20 [0]
+ *   coarse_strength        0 … 1 [0]                 fine_strength     0 … 1 [1]
+ *   coarse_sine_period_mm  0 = constant [0]          coarse_sine_phase_deg [0]
+ *   document               a *.texel.json path (instead of the parameters)
+ *   output                 'amplitude' (double in [0, 1], default) | 'u16'
+ *                          (uint16, round(a·65535)) | 'native' (uint8: the
+ *                          device's bytes, exactly `texel render -o map.bin`)
+ * map is a column; info holds device, samples, spacing_mm, length_mm,
+ * refresh_hz, format, bytes_per_sample, position_mm, params and document
+ * (the JSON text). */
+#include "texel_mex.h"
+
+struct render_args {
+  texel_params params;
+  char* device;
+  char* document;
+  enum tm_output output;
+  int from_params;
+};
+
+static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+  struct render_args* a = (struct render_args*)ctx;
+  texel_params* p = &a->params;
+  if (tm_is(name, "device"))
+    a->device = tm_text(fn, name, v);
+  else if (tm_is(name, "document"))
+    a->document = tm_text(fn, name, v);
+  else if (tm_is(name, "output"))
+    a->output = tm_output_of(fn, v);
+  else {
+    a->from_params = 1;
+    if (tm_is(name, "central_pitch_db"))
+      p->central_pitch_db = tm_scalar(fn, name, v);
+    else if (tm_is(name, "irregularity_db"))
+      p->irregularity_db = tm_scalar(fn, name, v);
+    else if (tm_is(name, "texel_length_mm"))
+      p->texel_length_mm = tm_scalar(fn, name, v);
+    else if (tm_is(name, "seed"))
+      p->seed = tm_count(fn, name, v);
+    else if (tm_is(name, "parameterization"))
+      p->parameterization = tm_parameterization(fn, v);
+    else if (tm_is(name, "quantization_db"))
+      p->quantization_db = tm_scalar(fn, name, v);
+    else if (tm_is(name, "coarse_strength"))
+      p->coarse_strength = tm_scalar(fn, name, v);
+    else if (tm_is(name, "fine_strength"))
+      p->fine_strength = tm_scalar(fn, name, v);
+    else if (tm_is(name, "coarse_sine_period_mm"))
+      p->coarse_sine_period_mm = tm_scalar(fn, name, v);
+    else if (tm_is(name, "coarse_sine_phase_deg"))
+      p->coarse_sine_phase_deg = tm_scalar(fn, name, v);
+    else
+      return 0;
+  }
+  return 1;
+}
+
+void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
+  static const char fn[] = "texel_render";
+  struct render_args a;
+  texel_document* doc = NULL;
+  texel_status st;
+  if (nlhs > 2) tm_usage(fn, "returns at most [map, info]");
+  memset(&a, 0, sizeof a);
+  a.params = texel_params_default();
+  tm_options(fn, nrhs, prhs, 0, take, &a,
+             "device, central_pitch_db, irregularity_db, texel_length_mm, seed, parameterization, quantization_db, "
+             "coarse_strength, fine_strength, coarse_sine_period_mm, coarse_sine_phase_deg, document, output");
+  if (a.document) {
+    if (a.from_params) tm_usage(fn, "give either 'document' or texture parameters, not both");
+    st = texel_document_load(a.document, &doc);
+  } else {
+    st = texel_document_from_params(a.device ? a.device : "tpad", &a.params, &doc);
+  }
+  tm_check(st);
+  tm_render_document(doc, a.document ? NULL : (a.device ? a.device : "tpad"), a.output, nlhs, plhs);
+  if (nlhs > 1 && !a.document) tm_set(plhs[1], "params", tm_params_struct(&a.params));
+}
