@@ -19,12 +19,14 @@ foreach(component IN LISTS TEXEL_COMPONENTS)
   if(NOT targets)
     continue()
   endif()
-  install(TARGETS ${targets} EXPORT texel-${component}-targets
+  # One install component per Texel component (cmake --install build --component capi),
+  # for packagers and for tests that need only part of an installation.
+  install(TARGETS ${targets} EXPORT texel-${component}-targets COMPONENT ${component}
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
           LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
           FILE_SET HEADERS DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   install(EXPORT texel-${component}-targets NAMESPACE texel:: FILE texel-${component}-targets.cmake
-          DESTINATION ${TEXEL_INSTALL_CMAKEDIR})
+          DESTINATION ${TEXEL_INSTALL_CMAKEDIR} COMPONENT ${component})
   list(APPEND TEXEL_INSTALLED_COMPONENTS ${component})
 endforeach()
 
@@ -53,5 +55,5 @@ if(TARGET texel_c)
   list(JOIN _texel_pc_private " " TEXEL_PC_LIBS_PRIVATE)
   set(TEXEL_PC_PREFIX "\${pcfiledir}/${_texel_pc_to_prefix}")
   configure_file(${CMAKE_CURRENT_LIST_DIR}/texel.pc.in ${CMAKE_CURRENT_BINARY_DIR}/texel.pc @ONLY)
-  install(FILES ${CMAKE_CURRENT_BINARY_DIR}/texel.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+  install(FILES ${CMAKE_CURRENT_BINARY_DIR}/texel.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT capi)
 endif()

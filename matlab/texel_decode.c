@@ -42,7 +42,7 @@ static uint8_t* read_file(const char* fn, const char* path, size_t* size) {
   } while (got > 0);
   if (ferror(f)) {
     fclose(f);
-    mexErrMsgIdAndTxt("texel:ioError", "%s: cannot read '%s'", fn, path);
+    mexErrMsgIdAndTxt("texel:ioError", "cannot read '%s'", path);
   }
   fclose(f);
   *size = n;

@@ -51,23 +51,23 @@ static void tm_check(texel_status s) {
   }
 }
 
-static void tm_usage(const char* fn, const char* message) { mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s", fn, message); }
+static void tm_usage(const char* fn, const char* message) { mexErrMsgIdAndTxt("texel:invalidArgument", "%s", message); }
 
 /* A char argument as a NUL-terminated string (mxFree'd by MATLAB on exit). */
 static char* tm_text(const char* fn, const char* name, const mxArray* a) {
   char* s;
   if (!mxIsChar(a)) {
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s must be text (char)", fn, name);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be text (char)", name);
   }
   s = mxArrayToString(a);
-  if (!s) mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s must be a char row", fn, name);
+  if (!s) mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a char row", name);
   return s;
 }
 
 /* A real scalar. */
 static double tm_scalar(const char* fn, const char* name, const mxArray* a) {
   if (!(mxIsNumeric(a) || mxIsLogical(a)) || mxIsComplex(a) || mxGetNumberOfElements(a) != 1)
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s must be a real scalar", fn, name);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a real scalar", name);
   return mxGetScalar(a);
 }
 
@@ -77,13 +77,12 @@ static uint64_t tm_count(const char* fn, const char* name, const mxArray* a) {
   if (mxGetNumberOfElements(a) == 1 && (mxIsUint64(a) || mxIsInt64(a)) && !mxIsComplex(a)) {
     uint64_t u;
     memcpy(&u, mxGetData(a), sizeof u);
-    if (mxIsInt64(a) && (int64_t)u < 0) mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s must be >= 0", fn, name);
+    if (mxIsInt64(a) && (int64_t)u < 0) mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be >= 0", name);
     return u;
   }
   v = tm_scalar(fn, name, a);
   if (!(v >= 0.0 && v <= 9007199254740992.0) || floor(v) != v)
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s is %.17g; allowed: a whole number 0 … 2^53 (pass uint64 for larger seeds)",
-                      fn, name, v);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s is %.17g; allowed: a whole number 0 … 2^53 (pass uint64 for larger seeds)", name, v);
   return (uint64_t)v;
 }
 
@@ -93,10 +92,10 @@ static double* tm_vector(const char* fn, const char* name, const mxArray* a, siz
   size_t n, i;
   double* out;
   if (!mxIsNumeric(a) || mxIsComplex(a) || mxIsSparse(a))
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s must be a real numeric vector", fn, name);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a real numeric vector", name);
   n = mxGetNumberOfElements(a);
   if (n > 0 && mxGetM(a) != 1 && mxGetN(a) != 1)
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s must be a vector (N×1 or 1×N)", fn, name);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a vector (N×1 or 1×N)", name);
   out = (double*)mxMalloc((n ? n : 1) * sizeof *out);
   if (mxIsDouble(a)) {
     if (n) memcpy(out, mxGetPr(a), n * sizeof *out);
@@ -113,7 +112,7 @@ static double* tm_vector(const char* fn, const char* name, const mxArray* a, siz
         case mxUINT32_CLASS: out[i] = ((const uint32_t*)d)[i]; break;
         case mxINT64_CLASS: out[i] = (double)((const int64_t*)d)[i]; break;
         case mxUINT64_CLASS: out[i] = (double)((const uint64_t*)d)[i]; break;
-        default: mexErrMsgIdAndTxt("texel:invalidArgument", "%s: %s has an unsupported class", fn, name);
+        default: mexErrMsgIdAndTxt("texel:invalidArgument", "%s has an unsupported class", name);
       }
     }
   }
@@ -138,7 +137,7 @@ static void tm_options(const char* fn, int nrhs, const mxArray* prhs[], int firs
   for (i = first; i < nrhs; i += 2) {
     char* name = tm_text(fn, "an option name", prhs[i]);
     if (!take(fn, name, prhs[i + 1], ctx))
-      mexErrMsgIdAndTxt("texel:invalidArgument", "%s: unknown option '%s'; allowed: %s", fn, name, allowed);
+      mexErrMsgIdAndTxt("texel:invalidArgument", "unknown option '%s'; allowed: %s", name, allowed);
     mxFree(name);
   }
 }
@@ -150,7 +149,7 @@ static texel_parameterization tm_parameterization(const char* fn, const mxArray*
   if (tm_is(s, "log"))
     p = TEXEL_PARAMETERIZATION_LOG;
   else if (!tm_is(s, "moments"))
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: parameterization '%s' is not one of moments, log", fn, s);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "parameterization '%s' is not one of moments, log", s);
   mxFree(s);
   return p;
 }
@@ -217,7 +216,7 @@ static enum tm_output tm_output_of(const char* fn, const mxArray* a) {
   else if (tm_is(s, "native"))
     o = TM_NATIVE;
   else if (!tm_is(s, "amplitude"))
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s: output '%s' is not one of amplitude, u16, native", fn, s);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "output '%s' is not one of amplitude, u16, native", s);
   mxFree(s);
   return o;
 }

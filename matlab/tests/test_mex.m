@@ -58,7 +58,12 @@ r = texel_encode([out '/render.bin'], 'device', 'tpad');
 same_bytes(r.bitstream, cli_bytes, 'texel_encode(file)');
 r2 = texel_encode(double(u16) / 65535, 'spacing_mm', info.spacing_mm);
 same_bytes(r2.bitstream, cli_bytes, 'texel_encode(array)');
-disp(json);
+% The same parameters as the CLI reports (its --json estimate).
+e = json.estimate;
+assert(r.central_pitch_db == e.central_pitch_db && r.irregularity_db == e.irregularity_db && ...
+       r.texel_length_mm == e.texel_length_mm && r.seed == e.seed && strcmp(r.parameterization, e.parameterization) && ...
+       r.coarse_strength == e.coarse_strength && r.fine_strength == e.fine_strength, 'texel_encode parameters differ from the CLI''s');
+assert(abs(r.distance_jnd - json.model.distance_jnd) <= 1e-12 && isequal(r2.central_pitch_db, r.central_pitch_db));
 printf('texel_encode: P = %.4f dB, I = %.4f dB, %.4f mm, distance %.4f JND\n', r.central_pitch_db, r.irregularity_db, ...
        r.texel_length_mm, r.distance_jnd);
 
@@ -87,8 +92,10 @@ function expect_error(f, id, message)
     f();
   catch err
     assert(strcmp(err.identifier, id), sprintf('identifier %s, expected %s', err.identifier, id));
-    assert(~isempty(strfind(message, err.message)), sprintf('message "%s" is not in the CLI''s "%s"', err.message, message));
-    printf('error %s: %s\n', err.identifier, err.message);
+    % Octave puts the MEX function's name first ("texel_render: ..."); MATLAB does not.
+    text = regexprep(err.message, '^texel_[a-z]+: ', '');
+    assert(~isempty(strfind(message, text)), sprintf('message "%s" is not in the CLI''s "%s"', text, message));
+    printf('error %s: %s\n  CLI: %s\n', err.identifier, text, message);
     return;
   end
   error('no error raised');
@@ -97,6 +104,7 @@ expect_error(@() texel_render('texel_length_mm', 2000), 'texel:invalidArgument',
              cli_error(texel, sprintf('render --texel-length 2000 -o "%s/x.bin"', out)));
 expect_error(@() texel_reference('no-such-reference'), 'texel:invalidArgument', ...
              cli_error(texel, sprintf('reference no-such-reference -o "%s/x.bin"', out)));
+f = fopen([out '/x.texel'], 'w'); fwrite(f, uint8([1 2 3])); fclose(f);
 expect_error(@() texel_decode(uint8([1 2 3])), 'texel:formatError', ...
              cli_error(texel, sprintf('decode "%s/x.texel" --device tpad -o "%s/x.bin"', out, out)));
 expect_error(@() texel_render('device', 'no-such-device'), 'texel:invalidArgument', ...

@@ -7,7 +7,7 @@
 #   pkg-config.static     cc with `pkg-config --static --libs texel`, -ltexel taken from libtexel.a
 # Shared programs must need libtexel.so.<ABI> and no libstdc++; static ones
 # must not need libtexel at all.
-#   cmake -DWORK=<dir> -DTEXEL_BUILD=<build> -DCONSUMER=<tests/consumer> -DGENERATOR=... -DBUILD_TYPE=...
+#   cmake -DWORK=<dir> -DTEXEL_BUILD=<build> -DTEXEL_CLI=<texel> -DCONSUMER=<tests/consumer> -DGENERATOR=... -DBUILD_TYPE=...
 #         -DCC=<C compiler> -DREADELF=<readelf> -DSONAME=<libtexel.so.N> -P run_c_consumer.cmake
 cmake_minimum_required(VERSION 3.25)
 
@@ -56,10 +56,13 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(prefix ${WORK}/prefix)
 now(t)
-run(${CMAKE_COMMAND} --install ${TEXEL_BUILD} --prefix ${prefix})
-report("install" ${t})
-run(${prefix}/bin/texel render --central-pitch 10 --irregularity -5 --texel-length 0.25 --seed 7 --device tpad
-    -o ${WORK}/cli.bin)
+# The C library, the core (find_package(texel) always loads it) and the
+# package files: what a C user's package would hold.
+foreach(component capi core Unspecified)
+  run(${CMAKE_COMMAND} --install ${TEXEL_BUILD} --prefix ${prefix} --component ${component})
+endforeach()
+report("install (components capi, core and the package files)" ${t})
+run(${TEXEL_CLI} render --central-pitch 10 --irregularity -5 --texel-length 0.25 --seed 7 --device tpad -o ${WORK}/cli.bin)
 
 foreach(link shared static)
   now(t)
