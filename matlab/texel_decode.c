@@ -17,13 +17,7 @@ struct decode_args {
 
 static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
   struct decode_args* a = (struct decode_args*)ctx;
-  if (tm_is(name, "device"))
-    a->device = tm_text(fn, name, v);
-  else if (tm_is(name, "output"))
-    a->output = tm_output_of(fn, v);
-  else
-    return 0;
-  return 1;
+  return tm_take_map_option(fn, name, v, &a->device, &a->output);
 }
 
 /* The bytes of a file, in mxMalloc memory. */

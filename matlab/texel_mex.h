@@ -82,7 +82,8 @@ static uint64_t tm_count(const char* fn, const char* name, const mxArray* a) {
   }
   v = tm_scalar(fn, name, a);
   if (!(v >= 0.0 && v <= 9007199254740992.0) || floor(v) != v)
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s is %.17g; allowed: a whole number 0 … 2^53 (pass uint64 for larger seeds)", name, v);
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s is %.17g; allowed: a whole number 0 … 2^53 (pass uint64 for larger seeds)",
+                      name, v);
   return (uint64_t)v;
 }
 
@@ -219,6 +220,18 @@ static enum tm_output tm_output_of(const char* fn, const mxArray* a) {
     mexErrMsgIdAndTxt("texel:invalidArgument", "output '%s' is not one of amplitude, u16, native", s);
   mxFree(s);
   return o;
+}
+
+/* The options of every function that returns a map: device and output.
+ * Returns 0 for another name. */
+static int tm_take_map_option(const char* fn, const char* name, const mxArray* v, char** device, enum tm_output* output) {
+  if (tm_is(name, "device"))
+    *device = tm_text(fn, name, v);
+  else if (tm_is(name, "output"))
+    *output = tm_output_of(fn, v);
+  else
+    return 0;
+  return 1;
 }
 
 /* Renders a document (taken over: destroyed here) into plhs[0] (the map) and,

@@ -16,14 +16,8 @@ struct reference_args {
 
 static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
   struct reference_args* a = (struct reference_args*)ctx;
-  if (tm_is(name, "seed"))
-    a->seed = tm_count(fn, name, v);
-  else if (tm_is(name, "device"))
-    a->device = tm_text(fn, name, v);
-  else if (tm_is(name, "output"))
-    a->output = tm_output_of(fn, v);
-  else
-    return 0;
+  if (!tm_is(name, "seed")) return tm_take_map_option(fn, name, v, &a->device, &a->output);
+  a->seed = tm_count(fn, name, v);
   return 1;
 }
 

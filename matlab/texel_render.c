@@ -31,37 +31,34 @@ struct render_args {
 static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
   struct render_args* a = (struct render_args*)ctx;
   texel_params* p = &a->params;
-  if (tm_is(name, "device"))
-    a->device = tm_text(fn, name, v);
-  else if (tm_is(name, "document"))
+  if (tm_take_map_option(fn, name, v, &a->device, &a->output)) return 1;
+  if (tm_is(name, "document")) {
     a->document = tm_text(fn, name, v);
-  else if (tm_is(name, "output"))
-    a->output = tm_output_of(fn, v);
-  else {
-    a->from_params = 1;
-    if (tm_is(name, "central_pitch_db"))
-      p->central_pitch_db = tm_scalar(fn, name, v);
-    else if (tm_is(name, "irregularity_db"))
-      p->irregularity_db = tm_scalar(fn, name, v);
-    else if (tm_is(name, "texel_length_mm"))
-      p->texel_length_mm = tm_scalar(fn, name, v);
-    else if (tm_is(name, "seed"))
-      p->seed = tm_count(fn, name, v);
-    else if (tm_is(name, "parameterization"))
-      p->parameterization = tm_parameterization(fn, v);
-    else if (tm_is(name, "quantization_db"))
-      p->quantization_db = tm_scalar(fn, name, v);
-    else if (tm_is(name, "coarse_strength"))
-      p->coarse_strength = tm_scalar(fn, name, v);
-    else if (tm_is(name, "fine_strength"))
-      p->fine_strength = tm_scalar(fn, name, v);
-    else if (tm_is(name, "coarse_sine_period_mm"))
-      p->coarse_sine_period_mm = tm_scalar(fn, name, v);
-    else if (tm_is(name, "coarse_sine_phase_deg"))
-      p->coarse_sine_phase_deg = tm_scalar(fn, name, v);
-    else
-      return 0;
+    return 1;
   }
+  a->from_params = 1;
+  if (tm_is(name, "central_pitch_db"))
+    p->central_pitch_db = tm_scalar(fn, name, v);
+  else if (tm_is(name, "irregularity_db"))
+    p->irregularity_db = tm_scalar(fn, name, v);
+  else if (tm_is(name, "texel_length_mm"))
+    p->texel_length_mm = tm_scalar(fn, name, v);
+  else if (tm_is(name, "seed"))
+    p->seed = tm_count(fn, name, v);
+  else if (tm_is(name, "parameterization"))
+    p->parameterization = tm_parameterization(fn, v);
+  else if (tm_is(name, "quantization_db"))
+    p->quantization_db = tm_scalar(fn, name, v);
+  else if (tm_is(name, "coarse_strength"))
+    p->coarse_strength = tm_scalar(fn, name, v);
+  else if (tm_is(name, "fine_strength"))
+    p->fine_strength = tm_scalar(fn, name, v);
+  else if (tm_is(name, "coarse_sine_period_mm"))
+    p->coarse_sine_period_mm = tm_scalar(fn, name, v);
+  else if (tm_is(name, "coarse_sine_phase_deg"))
+    p->coarse_sine_phase_deg = tm_scalar(fn, name, v);
+  else
+    return 0;
   return 1;
 }
 

@@ -38,8 +38,7 @@ static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
     else if (tm_is(w, "rectangular"))
       o->window = TEXEL_WINDOW_RECTANGULAR;
     else
-      mexErrMsgIdAndTxt("texel:invalidArgument", "window '%s' is not one of blackman-harris, hann, flat-top, rectangular",
-                        w);
+      mexErrMsgIdAndTxt("texel:invalidArgument", "window '%s' is not one of blackman-harris, hann, flat-top, rectangular", w);
     mxFree(w);
   } else if (tm_is(name, "zero_pad")) {
     const uint64_t z = tm_count(fn, name, v);

@@ -11,14 +11,7 @@
 #         -DCC=<C compiler> -DREADELF=<readelf> -DSONAME=<libtexel.so.N> -P run_c_consumer.cmake
 cmake_minimum_required(VERSION 3.25)
 
-function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
-  if(NOT rc EQUAL 0)
-    list(JOIN ARGN " " cmd)
-    message(FATAL_ERROR "${cmd}\nfailed (${rc}):\n${out}")
-  endif()
-  set(last_output "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/consumer_common.cmake)
 
 function(now var)
   string(TIMESTAMP t "%s%f")
