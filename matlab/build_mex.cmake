@@ -6,6 +6,10 @@
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 get_filename_component(libdir ${LIBRARY} DIRECTORY)
+# Plain C99 with warnings (mkoctfile takes CFLAGS from the environment); any
+# warning fails the build below. texel_mex.h is a header of static helpers
+# each MEX file uses some of: unused ones are not a warning.
+set(ENV{CFLAGS} "-O2 -std=c99 -Wall -Wextra -pedantic -Wno-unused-function")
 string(TIMESTAMP start "%s%f")
 foreach(fn texel_render texel_encode texel_decode texel_spectrum texel_reference)
   execute_process(

@@ -15,13 +15,13 @@ struct decode_args {
   enum tm_output output;
 };
 
-static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+static int take(const char* name, const mxArray* v, void* ctx) {
   struct decode_args* a = (struct decode_args*)ctx;
-  return tm_take_map_option(fn, name, v, &a->device, &a->output);
+  return tm_take_map_option(name, v, &a->device, &a->output);
 }
 
 /* The bytes of a file, in mxMalloc memory. */
-static uint8_t* read_file(const char* fn, const char* path, size_t* size) {
+static uint8_t* read_file(const char* path, size_t* size) {
   FILE* f = fopen(path, "rb");
   uint8_t* bytes = NULL;
   size_t cap = 0, n = 0, got;
@@ -44,25 +44,24 @@ static uint8_t* read_file(const char* fn, const char* path, size_t* size) {
 }
 
 void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
-  static const char fn[] = "texel_decode";
   struct decode_args a;
   texel_document* doc = NULL;
   const uint8_t* bytes;
   size_t size;
   const char* device;
-  if (nlhs > 2) tm_usage(fn, "returns at most [map, info]");
-  if (nrhs < 1) tm_usage(fn, "give the bitstream (uint8) or a .texel path first");
+  if (nlhs > 2) tm_usage("returns at most [map, info]");
+  if (nrhs < 1) tm_usage("give the bitstream (uint8) or a .texel path first");
   memset(&a, 0, sizeof a);
   if (mxIsChar(prhs[0])) {
-    bytes = read_file(fn, tm_text(fn, "the path", prhs[0]), &size);
+    bytes = read_file(tm_text("the path", prhs[0]), &size);
   } else if (mxIsUint8(prhs[0]) && !mxIsComplex(prhs[0])) {
     bytes = (const uint8_t*)mxGetData(prhs[0]);
     size = mxGetNumberOfElements(prhs[0]);
   } else {
-    tm_usage(fn, "the bitstream must be uint8 bytes or the path of a .texel file");
+    tm_usage("the bitstream must be uint8 bytes or the path of a .texel file");
     return;
   }
-  tm_options(fn, nrhs, prhs, 1, take, &a, "device, output");
+  tm_options(nrhs, prhs, 1, take, &a, "device, output");
   device = a.device ? a.device : "tpad";
   tm_check(texel_decode(bytes, size, device, &doc));
   tm_render_document(doc, device, a.output, nlhs, plhs);

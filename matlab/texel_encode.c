@@ -24,38 +24,37 @@ struct encode_args {
   char* device;
 };
 
-static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+static int take(const char* name, const mxArray* v, void* ctx) {
   struct encode_args* a = (struct encode_args*)ctx;
   texel_encode_options* o = &a->options;
   if (tm_is(name, "spacing_mm")) {
-    a->spacing_mm = tm_scalar(fn, name, v);
+    a->spacing_mm = tm_scalar(name, v);
     a->has_spacing = 1;
   } else if (tm_is(name, "device"))
-    a->device = tm_text(fn, name, v);
+    a->device = tm_text(name, v);
   else if (tm_is(name, "swipe_speed_mm_s"))
-    a->swipe_speed_mm_s = tm_scalar(fn, name, v);
+    a->swipe_speed_mm_s = tm_scalar(name, v);
   else if (tm_is(name, "boundary_mm"))
-    o->boundary_mm = tm_scalar(fn, name, v);
+    o->boundary_mm = tm_scalar(name, v);
   else if (tm_is(name, "texel_length_mm"))
-    o->texel_length_mm = tm_scalar(fn, name, v);
+    o->texel_length_mm = tm_scalar(name, v);
   else if (tm_is(name, "parameterization"))
-    o->parameterization = tm_parameterization(fn, v);
+    o->parameterization = tm_parameterization(v);
   else if (tm_is(name, "seed"))
-    o->seed = tm_count(fn, name, v);
+    o->seed = tm_count(name, v);
   else if (tm_is(name, "coarse_bits")) {
-    const uint64_t bits = tm_count(fn, name, v);
+    const uint64_t bits = tm_count(name, v);
     o->coarse_bits = bits > 1000 ? 1000u : (unsigned)bits; /* out of range either way: libtexel names it */
   } else if (tm_is(name, "max_bytes"))
-    o->max_bytes = (size_t)tm_count(fn, name, v);
+    o->max_bytes = (size_t)tm_count(name, v);
   else if (tm_is(name, "recover_texel"))
-    o->recover_texel = tm_scalar(fn, name, v) != 0.0;
+    o->recover_texel = tm_scalar(name, v) != 0.0;
   else
     return 0;
   return 1;
 }
 
 void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
-  static const char fn[] = "texel_encode";
   struct encode_args a;
   texel_encode_result* result = NULL;
   texel_params params;
@@ -65,22 +64,22 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   mxArray* bitstream = NULL;
   texel_status st;
   mxArray* r;
-  if (nlhs > 1) tm_usage(fn, "returns one struct");
-  if (nrhs < 1) tm_usage(fn, "give the map (a numeric vector) or a file path first");
+  if (nlhs > 1) tm_usage("returns one struct");
+  if (nrhs < 1) tm_usage("give the map (a numeric vector) or a file path first");
   memset(&a, 0, sizeof a);
   a.options = texel_encode_options_default();
-  tm_options(fn, nrhs, prhs, 1, take, &a,
+  tm_options(nrhs, prhs, 1, take, &a,
              "spacing_mm, device, swipe_speed_mm_s, boundary_mm, texel_length_mm, parameterization, seed, coarse_bits, "
              "max_bytes, recover_texel");
   if (mxIsChar(prhs[0])) {
-    char* path = tm_text(fn, "the path", prhs[0]);
-    if (a.has_spacing) tm_usage(fn, "spacing_mm is for arrays; a file carries its own spacing");
+    char* path = tm_text("the path", prhs[0]);
+    if (a.has_spacing) tm_usage("spacing_mm is for arrays; a file carries its own spacing");
     st = texel_encode_file(path, a.device, a.swipe_speed_mm_s, &a.options, &result);
   } else {
     size_t count = 0;
-    double* amplitude = tm_vector(fn, "the map", prhs[0], &count);
-    if (!a.has_spacing) tm_usage(fn, "an array needs 'spacing_mm' (the distance between its samples, mm)");
-    if (a.device || a.swipe_speed_mm_s != 0.0) tm_usage(fn, "device and swipe_speed_mm_s are for files; an array is a map");
+    double* amplitude = tm_vector("the map", prhs[0], &count);
+    if (!a.has_spacing) tm_usage("an array needs 'spacing_mm' (the distance between its samples, mm)");
+    if (a.device || a.swipe_speed_mm_s != 0.0) tm_usage("device and swipe_speed_mm_s are for files; an array is a map");
     st = texel_encode_with(amplitude, count, a.spacing_mm, &a.options, &result);
   }
   if (st == TEXEL_OK) st = texel_encode_result_params(result, &params, &has_profile);

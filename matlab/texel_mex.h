@@ -51,10 +51,10 @@ static void tm_check(texel_status s) {
   }
 }
 
-static void tm_usage(const char* fn, const char* message) { mexErrMsgIdAndTxt("texel:invalidArgument", "%s", message); }
+static void tm_usage(const char* message) { mexErrMsgIdAndTxt("texel:invalidArgument", "%s", message); }
 
 /* A char argument as a NUL-terminated string (mxFree'd by MATLAB on exit). */
-static char* tm_text(const char* fn, const char* name, const mxArray* a) {
+static char* tm_text(const char* name, const mxArray* a) {
   char* s;
   if (!mxIsChar(a)) {
     mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be text (char)", name);
@@ -65,14 +65,14 @@ static char* tm_text(const char* fn, const char* name, const mxArray* a) {
 }
 
 /* A real scalar. */
-static double tm_scalar(const char* fn, const char* name, const mxArray* a) {
+static double tm_scalar(const char* name, const mxArray* a) {
   if (!(mxIsNumeric(a) || mxIsLogical(a)) || mxIsComplex(a) || mxGetNumberOfElements(a) != 1)
     mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a real scalar", name);
   return mxGetScalar(a);
 }
 
 /* A non-negative integer (seeds, counts): uint64/int64 exactly, doubles when whole and below 2^53. */
-static uint64_t tm_count(const char* fn, const char* name, const mxArray* a) {
+static uint64_t tm_count(const char* name, const mxArray* a) {
   double v;
   if (mxGetNumberOfElements(a) == 1 && (mxIsUint64(a) || mxIsInt64(a)) && !mxIsComplex(a)) {
     uint64_t u;
@@ -80,7 +80,7 @@ static uint64_t tm_count(const char* fn, const char* name, const mxArray* a) {
     if (mxIsInt64(a) && (int64_t)u < 0) mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be >= 0", name);
     return u;
   }
-  v = tm_scalar(fn, name, a);
+  v = tm_scalar(name, a);
   if (!(v >= 0.0 && v <= 9007199254740992.0) || floor(v) != v)
     mexErrMsgIdAndTxt("texel:invalidArgument", "%s is %.17g; allowed: a whole number 0 … 2^53 (pass uint64 for larger seeds)",
                       name, v);
@@ -89,7 +89,7 @@ static uint64_t tm_count(const char* fn, const char* name, const mxArray* a) {
 
 /* A real numeric vector as doubles (a copy; any numeric class, as the CLI's
  * loaders take integers as their values). */
-static double* tm_vector(const char* fn, const char* name, const mxArray* a, size_t* count) {
+static double* tm_vector(const char* name, const mxArray* a, size_t* count) {
   size_t n, i;
   double* out;
   if (!mxIsNumeric(a) || mxIsComplex(a) || mxIsSparse(a))
@@ -130,22 +130,21 @@ static int tm_is(const char* a, const char* b) {
 
 /* Walks name/value pairs from prhs[first]: calls `take(name, value, ctx)`,
  * which returns 0 for a name it does not know. */
-typedef int (*tm_take_fn)(const char* fn, const char* name, const mxArray* value, void* ctx);
-static void tm_options(const char* fn, int nrhs, const mxArray* prhs[], int first, tm_take_fn take, void* ctx,
-                       const char* allowed) {
+typedef int (*tm_take_fn)(const char* name, const mxArray* value, void* ctx);
+static void tm_options(int nrhs, const mxArray* prhs[], int first, tm_take_fn take, void* ctx, const char* allowed) {
   int i;
-  if ((nrhs - first) % 2 != 0) tm_usage(fn, "options come in name/value pairs");
+  if ((nrhs - first) % 2 != 0) tm_usage("options come in name/value pairs");
   for (i = first; i < nrhs; i += 2) {
-    char* name = tm_text(fn, "an option name", prhs[i]);
-    if (!take(fn, name, prhs[i + 1], ctx))
+    char* name = tm_text("an option name", prhs[i]);
+    if (!take(name, prhs[i + 1], ctx))
       mexErrMsgIdAndTxt("texel:invalidArgument", "unknown option '%s'; allowed: %s", name, allowed);
     mxFree(name);
   }
 }
 
 /* Parameterization names as the CLI spells them. */
-static texel_parameterization tm_parameterization(const char* fn, const mxArray* a) {
-  char* s = tm_text(fn, "parameterization", a);
+static texel_parameterization tm_parameterization(const mxArray* a) {
+  char* s = tm_text("parameterization", a);
   texel_parameterization p = TEXEL_PARAMETERIZATION_MOMENTS;
   if (tm_is(s, "log"))
     p = TEXEL_PARAMETERIZATION_LOG;
@@ -168,11 +167,6 @@ static void tm_set(mxArray* s, const char* field, mxArray* value) {
 }
 static void tm_set_scalar(mxArray* s, const char* field, double v) { tm_set(s, field, mxCreateDoubleScalar(v)); }
 static void tm_set_text(mxArray* s, const char* field, const char* v) { tm_set(s, field, mxCreateString(v)); }
-static mxArray* tm_column(const double* v, size_t n) {
-  mxArray* a = mxCreateDoubleMatrix(n, 1, mxREAL);
-  if (n) memcpy(mxGetPr(a), v, n * sizeof *v);
-  return a;
-}
 static mxArray* tm_uint64(uint64_t v) {
   mxArray* a = mxCreateNumericMatrix(1, 1, mxUINT64_CLASS, mxREAL);
   memcpy(mxGetData(a), &v, sizeof v);
@@ -209,8 +203,8 @@ static const char* tm_format_name(texel_sample_format f) {
  * (uint16) or the device's own bytes, the .bin file (uint8). */
 enum tm_output { TM_AMPLITUDE, TM_U16, TM_NATIVE };
 
-static enum tm_output tm_output_of(const char* fn, const mxArray* a) {
-  char* s = tm_text(fn, "output", a);
+static enum tm_output tm_output_of(const mxArray* a) {
+  char* s = tm_text("output", a);
   enum tm_output o = TM_AMPLITUDE;
   if (tm_is(s, "u16"))
     o = TM_U16;
@@ -224,11 +218,11 @@ static enum tm_output tm_output_of(const char* fn, const mxArray* a) {
 
 /* The options of every function that returns a map: device and output.
  * Returns 0 for another name. */
-static int tm_take_map_option(const char* fn, const char* name, const mxArray* v, char** device, enum tm_output* output) {
+static int tm_take_map_option(const char* name, const mxArray* v, char** device, enum tm_output* output) {
   if (tm_is(name, "device"))
-    *device = tm_text(fn, name, v);
+    *device = tm_text(name, v);
   else if (tm_is(name, "output"))
-    *output = tm_output_of(fn, v);
+    *output = tm_output_of(v);
   else
     return 0;
   return 1;

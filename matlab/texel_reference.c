@@ -14,25 +14,24 @@ struct reference_args {
   enum tm_output output;
 };
 
-static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+static int take(const char* name, const mxArray* v, void* ctx) {
   struct reference_args* a = (struct reference_args*)ctx;
-  if (!tm_is(name, "seed")) return tm_take_map_option(fn, name, v, &a->device, &a->output);
-  a->seed = tm_count(fn, name, v);
+  if (!tm_is(name, "seed")) return tm_take_map_option(name, v, &a->device, &a->output);
+  a->seed = tm_count(name, v);
   return 1;
 }
 
 void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
-  static const char fn[] = "texel_reference";
   struct reference_args a;
   texel_document* doc = NULL;
   char* name;
   const char* device;
-  if (nlhs > 2) tm_usage(fn, "returns at most [map, info]");
-  if (nrhs < 1) tm_usage(fn, "give the reference's name first, e.g. texel_reference('pink')");
+  if (nlhs > 2) tm_usage("returns at most [map, info]");
+  if (nrhs < 1) tm_usage("give the reference's name first, e.g. texel_reference('pink')");
   memset(&a, 0, sizeof a);
   a.seed = 1;
-  name = tm_text(fn, "the reference name", prhs[0]);
-  tm_options(fn, nrhs, prhs, 1, take, &a, "seed, device, output");
+  name = tm_text("the reference name", prhs[0]);
+  tm_options(nrhs, prhs, 1, take, &a, "seed, device, output");
   device = a.device ? a.device : "tpad";
   tm_check(texel_document_from_reference(device, name, a.seed, &doc));
   tm_render_document(doc, device, a.output, nlhs, plhs);

@@ -21,14 +21,14 @@ struct spectrum_args {
   int has_spacing;
 };
 
-static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
+static int take(const char* name, const mxArray* v, void* ctx) {
   struct spectrum_args* a = (struct spectrum_args*)ctx;
   texel_spectrum_options* o = &a->options;
   if (tm_is(name, "spacing_mm")) {
-    a->spacing_mm = tm_scalar(fn, name, v);
+    a->spacing_mm = tm_scalar(name, v);
     a->has_spacing = 1;
   } else if (tm_is(name, "window")) {
-    char* w = tm_text(fn, name, v);
+    char* w = tm_text(name, v);
     if (tm_is(w, "blackman-harris"))
       o->window = TEXEL_WINDOW_BLACKMAN_HARRIS;
     else if (tm_is(w, "hann"))
@@ -41,16 +41,16 @@ static int take(const char* fn, const char* name, const mxArray* v, void* ctx) {
       mexErrMsgIdAndTxt("texel:invalidArgument", "window '%s' is not one of blackman-harris, hann, flat-top, rectangular", w);
     mxFree(w);
   } else if (tm_is(name, "zero_pad")) {
-    const uint64_t z = tm_count(fn, name, v);
+    const uint64_t z = tm_count(name, v);
     o->zero_pad = z > 1000 ? 1000u : (unsigned)z; /* out of range either way: libtexel names it */
   } else if (tm_is(name, "threshold_db"))
-    o->threshold_db = tm_scalar(fn, name, v);
+    o->threshold_db = tm_scalar(name, v);
   else if (tm_is(name, "max_peaks"))
-    o->max_peaks = (size_t)tm_count(fn, name, v);
+    o->max_peaks = (size_t)tm_count(name, v);
   else if (tm_is(name, "welch_segment"))
-    o->welch_segment = (size_t)tm_count(fn, name, v);
+    o->welch_segment = (size_t)tm_count(name, v);
   else if (tm_is(name, "welch_overlap"))
-    o->welch_overlap = tm_scalar(fn, name, v);
+    o->welch_overlap = tm_scalar(name, v);
   else
     return 0;
   return 1;
@@ -69,7 +69,6 @@ static mxArray* series(const texel_spectrum* s, texel_spectrum_series which, tex
 }
 
 void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
-  static const char fn[] = "texel_spectrum";
   struct spectrum_args a;
   texel_spectrum* spec = NULL;
   texel_spectrum_summary m;
@@ -78,13 +77,13 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   double* amplitude;
   texel_status st;
   int k;
-  if (nlhs > 1) tm_usage(fn, "returns one struct");
-  if (nrhs < 1) tm_usage(fn, "give the map (a numeric vector) first");
+  if (nlhs > 1) tm_usage("returns one struct");
+  if (nrhs < 1) tm_usage("give the map (a numeric vector) first");
   memset(&a, 0, sizeof a);
   a.options = texel_spectrum_options_default();
-  amplitude = tm_vector(fn, "the map", prhs[0], &count);
-  tm_options(fn, nrhs, prhs, 1, take, &a, "spacing_mm, window, zero_pad, threshold_db, max_peaks, welch_segment, welch_overlap");
-  if (!a.has_spacing) tm_usage(fn, "the map needs 'spacing_mm' (the distance between its samples, mm)");
+  amplitude = tm_vector("the map", prhs[0], &count);
+  tm_options(nrhs, prhs, 1, take, &a, "spacing_mm, window, zero_pad, threshold_db, max_peaks, welch_segment, welch_overlap");
+  if (!a.has_spacing) tm_usage("the map needs 'spacing_mm' (the distance between its samples, mm)");
   st = texel_spectrum_analyse(amplitude, count, a.spacing_mm, &a.options, &spec);
   if (st == TEXEL_OK) st = texel_spectrum_get_summary(spec, &m);
   for (k = 0; k < 11; ++k) v[k] = series(spec, (texel_spectrum_series)k, &st);
