@@ -1,13 +1,6 @@
-/* texel_decode — the map a .texel bitstream stands for on a device
- * (docs/matlab.md).
- *
- *   [map, info] = texel_decode(bitstream, 'device', 'tpad')   % uint8 bytes
- *   [map, info] = texel_decode('rough.texel', 'output', 'native')
- *
- * The first argument is the bitstream (a uint8 vector, e.g. texel_encode's
- * result.bitstream) or the path of a .texel file. Options: device ['tpad'],
- * output ('amplitude' | 'u16' | 'native', as texel_render). The map equals
- * `texel decode FILE --device D -o map.bin` byte for byte. */
+/* texel_decode — the map a .texel bitstream stands for on a device.
+ * The MEX function over the C ABI (texel_mex.h); its usage, options and
+ * results are documented in texel_decode.m, the help text MATLAB and Octave show. */
 #include "texel_mex.h"
 
 struct decode_args {

@@ -1,11 +1,6 @@
-/* texel_reference — one of Texel's reference textures on a device
- * (docs/matlab.md; `texel reference --list` names them).
- *
- *   [map, info] = texel_reference('pink', 'seed', 3, 'device', 'tpad', 'output', 'native')
- *
- * Options: seed [1], device ['tpad'], output ('amplitude' | 'u16' | 'native',
- * as texel_render). The map equals `texel reference NAME --seed S --device D
- * -o map.bin` byte for byte; info as texel_render's, with name and seed. */
+/* texel_reference — one of Texel's reference textures on a device.
+ * The MEX function over the C ABI (texel_mex.h); its usage, options and
+ * results are documented in texel_reference.m, the help text MATLAB and Octave show. */
 #include "texel_mex.h"
 
 struct reference_args {

@@ -1,18 +1,6 @@
 /* texel_spectrum — what `texel spectrum` reports for a map (docs/matlab.md).
- *
- *   s = texel_spectrum(amplitude, 'spacing_mm', info.spacing_mm)
- *   semilogx(s.frequency_cpm, s.magnitude)
- *
- * Options (texel.h's texel_spectrum_options; defaults as the CLI's):
- *   spacing_mm (required), window ('blackman-harris' | 'hann' | 'flat-top' |
- *   'rectangular'), zero_pad [4], threshold_db [-40], max_peaks [32],
- *   welch_segment [0 = auto], welch_overlap [0.5]
- * s holds frequency_cpm and magnitude (columns), psd_frequency_cpm and psd,
- * peaks (frequency_cpm, amplitude, level_db columns), bands (lo_cpm, hi_cpm,
- * mean_square, fraction) and the scalars samples, spacing_mm, nfft, bin_cpm,
- * resolution_cpm, mean_amplitude, rms_amplitude, centroid_cpm,
- * log_centroid_db, spread_cpm, log_spread_db, welch_segment, welch_segments,
- * psd_bin_cpm. */
+ * The MEX function over the C ABI (texel_mex.h); its usage, options and
+ * results are documented in texel_spectrum.m, the help text MATLAB and Octave show. */
 #include "texel_mex.h"
 
 struct spectrum_args {

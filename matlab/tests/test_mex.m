@@ -1,6 +1,7 @@
 % The MEX functions (matlab/*.c) against the texel command, from GNU Octave
 % (tests/capi/CMakeLists.txt, test capi.mex). Set before running:
-%   mexdir (the built .mex files), texel (the CLI), out (a scratch folder).
+%   mexdir (the built .mex files), srcdir (matlab/: help texts), texel (the CLI),
+%   out (a scratch folder).
 % Each check is an assert: a failure is an error and a non-zero exit.
 addpath(mexdir);
 
@@ -109,4 +110,9 @@ expect_error(@() texel_decode(uint8([1 2 3])), 'texel:formatError', ...
              cli_error(texel, sprintf('decode "%s/x.texel" --device tpad -o "%s/x.bin"', out, out)));
 expect_error(@() texel_render('device', 'no-such-device'), 'texel:invalidArgument', ...
              cli_error(texel, sprintf('render --device no-such-device -o "%s/x.bin"', out)));
+% Each function's help text (matlab/texel_*.m) names its options.
+for fn = {'texel_render', 'texel_encode', 'texel_decode', 'texel_spectrum', 'texel_reference'}
+  h = get_help_text([srcdir '/' fn{1} '.m']);
+  assert(~isempty(strfind(h, upper(fn{1}))) && ~isempty(strfind(h, 'docs/matlab.md')), ['help text of ' fn{1}]);
+end
 printf('all MEX checks passed\n');
