@@ -106,4 +106,6 @@ set(TEXEL_COMPONENT_NEEDS_io core)
 set(TEXEL_COMPONENT_NEEDS_codec core io spectrum)
 set(TEXEL_COMPONENT_NEEDS_experiment core codec player plot spectrum)
 set(TEXEL_COMPONENT_NEEDS_studio core codec experiment player plot spectrum)
-set(TEXEL_COMPONENT_NEEDS_capi core codec player)
+# The C library is whole in itself (libtexel.so, libtexel.a: src/capi), built
+# from core, codec and player but needing none of their targets installed.
+set(TEXEL_COMPONENT_NEEDS_capi "")

@@ -1,5 +1,5 @@
-# Install rules (TEXEL_INSTALL): the static libraries as exported targets
-# texel::<name>, the public headers of the components built, the texel CLI,
+# Install rules (TEXEL_INSTALL): the libraries as exported targets
+# texel::<name> (static, but for the C library's libtexel.so), the public headers of the components built, the texel CLI,
 # and the CMake package, so that
 #   cmake --install build --prefix /opt/texel
 #   find_package(texel [COMPONENTS player codec ...])   # CMAKE_PREFIX_PATH=/opt/texel
@@ -19,11 +19,14 @@ foreach(component IN LISTS TEXEL_COMPONENTS)
   if(NOT targets)
     continue()
   endif()
-  install(TARGETS ${targets} EXPORT texel-${component}-targets
+  # One install component per Texel component (cmake --install build --component capi),
+  # for packagers and for tests that need only part of an installation.
+  install(TARGETS ${targets} EXPORT texel-${component}-targets COMPONENT ${component}
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
           FILE_SET HEADERS DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   install(EXPORT texel-${component}-targets NAMESPACE texel:: FILE texel-${component}-targets.cmake
-          DESTINATION ${TEXEL_INSTALL_CMAKEDIR})
+          DESTINATION ${TEXEL_INSTALL_CMAKEDIR} COMPONENT ${component})
   list(APPEND TEXEL_INSTALLED_COMPONENTS ${component})
 endforeach()
 
@@ -39,3 +42,18 @@ write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/texelConfigVersion.
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/texelConfig.cmake ${CMAKE_CURRENT_BINARY_DIR}/texelConfigVersion.cmake
               ${CMAKE_CURRENT_LIST_DIR}/TexelDependencies.cmake
         DESTINATION ${TEXEL_INSTALL_CMAKEDIR})
+
+# pkg-config for C programs: texel.pc describes libtexel (the C ABI).
+#   cc app.c $(pkg-config --cflags --libs texel)            # libtexel.so
+#   pkg-config --static --libs texel                        # + what libtexel.a needs
+# Relocatable: the prefix is found from the .pc file's own place.
+if(TARGET texel_c)
+  file(RELATIVE_PATH _texel_pc_to_prefix ${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/pkgconfig ${CMAKE_INSTALL_PREFIX})
+  string(REGEX REPLACE "/$" "" _texel_pc_to_prefix "${_texel_pc_to_prefix}")
+  get_property(_texel_c_static_libs GLOBAL PROPERTY TEXEL_C_STATIC_LIBS)
+  list(TRANSFORM _texel_c_static_libs PREPEND -l OUTPUT_VARIABLE _texel_pc_private)
+  list(JOIN _texel_pc_private " " TEXEL_PC_LIBS_PRIVATE)
+  set(TEXEL_PC_PREFIX "\${pcfiledir}/${_texel_pc_to_prefix}")
+  configure_file(${CMAKE_CURRENT_LIST_DIR}/texel.pc.in ${CMAKE_CURRENT_BINARY_DIR}/texel.pc @ONLY)
+  install(FILES ${CMAKE_CURRENT_BINARY_DIR}/texel.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT capi)
+endif()

@@ -51,6 +51,15 @@
 extern "C" {
 #endif
 
+/* Marks what libtexel exports. The shared library (libtexel.so) exports
+ * exactly these functions and nothing else: Texel's C++ inside is hidden
+ * (docs/c-api.md "Linking"). Nothing for a caller to define. */
+#if defined(TEXEL_BUILDING_LIBRARY) && (defined(__GNUC__) || defined(__clang__))
+#define TEXEL_API __attribute__((visibility("default")))
+#else
+#define TEXEL_API
+#endif
+
 /* ---------------------------------------------------------------- version */
 
 /* The version this header describes; texel_version() gives the library's. */
@@ -59,9 +68,9 @@ extern "C" {
 #define TEXEL_VERSION_PATCH 0
 
 /* The library's version; any pointer may be NULL. */
-void texel_version(int* major, int* minor, int* patch);
+TEXEL_API void texel_version(int* major, int* minor, int* patch);
 /* The library's version as text, e.g. "0.1.0" (static storage). */
-const char* texel_version_string(void);
+TEXEL_API const char* texel_version_string(void);
 
 /* ----------------------------------------------------------------- status */
 
@@ -77,11 +86,11 @@ typedef enum texel_status {
 
 /* A fixed name for a status, e.g. "TEXEL_FORMAT_ERROR" ("unknown status"
  * for a value outside the enum). Static storage. */
-const char* texel_status_string(texel_status status);
+TEXEL_API const char* texel_status_string(texel_status status);
 /* The engine's message for the most recent call on this thread that returned
  * texel_status: "" after a success. Valid until the next such call on this
  * thread. Never NULL. */
-const char* texel_last_error(void);
+TEXEL_API const char* texel_last_error(void);
 
 /* ---------------------------------------------------------------- handles */
 
@@ -112,7 +121,7 @@ typedef struct texel_device_info {
 /* Looks a device profile up: a built-in name ("tpad", "tpad-tablet",
  * "generic"), NAME.json in a TEXEL_DEVICE_PATH directory, or a path to a
  * profile JSON file. Unknown names are TEXEL_INVALID_ARGUMENT. */
-texel_status texel_device_lookup(const char* name_or_path, texel_device_info* out);
+TEXEL_API texel_status texel_device_lookup(const char* name_or_path, texel_device_info* out);
 
 /* ------------------------------------------------------------- parameters */
 
@@ -136,53 +145,53 @@ typedef struct texel_params {
   double coarse_sine_phase_deg;            /* its phase, degrees, finite; used when the period is > 0 [0] */
 } texel_params;
 
-texel_params texel_params_default(void);
+TEXEL_API texel_params texel_params_default(void);
 
 /* -------------------------------------------------------------- documents */
 
 /* Loads and validates a texture document (*.texel.json). */
-texel_status texel_document_load(const char* path, texel_document** out);
+TEXEL_API texel_status texel_document_load(const char* path, texel_document** out);
 /* Parses and validates document JSON text of `length` bytes (no NUL needed). */
-texel_status texel_document_parse(const char* json, size_t length, texel_document** out);
+TEXEL_API texel_status texel_document_parse(const char* json, size_t length, texel_document** out);
 /* One Texel texture over the whole of `device` (name or path, as
  * texel_device_lookup). */
-texel_status texel_document_from_params(const char* device, const texel_params* params, texel_document** out);
+TEXEL_API texel_status texel_document_from_params(const char* device, const texel_params* params, texel_document** out);
 /* One reference texture (`texel reference --list` names them, e.g. "4sin",
  * "pink", "bandpass-f5-z0.5") with its default parameters over `device`. */
-texel_status texel_document_from_reference(const char* device, const char* name, uint64_t seed, texel_document** out);
+TEXEL_API texel_status texel_document_from_reference(const char* device, const char* name, uint64_t seed, texel_document** out);
 /* The document as JSON text (NUL-terminated), the *.texel.json format. */
-texel_status texel_document_json(const texel_document* doc, char* buffer, size_t capacity, size_t* needed);
-void texel_document_destroy(texel_document* doc);
+TEXEL_API texel_status texel_document_json(const texel_document* doc, char* buffer, size_t capacity, size_t* needed);
+TEXEL_API void texel_document_destroy(texel_document* doc);
 
 /* --------------------------------------------------------------- surfaces */
 
 /* Prepares every region's texture for rendering (allocates; O(texels)). */
-texel_status texel_surface_create(const texel_document* doc, texel_surface** out);
+TEXEL_API texel_status texel_surface_create(const texel_document* doc, texel_surface** out);
 /* Shorthand: texel_document_from_params then texel_surface_create. */
-texel_status texel_surface_from_params(const char* device, const texel_params* params, texel_surface** out);
+TEXEL_API texel_status texel_surface_from_params(const char* device, const texel_params* params, texel_surface** out);
 /* The surface's device grid and format. */
-texel_status texel_surface_device(const texel_surface* surface, texel_device_info* out);
+TEXEL_API texel_status texel_surface_device(const texel_surface* surface, texel_device_info* out);
 /* Samples in the whole map (texel_device_info.samples). */
-texel_status texel_surface_size(const texel_surface* surface, size_t* samples);
+TEXEL_API texel_status texel_surface_size(const texel_surface* surface, size_t* samples);
 
 /* Amplitudes in [0, 1] of samples [first, first + count) of the map; needs
  * first + count <= size. Any window gives the same values as the whole map. */
-texel_status texel_surface_render(const texel_surface* surface, int64_t first, double* out, size_t count);
+TEXEL_API texel_status texel_surface_render(const texel_surface* surface, int64_t first, double* out, size_t count);
 /* The same window as round(a·65535) in host byte order, whatever the device
  * format (on a little-endian host this is the tpad .bin file). */
-texel_status texel_surface_render_u16(const texel_surface* surface, int64_t first, uint16_t* out, size_t count);
+TEXEL_API texel_status texel_surface_render_u16(const texel_surface* surface, int64_t first, uint16_t* out, size_t count);
 /* The same window in the device's own format (texel_device_info.format):
  * count · bytes_per_sample bytes, exactly `texel render -o map.bin`. */
-texel_status texel_surface_render_native(const texel_surface* surface, int64_t first, size_t count, void* buffer, size_t capacity,
-                                         size_t* needed);
-void texel_surface_destroy(texel_surface* surface);
+TEXEL_API texel_status texel_surface_render_native(const texel_surface* surface, int64_t first, size_t count, void* buffer,
+                                                   size_t capacity, size_t* needed);
+TEXEL_API void texel_surface_destroy(texel_surface* surface);
 
 /* ------------------------------------------------------------------ codec */
 
 /* Encodes a map of `count` amplitudes sampled every `spacing_mm` (the
  * encoder's defaults, as `texel encode`): a .texel bitstream of a few bytes.
  * Takes from well under a second to a few seconds. */
-texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
+TEXEL_API texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
 /* What the encoder is given besides the samples; every field has the
  * default of `texel encode` (texel_encode_options_default()). */
 typedef struct texel_encode_options {
@@ -196,11 +205,11 @@ typedef struct texel_encode_options {
   double swipe_speed_mm_s;                 /* finger speed of the perceptual model, mm/s, > 0 [100] */
 } texel_encode_options;
 
-texel_encode_options texel_encode_options_default(void);
+TEXEL_API texel_encode_options texel_encode_options_default(void);
 
 /* texel_encode with options (NULL = the defaults). */
-texel_status texel_encode_with(const double* amplitudes, size_t count, double spacing_mm, const texel_encode_options* options,
-                               texel_encode_result** out);
+TEXEL_API texel_status texel_encode_with(const double* amplitudes, size_t count, double spacing_mm,
+                                         const texel_encode_options* options, texel_encode_result** out);
 
 /* Encodes a file through the engine's one signal loader, as `texel encode
  * PATH`: .bin (needs `device`), .npy, .csv, .mat, .wav and time/value .csv
@@ -211,24 +220,98 @@ texel_status texel_encode_with(const double* amplitudes, size_t count, double sp
  * perceptual model's loop, as `texel encode --device`); swipe_speed_mm_s 0 =
  * none, > 0 also sets the perceptual model's speed (as `texel encode
  * --swipe-speed`). */
-texel_status texel_encode_file(const char* path, const char* device, double swipe_speed_mm_s, const texel_encode_options* options,
-                               texel_encode_result** out);
+TEXEL_API texel_status texel_encode_file(const char* path, const char* device, double swipe_speed_mm_s,
+                                         const texel_encode_options* options, texel_encode_result** out);
 
 /* The bitstream bytes (a .texel file). */
-texel_status texel_encode_result_bytes(const texel_encode_result* result, uint8_t* buffer, size_t capacity, size_t* needed);
+TEXEL_API texel_status texel_encode_result_bytes(const texel_encode_result* result, uint8_t* buffer, size_t capacity,
+                                                 size_t* needed);
 /* The parameters the bitstream decodes to. A coarse profile other than a
  * sinusoid is not expressible in texel_params: coarse_sine_period_mm is 0 and
  * *has_coarse_profile (if not NULL) is 1; render such a result through
  * texel_decode. */
-texel_status texel_encode_result_params(const texel_encode_result* result, texel_params* out, int* has_coarse_profile);
+TEXEL_API texel_status texel_encode_result_params(const texel_encode_result* result, texel_params* out, int* has_coarse_profile);
 /* Distance between the input and the decoded texture under the perceptual
  * model, in just-noticeable differences. */
-texel_status texel_encode_result_distance(const texel_encode_result* result, double* jnd);
-void texel_encode_result_destroy(texel_encode_result* result);
+TEXEL_API texel_status texel_encode_result_distance(const texel_encode_result* result, double* jnd);
+TEXEL_API void texel_encode_result_destroy(texel_encode_result* result);
 
 /* Decodes a bitstream to the document it stands for on `device` (name or
  * path): rendering it gives `texel decode`'s map byte for byte. */
-texel_status texel_decode(const uint8_t* bytes, size_t size, const char* device, texel_document** out);
+TEXEL_API texel_status texel_decode(const uint8_t* bytes, size_t size, const char* device, texel_document** out);
+
+/* --------------------------------------------------------------- spectrum */
+
+/* What `texel spectrum` reports for a map: the magnitude spectrum, the Welch
+ * power spectral density, the peaks, the spectral centroid and spread, and
+ * the band energies, computed by the same library function. */
+typedef struct texel_spectrum texel_spectrum;
+
+/* The magnitude spectrum's window (`texel spectrum --window`). */
+typedef enum texel_window {
+  TEXEL_WINDOW_BLACKMAN_HARRIS = 0, /* the default: low leakage */
+  TEXEL_WINDOW_HANN = 1,
+  TEXEL_WINDOW_FLAT_TOP = 2, /* accurate peak amplitudes */
+  TEXEL_WINDOW_RECTANGULAR = 3
+} texel_window;
+
+/* Start from texel_spectrum_options_default() (the CLI's defaults). */
+typedef struct texel_spectrum_options {
+  texel_window window;  /* [BLACKMAN_HARRIS] */
+  unsigned zero_pad;    /* zero padding factor, 1 … 16 [4] */
+  double threshold_db;  /* peaks within this many dB of the highest, -300 … 0 [-40] */
+  size_t max_peaks;     /* most peaks to report, 1 … 100000 [32] */
+  size_t welch_segment; /* Welch segment, samples; 0 = about a quarter of the map [0] */
+  double welch_overlap; /* Welch overlap, 0 … 0.95 [0.5] */
+} texel_spectrum_options;
+
+TEXEL_API texel_spectrum_options texel_spectrum_options_default(void);
+
+/* Analyses `count` amplitudes (>= 16) sampled every `spacing_mm` (options
+ * NULL = the defaults), as `texel spectrum` does a map file. */
+TEXEL_API texel_status texel_spectrum_analyse(const double* amplitudes, size_t count, double spacing_mm,
+                                              const texel_spectrum_options* options, texel_spectrum** out);
+
+/* The scalars of an analysis (`texel spectrum --json` names). */
+typedef struct texel_spectrum_summary {
+  size_t samples;         /* input samples */
+  double spacing_mm;      /* input spacing */
+  size_t nfft;            /* transform length of the magnitude spectrum */
+  double bin_cpm;         /* its bin spacing, cycles/mm */
+  double resolution_cpm;  /* 1 / map length, cycles/mm */
+  double mean_amplitude;  /* removed before the analysis */
+  double rms_amplitude;   /* about the mean */
+  double centroid_cpm;    /* spectral centroid, cycles/mm */
+  double log_centroid_db; /* log-frequency centroid, dB re 1 cycle/mm */
+  double spread_cpm;      /* spectral spread, cycles/mm */
+  double log_spread_db;   /* log-frequency spread, dB */
+  size_t welch_segment;   /* Welch segment length used, samples */
+  size_t welch_segments;  /* segments averaged */
+  double psd_bin_cpm;     /* Welch bin spacing, cycles/mm */
+} texel_spectrum_summary;
+
+TEXEL_API texel_status texel_spectrum_get_summary(const texel_spectrum* spectrum, texel_spectrum_summary* out);
+
+/* The arrays of an analysis; each series has its own length. */
+typedef enum texel_spectrum_series {
+  TEXEL_SERIES_FREQUENCY_CPM = 0,      /* magnitude spectrum bins, cycles/mm */
+  TEXEL_SERIES_MAGNITUDE = 1,          /* amplitude-calibrated magnitude per bin */
+  TEXEL_SERIES_PSD_FREQUENCY_CPM = 2,  /* Welch bins, cycles/mm */
+  TEXEL_SERIES_PSD = 3,                /* one-sided density, amplitude²/(cycle/mm) */
+  TEXEL_SERIES_PEAK_FREQUENCY_CPM = 4, /* interpolated peak frequencies, ascending */
+  TEXEL_SERIES_PEAK_AMPLITUDE = 5,     /* their heights (magnitude units) */
+  TEXEL_SERIES_PEAK_LEVEL_DB = 6,      /* dB re the highest peak, <= 0 */
+  TEXEL_SERIES_BAND_LO_CPM = 7,        /* band energy: decades up to Nyquist */
+  TEXEL_SERIES_BAND_HI_CPM = 8,
+  TEXEL_SERIES_BAND_MEAN_SQUARE = 9, /* amplitude² in the band */
+  TEXEL_SERIES_BAND_FRACTION = 10    /* share of the total, 0 … 1 */
+} texel_spectrum_series;
+
+/* Copies one series into `values` (capacity and *needed count values, not
+ * bytes; otherwise the buffer rule of this header). */
+TEXEL_API texel_status texel_spectrum_get_series(const texel_spectrum* spectrum, texel_spectrum_series series, double* values,
+                                                 size_t capacity, size_t* needed);
+TEXEL_API void texel_spectrum_destroy(texel_spectrum* spectrum);
 
 /* ----------------------------------------------------------------- player */
 
@@ -265,37 +348,37 @@ typedef struct texel_player_config {
   double response_limit_db;                  /* LIMIT: the display's attenuation where driving stops, 3 … 60 dB [20] */
 } texel_player_config;
 
-texel_player_config texel_player_config_default(void);
+TEXEL_API texel_player_config texel_player_config_default(void);
 
 /* Prepares a player (allocates all it will ever need); silent until
  * texel_player_set_surface. */
-texel_status texel_player_create(const texel_player_config* config, texel_player** out);
+TEXEL_API texel_status texel_player_create(const texel_player_config* config, texel_player** out);
 /* Control thread: renders the surface's whole map into a new player map and
  * swaps it in (process crossfades to it). The map carries the frequency
  * response of the surface's device, which the player respects from the swap
  * on (config.response_handling); surfaces of different devices may follow
  * one another. Allocates; frees maps process has retired. The surface may be
  * destroyed afterwards. */
-texel_status texel_player_set_surface(texel_player* player, const texel_surface* surface);
+TEXEL_API texel_status texel_player_set_surface(texel_player* player, const texel_surface* surface);
 /* Control thread: queues one finger sample (time-ordered; t_s on the
  * player's clock, 0 = first output sample; x_mm in device coordinates;
  * touch 0 = lifted). TEXEL_BUFFER_TOO_SMALL: the event queue is full (let
  * process run, then push again). */
-texel_status texel_player_push(texel_player* player, double t_s, double x_mm, int touch);
+TEXEL_API texel_status texel_player_push(texel_player* player, double t_s, double x_mm, int touch);
 /* Control thread: queues a gain change (clamped to [0, 1], ramped over a block). */
-texel_status texel_player_set_gain(texel_player* player, double gain);
+TEXEL_API texel_status texel_player_set_gain(texel_player* player, double gain);
 /* Control thread: frees maps process has retired; *freed (may be NULL) gets
  * their number. */
-texel_status texel_player_collect(texel_player* player, size_t* freed);
+TEXEL_API texel_status texel_player_collect(texel_player* player, size_t* freed);
 /* Real-time thread: the next `frames` output samples into out[0 … frames),
  * and, if positions_mm is not NULL, the finger position used for each.
  * Real-time safe: never allocates, frees, locks, logs or does I/O; does not
  * set texel_last_error. TEXEL_INVALID_ARGUMENT for a NULL player or out. */
-texel_status texel_player_process(texel_player* player, float* out, size_t frames, float* positions_mm);
+TEXEL_API texel_status texel_player_process(texel_player* player, float* out, size_t frames, float* positions_mm);
 /* Output samples produced so far (any thread); 0 for NULL. */
-uint64_t texel_player_samples(const texel_player* player);
+TEXEL_API uint64_t texel_player_samples(const texel_player* player);
 /* Stop the real-time thread first. */
-void texel_player_destroy(texel_player* player);
+TEXEL_API void texel_player_destroy(texel_player* player);
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -28,6 +28,8 @@ packages=(
   # GNU Octave runs examples/matlab/*.m in the examples.matlab_* ctests: a
   # test-only tool (GPL, never linked); 74 MB download, 243 MB installed.
   octave
+  # mkoctfile builds the MEX functions (matlab/*.c) for the capi.mex ctest: test only
+  octave-dev
 )
 
 # Texel Studio's front end builds with the machine's Node.js (>= 20) and npm

@@ -112,6 +112,13 @@ struct MapData {
 /// values), IoError when the file cannot be opened.
 MapData read_map(const std::string& path, const ReadOptions& options = {});
 
+/// The char row named `name` in a .mat file (v5 or v7.3) as UTF-8, or
+/// nothing when the file has no such variable (e.g. the `document` a map
+/// Texel wrote carries). Throws FormatError naming the file and variable when
+/// it is not a char row (or is over options.max_elements characters), IoError
+/// when the file cannot be opened.
+std::optional<std::string> read_text(const std::string& path, const std::string& name, const ReadOptions& options = {});
+
 /// The names, classes and sizes in a .mat file, e.g. "amplitude double
 /// 19200x1", one entry per variable (for diagnostics and tests).
 std::vector<std::string> list_variables(const std::string& path);

@@ -25,6 +25,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
+#include "texel/matfile.hpp"
 #include "texel/surface.hpp"
 
 namespace texel::codec {
@@ -165,7 +166,8 @@ std::optional<Transcoded> transcode_file(const std::string& path, const SignalOp
     return std::nullopt;
   };
   const SignalFormat format = signal_format_of(path);
-  if (format != SignalFormat::document && format != SignalFormat::bitstream && format != SignalFormat::hjif)
+  if (format != SignalFormat::document && format != SignalFormat::bitstream && format != SignalFormat::hjif &&
+      format != SignalFormat::mat)
     return no("it holds samples, not Texel parameters");
   if (signal.region) return no("a region of it was asked for");
   if (signal.spacing) return no("another sample spacing was asked for");
@@ -177,6 +179,17 @@ std::optional<Transcoded> transcode_file(const std::string& path, const SignalOp
     hjif::Experience e = hjif::load_hjif(path);
     if (!e.carried) return no(e.carried_rejected.empty() ? "it carries no Texel document, only samples" : e.carried_rejected);
     doc = std::move(*e.carried);
+  } else if (format == SignalFormat::mat) {
+    // A map Texel rendered to .mat carries its document in the char variable
+    // `document` (docs/format.md "MATLAB .mat"): the same parameters as the
+    // document itself. A .mat without one is a recording to estimate.
+    std::optional<std::string> text = mat::read_text(path, "document");
+    if (!text) return no("it carries no Texel document, only samples");
+    try {
+      doc = parse_document(*text, path + ": variable 'document'");
+    } catch (const FormatError& e) {
+      return no(std::string("its variable 'document' is not a Texel document: ") + e.what());
+    }
   } else {
     doc = load_document(path);
   }

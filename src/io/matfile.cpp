@@ -57,6 +57,7 @@ namespace {
   X(Mat_VarCreate) \
   X(Mat_VarCreateStruct2) \
   X(Mat_VarFree) \
+  X(Mat_VarRead) \
   X(Mat_VarReadData) \
   X(Mat_VarReadNextInfo) \
   X(Mat_VarSetCell) \
@@ -140,6 +141,35 @@ std::vector<std::uint16_t> utf16(const std::string& s) {
       out.push_back(static_cast<std::uint16_t>(0xDC00 + (cp & 0x3FF)));
     } else {
       out.push_back(static_cast<std::uint16_t>(cp));
+    }
+  }
+  return out;
+}
+
+/// UTF-16 code units (MATLAB's char) → UTF-8. Unpaired surrogates become U+FFFD.
+std::string utf8(const std::vector<std::uint32_t>& units) {
+  std::string out;
+  out.reserve(units.size());
+  for (std::size_t i = 0; i < units.size(); ++i) {
+    std::uint32_t cp = units[i];
+    if (cp >= 0xD800 && cp <= 0xDBFF && i + 1 < units.size() && units[i + 1] >= 0xDC00 && units[i + 1] <= 0xDFFF)
+      cp = 0x10000 + ((cp - 0xD800) << 10) + (units[++i] - 0xDC00);
+    else if ((cp >= 0xD800 && cp <= 0xDFFF) || cp > 0x10FFFF)
+      cp = 0xFFFD;
+    if (cp < 0x80) {
+      out += static_cast<char>(cp);
+    } else if (cp < 0x800) {
+      out += static_cast<char>(0xC0 | (cp >> 6));
+      out += static_cast<char>(0x80 | (cp & 0x3F));
+    } else if (cp < 0x10000) {
+      out += static_cast<char>(0xE0 | (cp >> 12));
+      out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+      out += static_cast<char>(0x80 | (cp & 0x3F));
+    } else {
+      out += static_cast<char>(0xF0 | (cp >> 18));
+      out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
+      out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+      out += static_cast<char>(0x80 | (cp & 0x3F));
     }
   }
   return out;
@@ -590,6 +620,44 @@ class Reader {
     return out;
   }
 
+  /// The char row `info` as UTF-8; throws naming file and variable.
+  std::string text(const Info& info) {
+    const matvar_t* v = info.var.get();
+    const std::string what = "'" + path_ + "': variable '" + info.name + "'";
+    if (v->class_type != MAT_C_CHAR) throw FormatError(what + " is of class " + class_name(v->class_type) + ", not char");
+    if (!info.elements || *info.elements > options_.max_elements)
+      throw FormatError(what + " is " + info.shape + ", more than the " + std::to_string(options_.max_elements) +
+                        " characters allowed");
+    if (*info.elements == 0) return {};
+    if (!info.vector) throw FormatError(what + " is " + info.shape + "; text must be a char row");
+    // The header was checked (and, in a v5 file, every element's size against
+    // the file's) before matio reads the data.
+    VarPtr full(matio().Mat_VarRead(mat_.get(), info.name.c_str()));
+    if (!full || !full->data) throw FormatError(what + " cannot be read (truncated or corrupt file)" + matio_reason());
+    const std::size_t width = full->data_size > 0 ? static_cast<std::size_t>(full->data_size) : 2;
+    const std::size_t n = std::min(*info.elements, full->nbytes / width);
+    std::vector<std::uint32_t> units(n);
+    const auto* bytes = static_cast<const unsigned char*>(full->data);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (width == 1) {
+        units[i] = bytes[i];
+      } else if (width == 2) {
+        std::uint16_t u;
+        std::memcpy(&u, bytes + 2 * i, 2);
+        units[i] = u;
+      } else if (width == 4) {
+        std::uint32_t u;
+        std::memcpy(&u, bytes + 4 * i, 4);
+        units[i] = u;
+      } else {
+        throw FormatError(what + " has an unsupported character width (" + std::to_string(width) + " bytes)");
+      }
+    }
+    // 8-bit text (MAT_T_UTF8, or Latin-1 from old writers) is taken as UTF-8 bytes.
+    if (width == 1) return std::string(reinterpret_cast<const char*>(bytes), n);
+    return utf8(units);
+  }
+
   const std::string& path() const { return path_; }
 
  private:
@@ -768,6 +836,16 @@ MapData read_map(const std::string& path, const ReadOptions& options) {
     out.spacing_mm = v[0];
   }
   return out;
+}
+
+std::optional<std::string> read_text(const std::string& path, const std::string& name, const ReadOptions& options) {
+  const std::lock_guard lock(matio_mutex);
+  init_matio_logging();
+  last_matio_message.clear();
+  Reader r(path, options);
+  const Info* info = r.find(name);
+  if (!info) return std::nullopt;
+  return r.text(*info);
 }
 
 std::vector<std::string> list_variables(const std::string& path) {

@@ -26,6 +26,7 @@
 #include "texel/player.hpp"
 #include "texel/reference.hpp"
 #include "texel/signal.hpp"
+#include "texel/spectrum.hpp"
 #include "texel/surface.hpp"
 
 namespace {
@@ -458,6 +459,7 @@ TEST(CApi, DestroyNullIsANoOp) {
   texel_surface_destroy(nullptr);
   texel_encode_result_destroy(nullptr);
   texel_player_destroy(nullptr);
+  texel_spectrum_destroy(nullptr);
 }
 
 TEST(CApi, SurfaceOutlivesItsDocument) {
@@ -894,6 +896,102 @@ TEST(CApi, PlayerErrors) {
   float big[512];
   ASSERT_EQ(texel_player_process(p, big, 512, nullptr), TEXEL_OK);
   EXPECT_EQ(texel_player_push(p, 1.0, 1.0, 1), TEXEL_OK);
+}
+
+// --------------------------------------------------------------- spectrum
+
+struct SpecDel {
+  void operator()(texel_spectrum* s) const { texel_spectrum_destroy(s); }
+};
+using Spec = std::unique_ptr<texel_spectrum, SpecDel>;
+
+std::vector<double> series_of(const texel_spectrum* s, texel_spectrum_series which) {
+  std::size_t n = 0;
+  EXPECT_EQ(texel_spectrum_get_series(s, which, nullptr, 0, &n), TEXEL_OK) << texel_last_error();
+  std::vector<double> v(n);
+  EXPECT_EQ(texel_spectrum_get_series(s, which, v.data(), v.size(), nullptr), TEXEL_OK) << texel_last_error();
+  return v;
+}
+
+TEST(CApi, SpectrumEqualsTheLibrarys) {
+  const std::vector<double> map = cpp_map(study_spec());
+  const double spacing = texel::load_device("tpad").spacing.value();
+  texel_spectrum_options o = texel_spectrum_options_default();
+  EXPECT_EQ(o.window, TEXEL_WINDOW_BLACKMAN_HARRIS);
+  EXPECT_EQ(o.zero_pad, 4u);
+  EXPECT_EQ(o.max_peaks, 32u);
+  o.window = TEXEL_WINDOW_HANN;
+  o.threshold_db = -30;
+  texel_spectrum* raw = nullptr;
+  ASSERT_EQ(texel_spectrum_analyse(map.data(), map.size(), spacing, &o, &raw), TEXEL_OK) << texel_last_error();
+  const Spec s(raw);
+
+  texel::AnalysisOptions a;
+  a.spectrum.window = texel::Window::hann;
+  a.peaks.threshold_db = -30;
+  const texel::SpectralReport r = texel::analyse_spectrum(map, spacing, a);
+  texel_spectrum_summary m{};
+  ASSERT_EQ(texel_spectrum_get_summary(s.get(), &m), TEXEL_OK);
+  EXPECT_EQ(m.samples, map.size());
+  EXPECT_EQ(m.nfft, r.spectrum.nfft);
+  EXPECT_EQ(m.centroid_cpm, r.summary.centroid.value());
+  EXPECT_EQ(m.log_centroid_db, r.summary.log_centroid.value());
+  EXPECT_EQ(m.rms_amplitude, r.rms);
+  EXPECT_EQ(m.welch_segments, r.psd.segments);
+  EXPECT_EQ(series_of(s.get(), TEXEL_SERIES_MAGNITUDE), r.spectrum.magnitude);
+  EXPECT_EQ(series_of(s.get(), TEXEL_SERIES_PSD), r.psd.density);
+  const std::vector<double> peaks = series_of(s.get(), TEXEL_SERIES_PEAK_FREQUENCY_CPM);
+  ASSERT_EQ(peaks.size(), r.peaks.size());
+  for (std::size_t k = 0; k < peaks.size(); ++k) EXPECT_EQ(peaks[k], r.peaks[k].frequency.value());
+  EXPECT_EQ(series_of(s.get(), TEXEL_SERIES_BAND_FRACTION).size(), r.bands.size());
+
+  // Defaults (NULL options) are texel spectrum's.
+  ASSERT_EQ(texel_spectrum_analyse(map.data(), map.size(), spacing, nullptr, &raw), TEXEL_OK);
+  const Spec d(raw);
+  EXPECT_EQ(series_of(d.get(), TEXEL_SERIES_MAGNITUDE), texel::analyse_spectrum(map, spacing).spectrum.magnitude);
+}
+
+TEST(CApi, SpectrumErrors) {
+  const std::vector<double> map(64, 0.5);
+  texel_spectrum* s = reinterpret_cast<texel_spectrum*>(1);
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 8, 0.01, nullptr, &s), TEXEL_INVALID_ARGUMENT, "at least 16");
+  EXPECT_EQ(s, nullptr);
+  EXPECT_FAILS(texel_spectrum_analyse(nullptr, 64, 0.01, nullptr, &s), TEXEL_INVALID_ARGUMENT, "amplitudes is NULL");
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 64, nan_v, nullptr, &s), TEXEL_INVALID_ARGUMENT, "spacing_mm");
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 64, 0.01, nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "out is NULL");
+  texel_spectrum_options o = texel_spectrum_options_default();
+  o.zero_pad = 0;
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 64, 0.01, &o, &s), TEXEL_INVALID_ARGUMENT, "zero_pad is 0");
+  o = texel_spectrum_options_default();
+  o.threshold_db = 3;
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 64, 0.01, &o, &s), TEXEL_INVALID_ARGUMENT, "threshold_db");
+  o = texel_spectrum_options_default();
+  o.welch_overlap = 0.99;
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 64, 0.01, &o, &s), TEXEL_INVALID_ARGUMENT, "welch_overlap");
+  o = texel_spectrum_options_default();
+  const int bad = 9;
+  std::memcpy(&o.window, &bad, sizeof bad);
+  EXPECT_FAILS(texel_spectrum_analyse(map.data(), 64, 0.01, &o, &s), TEXEL_INVALID_ARGUMENT, "window is 9");
+
+  std::vector<double> ramp(256);
+  for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = std::sin(0.3 * static_cast<double>(i)) * 0.5 + 0.5;
+  ASSERT_EQ(texel_spectrum_analyse(ramp.data(), ramp.size(), 0.01, nullptr, &s), TEXEL_OK) << texel_last_error();
+  const Spec sp(s);
+  std::size_t n = 0;
+  ASSERT_EQ(texel_spectrum_get_series(sp.get(), TEXEL_SERIES_FREQUENCY_CPM, nullptr, 0, &n), TEXEL_OK);
+  ASSERT_GT(n, 1u);
+  std::vector<double> few(n - 1);
+  std::size_t needed = 0;
+  EXPECT_FAILS(texel_spectrum_get_series(sp.get(), TEXEL_SERIES_FREQUENCY_CPM, few.data(), few.size(), &needed),
+               TEXEL_BUFFER_TOO_SMALL, "needed");
+  EXPECT_EQ(needed, n);  // values, not bytes
+  EXPECT_FAILS(texel_spectrum_get_series(sp.get(), TEXEL_SERIES_FREQUENCY_CPM, nullptr, 0, nullptr), TEXEL_INVALID_ARGUMENT,
+               "both NULL");
+  texel_spectrum_series series;
+  const int worse = 11;
+  std::memcpy(&series, &worse, sizeof worse);
+  EXPECT_FAILS(texel_spectrum_get_series(sp.get(), series, nullptr, 0, &n), TEXEL_INVALID_ARGUMENT, "series is 11");
+  EXPECT_FAILS(texel_spectrum_get_summary(nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "spectrum is NULL");
 }
 
 }  // namespace

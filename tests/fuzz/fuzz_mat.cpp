@@ -1,5 +1,6 @@
-// libFuzzer target for the MATLAB .mat reader (mat::read_map and
-// mat::list_variables, matfile.hpp). libmatio opens files by name, so each
+// libFuzzer target for the MATLAB .mat reader (mat::read_map,
+// mat::read_text of the `document` variable and mat::list_variables,
+// matfile.hpp). libmatio opens files by name, so each
 // input is written to a file under /dev/shm (memory, not disk) first. Every
 // input is either
 //   - accepted: a non-empty map of finite values, a position_mm column as
@@ -48,6 +49,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (m.spacing_mm && !(*m.spacing_mm > 0.0 && std::isfinite(*m.spacing_mm))) std::abort();
   } catch (const texel::Error&) {
     // Rejected with a message: the expected outcome for most inputs.
+  }
+  try {
+    texel::mat::ReadOptions o;
+    o.max_elements = std::size_t{1} << 20;
+    const auto text = texel::mat::read_text(path, "document", o);
+    if (text && text->size() > 4 * o.max_elements) std::abort();  // at most 4 UTF-8 bytes per code unit
+  } catch (const texel::Error&) {
   }
   try {
     (void)texel::mat::list_variables(path);

@@ -86,16 +86,30 @@ check(np.allclose(h["position_mm"][0], np.arange(n) * spacing, rtol=0, atol=1e-9
 check(h["params"].attrs["MATLAB_class"] == b"struct", "v7.3 params is a struct")
 check(h["params"]["central_pitch_db"][0, 0] == 10 and h["params"]["seed"][0, 0] == 7, "v7.3 params values")
 dev = h["params"]["device"]
-check(dev.attrs["MATLAB_class"] == b"char" and "".join(map(chr, dev[:, 0])) == "tpad", "v7.3 params.device is char 'tpad'")
+check(dev.attrs["MATLAB_class"] == b"char" and dev.dtype == np.uint16 and "".join(map(chr, dev[:, 0])) == "tpad",
+      "v7.3 params.device is char 'tpad' (uint16 code units)")
+# MATLAB's own marker for text stored as integers: 2 = UTF-16 (what MATLAB writes for char).
+check(int(dev.attrs.get("MATLAB_int_decode", -1)) == 2, "v7.3 params.device has MATLAB_int_decode = 2")
+check(int(h["document"].attrs.get("MATLAB_int_decode", -1)) == 2, "v7.3 document has MATLAB_int_decode = 2")
 doc73 = h["document"][:, 0].astype(np.uint16).tobytes().decode("utf-16-le")
 check(doc73 == document, "v7.3 document is the texel.json text")
 check(h["texels"]["frequency_cpm"].shape == (1, k), "v7.3 texels columns")
 
 # --- sizes and the encoder ----------------------------------------------------
 print("sizes: .npy", os.path.getsize("map.npy"), "v5", os.path.getsize("map.mat"), "v7.3", os.path.getsize("map73.mat"))
+# A .mat Texel wrote carries its document: transcoded exactly, the bitstream
+# of the document itself, as a .hjif with its document is.
+run("encode", "doc.texel.json", "-o", "doc.texel")
 for f in ("map.mat", "map73.mat"):
-    out = run("encode", f, "--device", "tpad")
-    check("Central Pitch 10.00 dB" in out, f"texel encode {f} recovers the Central Pitch: {out.splitlines()[0]}")
+    out = run("encode", f, "-o", f + ".texel")
+    check(open(f + ".texel", "rb").read() == open("doc.texel", "rb").read(),
+          f"texel encode {f} transcodes its document exactly: {out.splitlines()[0]}")
+    out = run("encode", f, "--device", "tpad", "--estimate")
+    check("Central Pitch 10.00 dB" in out, f"texel encode {f} --estimate recovers the Central Pitch: {out.splitlines()[0]}")
+# Without a document, a .mat is samples to estimate from.
+scipy.io.savemat("plain.mat", {"amplitude": ref.reshape(-1, 1)})
+out = run("encode", "plain.mat", "--device", "tpad")
+check("Central Pitch 10.00 dB" in out, f"texel encode plain.mat estimates: {out.splitlines()[0]}")
 
 # A hostile input is one line naming the file.
 scipy.io.savemat("complex.mat", {"amplitude": np.array([[1 + 1j], [2 + 0j], [0.5 + 0j]])})

@@ -1,0 +1,87 @@
+# libtexel.so exports the C ABI and nothing else: the functions texel.h
+# declares (TEXEL_API), the version script's list (src/capi/libtexel.map) and
+# `nm -D --defined-only` of the library must be the same set, every symbol in
+# the version node TEXEL_<abi>. An accidental export (a C++ symbol, libstdc++,
+# a helper), a function missing from the map or a declaration without a
+# definition fails, naming the symbols. Also checks the SONAME and that no
+# C++ runtime is needed.
+#   cmake -DLIBRARY=<libtexel.so> -DHEADER=<texel.h> -DMAP=<libtexel.map> -DNM=<nm> -DREADELF=<readelf>
+#         -DSONAME=<expected> [-DSTATIC_RUNTIME=ON] -P check_exports.cmake
+file(READ ${HEADER} header)
+string(REGEX MATCHALL "\nTEXEL_API [^;(]*[ *](texel_[a-z0-9_]+)\\(" decls "${header}")
+set(declared "")
+foreach(d IN LISTS decls)
+  string(REGEX REPLACE ".*[ *](texel_[a-z0-9_]+)\\($" "\\1" name "${d}")
+  list(APPEND declared ${name})
+endforeach()
+
+file(READ ${MAP} map)
+string(REGEX REPLACE "/\\*.*\\*/" "" map "${map}")
+string(REGEX MATCH "global:([^}]*)local:" listed "${map}")
+string(REGEX MATCHALL "texel_[a-z0-9_]+" listed "${CMAKE_MATCH_1}")
+string(REGEX MATCH "(TEXEL_[0-9.]+) *{" node "${map}")
+set(node ${CMAKE_MATCH_1})
+
+execute_process(COMMAND ${NM} -D --defined-only ${LIBRARY} OUTPUT_VARIABLE nm_out RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${NM} -D --defined-only ${LIBRARY} failed (${rc})")
+endif()
+string(REPLACE "\n" ";" lines "${nm_out}")
+set(exported "")
+set(unversioned "")
+foreach(line IN LISTS lines)
+  if(line STREQUAL "")
+    continue()
+  endif()
+  string(REGEX REPLACE "^[0-9a-fA-F]* *[A-Za-z] " "" sym "${line}")
+  if(sym MATCHES "^([^@]+)@@?(.*)$")
+    set(sym ${CMAKE_MATCH_1})
+    set(version ${CMAKE_MATCH_2})
+  else()
+    set(version "")
+  endif()
+  # The version node's own definition (an absolute symbol named after it).
+  if(sym STREQUAL node)
+    continue()
+  endif()
+  list(APPEND exported ${sym})
+  if(NOT version STREQUAL node)
+    list(APPEND unversioned "${sym}@${version}")
+  endif()
+endforeach()
+
+function(diff a b label)
+  set(extra ${${a}})
+  list(REMOVE_ITEM extra ${${b}})
+  if(extra)
+    list(JOIN extra " " extra)
+    set(problems "${problems}\n  ${label}: ${extra}" PARENT_SCOPE)
+  endif()
+endfunction()
+set(problems "")
+diff(exported listed "exported by ${LIBRARY} but not in ${MAP} (an accidental export?)")
+diff(listed exported "in ${MAP} but not exported (no definition, or not TEXEL_API)")
+diff(declared listed "declared in texel.h but not in ${MAP}")
+diff(listed declared "in ${MAP} but not declared in texel.h")
+if(unversioned)
+  list(JOIN unversioned " " unversioned)
+  set(problems "${problems}\n  not in version node ${node}: ${unversioned}")
+endif()
+
+execute_process(COMMAND ${READELF} -d ${LIBRARY} OUTPUT_VARIABLE dyn)
+if(NOT dyn MATCHES "SONAME\\)[^\n]*\\[${SONAME}\\]")
+  set(problems "${problems}\n  SONAME is not ${SONAME}")
+endif()
+if(STATIC_RUNTIME AND dyn MATCHES "libstdc\\+\\+")
+  set(problems "${problems}\n  needs libstdc++ (it is linked statically inside)")
+endif()
+
+list(LENGTH exported n)
+if(problems)
+  message(FATAL_ERROR "libtexel's exports are not the C ABI:${problems}")
+endif()
+string(REGEX MATCHALL "NEEDED\\)[^\n]*\\[[^]]+\\]" needed "${dyn}")
+string(REGEX REPLACE "NEEDED\\)[^[]*\\[([^]]+)\\]" "\\1" needed "${needed}")
+file(SIZE ${LIBRARY} size)
+message(STATUS "${LIBRARY}: ${n} symbols, all texel_* in ${node}, as texel.h and ${MAP} list them; "
+               "SONAME ${SONAME}; ${size} bytes; needs ${needed}")
