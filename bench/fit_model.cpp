@@ -142,7 +142,8 @@ int main(int argc, char** argv) {
     fam.push_back(f);
     Family e{"equal weight per felt band above threshold (s, window)", {}};
     for (double s : {0.0, 0.5, 1.0})
-      for (double w : {3.0, 6.0, 10.0, 15.0, 20.0, 30.0}) e.grid.push_back(point("s " + fmt(s) + ", window " + fmt(w) + " dB", v2(W::equal, s, 1.0, 1.0 / 3.0, w)));
+      for (double w : {3.0, 6.0, 10.0, 15.0, 20.0, 30.0})
+        e.grid.push_back(point("s " + fmt(s) + ", window " + fmt(w) + " dB", v2(W::equal, s, 1.0, 1.0 / 3.0, w)));
     fam.push_back(e);
     Family c{"channels: Pacinian / non-Pacinian pooling (s, γ)", {}};
     for (double s : {0.25, 0.5, 1.0})
@@ -199,7 +200,8 @@ int main(int argc, char** argv) {
     double sq = 0, worst = 0;
     int worst_k = 0;
     for (int k = 0; k < 6; ++k) {
-      const Point* best = *std::min_element(ok.begin(), ok.end(), [&](auto a, auto b) { return rms(a->err, k) < rms(b->err, k); });
+      const Point* best =
+          *std::min_element(ok.begin(), ok.end(), [&](auto a, auto b) { return rms(a->err, k) < rms(b->err, k); });
       sq += best->err[k] * best->err[k];
       if (std::fabs(best->err[k]) > worst) worst = std::fabs(best->err[k]), worst_k = k;
     }

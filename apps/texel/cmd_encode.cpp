@@ -72,26 +72,27 @@ nlohmann::ordered_json result_json(const std::string& input, const Signal& sig, 
   j["method"] = "estimated";
   j["source"] = sig.description;
   if (output) j["output"] = *output;
-  for (auto& [key, value] : nlohmann::ordered_json::parse(codec::to_json(r)).items()) j[key] = value;
+  const nlohmann::ordered_json library = nlohmann::ordered_json::parse(codec::to_json(r));  // kept alive: items() refers to it
+  for (const auto& [key, value] : library.items()) j[key] = value;
   return j;
 }
 
 void print_summary(const std::string& input, const codec::EncodeResult& r, const std::optional<std::string>& out) {
   const TexelSpec& s = r.spec;
   if (r.no_texture) {
-    std::cout << input << ": no texture (variation RMS " << detail::num(r.texture_rms) << " <= " << detail::num(codec::no_texture_floor)
-              << "): a flat surface, coarse strength " << detail::fixed(s.coarse_strength, 3) << "; " << r.bytes.size()
-              << " bytes" << (out ? " in " + *out : std::string()) << "\n";
+    std::cout << input << ": no texture (variation RMS " << detail::num(r.texture_rms)
+              << " <= " << detail::num(codec::no_texture_floor) << "): a flat surface, coarse strength "
+              << detail::fixed(s.coarse_strength, 3) << "; " << r.bytes.size() << " bytes"
+              << (out ? " in " + *out : std::string()) << "\n";
     return;
   }
   std::cout << input << ": Central Pitch " << detail::fixed(s.central_pitch.value(), 2) << " dB"
             << (r.at_bound.central_pitch ? " (at the search bound)" : "") << ", Irregularity "
             << detail::fixed(s.irregularity.value(), 2) << " dB"
-            << (r.at_bound.irregularity          ? " (at the search bound: not identifiable)"
+            << (r.at_bound.irregularity       ? " (at the search bound: not identifiable)"
                 : r.irregularity_identifiable ? ""
                                               : " (not identifiable: narrower feels the same)")
-            << ", texel "
-            << detail::num(s.texel_length.value()) << " mm";
+            << ", texel " << detail::num(s.texel_length.value()) << " mm";
   if (r.coarse || s.coarse_strength > 0 || s.fine_strength < 1)
     std::cout << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength "
               << detail::fixed(s.fine_strength, 3);
@@ -215,7 +216,8 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
-  cmd->add_option("--model", a->model, "Perceptual model version: 2 (calibrated against people's matches) or 1 (the model before) [2]")
+  cmd->add_option("--model", a->model,
+                  "Perceptual model version: 2 (calibrated against people's matches) or 1 (the model before) [2]")
       ->group(g);
   cmd->add_option("--weight-exponent", a->weight_exponent,
                   "Perceptual model: exponent of a component's felt weight [the model version's]")

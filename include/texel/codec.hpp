@@ -100,7 +100,7 @@ struct PerceptualModel {
   /// level); negative: sensitivity_scale on both sides.
   double sensitivity_scale_low = -1.0;
   double band_octaves = 1.0;  ///< version 2 [fitted]: width of the constant-Q analysis bands, octaves (9 bands, 16 Hz … 4 kHz)
-  double window_db = 10.0;          ///< version 2, equal weighting: bands this far below the strongest still count
+  double window_db = 10.0;    ///< version 2, equal weighting: bands this far below the strongest still count
   /// Version 2: felt pitch as the weighted mean of log-frequency (true) or
   /// of frequency (false, as version 1).
   bool log_pitch = true;

@@ -297,7 +297,8 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       .def_property_readonly(
           "at_bound",
           [](const codec::EncodeResult& r) {
-            return py::dict(py::arg("central_pitch") = r.at_bound.central_pitch, py::arg("irregularity") = r.at_bound.irregularity);
+            return py::dict(py::arg("central_pitch") = r.at_bound.central_pitch,
+                            py::arg("irregularity") = r.at_bound.irregularity);
           },
           "Which fitted values ended at an edge of the search box (then not identifiable).")
       .def(

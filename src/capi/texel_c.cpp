@@ -285,7 +285,8 @@ texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
     throw InvalidArgument("model_version is " + std::to_string(o.model_version) + "; allowed: 1, 2");
   c.model = texel::codec::model_defaults(o.model_version);
   c.model.swipe_speed = texel::MmPerSecond(o.swipe_speed_mm_s);
-  c.no_texture = o.refuse_no_texture ? texel::codec::EncoderConfig::NoTexture::refuse : texel::codec::EncoderConfig::NoTexture::flag;
+  c.no_texture =
+      o.refuse_no_texture ? texel::codec::EncoderConfig::NoTexture::refuse : texel::codec::EncoderConfig::NoTexture::flag;
   return c;
 }
 

@@ -98,9 +98,9 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   fit_cfg.texel_length = Millimetres(f.texel_length_um / 1000.0);
 
   Split sp = split(a, dx, fit_cfg,
-                   rec                            ? SplitMode::fine_only
+                   rec                         ? SplitMode::fine_only
                    : stepped || res.no_texture ? SplitMode::coarse_only
-                                                  : SplitMode::automatic);
+                                               : SplitMode::automatic);
   FineFit fit;
   bool has_fine = sp.F >= 0.02 && !res.no_texture;
   bool recovered = false;

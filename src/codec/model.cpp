@@ -263,9 +263,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   // (through the display) and as drawn.
   struct Sums {
     std::vector<double> e, f, d, dd;
-    void reset(std::size_t n) {
-      e.assign(n, 0.0), f.assign(n, 0.0), d.assign(n, 0.0), dd.assign(n, 0.0);
-    }
+    void reset(std::size_t n) { e.assign(n, 0.0), f.assign(n, 0.0), d.assign(n, 0.0), dd.assign(n, 0.0); }
     void add(std::size_t k, double w, double f_, double d_) { e[k] += w, f[k] += w * f_, d[k] += w * d_, dd[k] += w * d_ * d_; }
   };
   thread_local Sums felt, drawn;
@@ -323,7 +321,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
         if (!(u.e[k] > 0.0)) continue;
         const double l = level(k, threshold_db(Hertz(x.centre_hz[k]))) - top;
         w[k] = model.weighting == PerceptualModel::Weighting::equal ? 1.0 / (1.0 + std::exp(-(l + model.window_db) / 1.5))
-                                                                     : std::pow(10.0, g * l / 20.0);
+                                                                    : std::pow(10.0, g * l / 20.0);
       }
     }
     double sw = 0, swf = 0, swd = 0, swdd = 0;
@@ -364,12 +362,9 @@ PerceptualModel model_defaults(int version) {
 
 std::string_view to_string(PerceptualModel::Weighting w) {
   switch (w) {
-    case PerceptualModel::Weighting::equal:
-      return "equal";
-    case PerceptualModel::Weighting::channels:
-      return "channels";
-    default:
-      return "power";
+    case PerceptualModel::Weighting::equal: return "equal";
+    case PerceptualModel::Weighting::channels: return "channels";
+    default: return "power";
   }
 }
 

@@ -477,8 +477,10 @@ TEST(HonestResults, InputsWithoutTextureAreFlaggedOrRefused) {
   const double dx = load_device("tpad").spacing.value();
   std::vector<double> tiny(19200, 0.5);
   for (std::size_t i = 0; i < tiny.size(); ++i) tiny[i] += (i % 2 ? 1.0 : -1.0) * 0.5 * no_texture_floor;  // RMS half the floor
-  for (const auto& [name, a] : std::vector<std::pair<std::string, std::vector<double>>>{
-           {"all zero", std::vector<double>(19200, 0.0)}, {"constant", std::vector<double>(19200, 0.7)}, {"below the floor", tiny}}) {
+  for (const auto& [name, a] :
+       std::vector<std::pair<std::string, std::vector<double>>>{{"all zero", std::vector<double>(19200, 0.0)},
+                                                                {"constant", std::vector<double>(19200, 0.7)},
+                                                                {"below the floor", tiny}}) {
     const EncodeResult r = encode(codec::Signal{a, Millimetres(dx), name}, EncoderConfig{});
     EXPECT_TRUE(r.no_texture) << name;
     EXPECT_LE(r.texture_rms, no_texture_floor) << name;
@@ -514,8 +516,8 @@ TEST(HonestResults, ValuesAtTheSearchBoundAreFlagged) {
   std::vector<double> nyquist(19200);
   for (std::size_t i = 0; i < nyquist.size(); ++i) nyquist[i] = 0.5 + 0.4 * (i % 2 ? 1.0 : -1.0);
   const EncodeResult top = encode(codec::Signal{nyquist, d.spacing, "nyquist"}, EncoderConfig{});
-  std::printf("Nyquist: P %.2f dB, I %.2f dB, at bound P %d I %d\n", top.spec.central_pitch.value(), top.spec.irregularity.value(),
-              top.at_bound.central_pitch, top.at_bound.irregularity);
+  std::printf("Nyquist: P %.2f dB, I %.2f dB, at bound P %d I %d\n", top.spec.central_pitch.value(),
+              top.spec.irregularity.value(), top.at_bound.central_pitch, top.at_bound.irregularity);
   EXPECT_TRUE(top.at_bound.central_pitch);
   EXPECT_FALSE(top.irregularity_identifiable);
   // A texture inside the box: no flag.
@@ -547,7 +549,8 @@ TEST(ModelVersions, VersionOneStaysSelectableAndIsNamedInTheResult) {
 }
 
 TEST(ResultJson, OneSerialisationNamesTheModelTheFlagsAndTheDistance) {
-  const EncodeResult r = encode(codec::Signal{std::vector<double>(19200, 0.0), load_device("tpad").spacing, "zero"}, EncoderConfig{});
+  const EncodeResult r =
+      encode(codec::Signal{std::vector<double>(19200, 0.0), load_device("tpad").spacing, "zero"}, EncoderConfig{});
   const std::string j = to_json(r);
   for (const char* key : {"\"distance_jnd\"", "\"version\":2", "\"no_texture\":true", "\"at_bound\"", "\"central_pitch\":false",
                           "\"irregularity_identifiable\""})

@@ -53,7 +53,8 @@ std::vector<double> recording(const std::string& kind, double speed, unsigned se
   auto add = [&](double cpm, double amplitude) {
     const double hz = cpm * speed, ph = phase(rng);
     if (hz >= 0.45 * fs) return;
-    for (std::size_t i = 0; i < n; ++i) y[i] += amplitude * std::sin(2.0 * std::numbers::pi * hz * static_cast<double>(i) / fs + ph);
+    for (std::size_t i = 0; i < n; ++i)
+      y[i] += amplitude * std::sin(2.0 * std::numbers::pi * hz * static_cast<double>(i) / fs + ph);
   };
   if (kind == "band") {  // a log-normal band around 3 cpm, 0.4 octave SD
     for (int k = 0; k < 200; ++k) add(3.0 * std::exp2(0.4 * normal(rng)), 1.0);
@@ -123,6 +124,8 @@ INSTANTIATE_TEST_SUITE_P(Synthesised, RecordedInputs,
                          ::testing::Values(Case{"band", 50}, Case{"band", 100}, Case{"band", 200}, Case{"ridges", 50, 2.5},
                                            Case{"ridges", 100, 4.0}, Case{"ridges", 200}, Case{"rough", 50}, Case{"rough", 100},
                                            Case{"rough", 200, 1.5}),
-                         [](const auto& info) { return info.param.kind + "_" + std::to_string(static_cast<int>(info.param.speed)); });
+                         [](const auto& info) {
+                           return info.param.kind + "_" + std::to_string(static_cast<int>(info.param.speed));
+                         });
 
 }  // namespace
