@@ -7,8 +7,9 @@
 // and over the two-scale maps, against the goals of issue #11 (10 ms and
 // 30 ms).
 //
-//   texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME]
+//   texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME] [--model 1|2]
 //
+// --model: the perceptual model version (default: the encoder's, 2).
 // --only keeps the maps whose name contains NAME (for profiling one map).
 #include <algorithm>
 #include <chrono>
@@ -98,6 +99,7 @@ int main(int argc, char** argv) {
   std::string device_name = "tpad";
   std::string json_path, only;
   int repeat = 3;
+  int model = codec::PerceptualModel{}.version;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--device" && i + 1 < argc) {
@@ -108,8 +110,10 @@ int main(int argc, char** argv) {
       json_path = argv[++i];
     } else if (a == "--only" && i + 1 < argc) {
       only = argv[++i];
+    } else if (a == "--model" && i + 1 < argc) {
+      model = std::atoi(argv[++i]);
     } else {
-      std::cerr << "usage: texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME]\n";
+      std::cerr << "usage: texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME] [--model 1|2]\n";
       return 2;
     }
   }
@@ -143,6 +147,7 @@ int main(int argc, char** argv) {
     double cpu_ms = 0.0;
     // As `texel encode --device D` encodes: D's frequency response in the model's loop.
     codec::EncoderConfig cfg;
+    cfg.model = codec::model_defaults(model);
     cfg.model.display = device.response;
     const double encode_ms = median_ms(
         repeat, [&] { r = codec::encode(signal, cfg); }, &cpu_ms);

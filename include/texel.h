@@ -203,6 +203,9 @@ typedef struct texel_encode_options {
   size_t max_bytes;                        /* bitstream budget in bytes; 0 = none [0] */
   int recover_texel;                       /* 1: recognise Texel renderings and recover their parameters [1] */
   double swipe_speed_mm_s;                 /* finger speed of the perceptual model, mm/s, > 0 [100] */
+  int model_version;                       /* perceptual model: 2, or 1 (the model before) [2] */
+  int refuse_no_texture;                   /* 1: an input without texture is TEXEL_INVALID_ARGUMENT; 0: encoded as a
+                                              flat surface with texel_encode_flags.no_texture set [0] */
 } texel_encode_options;
 
 TEXEL_API texel_encode_options texel_encode_options_default(void);
@@ -234,6 +237,17 @@ TEXEL_API texel_status texel_encode_result_params(const texel_encode_result* res
 /* Distance between the input and the decoded texture under the perceptual
  * model, in just-noticeable differences. */
 TEXEL_API texel_status texel_encode_result_distance(const texel_encode_result* result, double* jnd);
+/* What the encoder says about its own answer (docs/encoder.md, "Honest
+ * results"). */
+typedef struct texel_encode_flags {
+  int model_version;             /* the perceptual model that decided: 1 or 2 */
+  int no_texture;                /* 1: the input had no texture (variation at most 2^-16): a flat surface, Central
+                                    Pitch and Irregularity are defaults, not estimates */
+  int central_pitch_at_bound;    /* 1: Central Pitch ended at an edge of the search box (a limit, not an estimate) */
+  int irregularity_at_bound;     /* 1: Irregularity ended at an edge of the search box */
+  int irregularity_identifiable; /* 0: a narrower distribution feels the same, or a value is at a bound */
+} texel_encode_flags;
+TEXEL_API texel_status texel_encode_result_flags(const texel_encode_result* result, texel_encode_flags* out);
 TEXEL_API void texel_encode_result_destroy(texel_encode_result* result);
 
 /* Decodes a bitstream to the document it stands for on `device` (name or

@@ -27,8 +27,10 @@ struct EncodeArgs {
   std::uint64_t seed = 1;
   std::string parameterization = "moments";
   std::string fit = "least-squares";
-  double weight_exponent = codec::PerceptualModel{}.weight_exponent;
-  double sensitivity_scale = codec::PerceptualModel{}.sensitivity_scale;
+  int model = codec::PerceptualModel{}.version;
+  std::optional<double> weight_exponent;    ///< default: the model version's
+  std::optional<double> sensitivity_scale;  ///< default: the model version's
+  std::string no_texture = std::string(codec::to_string(codec::EncoderConfig{}.no_texture));
   std::string display_response = std::string(codec::to_string(codec::PerceptualModel{}.display_response));
   double drawn_weight = codec::PerceptualModel{}.drawn_weight;
   unsigned coarse_bits = 6;
@@ -46,8 +48,11 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   c.seed = a.seed;
   c.parameterization = parse_parameterization(a.parameterization, "--parameterization");
   c.fit_method = codec::parse_fit_method(a.fit, "--fit");
-  c.model.weight_exponent = a.weight_exponent;
-  c.model.sensitivity_scale = a.sensitivity_scale;
+  c.model = codec::model_defaults(a.model);
+  if (a.input.swipe_speed) c.model.swipe_speed = MmPerSecond(*a.input.swipe_speed);
+  if (a.weight_exponent) c.model.weight_exponent = *a.weight_exponent;
+  if (a.sensitivity_scale) c.model.sensitivity_scale = *a.sensitivity_scale;
+  c.no_texture = codec::parse_no_texture(a.no_texture, "--no-texture");
   // The display in the model's loop: the --device's frequency response
   // (--display-response device, the default; docs/encoder.md §2).
   c.model.display_response = codec::parse_display_response(a.display_response, "display_response");
@@ -58,75 +63,42 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   return c;
 }
 
-nlohmann::ordered_json percept_json(const codec::Percept& p) {
-  nlohmann::ordered_json j;
-  for (const auto& [name, value] : codec::fields(p)) j[name] = value;
-  return j;
-}
-
+/// The library's serialisation (codec::to_json) after what only the front
+/// door knows: the input's name, how it was read, the output file.
 nlohmann::ordered_json result_json(const std::string& input, const Signal& sig, const codec::EncodeResult& r,
-                                   const codec::EncoderConfig& cfg, const std::optional<std::string>& output) {
+                                   const std::optional<std::string>& output) {
   nlohmann::ordered_json j;
   j["input"] = input;
   j["method"] = "estimated";
   j["source"] = sig.description;
   if (output) j["output"] = *output;
-  j["samples"] = r.samples;
-  j["spacing_mm"] = r.spacing.value();
-  j["swipe_speed_mm_s"] = cfg.model.swipe_speed.value();
-  const TexelSpec& s = r.spec;
-  nlohmann::ordered_json e;
-  e["central_pitch_db"] = s.central_pitch.value();
-  e["irregularity_db"] = s.irregularity.value();
-  e["irregularity_identifiable"] = r.irregularity_identifiable;
-  if (!r.irregularity_identifiable) e["irregularity_feels_same_below_db"] = r.irregularity_bound_db;
-  e["texel_recovered"] = r.texel_recovered;  // the input was recognised as a Texel rendering
-  e["texel_length_mm"] = s.texel_length.value();
-  e["parameterization"] = std::string(to_string(s.parameterization));
-  e["seed"] = s.seed;
-  e["band_max_cpm"] = s.band_max.value();
-  e["coarse"] = r.coarse;
-  e["coarse_strength"] = s.coarse_strength;
-  e["fine_strength"] = s.fine_strength;
-  if (r.bitstream.coarse && r.bitstream.coarse->bits > 0) {
-    e["coarse_levels"] = r.bitstream.coarse->levels.size();
-    e["coarse_bits"] = r.bitstream.coarse->bits;
-    e["coarse_stride_texels"] = r.bitstream.coarse->stride;
-    e["coarse_correlation"] = r.coarse_correlation;
-  }
-  j["estimate"] = e;
-  nlohmann::ordered_json m;
-  m["input"] = percept_json(r.input);
-  m["decoded"] = percept_json(r.decoded);
-  m["distance_jnd"] = r.model_distance;
-  m["evaluations"] = r.evaluations;
-  m["fit"] = std::string(codec::to_string(cfg.fit_method));
-  m["display_response"] = std::string(codec::to_string(cfg.model.display_response));
-  if (codec::display_in_loop(cfg.model)) {
-    m["display"] = {{"corner_hz", cfg.model.display.corner.value()}, {"order", cfg.model.display.order}};
-    m["drawn_weight"] = cfg.model.drawn_weight;
-  }
-  j["model"] = m;
-  nlohmann::ordered_json z;
-  z["bitstream_bytes"] = r.bytes.size();
-  z["raw_u16_bytes"] = r.samples * 2;
-  z["ratio"] = static_cast<double>(r.samples * 2) / static_cast<double>(r.bytes.size());
-  j["sizes"] = z;
-  j["seconds"] = r.seconds;
+  const nlohmann::ordered_json library = nlohmann::ordered_json::parse(codec::to_json(r));  // kept alive: items() refers to it
+  for (const auto& [key, value] : library.items()) j[key] = value;
   return j;
 }
 
 void print_summary(const std::string& input, const codec::EncodeResult& r, const std::optional<std::string>& out) {
   const TexelSpec& s = r.spec;
-  std::cout << input << ": Central Pitch " << detail::fixed(s.central_pitch.value(), 2) << " dB, Irregularity "
+  if (r.no_texture) {
+    std::cout << input << ": no texture (variation RMS " << detail::num(r.texture_rms)
+              << " <= " << detail::num(codec::no_texture_floor) << "): a flat surface, coarse strength "
+              << detail::fixed(s.coarse_strength, 3) << "; " << r.bytes.size() << " bytes"
+              << (out ? " in " + *out : std::string()) << "\n";
+    return;
+  }
+  std::cout << input << ": Central Pitch " << detail::fixed(s.central_pitch.value(), 2) << " dB"
+            << (r.at_bound.central_pitch ? " (at the search bound)" : "") << ", Irregularity "
             << detail::fixed(s.irregularity.value(), 2) << " dB"
-            << (r.irregularity_identifiable ? "" : " (not identifiable: narrower feels the same)") << ", texel "
-            << detail::num(s.texel_length.value()) << " mm";
+            << (r.at_bound.irregularity       ? " (at the search bound: not identifiable)"
+                : r.irregularity_identifiable ? ""
+                                              : " (not identifiable: narrower feels the same)")
+            << ", texel " << detail::num(s.texel_length.value()) << " mm";
   if (r.coarse || s.coarse_strength > 0 || s.fine_strength < 1)
     std::cout << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength "
               << detail::fixed(s.fine_strength, 3);
   std::cout << "\n  " << r.samples << " samples (" << r.samples * 2 << " bytes as u16) -> " << r.bytes.size() << " bytes"
-            << (out ? " in " + *out : std::string()) << "; model distance " << detail::fixed(r.model_distance, 2) << " JND\n";
+            << (out ? " in " + *out : std::string()) << "; model " << r.model_version << " distance "
+            << detail::fixed(r.model_distance, 2) << " JND\n";
 }
 
 nlohmann::ordered_json transcoded_json(const std::string& input, const codec::Transcoded& t,
@@ -244,11 +216,18 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
+  cmd->add_option("--model", a->model,
+                  "Perceptual model version: 2 (calibrated against people's matches) or 1 (the model before) [2]")
+      ->group(g);
   cmd->add_option("--weight-exponent", a->weight_exponent,
-                  "Perceptual model: exponent of a component's felt weight (1 = amplitude-weighted, the model before) [1.75]")
+                  "Perceptual model: exponent of a component's felt weight [the model version's]")
       ->group(g);
   cmd->add_option("--sensitivity-scale", a->sensitivity_scale,
-                  "Perceptual model: share of the threshold curve in the weighting, 0 … 1 (1 = the model before) [0.5]")
+                  "Perceptual model: share of the threshold curve in the weighting, 0 … 1 [the model version's]")
+      ->group(g);
+  cmd->add_option("--no-texture", a->no_texture,
+                  "An input without texture (variation RMS <= 2^-16): flag (encode a flat surface, say so) or refuse "
+                  "(exit 2) [flag]")
       ->group(g);
   cmd->add_option("--display-response", a->display_response,
                   "Perceptual model: device (felt as the --device's frequency response passes it at the swipe speed) or "
@@ -287,7 +266,7 @@ void register_encode(CLI::App& app) {
       to.max_bytes = a->max_bytes;
       if (auto t = codec::transcode_file(a->inputs[0], signal_options(a->input), to)) {
         for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit", "--weight-exponent",
-                                 "--sensitivity-scale", "--display-response", "--drawn-weight"})
+                                 "--sensitivity-scale", "--display-response", "--drawn-weight", "--model", "--no-texture"})
           if (cmd->count(flag))
             throw InvalidArgument(std::string(flag) + " applies to estimation; '" + a->inputs[0] +
                                   "' holds Texel parameters and is transcoded with its own (add --estimate to re-estimate it)");
@@ -307,7 +286,7 @@ void register_encode(CLI::App& app) {
     const codec::EncodeResult r = codec::encode(codec::encoder_signal(sig), cfg);
     if (a->output) write_file_atomic(*a->output, std::string_view(reinterpret_cast<const char*>(r.bytes.data()), r.bytes.size()));
     if (a->json)
-      print_json(result_json(a->inputs[0], sig, r, cfg, a->output));
+      print_json(result_json(a->inputs[0], sig, r, a->output));
     else
       print_summary(a->inputs[0], r, a->output);
   });

@@ -79,6 +79,7 @@ std::string flag_of_field(std::string_view field) {
                                                                         {"sensitivity_scale", "--sensitivity-scale"},
                                                                         {"display_response", "--display-response"},
                                                                         {"drawn_weight", "--drawn-weight"},
+                                                                        {"model", "--model"},
                                                                         {"tolerance", "--tolerance"},
                                                                         {"date", "--date"},
                                                                         {"width", "--width"}};

@@ -71,20 +71,39 @@ Signal encoder_signal(const texel::Signal& signal);
 // --- the perceptual model ---------------------------------------------------
 
 struct PerceptualModel {
+  /// Which model (docs/encoder.md §2, "Model versions"): 2 [default] the
+  /// band model calibrated against people's matches; 1 the model before
+  /// (per-bin weighting). Each version's defaults: model_defaults(version).
+  /// Named in every EncodeResult and `--json` ("model_version").
+  int version = 2;
   MmPerSecond swipe_speed{100.0};  ///< mm/s; turns cycles/mm into Hz (typical exploration 50 … 200 mm/s)
   double pitch_jnd_db = 1.0;       ///< just-noticeable pitch change, dB (≈ 25 % frequency)
   double noisiness_jnd_db = 1.0;   ///< just-noticeable change of spread, dB [modelling choice]
   double tie_weight = 0.01;        ///< weight of the physical tie-break terms (see docs/encoder.md)
-  /// Felt weight of a component (docs/encoder.md §2) [choice]: its
-  /// sensitivity-weighted amplitude per unit log-frequency raised to this
-  /// power. 1.75: between amplitude (1, the model before) and energy (2)
-  /// weighting, so the strongest components dominate the felt pitch.
-  double weight_exponent = 1.75;
+  /// Felt weight of a component (docs/encoder.md §2): its sensation
+  /// amplitude raised to this power. Version 2 [fitted]: 3, each octave
+  /// band's amplitude above threshold cubed; version 1 [choice]: 1.75 per bin.
+  double weight_exponent = 3.0;
   /// How much of the threshold curve's frequency dependence (dB) the weight
-  /// keeps at the suprathreshold levels textures are felt at [choice]: 0.5
-  /// (equal-sensation contours flatten with level); 1 is the threshold curve
-  /// itself (the model before).
+  /// keeps at the suprathreshold levels textures are felt at (equal-sensation
+  /// contours flatten with level): version 2 [fitted] and version 1
+  /// [choice] 0.5; 1 is the threshold curve itself.
   double sensitivity_scale = 0.5;
+  /// Version 2 only: how a band's sensation level becomes its felt weight.
+  /// power: its amplitude above threshold raised to weight_exponent;
+  /// equal: every band within window_db of the strongest counts the same
+  /// (soft edge); channels: Pacinian and non-Pacinian sensation pooled per
+  /// channel, the weaker channel counting half.
+  enum class Weighting { power, equal, channels } weighting = Weighting::power;
+  /// Version 2: share of the threshold curve kept below 250 Hz (the
+  /// non-Pacinian side, where equal-sensation contours flatten most with
+  /// level); negative: sensitivity_scale on both sides.
+  double sensitivity_scale_low = -1.0;
+  double band_octaves = 1.0;  ///< version 2 [fitted]: width of the constant-Q analysis bands, octaves (9 bands, 16 Hz … 4 kHz)
+  double window_db = 10.0;    ///< version 2, equal weighting: bands this far below the strongest still count
+  /// Version 2: felt pitch as the weighted mean of log-frequency (true) or
+  /// of frequency (false, as version 1).
+  bool log_pitch = true;
   /// The display between the texture and the finger (DeviceProfile::response,
   /// docs/encoder.md §2 "The display in the loop"): what people feel through
   /// a display is the displayed texture filtered by the display's response,
@@ -107,6 +126,10 @@ struct PerceptualModel {
   double drawn_weight = 1.0;
 };
 
+/// The defaults of model `version` (1 or 2; InvalidArgument otherwise):
+/// version 1 is the model before, bit for bit.
+PerceptualModel model_defaults(int version);
+std::string_view to_string(PerceptualModel::Weighting w);
 std::string_view to_string(PerceptualModel::Display d);
 /// "device" or "flat"; errors name `field`.
 PerceptualModel::Display parse_display_response(std::string_view text, std::string_view field = "display_response");
@@ -178,7 +201,19 @@ struct EncoderConfig {
   /// texel length, Central Pitch and Irregularity from the texels'
   /// frequencies (kept when the model distance is below 1 JND; docs/encoder.md).
   bool recover_texel = true;
+  /// An input without texture (docs/encoder.md, "Honest results"): its
+  /// zero-mean RMS at most no_texture_floor (a constant or all-zero input).
+  /// [choice] flag: encoded as a flat surface with EncodeResult::no_texture
+  /// set; refuse: InvalidArgument (the CLI's exit 2 with one line).
+  enum class NoTexture { flag, refuse } no_texture = NoTexture::flag;
 };
+
+/// The floor of "no texture": zero-mean RMS of the amplitude (0 … 1) at or
+/// below one step of a 16-bit map, 2^-16.
+inline constexpr double no_texture_floor = 1.0 / 65536.0;
+std::string_view to_string(EncoderConfig::NoTexture n);
+/// "flag" or "refuse"; errors name `field`.
+EncoderConfig::NoTexture parse_no_texture(std::string_view text, std::string_view field = "no_texture");
 
 struct EncodeResult {
   Bitstream bitstream;
@@ -190,8 +225,26 @@ struct EncodeResult {
   bool coarse = false;              ///< a coarse profile was found
   double coarse_correlation = 1.0;  ///< envelope vs decoded envelope at texel centres
   bool texel_recovered = false;     ///< the input was recognised as a Texel rendering (texel length detected)
+  /// False when a narrower distribution feels the same (irregularity_bound_db
+  /// then says up to where), or when a fitted value is at a search bound.
   bool irregularity_identifiable = true;
-  double irregularity_bound_db = 0.0;  ///< when not identifiable: any value below this feels the same
+  double irregularity_bound_db = 0.0;  ///< when not identifiable by feel: any value below this feels the same
+  int model_version = 2;               ///< the perceptual model that decided (PerceptualModel::version)
+  PerceptualModel model;               ///< the model the encode used (its version, weighting, display)
+  FitMethod fit_method = FitMethod::least_squares;
+  /// The input has no texture (zero-mean RMS ≤ no_texture_floor): the
+  /// bitstream is a flat surface and Central Pitch / Irregularity are the
+  /// defaults, not estimates (EncoderConfig::NoTexture::flag).
+  bool no_texture = false;
+  double texture_rms = 0.0;  ///< zero-mean RMS of the input amplitude (what no_texture is decided on)
+  /// Which fitted values ended at an edge of the search box (docs/encoder.md
+  /// §3): such a value is a limit of the box, not an estimate, and makes
+  /// irregularity_identifiable false.
+  struct AtBound {
+    bool central_pitch = false;
+    bool irregularity = false;
+    [[nodiscard]] bool any() const { return central_pitch || irregularity; }
+  } at_bound;
   int evaluations = 0;
   double seconds = 0.0;
   std::size_t samples = 0;
@@ -201,6 +254,12 @@ struct EncodeResult {
 /// Encodes a signal. Throws InvalidArgument for unusable input (too short,
 /// constant, non-finite).
 EncodeResult encode(const Signal& signal, const EncoderConfig& config);
+
+/// The encode result as JSON text, the one serialisation every front door
+/// uses (`texel encode --json`, Python's EncodeResult.to_json; field names in
+/// docs/format.md, "Result field names"): estimate, model (version, percepts,
+/// distance_jnd), flags, sizes.
+std::string to_json(const EncodeResult& result);
 
 // --- transcoder -------------------------------------------------------------
 //

@@ -289,7 +289,21 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
           "percept", [](const codec::EncodeResult& r) { return percept_dict(r.input); },
           "The input's fine part under the perceptual model: pitch_db, noisiness_db, centroid_db, spread_db.")
       .def_property_readonly("decoded_percept", [](const codec::EncodeResult& r) { return percept_dict(r.decoded); })
-      .def_readonly("model_distance", &codec::EncodeResult::model_distance, "Model distance input ↔ decoded (JND units).")
+      .def_readonly("distance_jnd", &codec::EncodeResult::model_distance, "Model distance input ↔ decoded (JND units).")
+      .def_readonly("model_distance", &codec::EncodeResult::model_distance, "Old name of distance_jnd (kept for a release).")
+      .def_readonly("model_version", &codec::EncodeResult::model_version, "The perceptual model that decided (1 or 2).")
+      .def_readonly("no_texture", &codec::EncodeResult::no_texture,
+                    "The input has no texture (variation at most 2^-16): a flat surface; P and I are defaults.")
+      .def_property_readonly(
+          "at_bound",
+          [](const codec::EncodeResult& r) {
+            return py::dict(py::arg("central_pitch") = r.at_bound.central_pitch,
+                            py::arg("irregularity") = r.at_bound.irregularity);
+          },
+          "Which fitted values ended at an edge of the search box (then not identifiable).")
+      .def(
+          "to_json", [](const codec::EncodeResult& r) { return codec::to_json(r); },
+          "The result as JSON text, as `texel encode --json` prints it (without the input's name).")
       .def_readonly("coarse", &codec::EncodeResult::coarse, "A coarse profile was found.")
       .def_readonly("coarse_correlation", &codec::EncodeResult::coarse_correlation)
       .def_readonly("texel_recovered", &codec::EncodeResult::texel_recovered,
@@ -309,8 +323,10 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       [](const py::object& source, const py::object& device, std::optional<double> spacing_mm,
          std::optional<double> swipe_speed_mm_s, double boundary_mm, double texel_length_mm, std::uint64_t seed,
          const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes, const std::string& fit,
-         const std::string& display_response, double drawn_weight) {
+         const std::string& display_response, double drawn_weight, int model, const std::string& no_texture) {
         codec::EncoderConfig c;
+        c.model = codec::model_defaults(model);
+        c.no_texture = codec::parse_no_texture(no_texture, "no_texture");
         if (swipe_speed_mm_s) c.model.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
         c.boundary = Millimetres(boundary_mm);
         c.texel_length = Millimetres(texel_length_mm);
@@ -336,7 +352,8 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       py::arg("swipe_speed_mm_s") = py::none(), py::arg("boundary_mm") = 1.0, py::arg("texel_length_mm") = 0.25,
       py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("coarse_bits") = 6u,
       py::arg("max_bytes") = py::none(), py::arg("fit") = "least-squares", py::arg("display_response") = "device",
-      py::arg("drawn_weight") = codec::PerceptualModel{}.drawn_weight,
+      py::arg("drawn_weight") = codec::PerceptualModel{}.drawn_weight, py::arg("model") = codec::PerceptualModel{}.version,
+      py::arg("no_texture") = "flag",
       R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
 
 source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array: float amplitudes
@@ -356,6 +373,9 @@ display_response  'device': the model feels the texture through the device's fre
                   has none), or 'flat': as drawn ['device']
 drawn_weight      weight of the texture as drawn beside the displayed one in the fit (0: the display
                   alone) [1]
+model             perceptual model version: 2, or 1 (the model before) [2]
+no_texture        an input without texture: 'flag' (a flat surface, result.no_texture) or 'refuse'
+                  (InvalidArgument) ['flag']
 
 The GIL is released while encoding.)doc");
 

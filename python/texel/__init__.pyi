@@ -153,7 +153,12 @@ class EncodeResult:
     fine_strength: float
     percept: dict[str, float]
     decoded_percept: dict[str, float]
-    model_distance: float
+    distance_jnd: float
+    model_distance: float  # old name of distance_jnd
+    model_version: int
+    no_texture: bool
+    at_bound: dict[str, bool]
+    def to_json(self) -> str: ...
     coarse: bool
     coarse_correlation: float
     texel_recovered: bool
@@ -184,7 +189,8 @@ def encode(source: Union[_Path, _Array], *, device: Optional[_Device] = None, sp
            swipe_speed_mm_s: Optional[float] = None, boundary_mm: float = 1.0, texel_length_mm: float = 0.25,
            seed: int = 1, parameterization: str = "moments", coarse_bits: int = 6,
            max_bytes: Optional[int] = None, fit: str = "least-squares",
-           display_response: Literal["device", "flat"] = "device", drawn_weight: float = 1.0) -> EncodeResult: ...
+           display_response: Literal["device", "flat"] = "device", drawn_weight: float = 1.0, model: int = 2,
+           no_texture: Literal["flag", "refuse"] = "flag") -> EncodeResult: ...
 
 # ---------------------------------------------------------------- spectrum
 class Spectrum:

@@ -286,7 +286,14 @@ texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
   if (o.recover_texel != 0 && o.recover_texel != 1)
     throw InvalidArgument("recover_texel is " + std::to_string(o.recover_texel) + "; allowed: 0, 1");
   c.recover_texel = o.recover_texel == 1;
+  if (o.refuse_no_texture != 0 && o.refuse_no_texture != 1)
+    throw InvalidArgument("refuse_no_texture is " + std::to_string(o.refuse_no_texture) + "; allowed: 0, 1");
+  if (o.model_version != 1 && o.model_version != 2)
+    throw InvalidArgument("model_version is " + std::to_string(o.model_version) + "; allowed: 1, 2");
+  c.model = texel::codec::model_defaults(o.model_version);
   c.model.swipe_speed = texel::MmPerSecond(o.swipe_speed_mm_s);
+  c.no_texture =
+      o.refuse_no_texture ? texel::codec::EncoderConfig::NoTexture::refuse : texel::codec::EncoderConfig::NoTexture::flag;
   return c;
 }
 
@@ -484,6 +491,8 @@ texel_encode_options texel_encode_options_default(void) {
   o.max_bytes = c.max_bytes.value_or(0);
   o.recover_texel = c.recover_texel ? 1 : 0;
   o.swipe_speed_mm_s = c.model.swipe_speed.value();
+  o.model_version = c.model.version;
+  o.refuse_no_texture = c.no_texture == texel::codec::EncoderConfig::NoTexture::refuse ? 1 : 0;
   return o;
 }
 
@@ -542,6 +551,18 @@ texel_status texel_encode_result_distance(const texel_encode_result* result, dou
   return guarded([&] {
     const auto& r = need(result, "result").result;
     need(jnd, "jnd") = r.model_distance;
+  });
+}
+
+texel_status texel_encode_result_flags(const texel_encode_result* result, texel_encode_flags* out) {
+  return guarded([&] {
+    const auto& r = need(result, "result").result;
+    texel_encode_flags& f = need(out, "out");
+    f.model_version = r.model_version;
+    f.no_texture = r.no_texture ? 1 : 0;
+    f.central_pitch_at_bound = r.at_bound.central_pitch ? 1 : 0;
+    f.irregularity_at_bound = r.at_bound.irregularity ? 1 : 0;
+    f.irregularity_identifiable = r.irregularity_identifiable ? 1 : 0;
   });
 }
 

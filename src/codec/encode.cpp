@@ -54,6 +54,24 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   EncodeResult res;
   res.samples = n;
   res.spacing = Millimetres(dx);
+  res.model = cfg.model;
+  res.model_version = cfg.model.version;
+  res.fit_method = cfg.fit_method;
+  (void)model_defaults(cfg.model.version);  // FieldError "model" for an unknown version
+  // No texture (docs/encoder.md, "Honest results"): a constant or all-zero
+  // input, or one whose variation is below one 16-bit step.
+  {
+    double mean = 0.0, sq = 0.0;
+    for (double v : a) mean += v;
+    mean /= static_cast<double>(n);
+    for (double v : a) sq += (v - mean) * (v - mean);
+    res.texture_rms = std::sqrt(sq / static_cast<double>(n));
+    res.no_texture = res.texture_rms <= no_texture_floor;
+    if (res.no_texture) res.irregularity_identifiable = false;  // nothing was estimated
+    if (res.no_texture && cfg.no_texture == EncoderConfig::NoTexture::refuse)
+      throw InvalidArgument("the input has no texture: its variation (RMS " + num(res.texture_rms) + ") is at most " +
+                            num(no_texture_floor) + " of full scale (constant or all zero)");
+  }
   // The band the decoded texture draws from: the analysed grid's Nyquist
   // frequency, rounded down to the stream's 0.01 dB steps (device independent).
   Bitstream b;
@@ -71,16 +89,20 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   // is constant over each texel: its texel length is detected (§1 step 0).
   std::vector<double> lengths{cfg.texel_length.value()};
   lengths.insert(lengths.end(), candidate_texel_lengths_mm.begin(), candidate_texel_lengths_mm.end());
-  const std::optional<double> stepped = stepped_texel_length(a, dx, lengths);
-  const std::optional<TexelRecovery> rec = cfg.recover_texel && !stepped ? recover_texel(a, dx, cfg, band_max) : std::nullopt;
+  const std::optional<double> stepped = res.no_texture ? std::nullopt : stepped_texel_length(a, dx, lengths);
+  const std::optional<TexelRecovery> rec =
+      cfg.recover_texel && !stepped && !res.no_texture ? recover_texel(a, dx, cfg, band_max) : std::nullopt;
   const double L_used = rec ? rec->L : stepped ? *stepped : cfg.texel_length.value();
   f.texel_length_um = static_cast<std::uint16_t>(std::lround(L_used * 1000.0));
   EncoderConfig fit_cfg = cfg;
   fit_cfg.texel_length = Millimetres(f.texel_length_um / 1000.0);
 
-  Split sp = split(a, dx, fit_cfg, rec ? SplitMode::fine_only : stepped ? SplitMode::coarse_only : SplitMode::automatic);
+  Split sp = split(a, dx, fit_cfg,
+                   rec                         ? SplitMode::fine_only
+                   : stepped || res.no_texture ? SplitMode::coarse_only
+                                               : SplitMode::automatic);
   FineFit fit;
-  bool has_fine = sp.F >= 0.02;
+  bool has_fine = sp.F >= 0.02 && !res.no_texture;
   bool recovered = false;
   if (rec && has_fine) {
     FineFit r;
@@ -136,7 +158,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     fit = fit_fine(sp.fine, dx, cand, band_max, fit_cfg);
   }
   res.coarse = sp.coarse;
-  has_fine = sp.F >= 0.02;
+  has_fine = sp.F >= 0.02 && !res.no_texture;
   double p_est = 10.0, i_est = cfg.parameterization == Parameterization::log ? 1.0 : -5.0;
   if (has_fine) {
     p_est = fit.p_db;
@@ -145,6 +167,12 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     res.irregularity_identifiable = fit.identifiable;
     res.irregularity_bound_db = fit.bound_db;
     res.evaluations = fit.evaluations;
+    // A value at an edge of the search box is the box's limit, not an
+    // estimate (within half a stream step, 0.005 dB).
+    const Box box = fit_box(fit_cfg, band_max);
+    res.at_bound.central_pitch = p_est <= box.p_lo + 0.005 || p_est >= box.p_hi - 0.005;
+    res.at_bound.irregularity = i_est <= box.i_lo + 0.005 || i_est >= box.i_hi - 0.005;
+    if (res.at_bound.any()) res.irregularity_identifiable = false;
   }
   f.central_pitch_cdb = static_cast<std::int16_t>(std::lround(p_est * 100.0));
   f.irregularity_cdb = static_cast<std::int16_t>(std::lround(i_est * 100.0));

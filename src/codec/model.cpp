@@ -77,7 +77,11 @@ double threshold_db(Hertz f) {
   return std::min({pacinian, 30.0, 60.0});
 }
 
-Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
+namespace {
+
+/// Version 1 (the model before): every bin weighted by its own
+/// suprathreshold sensitivity and amplitude.
+Percept perceive_v1(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
   std::size_t m = 0;
   thread_local std::vector<double> p;  // reused: the fit perceives hundreds of candidates
   power_spectrum(fine, p, m);
@@ -185,6 +189,191 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     q.drawn_noisiness_db = std::sqrt(std::max(0.0, swdd0 / sw0 - md0 * md0));
   }
   return q;
+}
+
+/// Version 2 threshold of the non-Pacinian channel (dB above the Pacinian
+/// best, 250 Hz): flat 30 dB up to 100 Hz, rising 6 dB/octave above.
+double non_pacinian_db(double hz) { return 30.0 + 6.0 * std::max(0.0, std::log2(std::max(hz, 1e-6) / 100.0)); }
+/// Version 2 threshold of the Pacinian channel: the U of threshold_db without its floor.
+double pacinian_db(double hz) { return std::min(12.0 * std::fabs(std::log2(std::max(hz, 1e-6) / 250.0)), 60.0); }
+
+/// Version 2 (docs/encoder.md §2, "Version 2"): the spectrum pooled into
+/// constant-Q bands (energy per band, so a line and a continuous spectrum
+/// count alike), each band's sensation level its level above the
+/// (suprathreshold-scaled) threshold at its centre, the band's felt weight a
+/// function of that level (PerceptualModel::weighting), and felt pitch the
+/// weighted mean of the bands' log-frequency centroids.
+Percept perceive_v2(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
+  std::size_t m = 0;
+  thread_local std::vector<double> p;
+  power_spectrum(fine, p, m);
+  const double v = model.swipe_speed.value();
+  const double f_lo = std::max(0.01, f_min_cpm);
+  const bool display = display_in_loop(model);
+  const double corner = display ? model.display.corner.value() : 0.0;
+  const int order = display ? model.display.order : 0;
+  const double b = model.band_octaves;
+  struct Bins {
+    std::size_t m = 0;
+    double dx = 0, v = 0, f_min = 0, b = 0, corner = 0;
+    int order = 0;
+    std::vector<double> f, d, h2;
+    std::vector<int> band;  // band of each bin (−1: below f_min)
+    std::vector<double> centre_hz;
+    std::size_t first = 1;
+  };
+  thread_local std::array<Bins, 4> cache;
+  thread_local std::size_t replace = 0;
+  auto same = [&](const Bins& x) {
+    return x.m == m && x.dx == spacing_mm && x.v == v && x.f_min == f_lo && x.b == b && x.corner == corner && x.order == order;
+  };
+  auto hit = std::find_if(cache.begin(), cache.end(), same);
+  if (hit == cache.end()) {
+    if (display) validate(model.display, "display");
+    Bins& x = cache[replace];
+    replace = (replace + 1) % cache.size();
+    x.m = m, x.dx = spacing_mm, x.v = v, x.f_min = f_lo, x.b = b, x.corner = corner, x.order = order;
+    const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
+    x.f.assign(p.size(), 0.0);
+    x.d.assign(p.size(), 0.0);
+    x.h2.assign(p.size(), 1.0);
+    x.band.assign(p.size(), -1);
+    x.first = p.size();
+    // Band k is centred at 250 Hz · 2^((k + k0)·b) at the model's speed.
+    const auto index = [&](double f) { return static_cast<int>(std::floor(std::log2(f * v / 250.0) / b + 0.5)); };
+    const int k0 = index(f_lo);
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      const double f = static_cast<double>(i) * df;
+      x.f[i] = f;
+      x.d[i] = db_of(f);
+      const double h = display ? model.display.gain(Hertz(f * v)) : 1.0;
+      x.h2[i] = h * h;
+      if (f < f_lo) continue;
+      x.band[i] = index(f) - k0;
+      x.first = std::min(x.first, i);
+    }
+    const int bands = x.first < p.size() ? x.band.back() + 1 : 0;
+    x.centre_hz.resize(static_cast<std::size_t>(bands));
+    for (int k = 0; k < bands; ++k) x.centre_hz[static_cast<std::size_t>(k)] = 250.0 * std::exp2((k + k0) * b);
+    hit = cache.begin() + static_cast<std::ptrdiff_t>(&x - cache.data());
+  }
+  const Bins& x = *hit;
+  const std::size_t bands = x.centre_hz.size();
+  // Per band: energy, and its power-weighted sums of f, dB and dB², felt
+  // (through the display) and as drawn.
+  struct Sums {
+    std::vector<double> e, f, d, dd;
+    void reset(std::size_t n) { e.assign(n, 0.0), f.assign(n, 0.0), d.assign(n, 0.0), dd.assign(n, 0.0); }
+    void add(std::size_t k, double w, double f_, double d_) { e[k] += w, f[k] += w * f_, d[k] += w * d_, dd[k] += w * d_ * d_; }
+  };
+  thread_local Sums felt, drawn;
+  felt.reset(bands);
+  drawn.reset(display ? bands : 0);
+  double peak = 0.0, peak_felt = 0.0;
+  for (std::size_t i = x.first; i < p.size(); ++i) peak = std::max(peak, p[i]), peak_felt = std::max(peak_felt, p[i] * x.h2[i]);
+  const double floor = peak * std::pow(10.0, -masked_db / 10.0);
+  const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
+  double sp = 0, spf = 0, spd = 0, spdd = 0;
+  for (std::size_t i = x.first; i < p.size(); ++i) {
+    if (!(p[i] > floor)) continue;
+    const auto k = static_cast<std::size_t>(x.band[i]);
+    const double f = x.f[i], d = x.d[i];
+    sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+    if (p[i] * x.h2[i] > floor_felt) felt.add(k, p[i] * x.h2[i], f, d);
+    if (display) drawn.add(k, p[i], f, d);
+  }
+  if (!(sp > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
+  const double s = model.sensitivity_scale, g = model.weight_exponent;
+  // Felt pitch and noisiness of one set of band sums.
+  auto pool = [&](const Sums& u, double& pitch, double& noisiness) {
+    thread_local std::vector<double> w;
+    w.assign(bands, 0.0);
+    // Sensation levels (dB, relative): band level above the scaled threshold.
+    const double s_low = model.sensitivity_scale_low < 0.0 ? s : model.sensitivity_scale_low;
+    auto level = [&](std::size_t k, double threshold) {
+      return 10.0 * std::log10(u.e[k]) - (x.centre_hz[k] < 250.0 ? s_low : s) * threshold;
+    };
+    double top = -1e300;
+    for (std::size_t k = 0; k < bands; ++k) {
+      if (!(u.e[k] > 0.0)) continue;
+      const double hz = x.centre_hz[k];
+      if (model.weighting == PerceptualModel::Weighting::channels)
+        top = std::max({top, level(k, pacinian_db(hz)), level(k, non_pacinian_db(hz))});
+      else
+        top = std::max(top, level(k, threshold_db(Hertz(hz))));
+    }
+    if (model.weighting == PerceptualModel::Weighting::channels) {
+      double jp = 0, jn = 0;
+      thread_local std::vector<double> wp, wn;
+      wp.assign(bands, 0.0), wn.assign(bands, 0.0);
+      for (std::size_t k = 0; k < bands; ++k) {
+        if (!(u.e[k] > 0.0)) continue;
+        const double hz = x.centre_hz[k];
+        wp[k] = std::pow(10.0, g * (level(k, pacinian_db(hz)) - top) / 20.0);
+        wn[k] = std::pow(10.0, g * (level(k, non_pacinian_db(hz)) - top) / 20.0);
+        jp += wp[k], jn += wn[k];
+      }
+      // The stronger channel counts fully, the weaker about half.
+      const double ap = jp >= jn ? 1.0 : 0.5, an = jp >= jn ? 0.5 : 1.0;
+      for (std::size_t k = 0; k < bands; ++k) w[k] = ap * wp[k] + an * wn[k];
+    } else {
+      for (std::size_t k = 0; k < bands; ++k) {
+        if (!(u.e[k] > 0.0)) continue;
+        const double l = level(k, threshold_db(Hertz(x.centre_hz[k]))) - top;
+        w[k] = model.weighting == PerceptualModel::Weighting::equal ? 1.0 / (1.0 + std::exp(-(l + model.window_db) / 1.5))
+                                                                    : std::pow(10.0, g * l / 20.0);
+      }
+    }
+    double sw = 0, swf = 0, swd = 0, swdd = 0;
+    for (std::size_t k = 0; k < bands; ++k) {
+      if (!(u.e[k] > 0.0) || !(w[k] > 0.0)) continue;
+      const double a = w[k] / u.e[k];  // the band's weight shared over its bins by power
+      sw += w[k], swf += a * u.f[k], swd += a * u.d[k], swdd += a * u.dd[k];
+    }
+    if (!(sw > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
+    const double md = swd / sw;
+    pitch = model.log_pitch ? md : db_of(swf / sw);
+    noisiness = std::sqrt(std::max(0.0, swdd / sw - md * md));
+  };
+  Percept q;
+  pool(felt, q.pitch_db, q.noisiness_db);
+  q.mean_db = db_of(spf / sp);
+  const double pd = spd / sp;
+  q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  q.drawn_pitch_db = q.pitch_db;
+  q.drawn_noisiness_db = q.noisiness_db;
+  if (display) pool(drawn, q.drawn_pitch_db, q.drawn_noisiness_db);
+  return q;
+}
+
+}  // namespace
+
+PerceptualModel model_defaults(int version) {
+  PerceptualModel m;
+  if (version == 1) {
+    m.version = 1;
+    m.weight_exponent = 1.75;
+    m.sensitivity_scale = 0.5;
+    return m;
+  }
+  if (version != 2) throw FieldError("model", "is " + std::to_string(version) + "; allowed: 1, 2");
+  return m;
+}
+
+std::string_view to_string(PerceptualModel::Weighting w) {
+  switch (w) {
+    case PerceptualModel::Weighting::equal: return "equal";
+    case PerceptualModel::Weighting::channels: return "channels";
+    default: return "power";
+  }
+}
+
+Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
+  if (model.version == 1) return perceive_v1(fine, spacing_mm, model, f_min_cpm);
+  if (model.version != 2) throw FieldError("model", "is " + std::to_string(model.version) + "; allowed: 1, 2");
+  if (!(model.band_octaves >= 0.05 && model.band_octaves <= 2.0))
+    throw FieldError("band_octaves", "is " + num(model.band_octaves) + "; allowed: 0.05 … 2");
+  return perceive_v2(fine, spacing_mm, model, f_min_cpm);
 }
 
 double distance(const Percept& a, const Percept& b, const PerceptualModel& model) {

@@ -147,7 +147,11 @@ MatchPoint perceptual_target(const std::string& reference_name, const std::strin
   signal.amplitude = surface.render();
   signal.spacing = profile.spacing;
   signal.description = "reference " + reference_name + " on " + profile.name;
-  codec::EncoderConfig cfg;  // as `texel encode --device`: the display's response in the model's loop
+  // As `texel encode --device`: the encoder's default perceptual model
+  // (codec::PerceptualModel::version, docs/encoder.md §2), the display's
+  // response in its loop, so simulated observers feel what the encoder does.
+  codec::EncoderConfig cfg;
+  cfg.model = codec::model_defaults(codec::PerceptualModel{}.version);
   cfg.model.display = profile.response;
   const codec::EncodeResult r = codec::encode(signal, cfg);
   return {r.spec.central_pitch.value(), r.spec.irregularity.value()};

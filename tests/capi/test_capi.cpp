@@ -994,4 +994,36 @@ TEST(CApi, SpectrumErrors) {
   EXPECT_FAILS(texel_spectrum_get_summary(nullptr, nullptr), TEXEL_INVALID_ARGUMENT, "spectrum is NULL");
 }
 
+// Encode flags (docs/encoder.md, "Honest results"): a constant input is
+// flagged, or refused with refuse_no_texture; version 1 stays selectable.
+TEST(CApiEncode, FlagsNameTheModelAndAnInputWithoutTexture) {
+  std::vector<double> flat(19200, 0.5);
+  texel_encode_result* raw = nullptr;
+  ASSERT_EQ(texel_encode(flat.data(), flat.size(), 0.0053, &raw), TEXEL_OK) << texel_last_error();
+  texel_encode_flags f{};
+  ASSERT_EQ(texel_encode_result_flags(raw, &f), TEXEL_OK);
+  EXPECT_EQ(f.model_version, 2);
+  EXPECT_EQ(f.no_texture, 1);
+  EXPECT_EQ(f.irregularity_identifiable, 0);
+  EXPECT_EQ(f.central_pitch_at_bound, 0);
+  EXPECT_FAILS(texel_encode_result_flags(raw, nullptr), TEXEL_INVALID_ARGUMENT, "out");
+  texel_encode_result_destroy(raw);
+  texel_encode_options o = texel_encode_options_default();
+  EXPECT_EQ(o.model_version, 2);
+  EXPECT_EQ(o.refuse_no_texture, 0);
+  o.refuse_no_texture = 1;
+  EXPECT_FAILS(texel_encode_with(flat.data(), flat.size(), 0.0053, &o, &raw), TEXEL_INVALID_ARGUMENT, "no texture");
+  o.refuse_no_texture = 0;
+  o.model_version = 1;
+  std::vector<double> wave(19200);
+  for (std::size_t i = 0; i < wave.size(); ++i) wave[i] = 0.5 + 0.4 * std::sin(0.3 * static_cast<double>(i));
+  ASSERT_EQ(texel_encode_with(wave.data(), wave.size(), 0.0053, &o, &raw), TEXEL_OK) << texel_last_error();
+  ASSERT_EQ(texel_encode_result_flags(raw, &f), TEXEL_OK);
+  EXPECT_EQ(f.model_version, 1);
+  EXPECT_EQ(f.no_texture, 0);
+  texel_encode_result_destroy(raw);
+  o.model_version = 3;
+  EXPECT_FAILS(texel_encode_with(wave.data(), wave.size(), 0.0053, &o, &raw), TEXEL_INVALID_ARGUMENT, "model_version");
+}
+
 }  // namespace

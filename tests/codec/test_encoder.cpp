@@ -45,7 +45,7 @@ std::vector<double> sines(std::initializer_list<std::pair<double, double>> parts
   return y;
 }
 
-TEST(Encoder, AcceptanceCase) {
+TEST(Encoder, TexelRenderingEncodesToItsPitchWithinHalfADbInAtMost16Bytes) {
   // texel render --central-pitch 8 --irregularity 0 --texel-length 0.5 --seed 3 --device tpad
   TexelSpec s;
   s.central_pitch = Decibels(8.0);
@@ -231,11 +231,17 @@ TEST_P(EncoderTrends, WaveformsNearTheirFundamental) {
     EXPECT_NEAR(p, 0.0, 2.5);
     EXPECT_LT(p, two_sines - 1.0);
   }
-  EXPECT_LT(tri, square);
-  EXPECT_LT(square, saw);
+  // Version 1 also pulled them up in the order of the harmonics' strength
+  // (tri < square < saw); people put all three at the fundamental, and
+  // version 2 keeps them within 0.6 dB of it in another order.
+  if (config().model.version == 1) {
+    EXPECT_LT(tri, square);
+    EXPECT_LT(square, saw);
+  }
   // The model before (amplitude weighting, threshold sensitivity, no display)
   // put square and saw at 4.7 and 5.7 dB: its switches still reproduce that.
   EncoderConfig before;
+  before.model = model_defaults(1);
   before.model.weight_exponent = 1.0;
   before.model.sensitivity_scale = 1.0;
   EXPECT_GT(encode_reference("square", before).spec.central_pitch.value(), 4.0);
@@ -286,8 +292,10 @@ TEST(Encoder, RejectsUnusableInput) {
 // felt where it is whatever the display; the physical terms do not change.
 TEST(DisplayInTheLoop, LowPassPullsFeltPitchTowardTheLowComponent) {
   const double dx = load_device("tpad").spacing.value();
-  PerceptualModel flat;
-  PerceptualModel lowpass;
+  // The effect as documented for version 1 (per-bin weighting); version 2's
+  // octave bands and cubed weights already feel this pair at its low component.
+  PerceptualModel flat = model_defaults(1);
+  PerceptualModel lowpass = model_defaults(1);
   lowpass.display = load_device("tpad").response;  // first order, 400 Hz: 4 cpm at 100 mm/s
   lowpass.display_response = PerceptualModel::Display::device;
   // 2 cpm (200 Hz) and 8 cpm (800 Hz), equal amplitude: the display passes
@@ -335,7 +343,12 @@ TEST(DisplayInTheLoop, LowPassPullsFeltPitchTowardTheLowComponent) {
 // their fundamental. (The fit keeps them too, anchored by the texture as
 // drawn: EncoderTrends/tpad above.)
 TEST(DisplayInTheLoop, FeltTrendsHoldThroughTheTpad) {
-  PerceptualModel m;
+  // Version 1's percepts (the figures of docs/encoder.md §2). Version 2 is
+  // judged on what the fit returns (EncoderTrends, and texel_fit_model): its
+  // raw percept of saw is 2.6 dB and of the f_c = 1 cpm bands' noisiness
+  // flat within 0.02 dB, while its fitted Central Pitch and Irregularity
+  // keep every trend.
+  PerceptualModel m = model_defaults(1);
   m.display = load_device("tpad").response;
   m.display_response = PerceptualModel::Display::device;
   const DeviceProfile d = load_device("tpad");
@@ -455,6 +468,93 @@ TEST(DisplayInTheLoop, TheFitIsAnchoredByTheTextureAsDrawn) {
   EncoderConfig bad = anchored;
   bad.model.drawn_weight = -1.0;
   EXPECT_THROW((void)encode(render_signal(s), bad), InvalidArgument);
+}
+
+// Honest results (docs/encoder.md, "Honest results"): inputs without
+// texture are flagged or refused; values at an edge of the search box are
+// flagged and make Irregularity not identifiable.
+TEST(HonestResults, InputsWithoutTextureAreFlaggedOrRefused) {
+  const double dx = load_device("tpad").spacing.value();
+  std::vector<double> tiny(19200, 0.5);
+  for (std::size_t i = 0; i < tiny.size(); ++i) tiny[i] += (i % 2 ? 1.0 : -1.0) * 0.5 * no_texture_floor;  // RMS half the floor
+  for (const auto& [name, a] :
+       std::vector<std::pair<std::string, std::vector<double>>>{{"all zero", std::vector<double>(19200, 0.0)},
+                                                                {"constant", std::vector<double>(19200, 0.7)},
+                                                                {"below the floor", tiny}}) {
+    const EncodeResult r = encode(codec::Signal{a, Millimetres(dx), name}, EncoderConfig{});
+    EXPECT_TRUE(r.no_texture) << name;
+    EXPECT_LE(r.texture_rms, no_texture_floor) << name;
+    EXPECT_EQ(r.spec.fine_strength, 0.0) << name;  // a flat surface
+    EXPECT_EQ(r.evaluations, 0) << name;           // nothing fitted
+    EncoderConfig refuse;
+    refuse.no_texture = EncoderConfig::NoTexture::refuse;
+    try {
+      (void)encode(codec::Signal{a, Millimetres(dx), name}, refuse);
+      ADD_FAILURE() << name << ": not refused";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("no texture"), std::string::npos) << e.what();
+    }
+  }
+  // Just above the floor is a texture (a faint one): encoded, not flagged.
+  std::vector<double> faint(19200, 0.5);
+  for (std::size_t i = 0; i < faint.size(); ++i) faint[i] += 0.001 * std::sin(0.05 * static_cast<double>(i));
+  EXPECT_FALSE(encode(codec::Signal{faint, Millimetres(dx), "faint"}, EncoderConfig{}).no_texture);
+  EXPECT_EQ(parse_no_texture("refuse"), EncoderConfig::NoTexture::refuse);
+  EXPECT_THROW((void)parse_no_texture("ignore"), InvalidArgument);
+}
+
+TEST(HonestResults, ValuesAtTheSearchBoundAreFlagged) {
+  // A wide band fits the lognormal family at the top of its Irregularity box.
+  const EncodeResult wide = encode_reference("bandpass-f20-z5");
+  std::printf("bandpass-f20-z5: P %.2f dB, I %.2f dB, at bound P %d I %d, identifiable %d\n", wide.spec.central_pitch.value(),
+              wide.spec.irregularity.value(), wide.at_bound.central_pitch, wide.at_bound.irregularity,
+              wide.irregularity_identifiable);
+  EXPECT_TRUE(wide.at_bound.irregularity);
+  EXPECT_FALSE(wide.irregularity_identifiable);
+  // Content at the grid's Nyquist frequency: Central Pitch at the top of its box.
+  const DeviceProfile d = load_device("tpad");
+  std::vector<double> nyquist(19200);
+  for (std::size_t i = 0; i < nyquist.size(); ++i) nyquist[i] = 0.5 + 0.4 * (i % 2 ? 1.0 : -1.0);
+  const EncodeResult top = encode(codec::Signal{nyquist, d.spacing, "nyquist"}, EncoderConfig{});
+  std::printf("Nyquist: P %.2f dB, I %.2f dB, at bound P %d I %d\n", top.spec.central_pitch.value(),
+              top.spec.irregularity.value(), top.at_bound.central_pitch, top.at_bound.irregularity);
+  EXPECT_TRUE(top.at_bound.central_pitch);
+  EXPECT_FALSE(top.irregularity_identifiable);
+  // A texture inside the box: no flag.
+  TexelSpec s;
+  s.central_pitch = Decibels(8.0);
+  s.irregularity = Decibels(0.0);
+  const EncodeResult inside = encode(render_signal(s), EncoderConfig{});
+  EXPECT_FALSE(inside.at_bound.any());
+  EXPECT_FALSE(inside.no_texture);
+}
+
+TEST(ModelVersions, VersionOneStaysSelectableAndIsNamedInTheResult) {
+  EncoderConfig v1;
+  v1.model = model_defaults(1);
+  v1.model.display = load_device("tpad").response;
+  const EncodeResult a = encode_reference("2sin", v1);
+  EXPECT_EQ(a.model_version, 1);
+  // The model before, bit for bit: main's `texel encode 2sin.texel.json --device tpad --estimate` gave 4.49 dB.
+  EXPECT_NEAR(a.spec.central_pitch.value(), 4.49, 0.005);
+  EncoderConfig v2;
+  v2.model.display = load_device("tpad").response;
+  const EncodeResult b = encode_reference("2sin", v2);
+  EXPECT_EQ(b.model_version, 2);
+  EXPECT_EQ(PerceptualModel{}.version, 2);
+  EXPECT_THROW((void)model_defaults(3), InvalidArgument);
+  EncoderConfig bad;
+  bad.model.version = 7;
+  EXPECT_THROW((void)encode_reference("2sin", bad), InvalidArgument);
+}
+
+TEST(ResultJson, OneSerialisationNamesTheModelTheFlagsAndTheDistance) {
+  const EncodeResult r =
+      encode(codec::Signal{std::vector<double>(19200, 0.0), load_device("tpad").spacing, "zero"}, EncoderConfig{});
+  const std::string j = to_json(r);
+  for (const char* key : {"\"distance_jnd\"", "\"version\":2", "\"no_texture\":true", "\"at_bound\"", "\"central_pitch\":false",
+                          "\"irregularity_identifiable\""})
+    EXPECT_NE(j.find(key), std::string::npos) << key << " in " << j;
 }
 
 TEST(Encoder, PerceptualModelShape) {

@@ -155,6 +155,12 @@ TEST(Rater, RatingsAreOnTheScaleAndFallWithDistance) {
   EXPECT_THROW(Rater(RaterConfig{.scale_min = 5, .scale_max = 1}), texel::InvalidArgument);
 }
 
+TEST(PerceptualTarget, SimulatedObserversFeelWithTheEncodersDefaultModel) {
+  // 2sin through the tpad: version 2 of the perceptual model puts it at
+  // 5.41 dB (people: 4.8 dB), version 1 at 4.49 dB (docs/encoder.md §2).
+  EXPECT_NEAR(perceptual_target("2sin").pitch_db, 5.41, 0.005);
+}
+
 TEST(PerceptualTarget, ReferenceThroughTheEncoderLiesInTheDeviceBox) {
   const MatchPoint p = perceptual_target("4sin");
   EXPECT_TRUE(std::isfinite(p.pitch_db));

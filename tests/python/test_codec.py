@@ -26,6 +26,25 @@ def test_encode_array_equals_cli_bitstream(encoded):
     assert r.model_distance >= 0
 
 
+def test_encode_result_names_model_flags_and_serialises_like_the_cli(encoded, cli, tmp_path):
+    import json
+    src, _ = encoded
+    r = texel.encode(str(src), device="tpad")
+    assert r.distance_jnd == r.model_distance  # the old name, readable for a release
+    assert r.model_version == 2 and not r.no_texture
+    assert r.at_bound == {"central_pitch": False, "irregularity": False}
+    j = json.loads(r.to_json())
+    c = json.loads(cli("encode", src, "--device", "tpad", "--json").stdout)
+    assert j["model"]["version"] == c["model"]["version"] == 2
+    assert j["model"]["distance_jnd"] == c["model"]["distance_jnd"]
+    assert j["estimate"] == c["estimate"]
+    assert texel.encode(str(src), device="tpad", model=1).model_version == 1
+    flat = np.full(19200, 0.5)
+    assert texel.encode(flat).no_texture
+    with pytest.raises(ValueError, match="no texture"):
+        texel.encode(flat, no_texture="refuse")
+
+
 def test_encode_fit_method_equals_the_cli(cli, tmp_path):
     src = tmp_path / "saw.bin"
     cli("reference", "saw", "--device", "tpad", "-o", src)
