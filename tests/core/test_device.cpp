@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/device.hpp"
 #include "texel/error.hpp"
@@ -35,12 +36,7 @@ const char* const valid_profile = R"({
 })";
 
 std::string parse_error(const std::string& json) {
-  try {
-    parse_device_profile(json, "test.json");
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "(no FormatError)";
+  return test_support::message_of<FormatError>([&] { parse_device_profile(json, "test.json"); });
 }
 
 /// valid_profile with one "key": value replaced or added.
@@ -134,7 +130,7 @@ TEST(Device, UnknownNameListsTheBuiltins) {
 }
 
 TEST(Device, BadProfilesAreRejectedNamingTheField) {
-  EXPECT_EQ(parse_error(valid_profile), "(no FormatError)");
+  EXPECT_EQ(parse_error(valid_profile), "(no exception)");
   struct Case {
     std::string key, value, expect;
   };

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/expect.hpp"
 #include "texel/distribution.hpp"
 #include "texel/error.hpp"
 
@@ -67,14 +68,7 @@ Moments moments(const std::vector<double>& x) {
 
 double phi(double z) { return 0.5 * std::erfc(-z / std::numbers::sqrt2); }  // C library reference
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  return "(no InvalidArgument thrown)";
-}
+std::string message_of(const std::function<void()>& f) { return test_support::message_of<InvalidArgument>(f); }
 
 }  // namespace
 

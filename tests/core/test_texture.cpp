@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/grids.hpp"
 #include "texel/device.hpp"
 #include "texel/error.hpp"
 #include "texel/reference.hpp"
@@ -26,7 +27,7 @@ using namespace texel;
 
 namespace {
 
-constexpr double tpad_dx = 0.0053;
+using test_support::tpad_dx;
 constexpr double tpad_nyquist = 0.5 / tpad_dx;
 
 TexelTexture make(const TexelSpec& spec, double length_mm = 101.76) {
@@ -39,9 +40,7 @@ std::vector<double> render(const TexelTexture& t, const Grid& g) {
   return out;
 }
 
-Grid tpad_grid(double length_mm = 101.76) {
-  return Grid{Millimetres(0.0), Millimetres(tpad_dx), static_cast<std::int64_t>(std::llround(length_mm / tpad_dx))};
-}
+Grid tpad_grid(double length_mm = 101.76) { return test_support::tpad_grid(length_mm); }
 
 double ref_sin(double cycles) { return std::sin(2.0 * std::numbers::pi * cycles); }
 
