@@ -2,7 +2,7 @@
 // density against spatial frequency (cycles/mm), peak lists, spectral
 // centroids (linear and log-frequency, dB re 1 cycle/mm), spread, band
 // energy, and the temporal-frequency view for a swipe speed
-// (Hz = cycles/mm × mm/s, rendering.md §2).
+// (Hz = cycles/mm × mm/s, docs/algorithm.md §2).
 //
 // The FFT is KISS FFT (BSD-3, Debian's libkissfft-dev), wrapped in one place
 // (src/spectrum/fft.cpp) so it can be swapped. Its "plan" depends only on the

@@ -35,7 +35,7 @@ struct Rect {
 enum class HAlign { left, centre, right };
 enum class VAlign { top, middle, bottom };
 
-/// dB re 1 cycle/mm of f (power form, rendering.md §2), rounded for a label.
+/// dB re 1 cycle/mm of f (power form, docs/algorithm.md §2), rounded for a label.
 inline std::string db_text(double f) {
   const double db = 10.0 * std::log10(f);
   const double rounded = std::round(db);

@@ -1,4 +1,4 @@
-// Coarse profiles (coarse.hpp, rendering.md §7): c_k sampled at texel centres
+// Coarse profiles (coarse.hpp, docs/algorithm.md §7): c_k sampled at texel centres
 // for each kind, validation, and the position_mm,value CSV reader.
 #include <gtest/gtest.h>
 

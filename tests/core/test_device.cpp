@@ -1,4 +1,4 @@
-// Device profiles (device.hpp, rendering.md §8): built-ins, user profiles from
+// Device profiles (device.hpp, docs/algorithm.md §8): built-ins, user profiles from
 // a path and from TEXEL_DEVICE_PATH, validation naming the field, grid
 // overrides, and the sample encoders (round(a·65535) for u16).
 #include <gtest/gtest.h>
@@ -63,7 +63,7 @@ TEST(Device, BuiltinsLoad) {
 }
 
 TEST(Device, TpadIsTheReferenceDevice) {
-  // rendering.md §8: 19,200 unsigned 16-bit values, one per 0.0053 mm.
+  // docs/algorithm.md §8: 19,200 unsigned 16-bit values, one per 0.0053 mm.
   const DeviceProfile d = load_device("tpad");
   EXPECT_EQ(d.samples, 19200);
   EXPECT_EQ(d.spacing.value(), 0.0053);

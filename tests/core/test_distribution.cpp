@@ -1,4 +1,4 @@
-// The texel-frequency distribution (rendering.md §4, §5).
+// The texel-frequency distribution (docs/algorithm.md §4, §5).
 //
 // Statistical tolerances (stated once, used throughout): each test draws
 // n = 10^5 texel frequencies with a fixed seed and requires a sample statistic

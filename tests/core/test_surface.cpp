@@ -1,4 +1,4 @@
-// Surfaces (surface.hpp, rendering.md §8): a device split into regions, each
+// Surfaces (surface.hpp, docs/algorithm.md §8): a device split into regions, each
 // with its own texture. Each half of the studies' left/right layout must equal
 // its texture rendered alone; samples in no region are at rest; regions must
 // not overlap; any window equals the whole map.

@@ -1,4 +1,4 @@
-// The Texel texture (rendering.md §6, §7): phase continuity at texel
+// The Texel texture (docs/algorithm.md §6, §7): phase continuity at texel
 // boundaries, the strength formulas and their corner cases, the seed's effect
 // on fine but not coarse layout, determinism and window independence, fill.
 //

@@ -1,5 +1,5 @@
 // Units as types (units.hpp): literals, same-unit arithmetic, the dB scale of
-// rendering.md §2 (power form, re 1 cpm), and that different units do not mix.
+// docs/algorithm.md §2 (power form, re 1 cpm), and that different units do not mix.
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
@@ -63,7 +63,7 @@ TEST(Units, SameUnitArithmetic) {
 }
 
 TEST(Units, DecibelScaleIsPowerFormRe1Cpm) {
-  // rendering.md §2: 10 cpm = 10 dB, 1 cpm = 0 dB, 0.1 cpm = −10 dB, 94 cpm ≈ 19.7 dB.
+  // docs/algorithm.md §2: 10 cpm = 10 dB, 1 cpm = 0 dB, 0.1 cpm = −10 dB, 94 cpm ≈ 19.7 dB.
   EXPECT_NEAR(to_cpm(10_dB).value(), 10.0, 1e-14);
   EXPECT_NEAR(to_cpm(0_dB).value(), 1.0, 1e-15);
   EXPECT_NEAR(to_cpm(-10_dB).value(), 0.1, 1e-16);

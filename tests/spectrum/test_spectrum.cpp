@@ -1,6 +1,6 @@
 // Spectral analysis: calibration against analytic signals, peak picking,
 // Welch PSD, summaries, and the texel-versus-sum-of-sinusoids property of
-// rendering.md §10. Each test states its tolerance.
+// docs/algorithm.md §10. Each test states its tolerance.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -91,7 +91,7 @@ TEST(SpectrumErrors, BadInputIsNamed) {
 }
 
 TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
-  // rendering.md §10: N texels of length L/N with frequencies f_i versus the
+  // docs/algorithm.md §10: N texels of length L/N with frequencies f_i versus the
   // equally weighted sum of the N sinusoids over L. Rectangular window (the
   // property is about the plain DFT), 16× zero padding. For each f_i the
   // Texel rendering's highest peak within ±2N/L sits at f_i within 0.05·N/L
