@@ -98,7 +98,7 @@ endfunction()
 # step (tests/consumer loads one component and checks what comes along).
 set(TEXEL_COMPONENTS core controller spectrum plot player io codec experiment studio capi)
 set(TEXEL_COMPONENT_NEEDS_core "")
-set(TEXEL_COMPONENT_NEEDS_controller "")
+set(TEXEL_COMPONENT_NEEDS_controller core)
 set(TEXEL_COMPONENT_NEEDS_spectrum core)
 set(TEXEL_COMPONENT_NEEDS_plot core spectrum)
 set(TEXEL_COMPONENT_NEEDS_player core controller spectrum)

@@ -1,4 +1,4 @@
-// texel reference: one reference texture (references.md) on a device, in any
+// texel reference: one reference texture (docs/references.md) on a device, in any
 // output format `render` writes; --list names every generator and its
 // parameters.
 // texel atlas: every reference with its spectrum plot, and the overview of

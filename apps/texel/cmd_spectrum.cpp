@@ -90,7 +90,7 @@ ordered report_json(const Args& a, const Signal& sig, const SpectralReport& r) {
     pj["frequency_db"] = db_of(p.frequency.value());
     if (v) pj["frequency_hz"] = temporal(p.frequency, *v).value();
     pj["amplitude"] = p.amplitude;
-    pj["level_db"] = p.level_db;
+    pj["level_db"] = p.level.value();
     j["peaks"].push_back(pj);
   }
   const auto& s = r.summary;
@@ -131,7 +131,7 @@ void print_report(const Args& a, const Signal& sig, const SpectralReport& r) {
   std::cout << "  frequency_cpm      dB re 1 cpm   amplitude   level_dB" << (v ? "   frequency_Hz" : "") << "\n";
   for (const auto& p : r.peaks) {
     std::cout << "  " << std::setw(13) << fixed(p.frequency.value(), 4) << std::setw(14) << fixed(db_of(p.frequency.value()), 2)
-              << std::setw(12) << fixed(p.amplitude, 5) << std::setw(11) << fixed(p.level_db, 2);
+              << std::setw(12) << fixed(p.amplitude, 5) << std::setw(11) << fixed(p.level.value(), 2);
     if (v) std::cout << std::setw(15) << fixed(p.frequency.value() * *v, 2);
     std::cout << "\n";
   }
@@ -154,15 +154,15 @@ SpectrumPlot make_spectrum_plot(const std::string& title, const Signal& sig, con
   SpectrumPlot p;
   p.title = title;
   const double length = static_cast<double>(sig.samples.size()) * sig.spacing.value();
-  p.excerpt_mm = std::min(6.0, length);
-  const auto n = std::min(sig.samples.size(), static_cast<std::size_t>(std::ceil(p.excerpt_mm / sig.spacing.value())) + 1);
+  p.excerpt = Millimetres(std::min(6.0, length));
+  const auto n = std::min(sig.samples.size(), static_cast<std::size_t>(std::ceil(p.excerpt / sig.spacing)) + 1);
   for (std::size_t i = 0; i < n; ++i) {
     p.positions_mm.push_back(sig.origin.value() + static_cast<double>(i) * sig.spacing.value());
     p.amplitudes.push_back(sig.samples[i]);
   }
   p.spectrum = r.spectrum;
   p.peaks = r.peaks;
-  p.swipe_speed_mm_s = swipe_speed_mm_s;
+  if (swipe_speed_mm_s) p.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
   return p;
 }
 
@@ -171,7 +171,7 @@ SpectrumPlot make_spectrum_plot(const std::string& title, const Signal& sig, con
 std::vector<mat::Variable> spectrum_variables(const std::string& source, const Signal& sig, const SpectralReport& r) {
   using mat::Matrix;
   std::vector<double> pf, pa, pl;
-  for (const Peak& p : r.peaks) pf.push_back(p.frequency.value()), pa.push_back(p.amplitude), pl.push_back(p.level_db);
+  for (const Peak& p : r.peaks) pf.push_back(p.frequency.value()), pa.push_back(p.amplitude), pl.push_back(p.level.value());
   mat::Struct peaks;
   peaks.add("frequency_cpm", Matrix::column(std::move(pf)))
       .add("amplitude", Matrix::column(std::move(pa)))
@@ -244,7 +244,7 @@ void register_spectrum(CLI::App& app) {
     opt.welch.overlap = a->welch_overlap;
     if (!(a->welch_overlap >= 0.0 && a->welch_overlap <= 0.95))
       throw InvalidArgument("--welch-overlap is " + num(a->welch_overlap) + "; allowed: 0 … 0.95");
-    opt.peaks.threshold_db = a->threshold_db;
+    opt.peaks.threshold = DecibelsLevel(a->threshold_db);
     opt.peaks.max_peaks = a->max_peaks;
     for (const auto& b : a->bands) opt.bands.push_back(parse_band(b));
 

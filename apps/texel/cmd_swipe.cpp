@@ -67,13 +67,13 @@ void run(const SwipeArgs& a) {
   if (a.plot) {
     SwipePlot p;
     p.title = "Swipe: " + std::string(to_string(config.mode)) + " at " + detail::num(config.rate_hz) + " Hz";
-    p.rate_hz = config.rate_hz;
+    p.rate = Hertz(config.rate_hz);
     p.positions_mm = positions;
     p.output = out;
     p.output_label = std::string(to_string(config.mode));
     p.frequency_hz = spectrum.frequency_hz;
     p.magnitude = spectrum.magnitude;
-    p.marker_hz = peak;
+    p.marker = Hertz(peak);
     files.push_back({*a.plot, render_figure(swipe_figure(p), plot_format_for_path(*a.plot))});
   }
   if (ext == ".wav") write_wav(a.output, out, config.rate_hz, encoding);

@@ -180,7 +180,7 @@ void write_rendered(const std::string& path, const Document& doc, const Surface&
       for (std::size_t i = 0; i < map.size(); ++i) plot.positions_mm[i] = g.position(static_cast<std::int64_t>(i)).value();
       plot.amplitudes = map;
       plot.frequencies_cpm = frequencies_cpm;
-      plot.excerpt_mm = std::min(6.0, g.length().value());
+      plot.excerpt = Millimetres(std::min(6.0, g.length().value()));
       plot_map(plot, path);  // atomic on its own
       commit_extras_after(path, extra);
       return;

@@ -1,4 +1,4 @@
-// Coarse texture profiles (rendering.md §7): one value c_k in [0, 1] per
+// Coarse texture profiles (docs/algorithm.md §7): one value c_k in [0, 1] per
 // texel, sampled at the texel's centre from a function of position.
 //
 // Kinds: constant (the fine-only studies), a sinusoid of given period and

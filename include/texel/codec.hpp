@@ -10,7 +10,7 @@
 //     of about two fine periods, smoothed by a moving average one boundary
 //     long. A flat envelope is a fine-only texture; otherwise its values at
 //     the texel centres become the coarse profile c_k with strengths C and F
-//     (rendering.md §7: e_k = 1 − C(1 − c_k), trough/peak = 1 − F).
+//     (docs/algorithm.md §7: e_k = 1 − C(1 − c_k), trough/peak = 1 − F).
 //  2. Fine part by analysis-by-synthesis. A perceptual model maps a signal to
 //     a felt pitch (the mean frequency weighted by suprathreshold
 //     sensitivity and amplitude, raised so the strongest components

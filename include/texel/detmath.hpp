@@ -3,7 +3,7 @@
 // The C library's exp/log/sin are allowed to differ by an ulp between
 // implementations (glibc, musl, MSVC, Apple), and a compiler may constant-fold
 // them differently; a texture file must render to the same bytes everywhere
-// (rendering.md §9). Everything that feeds rendered samples therefore goes
+// (docs/algorithm.md §9). Everything that feeds rendered samples therefore goes
 // through these functions, built only from IEEE-754 +, -, *, / and exact
 // operations (frexp/ldexp-style bit manipulation, integer rounding), compiled
 // with -ffp-contract=off. Accuracy is a few ulp, far below the 16-bit output

@@ -1,4 +1,4 @@
-// Device profiles are data, not code paths (rendering.md §8): a JSON file per
+// Device profiles are data, not code paths (docs/algorithm.md §8): a JSON file per
 // device gives its sample grid, value format, refresh rate and band. Built-in
 // profiles (devices/*.json, compiled in) are found by name; users add their
 // own as files, by path or in a directory listed in TEXEL_DEVICE_PATH.

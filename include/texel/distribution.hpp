@@ -1,4 +1,4 @@
-// The texel-frequency distribution (rendering.md §4, §5).
+// The texel-frequency distribution (docs/algorithm.md §4, §5).
 //
 // Lognormal in two parameterizations:
 //  - moments (default, the source's): Central Pitch is the mean m and

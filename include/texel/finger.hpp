@@ -59,7 +59,7 @@ std::vector<FingerSample> load_trace_csv(const std::string& path);
 /// Writes "time_s,position_mm,touch" with one row per sample.
 std::string trace_csv(std::span<const FingerSample> trace);
 
-/// Swipe behaviour of a trace (experiments.md "Measures"). Speeds are taken
+/// Swipe behaviour of a trace (docs/procedures.md §7). Speeds are taken
 /// between consecutive samples that both touch: v_i = Δx/Δt.
 struct SwipeMeasures {
   std::size_t intervals = 0;     ///< touched intervals used

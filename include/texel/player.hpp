@@ -1,6 +1,6 @@
 // The real-time player: finger positions in, drive values out.
 //
-// config → prepare → process (style.md). A PlayerMap is the prepared,
+// config → prepare → process (docs/contributing.md §1). A PlayerMap is the prepared,
 // immutable amplitude map of a whole surface (all regions) on its device
 // grid; a Player is built from a PlayerConfig (allocating everything it will
 // ever need), then process() turns the finger stream into output samples at a

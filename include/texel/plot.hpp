@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "texel/units.hpp"
+
 namespace texel {
 
 // ---------------------------------------------------------------- figure layer
@@ -255,8 +257,8 @@ struct MapPlot {
   std::vector<double> positions_mm;     ///< x of each sample (mm), ascending
   std::vector<double> amplitudes;       ///< a in [0, 1] of each sample
   std::vector<double> frequencies_cpm;  ///< texel frequencies for the histogram (cycles/mm; may be empty)
-  double excerpt_mm = 6.0;              ///< length of the zoomed excerpt from the first sample (mm); 0 = none
-  double central_pitch_cpm = 0.0;       ///< > 0: marked on the histogram (cycles/mm)
+  Millimetres excerpt{6.0};             ///< length of the zoomed excerpt from the first sample; 0 = none
+  CyclesPerMm central_pitch{0.0};       ///< > 0: marked on the histogram
   int width_px = 1000;                  ///< plot_map image width, px
   int height_px = 0;                    ///< plot_map image height, px; 0 = 260 per panel
 };

@@ -1,5 +1,5 @@
 // Texel's own random numbers, specified so that a texture file re-creates the
-// same draw on every platform and compiler (rendering.md §9).
+// same draw on every platform and compiler (docs/algorithm.md §9).
 //
 // Counter-based: a draw is a pure function of (seed, stream, counter), so the
 // frequency of texel k is computed without drawing texels 0..k-1. That gives

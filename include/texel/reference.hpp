@@ -1,4 +1,4 @@
-// Reference textures (docs: /spec/references.md): every texture the Texel
+// Reference textures (docs/references.md): every texture the Texel
 // method was validated against, generated on the same device grid and
 // amplitude scale as Texel renderings, deterministic from a seed.
 //
@@ -16,7 +16,7 @@
 // Method and trade-off. Every signal-defined reference (noise, sinusoids,
 // waveforms) is a finite sum of sinusoids
 //     y(x) = Σ_k a_k · sin(2π(f_k·x + φ_k))
-// mapped to amplitude by a = 0.5 + 0.5·y / max|y| (references.md [choice];
+// mapped to amplitude by a = 0.5 + 0.5·y / max|y| (docs/references.md §1 [choice];
 // max over the prepared grid's samples). Noise is Gaussian noise specified in
 // the frequency domain: components sit at the harmonics k/P of the texture's
 // length P (the bins of a DFT over the whole texture), with Rayleigh
@@ -243,7 +243,7 @@ class ReferenceTexture final : public Texture {
 /// = the texture's left edge), over the grid's length.
 std::vector<double> render_reference(const ReferenceSpec& spec, const Grid& grid);
 
-/// A reference as a coarse profile (references.md, coarse-feature study):
+/// A reference as a coarse profile (docs/references.md §7, coarse-feature study):
 /// the reference prepared over `length` and sampled every `spacing`.
 SampledProfile reference_profile(const ReferenceSpec& spec, Millimetres length, Millimetres spacing);
 

@@ -2,7 +2,7 @@
 // density against spatial frequency (cycles/mm), peak lists, spectral
 // centroids (linear and log-frequency, dB re 1 cycle/mm), spread, band
 // energy, and the temporal-frequency view for a swipe speed
-// (Hz = cycles/mm × mm/s, rendering.md §2).
+// (Hz = cycles/mm × mm/s, docs/algorithm.md §2).
 //
 // The FFT is KISS FFT (BSD-3, Debian's libkissfft-dev), wrapped in one place
 // (src/spectrum/fft.cpp) so it can be swapped. Its "plan" depends only on the
@@ -27,6 +27,7 @@
 #include <string_view>
 #include <vector>
 
+#include "texel/level.hpp"
 #include "texel/units.hpp"
 
 namespace texel {
@@ -86,14 +87,14 @@ Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOpt
 struct Peak {
   CyclesPerMm frequency;   ///< interpolated peak frequency
   double amplitude = 0.0;  ///< interpolated peak height (magnitude units)
-  double level_db = 0.0;   ///< 20·log10(amplitude / highest peak's amplitude), <= 0
+  DecibelsLevel level;     ///< 20·log10(amplitude / highest peak's amplitude), <= 0
 };
 
 struct PeakOptions {
-  double threshold_db = -40.0;     ///< keep peaks within this many dB of the highest
+  DecibelsLevel threshold{-40.0};  ///< keep peaks within this many dB of the highest
   std::size_t max_peaks = 32;      ///< strongest first, then reported by frequency
-  double min_frequency_cpm = 0.0;  ///< ignore bins below (DC is always ignored)
-  double max_frequency_cpm = std::numeric_limits<double>::infinity();
+  CyclesPerMm min_frequency{0.0};  ///< ignore bins below (DC is always ignored)
+  CyclesPerMm max_frequency{std::numeric_limits<double>::infinity()};
 };
 
 /// Local maxima that dominate ±(window main-lobe half-width) bins (so leakage

@@ -18,11 +18,11 @@ struct SpectrumPlot {
   std::string title;                       ///< figure title; empty = "Spectrum"
   std::vector<double> positions_mm;        ///< x of each map sample (mm), ascending
   std::vector<double> amplitudes;          ///< a of each map sample
-  double excerpt_mm = 6.0;                 ///< excerpt length from the first sample (mm); 0 = no excerpt panel
+  Millimetres excerpt{6.0};                ///< excerpt length from the first sample; 0 = no excerpt panel
   Spectrum spectrum;                       ///< from magnitude_spectrum()
   std::vector<Peak> peaks;                 ///< marked as stems (may be empty)
-  std::optional<double> swipe_speed_mm_s;  ///< > 0: add the temporal-frequency panel
-  double range_db = 80.0;                  ///< magnitude axis spans the top range_db dB (10 … 200)
+  std::optional<MmPerSecond> swipe_speed;  ///< > 0: add the temporal-frequency panel
+  DecibelsLevel range{80.0};               ///< the magnitude axis spans the top `range` dB (10 … 200)
   int width_px = 1000;
   int height_px = 0;  ///< 0 = 280 per panel
 };

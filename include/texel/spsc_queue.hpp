@@ -1,6 +1,6 @@
 // A fixed-capacity, lock-free, single-producer / single-consumer ring.
 //
-// The only way control data reaches the real-time thread (style.md, "Real-time
+// The only way control data reaches the real-time thread (docs/contributing.md §2, "Real-time
 // code"): one thread pushes, one other thread pops, neither ever blocks,
 // allocates or frees. The ring is allocated once, by the constructor (in
 // prepare), with a capacity chosen then; push and pop never touch the heap.

@@ -1,5 +1,5 @@
 // A Surface is a device's active length split into regions, each holding its
-// own prepared Texture (rendering.md §8: the studies put a reference on the
+// own prepared Texture (docs/algorithm.md §8: the studies put a reference on the
 // left half, 50.88 mm, and the texture under test on the right). Samples that
 // fall in no region are at rest (0).
 #pragma once

@@ -8,19 +8,20 @@
 #include <vector>
 
 #include "texel/plot.hpp"
+#include "texel/units.hpp"
 
 namespace texel {
 
 struct SwipePlot {
   std::string title;                ///< figure title; empty = "Swipe"
-  double rate_hz = 48000.0;         ///< output sample rate (Hz)
+  Hertz rate{48000.0};              ///< output sample rate
   std::vector<float> positions_mm;  ///< finger position per output sample (mm)
   std::vector<float> output;        ///< output samples
   std::string output_label = "output";
   std::vector<double> frequency_hz;  ///< spectrum bins (Hz)
   std::vector<double> magnitude;     ///< spectrum magnitudes (linear)
-  double marker_hz = 0.0;            ///< > 0: a labelled marker (e.g. the expected pitch × speed)
-  double excerpt_s = 0.02;           ///< length of the zoomed output excerpt (s); 0 = none
+  Hertz marker{0.0};                 ///< > 0: a labelled marker (e.g. the expected pitch × speed)
+  Seconds excerpt{0.02};             ///< length of the zoomed output excerpt; 0 = none
   int width_px = 1000;
   int height_px = 0;  ///< 0 = 240 per panel
 };

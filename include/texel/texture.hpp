@@ -6,7 +6,7 @@
 // outside [0, length) are at rest (0).
 //
 // `TexelSpec` is the configuration of a multi-scale Texel texture
-// (rendering.md §3–§7): the fine texture is defined by (pitch distribution,
+// (docs/algorithm.md §3–§7): the fine texture is defined by (pitch distribution,
 // texel length, seed) alone; the coarse profile and strengths shape its
 // envelope. `TexelTexture` is its prepared form: per-texel frequency, start
 // phase and envelope, computed once (texel k's draw depends only on k, so this
@@ -54,7 +54,7 @@ class Texture {
 /// renderable band (0 = the grid's Nyquist frequency). Texel textures bound
 /// their pitch distribution by `band_top` when their spec leaves band_max at
 /// 0; references are defined up to the grid's Nyquist frequency
-/// (references.md) and take their amplitude scale from the grid's samples.
+/// (docs/references.md) and take their amplitude scale from the grid's samples.
 struct Sampling {
   Grid grid;
   CyclesPerMm band_top{0.0};

@@ -5,7 +5,7 @@
 // A Quantity is a double with a tag. Same-unit arithmetic is allowed;
 // conversions between units are explicit functions (to_cpm, to_db, ...).
 // The dB scale is the spec's power form: X_dB = 10·log10(X / 1 cpm)
-// (rendering.md §2), so 10 cpm = 10 dB and 0.1 cpm = -10 dB.
+// (docs/algorithm.md §2), so 10 cpm = 10 dB and 0.1 cpm = -10 dB.
 #pragma once
 
 #include <compare>

@@ -429,7 +429,7 @@ The GIL is released while encoding.)doc");
           py::dict pd;
           pd["frequency_cpm"] = p.frequency.value();
           pd["amplitude"] = p.amplitude;
-          pd["level_db"] = p.level_db;
+          pd["level_db"] = p.level.value();
           peaks.append(pd);
         }
         d["peaks"] = peaks;

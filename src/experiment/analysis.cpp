@@ -40,7 +40,7 @@ namespace {
 using json = nlohmann::ordered_json;
 using Rows = std::vector<const TrialRow*>;
 
-// Studies in the order of experiments.md, which is the summary's key order.
+// Studies in the order of docs/procedures.md §6, which is the summary's key order.
 const std::vector<std::string>& study_order() {
   static const std::vector<std::string> order{"texel-length",       "parameter-mapping", "free-exploration", "quantization",
                                               "guided-exploration", "coarse-features",   "working-memory"};

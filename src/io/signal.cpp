@@ -71,7 +71,7 @@ double uniform_step(const std::vector<double>& axis, std::string_view origin, co
   return step;
 }
 
-/// Full range: a = 0.5 + 0.5·y/max|y|, y the zero-mean signal (references.md).
+/// Full range: a = 0.5 + 0.5·y/max|y|, y the zero-mean signal (docs/references.md §1).
 void scale_full_range(std::vector<double>& y, std::string_view origin) {
   double mean = 0.0;
   for (double v : y) mean += v;

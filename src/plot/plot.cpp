@@ -1,5 +1,6 @@
-// The figure layer: layout, ticks, decimation and Cairo drawing for
-// texel/plot.hpp, plus the PNG/SVG encoders and the atomic save.
+// The figure layer: layout, ticks, decimation, axes and legends for
+// texel/plot.hpp, plus the PNG/SVG encoders and the atomic save. The series
+// themselves are drawn in series.cpp; the map figures are in map_plot.cpp.
 //
 // Layout is two passes over the panels: the first computes ranges, ticks and
 // the margins their labels need; the second aligns the plot areas (shared
@@ -23,22 +24,20 @@
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
+#include "drawing.hpp"
+
 namespace texel {
+// The painter, scales and panel plans shared with series.cpp.
+using namespace plot_detail;
+
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 constexpr int min_side_px = 64;
 constexpr int max_side_px = 16384;
 // 64 Mpx ≈ 256 MB of ARGB: beyond that an atlas is a mistake, not a plot.
 constexpr double max_area_px = 64.0 * 1024 * 1024;
 
 // ------------------------------------------------------------------- numbers
-
-/// Replaces a leading '-' by U+2212 (typographic minus), which lines up with '+'.
-std::string typographic(std::string s) {
-  if (!s.empty() && s[0] == '-') s.replace(0, 1, "\u2212");
-  return s;
-}
 
 /// A tick value printed with as many decimals as `step` needs ("0.25", "100", "1e-06").
 std::string format_tick(double v, double step) {
@@ -51,14 +50,6 @@ std::string format_tick(double v, double step) {
   }
   const int digits = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
   return typographic(detail::fixed(v, digits));
-}
-
-/// dB re 1 cycle/mm of f (power form, rendering.md §2), rounded for a label.
-std::string db_text(double f) {
-  const double db = 10.0 * std::log10(f);
-  const double rounded = std::round(db);
-  const std::string s = std::abs(db - rounded) < 0.05 ? detail::fixed(rounded == 0.0 ? 0.0 : rounded, 0) : detail::fixed(db, 1);
-  return typographic(s) + " dB";
 }
 
 /// The smallest 1-2-5 × 10^k step at least `raw`.
@@ -266,117 +257,7 @@ cairo_status_t append_to_string(void* closure, const unsigned char* data, unsign
   return CAIRO_STATUS_SUCCESS;
 }
 
-struct Rect {
-  double x = 0, y = 0, w = 0, h = 0;
-  [[nodiscard]] double right() const { return x + w; }
-  [[nodiscard]] double bottom() const { return y + h; }
-};
-
-enum class HAlign { left, centre, right };
-enum class VAlign { top, middle, bottom };
-
-const Rgb text_colour{0.1, 0.1, 0.1};
-const Rgb muted_colour{0.38, 0.38, 0.38};
-const Rgb frame_colour{0.3, 0.3, 0.3};
-const Rgb grid_colour{0.88, 0.88, 0.88};
-
-/// Thin wrapper over a cairo_t: colours, text with alignment, measurement.
-class Painter {
- public:
-  explicit Painter(cairo_t* cr) : cr_(cr) {
-    cairo_font_options_t* opts = cairo_font_options_create();
-    // Unhinted metrics: text measures the same in PNG and SVG.
-    cairo_font_options_set_hint_metrics(opts, CAIRO_HINT_METRICS_OFF);
-    cairo_font_options_set_hint_style(opts, CAIRO_HINT_STYLE_SLIGHT);
-    cairo_font_options_set_antialias(opts, CAIRO_ANTIALIAS_GRAY);
-    cairo_set_font_options(cr_, opts);
-    cairo_font_options_destroy(opts);
-    cairo_set_antialias(cr_, CAIRO_ANTIALIAS_DEFAULT);
-  }
-  [[nodiscard]] cairo_t* cr() const { return cr_; }
-
-  void colour(Rgb c, double alpha = 1.0) const { cairo_set_source_rgba(cr_, c.r, c.g, c.b, alpha); }
-
-  void font(double size_px, bool bold = false) const {
-    cairo_select_font_face(cr_, "sans-serif", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr_, size_px);
-  }
-  /// Advance width of `s` in the current font, px.
-  [[nodiscard]] double width(const std::string& s) const {
-    if (s.empty()) return 0.0;
-    cairo_text_extents_t e;
-    cairo_text_extents(cr_, s.c_str(), &e);
-    return e.x_advance;
-  }
-  /// Line height of the current font, px.
-  [[nodiscard]] double line_height() const {
-    cairo_font_extents_t e;
-    cairo_font_extents(cr_, &e);
-    return e.height;
-  }
-  /// Draws `s` anchored at (x, y), rotated by `angle` radians about the anchor.
-  /// Vertical alignment uses the font's ascent/descent, not the glyphs', so
-  /// labels with and without descenders share a baseline.
-  void text(const std::string& s, double x, double y, HAlign h, VAlign v, double angle = 0.0) const {
-    if (s.empty()) return;
-    cairo_font_extents_t fe;
-    cairo_font_extents(cr_, &fe);
-    const double w = width(s);
-    const double dx = h == HAlign::left ? 0.0 : h == HAlign::centre ? -w / 2 : -w;
-    const double dy = v == VAlign::top ? fe.ascent : v == VAlign::middle ? (fe.ascent - fe.descent) / 2 : -fe.descent;
-    cairo_save(cr_);
-    cairo_translate(cr_, x, y);
-    if (angle != 0.0) cairo_rotate(cr_, angle);
-    cairo_move_to(cr_, dx, dy);
-    cairo_show_text(cr_, s.c_str());
-    cairo_restore(cr_);
-  }
-  void rect(const Rect& r) const { cairo_rectangle(cr_, r.x, r.y, r.w, r.h); }
-
-  /// `s` fitted into `max_w` px: the font shrinks down to 70 % of `size_px`,
-  /// then the text is cut with an ellipsis. Selects the font it fits with.
-  [[nodiscard]] std::string fit(std::string s, double max_w, double size_px, bool bold) const {
-    font(size_px, bold);
-    const double w = width(s);
-    if (w <= max_w) return s;
-    const double shrunk = std::max(size_px * 0.7, size_px * max_w / w);
-    font(shrunk, bold);
-    // Cut whole UTF-8 characters (continuation bytes, then the lead byte).
-    while (!s.empty() && width(s + "\u2026") > max_w) {
-      while (!s.empty() && (static_cast<unsigned char>(s.back()) & 0xC0) == 0x80) s.pop_back();
-      if (!s.empty()) s.pop_back();
-    }
-    return s + "\u2026";
-  }
-
- private:
-  cairo_t* cr_;
-};
-
 // ------------------------------------------------------------------- scales
-
-/// Maps data to pixels along one axis.
-struct Scale {
-  double lo = 0, hi = 1;  // data range
-  double p0 = 0, p1 = 1;  // pixel positions of lo and hi
-  bool log = false;
-  double l0 = 0, l1 = 1;
-
-  Scale() = default;
-  Scale(double lo_, double hi_, double p0_, double p1_, bool log_) : lo(lo_), hi(hi_), p0(p0_), p1(p1_), log(log_) {
-    l0 = log ? std::log10(lo) : lo;
-    l1 = log ? std::log10(hi) : hi;
-  }
-  /// Pixel position of v; NaN where v cannot be drawn (log of v <= 0, NaN).
-  [[nodiscard]] double operator()(double v) const {
-    if (log) {
-      if (!(v > 0)) return nan;
-      v = std::log10(v);
-    }
-    if (!std::isfinite(v)) return nan;
-    return p0 + (v - l0) / (l1 - l0) * (p1 - p0);
-  }
-};
 
 struct Range {
   double lo = std::numeric_limits<double>::infinity();
@@ -496,55 +377,6 @@ std::vector<std::pair<double, double>> line_vertices(const LineSeries& s, const 
 }
 
 // ------------------------------------------------------------------ layout
-
-struct Swatch {
-  enum Kind { line, stem, bar } kind;
-  Rgb colour;
-  std::string label;
-};
-
-/// Everything about a panel that is known before it is placed.
-struct PanelPlan {
-  const Panel* panel = nullptr;
-  Rect cell;  // the panel's share of the figure
-  double xlo = 0, xhi = 1, ylo = 0, yhi = 1;
-  std::vector<Tick> xticks, yticks;
-  std::vector<Rgb> line_colours, stem_colours, hist_colours, box_colours, error_colours;
-  std::vector<std::vector<BoxStats>> boxes;
-  std::vector<std::string> xcats, ycats;            // category labels in effect (axis or heatmap)
-  double heat_lo = 0, heat_hi = 1;                  // colour-scale range of the heatmap
-  double colour_bar = 0;                            // px reserved right of the plot for the heatmap's colour bar
-  double left = 0, right = 0, top = 0, bottom = 0;  // margins, px
-  Rect plot;
-};
-
-constexpr double colour_bar_px = 12.0;  // width of a heatmap's colour bar
-
-/// A heatmap value as printed in its cell and on the colour bar.
-std::string format_heat(double v, const HeatmapSeries& h) { return typographic(detail::fixed(v, std::max(0, h.decimals))); }
-
-/// ColorBrewer "Blues" (Brewer 2003; sequential, print- and colour-blind-safe)
-/// at t in [0, 1], interpolated linearly between its nine classes.
-Rgb blues(double t) {
-  static constexpr Rgb stops[] = {{0.969, 0.984, 1.000}, {0.871, 0.922, 0.969}, {0.776, 0.859, 0.937},
-                                  {0.620, 0.792, 0.882}, {0.420, 0.682, 0.839}, {0.259, 0.573, 0.776},
-                                  {0.129, 0.443, 0.710}, {0.031, 0.318, 0.612}, {0.031, 0.188, 0.420}};
-  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * 8.0;
-  const auto i = std::min<std::size_t>(7, static_cast<std::size_t>(t));
-  const double u = t - static_cast<double>(i);
-  const Rgb a = stops[i], b = stops[i + 1];
-  return {a.r + (b.r - a.r) * u, a.g + (b.g - a.g) * u, a.b + (b.b - a.b) * u};
-}
-
-struct Fonts {
-  double base, title, tick, small;
-  explicit Fonts(double b) : base(b), title(b * 1.12), tick(b * 0.88), small(b * 0.82) {}
-};
-
-/// x of box group `g` of series `b`.
-double box_x(const BoxSeries& b, std::size_t g) {
-  return (b.positions.empty() ? static_cast<double>(g) : b.positions[g]) + b.offset;
-}
 
 /// Category labels in effect for the panel's axes: the axis' own, else a
 /// heatmap's row/column labels (rows reversed: row 0 is drawn at the top).
@@ -829,286 +661,6 @@ void draw_axes(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Sca
   pa.colour(frame_colour);
   cairo_rectangle(cr, snap(r.x), snap(r.y), std::round(r.w), std::round(r.h));
   cairo_stroke(cr);
-}
-
-using Vertices = std::vector<std::pair<double, double>>;
-
-/// Where a vertical marker's label goes: right of the line at the top of the
-/// plot, or left of it where there is no room on the right.
-Rect marker_label_box(const VerticalMarker& m, double x, const Rect& r, const Painter& pa, const Fonts& f) {
-  pa.font(f.small);
-  const double w = pa.width(m.label), h = pa.line_height();
-  const bool left = x + 4 + w > r.right() - 2;
-  return {left ? x - 4 - w : x + 4, r.y + 4, w, h};
-}
-
-void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Scale& xs, const Scale& ys,
-                 const std::vector<Vertices>& line_px) {
-  cairo_t* cr = pa.cr();
-  const Panel& p = *pp.panel;
-  const Rect& r = pp.plot;
-  cairo_save(cr);
-  pa.rect(r);
-  cairo_clip(cr);
-
-  if (const auto& h = p.heatmap) {
-    pa.font(f.tick);
-    for (std::size_t row = 0; row < h->rows; ++row)
-      for (std::size_t col = 0; col < h->cols; ++col) {
-        const double v = h->values[row * h->cols + col];
-        if (!std::isfinite(v)) continue;
-        const double cx = static_cast<double>(col), cy = static_cast<double>(h->rows - 1 - row);
-        const double x0 = xs(cx - 0.5), x1 = xs(cx + 0.5), y0 = ys(cy + 0.5), y1 = ys(cy - 0.5);
-        const double t = (v - pp.heat_lo) / (pp.heat_hi - pp.heat_lo);
-        pa.colour(blues(t));
-        cairo_rectangle(cr, x0, y0, x1 - x0, y1 - y0);
-        cairo_fill(cr);
-        if (h->decimals >= 0) {
-          // Light text on the darker half of the scale keeps every value legible.
-          pa.colour(t > 0.55 ? Rgb{1, 1, 1} : text_colour);
-          pa.text(format_heat(v, *h), (x0 + x1) / 2, (y0 + y1) / 2, HAlign::centre, VAlign::middle);
-        }
-      }
-    // White cell borders read as a table without a grid behind it.
-    cairo_set_line_width(cr, 1.0);
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    for (std::size_t c = 1; c < h->cols; ++c) {
-      const double x = xs(static_cast<double>(c) - 0.5);
-      cairo_move_to(cr, x, r.y);
-      cairo_line_to(cr, x, r.bottom());
-    }
-    for (std::size_t k = 1; k < h->rows; ++k) {
-      const double y = ys(static_cast<double>(k) - 0.5);
-      cairo_move_to(cr, r.x, y);
-      cairo_line_to(cr, r.right(), y);
-    }
-    cairo_stroke(cr);
-  }
-
-  const double y_base = ys.log ? r.bottom() : ys(std::clamp(0.0, pp.ylo, pp.yhi));
-  for (std::size_t i = 0; i < p.histograms.size(); ++i) {
-    const auto& h = p.histograms[i];
-    const Rgb c = pp.hist_colours[i];
-    bool outline = true;
-    for (std::size_t b = 0; b < h.counts.size(); ++b) {
-      const double x0 = xs(h.edges[b]), x1 = xs(h.edges[b + 1]), y1 = ys(h.counts[b]);
-      if (std::isnan(x0) || std::isnan(x1) || std::isnan(y1) || h.counts[b] == 0) continue;
-      cairo_rectangle(cr, x0, std::min(y1, y_base), x1 - x0, std::abs(y_base - y1));
-      outline = outline && x1 - x0 >= 3;
-    }
-    pa.colour(c, 0.55);
-    if (outline) {
-      cairo_fill_preserve(cr);
-      pa.colour(c);
-      cairo_set_line_width(cr, 0.8);
-      cairo_stroke(cr);
-    } else {
-      cairo_fill(cr);
-    }
-  }
-
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
-  for (const auto& m : p.markers) {
-    const double x = xs(m.x);
-    if (std::isnan(x) || x < r.x - 1 || x > r.right() + 1) continue;
-    pa.colour(m.colour);
-    cairo_set_line_width(cr, 1.2);
-    const double dash[] = {5.0, 3.0};
-    cairo_set_dash(cr, dash, m.dashed ? 2 : 0, 0);
-    cairo_move_to(cr, x, r.y);
-    cairo_line_to(cr, x, r.bottom());
-    cairo_stroke(cr);
-    cairo_set_dash(cr, nullptr, 0, 0);
-    if (!m.label.empty()) {
-      const Rect b = marker_label_box(m, x, r, pa, f);  // also selects the font
-      cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
-      cairo_rectangle(cr, b.x - 2, b.y - 1, b.w + 4, b.h + 2);
-      cairo_fill(cr);
-      pa.colour(m.colour);
-      pa.text(m.label, b.x, b.y, HAlign::left, VAlign::top);
-    }
-  }
-
-  for (std::size_t i = 0; i < p.boxes.size(); ++i) {
-    const auto& b = p.boxes[i];
-    const Rgb c = pp.box_colours[i];
-    cairo_set_line_width(cr, 1.2);
-    for (std::size_t g = 0; g < b.groups.size(); ++g) {
-      const BoxStats& st = pp.boxes[i][g];
-      if (st.n == 0) continue;
-      const double xc = box_x(b, g);
-      const double x0 = xs(xc - b.box_width / 2), x1 = xs(xc + b.box_width / 2), xm = xs(xc);
-      const double yq1 = ys(st.q1), yq3 = ys(st.q3), ymed = ys(st.median);
-      if (std::isnan(x0) || std::isnan(x1) || std::isnan(yq1) || std::isnan(yq3)) continue;
-      const double cap = (x1 - x0) * 0.25;
-      pa.colour(c);
-      // Whiskers and their caps.
-      for (const double w : {st.whisker_low, st.whisker_high}) {
-        const double yw = ys(w);
-        if (std::isnan(yw)) continue;
-        cairo_move_to(cr, xm, w < st.q1 ? yq1 : yq3);
-        cairo_line_to(cr, xm, yw);
-        cairo_move_to(cr, xm - cap, yw);
-        cairo_line_to(cr, xm + cap, yw);
-      }
-      cairo_stroke(cr);
-      cairo_rectangle(cr, x0, std::min(yq1, yq3), x1 - x0, std::abs(yq1 - yq3));
-      pa.colour(c, 0.3);
-      cairo_fill_preserve(cr);
-      pa.colour(c);
-      cairo_stroke(cr);
-      cairo_set_line_width(cr, 2.2);
-      cairo_move_to(cr, x0, ymed);
-      cairo_line_to(cr, x1, ymed);
-      cairo_stroke(cr);
-      cairo_set_line_width(cr, 1.2);
-      for (const double o : st.outliers) {
-        const double yo = ys(o);
-        if (std::isnan(yo)) continue;
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, xm, yo, 3.2, 0, 2 * std::numbers::pi);
-      }
-      cairo_stroke(cr);
-      if (b.show_points) {
-        pa.colour(c, 0.7);
-        for (const double v : b.groups[g]) {
-          const double yv = ys(v);
-          if (std::isnan(yv)) continue;
-          cairo_new_sub_path(cr);
-          cairo_arc(cr, xm, yv, 1.8, 0, 2 * std::numbers::pi);
-        }
-        cairo_fill(cr);
-      }
-      if (b.show_mean && std::isfinite(ys(st.mean))) {
-        const double ym = ys(st.mean), d = 3.5;
-        pa.colour(text_colour);
-        cairo_move_to(cr, xm - d, ym - d);
-        cairo_line_to(cr, xm + d, ym + d);
-        cairo_move_to(cr, xm - d, ym + d);
-        cairo_line_to(cr, xm + d, ym - d);
-        cairo_stroke(cr);
-      }
-    }
-  }
-
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-  // Stroked in chunks: Cairo tessellates a path as a whole, and a dense
-  // envelope crosses itself so often that one path costs seconds. Chunks
-  // overlap only at their shared vertex, invisible under a round join.
-  constexpr std::size_t chunk = 512;
-  for (std::size_t i = 0; i < p.lines.size(); ++i) {
-    pa.colour(pp.line_colours[i]);
-    cairo_set_line_width(cr, p.lines[i].width_px);
-    const double dash[] = {6.0, 4.0};
-    cairo_set_dash(cr, dash, p.lines[i].dashed ? 2 : 0, 0);
-    bool pen_down = false;
-    std::size_t in_path = 0;
-    for (const auto& [x, y] : line_px[i]) {
-      if (std::isnan(x)) {
-        pen_down = false;
-        continue;
-      }
-      if (pen_down) {
-        cairo_line_to(cr, x, y);
-        if (++in_path >= chunk) {
-          cairo_stroke(cr);
-          cairo_move_to(cr, x, y);
-          in_path = 0;
-        }
-      } else {
-        cairo_move_to(cr, x, y);
-      }
-      pen_down = true;
-    }
-    cairo_stroke(cr);
-  }
-  cairo_set_dash(cr, nullptr, 0, 0);
-
-  for (std::size_t i = 0; i < p.error_bars.size(); ++i) {
-    const auto& e = p.error_bars[i];
-    const Rgb c = pp.error_colours[i];
-    pa.colour(c);
-    if (e.connect) {
-      std::vector<std::size_t> order(e.x.size());
-      for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return e.x[a] < e.x[b]; });
-      cairo_set_line_width(cr, 1.5);
-      bool pen_down = false;
-      for (const std::size_t k : order) {
-        const double x = xs(e.x[k]), y = ys(e.y[k]);
-        if (std::isnan(x) || std::isnan(y)) {
-          pen_down = false;
-          continue;
-        }
-        pen_down ? cairo_line_to(cr, x, y) : cairo_move_to(cr, x, y);
-        pen_down = true;
-      }
-      cairo_stroke(cr);
-    }
-    cairo_set_line_width(cr, 1.3);
-    for (std::size_t k = 0; k < e.x.size(); ++k) {
-      const double x = xs(e.x[k]), y = ys(e.y[k]);
-      if (std::isnan(x) || std::isnan(y)) continue;
-      if (std::isfinite(e.error[k]) && e.error[k] > 0) {
-        const double lo = ys(e.y[k] - e.error[k]), hi = ys(e.y[k] + e.error[k]);
-        const double ylo = std::isnan(lo) ? r.bottom() : lo;  // log axis: a bar below 0 runs off the plot
-        if (!std::isnan(hi)) {
-          cairo_move_to(cr, x, ylo);
-          cairo_line_to(cr, x, hi);
-          cairo_move_to(cr, x - e.cap_px, hi);
-          cairo_line_to(cr, x + e.cap_px, hi);
-          if (!std::isnan(lo)) {
-            cairo_move_to(cr, x - e.cap_px, lo);
-            cairo_line_to(cr, x + e.cap_px, lo);
-          }
-          cairo_stroke(cr);
-        }
-      }
-      if (e.marker_radius_px > 0) {
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x, y, e.marker_radius_px, 0, 2 * std::numbers::pi);
-        cairo_fill(cr);
-      }
-    }
-  }
-
-  for (std::size_t i = 0; i < p.stems.size(); ++i) {
-    const auto& s = p.stems[i];
-    const Rgb c = pp.stem_colours[i];
-    const double foot = ys.log ? (s.baseline > 0 ? std::min(ys(s.baseline), r.bottom()) : r.bottom())
-                               : ys(std::clamp(s.baseline, pp.ylo, pp.yhi));
-    pa.colour(c);
-    cairo_set_line_width(cr, 1.2);
-    for (std::size_t k = 0; k < s.x.size(); ++k) {
-      const double x = xs(s.x[k]), y = ys(s.y[k]);
-      if (std::isnan(x) || std::isnan(y) || x < r.x - 20 || x > r.right() + 20) continue;
-      if (s.stems) {
-        cairo_move_to(cr, x, foot);
-        cairo_line_to(cr, x, y);
-        cairo_stroke(cr);
-      }
-      if (s.marker_radius_px > 0) {
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x, y, s.marker_radius_px, 0, 2 * std::numbers::pi);
-        pa.colour(c, 0.85);
-        cairo_fill_preserve(cr);
-        pa.colour(c);
-        cairo_stroke(cr);
-      }
-    }
-  }
-
-  if (!p.notes.empty()) {
-    pa.font(f.small);
-    for (const auto& t : p.notes) {
-      const double x = xs(t.x), y = ys(t.y);
-      if (std::isnan(x) || std::isnan(y)) continue;
-      pa.colour(t.colour);
-      pa.text(t.text, x, y + t.dy_px, HAlign::centre, VAlign::middle);
-    }
-  }
-  cairo_restore(cr);
 }
 
 /// The heatmap's colour scale: a vertical bar right of the plot, its two
@@ -1511,117 +1063,6 @@ void save_figure_grid(const FigureGrid& grid, const std::string& path) {
   const PlotFormat format = plot_format_for_path(path);
   check_writable(path);
   write_file_atomic(path, render_figure_grid(grid, format));
-}
-
-// ------------------------------------------------------------ texture plots
-
-namespace {
-
-void check_map(const MapPlot& m) {
-  if (m.positions_mm.empty()) throw InvalidArgument("map plot has no samples (positions_mm is empty)");
-  if (m.positions_mm.size() != m.amplitudes.size())
-    throw InvalidArgument("map plot has " + std::to_string(m.positions_mm.size()) + " positions_mm and " +
-                          std::to_string(m.amplitudes.size()) + " amplitudes; they must match");
-  if (!(m.excerpt_mm >= 0) || !std::isfinite(m.excerpt_mm))
-    throw InvalidArgument("map plot excerpt_mm is " + detail::num(m.excerpt_mm) + "; must be >= 0 (0 = no excerpt)");
-}
-
-// Amplitude axis: 0 … 1 with a sliver of room so a line at a = 0 or 1 is not
-// half clipped by the frame.
-Axis amplitude_axis(std::string label) { return Axis{std::move(label), AxisScale::linear, -0.03, 1.03, false}; }
-
-Panel excerpt_panel(const MapPlot& m, std::string title) {
-  const double x0 = m.positions_mm.front();
-  Panel p;
-  p.title = std::move(title);
-  p.x = Axis{"position (mm)", AxisScale::linear, x0, x0 + m.excerpt_mm, false};
-  p.y = amplitude_axis("amplitude");
-  p.lines.push_back(LineSeries{m.positions_mm, m.amplitudes, palette_colour(0), 1.25, {}});
-  return p;
-}
-
-Panel histogram_panel(const MapPlot& m, std::string title) {
-  Panel p;
-  p.title = std::move(title);
-  p.x = Axis{"texel frequency: cycles/mm (dB re 1 cycle/mm)", AxisScale::log10, std::nullopt, std::nullopt, true};
-  p.y = Axis{"texels", AxisScale::linear, std::nullopt, std::nullopt, false};
-  Histogram h = make_histogram(m.frequencies_cpm, 0, AxisScale::log10);
-  h.colour = palette_colour(1);
-  if (!h.edges.empty() && m.central_pitch_cpm > 0) {
-    // Keep the marker in view even when the draw missed the central pitch.
-    p.x.min = std::min(h.edges.front(), m.central_pitch_cpm / 1.25);
-    p.x.max = std::max(h.edges.back(), m.central_pitch_cpm * 1.25);
-    char cpm[32];
-    std::snprintf(cpm, sizeof cpm, "%.3g", m.central_pitch_cpm);
-    p.markers.push_back({m.central_pitch_cpm,
-                         "central pitch " + std::string(cpm) + " cpm (" + db_text(m.central_pitch_cpm) + ")",
-                         {0.2, 0.2, 0.2},
-                         true});
-  }
-  p.histograms.push_back(std::move(h));
-  return p;
-}
-
-bool has_excerpt(const MapPlot& m) {
-  return m.excerpt_mm > 0 && m.positions_mm.back() - m.positions_mm.front() > m.excerpt_mm * 1.01;
-}
-
-std::string excerpt_title(const MapPlot& m) {
-  const double x0 = m.positions_mm.front();
-  if (x0 == 0.0) return "Excerpt: first " + detail::num(m.excerpt_mm) + " mm";
-  return "Excerpt: " + detail::num(x0) + " \u2013 " + detail::num(x0 + m.excerpt_mm) + " mm";
-}
-
-}  // namespace
-
-Figure map_figure(const MapPlot& m) {
-  check_map(m);
-  Figure fig;
-  fig.width_px = m.width_px;
-  fig.title = m.title.empty() ? "Friction map" : m.title;
-
-  Panel whole;
-  whole.title = "Whole map (" + std::to_string(m.positions_mm.size()) + " samples)";
-  whole.x = Axis{"position (mm)", AxisScale::linear, std::nullopt, std::nullopt, false};
-  whole.y = amplitude_axis("amplitude");
-  // The whole map is usually far denser than the image: a thinner line keeps
-  // the envelope from reading as a solid block.
-  whole.lines.push_back(LineSeries{m.positions_mm, m.amplitudes, palette_colour(0), 0.8, {}});
-  fig.panels.push_back(std::move(whole));
-  if (has_excerpt(m)) fig.panels.push_back(excerpt_panel(m, excerpt_title(m)));
-  if (!m.frequencies_cpm.empty())
-    fig.panels.push_back(histogram_panel(m, "Texel frequencies (" + std::to_string(m.frequencies_cpm.size()) + " texels)"));
-  fig.height_px = m.height_px > 0 ? m.height_px : 60 + 260 * static_cast<int>(fig.panels.size());
-  return fig;
-}
-
-Figure map_cell_figure(const MapPlot& m, int width_px, int height_px) {
-  check_map(m);
-  Figure fig;
-  fig.width_px = width_px;
-  fig.height_px = height_px;
-  fig.font_px = 11.0;
-  fig.title = m.title;
-  MapPlot cut = m;
-  if (!has_excerpt(cut)) cut.excerpt_mm = std::max(1e-9, m.positions_mm.back() - m.positions_mm.front());
-  fig.panels.push_back(excerpt_panel(cut, {}));
-  if (!m.frequencies_cpm.empty()) {
-    Panel h = histogram_panel(m, {});
-    h.x.label = "cycles/mm (dB)";
-    h.markers.clear();  // the label would crowd a small cell; the histogram speaks for itself
-    fig.panels.push_back(std::move(h));
-  }
-  return fig;
-}
-
-void plot_map(const MapPlot& plot, const std::string& path) { save_figure(map_figure(plot), path); }
-
-void plot_map_grid(std::span<const MapPlot> plots, const std::string& path, int columns, const std::string& title) {
-  FigureGrid grid;
-  grid.title = title;
-  grid.columns = columns;
-  for (const auto& m : plots) grid.cells.push_back(map_cell_figure(m));
-  save_figure_grid(grid, path);
 }
 
 }  // namespace texel

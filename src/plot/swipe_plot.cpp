@@ -14,7 +14,7 @@ Figure swipe_figure(const SwipePlot& p) {
     throw InvalidArgument("swipe plot: " + std::to_string(p.output.size()) + " output samples and " +
                           std::to_string(p.positions_mm.size()) + " positions; they must match and be non-empty");
   if (p.frequency_hz.size() != p.magnitude.size()) throw InvalidArgument("swipe plot: spectrum columns differ in length");
-  const double dt = 1.0 / p.rate_hz;
+  const double dt = 1.0 / p.rate.value();
   Figure fig;
   fig.width_px = p.width_px;
   fig.title = p.title.empty() ? "Swipe" : p.title;
@@ -41,15 +41,15 @@ Figure swipe_figure(const SwipePlot& p) {
   out.lines.push_back(std::move(ol));
   fig.panels.push_back(std::move(out));
 
-  if (p.excerpt_s > 0 && p.excerpt_s < static_cast<double>(p.output.size()) * dt) {
+  if (p.excerpt.value() > 0 && p.excerpt.value() < static_cast<double>(p.output.size()) * dt) {
     // The excerpt starts where the output is loudest, so it shows texture.
     std::size_t at = 0;
     for (std::size_t i = 0; i < p.output.size(); ++i)
       if (std::fabs(p.output[i]) > std::fabs(p.output[at])) at = i;
-    const auto n = static_cast<std::size_t>(p.excerpt_s * p.rate_hz);
+    const auto n = static_cast<std::size_t>(p.excerpt.value() * p.rate.value());
     const std::size_t first = at > n / 2 ? std::min(at - n / 2, p.output.size() - n) : 0;
     Panel ex;
-    ex.title = detail::num(p.excerpt_s * 1000) + " ms excerpt";
+    ex.title = detail::num(p.excerpt.value() * 1000) + " ms excerpt";
     ex.x.label = "time (s)";
     ex.y.label = p.output_label;
     LineSeries el;
@@ -84,7 +84,8 @@ Figure swipe_figure(const SwipePlot& p) {
       sp.x.max = sl.x.back();
     }
     sp.lines.push_back(std::move(sl));
-    if (p.marker_hz > 0) sp.markers.push_back(VerticalMarker{p.marker_hz, detail::num(std::round(p.marker_hz)) + " Hz"});
+    if (p.marker.value() > 0)
+      sp.markers.push_back(VerticalMarker{p.marker.value(), detail::num(std::round(p.marker.value())) + " Hz"});
     fig.panels.push_back(std::move(sp));
   }
   fig.height_px = p.height_px > 0 ? p.height_px : 240 * static_cast<int>(fig.panels.size());

@@ -1,5 +1,5 @@
 // The registry of reference generators: names, families, parameters with
-// units, defaults and ranges (references.md gives the defaults), and the
+// units, defaults and ranges (docs/references.md gives the defaults), and the
 // validation / parsing every front door shares.
 #include <algorithm>
 #include <charconv>

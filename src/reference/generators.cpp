@@ -197,7 +197,7 @@ void synthesize_harmonics(const std::vector<ReferenceComponent>& comps, const Ha
 }
 
 /// A synthesised sum y as amplitude: 0.5 + scale·y, clamped to [0, 1]
-/// (references.md [choice]; scale = 0.5 / max|y|).
+/// (docs/references.md §1 [choice]; scale = 0.5 / max|y|).
 double amplitude_of(double scale, double y) {
   const double v = 0.5 + scale * y;
   return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);

@@ -184,7 +184,7 @@ std::vector<Peak> find_peaks(const Spectrum& s, const PeakOptions& options) {
   std::vector<Candidate> cands;
   for (std::size_t k = 1; k + 1 < bins; ++k) {
     const double f = s.frequency_cpm[k];
-    if (f < options.min_frequency_cpm || f > options.max_frequency_cpm) continue;
+    if (f < options.min_frequency.value() || f > options.max_frequency.value()) continue;
     const double m = s.magnitude[k];
     if (!(m > s.magnitude[k - 1] && m >= s.magnitude[k + 1]) || m <= 0.0) continue;
     bool dominant = true;
@@ -214,8 +214,8 @@ std::vector<Peak> find_peaks(const Spectrum& s, const PeakOptions& options) {
   std::sort(cands.begin(), cands.end(), [](auto& x, auto& y) { return x.amp > y.amp; });
   for (const auto& c : cands) {
     const double level = 20.0 * std::log10(c.amp / top);
-    if (level < options.threshold_db || peaks.size() >= options.max_peaks) break;
-    peaks.push_back({CyclesPerMm(c.f), c.amp, level});
+    if (level < options.threshold.value() || peaks.size() >= options.max_peaks) break;
+    peaks.push_back({CyclesPerMm(c.f), c.amp, DecibelsLevel(level)});
   }
   std::sort(peaks.begin(), peaks.end(), [](const Peak& x, const Peak& y) { return x.frequency < y.frequency; });
   return peaks;

@@ -24,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/wav.hpp"
 #include "texel/io.hpp"
 
 namespace fs = std::filesystem;
@@ -356,34 +357,12 @@ TEST_F(Cli, ValidDocumentWithRegionsRenders) {
 
 namespace {
 
-/// A PCM16 WAV of `channels` channels, a sine in channel 0 (hand-made so the
-/// test needs no audio library).
+/// A PCM16 WAV of `channels` channels, a sine in channel 0.
 std::string stereo_wav(unsigned channels, unsigned rate, std::size_t frames) {
-  std::string out;
-  auto u32 = [&](std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
-  };
-  auto u16 = [&](std::uint16_t v) {
-    out.push_back(static_cast<char>(v & 0xFF));
-    out.push_back(static_cast<char>(v >> 8));
-  };
-  const auto data = static_cast<std::uint32_t>(frames * channels * 2);
-  out += "RIFF";
-  u32(36 + data);
-  out += "WAVEfmt ";
-  u32(16);
-  u16(1);
-  u16(static_cast<std::uint16_t>(channels));
-  u32(rate);
-  u32(rate * channels * 2);
-  u16(static_cast<std::uint16_t>(channels * 2));
-  u16(16);
-  out += "data";
-  u32(data);
+  std::vector<std::int16_t> interleaved(frames * channels, 0);
   for (std::size_t i = 0; i < frames; ++i)
-    for (unsigned c = 0; c < channels; ++c)
-      u16(static_cast<std::uint16_t>(c == 0 ? static_cast<std::int16_t>(16000 * std::sin(0.3 * static_cast<double>(i))) : 0));
-  return out;
+    interleaved[i * channels] = static_cast<std::int16_t>(16000 * std::sin(0.3 * static_cast<double>(i)));
+  return texel::test_support::wav_bytes(channels, rate, interleaved);
 }
 
 }  // namespace

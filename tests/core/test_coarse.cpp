@@ -1,4 +1,4 @@
-// Coarse profiles (coarse.hpp, rendering.md §7): c_k sampled at texel centres
+// Coarse profiles (coarse.hpp, docs/algorithm.md §7): c_k sampled at texel centres
 // for each kind, validation, and the position_mm,value CSV reader.
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/coarse.hpp"
 #include "texel/error.hpp"
@@ -22,12 +23,7 @@ namespace {
 using texel::test_support::TempDir;
 
 std::string format_error(const std::string& path) {
-  try {
-    read_profile_csv(path);
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "(no FormatError)";
+  return test_support::message_of<FormatError>([&] { read_profile_csv(path); });
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// detmath: Texel's own exp/log/sin/normal quantile (rendering.md §9).
+// detmath: Texel's own exp/log/sin/normal quantile (docs/algorithm.md §9).
 //
 // They exist for bit-identity across platforms, but they must still be the
 // functions they claim to be: each is compared with the C library (or long

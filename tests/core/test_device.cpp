@@ -1,4 +1,4 @@
-// Device profiles (device.hpp, rendering.md §8): built-ins, user profiles from
+// Device profiles (device.hpp, docs/algorithm.md §8): built-ins, user profiles from
 // a path and from TEXEL_DEVICE_PATH, validation naming the field, grid
 // overrides, and the sample encoders (round(a·65535) for u16).
 #include <gtest/gtest.h>
@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/device.hpp"
 #include "texel/error.hpp"
@@ -35,12 +36,7 @@ const char* const valid_profile = R"({
 })";
 
 std::string parse_error(const std::string& json) {
-  try {
-    parse_device_profile(json, "test.json");
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "(no FormatError)";
+  return test_support::message_of<FormatError>([&] { parse_device_profile(json, "test.json"); });
 }
 
 /// valid_profile with one "key": value replaced or added.
@@ -67,7 +63,7 @@ TEST(Device, BuiltinsLoad) {
 }
 
 TEST(Device, TpadIsTheReferenceDevice) {
-  // rendering.md §8: 19,200 unsigned 16-bit values, one per 0.0053 mm.
+  // docs/algorithm.md §8: 19,200 unsigned 16-bit values, one per 0.0053 mm.
   const DeviceProfile d = load_device("tpad");
   EXPECT_EQ(d.samples, 19200);
   EXPECT_EQ(d.spacing.value(), 0.0053);
@@ -134,7 +130,7 @@ TEST(Device, UnknownNameListsTheBuiltins) {
 }
 
 TEST(Device, BadProfilesAreRejectedNamingTheField) {
-  EXPECT_EQ(parse_error(valid_profile), "(no FormatError)");
+  EXPECT_EQ(parse_error(valid_profile), "(no exception)");
   struct Case {
     std::string key, value, expect;
   };

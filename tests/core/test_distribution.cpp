@@ -1,4 +1,4 @@
-// The texel-frequency distribution (rendering.md §4, §5).
+// The texel-frequency distribution (docs/algorithm.md §4, §5).
 //
 // Statistical tolerances (stated once, used throughout): each test draws
 // n = 10^5 texel frequencies with a fixed seed and requires a sample statistic
@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/expect.hpp"
 #include "texel/distribution.hpp"
 #include "texel/error.hpp"
 
@@ -67,14 +68,7 @@ Moments moments(const std::vector<double>& x) {
 
 double phi(double z) { return 0.5 * std::erfc(-z / std::numbers::sqrt2); }  // C library reference
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  return "(no InvalidArgument thrown)";
-}
+std::string message_of(const std::function<void()>& f) { return test_support::message_of<InvalidArgument>(f); }
 
 }  // namespace
 

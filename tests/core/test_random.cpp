@@ -1,4 +1,4 @@
-// CounterRng: Texel's specified generator (random.hpp, rendering.md §9).
+// CounterRng: Texel's specified generator (random.hpp, docs/algorithm.md §9).
 //
 // Pinned first values make any change to the generator fail loudly: every
 // saved texture would otherwise silently re-render differently. The values

@@ -12,6 +12,7 @@
 #include <limits>
 #include <vector>
 
+#include "../support/grids.hpp"
 #include "texel/device.hpp"
 #include "texel/texture.hpp"
 
@@ -27,7 +28,7 @@ struct Case {
 
 std::vector<Case> cases() {
   std::vector<Case> c;
-  const Grid tpad{Millimetres(0.0), Millimetres(0.0053), 19200};
+  const Grid tpad = test_support::tpad_grid();
   {
     TexelSpec s;
     s.seed = 7;

@@ -1,4 +1,4 @@
-// The Texel texture (rendering.md §6, §7): phase continuity at texel
+// The Texel texture (docs/algorithm.md §6, §7): phase continuity at texel
 // boundaries, the strength formulas and their corner cases, the seed's effect
 // on fine but not coarse layout, determinism and window independence, fill.
 //
@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/grids.hpp"
 #include "texel/device.hpp"
 #include "texel/error.hpp"
 #include "texel/reference.hpp"
@@ -26,7 +27,7 @@ using namespace texel;
 
 namespace {
 
-constexpr double tpad_dx = 0.0053;
+using test_support::tpad_dx;
 constexpr double tpad_nyquist = 0.5 / tpad_dx;
 
 TexelTexture make(const TexelSpec& spec, double length_mm = 101.76) {
@@ -39,9 +40,7 @@ std::vector<double> render(const TexelTexture& t, const Grid& g) {
   return out;
 }
 
-Grid tpad_grid(double length_mm = 101.76) {
-  return Grid{Millimetres(0.0), Millimetres(tpad_dx), static_cast<std::int64_t>(std::llround(length_mm / tpad_dx))};
-}
+Grid tpad_grid(double length_mm = 101.76) { return test_support::tpad_grid(length_mm); }
 
 double ref_sin(double cycles) { return std::sin(2.0 * std::numbers::pi * cycles); }
 

@@ -1,11 +1,12 @@
 // Units as types (units.hpp): literals, same-unit arithmetic, the dB scale of
-// rendering.md §2 (power form, re 1 cpm), and that different units do not mix.
+// docs/algorithm.md §2 (power form, re 1 cpm), and that different units do not mix.
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
 #include <cmath>
 #include <type_traits>
 
+#include "texel/level.hpp"
 #include "texel/units.hpp"
 
 using namespace texel;
@@ -24,6 +25,11 @@ concept Addable = requires(A a, B b) {
 static_assert(Addable<Millimetres, Millimetres>);
 static_assert(!Addable<Millimetres, Decibels>);
 static_assert(!Addable<CyclesPerMm, Hertz>);
+// A level in dB (a gain, a peak below the highest) is not a frequency in dB.
+static_assert(!std::is_convertible_v<DecibelsLevel, Decibels>);
+static_assert(!std::is_constructible_v<Decibels, DecibelsLevel>);
+static_assert(!std::is_constructible_v<DecibelsLevel, Decibels>);
+static_assert(!Addable<Decibels, DecibelsLevel>);
 
 TEST(Units, LiteralsCarryTheirValue) {
   EXPECT_EQ((0.25_mm).value(), 0.25);
@@ -35,6 +41,8 @@ TEST(Units, LiteralsCarryTheirValue) {
   EXPECT_EQ((0.5_s).value(), 0.5);
   EXPECT_EQ((100_mm_per_s).value(), 100.0);
   static_assert(std::is_same_v<decltype(1_mm), Millimetres>);
+  static_assert(std::is_same_v<decltype(-40.0_level_dB), DecibelsLevel>);
+  EXPECT_EQ((-40.0_level_dB).value(), -40.0);
   static_assert(std::is_same_v<decltype(1.0_dB), Decibels>);
 }
 
@@ -55,7 +63,7 @@ TEST(Units, SameUnitArithmetic) {
 }
 
 TEST(Units, DecibelScaleIsPowerFormRe1Cpm) {
-  // rendering.md §2: 10 cpm = 10 dB, 1 cpm = 0 dB, 0.1 cpm = −10 dB, 94 cpm ≈ 19.7 dB.
+  // docs/algorithm.md §2: 10 cpm = 10 dB, 1 cpm = 0 dB, 0.1 cpm = −10 dB, 94 cpm ≈ 19.7 dB.
   EXPECT_NEAR(to_cpm(10_dB).value(), 10.0, 1e-14);
   EXPECT_NEAR(to_cpm(0_dB).value(), 1.0, 1e-15);
   EXPECT_NEAR(to_cpm(-10_dB).value(), 0.1, 1e-16);

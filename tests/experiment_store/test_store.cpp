@@ -8,6 +8,7 @@
 
 #include <filesystem>
 
+#include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "fixtures.hpp"
 #include "texel/error.hpp"
@@ -25,17 +26,7 @@ std::int64_t new_session(ex::Store& s, const std::string& who = "S01") {
   return s.create_session(who, "texel-length", "texel-length", R"({"name":"texel-length"})", 18446744073709551615ull, "", 40);
 }
 
-template <class E, class F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("wrong exception type: ") + e.what();
-  }
-  return "no exception";
-}
+using texel::test_support::message_of;
 
 }  // namespace
 

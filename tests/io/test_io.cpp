@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -45,14 +46,7 @@ std::string raw_bytes(std::initializer_list<T> values) {
   return s;
 }
 
-std::string format_error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "(no FormatError)";
-}
+std::string format_error_of(const std::function<void()>& f) { return test_support::message_of<FormatError>(f); }
 
 }  // namespace
 
@@ -90,9 +84,9 @@ TEST(Npy, ReadsOtherDtypesAndColumnShapes) {
 
 TEST(Npy, RejectsMalformedFilesNamingTheOrigin) {
   const std::string good = npy_bytes(std::vector<double>{1.0, 2.0});
-  EXPECT_NE(format_error_of([] { parse_npy("not numpy at all", "x.npy"); }).find("x.npy: not a .npy file"), std::string::npos);
-  EXPECT_NE(format_error_of([&] { parse_npy(good.substr(0, good.size() - 3), "x.npy"); }).find("bytes"), std::string::npos);
-  EXPECT_NE(format_error_of([&] { parse_npy(good.substr(0, 20), "x.npy"); }).find("truncated"), std::string::npos);
+  EXPECT_THROW_MSG(parse_npy("not numpy at all", "x.npy"), FormatError, "x.npy: not a .npy file");
+  EXPECT_THROW_MSG(parse_npy(good.substr(0, good.size() - 3), "x.npy"), FormatError, "bytes");
+  EXPECT_THROW_MSG(parse_npy(good.substr(0, 20), "x.npy"), FormatError, "truncated");
   EXPECT_NE(format_error_of([] {
               parse_npy(npy_with("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }", std::string(48, '\0')), "x.npy");
             }).find("not one-dimensional"),
@@ -157,11 +151,11 @@ TEST(Csv, ParsesSeparatorsCommentsAndCrlf) {
 }
 
 TEST(Csv, RejectsMalformedRowsNamingTheLine) {
-  EXPECT_NE(format_error_of([] { parse_csv_columns("x,y\n1,2\n3,four\n", "t.csv"); }).find("t.csv:3"), std::string::npos);
-  EXPECT_NE(format_error_of([] { parse_csv_columns("1,2\n3\n", "t.csv"); }).find("t.csv:2"), std::string::npos);
-  EXPECT_NE(format_error_of([] { parse_csv_columns("1,2x\n", "t.csv"); }), "(no FormatError)");  // trailing junk
-  EXPECT_NE(format_error_of([] { parse_csv_columns("x,y\n", "t.csv"); }).find("no numeric rows"), std::string::npos);
-  EXPECT_NE(format_error_of([] { parse_csv_columns("", "t.csv"); }).find("no numeric rows"), std::string::npos);
+  EXPECT_THROW_MSG(parse_csv_columns("x,y\n1,2\n3,four\n", "t.csv"), FormatError, "t.csv:3");
+  EXPECT_THROW_MSG(parse_csv_columns("1,2\n3\n", "t.csv"), FormatError, "t.csv:2");
+  EXPECT_THROW_MSG(parse_csv_columns("1,2x\n", "t.csv"), FormatError, "t.csv");  // trailing junk
+  EXPECT_THROW_MSG(parse_csv_columns("x,y\n", "t.csv"), FormatError, "no numeric rows");
+  EXPECT_THROW_MSG(parse_csv_columns("", "t.csv"), FormatError, "no numeric rows");
 }
 
 TEST(AtomicWrite, WritesTheBytesAndLeavesNoTemporary) {

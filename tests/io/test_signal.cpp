@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "../support/expect.hpp"
+#include "../support/wav.hpp"
 #include "texel/bitstream.hpp"
 #include "texel/codec.hpp"
 #include "texel/document.hpp"
@@ -26,34 +28,7 @@ using namespace texel;
 
 namespace {
 
-/// A little-endian PCM16 WAV of interleaved frames (hand-made so a test can
-/// declare any channel count and any data size).
-std::string wav_bytes(unsigned channels, unsigned rate, const std::vector<std::int16_t>& interleaved,
-                      std::uint32_t declared_data_bytes = 0) {
-  std::string out;
-  auto u32 = [&](std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
-  };
-  auto u16 = [&](std::uint16_t v) {
-    out.push_back(static_cast<char>(v & 0xFF));
-    out.push_back(static_cast<char>(v >> 8));
-  };
-  const auto data = static_cast<std::uint32_t>(interleaved.size() * 2);
-  out += "RIFF";
-  u32(36 + data);
-  out += "WAVEfmt ";
-  u32(16);
-  u16(1);
-  u16(static_cast<std::uint16_t>(channels));
-  u32(rate);
-  u32(rate * channels * 2);
-  u16(static_cast<std::uint16_t>(channels * 2));
-  u16(16);
-  out += "data";
-  u32(declared_data_bytes ? declared_data_bytes : data);
-  for (std::int16_t s : interleaved) u16(static_cast<std::uint16_t>(s));
-  return out;
-}
+using test_support::wav_bytes;
 
 std::span<const std::byte> as_span(const std::string& s) { return std::as_bytes(std::span(s.data(), s.size())); }
 
@@ -107,17 +82,7 @@ std::string field_of(F&& f) {
   return "(no error)";
 }
 
-template <class E, class F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("wrong type: ") + e.what();
-  }
-  return "(no error)";
-}
+using texel::test_support::message_of;
 
 }  // namespace
 
@@ -163,7 +128,7 @@ TEST_F(SignalLoader, BitstreamsDecodeThroughTheCodecOnTheGivenDevice) {
   EXPECT_EQ(s.format, SignalFormat::bitstream);
   EXPECT_EQ(s.samples.size(), static_cast<std::size_t>(tpad.samples));
   // texel::load_signal alone does not decode bitstreams; it says where to go.
-  EXPECT_NE(message_of<InvalidArgument>([&] { load_signal(path, o); }).find("codec::load_signal"), std::string::npos);
+  EXPECT_THROW_MSG(load_signal(path, o), InvalidArgument, "codec::load_signal");
 }
 
 TEST_F(SignalLoader, TimeRecordingsBecomePositionsAtTheSwipeSpeed) {
@@ -199,7 +164,7 @@ TEST_F(SignalLoader, ChannelPolicyOfMultiChannelRecordings) {
   o.swipe_speed = MmPerSecond(100.0);
   // Default: refused, naming the channel count.
   EXPECT_EQ(field_of([&] { load_signal(wav, o); }), "channel");
-  EXPECT_NE(message_of<FieldError>([&] { load_signal(wav, o); }).find("2 channels"), std::string::npos);
+  EXPECT_THROW_MSG(load_signal(wav, o), FieldError, "2 channels");
   // select: the channel asked for (channel 1 is silent: nothing to scale).
   o.channels = ChannelPolicy::select;
   o.channel = 0;
@@ -236,10 +201,10 @@ TEST_F(SignalLoader, SpacingPolicy) {
   EXPECT_EQ(field_of([&] { load_signal(put("m.bin", std::string(200, '\0'))); }), "device");
   // Uneven positions are a format error naming the row.
   const std::string uneven = put("u.csv", "position_mm,amplitude\n0,0.1\n1,0.2\n2,0.3\n3.5,0.4\n4,0.5\n");
-  EXPECT_NE(message_of<FormatError>([&] { load_signal(uneven); }).find("not uniformly sampled"), std::string::npos);
+  EXPECT_THROW_MSG(load_signal(uneven), FormatError, "not uniformly sampled");
 }
 
-TEST_F(SignalLoader, Regions) {
+TEST_F(SignalLoader, ARegionKeepsOnlyTheSamplesInsideIt) {
   const std::string csv = put("m.csv", csv_columns("position_mm", "amplitude", positions(), map));
   SignalOptions o;
   o.region = SignalOptions::Region{"", Millimetres(10.0), Millimetres(20.0)};
@@ -279,7 +244,7 @@ TEST_F(SignalLoader, DeclaredSizesAreBoundedBeforeAllocating) {
 }
 
 TEST_F(SignalLoader, RejectsBadInput) {
-  EXPECT_NE(message_of<InvalidArgument>([&] { load_signal(put("m.txt", "1,2\n")); }).find("allowed: .bin"), std::string::npos);
+  EXPECT_THROW_MSG(load_signal(put("m.txt", "1,2\n")), InvalidArgument, "allowed: .bin");
   EXPECT_THROW(load_signal((dir / "missing.csv").string()), IoError);
   EXPECT_NE(message_of<FormatError>([&] { load_signal(put("e.csv", "position_mm,amplitude\n")); }).find("e.csv"),
             std::string::npos);

@@ -13,50 +13,27 @@
 #include <optional>
 #include <thread>
 
+#include "../support/alloc_counter.hpp"
+#include "../support/grids.hpp"
 #include "texel/player.hpp"
 
-// The replacements below pair malloc with free on purpose.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
 namespace {
-thread_local bool in_process = false;
-std::atomic<std::uint64_t> rt_allocations{0};
-std::atomic<std::uint64_t> rt_frees{0};
-std::atomic<std::uint64_t> all_allocations{0};
+using texel::test_support::alloc::all_allocations;
+// Counting is on while the audio thread is inside process().
+using texel::test_support::alloc::counted_allocations;
+using texel::test_support::alloc::counted_frees;
+using texel::test_support::alloc::counting;
 }  // namespace
-
-void* operator new(std::size_t n) {
-  all_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (in_process) rt_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return operator new(n);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return operator new(n, std::nothrow); }
-void operator delete(void* p) noexcept {
-  if (p && in_process) rt_frees.fetch_add(1, std::memory_order_relaxed);
-  std::free(p);
-}
-void operator delete[](void* p) noexcept { operator delete(p); }
-void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
-void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
 
 using namespace texel;
 
 TEST(PlayerAlloc, CountingAllocatorWorks) {
-  in_process = true;
+  counting = true;
   auto* p = new int(3);
   delete p;
-  in_process = false;
-  EXPECT_EQ(rt_allocations.exchange(0), 1u);
-  EXPECT_EQ(rt_frees.exchange(0), 1u);
+  counting = false;
+  EXPECT_EQ(counted_allocations.exchange(0), 1u);
+  EXPECT_EQ(counted_frees.exchange(0), 1u);
 }
 
 // The event and retire rings are allocated by the constructor (prepare) and
@@ -97,7 +74,7 @@ TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
     std::optional<FrequencyResponse> r;
     if (k % 3 == 1) r = FrequencyResponse{};
     if (k % 3 == 2) r = FrequencyResponse{Hertz(300.0), 2, "a second-order display"};
-    return std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, std::move(v), std::move(r));
+    return std::make_unique<const PlayerMap>(texel::test_support::tpad_grid(), std::move(v), std::move(r));
   };
   for (OutputMode mode : {OutputMode::vibration, OutputMode::carrier, OutputMode::amplitude}) {
     PlayerConfig c;
@@ -126,20 +103,20 @@ TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
       }
     });
     std::vector<float> out(frames);
-    rt_allocations = 0;
-    rt_frees = 0;
+    counted_allocations = 0;
+    counted_frees = 0;
     double sum = 0;
     for (std::uint64_t b = 0; b < blocks; ++b) {
-      in_process = true;
+      counting = true;
       const BlockInfo info = player.process(out);
-      in_process = false;
+      counting = false;
       sum += info.peak;
       done.store(b + 1, std::memory_order_relaxed);
     }
     stop = true;
     control.join();
-    EXPECT_EQ(rt_allocations.load(), 0u) << to_string(mode);
-    EXPECT_EQ(rt_frees.load(), 0u) << to_string(mode);
+    EXPECT_EQ(counted_allocations.load(), 0u) << to_string(mode);
+    EXPECT_EQ(counted_frees.load(), 0u) << to_string(mode);
     EXPECT_GT(swaps, 100u) << to_string(mode);
     EXPECT_GT(sum, 0.0) << to_string(mode);
   }

@@ -95,7 +95,7 @@ MapPlot sample_map() {
     m.amplitudes.push_back(0.5 + 0.5 * std::sin(2 * std::numbers::pi * 3 * x));
   }
   for (int i = 0; i < 160; ++i) m.frequencies_cpm.push_back(std::exp(std::log(3.0) + 0.4 * std::sin(i * 1.7)));
-  m.central_pitch_cpm = 3.0;
+  m.central_pitch = CyclesPerMm(3.0);
   return m;
 }
 
@@ -412,7 +412,7 @@ TEST(PlotMap, FigureHasMapExcerptAndHistogram) {
   EXPECT_TRUE(fig.panels[2].x.db_labels);
   MapPlot no_extras = sample_map();
   no_extras.frequencies_cpm.clear();
-  no_extras.excerpt_mm = 0.0;
+  no_extras.excerpt = Millimetres(0.0);
   EXPECT_EQ(map_figure(no_extras).panels.size(), 1u);
 }
 

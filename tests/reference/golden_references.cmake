@@ -20,4 +20,6 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "texel-golden failed (${rc}): ${err}")
 endif()
 include(${CMAKE_CURRENT_LIST_DIR}/../support/check_digests.cmake)
-check_digests(${GOLDEN} ${OUT}/references "*.f64" reference)
+# Files that match are kept in OUT-accepted, so a later failure names the
+# first differing sample (check_digests.cmake).
+check_digests(${GOLDEN} ${OUT}/references "*.f64" reference ACCEPTED ${OUT}-accepted FORMAT f64le)

@@ -7,6 +7,8 @@
 #include <map>
 #include <numeric>
 
+#include "../support/grids.hpp"
+#include "../support/specs.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/reference.hpp"
@@ -14,14 +16,9 @@
 using namespace texel;
 
 namespace {
-const Grid tpad{Millimetres(0.0), Millimetres(0.0053), 19200};
+const Grid tpad = test_support::tpad_grid();
 
-ReferenceSpec spec(const std::string& name, std::uint64_t seed = 1) {
-  ReferenceSpec s;
-  s.name = name;
-  s.seed = seed;
-  return s;
-}
+ReferenceSpec spec(const std::string& name, std::uint64_t seed = 1) { return test_support::reference_spec(name, seed); }
 }  // namespace
 
 TEST(ReferenceCatalogue, HasEveryFamilyAndTheNineFirstStudyPairs) {
@@ -166,10 +163,9 @@ TEST(ReferenceDocument, ReferenceLeftTexelRightOnOneMap) {
   const auto map = prepare_surface(doc).render();
   ASSERT_EQ(map.size(), 19200u);
   // Left half: exactly the reference rendered over 50.88 mm on the same grid.
-  const ReferenceTexture ref(doc.regions[0].reference.value(), Millimetres(50.88),
-                             Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}});
+  const ReferenceTexture ref(doc.regions[0].reference.value(), Millimetres(50.88), Sampling{tpad});
   std::vector<double> left(9600);
-  ref.render(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, 0, left);
+  ref.render(tpad, 0, left);
   for (std::size_t i = 0; i < 9600; ++i) ASSERT_EQ(map[i], left[i]) << i;
   // Right half: exactly the Texel rendering of the right region alone.
   Document right = make_document(doc.device, doc.regions[1].texel);

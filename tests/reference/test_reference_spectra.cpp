@@ -6,20 +6,17 @@
 #include <cmath>
 #include <numeric>
 
+#include "../support/grids.hpp"
+#include "../support/specs.hpp"
 #include "texel/reference.hpp"
 #include "texel/spectrum.hpp"
 
 using namespace texel;
 
 namespace {
-const Grid tpad{Millimetres(0.0), Millimetres(0.0053), 19200};
+const Grid tpad = test_support::tpad_grid();
 
-ReferenceSpec spec(const std::string& name, std::uint64_t seed = 1) {
-  ReferenceSpec s;
-  s.name = name;
-  s.seed = seed;
-  return s;
-}
+ReferenceSpec spec(const std::string& name, std::uint64_t seed = 1) { return test_support::reference_spec(name, seed); }
 
 double db20(double x) { return 20.0 * std::log10(x); }
 }  // namespace
@@ -32,11 +29,11 @@ TEST(SinusoidReferences, PeaksAtTheirFrequenciesWithEqualHeights) {
   for (const auto& [name, freqs] : cases) {
     const auto a = render_reference(spec(name), tpad);
     const Spectrum s = magnitude_spectrum(a, tpad.spacing.value());
-    const auto peaks = find_peaks(s, {.threshold_db = -40.0});
+    const auto peaks = find_peaks(s, {.threshold = DecibelsLevel(-40.0)});
     ASSERT_EQ(peaks.size(), freqs.size()) << name;
     for (std::size_t i = 0; i < freqs.size(); ++i) {
       EXPECT_NEAR(peaks[i].frequency.value(), freqs[i], 0.1 * s.resolution_cpm) << name;
-      EXPECT_NEAR(peaks[i].level_db, 0.0, 0.1) << name;
+      EXPECT_NEAR(peaks[i].level.value(), 0.0, 0.1) << name;
     }
   }
 }
@@ -49,7 +46,7 @@ TEST(SinusoidReferences, RandomPhasesKeepTheSpectrum) {
   EXPECT_NE(a, render_reference(spec("4sin"), tpad));
   const auto peaks = find_peaks(magnitude_spectrum(a, tpad.spacing.value()));
   ASSERT_EQ(peaks.size(), 4u);
-  for (const auto& p : peaks) EXPECT_NEAR(p.level_db, 0.0, 0.1);
+  for (const auto& p : peaks) EXPECT_NEAR(p.level.value(), 0.0, 0.1);
 }
 
 namespace {
@@ -116,7 +113,7 @@ TEST(Waveforms, HarmonicRatiosAndNoAliasing) {
   for (const std::string name : {"square", "tri", "saw"}) {
     const auto a = render_reference(spec(name), tpad);
     const Spectrum s = magnitude_spectrum(a, tpad.spacing.value(), {.zero_pad = 4});
-    const auto peaks = find_peaks(s, {.threshold_db = -120.0, .max_peaks = 1000});
+    const auto peaks = find_peaks(s, {.threshold = DecibelsLevel(-120.0), .max_peaks = 1000});
     auto level_at = [&](double f) {
       for (const auto& p : peaks)
         if (std::abs(p.frequency.value() - f) < 0.02) return p.amplitude;

@@ -1,20 +1,21 @@
 // Spectral analysis: calibration against analytic signals, peak picking,
 // Welch PSD, summaries, and the texel-versus-sum-of-sinusoids property of
-// rendering.md §10. Each test states its tolerance.
+// docs/algorithm.md §10. Each test states its tolerance.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <complex>
 #include <cstdint>
-#include <vector>
 #include <numbers>
 #include <set>
+#include <vector>
 
+#include "../../src/spectrum/fft.hpp"
+#include "../support/grids.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/spectrum.hpp"
 #include "texel/texture.hpp"
-#include "../../src/spectrum/fft.hpp"
 
 using namespace texel;
 
@@ -90,12 +91,12 @@ TEST(SpectrumErrors, BadInputIsNamed) {
 }
 
 TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
-  // rendering.md §10: N texels of length L/N with frequencies f_i versus the
+  // docs/algorithm.md §10: N texels of length L/N with frequencies f_i versus the
   // equally weighted sum of the N sinusoids over L. Rectangular window (the
   // property is about the plain DFT), 16× zero padding. For each f_i the
   // Texel rendering's highest peak within ±2N/L sits at f_i within 0.05·N/L
   // and has the sum's height within 0.3 dB.
-  const Grid g{Millimetres(0.0), Millimetres(0.0053), 19200};
+  const Grid g = test_support::tpad_grid();
   const double L = g.length().value();
   for (std::size_t N : {3u, 4u, 6u}) {
     TexelSpec spec;
@@ -124,8 +125,10 @@ TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
       sum[i] = 0.5 + 0.5 * y / static_cast<double>(N);
     }
     const SpectrumOptions opt{.window = Window::rectangular, .zero_pad = 16};
-    const auto pt = find_peaks(magnitude_spectrum(texel, g.spacing.value(), opt), {.threshold_db = -60, .max_peaks = 1000});
-    const auto ps = find_peaks(magnitude_spectrum(sum, g.spacing.value(), opt), {.threshold_db = -60, .max_peaks = 1000});
+    const auto pt =
+        find_peaks(magnitude_spectrum(texel, g.spacing.value(), opt), {.threshold = DecibelsLevel(-60), .max_peaks = 1000});
+    const auto ps =
+        find_peaks(magnitude_spectrum(sum, g.spacing.value(), opt), {.threshold = DecibelsLevel(-60), .max_peaks = 1000});
     const double wide = static_cast<double>(N) / L;
     for (const auto& x : t->texels()) {
       auto best = [&](const std::vector<Peak>& peaks, double span) {
@@ -192,7 +195,8 @@ TEST(Pow2RealFft, EqualsTheDftAndKissFft) {
   texel::detail::Pow2RealFft(n).forward(x, a);
   texel::detail::RealFft(n).forward(x, b);
   double worst = 0.0, scale = 0.0;
-  for (std::size_t k = 0; k <= n / 2; ++k) worst = std::max(worst, std::abs(a[k] - b[k])), scale = std::max(scale, std::abs(a[k]));
+  for (std::size_t k = 0; k <= n / 2; ++k)
+    worst = std::max(worst, std::abs(a[k] - b[k])), scale = std::max(scale, std::abs(a[k]));
   EXPECT_LT(worst, 1e-4 * scale);
   EXPECT_THROW(texel::detail::Pow2RealFft(6), texel::InvalidArgument);
   EXPECT_THROW(texel::detail::Pow2RealFft(2), texel::InvalidArgument);

@@ -18,25 +18,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/cli_run.hpp"
+#include "../support/temp_dir.hpp"
+
 namespace texel_stats_test {
 
 namespace fs = std::filesystem;
 
-struct ProcessResult {
-  int status = -1;
-  std::string out;
-};
+using ProcessResult = texel::test_support::CliRun;
 
 // Runs a shell command; stdout (and stderr when merge) captured.
 inline ProcessResult run_command(const std::string& cmd, bool merge = true) {
-  ProcessResult r;
-  FILE* p = ::popen((cmd + (merge ? " 2>&1" : "")).c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), static_cast<int>(buf.size()), p)) r.out += buf.data();
-  const int s = ::pclose(p);
-  r.status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  return r;
+  return texel::test_support::run_cli(cmd, "", merge);
 }
 
 // Debian's interpreter, where python3-scipy is installed (not whatever
@@ -131,16 +124,11 @@ inline LongData make_rm_data(std::vector<std::string> factor_names, std::vector<
   return d;
 }
 
-class TempDir : public ::testing::Test {
+// Tests that write CSV files for the oracle and the CLI: a fresh directory per test.
+class StatsFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("texel-stats-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir);
-  }
-  void TearDown() override { fs::remove_all(dir); }
-  std::string path(const std::string& name) const { return (dir / name).string(); }
-  fs::path dir;
+  std::string path(const std::string& name) const { return tmp.at(name); }
+  texel::test_support::TempDir tmp{"texel-stats"};
 };
 
 }  // namespace texel_stats_test

@@ -44,7 +44,7 @@ void expect_effects_match(const nlohmann::json& got, const nlohmann::json& want)
   }
 }
 
-class StatsCli : public TempDir {};
+class StatsCli : public StatsFiles {};
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 #include <vector>
@@ -169,12 +170,27 @@ bool eventually(Pred pred, std::chrono::milliseconds timeout = 5s) {
 
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-// ------------------------------------------------------------------ HTTP
-
-TEST(StudioServerHttp, ServesFilesWithTheirMimeTypes) {
+// Every test has a site, a fake handler and, once start() is called, a
+// server running on its own thread; they go in reverse order at the end of
+// the test (the server stops first).
+class ServerTest : public ::testing::Test {
+ protected:
   Site site;
   FakeHandler h;
-  Running r(h, options_for(site));
+  std::optional<Running> running;
+
+  ServerOptions options() const { return options_for(site); }
+  Running& start(ServerOptions o) { return running.emplace(h, std::move(o)); }
+  Running& start() { return start(options()); }
+};
+class StudioServerHttp : public ServerTest {};
+class StudioServerStart : public ServerTest {};
+class StudioServerWs : public ServerTest {};
+
+// ------------------------------------------------------------------ HTTP
+
+TEST_F(StudioServerHttp, ServesFilesWithTheirMimeTypes) {
+  Running& r = start();
   const std::pair<std::string, std::string> cases[] = {
       {"/", "text/html; charset=utf-8"},
       {"/index.html", "text/html; charset=utf-8"},
@@ -198,10 +214,8 @@ TEST(StudioServerHttp, ServesFilesWithTheirMimeTypes) {
   EXPECT_EQ(texel::test_support::http_request(r.port, "GET", "/app.js").header("cache-control"), "");
 }
 
-TEST(StudioServerHttp, HeadSendsTheLengthWithoutABody) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerHttp, HeadSendsTheLengthWithoutABody) {
+  Running& r = start();
   const HttpReply reply = texel::test_support::http_request(r.port, "HEAD", "/app.js");
   EXPECT_EQ(reply.status, 200);
   EXPECT_EQ(reply.header("content-length"), "21");
@@ -211,10 +225,8 @@ TEST(StudioServerHttp, HeadSendsTheLengthWithoutABody) {
   EXPECT_EQ(missing.body, "");
 }
 
-TEST(StudioServerHttp, OnlyGetAndHeadAreAllowed) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerHttp, OnlyGetAndHeadAreAllowed) {
+  Running& r = start();
   for (const std::string method : {"POST", "PUT", "DELETE", "OPTIONS", "PATCH"}) {
     const HttpReply reply = texel::test_support::http_raw(
         r.port, method + " /index.html HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\nConnection: close\r\n\r\nhi");
@@ -223,10 +235,8 @@ TEST(StudioServerHttp, OnlyGetAndHeadAreAllowed) {
   }
 }
 
-TEST(StudioServerHttp, MissingFilesAndDirectoriesAreNotFound) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerHttp, MissingFilesAndDirectoriesAreNotFound) {
+  Running& r = start();
   for (const std::string target : {"/missing.js", "/assets", "/assets/", "/assets/missing/", "/ws", "/.hidden"}) {
     const HttpReply reply = texel::test_support::http_request(r.port, "GET", target);
     EXPECT_EQ(reply.status, 404) << target;
@@ -234,10 +244,8 @@ TEST(StudioServerHttp, MissingFilesAndDirectoriesAreNotFound) {
   }
 }
 
-TEST(StudioServerHttp, PathTraversalIsRefused) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerHttp, PathTraversalIsRefused) {
+  Running& r = start();
   const std::string targets[] = {
       "/../secret.txt",
       "/%2e%2e/secret.txt",
@@ -271,15 +279,13 @@ TEST(StudioServerHttp, PathTraversalIsRefused) {
   EXPECT_EQ(texel::test_support::http_request(r.port, "GET", "/").status, 200);
 }
 
-TEST(StudioServerHttp, SymlinksLeadingOutAreRefusedAndInsideAreServed) {
-  Site site;
+TEST_F(StudioServerHttp, SymlinksLeadingOutAreRefusedAndInsideAreServed) {
   fs::create_symlink(site.dir.path / "secret.txt", site.web / "leak.txt");
   fs::create_directory_symlink("/etc", site.web / "etc");
   fs::create_directory_symlink(site.dir.path, site.web / "assets" / "up");
   fs::create_symlink(site.web / "app.js", site.web / "alias.js");
   fs::create_symlink("../app.js", site.web / "assets" / "relative.js");
-  FakeHandler h;
-  Running r(h, options_for(site));
+  Running& r = start();
   for (const std::string target : {"/leak.txt", "/etc/passwd", "/etc/hostname", "/assets/up/secret.txt"}) {
     const HttpReply reply = texel::test_support::http_request(r.port, "GET", target);
     EXPECT_EQ(reply.status, 404) << target;
@@ -289,12 +295,10 @@ TEST(StudioServerHttp, SymlinksLeadingOutAreRefusedAndInsideAreServed) {
   EXPECT_EQ(texel::test_support::http_request(r.port, "GET", "/assets/relative.js").status, 200);
 }
 
-TEST(StudioServerHttp, OversizedHeadersAndBodiesAreRefused) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerHttp, OversizedHeadersAndBodiesAreRefused) {
+  ServerOptions o = options();
   o.limits.max_request_bytes = 4096;
-  Running r(h, o);
+  Running& r = start(o);
   const HttpReply big_header =
       texel::test_support::http_raw(r.port, "GET / HTTP/1.1\r\nHost: x\r\nX-Junk: " + std::string(8000, 'a') + "\r\n\r\n");
   EXPECT_EQ(big_header.status, 431);
@@ -306,22 +310,18 @@ TEST(StudioServerHttp, OversizedHeadersAndBodiesAreRefused) {
   EXPECT_EQ(texel::test_support::http_request(r.port, "GET", "/").status, 200);
 }
 
-TEST(StudioServerHttp, KeepAliveServesSeveralRequestsOnOneConnection) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerHttp, KeepAliveServesSeveralRequestsOnOneConnection) {
+  Running& r = start();
   const HttpReply reply = texel::test_support::http_raw(
       r.port, "GET /app.js HTTP/1.1\r\nHost: x\r\n\r\nGET /index.html HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(reply.status, 200);
   EXPECT_NE(reply.body.find("<title>studio</title>"), std::string::npos) << "second response arrived";
 }
 
-TEST(StudioServerHttp, SlowlorisHeaderIsReapedByTheRequestTimeout) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerHttp, SlowlorisHeaderIsReapedByTheRequestTimeout) {
+  ServerOptions o = options();
   o.limits.http_timeout = 300ms;
-  Running r(h, o);
+  Running& r = start(o);
   const int fd = texel::test_support::tcp_connect(r.port);
   ASSERT_GE(fd, 0);
   ASSERT_TRUE(texel::test_support::send_all(fd, "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: "));
@@ -338,8 +338,7 @@ TEST(StudioServerHttp, SlowlorisHeaderIsReapedByTheRequestTimeout) {
 
 // ------------------------------------------------------------- start-up checks
 
-TEST(StudioServerStart, AMissingFrontEndIsAClearError) {
-  FakeHandler h;
+TEST_F(StudioServerStart, AMissingFrontEndIsAClearError) {
   ServerOptions o;
   o.web_root = "/nonexistent/web";
   Server server(h, o);
@@ -352,8 +351,7 @@ TEST(StudioServerStart, AMissingFrontEndIsAClearError) {
   }
 }
 
-TEST(StudioServerStart, NonLoopbackAddressesNeedAllowRemote) {
-  FakeHandler h;
+TEST_F(StudioServerStart, NonLoopbackAddressesNeedAllowRemote) {
   ServerOptions o;
   o.address = "0.0.0.0";
   EXPECT_THROW(Server(h, o), texel::InvalidArgument);
@@ -371,11 +369,9 @@ TEST(StudioServerStart, NonLoopbackAddressesNeedAllowRemote) {
   EXPECT_FALSE(texel::studio::is_loopback_address("localhost"));
 }
 
-TEST(StudioServerStart, APortInUseIsAClearError) {
-  Site site;
-  FakeHandler h;
-  Running first(h, options_for(site));
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerStart, APortInUseIsAClearError) {
+  Running& first = start();
+  ServerOptions o = options();
   o.port = first.port;
   Server second(h, o);
   try {
@@ -390,10 +386,8 @@ TEST(StudioServerStart, APortInUseIsAClearError) {
 
 // ----------------------------------------------------------------- WebSocket
 
-TEST(StudioServerWs, TextRoundTripAndOneDisconnectPerConnect) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, TextRoundTripAndOneDisconnectPerConnect) {
+  Running& r = start();
   {
     WsClient c;
     ASSERT_TRUE(c.connect(r.port)) << c.error();
@@ -411,10 +405,8 @@ TEST(StudioServerWs, TextRoundTripAndOneDisconnectPerConnect) {
   EXPECT_TRUE(eventually([&] { return r.server.connections() == 0; }));
 }
 
-TEST(StudioServerWs, UpgradesElsewhereThanWsAreNotFound) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, UpgradesElsewhereThanWsAreNotFound) {
+  Running& r = start();
   for (const std::string target : {"/", "/index.html", "/ws/x", "/wss"}) {
     WsClient c;
     EXPECT_FALSE(c.connect(r.port, target)) << target;
@@ -425,12 +417,10 @@ TEST(StudioServerWs, UpgradesElsewhereThanWsAreNotFound) {
   EXPECT_TRUE(eventually([&] { return h.connects() == 1; }));
 }
 
-TEST(StudioServerWs, BrowserOriginsMustBeThisServer) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, BrowserOriginsMustBeThisServer) {
+  ServerOptions o = options();
   o.allowed_origins = {"http://localhost:5173"};
-  Running r(h, o);
+  Running& r = start(o);
   const std::string port = std::to_string(r.port);
   struct Case {
     std::string origin, host;
@@ -455,10 +445,8 @@ TEST(StudioServerWs, BrowserOriginsMustBeThisServer) {
   }
 }
 
-TEST(StudioServerWs, BinaryFramesGetAnErrorAndNeverReachTheHandler) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, BinaryFramesGetAnErrorAndNeverReachTheHandler) {
+  Running& r = start();
   WsClient c;
   ASSERT_TRUE(c.connect(r.port));
   ASSERT_TRUE(c.send_binary(std::string("\x00\x01\x02", 3)));
@@ -468,10 +456,8 @@ TEST(StudioServerWs, BinaryFramesGetAnErrorAndNeverReachTheHandler) {
   EXPECT_EQ(c.read(), "still here");
 }
 
-TEST(StudioServerWs, AThrowingHandlerIsAnsweredAndTheConnectionStays) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, AThrowingHandlerIsAnsweredAndTheConnectionStays) {
+  Running& r = start();
   WsClient c;
   ASSERT_TRUE(c.connect(r.port));
   ASSERT_TRUE(c.send_text("throw"));
@@ -480,12 +466,10 @@ TEST(StudioServerWs, AThrowingHandlerIsAnsweredAndTheConnectionStays) {
   EXPECT_EQ(c.read(), "after");
 }
 
-TEST(StudioServerWs, OversizedMessagesCloseWithTooBig) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, OversizedMessagesCloseWithTooBig) {
+  ServerOptions o = options();
   o.limits.max_message_bytes = 1024;
-  Running r(h, o);
+  Running& r = start(o);
   WsClient c;
   ASSERT_TRUE(c.connect(r.port));
   ASSERT_TRUE(c.send_text(std::string(1024, 'a')));
@@ -501,10 +485,8 @@ TEST(StudioServerWs, OversizedMessagesCloseWithTooBig) {
   EXPECT_EQ(next.read(), "ok");
 }
 
-TEST(StudioServerWs, InvalidUtf8TextIsRefused) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, InvalidUtf8TextIsRefused) {
+  Running& r = start();
   WsClient c;
   ASSERT_TRUE(c.connect(r.port));
   c.send_raw(texel::test_support::ws_frame_header(2) + "\xc3\x28");
@@ -514,10 +496,8 @@ TEST(StudioServerWs, InvalidUtf8TextIsRefused) {
   EXPECT_EQ(h.messages(), 0u);
 }
 
-TEST(StudioServerWs, AFloodOfTenThousandMessagesIsAnsweredInOrder) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, AFloodOfTenThousandMessagesIsAnsweredInOrder) {
+  Running& r = start();
   WsClient flooder;
   ASSERT_TRUE(flooder.connect(r.port));
   constexpr int n = 10000;
@@ -540,12 +520,10 @@ TEST(StudioServerWs, AFloodOfTenThousandMessagesIsAnsweredInOrder) {
   std::printf("flood: %d messages echoed in %.0f ms (%.0f messages/s)\n", n, ms, n / ms * 1000);
 }
 
-TEST(StudioServerWs, ConnectionsBeyondTheLimitAreRefusedWith503) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, ConnectionsBeyondTheLimitAreRefusedWith503) {
+  ServerOptions o = options();
   o.limits.max_connections = 4;
-  Running r(h, o);
+  Running& r = start(o);
   std::vector<std::unique_ptr<WsClient>> clients;
   for (int i = 0; i < 4; ++i) {
     clients.push_back(std::make_unique<WsClient>());
@@ -566,12 +544,10 @@ TEST(StudioServerWs, ConnectionsBeyondTheLimitAreRefusedWith503) {
   EXPECT_TRUE(again.connect(r.port)) << again.error();
 }
 
-TEST(StudioServerWs, AStalledPartialFrameIsReapedByTheIdleTimeout) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, AStalledPartialFrameIsReapedByTheIdleTimeout) {
+  ServerOptions o = options();
   o.limits.ws_idle_timeout = 400ms;
-  Running r(h, o);
+  Running& r = start(o);
   WsClient c;
   ASSERT_TRUE(c.connect(r.port));
   ASSERT_TRUE(c.send_raw(texel::test_support::ws_frame_header(1000) + std::string(10, 'a')));
@@ -584,12 +560,10 @@ TEST(StudioServerWs, AStalledPartialFrameIsReapedByTheIdleTimeout) {
   std::printf("half-open WebSocket (stalled mid-frame) reaped after %.0f ms (idle timeout 400 ms)\n", reaped_ms);
 }
 
-TEST(StudioServerWs, AStalledHandshakeIsReaped) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, AStalledHandshakeIsReaped) {
+  ServerOptions o = options();
   o.limits.http_timeout = 300ms;
-  Running r(h, o);
+  Running& r = start(o);
   const int fd = texel::test_support::tcp_connect(r.port);
   ASSERT_TRUE(texel::test_support::send_all(fd, "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"));
   EXPECT_EQ(texel::test_support::read_until_close(fd, 3s), "");
@@ -597,10 +571,8 @@ TEST(StudioServerWs, AStalledHandshakeIsReaped) {
   EXPECT_EQ(h.connects(), 0u);
 }
 
-TEST(StudioServerWs, AnAbruptResetMidFrameDisconnectsOnce) {
-  Site site;
-  FakeHandler h;
-  Running r(h, options_for(site));
+TEST_F(StudioServerWs, AnAbruptResetMidFrameDisconnectsOnce) {
+  Running& r = start();
   for (int i = 0; i < 20; ++i) {
     WsClient c;
     ASSERT_TRUE(c.connect(r.port));
@@ -614,12 +586,10 @@ TEST(StudioServerWs, AnAbruptResetMidFrameDisconnectsOnce) {
   EXPECT_TRUE(eventually([&] { return r.server.connections() == 0; }));
 }
 
-TEST(StudioServerWs, AReaderThatNeverReadsIsDroppedAndMemoryStaysBounded) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, AReaderThatNeverReadsIsDroppedAndMemoryStaysBounded) {
+  ServerOptions o = options();
   o.limits.max_queued_bytes = 1u << 20;
-  Running r(h, o);
+  Running& r = start(o);
   const long before = rss_kib();
   WsClient slow;
   ASSERT_TRUE(slow.connect(r.port));
@@ -638,25 +608,22 @@ TEST(StudioServerWs, AReaderThatNeverReadsIsDroppedAndMemoryStaysBounded) {
   EXPECT_EQ(other.read(), "fine");
 }
 
-TEST(StudioServerWs, LateSinkCallsAfterCloseAreHarmless) {
-  Site site;
-  FakeHandler h;
+TEST_F(StudioServerWs, LateSinkCallsAfterCloseAreHarmless) {
   {
-    Running r(h, options_for(site));
+    Running& r = start();
     WsClient c;
     ASSERT_TRUE(c.connect(r.port));
     c.close();
     ASSERT_TRUE(h.wait_disconnects(1));
     for (auto& sink : h.kept_sinks()) sink("late reply, connection closed");
   }
+  running.reset();  // the server is gone
   for (auto& sink : h.kept_sinks()) sink("late reply, server gone");
   SUCCEED();
 }
 
-TEST(StudioServerWs, StopSaysGoingAwayAndRunReturns) {
-  Site site;
-  FakeHandler h;
-  Server server(h, options_for(site));
+TEST_F(StudioServerWs, StopSaysGoingAwayAndRunReturns) {
+  Server server(h, options());
   const std::uint16_t port = server.start();
   std::thread runner([&] { server.run(); });
   WsClient a, b;
@@ -679,10 +646,8 @@ TEST(StudioServerWs, StopSaysGoingAwayAndRunReturns) {
   std::printf("stop with 3 open connections: run() returned after %.0f ms\n", stop_ms);
 }
 
-TEST(StudioServerWs, StopCutsAPeerThatIgnoresTheClosingHandshake) {
-  Site site;
-  FakeHandler h;
-  ServerOptions o = options_for(site);
+TEST_F(StudioServerWs, StopCutsAPeerThatIgnoresTheClosingHandshake) {
+  ServerOptions o = options();
   o.limits.stop_grace = 300ms;
   Server server(h, o);
   const std::uint16_t port = server.start();

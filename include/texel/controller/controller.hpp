@@ -2,7 +2,7 @@
 // (docs/serial-protocol.md). It receives maps from the host, reads the
 // finger position (from its own sensor or from the host's stream) and writes
 // the friction amplitude at the display's refresh rate (8,333 Hz on `tpad`),
-// as the TPaD's microcontroller does (rendering.md §8).
+// as the TPaD's microcontroller does (docs/algorithm.md §8).
 //
 // Portable C++20 for a microcontroller: no heap, no exceptions, no RTTI
 // needed at run time, no standard library beyond <cstdint>/<cstring>. All

@@ -1,5 +1,5 @@
 // Matching optimizers: the common interface and the guided-exploration
-// optimizer (experiments.md "Guided exploration").
+// optimizer (docs/procedures.md §3.1).
 //
 // A matching optimizer hands out one pair of textures (A, B) in
 // (Central Pitch dB, Irregularity dB), takes one choice ("which feels more
@@ -123,7 +123,7 @@ struct MatchBox {
   [[nodiscard]] bool contains(const MatchBox& inner, double tolerance = 1e-9) const;
 };
 
-/// Guided exploration (Vardar's thesis; experiments.md): from the box
+/// Guided exploration (Vardar's thesis; docs/procedures.md §3.1): from the box
 /// centroid c with half-widths (hP, hI), eight points at c ± (hP/2, 0),
 /// c ± (0, hI/2), c ± (hP/2, ±hI/2); four questions, one per pair of
 /// opposite points, in an order drawn from (seed, iteration), A/B sides from

@@ -1,5 +1,5 @@
 // Simulated observers: seeded stand-ins for participants, to test and
-// benchmark the adaptive procedures (experiments.md "Simulated observer").
+// benchmark the adaptive procedures (docs/procedures.md §4).
 // Every draw is a pure function of (seed, trial index) through
 // texel::CounterRng, so a simulated session is exact and any trial can be
 // re-drawn without the ones before it.

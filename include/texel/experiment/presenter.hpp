@@ -1,6 +1,6 @@
 // Stimulus presentation: the textures of a trial played through the
 // existing player backends (null, audio, serial display), switching when the
-// participant selects one (experiments.md: the participant may switch among
+// participant selects one (docs/procedures.md §6: the participant may switch among
 // the stimuli freely).
 //
 // A Presenter owns a backend and a Player for the whole session. show()

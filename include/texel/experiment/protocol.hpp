@@ -1,4 +1,4 @@
-// Protocol files: an experiment is data, not code (experiments.md; format in
+// Protocol files: an experiment is data, not code (docs/procedures.md §6; format in
 // docs/experiments.md, schema in docs/schema/texel-protocol.schema.json).
 //
 // A protocol names its study, a device, a randomization seed, the simulated
@@ -31,7 +31,7 @@ enum class TaskKind { oddity, two_alternative, match, rating, guided, same_diffe
 std::string_view to_string(TaskKind t);
 TaskKind parse_task_kind(std::string_view text, std::string_view field = "task");
 
-/// The seven studies of experiments.md.
+/// The seven studies of docs/procedures.md §6.
 inline constexpr std::string_view study_names[] = {"working-memory",   "texel-length", "parameter-mapping",
                                                    "free-exploration", "quantization", "guided-exploration",
                                                    "coarse-features"};

@@ -74,7 +74,7 @@ struct TrialRow {
   double digit_response = missing;  ///< digit answered
   double digit_correct = missing;   ///< 1 / 0
 
-  // -- swipe behaviour (experiments.md "Measures"), when a finger trace exists
+  // -- swipe behaviour (docs/procedures.md §7), when a finger trace exists
   double swipe_mean_speed_mm_s = missing;
   double swipe_sd_speed_mm_s = missing;
   double directional_proportion = missing;

@@ -1,7 +1,7 @@
 // The experiment engine: a protocol in, one question at a time out, answers
 // in, records to store out. No terminal, network or file I/O inside: the
 // terminal runner (`texel experiment run`), the studio and the Python
-// bindings all drive this same object (style.md: "a procedure is a state
+// bindings all drive this same object (docs/contributing.md §5: "a procedure is a state
 // machine you step").
 //
 //   Session s(protocol, context);
@@ -171,7 +171,7 @@ class Session {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Slider mappings (experiments.md studies 2 and 3): slider positions to
+/// Slider mappings (docs/procedures.md §6, studies 2 and 3): slider positions to
 /// (Central Pitch dB, Irregularity dB) under the moments parameterization.
 MatchResult slider_to_parameters(SliderMapping mapping, double slider_p, double slider_i);
 

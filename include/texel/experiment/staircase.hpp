@@ -1,4 +1,4 @@
-// Adaptive N-up / M-down staircase (experiments.md "Adaptive staircase").
+// Adaptive N-up / M-down staircase (docs/procedures.md §2).
 //
 // Method: PsychoPy's StairHandler semantics, re-implemented from the facts
 // the spec states (initial 1-up/1-down rule until the first reversal, a run

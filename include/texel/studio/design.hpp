@@ -9,7 +9,7 @@
 // prepared TexelTexture drew (its PitchDistribution gives the expected
 // counts); the spectrum is magnitude_spectrum(); the bytes are from_spec() +
 // write_bitstream(); matching and importing signals are codec::encode(). So
-// the studio, the CLI and Python see the same numbers (style.md: "one core,
+// the studio, the CLI and Python see the same numbers (docs/contributing.md §1: "one core,
 // many front doors").
 //
 // Trade-off: a design view is computed whole on every slider move (the tpad
