@@ -214,15 +214,8 @@ ojson reference_param_json(const ReferenceParam& p) {
   return j;
 }
 
-// What participant screens may see of a question: the engine's view without
-// the stimulus documents (their parameters would give the odd one away),
-// unless the question asks to draw the maps (visual practice).
-ojson participant_question(const ex::Question& q) {
-  ojson j = q.to_json();
-  if (!q.show_maps)
-    for (auto& s : j["stimuli"]) s.erase("document");
-  return j;
-}
+// What participant screens may see of a question (the library's participant view).
+ojson participant_question(const ex::Question& q) { return ojson::parse(q.participant_json()); }
 
 }  // namespace
 
@@ -802,13 +795,12 @@ struct Service::Impl {
     return out;
   }
 
-  ojson session_json() const {
-    const ex::SessionInfo& i = active->info;
-    return ojson{{"id", i.id},
-                 {"participant", i.participant},
-                 {"protocol", i.protocol},
-                 {"study", i.study},
-                 {"simulated", !active->simulate.empty()}};
+  // The running session as the library serialises it (as stored now), with
+  // "simulated" for the spec in force.
+  ojson session_json() {
+    ojson j = ojson::parse(ex::to_json(the_store().session(active->info.id)));
+    j["simulated"] = !active->simulate.empty();
+    return j;
   }
 
   ojson progress_json() const {
@@ -859,18 +851,7 @@ struct Service::Impl {
                                 {"description", s.protocol.description},
                                 {"trials_planned", s.protocol.planned_trials()}});
     r["sessions"] = ojson::array();
-    for (const auto& s : the_store().sessions())
-      r["sessions"].push_back({{"id", s.id},
-                               {"participant", s.participant},
-                               {"protocol", s.protocol},
-                               {"study", s.study},
-                               {"status", s.status},
-                               {"finished", s.status == "finished"},
-                               {"simulated", !s.simulate.empty()},
-                               {"trials_done", s.trials_done},
-                               {"trials_planned", s.trials_planned},
-                               {"created_at", s.created_at},
-                               {"updated_at", s.updated_at}});
+    for (const auto& s : the_store().sessions()) r["sessions"].push_back(ojson::parse(ex::to_json(s)));
     r["active"] = active ? session_json() : ojson(nullptr);
     send(c, r);
   }
@@ -975,7 +956,7 @@ struct Service::Impl {
         throw Reject{"invalid", "experiment.answer: simulated answers need a session started with 'simulate'"};
       response = ex::simulated_participant(*active).respond(active->session);
     } else {
-      response = ex::Response::from_json(f.object("response"));
+      response = ex::Response::from_json(f.object("response").dump());
     }
     if (!response.swipe_mean_speed_mm_s) {
       std::lock_guard lock(feel_mutex);
