@@ -86,7 +86,6 @@ void wait_pumping(ex::Presenter* presenter, double seconds) {
   if (presenter) presenter->pump();
 }
 
-
 // ------------------------------------------------------------- terminal UI
 
 // Presents one question on the terminal and collects a valid answer.
@@ -104,7 +103,8 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
     event("select", q.stimuli[static_cast<std::size_t>(i)].label);
   };
   std::cout << "\n── trial " << q.trial + 1 << (q.practice ? " (practice)" : "") << " · " << q.block << " "
-            << q.trial_in_block + 1 << (q.block_trials && *q.block_trials > 0 ? " of " + std::to_string(*q.block_trials) : std::string()) << " ──\n"
+            << q.trial_in_block + 1
+            << (q.block_trials && *q.block_trials > 0 ? " of " + std::to_string(*q.block_trials) : std::string()) << " ──\n"
             << q.prompt << "\n";
   event("show", "trial " + std::to_string(q.trial));
 
@@ -112,8 +112,8 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   for (const auto& ph : q.phases) {
     if (ph.kind == ex::PhaseKind::stimulus && ph.stimulus) {
       feel(*ph.stimulus);
-      std::cout << "  feeling " << q.stimuli[static_cast<std::size_t>(*ph.stimulus)].label << " for " << detail::num(ph.duration_s)
-                << " s ...\n";
+      std::cout << "  feeling " << q.stimuli[static_cast<std::size_t>(*ph.stimulus)].label << " for "
+                << detail::num(ph.duration_s) << " s ...\n";
       std::cout.flush();
     } else {
       if (presenter) presenter->blank();

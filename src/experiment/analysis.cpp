@@ -19,11 +19,11 @@
 
 #include <boost/math/distributions/students_t.hpp>
 
+#include "json_views.hpp"
+#include "studies.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/stats.hpp"
-#include "json_views.hpp"
-#include "studies.hpp"
 
 namespace texel::experiment {
 
@@ -41,7 +41,6 @@ namespace {
 
 using json = nlohmann::ordered_json;
 using Rows = std::vector<const TrialRow*>;
-
 
 // ------------------------------------------------------------------ helpers
 
@@ -630,8 +629,7 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       std::error_code ec;
       std::filesystem::create_directories(options.out_dir, ec);
       if (ec) throw IoError("cannot create figure directory '" + options.out_dir + "': " + ec.message());
-      for (auto& f : analysis_figures::study_figures(st, summary[study], rs, options))
-        report.figures.push_back(std::move(f));
+      for (auto& f : analysis_figures::study_figures(st, summary[study], rs, options)) report.figures.push_back(std::move(f));
     }
   }
   report.summary = summary.dump();

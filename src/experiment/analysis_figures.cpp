@@ -16,12 +16,12 @@
 #include <optional>
 #include <set>
 
+#include "json_views.hpp"
+#include "studies.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/stats.hpp"
-#include "json_views.hpp"
-#include "studies.hpp"
 #include "texel/plot.hpp"
 
 namespace texel::experiment::analysis_figures {
@@ -112,8 +112,7 @@ Figure staircase_tracks(const Study& study, const Rows& rows) {
   }
   const int cols = static_cast<int>(std::min<std::size_t>(3, runs.size()));
   const int nrows = static_cast<int>((runs.size() + 2) / 3);
-  Figure f = figure(std::string(study.title) + " staircases", 420 * cols + 40,
-                    std::min(16000, 60 + 300 * nrows), cols);
+  Figure f = figure(std::string(study.title) + " staircases", 420 * cols + 40, std::min(16000, 60 + 300 * nrows), cols);
   for (const auto& [key, by_block] : runs) {
     Panel p;
     p.title = key.first + (sessions[key.first].size() > 1 ? " (session " + std::to_string(key.second) + ")" : "");

@@ -7,10 +7,10 @@
 #include <set>
 #include <sstream>
 
+#include "json_views.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/bayes_match.hpp"
 #include "texel/random.hpp"
-#include "json_views.hpp"
 
 namespace texel::experiment {
 

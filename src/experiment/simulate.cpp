@@ -218,8 +218,9 @@ SimulatedParticipant::SimulatedParticipant(std::string observer, const Session& 
   model->observer = parse_json_text(observer_, "observer");
   const json& observer_json = model->observer;
   if (!observer_json.is_object()) throw InvalidArgument("observer must be a JSON object");
-  seed_ = observer_json.contains("seed") && observer_json["seed"].is_number_unsigned() ? observer_json["seed"].get<std::uint64_t>()
-                                                                                       : mix64(session.context().seed ^ 0x51u);
+  seed_ = observer_json.contains("seed") && observer_json["seed"].is_number_unsigned()
+              ? observer_json["seed"].get<std::uint64_t>()
+              : mix64(session.context().seed ^ 0x51u);
   rng_ = CounterRng(seed_, stream_behaviour);
   // Validate the parts a protocol will need, up front, with the spec's names.
   const json& p = observer_json.contains("psychometric") ? observer_json["psychometric"] : json::object();

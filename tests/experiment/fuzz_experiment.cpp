@@ -17,7 +17,6 @@
 #include <cstdlib>
 #include <string_view>
 
-
 #include "texel/error.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/records.hpp"

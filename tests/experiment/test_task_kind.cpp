@@ -44,7 +44,8 @@ class PressBlock : public ex::TaskBlock {
     q.block_trials = presses(b);
     const bool left = s.trial_below(0, 2) == 0;
     const json texture = ex::texel_texture(ex::texture_of(b.texture), s.seed_draw(1));
-    const json flat = {{"kind", "texel"}, {"seed", 1}, {"texel_length_mm", 5.0}, {"central_pitch_db", 0.0}, {"irregularity_db", -20.0}};
+    const json flat = {
+        {"kind", "texel"}, {"seed", 1}, {"texel_length_mm", 5.0}, {"central_pitch_db", 0.0}, {"irregularity_db", -20.0}};
     q.stimuli.push_back({"Surface", s.halves(left ? texture : flat, left ? flat : texture)});
     q.choices = {"left", "right"};
     q.prompt = "Which half is textured?";
@@ -112,12 +113,14 @@ TEST(TaskKind, TestOnlyKindIsValidatedLikeABuiltInOne) {
     return std::string("no error");
   };
   EXPECT_NE(message("\"presses\": 5", "\"presses\": 500").find("blocks[1].presses is 500"), std::string::npos);
-  EXPECT_NE(message("\"presses\": 5", "\"presses\": 5, \"staircase\": {}").find("blocks[1].staircase does not apply to task "
-                                                                                  "'press-side'"),
+  EXPECT_NE(message("\"presses\": 5", "\"presses\": 5, \"staircase\": {}")
+                .find("blocks[1].staircase does not apply to task "
+                      "'press-side'"),
             std::string::npos);
   EXPECT_NE(message("\"presses\": 5", "\"presses\": 5, \"pressess\": 1").find("unknown key 'pressess'"), std::string::npos);
   // A built-in kind refuses the new kind's key.
-  EXPECT_NE(message("\"task\": \"press-side\", \"presses\": 5", "\"task\": \"match\", \"references\": [\"4sin\"], \"presses\": 5")
+  EXPECT_NE(message("\"task\": \"press-side\", \"presses\": 5",
+                    "\"task\": \"match\", \"references\": [\"bandpass-f1-z0.5\"], \"presses\": 5")
                 .find("blocks[1].presses does not apply to task 'match'"),
             std::string::npos);
 }
@@ -192,10 +195,8 @@ TEST(TaskKind, TestOnlyKindRunsThroughTheStudio) {
     service.handle(client, msg.dump());
     return inbox.wait_for(id);
   };
-  const json started = ask({{"type", "experiment.start"},
-                            {"protocol", json::parse(protocol_text)},
-                            {"participant", "P01"},
-                            {"simulate", "default"}});
+  const json started = ask(
+      {{"type", "experiment.start"}, {"protocol", json::parse(protocol_text)}, {"participant", "P01"}, {"simulate", "default"}});
   ASSERT_EQ(started["type"], "experiment.started") << started.dump();
   EXPECT_EQ(started["progress"]["planned"], 7);
   json q = ask({{"type", "experiment.current"}});

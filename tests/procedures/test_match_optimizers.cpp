@@ -296,8 +296,8 @@ static std::unique_ptr<MatchOptimizer> make(const std::string& kind, const nlohm
 }
 
 TEST(Factory, BuildsBothKindsWithParameters) {
-  auto g = make(
-      "guided", nlohmann::json{{"iterations", 4}, {"shrink_rate", 0.25}, {"unsure", "repeat"}, {"bound", "joint"}, {"seed", 3}});
+  auto g = make("guided",
+                nlohmann::json{{"iterations", 4}, {"shrink_rate", 0.25}, {"unsure", "repeat"}, {"bound", "joint"}, {"seed", 3}});
   EXPECT_EQ(g->name(), "guided");
   EXPECT_EQ(g->budget(), 16);
   auto b = make("bayesian", nlohmann::json{{"comparisons", 12}, {"sd_stop_db", 1.5}, {"noise_db", 3}});

@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-
 namespace texel::experiment::stats {
 
 /// Summary of a sample. NaNs are skipped (n counts the finite values only).

@@ -77,8 +77,8 @@ class GuidedBlock : public TaskBlock {
     json params = json::parse(b.optimizer_params);
     // Question order and A/B sides differ per participant and reference.
     if (!params.contains("seed"))
-      params["seed"] = mix64(s.ctx.seed ^ draw_counter(static_cast<std::uint64_t>(s.block_index),
-                                                       static_cast<std::uint64_t>(reference_)));
+      params["seed"] =
+          mix64(s.ctx.seed ^ draw_counter(static_cast<std::uint64_t>(s.block_index), static_cast<std::uint64_t>(reference_)));
     optimizer_ = make_optimizer_from(b.optimizer, params);
   }
 
@@ -127,9 +127,9 @@ class GuidedTask : public TaskType {
   }
 
   std::vector<std::string_view> columns() const override {
-    return {"response",           "iteration",       "pitch_a_db",         "irregularity_a_db", "pitch_b_db",
-            "irregularity_b_db",  "pitch_db",        "irregularity_db",    "procedure_finished", "texel_length_mm",
-            "reference_pitch_db", "reference_irregularity_db"};
+    return {"response",           "iteration",         "pitch_a_db",         "irregularity_a_db",
+            "pitch_b_db",         "irregularity_b_db", "pitch_db",           "irregularity_db",
+            "procedure_finished", "texel_length_mm",   "reference_pitch_db", "reference_irregularity_db"};
   }
 
   bool makes_matches() const override { return true; }

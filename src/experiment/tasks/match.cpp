@@ -45,12 +45,10 @@ class MatchBlock : public TaskBlock {
     require(r.slider_p.has_value() && r.slider_i.has_value(), "a match needs slider_p and slider_i");
     const auto& sp = q.sliders[0];
     const auto& si = q.sliders[1];
-    require(*r.slider_p >= sp.min && *r.slider_p <= sp.max, "slider_p is " + detail::num(*r.slider_p) +
-                                                                "; allowed: " + detail::num(sp.min) + " … " +
-                                                                detail::num(sp.max));
-    require(*r.slider_i >= si.min && *r.slider_i <= si.max, "slider_i is " + detail::num(*r.slider_i) +
-                                                                "; allowed: " + detail::num(si.min) + " … " +
-                                                                detail::num(si.max));
+    require(*r.slider_p >= sp.min && *r.slider_p <= sp.max,
+            "slider_p is " + detail::num(*r.slider_p) + "; allowed: " + detail::num(sp.min) + " … " + detail::num(sp.max));
+    require(*r.slider_i >= si.min && *r.slider_i <= si.max,
+            "slider_i is " + detail::num(*r.slider_i) + "; allowed: " + detail::num(si.min) + " … " + detail::num(si.max));
     if (q.confidence) {
       require(r.confidence && *r.confidence >= 1 && *r.confidence <= 5 && *r.confidence == std::floor(*r.confidence),
               "confidence is " + (r.confidence ? detail::num(*r.confidence) : std::string("missing")) + "; allowed: 1 … 5");
@@ -133,7 +131,8 @@ class MatchTask : public TaskType {
   }
 
   std::vector<std::string_view> columns() const override {
-    return {"response",        "confidence",         "slider_p",       "slider_i", "pitch_db", "irregularity_db",
+    return {"response",        "confidence",         "slider_p",
+            "slider_i",        "pitch_db",           "irregularity_db",
             "texel_length_mm", "reference_pitch_db", "reference_irregularity_db"};
   }
 

@@ -158,8 +158,8 @@ class RatingTask : public TaskType {
   }
 
   std::vector<std::string_view> columns() const override {
-    return {"rating", "response", "quantization_db", "pitch_db", "irregularity_db", "reference_pitch_db",
-            "reference_irregularity_db"};
+    return {"rating",          "response",           "quantization_db",          "pitch_db",
+            "irregularity_db", "reference_pitch_db", "reference_irregularity_db"};
   }
 };
 

@@ -31,8 +31,8 @@ class SameDifferentBlock : public TaskBlock {
     const MemoryCondition& cond = b.conditions[static_cast<std::size_t>(code / 2)];
     const bool same = code % 2 == 1;
     t.condition = cond.name;
-    const MemoryStimulus& ms = *std::find_if(b.memory_stimuli.begin(), b.memory_stimuli.end(),
-                                             [&](const auto& m) { return m.name == cond.stimulus; });
+    const MemoryStimulus& ms =
+        *std::find_if(b.memory_stimuli.begin(), b.memory_stimuli.end(), [&](const auto& m) { return m.name == cond.stimulus; });
     const std::uint64_t seed = s.seed_draw(0);
     const json first = texel_texture(texture_of(ms.texture), seed);
     const json second = same ? first : texel_texture(texture_of(ms.different), seed);
@@ -55,7 +55,8 @@ class SameDifferentBlock : public TaskBlock {
       if (b.recall_question) q.recall = RecallQuestion{std::nullopt};
     }
     q.matrix = m;
-    q.phases = {{PhaseKind::stimulus, 0, b.texture_s}, {PhaseKind::matrix, std::nullopt, b.matrix_s},
+    q.phases = {{PhaseKind::stimulus, 0, b.texture_s},
+                {PhaseKind::matrix, std::nullopt, b.matrix_s},
                 {PhaseKind::stimulus, 1, b.texture_s}};
     q.choices = {"same", "different"};
     t.correct_answer = same ? "same" : "different";
@@ -145,7 +146,8 @@ class SameDifferentTask : public TaskType {
     if (q.recall) {
       const int expected = SameDifferentBlock::recalled_digit(q);
       const bool recall = rng.uniform(trial * 8 + 3) < who.memory_p_digit();
-      r.digit = recall ? expected : 1 + static_cast<int>((static_cast<std::uint64_t>(expected) + rng.below(trial * 8 + 4, 8)) % 9);
+      r.digit =
+          recall ? expected : 1 + static_cast<int>((static_cast<std::uint64_t>(expected) + rng.below(trial * 8 + 4, 8)) % 9);
     }
   }
 

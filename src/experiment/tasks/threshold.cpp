@@ -11,8 +11,8 @@
 namespace texel::experiment {
 namespace {
 
-using nlohmann::json;
 using detail::JsonObject;
+using nlohmann::json;
 
 constexpr std::size_t max_list = 4096;
 
@@ -94,8 +94,7 @@ class ThresholdBlock : public TaskBlock {
       q.choices = {"A", "B"};
       t.correct_answer = which == 0 ? "A" : "B";
       t.reference = b.references[static_cast<std::size_t>(which)];
-      q.prompt =
-          b.prompt.empty() ? "Feel A, B and the test texture. Which reference does the test texture feel like?" : b.prompt;
+      q.prompt = b.prompt.empty() ? "Feel A, B and the test texture. Which reference does the test texture feel like?" : b.prompt;
       return;
     }
     base[b.variable] = x;
@@ -155,8 +154,8 @@ class ThresholdTask : public TaskType {
   std::string_view name() const override { return two_alternative_ ? "two-alternative" : "oddity"; }
 
   std::vector<std::string_view> keys() const override {
-    std::vector<std::string_view> k{"texture", "display_mm", "time_limit_s", "show_maps", "staircase", "trials", "variable",
-                                    "value"};
+    std::vector<std::string_view> k{"texture",   "display_mm", "time_limit_s", "show_maps",
+                                    "staircase", "trials",     "variable",     "value"};
     if (two_alternative_) k.push_back("references");
     return k;
   }
@@ -183,8 +182,7 @@ class ThresholdTask : public TaskType {
     if (two_alternative_) {
       b.references = string_list(o, "references", 2);
       if (b.references.size() != 2) throw FormatError(o.field("references") + " must name exactly two references (A, B)");
-      for (std::size_t i = 0; i < 2; ++i)
-        check_reference(b.references[i], o.field("references") + "[" + std::to_string(i) + "]");
+      for (std::size_t i = 0; i < 2; ++i) check_reference(b.references[i], o.field("references") + "[" + std::to_string(i) + "]");
     }
   }
 
@@ -200,13 +198,14 @@ class ThresholdTask : public TaskType {
   void simulate(const SimulatedParticipant& who, const Session& session, Response& r) const override {
     const Question& q = session.question();
     const TrialTruth& t = session.truth();
-    const bool ok = who.psychometric_correct(t, two_alternative_ ? guess_2afc : guess_oddity3, static_cast<std::uint64_t>(q.trial));
+    const bool ok =
+        who.psychometric_correct(t, two_alternative_ ? guess_2afc : guess_oddity3, static_cast<std::uint64_t>(q.trial));
     r.choice = ok ? t.correct_answer : who.wrong_choice(q, t.correct_answer);
   }
 
   std::vector<std::string_view> columns() const override {
-    return {"response", "correct_answer", "correct", "variable", "intensity", "next_intensity", "reversal",
-            "procedure_finished", "texel_length_mm", "coarse_strength", "fine_strength"};
+    return {"response", "correct_answer",     "correct",         "variable",        "intensity",    "next_intensity",
+            "reversal", "procedure_finished", "texel_length_mm", "coarse_strength", "fine_strength"};
   }
 
  private:
