@@ -26,7 +26,7 @@ TEST(ResultJson, SessionIsTheSameFromCliStudioAndLibrary) {
   const std::string protocol = dir.at("p.json");
   texel::write_file_atomic(protocol, R"({"format": "texel-protocol", "version": 1, "name": "json-views", "study": "texel-length",
     "blocks": [{"name": "practice", "task": "oddity", "practice": true, "trials": 3, "variable": "texel_length_mm",
-                "value": 20, "texture": {"central_pitch_db": 6, "irregularity_db": 0, "texel_length_mm": 20}}]})");
+                "value": 20, "texture": {"kind": "texel", "central_pitch_db": 6, "irregularity_db": 0, "texel_length_mm": 20}}]})");
   const std::string db = dir.at("s.db");
   const auto ran = texel::test_support::run_cli(
       TEXEL_CLI, "experiment run " + protocol + " --participant P01 --db " + db + " --simulate default --quiet");

@@ -90,9 +90,9 @@ const std::string protocol_text = R"({
   "device": "tpad", "seed": 7,
   "blocks": [
     {"name": "warm-up", "task": "press-side", "practice": true, "presses": 2,
-     "texture": {"texel_length_mm": 4, "central_pitch_db": 6, "irregularity_db": -6}},
+     "texture": {"kind": "texel", "texel_length_mm": 4, "central_pitch_db": 6, "irregularity_db": -6}},
     {"name": "main", "task": "press-side", "presses": 5,
-     "texture": {"texel_length_mm": 6, "central_pitch_db": 6, "irregularity_db": -6}}
+     "texture": {"kind": "texel", "texel_length_mm": 6, "central_pitch_db": 6, "irregularity_db": -6}}
   ]
 })";
 
