@@ -9,8 +9,8 @@
 # dependencies are still needed when the consumer links. Header-only private
 # dependencies (nlohmann-json, Boost.Math, Boost.Beast) are linked as
 # $<BUILD_INTERFACE:...>, so they are looked up for the build only (BUILD)
-# and an installed Texel never asks for them; the exception is nlohmann-json
-# for the experiment component, whose public headers use nlohmann::json.
+# and an installed Texel never asks for them (no public header includes
+# them: the experiment headers hand out JSON as text).
 #
 #   texel_find_dependencies(<component> <missing-var> [BUILD])
 #
@@ -73,8 +73,8 @@ function(texel_find_dependencies component missing_var)
     _texel_pkg_module(TEXEL_ZSTD libzstd libzstd-dev)
   elseif(component STREQUAL "experiment")
     _texel_package(libsqlite3-dev SQLite3_FOUND SQLite3)
-    _texel_package(nlohmann-json3-dev nlohmann_json_FOUND nlohmann_json 3.10)
     if(for_build)
+      _texel_package(nlohmann-json3-dev nlohmann_json_FOUND nlohmann_json 3.10)
       _texel_package(libboost-dev Boost_FOUND Boost 1.74)
     endif()
   elseif(component STREQUAL "studio")

@@ -126,7 +126,7 @@ void register_anova(CLI::App& stats) {
       j["csv"] = a->csv;
       j["dv"] = a->dv;
       j["subject"] = a->subject;
-      j.update(st::to_json(res));
+      j.update(nlohmann::ordered_json::parse(st::to_json(res)));
       print_json(j);
       return;
     }
@@ -179,7 +179,7 @@ void register_ttest(CLI::App& stats) {
       j["csv"] = a->csv;
       j["column"] = a->column;
       if (a->paired) j["paired"] = *a->paired;
-      j.update(st::to_json(r));
+      j.update(nlohmann::ordered_json::parse(st::to_json(r)));
       print_json(j);
       return;
     }
@@ -241,7 +241,7 @@ void register_ellipse(CLI::App& stats) {
         const st::Ellipse& e = res[i];
         nlohmann::ordered_json x;
         if (a->by) x["group"] = groups[i];
-        x.update(st::to_json(e));
+        x.update(nlohmann::ordered_json::parse(st::to_json(e)));
         if (a->outline > 0) {
           nlohmann::ordered_json pts = nlohmann::ordered_json::array();
           for (const auto& p : e.outline(a->outline)) pts.push_back({p[0], p[1]});

@@ -129,19 +129,10 @@ py::object rows_py(const std::vector<TrialRow>& rows, bool as_columns) {
   return as_columns ? py::object(rows_columns(rows)) : py::object(rows_records(rows));
 }
 
+// The library's one session view (to_json: the CLI's and the studio's
+// fields, trials_planned -1 when adaptive) plus the stored protocol copy.
 py::dict session_dict(const SessionInfo& s) {
-  py::dict d;
-  d["id"] = s.id;
-  d["participant"] = s.participant;
-  d["protocol"] = s.protocol;
-  d["study"] = s.study;
-  d["seed"] = s.seed;
-  d["simulate"] = s.simulate;
-  d["status"] = s.status;
-  d["created_at"] = s.created_at;
-  d["updated_at"] = s.updated_at;
-  d["trials_done"] = s.trials_done;
-  d["trials_planned"] = s.trials_planned >= 0 ? py::object(py::int_(s.trials_planned)) : py::object(py::none());
+  auto d = py::module_::import("json").attr("loads")(to_json(s)).cast<py::dict>();
   d["protocol_json"] = s.protocol_json;
   return d;
 }
@@ -402,7 +393,7 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       "optimizer",
       [](const std::string& kind, const py::kwargs& params) {
         const auto text = py::module_::import("json").attr("dumps")(params).cast<std::string>();
-        return make_optimizer(kind, nlohmann::json::parse(text));
+        return make_optimizer(parse_optimizer_kind(kind, "kind"), text);
       },
       py::arg("kind"),
       "A matching optimizer from protocol parameters: kind 'guided' | 'bayesian', keyword arguments as the\n"
@@ -469,9 +460,13 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
             for (const auto& x : s.sessions()) l.append(session_dict(x));
             return l;
           },
-          "Every session as a dict (id, participant, protocol, study, seed, status, trials_done, …).")
+          "Every session as a dict: the fields of `texel experiment list --json` (id, participant, protocol,\n"
+          "study, status, trials_done, trials_planned (-1 = adaptive), seed, …) and protocol_json.")
       .def(
           "session", [](const Store& s, std::int64_t id) { return session_dict(s.session(id)); }, py::arg("session_id"))
+      .def(
+          "session_json", [](const Store& s, std::int64_t id) { return to_json(s.session(id)); }, py::arg("session_id"),
+          "The session as JSON text, exactly as `texel experiment list --json` and the studio write it.")
       .def(
           "trials",
           [](const Store& s, std::int64_t id) {

@@ -19,6 +19,8 @@
 
 #include <boost/math/distributions/students_t.hpp>
 
+#include "json_views.hpp"
+#include "studies.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/stats.hpp"
@@ -31,7 +33,7 @@ namespace texel::experiment {
 // public header, which keeps a second `detail` namespace out of
 // texel::experiment (it would hide texel::detail from unqualified lookups).
 namespace analysis_figures {
-std::vector<std::string> study_figures(const std::string& study, const nlohmann::ordered_json& summary,
+std::vector<std::string> study_figures(const Study& study, const nlohmann::ordered_json& summary,
                                        const std::vector<const TrialRow*>& rows, const AnalysisOptions& options);
 }  // namespace analysis_figures
 
@@ -39,13 +41,6 @@ namespace {
 
 using json = nlohmann::ordered_json;
 using Rows = std::vector<const TrialRow*>;
-
-// Studies in the order of docs/procedures.md §6, which is the summary's key order.
-const std::vector<std::string>& study_order() {
-  static const std::vector<std::string> order{"texel-length",       "parameter-mapping", "free-exploration", "quantization",
-                                              "guided-exploration", "coarse-features",   "working-memory"};
-  return order;
-}
 
 // ------------------------------------------------------------------ helpers
 
@@ -55,8 +50,8 @@ json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 /// Mean of the finite values (NaN when there are none).
 double mean_of(const std::vector<double>& v) { return stats::describe(v).mean; }
 
-json describe_json(const std::vector<double>& v) { return stats::to_json(stats::describe(v)); }
-json ttest_json(const stats::TTest& t) { return stats::to_json(t); }
+json describe_json(const std::vector<double>& v) { return stats::view(stats::describe(v)); }
+json ttest_json(const stats::TTest& t) { return stats::view(t); }
 
 json skipped(const std::string& why) { return json{{"skipped", why}}; }
 
@@ -71,7 +66,7 @@ json guarded(F&& f) {
   }
 }
 
-json anova_json(const stats::AnovaTable& a) { return stats::to_json(a); }
+json anova_json(const stats::AnovaTable& a) { return stats::view(a); }
 
 /// Names in order of first appearance.
 struct Ordered {
@@ -113,7 +108,7 @@ std::vector<Run> staircase_runs(const Rows& rows) {
 }
 
 json staircase_summary(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
-  const bool coarse = study == "coarse-features";
+  const bool coarse = find_study(study)->blocks_by_fine_strength;
   json out;
   out["variable"] = rows.empty() ? std::string() : rows.front()->variable;
   out["reversals_k"] = o.reversals_k;
@@ -597,7 +592,9 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
   for (const TrialRow& r : rows)
     if (!r.practice) by_study[r.study].push_back(&r);
   AnalysisReport report;
-  for (const std::string& study : study_order()) {
+  json summary = json::object();
+  for (const Study& st : studies()) {  // the summary's key order
+    const std::string study(st.name);
     auto it = by_study.find(study);
     if (it == by_study.end()) continue;
     Rows& rs = it->second;
@@ -608,16 +605,13 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
     std::set<std::string> participants;
     for (const TrialRow* r : rs) participants.insert(r->participant);
     json s;
-    if (study == "texel-length" || study == "coarse-features")
-      s = staircase_summary(study, rs, options, report.text);
-    else if (study == "parameter-mapping" || study == "free-exploration")
-      s = match_study(study, rs, options, report.text);
-    else if (study == "quantization")
-      s = quantization_summary(rs, options, report.text);
-    else if (study == "guided-exploration")
-      s = guided_summary(rs, options, report.text);
-    else
-      s = memory_summary(rs, options, report.text);
+    switch (st.design) {
+      case StudyDesign::staircase: s = staircase_summary(study, rs, options, report.text); break;
+      case StudyDesign::matching: s = match_study(study, rs, options, report.text); break;
+      case StudyDesign::quantization: s = quantization_summary(rs, options, report.text); break;
+      case StudyDesign::guided: s = guided_summary(rs, options, report.text); break;
+      case StudyDesign::memory: s = memory_summary(rs, options, report.text); break;
+    }
     json head{{"participants", participants.size()}, {"rows", rs.size()}};
     // Reaction times: each participant's median (robust to a trial left
     // open), described over participants.
@@ -630,15 +624,15 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       head["rt_ms_median"] = describe_json(medians);
     }
     head.update(s);
-    report.summary[study] = std::move(head);
+    summary[study] = std::move(head);
     if (!options.out_dir.empty()) {
       std::error_code ec;
       std::filesystem::create_directories(options.out_dir, ec);
       if (ec) throw IoError("cannot create figure directory '" + options.out_dir + "': " + ec.message());
-      for (auto& f : analysis_figures::study_figures(study, report.summary[study], rs, options))
-        report.figures.push_back(std::move(f));
+      for (auto& f : analysis_figures::study_figures(st, summary[study], rs, options)) report.figures.push_back(std::move(f));
     }
   }
+  report.summary = summary.dump();
   return report;
 }
 

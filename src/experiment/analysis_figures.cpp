@@ -16,6 +16,8 @@
 #include <optional>
 #include <set>
 
+#include "json_views.hpp"
+#include "studies.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
@@ -95,13 +97,11 @@ std::string percent(double v) { return texel::detail::fixed(v * 100, 0) + " %"; 
 
 // --------------------------------------------------------------- staircases
 
-std::string variable_label(const std::string& study) {
-  return study == "texel-length" ? "texel length (mm)" : "coarse strength (0 … 1)";
-}
+std::string variable_label(const Study& study) { return std::string(study.variable_label); }
 
 /// Intensity against trial, one line per block, reversals marked; one panel
 /// per participant (and session).
-Figure staircase_tracks(const std::string& study, const Rows& rows) {
+Figure staircase_tracks(const Study& study, const Rows& rows) {
   std::map<std::pair<std::string, std::int64_t>, std::map<std::string, Rows>> runs;
   std::vector<std::string> blocks;
   std::map<std::string, std::set<std::int64_t>> sessions;
@@ -112,8 +112,7 @@ Figure staircase_tracks(const std::string& study, const Rows& rows) {
   }
   const int cols = static_cast<int>(std::min<std::size_t>(3, runs.size()));
   const int nrows = static_cast<int>((runs.size() + 2) / 3);
-  Figure f = figure(study == "texel-length" ? "Texel length staircases" : "Coarse strength staircases", 420 * cols + 40,
-                    std::min(16000, 60 + 300 * nrows), cols);
+  Figure f = figure(std::string(study.title) + " staircases", 420 * cols + 40, std::min(16000, 60 + 300 * nrows), cols);
   for (const auto& [key, by_block] : runs) {
     Panel p;
     p.title = key.first + (sessions[key.first].size() > 1 ? " (session " + std::to_string(key.second) + ")" : "");
@@ -154,8 +153,8 @@ Figure staircase_tracks(const std::string& study, const Rows& rows) {
 
 /// Box plots of the per-participant convergent values per block, with the
 /// group mean ± 95 % CI beside each box.
-Figure convergent_boxes(const std::string& study, const json& s) {
-  const bool coarse = study == "coarse-features";
+Figure convergent_boxes(const Study& study, const json& s) {
+  const bool coarse = study.blocks_by_fine_strength;
   std::vector<std::string> cats;
   std::map<std::string, std::map<std::string, std::vector<double>>> per;  // block → participant → values
   for (const auto& r : s["runs"])
@@ -589,33 +588,33 @@ Figure memory_figure(const json& s) {
 
 }  // namespace
 
-std::vector<std::string> study_figures(const std::string& study, const nlohmann::ordered_json& summary, const Rows& rows,
+std::vector<std::string> study_figures(const Study& study, const nlohmann::ordered_json& summary, const Rows& rows,
                                        const AnalysisOptions& options) {
-  Writer w{study, options, {}};
-  if (study == "texel-length" || study == "coarse-features") {
-    w.save(staircase_tracks(study, rows), "tracks");
-    w.save(convergent_boxes(study, summary), "convergent");
-    if (study == "texel-length")
-      if (auto f = directional_scatter(summary)) w.save(*f, "directional");
-  } else if (study == "parameter-mapping" || study == "free-exploration" || study == "guided-exploration") {
-    const std::string title = study == "parameter-mapping"  ? "Parameter mapping"
-                              : study == "free-exploration" ? "Free exploration"
-                                                            : "Guided exploration";
-    if (!summary["matches"].empty()) {
-      w.save(matched_vs_reference(title, summary), "matched-vs-reference");
-      w.save(matched_boxes(title, summary), "matched-boxes");
-      w.save(match_ellipses(title, summary, options.level), "ellipses");
-    }
-    if (auto f = confidence_vs_distance(title, summary)) w.save(*f, "confidence");
-    if (study == "parameter-mapping" && summary.contains("ratings")) w.save(rating_boxes(title, rows, "0 … 10"), "ratings");
-    if (study == "guided-exploration") {
-      w.save(guided_convergence(rows), "convergence");
-      if (summary.contains("similarity")) w.save(similarity_heatmap(summary["similarity"]), "similarity");
-    }
-  } else if (study == "quantization") {
-    w.save(quantization_figure(summary, rows), "rating-change");
-  } else if (study == "working-memory") {
-    w.save(memory_figure(summary), "performance");
+  const std::string name(study.name), title(study.title);
+  Writer w{name, options, {}};
+  switch (study.design) {
+    case StudyDesign::staircase:
+      w.save(staircase_tracks(study, rows), "tracks");
+      w.save(convergent_boxes(study, summary), "convergent");
+      if (study.directional)
+        if (auto f = directional_scatter(summary)) w.save(*f, "directional");
+      break;
+    case StudyDesign::matching:
+    case StudyDesign::guided:
+      if (!summary["matches"].empty()) {
+        w.save(matched_vs_reference(title, summary), "matched-vs-reference");
+        w.save(matched_boxes(title, summary), "matched-boxes");
+        w.save(match_ellipses(title, summary, options.level), "ellipses");
+      }
+      if (auto f = confidence_vs_distance(title, summary)) w.save(*f, "confidence");
+      if (study.ratings_figure && summary.contains("ratings")) w.save(rating_boxes(title, rows, "0 … 10"), "ratings");
+      if (study.design == StudyDesign::guided) {
+        w.save(guided_convergence(rows), "convergence");
+        if (summary.contains("similarity")) w.save(similarity_heatmap(summary["similarity"]), "similarity");
+      }
+      break;
+    case StudyDesign::quantization: w.save(quantization_figure(summary, rows), "rating-change"); break;
+    case StudyDesign::memory: w.save(memory_figure(summary), "performance"); break;
   }
   return w.paths;
 }

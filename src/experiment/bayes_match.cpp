@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "texel/error.hpp"
 #include "texel/random.hpp"
 

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "json_views.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/bayes_match.hpp"
 #include "texel/random.hpp"
@@ -299,8 +300,28 @@ class Params {
 
 }  // namespace
 
-std::unique_ptr<MatchOptimizer> make_optimizer(const std::string& kind, const nlohmann::json& params) {
-  if (kind == "guided") {
+OptimizerKind parse_optimizer_kind(std::string_view text, std::string_view field) {
+  if (text == "guided") return OptimizerKind::guided;
+  if (text == "bayesian") return OptimizerKind::bayesian;
+  throw InvalidArgument(std::string(field) + ": '" + std::string(text) + "' is not an optimizer (allowed: guided, bayesian)");
+}
+
+std::string_view to_string(OptimizerKind k) { return k == OptimizerKind::guided ? "guided" : "bayesian"; }
+
+std::unique_ptr<MatchOptimizer> make_optimizer(OptimizerKind kind, std::string_view params_json) {
+  nlohmann::json params;
+  if (!params_json.empty()) {
+    try {
+      params = nlohmann::json::parse(params_json);
+    } catch (const nlohmann::json::exception&) {
+      throw InvalidArgument("optimizer parameters are not JSON");
+    }
+  }
+  return make_optimizer_from(kind, params);
+}
+
+std::unique_ptr<MatchOptimizer> make_optimizer_from(OptimizerKind kind, const nlohmann::json& params) {
+  if (kind == OptimizerKind::guided) {
     const Params p(params, {"pitch_min_db", "pitch_max_db", "irregularity_min_db", "irregularity_max_db", "iterations",
                             "shrink_rate", "unsure", "bound", "seed"});
     GuidedConfig c;
@@ -315,7 +336,7 @@ std::unique_ptr<MatchOptimizer> make_optimizer(const std::string& kind, const nl
     p.seed("seed", c.seed);
     return std::make_unique<GuidedOptimizer>(c);
   }
-  if (kind == "bayesian") {
+  {
     const Params p(params, {"pitch_min_db", "pitch_max_db", "irregularity_min_db", "irregularity_max_db", "comparisons",
                             "sd_stop_db", "noise_db", "unsure_band_db", "lapse", "irregularity_weight", "grid_step_db",
                             "candidates", "particles", "seed"});
@@ -336,7 +357,6 @@ std::unique_ptr<MatchOptimizer> make_optimizer(const std::string& kind, const nl
     p.seed("seed", c.seed);
     return std::make_unique<BayesOptimizer>(c);
   }
-  throw InvalidArgument("kind: '" + kind + "' is not an optimizer (allowed: guided, bayesian)");
 }
 
 }  // namespace texel::experiment

@@ -1,6 +1,8 @@
 // Sessions against the store (runner.hpp).
 #include "texel/experiment/runner.hpp"
 
+#include "task.hpp"
+
 #include <cmath>
 #include <set>
 
@@ -22,7 +24,8 @@ std::map<std::string, std::map<std::string, MatchResult>> prior_matches(const St
   for (const auto& s : store.sessions()) {
     if (s.participant != participant || s.status != "finished" || !wanted.count(s.protocol)) continue;
     for (const auto& row : store.rows(s.id)) {
-      const bool match_row = row.task == "match" || (row.task == "guided" && row.procedure_finished);
+      const TaskType* kind = find_task_type(row.task);
+      const bool match_row = kind && kind->holds_match(row);
       if (match_row && !row.practice && std::isfinite(row.pitch_db))
         out[s.protocol][row.reference] = MatchResult{row.pitch_db, row.irregularity_db};
     }

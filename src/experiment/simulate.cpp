@@ -13,6 +13,9 @@
 #include "texel/random.hpp"
 #include "texel/reference.hpp"
 
+#include "json_views.hpp"
+#include "task.hpp"
+
 namespace texel::experiment {
 namespace {
 
@@ -53,7 +56,16 @@ double get(const json& o, const char* key, double fallback) {
 
 }  // namespace
 
-void validate_observer(const json& o) {
+struct SimulatedParticipant::Model {
+  json observer;
+  double threshold_scale = 1.0;  // this participant's deviations from the group
+  double bias_pitch_db = 0.0, bias_irregularity_db = 0.0;
+  double memory_shift = 0.0;
+};
+
+void validate_observer(std::string_view observer_json) { validate_observer_object(parse_json_text(observer_json, "observer")); }
+
+void validate_observer_object(const json& o) {
   using texel::detail::JsonObject;
   const double inf = std::numeric_limits<double>::infinity();
   JsonObject top(o, "observer");
@@ -126,12 +138,13 @@ void validate_observer(const json& o) {
   top.finish();
 }
 
-json simulation_observer(const json& protocol_observer, const std::string& spec) {
-  json o = protocol_observer.is_object() ? protocol_observer : json::object();
-  validate_observer(o);
+std::string simulation_observer(std::string_view protocol_observer_json, const std::string& spec) {
+  const json given = protocol_observer_json.empty() ? json::object() : parse_json_text(protocol_observer_json, "observer");
+  json o = given.is_object() ? given : json::object();
+  validate_observer_object(o);
   for (const char* section : {"psychometric", "matcher", "rater", "memory", "explorer"})
     if (!o.contains(section)) o[section] = json::object();
-  if (spec.empty() || spec == "default") return o;
+  if (spec.empty() || spec == "default") return o.dump();
   std::size_t pos = 0;
   while (pos <= spec.size()) {
     const std::size_t comma = spec.find(',', pos);
@@ -193,18 +206,24 @@ json simulation_observer(const json& protocol_observer, const std::string& spec)
     }
   }
   try {
-    validate_observer(o);
+    validate_observer_object(o);
   } catch (const FormatError& e) {
     throw InvalidArgument(std::string("--simulate: ") + e.what());
   }
-  return o;
+  return o.dump();
 }
 
-SimulatedParticipant::SimulatedParticipant(json observer, const Session& session) : observer_(std::move(observer)) {
-  seed_ = observer_.contains("seed") && observer_["seed"].is_number_unsigned() ? observer_["seed"].get<std::uint64_t>()
-                                                                               : mix64(session.context().seed ^ 0x51u);
+SimulatedParticipant::SimulatedParticipant(std::string observer, const Session& session) : observer_(std::move(observer)) {
+  auto model = std::make_shared<Model>();
+  model->observer = parse_json_text(observer_, "observer");
+  const json& observer_json = model->observer;
+  if (!observer_json.is_object()) throw InvalidArgument("observer must be a JSON object");
+  seed_ = observer_json.contains("seed") && observer_json["seed"].is_number_unsigned()
+              ? observer_json["seed"].get<std::uint64_t>()
+              : mix64(session.context().seed ^ 0x51u);
+  rng_ = CounterRng(seed_, stream_behaviour);
   // Validate the parts a protocol will need, up front, with the spec's names.
-  const json& p = observer_["psychometric"];
+  const json& p = observer_json.contains("psychometric") ? observer_json["psychometric"] : json::object();
   const double lapse = get(p, "lapse", 0.02);
   const double guess = get(p, "guess", 0.0);
   if (!(lapse >= 0 && lapse < 0.5))
@@ -215,125 +234,95 @@ SimulatedParticipant::SimulatedParticipant(json observer, const Session& session
   // observers): this participant's threshold is scaled by exp(sd·n₀), the
   // matcher's target shifted by 3·sd·(n₁, n₂) dB, and memory accuracy
   // shifted by 0.3·sd·n₃, with n drawn once from the observer seed.
-  const double sd = get(observer_, "participant_sd", 0.0);
+  const double sd = get(observer_json, "participant_sd", 0.0);
   if (!(sd >= 0 && sd <= 3)) throw InvalidArgument("observer participant_sd is " + texel::detail::num(sd) + "; allowed: 0 … 3");
   const CounterRng person(seed_, stream_behaviour + 1);
-  threshold_scale_ = std::exp(sd * person.normal(0));
-  bias_pitch_db_ = 3.0 * sd * person.normal(1);
-  bias_irregularity_db_ = 3.0 * sd * person.normal(2);
-  memory_shift_ = 0.3 * sd * person.normal(3);
-  const json& m = observer_["memory"];
+  model->threshold_scale = std::exp(sd * person.normal(0));
+  model->bias_pitch_db = 3.0 * sd * person.normal(1);
+  model->bias_irregularity_db = 3.0 * sd * person.normal(2);
+  model->memory_shift = 0.3 * sd * person.normal(3);
+  const json& m = observer_json.contains("memory") ? observer_json["memory"] : json::object();
   if (m.contains("p_correct") && m["p_correct"].is_number()) {
     const double pc = m["p_correct"].get<double>();
     if (!(pc >= 0 && pc <= 1)) throw InvalidArgument("observer p is " + texel::detail::num(pc) + "; allowed: 0 … 1");
   }
+  model_ = std::move(model);
 }
+
+// The observer's section `key` (an empty object when missing).
+static const json& section_of(const json& observer, const char* key) {
+  static const json empty = json::object();
+  return observer.contains(key) ? observer[key] : empty;
+}
+
+std::string SimulatedParticipant::wrong_choice(const Question& q, const std::string& correct) const {
+  std::vector<std::string> others;
+  for (const auto& c : q.choices)
+    if (c != correct && c != "unsure") others.push_back(c);
+  return others[static_cast<std::size_t>(rng_.below(static_cast<std::uint64_t>(q.trial) * 8 + 1, others.size()))];
+}
+
+bool SimulatedParticipant::psychometric_correct(const TrialTruth& t, double default_guess, std::uint64_t trial) const {
+  const json& pj = section_of(model_->observer, "psychometric");
+  PsychometricConfig pc;
+  pc.shape = parse_psychometric_shape(pj.value("shape", std::string("weibull")), "observer shape");
+  pc.threshold = model_->threshold_scale *
+                 get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
+  pc.slope = get(pj, "slope", 3.5);
+  pc.guess = get(pj, "guess", default_guess);
+  pc.lapse = get(pj, "lapse", 0.02);
+  pc.seed = seed_;
+  return PsychometricObserver(pc).respond(t.intensity, trial);
+}
+
+Matcher SimulatedParticipant::matcher(const MatchResult& fallback, const Session& session) const {
+  const json& mj = section_of(model_->observer, "matcher");
+  MatcherConfig mc;
+  mc.noise_db = get(mj, "noise_db", 1.5);
+  mc.unsure_band_db = get(mj, "unsure_db", 0.5);
+  mc.irregularity_weight = get(mj, "irregularity_weight", 1.0);
+  mc.seed = seed_;
+  MatchResult target = fallback;
+  if (mj.contains("target") && mj["target"].is_array() && mj["target"].size() == 2) {
+    target = {mj["target"][0].get<double>(), mj["target"][1].get<double>()};
+  } else if (mj.contains("target") && mj["target"].is_string() && mj["target"].get<std::string>() != "reference") {
+    target = session.reference_position(mj["target"].get<std::string>());
+  }
+  mc.target = MatchPoint{target.pitch_db + model_->bias_pitch_db, target.irregularity_db + model_->bias_irregularity_db};
+  return Matcher(mc);
+}
+
+Rater SimulatedParticipant::rater(double scale_min, double scale_max) const {
+  const json& rj = section_of(model_->observer, "rater");
+  RaterConfig rc;
+  rc.scale_min = scale_min;
+  rc.scale_max = scale_max;
+  rc.distance_scale_db = get(rj, "distance_scale_db", 10.0);
+  rc.noise = get(rj, "noise", 0.5);
+  rc.seed = seed_;
+  return Rater(rc);
+}
+
+double SimulatedParticipant::memory_p_correct(const std::string& condition) const {
+  const json& mj = section_of(model_->observer, "memory");
+  double p = 0.85;
+  if (mj.contains("p_correct") && mj["p_correct"].is_number()) p = mj["p_correct"].get<double>();
+  if (mj.contains("p_correct") && mj["p_correct"].is_object()) p = get(mj["p_correct"], condition.c_str(), p);
+  return std::clamp(p + model_->memory_shift, 0.0, 1.0);
+}
+
+double SimulatedParticipant::memory_p_digit() const { return get(section_of(model_->observer, "memory"), "p_digit", 0.8); }
 
 Response SimulatedParticipant::respond(const Session& session) const {
   const Question& q = session.question();
-  const TrialTruth& t = session.truth();
   const auto trial = static_cast<std::uint64_t>(q.trial);
-  const CounterRng rng(seed_, stream_behaviour);
+  const CounterRng& rng = rng_;
   Response r;
-
-  auto wrong_choice = [&](const std::string& correct) {
-    std::vector<std::string> others;
-    for (const auto& c : q.choices)
-      if (c != correct && c != "unsure") others.push_back(c);
-    return others[static_cast<std::size_t>(rng.below(trial * 8 + 1, others.size()))];
-  };
-  auto matcher = [&](std::optional<MatchResult> fallback_target) {
-    const json& mj = observer_["matcher"];
-    MatcherConfig mc;
-    mc.noise_db = get(mj, "noise_db", 1.5);
-    mc.unsure_band_db = get(mj, "unsure_db", 0.5);
-    mc.irregularity_weight = get(mj, "irregularity_weight", 1.0);
-    mc.seed = seed_;
-    MatchResult target = fallback_target.value_or(MatchResult{});
-    if (mj.contains("target") && mj["target"].is_array() && mj["target"].size() == 2) {
-      target = {mj["target"][0].get<double>(), mj["target"][1].get<double>()};
-    } else if (mj.contains("target") && mj["target"].is_string() && mj["target"].get<std::string>() != "reference") {
-      target = session.reference_position(mj["target"].get<std::string>());
-    }
-    mc.target = MatchPoint{target.pitch_db + bias_pitch_db_, target.irregularity_db + bias_irregularity_db_};
-    return Matcher(mc);
-  };
-
-  switch (q.task) {
-    case TaskKind::oddity:
-    case TaskKind::two_alternative: {
-      const json& pj = observer_["psychometric"];
-      PsychometricConfig pc;
-      pc.shape = parse_psychometric_shape(pj.value("shape", std::string("weibull")), "observer shape");
-      pc.threshold =
-          threshold_scale_ * get(pj, "threshold", std::isfinite(t.intensity) ? std::max(std::abs(t.intensity) * 0.3, 1e-6) : 1.0);
-      pc.slope = get(pj, "slope", 3.5);
-      pc.guess = get(pj, "guess", q.task == TaskKind::oddity ? guess_oddity3 : guess_2afc);
-      pc.lapse = get(pj, "lapse", 0.02);
-      pc.seed = seed_;
-      const PsychometricObserver obs(pc);
-      r.choice = obs.respond(t.intensity, trial) ? t.correct_answer : wrong_choice(t.correct_answer);
-      break;
-    }
-    case TaskKind::match: {
-      const Matcher m = matcher(session.reference_position(t.reference));
-      const MatchPoint p = m.adjust(trial);
-      const auto& sp = q.sliders[0];
-      const auto& si = q.sliders[1];
-      double xp = p.pitch_db, xi = p.irregularity_db;
-      if (session.protocol().blocks[static_cast<std::size_t>(q.block_index)].sliders == SliderMapping::lognormal) {
-        // Study 2's sliders: invert m = 0.75·1.04^P and s = 3·I/10.
-        xp = std::log(std::pow(10.0, p.pitch_db / 10.0) / 0.75) / std::log(1.04);
-        xi = std::pow(10.0, p.irregularity_db / 10.0) * 10.0 / 3.0;
-      }
-      r.slider_p = std::clamp(xp, sp.min, sp.max);
-      r.slider_i = std::clamp(xi, si.min, si.max);
-      if (q.confidence) r.confidence = m.confidence(trial);
-      break;
-    }
-    case TaskKind::rating: {
-      const json& rj = observer_["rater"];
-      RaterConfig rc;
-      rc.scale_min = (*q.rating_scale)[0];
-      rc.scale_max = (*q.rating_scale)[1];
-      rc.distance_scale_db = get(rj, "distance_scale_db", 10.0);
-      rc.noise = get(rj, "noise", 0.5);
-      rc.seed = seed_;
-      const MatchResult ref = session.reference_position(t.reference);
-      const MatchResult ren = t.rendering.value_or(ref);
-      // Assumption of the simulated rater (not a perceptual claim): a
-      // quantization step of q dB adds q/2 dB of felt difference.
-      const double d =
-          std::hypot(ren.pitch_db - ref.pitch_db, ren.irregularity_db - ref.irregularity_db) + 0.5 * t.quantization_db;
-      r.rating = Rater(rc).rate(d, trial);
-      break;
-    }
-    case TaskKind::guided: {
-      const Matcher m = matcher(session.reference_position(t.reference));
-      const MatchChoice c = m.choose(*t.pair, trial);
-      r.choice = c == MatchChoice::a ? "A" : c == MatchChoice::b ? "B" : "unsure";
-      break;
-    }
-    case TaskKind::same_different: {
-      const json& mj = observer_["memory"];
-      double p = 0.85;
-      if (mj.contains("p_correct") && mj["p_correct"].is_number()) p = mj["p_correct"].get<double>();
-      if (mj.contains("p_correct") && mj["p_correct"].is_object()) p = get(mj["p_correct"], t.condition.c_str(), p);
-      const bool ok = rng.uniform(trial * 8 + 2) < std::clamp(p + memory_shift_, 0.0, 1.0);
-      r.choice = ok ? t.correct_answer : wrong_choice(t.correct_answer);
-      if (q.recall_cell != -2) {
-        const int expected = q.recall_cell >= 0 ? (*q.matrix)[static_cast<std::size_t>(q.recall_cell)] : 1;
-        const bool recall = rng.uniform(trial * 8 + 3) < get(mj, "p_digit", 0.8);
-        r.digit =
-            recall ? expected : 1 + static_cast<int>((static_cast<std::uint64_t>(expected) + rng.below(trial * 8 + 4, 8)) % 9);
-      }
-      break;
-    }
-  }
+  task_type(q.task).simulate(*this, session, r);
 
   // Exploration: a reaction time (lognormal around rt_s), the stimuli visited
   // in turn, and a back-and-forth swipe at a drawn speed over that time.
-  const json& ej = observer_["explorer"];
+  const json& ej = section_of(model_->observer, "explorer");
   const double rt_s = get(ej, "rt_s", 4.0) * std::exp(0.3 * rng.normal(trial * 8 + 5));
   r.rt_ms = std::round(rt_s * 1000.0);
   r.events.push_back({0.0, "show", "trial " + std::to_string(q.trial), ""});

@@ -10,6 +10,8 @@
 // One code path serves one and two factors, main effects and the interaction.
 #include "texel/experiment/stats.hpp"
 
+#include "json_views.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -372,7 +374,7 @@ namespace {
 nlohmann::ordered_json jnum(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
 }  // namespace
 
-nlohmann::ordered_json to_json(const Descriptive& d) {
+nlohmann::ordered_json view(const Descriptive& d) {
   return {{"n", d.n},
           {"mean", jnum(d.mean)},
           {"sd", jnum(d.sd)},
@@ -386,13 +388,13 @@ nlohmann::ordered_json to_json(const Descriptive& d) {
           {"ci95_high", jnum(d.ci95_high)}};
 }
 
-nlohmann::ordered_json to_json(const TTest& t) {
+nlohmann::ordered_json view(const TTest& t) {
   return {{"n", t.n},         {"mean", jnum(t.mean)},     {"sd", jnum(t.sd)},           {"se", jnum(t.se)},
           {"mu", jnum(t.mu)}, {"t", jnum(t.t)},           {"df", jnum(t.df)},           {"p", jnum(t.p)},
           {"level", t.level}, {"ci_low", jnum(t.ci_low)}, {"ci_high", jnum(t.ci_high)}, {"cohen_d", jnum(t.cohen_d)}};
 }
 
-nlohmann::ordered_json to_json(const AnovaTable& a) {
+nlohmann::ordered_json view(const AnovaTable& a) {
   nlohmann::ordered_json effects = nlohmann::ordered_json::array();
   for (const auto& e : a.effects)
     effects.push_back({{"effect", e.effect},
@@ -413,7 +415,7 @@ nlohmann::ordered_json to_json(const AnovaTable& a) {
   return {{"factors", a.factors}, {"subjects", a.subjects}, {"effects", effects}};
 }
 
-nlohmann::ordered_json to_json(const Ellipse& e) {
+nlohmann::ordered_json view(const Ellipse& e) {
   return {{"n", e.n},
           {"mean_x", jnum(e.mean_x)},
           {"mean_y", jnum(e.mean_y)},
@@ -425,5 +427,10 @@ nlohmann::ordered_json to_json(const Ellipse& e) {
           {"semi_minor", jnum(e.semi_minor)},
           {"angle_deg", jnum(e.angle_deg)}};
 }
+
+std::string to_json(const Descriptive& d) { return view(d).dump(); }
+std::string to_json(const TTest& t) { return view(t).dump(); }
+std::string to_json(const AnovaTable& a) { return view(a).dump(); }
+std::string to_json(const Ellipse& e) { return view(e).dump(); }
 
 }  // namespace texel::experiment::stats

@@ -41,31 +41,23 @@ std::vector<Shipped> shipped_protocols(const State& s) {
   return out;
 }
 
-ojson session_json(const State& s) {
-  const ex::SessionInfo& i = s.active->info;
-  return ojson{{"id", i.id},
-               {"participant", i.participant},
-               {"protocol", i.protocol},
-               {"study", i.study},
-               {"simulated", !s.active->simulate.empty()}};
+// The running session as the library serialises it (as stored now), with
+// "simulated" for the spec in force.
+ojson session_json(State& s) {
+  ojson j = ojson::parse(ex::to_json(the_store(s).session(s.active->info.id)));
+  j["simulated"] = !s.active->simulate.empty();
+  return j;
 }
 
 ojson progress_json(const State& s) {
   return ojson{{"done", s.active->session.trials_done()}, {"planned", s.active->session.trials_planned()}};
 }
 
-// What participant screens may see of a question: the engine's view without
-// the stimulus documents (their parameters would give the odd one away),
-// unless the question asks to draw the maps (visual practice).
-ojson participant_question(const ex::Question& q) {
-  ojson j = q.to_json();
-  if (!q.show_maps)
-    for (auto& st : j["stimuli"]) st.erase("document");
-  return j;
-}
+// What participant screens may see of a question (the library's participant view).
+ojson participant_question(const ex::Question& q) { return ojson::parse(q.participant_json()); }
 
 // The state participant screens show: the question, finished or idle.
-ojson current_state(const State& s, const json& id) {
+ojson current_state(State& s, const json& id) {
   if (!s.active) return reply("experiment.idle", id);
   ojson r = reply(s.active->session.finished() ? "experiment.finished" : "experiment.question", id);
   r["session"] = session_json(s);
@@ -126,18 +118,7 @@ void on_experiment_list(State& s, Client& c, const Job& job) {
                               {"description", sh.protocol.description},
                               {"trials_planned", sh.protocol.planned_trials()}});
   r["sessions"] = ojson::array();
-  for (const auto& i : the_store(s).sessions())
-    r["sessions"].push_back({{"id", i.id},
-                             {"participant", i.participant},
-                             {"protocol", i.protocol},
-                             {"study", i.study},
-                             {"status", i.status},
-                             {"finished", i.status == "finished"},
-                             {"simulated", !i.simulate.empty()},
-                             {"trials_done", i.trials_done},
-                             {"trials_planned", i.trials_planned},
-                             {"created_at", i.created_at},
-                             {"updated_at", i.updated_at}});
+  for (const auto& i : the_store(s).sessions()) r["sessions"].push_back(ojson::parse(ex::to_json(i)));
   r["active"] = s.active ? session_json(s) : ojson(nullptr);
   send(c, r);
 }
@@ -223,7 +204,7 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
       throw Reject{"invalid", "experiment.answer: simulated answers need a session started with 'simulate'"};
     response = ex::simulated_participant(*s.active).respond(s.active->session);
   } else {
-    response = ex::Response::from_json(f.object("response"));
+    response = ex::Response::from_json(f.object("response").dump());
   }
   if (!response.swipe_mean_speed_mm_s) {
     std::lock_guard lock(s.feel_mutex);

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
@@ -19,6 +21,9 @@
 using namespace texel;
 using namespace texel::experiment;
 using json = nlohmann::ordered_json;
+
+// The report's summary (JSON text) as JSON.
+static json summary_of(const AnalysisReport& r) { return json::parse(r.summary); }
 
 namespace {
 
@@ -246,7 +251,7 @@ TEST(Analysis, EmptyInputIsAnEmptySummary) {
   AnalysisOptions o;
   o.out_dir = dir.at("figs");
   const AnalysisReport r = analyze({}, o);
-  EXPECT_TRUE(r.summary.empty());
+  EXPECT_TRUE(summary_of(r).empty());
   EXPECT_TRUE(r.figures.empty());
 }
 
@@ -268,18 +273,19 @@ TEST(Analysis, BadOptionsThrowInvalidArgument) {
 TEST(Analysis, StudiesInSpecOrderAndOnlyThoseWithData) {
   const AnalysisReport r = analyze(all_rows(), {});
   std::vector<std::string> keys;
-  for (const auto& [k, v] : r.summary.items()) keys.push_back(k);
+  const json all = summary_of(r);
+  for (const auto& [k, v] : all.items()) keys.push_back(k);
   EXPECT_EQ(keys, (std::vector<std::string>{"texel-length", "parameter-mapping", "free-exploration", "quantization",
                                             "guided-exploration", "coarse-features", "working-memory"}));
   const AnalysisReport only = analyze(quantization_rows(), {});
-  EXPECT_EQ(only.summary.size(), 1u);
+  EXPECT_EQ(summary_of(only).size(), 1u);
   EXPECT_FALSE(r.text.empty());
 }
 
 TEST(Analysis, TexelLengthConvergentValuesAndReversalMeans) {
   AnalysisOptions o;
   o.reversals_k = 2;
-  const json s = analyze(texel_length_rows(), o).summary["texel-length"];
+  const json s = summary_of(analyze(texel_length_rows(), o))["texel-length"];
   EXPECT_EQ(s["participants"], 3);
   EXPECT_EQ(s["variable"], "texel_length_mm");
   const json& a = run_of(s, "S01", "narrow");
@@ -308,7 +314,7 @@ TEST(Analysis, TexelLengthConvergentValuesAndReversalMeans) {
 }
 
 TEST(Analysis, CoarseFeaturesAnovaOverFineStrength) {
-  const json s = analyze(coarse_rows(), {}).summary["coarse-features"];
+  const json s = summary_of(analyze(coarse_rows(), {}))["coarse-features"];
   ASSERT_EQ(s["blocks"].size(), 3u);
   EXPECT_DOUBLE_EQ(s["blocks"][2]["fine_strength"].get<double>(), 1.0);
   EXPECT_NEAR(s["blocks"][2]["convergent"]["mean"].get<double>(), (0.55 + 0.60 + 0.70) / 3, 1e-12);
@@ -319,7 +325,7 @@ TEST(Analysis, CoarseFeaturesAnovaOverFineStrength) {
 }
 
 TEST(Analysis, MatchingMeansEllipsesAndDistances) {
-  const json s = analyze(mapping_rows("parameter-mapping"), {}).summary["parameter-mapping"];
+  const json s = summary_of(analyze(mapping_rows("parameter-mapping"), {}))["parameter-mapping"];
   ASSERT_EQ(s["references"].size(), 2u);
   const json& a = s["references"][0];
   EXPECT_EQ(a["reference"], "noise-a");
@@ -339,7 +345,7 @@ TEST(Analysis, MatchingMeansEllipsesAndDistances) {
 }
 
 TEST(Analysis, FreeExplorationConfidenceAgainstDistance) {
-  const json s = analyze(mapping_rows("free-exploration"), {}).summary["free-exploration"];
+  const json s = summary_of(analyze(mapping_rows("free-exploration"), {}))["free-exploration"];
   const json& c = s["confidence_vs_distance"];
   EXPECT_EQ(c["n"], 6);
   // Hand computation of Pearson's r.
@@ -358,7 +364,7 @@ TEST(Analysis, FreeExplorationConfidenceAgainstDistance) {
 }
 
 TEST(Analysis, QuantizationChangesAndOneSampleTTests) {
-  const json s = analyze(quantization_rows(), {}).summary["quantization"];
+  const json s = summary_of(analyze(quantization_rows(), {}))["quantization"];
   ASSERT_EQ(s["changes"].size(), 2u);
   const json& q1 = s["changes"][0];
   const json& q5 = s["changes"][1];
@@ -376,12 +382,12 @@ TEST(Analysis, QuantizationChangesAndOneSampleTTests) {
   std::vector<TrialRow> one;
   for (const auto& r : quantization_rows())
     if (r.participant == "S01") one.push_back(r);
-  const json s1 = analyze(one, {}).summary["quantization"];
+  const json s1 = summary_of(analyze(one, {}))["quantization"];
   EXPECT_TRUE(s1["changes"][1]["t_test"].contains("skipped"));
 }
 
 TEST(Analysis, GuidedMatchesAndSimilarityMatrix) {
-  const json s = analyze(guided_rows(), {}).summary["guided-exploration"];
+  const json s = summary_of(analyze(guided_rows(), {}))["guided-exploration"];
   ASSERT_EQ(s["references"].size(), 3u);
   // The match is the last (finished) row per participant × reference.
   EXPECT_NEAR(s["references"][1]["pitch_db"]["mean"].get<double>(), 5.0, 1e-12);
@@ -397,7 +403,7 @@ TEST(Analysis, GuidedMatchesAndSimilarityMatrix) {
 }
 
 TEST(Analysis, WorkingMemoryOutlierRuleAndAnova) {
-  const json s = analyze(memory_rows(), {}).summary["working-memory"];
+  const json s = summary_of(analyze(memory_rows(), {}))["working-memory"];
   EXPECT_EQ(s["participants"].size(), 5u);
   EXPECT_EQ(s["included"], 4);
   EXPECT_TRUE(s["participants"][4]["excluded"].is_string());
@@ -420,13 +426,13 @@ TEST(Analysis, WorkingMemoryOutlierRuleAndAnova) {
   AnalysisOptions off;
   off.memory_recall_chance = -1;
   off.memory_accuracy_sd = 0;
-  EXPECT_EQ(analyze(memory_rows(), off).summary["working-memory"]["included"], 5);
+  EXPECT_EQ(summary_of(analyze(memory_rows(), off))["working-memory"]["included"], 5);
   // The SD rule alone, at 1.2 SD: accuracies 0.75, 0.8125, 0.5625, 0.8125,
   // 0.5 (mean 0.6875, SD 0.1466): S05 lies 1.28 SD below, the others within 0.86.
   AnalysisOptions sd_only;
   sd_only.memory_recall_chance = -1;
   sd_only.memory_accuracy_sd = 1.2;
-  const json s2 = analyze(memory_rows(), sd_only).summary["working-memory"];
+  const json s2 = summary_of(analyze(memory_rows(), sd_only))["working-memory"];
   EXPECT_EQ(s2["included"], 4);
   EXPECT_TRUE(s2["participants"][4]["excluded"].is_string());
 }
@@ -483,19 +489,19 @@ TEST(Analysis, SingleParticipantReportsSkippedTestsAndStillDraws) {
   o.out_dir = dir.at("one");
   AnalysisReport r;
   ASSERT_NO_THROW(r = analyze(one, o));
-  EXPECT_EQ(r.summary.size(), 7u);
-  EXPECT_TRUE(r.summary["texel-length"]["paired_t_test"].contains("skipped"));
-  EXPECT_TRUE(r.summary["coarse-features"]["rm_anova"].contains("skipped"));
-  EXPECT_TRUE(r.summary["working-memory"]["rm_anova"].contains("skipped"));
-  EXPECT_TRUE(r.summary["guided-exploration"]["references"][0]["ellipse"].contains("skipped"));
-  EXPECT_TRUE(r.summary["guided-exploration"]["similarity"]["own_vs_other_t_test"].contains("skipped"));
+  EXPECT_EQ(summary_of(r).size(), 7u);
+  EXPECT_TRUE(summary_of(r)["texel-length"]["paired_t_test"].contains("skipped"));
+  EXPECT_TRUE(summary_of(r)["coarse-features"]["rm_anova"].contains("skipped"));
+  EXPECT_TRUE(summary_of(r)["working-memory"]["rm_anova"].contains("skipped"));
+  EXPECT_TRUE(summary_of(r)["guided-exploration"]["references"][0]["ellipse"].contains("skipped"));
+  EXPECT_TRUE(summary_of(r)["guided-exploration"]["similarity"]["own_vs_other_t_test"].contains("skipped"));
   EXPECT_EQ(r.figures.size(), 20u);
 }
 
 TEST(Analysis, ReactionTimesAreParticipantMedians) {
   std::vector<TrialRow> rows = quantization_rows();
   for (auto& r : rows) r.rt_ms = r.participant == "S01" ? (r.condition == "q5" ? 5000 : 1000) : 2000;
-  const json s = analyze(rows, {}).summary["quantization"];
+  const json s = summary_of(analyze(rows, {}))["quantization"];
   EXPECT_EQ(s["rt_ms_median"]["n"], 3);
   EXPECT_DOUBLE_EQ(s["rt_ms_median"]["min"].get<double>(), 1000);  // S01's median ignores its slow q5 trials
   EXPECT_DOUBLE_EQ(s["rt_ms_median"]["max"].get<double>(), 2000);
@@ -531,7 +537,7 @@ TEST(Analysis, ExportedCsvGivesTheSameSummary) {
   const std::vector<TrialRow> rows = all_rows();
   const std::vector<TrialRow> back = parse_trials_csv(trials_csv(rows), "export.csv");
   ASSERT_EQ(back.size(), rows.size());
-  expect_same(analyze(rows, {}).summary, analyze(back, {}).summary, "");
+  expect_same(summary_of(analyze(rows, {})), summary_of(analyze(back, {})), "");
 }
 
 TEST(Analysis, SvgFiguresOnRequest) {

@@ -53,7 +53,7 @@ TEST(Protocol, SpecValuesOfTheShippedStudies) {
   EXPECT_EQ(len.blocks[0].time_limit_s, 30);
   const auto coarse = ex::load_protocol((protocols / "coarse-features.json").string());
   ASSERT_EQ(coarse.blocks.size(), 3u);
-  EXPECT_EQ(coarse.blocks[1].texture["fine_strength"].get<double>(), 0.5);
+  EXPECT_EQ(coarse.blocks[1].texture.number("fine_strength"), 0.5);
   EXPECT_EQ(*coarse.blocks[0].staircase->max_value, 1.0);
   const auto wm = ex::load_protocol((protocols / "working-memory.json").string());
   EXPECT_EQ(wm.planned_trials(), 40);

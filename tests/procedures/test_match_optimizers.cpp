@@ -290,19 +290,25 @@ TEST(Bayes, DeterministicAndReplayable) {
 
 // --- factory -----------------------------------------------------------------------
 
+// make_optimizer() from a kind's protocol name and parameters written as JSON here.
+static std::unique_ptr<MatchOptimizer> make(const std::string& kind, const nlohmann::json& params) {
+  return make_optimizer(parse_optimizer_kind(kind), params.dump());
+}
+
 TEST(Factory, BuildsBothKindsWithParameters) {
-  auto g = make_optimizer(
-      "guided", nlohmann::json{{"iterations", 4}, {"shrink_rate", 0.25}, {"unsure", "repeat"}, {"bound", "joint"}, {"seed", 3}});
+  auto g = make("guided",
+                nlohmann::json{{"iterations", 4}, {"shrink_rate", 0.25}, {"unsure", "repeat"}, {"bound", "joint"}, {"seed", 3}});
   EXPECT_EQ(g->name(), "guided");
   EXPECT_EQ(g->budget(), 16);
-  auto b = make_optimizer("bayesian", nlohmann::json{{"comparisons", 12}, {"sd_stop_db", 1.5}, {"noise_db", 3}});
+  auto b = make("bayesian", nlohmann::json{{"comparisons", 12}, {"sd_stop_db", 1.5}, {"noise_db", 3}});
   EXPECT_EQ(b->name(), "bayesian");
   EXPECT_EQ(b->budget(), 12);
-  EXPECT_EQ(make_optimizer("guided", nlohmann::json())->budget(), 20);
-  EXPECT_EQ(make_optimizer("bayesian", nlohmann::json::object())->budget(), 20);
+  EXPECT_EQ(make("guided", nlohmann::json())->budget(), 20);
+  EXPECT_EQ(make("bayesian", nlohmann::json::object())->budget(), 20);
+  EXPECT_EQ(make_optimizer(OptimizerKind::bayesian)->budget(), 20);
   // replay() through the interface
   const std::vector<MatchChoice> answers(20, MatchChoice::b);
-  auto g2 = make_optimizer("guided", nullptr);
+  auto g2 = make_optimizer(OptimizerKind::guided);
   replay(*g2, answers);
   EXPECT_TRUE(g2->finished());
 }
@@ -310,7 +316,7 @@ TEST(Factory, BuildsBothKindsWithParameters) {
 TEST(Factory, BadParametersNameTheKey) {
   auto message = [](const std::string& kind, const nlohmann::json& p) {
     try {
-      (void)make_optimizer(kind, p);
+      (void)make(kind, p);
     } catch (const texel::InvalidArgument& e) {
       return std::string(e.what());
     }

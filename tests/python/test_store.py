@@ -62,3 +62,17 @@ def test_store_sessions_and_trials(database):
     trials = s.trials(session["id"])
     assert trials[0]["trial"] == 0 and trials[0]["state_json"]
     assert repr(texel.Store(str(db)).rows(session["id"])) == repr(texel.read_trials(str(db)))  # NaN-aware
+
+
+def test_session_json_is_the_cli_and_studio_view(database, cli_json):
+    # One serialiser (texel::experiment::to_json(SessionInfo)): Python's view of
+    # a session is the one `texel experiment list --json` (and the studio) writes.
+    import json
+
+    db, _ = database
+    (listed,) = cli_json("experiment", "list", "--db", db, "--json")
+    s = texel.Store(str(db))
+    assert json.loads(s.session_json(listed["id"])) == listed
+    (session,) = s.sessions()
+    assert {k: v for k, v in session.items() if k != "protocol_json"} == listed
+    assert session["protocol_json"]

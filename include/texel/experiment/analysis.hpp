@@ -10,16 +10,14 @@
 // One front door: `texel experiment analyze`, the studio and the bindings
 // all call analyze(). It is a pure function of the rows and the options
 // apart from the figure files it writes; statistics come from stats.hpp.
-// Trade-off: summaries are plain JSON (nlohmann::ordered_json, keys in a
-// fixed order) rather than typed structs, so the CLI, the studio and R read
-// the same document and a new measure is one more key, not an ABI change.
+// Trade-off: summaries are plain JSON text (keys in a fixed order) rather
+// than typed structs, so the CLI, the studio and R read the same document and
+// a new measure is one more key, not an ABI change.
 #pragma once
 
 #include <cstddef>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "texel/experiment/records.hpp"
 
@@ -51,9 +49,10 @@ struct AnalysisOptions {
 
 /// The result of analyze().
 struct AnalysisReport {
-  /// One key per study that has (non-practice) rows, in a fixed study order;
-  /// a study with no data is absent. Layout per study: docs/analysis.md.
-  nlohmann::ordered_json summary = nlohmann::ordered_json::object();
+  /// JSON object text: one key per study that has (non-practice) rows, in a
+  /// fixed study order; a study with no data is absent. Layout per study:
+  /// docs/analysis.md.
+  std::string summary = "{}";
   /// Paths of the figures written, in the order written.
   std::vector<std::string> figures;
   /// Human-readable summary (a few lines per study).

@@ -16,8 +16,6 @@
 #include <string_view>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 namespace texel::experiment {
 
 /// A point of the matching space: Central Pitch (dB re 1 cpm), Irregularity (dB).
@@ -68,11 +66,17 @@ class MatchOptimizer {
 /// optimizer finishes before all are used.
 void replay(MatchOptimizer& optimizer, std::span<const MatchChoice> choices);
 
-/// Builds an optimizer from a protocol's parameters. kind: "guided" |
-/// "bayesian"; params: a JSON object whose keys are the config fields below
-/// (unknown keys, wrong types and bad values throw InvalidArgument naming
-/// the key). A null or empty object gives the defaults.
-std::unique_ptr<MatchOptimizer> make_optimizer(const std::string& kind, const nlohmann::json& params);
+/// The matching optimizers a protocol may name.
+enum class OptimizerKind { guided, bayesian };
+/// "guided" | "bayesian"; throws InvalidArgument naming `field` and the allowed names.
+OptimizerKind parse_optimizer_kind(std::string_view text, std::string_view field = "kind");
+std::string_view to_string(OptimizerKind k);
+
+/// Builds an optimizer from a protocol's parameters: `params_json` is the
+/// text of a JSON object whose keys are the config fields below (unknown
+/// keys, wrong types and bad values throw InvalidArgument naming the key).
+/// "", "null" or "{}" give the defaults.
+std::unique_ptr<MatchOptimizer> make_optimizer(OptimizerKind kind, std::string_view params_json = {});
 
 // --- guided exploration ------------------------------------------------------
 

@@ -3,38 +3,54 @@
 //
 // A protocol names its study, a device, a randomization seed, the simulated
 // observer that `--simulate default` uses, and an ordered list of blocks.
-// Each block runs one task — oddity, two-alternative, match, rating, guided,
-// same-different — with its stimuli, timings, response type and (for the
-// threshold tasks) a staircase. Validation names the field by its JSON path,
-// the value and what is allowed; unknown keys are errors, so a misspelt key
-// never falls back to a default.
+// Each block runs one task kind — oddity, two-alternative, match, rating,
+// guided, same-different — with its stimuli, timings, response type and (for
+// the threshold tasks) a staircase. What a task kind is (its keys, plan,
+// questions, scoring, simulated answers, export columns) is owned by one
+// type per kind in src/experiment/tasks/, registered in one table
+// (docs/experiments.md "Adding a task kind"). Validation names the field by
+// its JSON path, the value and what is allowed; unknown keys are errors, so
+// a misspelt key never falls back to a default.
 //
-// Trade-off: one flat Block type with per-task fields (validated per task)
-// rather than a class per task, so a front end can show any block's settings
-// and the stored protocol copy stays plain JSON.
+// Trade-off: the built-in kinds' settings stay one flat Block type (read per
+// kind) rather than a settings class per kind, so a front end can show any
+// block's settings; a kind added later keeps its own in Block::settings.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "texel/experiment/guided.hpp"
 #include "texel/experiment/staircase.hpp"
 
 namespace texel::experiment {
 
-enum class TaskKind { oddity, two_alternative, match, rating, guided, same_different };
-std::string_view to_string(TaskKind t);
-TaskKind parse_task_kind(std::string_view text, std::string_view field = "task");
+/// The task kinds a protocol may name ("oddity", "two-alternative", …), in
+/// the order of the task table.
+std::vector<std::string> task_names();
 
-/// The seven studies of docs/procedures.md §6.
-inline constexpr std::string_view study_names[] = {"working-memory",   "texel-length", "parameter-mapping",
-                                                   "free-exploration", "quantization", "guided-exploration",
-                                                   "coarse-features"};
+/// A validated texture template: a document "texture" object (kind texel
+/// unless it says otherwise; the seed may be missing, the engine draws one
+/// per trial), kept as its JSON text.
+struct TextureTemplate {
+  std::string json;  ///< JSON object text; empty = none
+  [[nodiscard]] bool empty() const { return json.empty(); }
+  /// The template's number at `key` (e.g. "fine_strength"), if it has one.
+  [[nodiscard]] std::optional<double> number(std::string_view key) const;
+};
+
+/// Settings of a task kind that are not fields of Block (kinds added after
+/// the built-in ones derive from this; see docs/experiments.md).
+struct TaskSettings {
+  virtual ~TaskSettings() = default;
+};
+
+/// The seven studies of docs/procedures.md §6 (a protocol's "study"), in that order.
+std::vector<std::string> study_names();
 
 /// Slider mappings of the matching studies.
 enum class SliderMapping {
@@ -44,7 +60,7 @@ enum class SliderMapping {
 
 /// A rendering shown on the right in a rating trial.
 struct RenderingSource {
-  nlohmann::json texture;        ///< explicit texel texture (document "texture" object); may be empty
+  TextureTemplate texture;       ///< explicit texel texture; may be empty
   std::string match_of;          ///< use the match of this reference …
   std::string from_block;        ///< … made in this block of the same session
   std::string from_protocol;     ///< … or in the participant's finished session of this protocol
@@ -65,13 +81,13 @@ struct MemoryCondition {
 };
 struct MemoryStimulus {
   std::string name;
-  nlohmann::json texture;    ///< texture 1 (document "texture" object)
-  nlohmann::json different;  ///< texture 2 on "different" trials
+  TextureTemplate texture;    ///< texture 1
+  TextureTemplate different;  ///< texture 2 on "different" trials
 };
 
 struct Block {
   std::string name;
-  TaskKind task = TaskKind::oddity;
+  std::string task = "oddity";  ///< a name of task_names()
   bool practice = false;
   std::string condition;  ///< label copied to every row ("narrow", "fine-50", …)
   std::string prompt;     ///< participant-facing instruction (empty: the task's default)
@@ -80,7 +96,7 @@ struct Block {
   double display_mm = 0.0;    ///< oddity / two-alternative: textured length from 0 (0 = the whole device)
   double time_limit_s = 0.0;  ///< 0 = none (oddity: 30 s)
   bool show_maps = false;     ///< visual practice: the front end draws the friction maps
-  nlohmann::json texture;     ///< base texel texture (document "texture" object, seed optional)
+  TextureTemplate texture;    ///< base texel texture (seed optional)
 
   // Adaptive (oddity, two-alternative).
   std::optional<StaircaseConfig> staircase;
@@ -102,8 +118,8 @@ struct Block {
   int repeats = 1;
 
   // Guided.
-  std::string optimizer = "guided";  ///< "guided" | "bayesian"
-  nlohmann::json optimizer_params = nlohmann::json::object();
+  OptimizerKind optimizer = OptimizerKind::guided;
+  std::string optimizer_params = "{}";  ///< the optimizer's keys (JSON object text, without "kind")
 
   // Same-different.
   std::vector<MemoryCondition> conditions;
@@ -112,6 +128,9 @@ struct Block {
   double texture_s = 10.0, matrix_s = 10.0;
   int matrix_cells = 5;
   bool recall_question = true;
+
+  /// A kind's own settings (nullptr for the built-in kinds).
+  std::shared_ptr<const TaskSettings> settings;
 };
 
 struct Protocol {
@@ -123,7 +142,7 @@ struct Protocol {
   std::string description;
   std::string device = "tpad";
   std::uint64_t seed = 1;
-  nlohmann::json observer = nlohmann::json::object();  ///< simulated observer for `--simulate default`
+  std::string observer = "{}";  ///< simulated observer for `--simulate default` (JSON object text)
   std::vector<Block> blocks;
   std::string json;  ///< the validated source (stored with every session)
 

@@ -28,9 +28,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "texel/experiment/guided.hpp"
 #include "texel/experiment/protocol.hpp"
@@ -48,10 +47,17 @@ struct Stimulus {
 
 /// One timed phase of a trial (working memory): show a stimulus, the digit
 /// matrix, or nothing, for a fixed time.
+enum class PhaseKind { stimulus, matrix };
+std::string_view to_string(PhaseKind k);  ///< "stimulus" | "matrix"
 struct Phase {
-  std::string kind;   ///< "stimulus" | "matrix"
-  int stimulus = -1;  ///< index into Question::stimuli for "stimulus"
+  PhaseKind kind = PhaseKind::stimulus;
+  std::optional<int> stimulus;  ///< index into Question::stimuli (stimulus phases)
   double duration_s = 0.0;
+};
+
+/// Working memory's recall question after the same/different answer.
+struct RecallQuestion {
+  std::optional<int> cell;  ///< the cell asked (0 … 15, row-major); nullopt = "the digit in the cells" (control)
 };
 
 struct SliderSpec {
@@ -67,9 +73,9 @@ struct Question {
   int block_index = 0;
   std::string block;
   int trial_in_block = 0;
-  int block_trials = -1;  ///< planned trials in this block, -1 = adaptive
+  std::optional<int> block_trials;  ///< planned trials in this block; nullopt = adaptive
   bool practice = false;
-  TaskKind task = TaskKind::oddity;
+  std::string task;  ///< the block's task kind
   std::string prompt;
   std::vector<Stimulus> stimuli;
   std::vector<std::string> choices;                   ///< allowed Response::choice values (empty: none asked)
@@ -80,9 +86,15 @@ struct Question {
   bool show_maps = false;                     ///< visual practice: draw the stimuli's friction maps
   std::vector<Phase> phases;                  ///< timed sequence before the questions (working memory)
   std::optional<std::array<int, 16>> matrix;  ///< working memory: 4 × 4 digits, 0 = empty cell
-  int recall_cell = -2;  ///< working memory: cell asked (0 … 15), -1 = "all cells", -2 = no recall question
+  std::optional<RecallQuestion> recall;       ///< working memory: the digit question, if asked
 
-  [[nodiscard]] nlohmann::ordered_json to_json() const;  ///< participant-safe view (studio messages)
+  /// The engine's JSON view (JSON text; stored with every trial, so its bytes
+  /// are part of the store format: docs/format.md "Result field names").
+  [[nodiscard]] std::string to_json() const;
+  /// What a participant's screen may see: to_json() without the stimulus
+  /// documents (their parameters would give the odd one away) unless the
+  /// question asks to draw the maps.
+  [[nodiscard]] std::string participant_json() const;
 };
 
 /// A participant's answer. Only the fields the question asks for are read.
@@ -97,8 +109,9 @@ struct Response {
   std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
   std::string shown_at, answered_at;  ///< ISO 8601 UTC
 
-  [[nodiscard]] nlohmann::ordered_json to_json() const;
-  static Response from_json(const nlohmann::json& j);  ///< throws FormatError
+  [[nodiscard]] std::string to_json() const;  ///< JSON text (stored with every trial)
+  /// Parses a front end's answer (JSON object text); throws FormatError naming the field.
+  static Response from_json(std::string_view json_text);
 };
 
 /// A finished match (slider or guided), by reference.

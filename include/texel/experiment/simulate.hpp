@@ -26,34 +26,60 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <string_view>
 
-#include <nlohmann/json.hpp>
-
+#include "texel/experiment/observer.hpp"
 #include "texel/experiment/session.hpp"
+#include "texel/random.hpp"
 
 namespace texel::experiment {
 
-/// Validates an "observer" object (its sections, keys, types and ranges);
-/// throws FormatError naming the field ("observer.psychometric.slope …").
-void validate_observer(const nlohmann::json& observer);
+/// Validates an "observer" object (JSON object text: its sections, keys,
+/// types and ranges); throws FormatError naming the field
+/// ("observer.psychometric.slope …").
+void validate_observer(std::string_view observer_json);
 
-/// The observer description a SPEC produces over the protocol's observer
-/// (throws InvalidArgument naming the key, the value and what is allowed).
-nlohmann::json simulation_observer(const nlohmann::json& protocol_observer, const std::string& spec);
+/// The observer description (JSON object text) a SPEC produces over the
+/// protocol's observer (throws InvalidArgument naming the key, the value and
+/// what is allowed).
+std::string simulation_observer(std::string_view protocol_observer_json, const std::string& spec);
 
 class SimulatedParticipant {
  public:
   /// `observer` as returned by simulation_observer(). Validates it.
-  SimulatedParticipant(nlohmann::json observer, const Session& session);
-  /// The answer to the session's current question, with a simulated finger
-  /// trace's swipe measures, exploration events and reaction time.
+  SimulatedParticipant(std::string observer, const Session& session);
+  /// The answer to the session's current question (its task kind answers,
+  /// see TaskType::simulate), with a simulated finger trace's swipe
+  /// measures, exploration events and reaction time.
   [[nodiscard]] Response respond(const Session& session) const;
-  [[nodiscard]] const nlohmann::json& observer() const { return observer_; }
+  [[nodiscard]] const std::string& observer() const { return observer_; }
+
+  // The observer's parts, for the task kinds' simulated answers.
+  /// The behaviour stream (seeded by the observer seed).
+  [[nodiscard]] const CounterRng& behaviour() const { return rng_; }
+  /// The psychometric observer's answer to a threshold trial (true = correct);
+  /// `default_guess` is the task's chance rate.
+  [[nodiscard]] bool psychometric_correct(const TrialTruth& t, double default_guess, std::uint64_t trial) const;
+  /// The matcher, aiming at the observer's target or else `fallback`
+  /// (each trial's own reference), shifted by this participant's bias.
+  [[nodiscard]] Matcher matcher(const MatchResult& fallback, const Session& session) const;
+  /// The similarity rater on a scale.
+  [[nodiscard]] Rater rater(double scale_min, double scale_max) const;
+  /// Working memory: P(correct) in a condition (this participant's shift applied).
+  [[nodiscard]] double memory_p_correct(const std::string& condition) const;
+  /// Working memory: P(digit recalled).
+  [[nodiscard]] double memory_p_digit() const;
+  /// A wrong choice (never "unsure"), drawn from the behaviour stream.
+  [[nodiscard]] std::string wrong_choice(const Question& q, const std::string& correct) const;
 
  private:
-  nlohmann::json observer_;
+  struct Model;
+  std::shared_ptr<const Model> model_;  // the parsed observer
+  std::string observer_;
   std::uint64_t seed_ = 1;
+  CounterRng rng_{1, 0};
   double threshold_scale_ = 1.0;  // this participant's deviations from the group
   double bias_pitch_db_ = 0.0, bias_irregularity_db_ = 0.0;
   double memory_shift_ = 0.0;

@@ -18,8 +18,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 namespace texel::experiment::stats {
 
 /// Summary of a sample. NaNs are skipped (n counts the finite values only).
@@ -113,10 +111,10 @@ Ellipse mean_confidence_ellipse(std::span<const double> x, std::span<const doubl
 
 /// JSON views under the fields' names (what `texel stats --json` prints and
 /// the analysis summaries embed); non-finite numbers become null, since JSON
-/// has no NaN.
-nlohmann::ordered_json to_json(const Descriptive& d);
-nlohmann::ordered_json to_json(const TTest& t);
-nlohmann::ordered_json to_json(const AnovaTable& a);  ///< factors, subjects, effects
-nlohmann::ordered_json to_json(const Ellipse& e);     ///< without the outline
+/// has no NaN. JSON object text.
+std::string to_json(const Descriptive& d);
+std::string to_json(const TTest& t);
+std::string to_json(const AnovaTable& a);  ///< factors, subjects, effects
+std::string to_json(const Ellipse& e);     ///< without the outline
 
 }  // namespace texel::experiment::stats

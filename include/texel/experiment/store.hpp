@@ -29,6 +29,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "texel/experiment/records.hpp"
@@ -61,6 +62,13 @@ struct SessionInfo {
   int trials_done = 0;
   int trials_planned = -1;  ///< -1 = adaptive (open-ended)
 };
+
+/// The session as JSON object text, the one view every front door prints
+/// (CLI --json, the studio's messages, Python): id, participant, protocol,
+/// study, status, finished, trials_done, trials_planned (-1 = adaptive),
+/// seed, simulate, simulated, created_at, updated_at (docs/format.md
+/// "Result field names"). The protocol copy is not included.
+std::string to_json(const SessionInfo& s);
 
 enum class StoreMode { read_only, read_write };
 
@@ -130,5 +138,13 @@ class Store {
   explicit Store(std::shared_ptr<StoreConnection> impl);
   std::shared_ptr<StoreConnection> impl_;
 };
+
+/// Where every session stands (`texel experiment status --json`), as JSON
+/// object text: database (the `database` label given), schema_version,
+/// participants, and sessions — each to_json(SessionInfo) plus "blocks": per
+/// block its trials and, for staircase blocks, variable, current_value,
+/// reversals and finished. `participant` limits the sessions to one.
+std::string status_json(const Store& store, std::string_view database,
+                        const std::optional<std::string>& participant = std::nullopt);
 
 }  // namespace texel::experiment

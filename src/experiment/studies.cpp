@@ -1,0 +1,28 @@
+// The study table (studies.hpp).
+#include "studies.hpp"
+
+namespace texel::experiment {
+
+namespace {
+
+constexpr Study table[] = {
+    {"texel-length", "Texel length", StudyDesign::staircase, "texel length (mm)", false, true, false},
+    {"parameter-mapping", "Parameter mapping", StudyDesign::matching, {}, false, false, true},
+    {"free-exploration", "Free exploration", StudyDesign::matching},
+    {"quantization", "Quantization", StudyDesign::quantization},
+    {"guided-exploration", "Guided exploration", StudyDesign::guided},
+    {"coarse-features", "Coarse strength", StudyDesign::staircase, "coarse strength (0 … 1)", true, false, false},
+    {"working-memory", "Working memory", StudyDesign::memory},
+};
+
+}  // namespace
+
+std::span<const Study> studies() { return table; }
+
+const Study* find_study(std::string_view name) {
+  for (const Study& s : table)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+}  // namespace texel::experiment

@@ -1,0 +1,163 @@
+// Same-different with a working-memory load (docs/experiments.md, study 7):
+// texture 1, a 4 × 4 digit matrix to remember (or the control matrix),
+// texture 2; "same or different?", then the digit in one cell.
+#include <algorithm>
+
+#include "../task.hpp"
+#include "texel/error.hpp"
+#include "texel/experiment/simulate.hpp"
+
+namespace texel::experiment {
+namespace {
+
+using detail::JsonObject;
+using nlohmann::json;
+
+class SameDifferentBlock : public TaskBlock {
+ public:
+  explicit SameDifferentBlock(const SessionCore& s) {
+    // Balanced: each condition trials_per_condition times, half "same"
+    // (odd counts: the extra trial is "different"); trial = condition·2 + same.
+    const Block& b = s.block();
+    for (int c = 0; c < static_cast<int>(b.conditions.size()); ++c)
+      for (int k = 0; k < b.trials_per_condition; ++k) plan_.push_back(c * 2 + (k < b.trials_per_condition / 2 ? 1 : 0));
+    if (b.shuffle) s.shuffle(plan_);
+  }
+
+  void prepare(const SessionCore& s, Question& q, TrialTruth& t) override {
+    const Block& b = s.block();
+    q.block_trials = static_cast<int>(plan_.size());
+    const int code = plan_[static_cast<std::size_t>(s.trial_in_block)];
+    const MemoryCondition& cond = b.conditions[static_cast<std::size_t>(code / 2)];
+    const bool same = code % 2 == 1;
+    t.condition = cond.name;
+    const MemoryStimulus& ms =
+        *std::find_if(b.memory_stimuli.begin(), b.memory_stimuli.end(), [&](const auto& m) { return m.name == cond.stimulus; });
+    const std::uint64_t seed = s.seed_draw(0);
+    const json first = texel_texture(texture_of(ms.texture), seed);
+    const json second = same ? first : texel_texture(texture_of(ms.different), seed);
+    q.stimuli.push_back({"Texture 1", s.single(first)});
+    q.stimuli.push_back({"Texture 2", s.single(second)});
+    std::array<int, 16> m{};
+    if (cond.distractor) {
+      // Five (matrix_cells) random cells hold distinct random digits 1–9.
+      std::vector<int> cells(16), digits(9);
+      for (int i = 0; i < 16; ++i) cells[static_cast<std::size_t>(i)] = i;
+      for (int i = 0; i < 9; ++i) digits[static_cast<std::size_t>(i)] = i + 1;
+      for (std::size_t i = 16; i > 1; --i) std::swap(cells[i - 1], cells[static_cast<std::size_t>(s.trial_below(16 + i, i))]);
+      for (std::size_t i = 9; i > 1; --i) std::swap(digits[i - 1], digits[static_cast<std::size_t>(s.trial_below(48 + i, i))]);
+      for (int k = 0; k < b.matrix_cells; ++k)
+        m[static_cast<std::size_t>(cells[static_cast<std::size_t>(k)])] = digits[static_cast<std::size_t>(k)];
+      const int asked = cells[static_cast<std::size_t>(s.trial_below(5, static_cast<std::uint64_t>(b.matrix_cells)))];
+      if (b.recall_question) q.recall = RecallQuestion{asked};
+    } else {
+      m.fill(1);  // control: every cell holds 1; the recall question indicates all cells
+      if (b.recall_question) q.recall = RecallQuestion{std::nullopt};
+    }
+    q.matrix = m;
+    q.phases = {{PhaseKind::stimulus, 0, b.texture_s},
+                {PhaseKind::matrix, std::nullopt, b.matrix_s},
+                {PhaseKind::stimulus, 1, b.texture_s}};
+    q.choices = {"same", "different"};
+    t.correct_answer = same ? "same" : "different";
+    q.prompt = b.prompt.empty() ? "Were the two textures the same or different?" : b.prompt;
+  }
+
+  std::string answer(SessionCore&, const Question& q, const TrialTruth& t, const Response& r, TrialRow& row) override {
+    row.correct = r.choice == t.correct_answer ? 1.0 : 0.0;
+    if (q.recall) {
+      require(r.digit.has_value() && *r.digit >= 1 && *r.digit <= 9,
+              "digit is " + (r.digit ? std::to_string(*r.digit) : std::string("missing")) + "; allowed: 1 … 9");
+      const int expected = recalled_digit(q);
+      row.digit_cell = q.recall->cell ? *q.recall->cell : missing;
+      row.digit_response = *r.digit;
+      row.digit_correct = *r.digit == expected ? 1.0 : 0.0;
+    }
+    return "{}";
+  }
+
+  bool finished(const SessionCore& s) const override { return s.trial_in_block >= static_cast<int>(plan_.size()); }
+
+  // The digit the recall question asks for (control: every cell holds 1).
+  static int recalled_digit(const Question& q) {
+    return q.recall->cell ? (*q.matrix)[static_cast<std::size_t>(*q.recall->cell)] : 1;
+  }
+
+ private:
+  std::vector<int> plan_;  // condition·2 + same, per trial
+};
+
+class SameDifferentTask : public TaskType {
+ public:
+  std::string_view name() const override { return "same-different"; }
+  std::vector<std::string_view> keys() const override {
+    return {"stimuli", "conditions", "trials_per_condition", "texture_s", "matrix_s", "matrix_cells", "recall_question"};
+  }
+
+  void parse(BlockInput& in, Block& b) const override {
+    JsonObject& o = in.o;
+    const auto& stimuli = o.raw("stimuli");
+    if (!stimuli.is_object() || stimuli.empty())
+      throw FormatError(o.field("stimuli") + " must be an object of named stimuli {\"texture\", \"different\"}");
+    for (auto it = stimuli.begin(); it != stimuli.end(); ++it) {
+      JsonObject s(it.value(), o.field("stimuli") + "." + it.key());
+      BlockInput sin{s, in.device};
+      MemoryStimulus ms;
+      ms.name = it.key();
+      ms.texture = sin.texture("texture");
+      ms.different = sin.texture("different");
+      s.finish();
+      b.memory_stimuli.push_back(std::move(ms));
+    }
+    const auto& conds = o.raw("conditions");
+    if (!conds.is_array() || conds.empty() || conds.size() > 64)
+      throw FormatError(o.field("conditions") + " must be a non-empty array of {name, stimulus, distractor}");
+    for (std::size_t i = 0; i < conds.size(); ++i) {
+      JsonObject c(conds[i], o.field("conditions") + "[" + std::to_string(i) + "]");
+      MemoryCondition mc;
+      mc.name = c.string("name");
+      mc.stimulus = c.string("stimulus");
+      if (std::none_of(b.memory_stimuli.begin(), b.memory_stimuli.end(), [&](const auto& s) { return s.name == mc.stimulus; }))
+        throw FormatError(c.field("stimulus") + " is '" + mc.stimulus + "'; allowed: a key of " + o.field("stimuli"));
+      mc.distractor = c.boolean_or("distractor", true);
+      c.finish();
+      b.conditions.push_back(std::move(mc));
+    }
+    b.trials_per_condition = static_cast<int>(o.integer("trials_per_condition", 1, 1000));
+    b.texture_s = o.number_or("texture_s", 10.0, 0.0, 600.0);
+    b.matrix_s = o.number_or("matrix_s", 10.0, 0.0, 600.0);
+    b.matrix_cells = static_cast<int>(o.has("matrix_cells") ? o.integer("matrix_cells", 1, 9) : (o.skip("matrix_cells"), 5));
+    b.recall_question = o.boolean_or("recall_question", true);
+  }
+
+  std::optional<int> planned_trials(const Block& b) const override {
+    return b.trials_per_condition * static_cast<int>(b.conditions.size());
+  }
+
+  std::unique_ptr<TaskBlock> start(const SessionCore& s) const override { return std::make_unique<SameDifferentBlock>(s); }
+
+  void simulate(const SimulatedParticipant& who, const Session& session, Response& r) const override {
+    const Question& q = session.question();
+    const TrialTruth& t = session.truth();
+    const auto trial = static_cast<std::uint64_t>(q.trial);
+    const CounterRng& rng = who.behaviour();
+    const bool ok = rng.uniform(trial * 8 + 2) < who.memory_p_correct(t.condition);
+    r.choice = ok ? t.correct_answer : who.wrong_choice(q, t.correct_answer);
+    if (q.recall) {
+      const int expected = SameDifferentBlock::recalled_digit(q);
+      const bool recall = rng.uniform(trial * 8 + 3) < who.memory_p_digit();
+      r.digit =
+          recall ? expected : 1 + static_cast<int>((static_cast<std::uint64_t>(expected) + rng.below(trial * 8 + 4, 8)) % 9);
+    }
+  }
+
+  std::vector<std::string_view> columns() const override {
+    return {"response", "correct_answer", "correct", "digit_cell", "digit_response", "digit_correct"};
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<TaskType> make_same_different_task() { return std::make_unique<SameDifferentTask>(); }
+
+}  // namespace texel::experiment
