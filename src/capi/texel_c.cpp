@@ -584,7 +584,7 @@ texel_spectrum_options texel_spectrum_options_default(void) {
   texel_spectrum_options o{};
   o.window = TEXEL_WINDOW_BLACKMAN_HARRIS;
   o.zero_pad = static_cast<unsigned>(a.spectrum.zero_pad);
-  o.threshold_db = a.peaks.threshold_db;
+  o.threshold_db = a.peaks.threshold.value();
   o.max_peaks = a.peaks.max_peaks;
   o.welch_segment = a.welch.segment;
   o.welch_overlap = a.welch.overlap;
@@ -621,7 +621,7 @@ texel_status texel_spectrum_analyse(const double* amplitudes, std::size_t count,
     if (count > 0) need(amplitudes, "amplitudes");
     if (count < 16) throw InvalidArgument("count is " + std::to_string(count) + " samples; a spectrum needs at least 16");
     a.spectrum.zero_pad = static_cast<int>(o.zero_pad);
-    a.peaks.threshold_db = o.threshold_db;
+    a.peaks.threshold = texel::DecibelsLevel{o.threshold_db};
     a.peaks.max_peaks = o.max_peaks;
     a.welch.segment = o.welch_segment;
     a.welch.overlap = o.welch_overlap;
@@ -674,7 +674,7 @@ texel_status texel_spectrum_get_series(const texel_spectrum* spectrum, texel_spe
         for (const auto& p : r.peaks) picked.push_back(p.amplitude);
         break;
       case TEXEL_SERIES_PEAK_LEVEL_DB:
-        for (const auto& p : r.peaks) picked.push_back(p.level_db);
+        for (const auto& p : r.peaks) picked.push_back(p.level.value());
         break;
       case TEXEL_SERIES_BAND_LO_CPM:
         for (const auto& b : r.bands) picked.push_back(b.lo_cpm);

@@ -9,18 +9,22 @@ namespace texel::studio::detail {
 
 namespace {
 
-// The encoder's result as the studio has always sent it (field names kept;
-// docs/studio.md).
+// The encoder's result: the fields the studio has always sent (model_distance
+// kept readable for a release beside distance_jnd; docs/format.md "Result field
+// names") and, under "result", the library's one serialisation of it
+// (codec::to_json, the same text as `texel encode --json`).
 ojson encode_json(const codec::EncodeResult& r) {
   return ojson{{"bytes", r.bytes.size()},
                {"hex", hex(r.bytes)},
+               {"distance_jnd", r.model_distance},
                {"model_distance", r.model_distance},
                {"central_pitch_db", r.spec.central_pitch.value()},
                {"irregularity_db", r.spec.irregularity.value()},
                {"texel_length_mm", r.spec.texel_length.value()},
                {"coarse", r.coarse},
                {"texel_recovered", r.texel_recovered},
-               {"seconds", r.seconds}};
+               {"seconds", r.seconds},
+               {"result", ojson::parse(codec::to_json(r))}};
 }
 
 }  // namespace
@@ -38,6 +42,7 @@ void on_match(State& s, Client& c, const Job& job) {
   r["region"] = doc["regions"][m.into];
   r["document"] = doc;
   r["encoded"] = encode_json(m.result);
+  r["distance_jnd"] = m.result.model_distance;
   r["model_distance"] = m.result.model_distance;
   r["target_spectrum"] = spectrum_json(m.target);
   r["match_spectrum"] = spectrum_json(m.match);

@@ -928,7 +928,7 @@ TEST(CApi, SpectrumEqualsTheLibrarys) {
 
   texel::AnalysisOptions a;
   a.spectrum.window = texel::Window::hann;
-  a.peaks.threshold_db = -30;
+  a.peaks.threshold = texel::DecibelsLevel{-30.0};
   const texel::SpectralReport r = texel::analyse_spectrum(map, spacing, a);
   texel_spectrum_summary m{};
   ASSERT_EQ(texel_spectrum_get_summary(s.get(), &m), TEXEL_OK);

@@ -443,7 +443,16 @@ export function mountDesigner(root: HTMLElement): void {
       // Region 0 is the reference on the left; the service puts the match into the last Texel region.
       const r = await client.call('match', { document: buildDocument(store.get()), region: 0 }, 120000);
       const reg = r.region as unknown as RegionDoc;
-      matchInfo.textContent = `matched in ${r.encoded.bytes} bytes, model distance ${fmt(r.model_distance, 2)}`;
+      const est = r.encoded.result.estimate;
+      const flags = [
+        est.no_texture ? 'the reference has no texture' : '',
+        est.at_bound.central_pitch ? 'Central Pitch at the edge of the search range' : '',
+        est.at_bound.irregularity ? 'Irregularity at the edge of the search range' : '',
+      ].filter(Boolean);
+      // 1 JND: the smallest difference in felt pitch or noisiness a person notices (docs/encoder.md).
+      matchInfo.textContent =
+        `matched in ${r.encoded.bytes} bytes; felt distance ${fmt(r.distance_jnd, 2)} JND (model ${r.encoded.result.model.version}; ` +
+        `below 1 JND the two feel alike)` + (flags.length ? ` — ${flags.join('; ')}` : '');
       store.update((st) => {
         const ns: DesignerState = { ...st, overlays: { target: r.target_spectrum, match: r.match_spectrum } };
         if (reg?.texture?.kind === 'texel') applyTexel(ns, reg.texture);
