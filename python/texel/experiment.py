@@ -1,0 +1,1 @@
+"""Running a protocol's sessions from Python (placeholder until Session lands)."""
