@@ -18,6 +18,7 @@
 #include "texel/device.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/records.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/signal.hpp"
 #include "texel/texture.hpp"
@@ -66,14 +67,38 @@ py::array render_document_array(const Document& doc, const std::string& dtype);
 /// decides when the file is let go, not the garbage collector. A
 /// texel.experiment.Session shares it.
 struct StoreHandle {
-  explicit StoreHandle(experiment::Store s) : store(std::move(s)) {}
+  StoreHandle(experiment::Store s, experiment::StoreMode m) : store(std::move(s)), mode(m) {}
   std::optional<experiment::Store> store;
+  experiment::StoreMode mode;
   experiment::Store& get() {
     if (!store) throw InvalidArgument("the store is closed");
     return *store;
   }
-  void close() { store.reset(); }
+  /// Closes the connection. A read-only SQLite connection cannot remove the
+  /// -wal/-shm files a WAL database keeps beside it (only the last
+  /// read-write connection to close does), so after a read a writable
+  /// database is opened read-write once and closed: if nothing else has it
+  /// open, SQLite checkpoints and removes them. Nothing is written (the file
+  /// was validated as a current-schema database when it was opened).
+  void close() {
+    if (!store) return;
+    const std::string path = store->path();
+    store.reset();
+    if (mode == experiment::StoreMode::read_only) try {
+        (void)experiment::Store::open(path, experiment::StoreMode::read_write);
+      } catch (const Error&) {  // write-protected or in use: the files stay, as SQLite wants
+      }
+  }
 };
+
+// Declarations shared between areas (defined in experiment.cpp).
+
+/// Trial rows as a list of dicts, one key per trial_columns() name.
+py::list rows_records(const std::vector<experiment::TrialRow>& rows);
+/// A session's record as a dict (id, participant, protocol, status, …).
+py::dict session_dict(const experiment::SessionInfo& s);
+
+void register_session(py::module_& m);
 
 // Declarations shared between areas (defined in signal.cpp).
 

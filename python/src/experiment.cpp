@@ -94,6 +94,8 @@ const Columns& columns() {
   return c;
 }
 
+}  // namespace
+
 py::list rows_records(const std::vector<TrialRow>& rows) {
   py::list out;
   for (const auto& r : rows) {
@@ -103,6 +105,8 @@ py::list rows_records(const std::vector<TrialRow>& rows) {
   }
   return out;
 }
+
+namespace {
 
 py::dict rows_columns(const std::vector<TrialRow>& rows) {
   py::module_ np = py::module_::import("numpy");
@@ -129,6 +133,8 @@ py::object rows_py(const std::vector<TrialRow>& rows, bool as_columns) {
   return as_columns ? py::object(rows_columns(rows)) : py::object(rows_records(rows));
 }
 
+}  // namespace
+
 py::dict session_dict(const SessionInfo& s) {
   py::dict d;
   d["id"] = s.id;
@@ -145,6 +151,8 @@ py::dict session_dict(const SessionInfo& s) {
   d["protocol_json"] = s.protocol_json;
   return d;
 }
+
+namespace {
 
 // ------------------------------------------------------------------ helpers
 MatchChoice choice_of(const std::string& c) { return parse_match_choice(c, "choice"); }
@@ -457,20 +465,19 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       "The (Central Pitch, Irregularity) of a reference under the encoder's perceptual model (about 1 s).");
 
   // ------------------------------------------------------------------ store
-  py::class_<StoreHandle, std::shared_ptr<StoreHandle>>(
-      m, "Store",
-      R"doc(A session database (SQLite): sessions, trials and long-format rows.
+  py::class_<StoreHandle, std::shared_ptr<StoreHandle>>(m, "Store",
+                                                        R"doc(A session database (SQLite): sessions, trials and long-format rows.
 
     with texel.Store("cohort.db") as store:     # closed at the end of the block
         rows = store.rows(columns=True)
 
 mode  'r': read-only, never creates or writes (default); 'rw': read-write, created if missing
-      (what experiment.Session records into). close() ends the connection; the database then
-      holds no -wal/-shm files.)doc")
+      (what experiment.Session records into). close() ends the connection; unless another
+      program has the database open, it then holds no -wal/-shm files.)doc")
       .def(py::init([](const py::object& path, const std::string& mode) {
              if (mode != "r" && mode != "rw") throw InvalidArgument("mode is '" + mode + "'; allowed: r, rw");
-             return std::make_shared<StoreHandle>(
-                 Store::open(path_of(path), mode == "r" ? StoreMode::read_only : StoreMode::read_write));
+             const StoreMode sm = mode == "r" ? StoreMode::read_only : StoreMode::read_write;
+             return std::make_shared<StoreHandle>(Store::open(path_of(path), sm), sm);
            }),
            py::arg("path"), py::arg("mode") = "r")
       .def("close", &StoreHandle::close, "Closes the database (again: nothing).")
@@ -520,14 +527,18 @@ mode  'r': read-only, never creates or writes (default); 'rw': read-write, creat
           },
           py::arg("session_id"), "Every stored trial of a session: question, response, state (JSON text), row, events.")
       .def(
-          "rows", [](StoreHandle& h, std::optional<std::int64_t> id, bool as_columns) { return rows_py(h.get().rows(id), as_columns); },
+          "rows",
+          [](StoreHandle& h, std::optional<std::int64_t> id, bool as_columns) { return rows_py(h.get().rows(id), as_columns); },
           py::arg("session_id") = py::none(), py::kw_only(), py::arg("columns") = false,
           "Long-format rows (the export CSV's), as a list of dicts (columns=False) or a dict of numpy\n"
           "columns (columns=True; pandas.DataFrame accepts either). Missing numbers are NaN.");
   m.def(
       "read_trials",
       [](const py::object& path, std::optional<std::int64_t> id, bool as_columns) {
-        return rows_py(Store::open(path_of(path), StoreMode::read_only).rows(id), as_columns);
+        StoreHandle h(Store::open(path_of(path), StoreMode::read_only), StoreMode::read_only);
+        py::object rows = rows_py(h.get().rows(id), as_columns);
+        h.close();
+        return rows;
       },
       py::arg("path"), py::arg("session_id") = py::none(), py::kw_only(), py::arg("columns") = false,
       "The rows of a session database, as `texel experiment export` writes them (see Store.rows).");

@@ -100,4 +100,5 @@ PYBIND11_MODULE(_texel, m) {
   register_interchange(m);
   register_player(m);
   register_experiment(m);
+  register_session(m);
 }

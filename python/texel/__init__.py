@@ -29,9 +29,13 @@ from . import _front
 
 __version__ = _texel.__version__
 
-__all__ = sorted(name for name in dir(_texel) if not name.startswith("_"))
+__all__ = sorted(name for name in dir(_texel) if not name.startswith("_") and name != "experiment")
 
 # Python-level fronts of the extension's names: real signatures (from the
 # stub, __init__.pyi) and reprs. Functions become Python functions calling
 # the extension; classes stay the extension's, their methods wrapped.
 globals().update(_front.apply(_texel, __name__, _front.pathlib.Path(__file__).with_name("__init__.pyi"), _front.REPRS))
+
+# The package's module, not the extension's submodule the star import brought.
+from . import experiment  # noqa: E402
+
