@@ -84,10 +84,11 @@ struct StoreHandle {
     if (!store) return;
     const std::string path = store->path();
     store.reset();
-    if (mode == experiment::StoreMode::read_only) try {
-        (void)experiment::Store::open(path, experiment::StoreMode::read_write);
-      } catch (const Error&) {  // write-protected or in use: the files stay, as SQLite wants
-      }
+    if (mode != experiment::StoreMode::read_only) return;
+    try {
+      (void)experiment::Store::open(path, experiment::StoreMode::read_write);
+    } catch (const Error&) {  // write-protected or in use: the files stay, as SQLite wants
+    }
   }
 };
 

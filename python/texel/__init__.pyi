@@ -7,6 +7,8 @@ from typing import Any, Iterator, Literal, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from . import experiment as experiment
+
 __version__: str
 __all__: list[str]
 
