@@ -10,6 +10,8 @@ Environment:
                          target is brought up to date there and its extension
                          packaged, instead of configuring a fresh build
                          (which compiles the whole library: minutes).
+  TEXEL_PYTHON_EXTENSION the extension file itself (build/python/texel/_texel*.so),
+                         packaged as it is: no CMake run at all (the tests).
   TEXEL_CMAKE_ARGS       extra arguments for a fresh configure.
   TEXEL_SETUP_BUILD_DIR  where setuptools builds (default: build-pip/ in the
                          repository, beside the CMake build folders).
@@ -51,6 +53,15 @@ class CMakeBuild(build_ext):
 
     def build_extension(self, ext):
         dest = pathlib.Path(self.get_ext_fullpath(ext.name)).resolve()
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        suffix = sysconfig.get_config_var("EXT_SUFFIX")
+        prebuilt = os.environ.get("TEXEL_PYTHON_EXTENSION")
+        if prebuilt:
+            if not prebuilt.endswith(suffix):
+                raise SystemExit(f"setup.py: TEXEL_PYTHON_EXTENSION={prebuilt} is not built for {sys.executable} "
+                                 f"(its extensions end in {suffix})")
+            shutil.copyfile(prebuilt, dest)
+            return
         given = os.environ.get("TEXEL_CMAKE_BUILD_DIR")
         build_dir = pathlib.Path(given).resolve() if given else pathlib.Path(self.build_temp).resolve() / "cmake"
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL", str(os.cpu_count() or 2))
@@ -62,13 +73,11 @@ class CMakeBuild(build_ext):
             configure += shlex.split(os.environ.get("TEXEL_CMAKE_ARGS", ""))
             subprocess.run(configure, check=True)
         subprocess.run(["cmake", "--build", str(build_dir), "--target", "texel_python", "-j", jobs], check=True)
-        suffix = sysconfig.get_config_var("EXT_SUFFIX")
         built = build_dir / "python" / "texel" / f"_texel{suffix}"
         if not built.exists():
             found = sorted(p.name for p in (build_dir / "python" / "texel").glob("_texel*"))
             raise SystemExit(f"setup.py: {built} does not exist; {build_dir} holds {found or 'no extension'}: "
                              f"it was configured for another Python than {sys.executable} ({suffix})")
-        dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(built, dest)
 
 

@@ -1,8 +1,8 @@
 """The package as Python users install it (python/README.md): pip, offline,
 with Debian's pip, setuptools and wheel and no build isolation, into a fresh
 venv that sees the system's numpy, and a wheel installed into a system-style
-prefix. The extension is the one this build made (TEXEL_CMAKE_BUILD_DIR), so
-the test packages and installs, it does not compile the library again."""
+prefix. The extension is the one this build made (TEXEL_PYTHON_EXTENSION),
+so the test packages and installs; it neither compiles nor runs CMake."""
 import os
 import pathlib
 import subprocess
@@ -30,7 +30,8 @@ print("ok", texel.__version__)
 
 def clean_env(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PIP_INDEX_URL", "PIP_FIND_LINKS")}
-    env["TEXEL_CMAKE_BUILD_DIR"] = str(BUILD_DIR)
+    (extension,) = pathlib.Path(texel._texel.__file__).parent.glob("_texel*.so")
+    env["TEXEL_PYTHON_EXTENSION"] = str(extension)
     env["TEXEL_SETUP_BUILD_DIR"] = str(tmp_path / "setup")
     env["PIP_NO_INPUT"] = "1"
     env["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
@@ -53,9 +54,12 @@ def build_dir():
 def test_pip_install_into_a_venv(build_dir, tmp_path):
     env = clean_env(tmp_path)
     venv = tmp_path / "venv"
-    run([sys.executable, "-m", "venv", "--system-site-packages", venv], env, tmp_path)
+    # Without its own pip (ensurepip is most of a venv's creation time): Debian's
+    # pip installs into it through --python, as the venv's own pip would.
+    run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", venv], env, tmp_path)
     python = venv / "bin" / "python"
-    run([python, "-m", "pip", "install", "--no-build-isolation", "--no-index", SOURCE_DIR / "python"], env, tmp_path)
+    run([sys.executable, "-m", "pip", "--python", python, "install", "--no-build-isolation", "--no-index",
+         SOURCE_DIR / "python"], env, tmp_path)
     assert run([python, "-c", CHECK, venv], env, tmp_path).startswith("ok")
     # The source tree stays clean: setuptools built under TEXEL_SETUP_BUILD_DIR.
     assert not list((SOURCE_DIR / "python").glob("*.egg-info"))
