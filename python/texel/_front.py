@@ -6,8 +6,10 @@ state every public signature for type checkers, so they are the one place a
 signature is written: at import each public function is wrapped in a plain
 Python function that carries its stub signature and the extension's
 docstring and calls the extension, and each stubbed method of an extension
-class is wrapped the same way. tests/python/test_front.py checks that every
-stubbed parameter is one the extension accepts, so the stub cannot drift.
+class is wrapped the same way. A stub that drifts from the extension shows
+as a TypeError where the tests call with keywords (tests/python: every
+area), and test_front.py spells out every stubbed default of the functions
+that take only defaults.
 
 Reprs: every result type prints its main values (a table below), never a
 bare ``<... object at 0x...>``.
