@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD := build
 PY := /usr/bin/python3
 
-.PHONY: all deps configure build python web web-test demo test test-unit test-browser test-asan test-determinism bench fuzz format clean
+.PHONY: all deps configure build python wheel web web-test demo test test-unit test-browser test-asan test-determinism bench fuzz format clean
 
 all: build
 
@@ -21,6 +21,15 @@ build: configure
 # PYTHONPATH=build/python /usr/bin/python3.
 python: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target texel_python
+
+# A wheel of the package (python/setup.py), in build/wheel/, from the
+# extension `make python` built: install it with
+#   pip install --no-build-isolation build/wheel/texel-*.whl
+# Offline: Debian's pip, setuptools and wheel, no build isolation, no index.
+wheel: python
+	rm -f $(BUILD)/wheel/texel-*.whl
+	TEXEL_CMAKE_BUILD_DIR=$(CURDIR)/$(BUILD) $(PY) -m pip wheel --no-build-isolation --no-index --no-deps -q -w $(BUILD)/wheel ./python
+	@ls -l $(BUILD)/wheel/texel-*.whl
 
 # Texel Studio's front end (web/, TypeScript + Vite + uPlot), built once into
 # build/web and rebuilt only when its sources or lockfile change. `npm ci`

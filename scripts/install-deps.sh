@@ -21,8 +21,11 @@ packages=(
   # tests and benchmarks
   libgtest-dev librapidcheck-dev libbenchmark-dev
   # the Python package and the Python-side checks (pytest, the statistics
-  # oracle, the protocol schema, reading .mat v5/v7.3 files)
+  # oracle, the protocol schema, reading .mat v5/v7.3 files); pip, setuptools,
+  # wheel and venv build and install it as a Python package, offline
+  # (python/README.md)
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-h5py
+  python3-pip python3-setuptools python3-wheel python3-venv
   # Texel Studio's browser tests
   chromium firefox-esr
   # GNU Octave runs examples/matlab/*.m in the examples.matlab_* ctests: a

@@ -1,25 +1,14 @@
-// Binding of the codec (bitstreams, encoder, decoder) and the spectral
-// analysis. Inputs are numpy arrays or paths; the library does the work
-// (codec::load_signal, codec::encode, codec::decode_document,
-// analyse_spectrum), with the GIL released while it runs.
-#include <cstring>
-
-#include "common.hpp"
+// Binding of the codec (texel/codec.hpp): bitstreams, the transcoder, the
+// decoder and the encoder. Inputs are bytes, paths or arrays; signals are
+// read by the one loader (signal.cpp: signal_of), and the library does the
+// work with the GIL released while it runs.
 #include "texel/codec.hpp"
+#include "common.hpp"
 #include "texel/error.hpp"
-#include "texel/interchange.hpp"
 #include "texel/signal.hpp"
-#include "texel/spectrum.hpp"
 
 namespace texel::python {
 namespace {
-
-std::vector<std::byte> bytes_of(const py::bytes& b) {
-  const auto s = std::as_bytes(std::span(std::string_view(b)));
-  return {s.begin(), s.end()};
-}
-
-py::bytes to_bytes(std::span<const std::byte> v) { return py::bytes(reinterpret_cast<const char*>(v.data()), v.size()); }
 
 // Bytes from `bytes`, `bytearray`, a uint8 array or a path to a .texel file.
 codec::Bitstream bitstream_of(const py::handle& source) {
@@ -39,73 +28,6 @@ py::dict percept_dict(const codec::Percept& p) {
   py::dict d;
   for (const auto& [name, value] : codec::fields(p)) d[name] = value;
   return d;
-}
-
-// The library options of a load_signal()/encode() call (texel/signal.hpp).
-SignalOptions signal_options(const py::object& device, std::optional<double> spacing_mm, const py::object& region,
-                             std::optional<double> swipe_speed, const py::object& channel, std::size_t max_samples) {
-  SignalOptions o;
-  if (!device.is_none()) o.device = device_of(device, std::nullopt, std::nullopt);
-  if (spacing_mm) o.spacing = Millimetres(*spacing_mm);
-  if (swipe_speed) o.swipe_speed = MmPerSecond(*swipe_speed);
-  if (py::isinstance<py::str>(region)) {
-    o.region = SignalOptions::Region{region.cast<std::string>(), {}, {}};
-  } else if (!region.is_none()) {
-    const auto span = region.cast<std::pair<double, double>>();
-    o.region = SignalOptions::Region{"", Millimetres(span.first), Millimetres(span.second)};
-  }
-  if (py::isinstance<py::str>(channel)) {
-    if (channel.cast<std::string>() != "mix")
-      throw InvalidArgument("channel is '" + channel.cast<std::string>() + "'; allowed: an index or 'mix'");
-    o.channels = ChannelPolicy::mix;
-  } else if (!channel.is_none()) {
-    o.channels = ChannelPolicy::select;
-    o.channel = channel.cast<unsigned>();
-  }
-  o.max_samples = max_samples;
-  return o;
-}
-
-std::string path_of(const py::handle& source) {
-  return py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
-}
-
-// The signal an encode() call describes: a path (any format load_signal
-// reads) or an array of amplitudes (float, 0 … 1) or device samples
-// (uint16 / uint8, decoded with the library's decode_samples).
-codec::Signal signal_of(const py::handle& source, const py::object& device, std::optional<double> spacing_mm,
-                        std::optional<double> swipe_speed) {
-  if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
-    const SignalOptions o = signal_options(device, spacing_mm, py::none(), swipe_speed, py::none(), SignalOptions{}.max_samples);
-    const std::string path = path_of(source);
-    py::gil_scoped_release release;
-    return codec::encoder_signal(codec::load_signal(path, o));
-  }
-  const DeviceProfile d = device.is_none() ? load_device("tpad") : device_of(device, std::nullopt, std::nullopt);
-  codec::Signal s;
-  s.spacing = Millimetres(spacing_mm.value_or(d.spacing.value()));
-  s.description = "array";
-  const py::array a = py::array::ensure(source);
-  if (!a) throw py::type_error("encode: source must be a path or a 1-D array");
-  if (a.dtype().is(py::dtype::of<std::uint16_t>()) || a.dtype().is(py::dtype::of<std::uint8_t>())) {
-    const bool u16 = a.dtype().itemsize() == 2;
-    const auto c = py::array::ensure(a, py::array::c_style);
-    if (c.ndim() != 1) throw py::value_error("encode: source must be 1-D");
-    const auto* p = static_cast<const std::byte*>(c.data());
-    s.amplitude = decode_samples(u16 ? SampleFormat::u16le : SampleFormat::u8,
-                                 std::span<const std::byte>(p, static_cast<std::size_t>(c.nbytes())));
-  } else {
-    s.amplitude = as_doubles(source, "encode: source");
-  }
-  return s;
-}
-
-SpectrumOptions spectrum_options(const std::string& window, int zero_pad, bool remove_mean) {
-  SpectrumOptions o;
-  o.window = parse_window(window, "window");
-  o.zero_pad = zero_pad;
-  o.remove_mean = remove_mean;
-  return o;
 }
 
 }  // namespace
@@ -218,59 +140,6 @@ Raises InvalidArgument when the source is sample data or not one Texel texture o
       "Decodes a bitstream (bytes, Bitstream or .texel path) and renders it on a device, exactly as\n"
       "`texel decode IN.texel -o map.bin`; dtype as for render().");
 
-  // ----------------------------------------------------------------- signals
-  py::class_<Signal>(m, "Signal", "A texture signal as texel::load_signal read it: samples on a uniform grid.")
-      .def_property_readonly(
-          "samples",
-          [](py::object self) {
-            const auto& s = self.cast<const Signal&>();
-            // Zero copy: the array keeps the Signal alive.
-            py::array_t<double> a(static_cast<py::ssize_t>(s.samples.size()), s.samples.data(), self);
-            a.attr("setflags")(py::arg("write") = false);
-            return a;
-          },
-          "Amplitudes, 0 … 1 (read-only view)")
-      .def_property_readonly("spacing_mm", [](const Signal& s) { return s.spacing.value(); })
-      .def_property_readonly("origin_mm", [](const Signal& s) { return s.origin.value(); })
-      .def_property_readonly("length_mm", [](const Signal& s) { return s.length().value(); })
-      .def_property_readonly("format", [](const Signal& s) { return std::string(to_string(s.format)); })
-      .def_property_readonly("scaled", [](const Signal& s) { return s.scaled; })
-      .def_property_readonly("sample_rate_hz",
-                             [](const Signal& s) -> std::optional<double> {
-                               if (s.sample_rate) return s.sample_rate->value();
-                               return std::nullopt;
-                             })
-      .def_readonly("description", &Signal::description)
-      .def("__len__", [](const Signal& s) { return s.samples.size(); })
-      .def("__repr__", [](const Signal& s) {
-        return "<texel.Signal " + std::string(to_string(s.format)) + ", " + std::to_string(s.samples.size()) + " samples × " +
-               std::to_string(s.spacing.value()) + " mm>";
-      });
-  m.def(
-      "load_signal",
-      [](const py::object& path, const py::object& device, std::optional<double> spacing_mm, const py::object& region,
-         std::optional<double> swipe_speed_mm_s, const py::object& channel, std::size_t max_samples) {
-        const SignalOptions o = signal_options(device, spacing_mm, region, swipe_speed_mm_s, channel, max_samples);
-        const std::string p = path_of(path);
-        py::gil_scoped_release release;
-        return codec::load_signal(p, o);
-      },
-      py::arg("path"), py::kw_only(), py::arg("device") = py::none(), py::arg("spacing_mm") = py::none(),
-      py::arg("region") = py::none(), py::arg("swipe_speed_mm_s") = py::none(), py::arg("channel") = py::none(),
-      py::arg("max_samples") = SignalOptions{}.max_samples,
-      R"doc(Reads any texture signal file with the library's one loader (the same samples `texel info`,
-`texel spectrum` and `texel encode` see).
-
-path              .bin (needs device), .npy (device or spacing_mm), .csv (position_mm,amplitude or
-                  time_s,value), .wav (swipe_speed_mm_s), .mat, .texel.json, .texel (needs device)
-device            a device name, profile path or Device: grid and sample format of a .bin
-spacing_mm        sample spacing, mm; must agree with a file's own grid
-region            (start_mm, end_mm), or a document region's name or index
-swipe_speed_mm_s  turns a time recording into positions
-channel           a multi-channel recording's channel index, or "mix" (default: mono files only)
-max_samples       largest size a file may declare, checked before allocating
-Raises InvalidArgument naming the keyword, FormatError or IoError naming the file.)doc");
-
   // ----------------------------------------------------------------- encoder
   py::class_<codec::EncodeResult>(m, "EncodeResult",
                                   "What encode() found: the Texel parameters, the bitstream and the model's view.")
@@ -339,12 +208,11 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
         // --device`: the given one, or for an array the tpad it defaults to.
         c.model.display_response = codec::parse_display_response(display_response, "display_response");
         c.model.drawn_weight = drawn_weight;
-        const bool path = py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__");
-        if (!device.is_none())
-          c.model.display = device_of(device, std::nullopt, std::nullopt).response;
-        else if (!path)
-          c.model.display = load_device("tpad").response;
-        const codec::Signal signal = signal_of(source, device, spacing_mm, swipe_speed_mm_s);
+        // An array is on the tpad's grid unless told otherwise.
+        const py::object d = device.is_none() && !is_path(source) ? py::str("tpad") : device;
+        if (!d.is_none()) c.model.display = device_of(d, std::nullopt, std::nullopt).response;
+        const codec::Signal signal = codec::encoder_signal(signal_of(
+            source, signal_options(d, spacing_mm, py::none(), swipe_speed_mm_s, py::none(), SignalOptions{}.max_samples)));
         py::gil_scoped_release release;
         return codec::encode(signal, c);
       },
@@ -356,8 +224,10 @@ Raises InvalidArgument naming the keyword, FormatError or IoError naming the fil
       py::arg("no_texture") = "flag",
       R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
 
-source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array: float amplitudes
-                  0 … 1, or uint16/uint8 device samples
+source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array, read by
+                  load_signal(): as the .npy file np.save() writes from it, so an array and that
+                  file encode alike (float amplitudes 0 … 1 as they are, uint16/uint8 device
+                  samples, anything outside [0, 1] scaled to full range)
 device            grid and format of .bin/.npy input and of arrays (default tpad)
 spacing_mm        sample spacing of arrays / .bin / .npy (mm) [the device's]
 swipe_speed_mm_s  swipe speed of time recordings and of the perceptual model (mm/s) [100]
@@ -378,131 +248,6 @@ no_texture        an input without texture: 'flag' (a flat surface, result.no_te
                   (InvalidArgument) ['flag']
 
 The GIL is released while encoding.)doc");
-
-  // ---------------------------------------------------------------- spectrum
-  py::class_<Spectrum>(m, "Spectrum", "One-sided magnitude spectrum on bins k·bin_cpm.")
-      .def_readonly("bin_cpm", &Spectrum::bin_cpm, "Bin spacing (cycles/mm).")
-      .def_readonly("resolution_cpm", &Spectrum::resolution_cpm, "1 / signal length (cycles/mm).")
-      .def_readonly("samples", &Spectrum::samples)
-      .def_readonly("nfft", &Spectrum::nfft)
-      .def_property_readonly(
-          "frequency_cpm", [](const Spectrum& s) { return py::array_t<double>(s.frequency_cpm.size(), s.frequency_cpm.data()); },
-          "Bin frequencies (cycles/mm).")
-      .def_property_readonly(
-          "magnitude", [](const Spectrum& s) { return py::array_t<double>(s.magnitude.size(), s.magnitude.data()); },
-          "Amplitude-calibrated |X_k| (a sinusoid of amplitude A peaks at A).")
-      .def_property_readonly(
-          "power", [](const Spectrum& s) { return py::array_t<double>(s.power.size(), s.power.data()); },
-          "Mean-square amplitude per bin (sums to the variance).");
-  m.def(
-      "magnitude_spectrum",
-      [](const py::object& samples, double spacing_mm, const std::string& window, int zero_pad, bool remove_mean) {
-        const auto x = as_doubles(samples, "samples");
-        const auto o = spectrum_options(window, zero_pad, remove_mean);
-        py::gil_scoped_release release;
-        return magnitude_spectrum(x, spacing_mm, o);
-      },
-      py::arg("samples"), py::arg("spacing_mm"), py::kw_only(), py::arg("window") = "blackman-harris", py::arg("zero_pad") = 4,
-      py::arg("remove_mean") = true,
-      "Magnitude spectrum of amplitudes sampled every spacing_mm (mm); window rectangular | hann |\n"
-      "blackman-harris | flat-top, zero_pad 1 … 16.");
-  m.def(
-      "analyse_spectrum",
-      [](const py::object& samples, double spacing_mm) {
-        const auto x = as_doubles(samples, "samples");
-        SpectralReport r;
-        {
-          py::gil_scoped_release release;
-          r = analyse_spectrum(x, spacing_mm);
-        }
-        py::dict d;
-        d["spectrum"] = py::cast(std::move(r.spectrum));
-        py::dict psd;
-        psd["bin_cpm"] = r.psd.bin_cpm;
-        psd["segment"] = r.psd.segment;
-        psd["segments"] = r.psd.segments;
-        psd["frequency_cpm"] = to_numpy(std::move(r.psd.frequency_cpm));
-        psd["density"] = to_numpy(std::move(r.psd.density));
-        d["psd"] = psd;
-        py::list peaks;
-        for (const Peak& p : r.peaks) {
-          py::dict pd;
-          pd["frequency_cpm"] = p.frequency.value();
-          pd["amplitude"] = p.amplitude;
-          pd["level_db"] = p.level.value();
-          peaks.append(pd);
-        }
-        d["peaks"] = peaks;
-        py::dict s;
-        s["centroid_cpm"] = r.summary.centroid.value();
-        s["log_centroid_db"] = r.summary.log_centroid.value();
-        s["spread_cpm"] = r.summary.spread.value();
-        s["log_spread_db"] = r.summary.log_spread_db;
-        s["total_power"] = r.summary.total_power;
-        d["summary"] = s;
-        py::list bands;
-        for (const BandEnergy& b : r.bands) {
-          py::dict bd;
-          bd["lo_cpm"] = b.lo_cpm;
-          bd["hi_cpm"] = b.hi_cpm;
-          bd["mean_square"] = b.mean_square;
-          bd["fraction"] = b.fraction;
-          bands.append(bd);
-        }
-        d["bands"] = bands;
-        d["mean"] = r.mean;
-        d["rms"] = r.rms;
-        return d;
-      },
-      py::arg("samples"), py::arg("spacing_mm"),
-      "Everything `texel spectrum` reports for amplitudes sampled every spacing_mm (mm): spectrum,\n"
-      "psd (Welch, a²/(cycle/mm)), peaks, summary (centroids, spreads), bands, mean, rms.");
-
-  // ------------------------------------------- MPEG-I Haptics, glTF (docs/interchange.md)
-  m.def(
-      "export_hjif",
-      [](const Document& doc, const std::string& modality, double tolerance, const std::string& date) {
-        hjif::ExportOptions o;
-        o.modality = hjif::parse_modality(modality, "modality");
-        o.tolerance = tolerance;
-        o.date = date;
-        const hjif::Exported x = hjif::export_hjif(doc, o);
-        py::dict d;
-        d["json"] = x.json;
-        d["perceptions"] = x.stats.perceptions;
-        d["keyframes"] = x.stats.keyframes;
-        d["samples"] = x.stats.samples;
-        d["timescale_ticks_per_mm"] = x.stats.timescale;
-        d["max_error"] = x.stats.max_error;
-        return d;
-      },
-      py::arg("document"), py::kw_only(), py::arg("modality") = "friction", py::arg("tolerance") = hjif::default_tolerance,
-      py::arg("date") = "",
-      R"doc(The document as an MPEG-I Haptics (.hjif) text, as `texel export DOC -o X.hjif`: one spatial
-perception per region, Linear Curve keyframes within `tolerance` (full scale) of the map on the
-document's device grid, the document carried in the description (docs/interchange.md).
-Returns a dict: json (the text), perceptions, keyframes, samples, timescale_ticks_per_mm, max_error.
-modality  "friction" | "vibrotactile-texture";  date  YYYY-MM-DD (default: $SOURCE_DATE_EPOCH or today))doc");
-  m.def(
-      "export_gltf",
-      [](const Document& doc, const std::string& hjif_uri, const std::string& container, const std::string& modality,
-         double width_mm) {
-        gltf::AssetOptions o;
-        o.hjif_uri = hjif_uri;
-        o.modality = hjif::parse_modality(modality, "modality");
-        o.width_mm = width_mm;
-        if (container != "gltf" && container != "glb")
-          throw FieldError("container", "is '" + container + "'; allowed: gltf, glb");
-        const auto b = gltf::asset(doc, o, container == "glb" ? gltf::Container::glb : gltf::Container::gltf);
-        return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
-      },
-      py::arg("document"), py::kw_only(), py::arg("hjif_uri"), py::arg("container") = "gltf", py::arg("modality") = "friction",
-      py::arg("width_mm") = 25.0,
-      R"doc(A glTF 2.0 asset (bytes: .gltf text or .glb) of the display as a quad with the MPEG_haptic /
-MPEG_haptic_material extensions, referencing the .hjif at `hjif_uri` (write export_hjif's json there).)doc");
-  m.def(
-      "hjif_conformance_errors", [](const std::string& text) { return hjif::conformance_errors(text); }, py::arg("text"),
-      "Every rule of MPEG-I Haptics Texel checks, applied to a .hjif text: the violations (empty: conformant).");
 }
 
 }  // namespace texel::python

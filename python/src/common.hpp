@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,10 @@
 
 #include "texel/device.hpp"
 #include "texel/document.hpp"
+#include "texel/error.hpp"
+#include "texel/experiment/records.hpp"
+#include "texel/experiment/store.hpp"
+#include "texel/signal.hpp"
 #include "texel/texture.hpp"
 
 namespace texel::python {
@@ -39,7 +44,10 @@ py::array bytes_as_numpy(std::vector<std::byte>&& bytes, const py::dtype& dtype)
 std::vector<double> as_doubles(const py::handle& values, const char* name);
 
 void register_render(py::module_& m);
+void register_signal(py::module_& m);
 void register_codec(py::module_& m);
+void register_spectrum(py::module_& m);
+void register_interchange(py::module_& m);
 void register_player(py::module_& m);
 void register_experiment(py::module_& m);
 
@@ -54,5 +62,58 @@ py::dict spec_dict(const TexelSpec& spec);
 /// format), "float64" (amplitudes), "uint16", "uint8" or "float32". The GIL
 /// is released while rendering.
 py::array render_document_array(const Document& doc, const std::string& dtype);
+
+/// A session database held open until close() (texel.Store): Python code
+/// decides when the file is let go, not the garbage collector. A
+/// texel.experiment.Session shares it.
+struct StoreHandle {
+  StoreHandle(experiment::Store s, experiment::StoreMode m) : store(std::move(s)), mode(m) {}
+  std::optional<experiment::Store> store;
+  experiment::StoreMode mode;
+  experiment::Store& get() {
+    if (!store) throw InvalidArgument("the store is closed");
+    return *store;
+  }
+  /// Closes the connection. A read-only SQLite connection cannot remove the
+  /// -wal/-shm files a WAL database keeps beside it (only the last
+  /// read-write connection to close does), so after a read a writable
+  /// database is opened read-write once and closed: if nothing else has it
+  /// open, SQLite checkpoints and removes them. Nothing is written (the file
+  /// was validated as a current-schema database when it was opened).
+  void close() {
+    if (!store) return;
+    const std::string path = store->path();
+    store.reset();
+    if (mode != experiment::StoreMode::read_only) return;
+    try {
+      (void)experiment::Store::open(path, experiment::StoreMode::read_write);
+    } catch (const Error&) {  // write-protected or in use: the files stay, as SQLite wants
+    }
+  }
+};
+
+// Declarations shared between areas (defined in experiment.cpp).
+
+/// Trial rows as a list of dicts, one key per trial_columns() name.
+py::list rows_records(const std::vector<experiment::TrialRow>& rows);
+/// A session's record as a dict (id, participant, protocol, status, …).
+py::dict session_dict(const experiment::SessionInfo& s);
+
+void register_session(py::module_& m);
+
+// Declarations shared between areas (defined in signal.cpp).
+
+std::vector<std::byte> bytes_of(const py::bytes& b);
+py::bytes to_bytes(std::span<const std::byte> v);
+/// A str or os.PathLike (anything else is data: an array, bytes).
+bool is_path(const py::handle& source);
+std::string path_of(const py::handle& source);
+/// The library options of a load_signal()/encode() call (texel/signal.hpp),
+/// from this package's keywords.
+SignalOptions signal_options(const py::object& device, std::optional<double> spacing_mm, const py::object& region,
+                             std::optional<double> swipe_speed, const py::object& channel, std::size_t max_samples);
+/// A path (codec::load_signal: every format, bitstreams too) or an array
+/// (read as the .npy file that holds it) as a signal. Releases the GIL while reading.
+texel::Signal signal_of(const py::handle& source, const SignalOptions& options);
 
 }  // namespace texel::python

@@ -94,6 +94,8 @@ const Columns& columns() {
   return c;
 }
 
+}  // namespace
+
 py::list rows_records(const std::vector<TrialRow>& rows) {
   py::list out;
   for (const auto& r : rows) {
@@ -103,6 +105,8 @@ py::list rows_records(const std::vector<TrialRow>& rows) {
   }
   return out;
 }
+
+namespace {
 
 py::dict rows_columns(const std::vector<TrialRow>& rows) {
   py::module_ np = py::module_::import("numpy");
@@ -129,6 +133,8 @@ py::object rows_py(const std::vector<TrialRow>& rows, bool as_columns) {
   return as_columns ? py::object(rows_columns(rows)) : py::object(rows_records(rows));
 }
 
+}  // namespace
+
 // The library's one session view (to_json: the CLI's and the studio's
 // fields, trials_planned -1 when adaptive) plus the stored protocol copy.
 py::dict session_dict(const SessionInfo& s) {
@@ -136,6 +142,8 @@ py::dict session_dict(const SessionInfo& s) {
   d["protocol_json"] = s.protocol_json;
   return d;
 }
+
+namespace {
 
 // ------------------------------------------------------------------ helpers
 MatchChoice choice_of(const std::string& c) { return parse_match_choice(c, "choice"); }
@@ -448,14 +456,33 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       "The (Central Pitch, Irregularity) of a reference under the encoder's perceptual model (about 1 s).");
 
   // ------------------------------------------------------------------ store
-  py::class_<Store>(m, "Store", "A session database (SQLite), opened read-only: sessions, trials and long-format rows.")
-      .def(py::init([](const std::string& path) { return Store::open(path, StoreMode::read_only); }), py::arg("path"))
-      .def_property_readonly("schema_version", &Store::schema_version)
-      .def_property_readonly("path", &Store::path)
-      .def("participants", &Store::participants)
+  py::class_<StoreHandle, std::shared_ptr<StoreHandle>>(m, "Store",
+                                                        R"doc(A session database (SQLite): sessions, trials and long-format rows.
+
+    with texel.Store("cohort.db") as store:     # closed at the end of the block
+        rows = store.rows(columns=True)
+
+mode  'r': read-only, never creates or writes (default); 'rw': read-write, created if missing
+      (what experiment.Session records into). close() ends the connection; unless another
+      program has the database open, it then holds no -wal/-shm files.)doc")
+      .def(py::init([](const py::object& path, const std::string& mode) {
+             if (mode != "r" && mode != "rw") throw InvalidArgument("mode is '" + mode + "'; allowed: r, rw");
+             const StoreMode sm = mode == "r" ? StoreMode::read_only : StoreMode::read_write;
+             return std::make_shared<StoreHandle>(Store::open(path_of(path), sm), sm);
+           }),
+           py::arg("path"), py::arg("mode") = "r")
+      .def("close", &StoreHandle::close, "Closes the database (again: nothing).")
+      .def_property_readonly(
+          "closed", [](const StoreHandle& h) { return !h.store; }, "True after close().")
+      .def("__enter__", [](py::object self) { return self; })
+      .def("__exit__", [](StoreHandle& h, const py::args&) { h.close(); })
+      .def_property_readonly("schema_version", [](StoreHandle& h) { return h.get().schema_version(); })
+      .def_property_readonly("path", [](StoreHandle& h) { return h.get().path(); })
+      .def("participants", [](StoreHandle& h) { return h.get().participants(); })
       .def(
           "sessions",
-          [](const Store& s) {
+          [](StoreHandle& h) {
+            const Store& s = h.get();
             py::list l;
             for (const auto& x : s.sessions()) l.append(session_dict(x));
             return l;
@@ -463,13 +490,14 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
           "Every session as a dict: the fields of `texel experiment list --json` (id, participant, protocol,\n"
           "study, status, trials_done, trials_planned (-1 = adaptive), seed, …) and protocol_json.")
       .def(
-          "session", [](const Store& s, std::int64_t id) { return session_dict(s.session(id)); }, py::arg("session_id"))
+          "session", [](StoreHandle& h, std::int64_t id) { return session_dict(h.get().session(id)); }, py::arg("session_id"))
       .def(
-          "session_json", [](const Store& s, std::int64_t id) { return to_json(s.session(id)); }, py::arg("session_id"),
+          "session_json", [](StoreHandle& h, std::int64_t id) { return to_json(h.get().session(id)); }, py::arg("session_id"),
           "The session as JSON text, exactly as `texel experiment list --json` and the studio write it.")
       .def(
           "trials",
-          [](const Store& s, std::int64_t id) {
+          [](StoreHandle& h, std::int64_t id) {
+            const Store& s = h.get();
             py::list l;
             for (const auto& t : s.trials(id)) {
               py::dict d;
@@ -494,14 +522,18 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
           },
           py::arg("session_id"), "Every stored trial of a session: question, response, state (JSON text), row, events.")
       .def(
-          "rows", [](const Store& s, std::optional<std::int64_t> id, bool as_columns) { return rows_py(s.rows(id), as_columns); },
+          "rows",
+          [](StoreHandle& h, std::optional<std::int64_t> id, bool as_columns) { return rows_py(h.get().rows(id), as_columns); },
           py::arg("session_id") = py::none(), py::kw_only(), py::arg("columns") = false,
           "Long-format rows (the export CSV's), as a list of dicts (columns=False) or a dict of numpy\n"
           "columns (columns=True; pandas.DataFrame accepts either). Missing numbers are NaN.");
   m.def(
       "read_trials",
-      [](const std::string& path, std::optional<std::int64_t> id, bool as_columns) {
-        return rows_py(Store::open(path, StoreMode::read_only).rows(id), as_columns);
+      [](const py::object& path, std::optional<std::int64_t> id, bool as_columns) {
+        StoreHandle h(Store::open(path_of(path), StoreMode::read_only), StoreMode::read_only);
+        py::object rows = rows_py(h.get().rows(id), as_columns);
+        h.close();
+        return rows;
       },
       py::arg("path"), py::arg("session_id") = py::none(), py::kw_only(), py::arg("columns") = false,
       "The rows of a session database, as `texel experiment export` writes them (see Store.rows).");

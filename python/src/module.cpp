@@ -77,7 +77,12 @@ std::vector<double> as_doubles(const py::handle& values, const char* name) {
 PYBIND11_MODULE(_texel, m) {
   namespace py = pybind11;
   using namespace texel::python;
+  // The signatures are the pure-Python layer's (python/texel/__init__.py,
+  // from the stubs), so docstrings start with the text, not a signature line.
+  py::options options;
+  options.disable_function_signatures();
   m.doc() = "Texel: multi-scale virtual haptic textures (the C++ engine's Python binding).";
+  m.attr("__version__") = TEXEL_VERSION;
 
   error_type = new_exception(m, "Error", "Base of every error the Texel engine raises on purpose.", PyExc_RuntimeError);
   invalid_type = new_exception(m, "InvalidArgument", "A parameter outside its allowed range or set (also a ValueError).",
@@ -89,7 +94,11 @@ PYBIND11_MODULE(_texel, m) {
   py::register_exception_translator(&translate);
 
   register_render(m);
+  register_signal(m);
   register_codec(m);
+  register_spectrum(m);
+  register_interchange(m);
   register_player(m);
   register_experiment(m);
+  register_session(m);
 }

@@ -12,19 +12,30 @@ engine's buffers (no copy).
     >>> m.dtype, m.shape
     (dtype('uint16'), (19200,))
 
-Areas: rendering (render, reference, document, Document), the codec
-(encode, decode, parse_bitstream), spectra (magnitude_spectrum,
-analyse_spectrum), the player (simulate_swipe, render_trace, swipe), the
-step-wise procedures (Staircase, GuidedOptimizer, BayesOptimizer), simulated
-observers (PsychometricObserver, Matcher, Rater) and session databases
-(Store, read_trials). Engine errors raise texel.Error subclasses
-(InvalidArgument is also a ValueError, IoError also an OSError) with the
-engine's message.
+Areas: rendering (render, reference, document, Document), signals
+(load_signal: files and arrays by one rule), the codec (encode, decode,
+parse_bitstream), spectra (magnitude_spectrum, analyse_spectrum), the player
+(simulate_swipe, render_trace, swipe), the step-wise procedures (Staircase,
+GuidedOptimizer, BayesOptimizer), simulated observers (PsychometricObserver,
+Matcher, Rater), session databases (Store, read_trials) and running a
+protocol's sessions (texel.experiment.Session). Engine errors raise
+texel.Error subclasses (InvalidArgument is also a ValueError, IoError also an
+OSError) with the engine's message.
 """
 
 from . import _texel
 from ._texel import *  # noqa: F401,F403  (the extension's public names)
+from . import _front
 
-__version__ = "0.1.0"
+__version__ = _texel.__version__
 
-__all__ = sorted(name for name in dir(_texel) if not name.startswith("_"))
+__all__ = sorted(name for name in dir(_texel) if not name.startswith("_") and name != "experiment")
+
+# Python-level fronts of the extension's names: real signatures (from the
+# stub, __init__.pyi) and reprs. Functions become Python functions calling
+# the extension; classes stay the extension's, their methods wrapped.
+globals().update(_front.apply(_texel, __name__, _front.pathlib.Path(__file__).with_name("__init__.pyi"), _front.REPRS))
+
+# The package's module, not the extension's submodule the star import brought.
+from . import experiment  # noqa: E402
+
