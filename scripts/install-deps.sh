@@ -22,7 +22,7 @@ packages=(
   libgtest-dev librapidcheck-dev libbenchmark-dev
   # the Python package and the Python-side checks (pytest, the statistics
   # oracle, the protocol schema, reading .mat v5/v7.3 files)
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-h5py
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-rfc3339 python3-h5py
   # Texel Studio's browser tests
   chromium firefox-esr
   # GNU Octave runs examples/matlab/*.m in the examples.matlab_* ctests: a
