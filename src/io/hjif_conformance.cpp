@@ -50,12 +50,6 @@ constexpr std::string_view kEffectTypes[] = {"Basis", "Composite", "Reference"};
 constexpr std::string_view kBaseSignals[] = {"Sine", "Square", "Triangle", "SawToothUp", "SawToothDown"};
 constexpr std::string_view kAvatarTypes[] = {"Vibration", "Pressure", "Temperature", "Custom"};
 constexpr std::string_view kDeviceTypes[] = {"LRA", "VCA", "ERM", "Piezo", "Unknown"};
-constexpr std::string_view kBodyParts[] = {
-    "Unknown",        "All",           "Upper", "Lower",  "Right",     "Left",       "Front",    "Back",      "Arm",
-    "Head",           "Chest",         "Waist", "Leg",    "Upper-arm", "Forearm",    "Hand",     "Crane",     "Neck",
-    "Thigh",          "Calf",          "Foot",  "Palm",   "Finger",    "Sole",       "Toe",      "Thumb",     "Index",
-    "Middle",         "Ring",          "Pinky", "Hallux", "Index-Toe", "Middle-Toe", "Ring-Toe", "Pinky-Toe", "First Phalanx",
-    "Second Phalanx", "Third Phalanx", "Minus", "Plus"};
 constexpr std::string_view kDeviceNumbers[] = {"maximum_frequency",
                                                "minimum_frequency",
                                                "resonance_frequency",

@@ -24,6 +24,14 @@ enum class Mode {
   check,
 };
 
+/// The schema's body parts (channel body_part_target), in the order of their binary codes.
+inline constexpr std::string_view kBodyParts[] = {
+    "Unknown",        "All",           "Upper", "Lower",  "Right",     "Left",       "Front",    "Back",      "Arm",
+    "Head",           "Chest",         "Waist", "Leg",    "Upper-arm", "Forearm",    "Hand",     "Crane",     "Neck",
+    "Thigh",          "Calf",          "Foot",  "Palm",   "Finger",    "Sole",       "Toe",      "Thumb",     "Index",
+    "Middle",         "Ring",          "Pinky", "Hallux", "Index-Toe", "Middle-Toe", "Ring-Toe", "Pinky-Toe", "First Phalanx",
+    "Second Phalanx", "Third Phalanx", "Minus", "Plus"};
+
 /// Every violation found (read: the reader's subset), and what was read.
 struct Walked {
   std::vector<std::string> errors;

@@ -64,6 +64,10 @@ constexpr std::string_view kDeviceFields[] = {"maximum_frequency",
                                               "weight",
                                               "size",
                                               "custom"};
+// Body-part codes, parallel to hjif::detail::kBodyParts (the schema's names).
+constexpr std::uint8_t kBodyPartCodes[] = {0,  1,  10, 11, 12, 13, 14, 15, 20, 21, 22, 23, 24, 30, 31, 32, 33, 34, 35,  36,
+                                           37, 40, 41, 42, 43, 50, 51, 52, 53, 54, 55, 56, 57, 58, 59, 60, 61, 62, 254, 255};
+static_assert(std::size(kBodyPartCodes) == std::size(hjif::detail::kBodyParts));
 constexpr double kMaxFloat = 10000.0;
 constexpr std::uint32_t kNominalDuration = 128;  // the reference writer's packet duration
 constexpr std::size_t kMaxPayload = (std::size_t{1} << 17) - 1;
@@ -324,7 +328,8 @@ class Decoder {
     for (const char* k : {"version", "profile", "level", "date", "description", "timescale", "avatars"}) out[k] = root_[k];
     out["perceptions"] = perceptions_;
     out["syncs"] = ojson::array();
-    return out.dump();
+    // Strings are bytes in the stream: what is not UTF-8 is read as U+FFFD.
+    return out.dump(-1, ' ', false, ojson::error_handler_t::replace);
   }
 
  private:
@@ -487,47 +492,15 @@ class Decoder {
       c["actuator_resolution"] = vector(r, "a channel's actuator resolution");
       const std::size_t parts = r.count(8, 8, "a channel's body part target count");
       ojson targets = ojson::array();
-      static constexpr std::string_view kParts[] = {"Unknown",
-                                                    "All",
-                                                    "Upper",
-                                                    "Lower",
-                                                    "Right",
-                                                    "Left",
-                                                    "Front",
-                                                    "Back",
-                                                    "Arm",
-                                                    "Head",
-                                                    "Chest",
-                                                    "Waist",
-                                                    "Leg",
-                                                    "Upper-arm",
-                                                    "Forearm",
-                                                    "Hand",
-                                                    "Crane",
-                                                    "Neck",
-                                                    "Thigh",
-                                                    "Calf",
-                                                    "Foot",
-                                                    "Palm",
-                                                    "Finger",
-                                                    "Sole",
-                                                    "Toe",
-                                                    "Thumb",
-                                                    "Index",
-                                                    "Middle",
-                                                    "Ring",
-                                                    "Pinky",
-                                                    "Hallux",
-                                                    "Index-Toe",
-                                                    "Middle-Toe",
-                                                    "Ring-Toe",
-                                                    "Pinky-Toe",
-                                                    "First Phalanx",
-                                                    "Second Phalanx",
-                                                    "Third Phalanx",
-                                                    "Minus",
-                                                    "Plus"};
-      for (std::size_t i = 0; i < parts; ++i) targets.push_back(r.code(8, kParts, "a body part target"));
+      for (std::size_t i = 0; i < parts; ++i) {
+        const auto at = r.pos() / 8;
+        const auto code = r.get(8, "a body part target");
+        const auto* it = std::find(std::begin(kBodyPartCodes), std::end(kBodyPartCodes), code);
+        if (it == std::end(kBodyPartCodes))
+          r.fail("a body part target has code " + std::to_string(code) + " (at byte " + std::to_string(at) +
+                 "), which the syntax does not define");
+        targets.push_back(hjif::detail::kBodyParts[it - std::begin(kBodyPartCodes)]);
+      }
       c["body_part_target"] = std::move(targets);
       const std::size_t actuators = r.count(8, 24, "a channel's actuator target count");
       ojson at = ojson::array();
@@ -777,47 +750,7 @@ std::vector<std::byte> encode(std::string_view text) {
         const ojson targets = cj.value("actuator_target", ojson::array());
         bounded(static_cast<std::int64_t>(parts.size()), 255, cp + ".body_part_target (count)");
         m.put(parts.size(), 8);
-        static constexpr std::string_view kParts[] = {"Unknown",
-                                                      "All",
-                                                      "Upper",
-                                                      "Lower",
-                                                      "Right",
-                                                      "Left",
-                                                      "Front",
-                                                      "Back",
-                                                      "Arm",
-                                                      "Head",
-                                                      "Chest",
-                                                      "Waist",
-                                                      "Leg",
-                                                      "Upper-arm",
-                                                      "Forearm",
-                                                      "Hand",
-                                                      "Crane",
-                                                      "Neck",
-                                                      "Thigh",
-                                                      "Calf",
-                                                      "Foot",
-                                                      "Palm",
-                                                      "Finger",
-                                                      "Sole",
-                                                      "Toe",
-                                                      "Thumb",
-                                                      "Index",
-                                                      "Middle",
-                                                      "Ring",
-                                                      "Pinky",
-                                                      "Hallux",
-                                                      "Index-Toe",
-                                                      "Middle-Toe",
-                                                      "Ring-Toe",
-                                                      "Pinky-Toe",
-                                                      "First Phalanx",
-                                                      "Second Phalanx",
-                                                      "Third Phalanx",
-                                                      "Minus",
-                                                      "Plus"};
-        for (const auto& part : parts) m.put(*code_of(part.get<std::string>(), kParts), 8);
+        for (const auto& part : parts) m.put(kBodyPartCodes[*code_of(part.get<std::string>(), hjif::detail::kBodyParts)], 8);
         bounded(static_cast<std::int64_t>(targets.size()), 255, cp + ".actuator_target (count)");
         m.put(targets.size(), 8);
         for (const auto& t : targets) write_vector(m, t);

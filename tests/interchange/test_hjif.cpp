@@ -410,14 +410,14 @@ TEST(Hjif, MalformedFilesAreRefusedWithOneLineNamingTheField) {
                  with([](json& j) { j["perceptions"][0]["reference_devices"] = json::parse(R"([{"id":0,"name":"tpad"}])"); }),
                  "reference_devices[0].id is 0; allowed: >= 1", true});
   bad.push_back({"negative gain", with([](json& j) { j["perceptions"][0]["channels"][0]["gain"] = -1.0; }), "gain is -1", true});
-  bad.push_back({"negative position", with([](json& j) { band(j)["effects"][0]["position"] = -5; }), "position is -5", true});
-  bad.push_back({"phase", with([](json& j) { band(j)["effects"][0]["phase"] = 7; }), "phase is 7", true});
-  bad.push_back({"block length", with([](json& j) { band(j)["block_length"] = 8; }), "block_length is 8", true});
+  bad.push_back({"negative position", with([&](json& j) { band(j)["effects"][0]["position"] = -5; }), "position is -5", true});
+  bad.push_back({"phase", with([&](json& j) { band(j)["effects"][0]["phase"] = 7; }), "phase is 7", true});
+  bad.push_back({"block length", with([&](json& j) { band(j)["block_length"] = 8; }), "block_length is 8", true});
   bad.push_back({"vector",
                  with([](json& j) { j["perceptions"][0]["channels"][0]["direction"] = json::parse(R"({"X":128,"Y":0,"Z":0})"); }),
                  "direction.X is 128", true});
   bad.push_back(
-      {"frequency", with([](json& j) { band(j)["upper_frequency_limit"] = 20000; }), "upper_frequency_limit is 20000", true});
+      {"frequency", with([&](json& j) { band(j)["upper_frequency_limit"] = 20000; }), "upper_frequency_limit is 20000", true});
   bad.push_back(
       {"amplitude", with([&](json& j) { kf(j)[1]["amplitude_modulation"] = 1.5; }), "amplitude_modulation is 1.5", true});
   bad.push_back({"fractional position", with([&](json& j) { kf(j)[1]["relative_position"] = 2000.5; }), "whole number", true});

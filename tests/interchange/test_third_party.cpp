@@ -70,10 +70,13 @@ TEST(ReferenceSoftware, ItsBinaryStreamReproducesTheMapWithinTheToleranceAndTheA
   const hjif::Experience e = hmpg::load(dir + "/rm-binary.hmpg");
   const double err = error_against_original(e, dir);
   std::cout << "[ rm ] rm-binary.hmpg: max error " << err << "\n";
-  // The reference writer truncates to the 8-bit code below: up to one whole step (2/255).
-  EXPECT_LE(err, hjif::default_tolerance + hmpg::amplitude_step + 1e-6);
+  // The reference writer truncates to the 8-bit code below (up to one whole step, 2/255), and its
+  // gain code for 1, computed in single precision, reads 1.000164.
+  EXPECT_LE(err, hjif::default_tolerance + hmpg::amplitude_step + 1.7e-4);
   EXPECT_NE(e.description.find("texel-document:"), std::string::npos);  // its 525-byte description, length wrapped
-  EXPECT_TRUE(hjif::conformance_errors(hmpg::decode(std::as_bytes(std::span(read_file(dir + "/rm-binary.hmpg"))))).size() <= 1);
+  const std::string bytes = read_file(dir + "/rm-binary.hmpg");
+  const std::string text = hmpg::decode(std::as_bytes(std::span(bytes.data(), bytes.size())));
+  EXPECT_EQ(hjif::conformance_errors(text).size(), 1u);  // its date, a day without a time (Texel's old export)
 }
 
 TEST(ReferenceSoftware, ItsTemporalFileImportsAtASwipeSpeed) {
