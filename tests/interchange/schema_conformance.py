@@ -17,7 +17,8 @@ package):
 1. every kind of file Texel writes (fine, coarse, quantized, two regions,
    reference, generic grid, vibrotactile texture) is valid and Texel's own
    checker (hjif::conformance_errors) finds it conformant;
-2. on 200 files mutated field by field from them, Texel's schema checker
+2. on 200 files mutated field by field from them (their effects cut to 12
+   keyframes), Texel's schema checker
    (hjif::schema_errors) and the validator give the same verdict;
 3. the reference software's own .hjif files get the same verdict from both
    (its date form, 2026-11-26 14:06:29, is not RFC 3339: both refuse it).
@@ -139,6 +140,14 @@ def main():
     # 200 mutated files: the two schema readings agree.
     rng = random.Random(24)
     sources = [json.load(open(p, encoding="utf-8")) for p in written]
+    # Each effect keeps its first 12 keyframes: the mutations aim at fields, and a validator
+    # walking 18,000 keyframes per file through $ref would take minutes for 200 files.
+    for doc in sources:
+        for p in doc["perceptions"]:
+            for c in p["channels"]:
+                for b in c["bands"]:
+                    for e in b["effects"]:
+                        e["keyframes"] = e["keyframes"][:12]
     mutated = []
     for k in range(200):
         doc = mutate(rng.choice(sources), rng)
