@@ -47,19 +47,8 @@ constexpr std::string_view kModalities[] = {"Pressure",
 constexpr std::string_view kBandTypes[] = {"WaveletWave", "VectorialWave", "Curve", "Transient"};
 constexpr std::string_view kCurveTypes[] = {"Linear", "Cubic", "Akima", "Bezier", "BSpline", "Unknown"};
 constexpr std::string_view kEffectTypes[] = {"Basis", "Composite", "Reference"};
-constexpr std::string_view kBaseSignals[] = {"Sine", "Square", "Triangle", "SawToothUp", "SawToothDown"};
 constexpr std::string_view kAvatarTypes[] = {"Vibration", "Pressure", "Temperature", "Custom"};
 constexpr std::string_view kDeviceTypes[] = {"LRA", "VCA", "ERM", "Piezo", "Unknown"};
-constexpr std::string_view kDeviceNumbers[] = {"maximum_frequency",
-                                               "minimum_frequency",
-                                               "resonance_frequency",
-                                               "maximum_amplitude",
-                                               "impedance",
-                                               "maximum_voltage",
-                                               "maximum_current",
-                                               "maximum_displacement",
-                                               "weight",
-                                               "size"};
 
 // The reference software's profile and level rules (its semantic checks).
 constexpr std::string_view kProfiles[] = {"Main", "Simple Parametric"};

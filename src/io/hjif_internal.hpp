@@ -32,6 +32,22 @@ inline constexpr std::string_view kBodyParts[] = {
     "Middle",         "Ring",          "Pinky", "Hallux", "Index-Toe", "Middle-Toe", "Ring-Toe", "Pinky-Toe", "First Phalanx",
     "Second Phalanx", "Third Phalanx", "Minus", "Plus"};
 
+/// Base signals, in the order of their binary codes.
+inline constexpr std::string_view kBaseSignals[] = {"Sine", "Square", "Triangle", "SawToothUp", "SawToothDown"};
+
+/// A reference device's optional numbers (all ≥ 0), in the order of the binary
+/// syntax's presence mask (which adds `custom`, then `type`).
+inline constexpr std::string_view kDeviceNumbers[] = {"maximum_frequency",
+                                                      "minimum_frequency",
+                                                      "resonance_frequency",
+                                                      "maximum_amplitude",
+                                                      "impedance",
+                                                      "maximum_voltage",
+                                                      "maximum_current",
+                                                      "maximum_displacement",
+                                                      "weight",
+                                                      "size"};
+
 /// Every violation found (read: the reader's subset), and what was read.
 struct Walked {
   std::vector<std::string> errors;

@@ -4,6 +4,7 @@
 // writer produces; docs/interchange.md "Binary .hmpg" lists every field read
 // and written here, and where Texel reads more liberally than that writer.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -49,26 +50,20 @@ constexpr std::string_view kModalityCodes[] = {
 constexpr std::string_view kBandCodes[] = {"Transient", "Curve", "VectorialWave", "WaveletWave"};
 constexpr std::string_view kCurveCodes[] = {"Unknown", "Cubic", "Linear", "Akima", "Bezier", "BSpline"};
 constexpr std::string_view kEffectCodes[] = {"Basis", "Reference", "Composite"};
-constexpr std::string_view kBaseSignalCodes[] = {"Sine", "Square", "Triangle", "SawToothUp", "SawToothDown"};
 constexpr std::string_view kAvatarCodes[] = {"Custom", "Vibration", "Pressure", "Temperature"};
 constexpr std::string_view kDeviceTypeCodes[] = {"Unknown", "LRA", "VCA", "ERM", "Piezo"};
-// Optional reference-device numbers, in the order of their presence mask, all over [0, 10000].
-constexpr std::string_view kDeviceFields[] = {"maximum_frequency",
-                                              "minimum_frequency",
-                                              "resonance_frequency",
-                                              "maximum_amplitude",
-                                              "impedance",
-                                              "maximum_voltage",
-                                              "maximum_current",
-                                              "maximum_displacement",
-                                              "weight",
-                                              "size",
-                                              "custom"};
 // Body-part codes, parallel to hjif::detail::kBodyParts (the schema's names).
 constexpr std::uint8_t kBodyPartCodes[] = {0,  1,  10, 11, 12, 13, 14, 15, 20, 21, 22, 23, 24, 30, 31, 32, 33, 34, 35,  36,
                                            37, 40, 41, 42, 43, 50, 51, 52, 53, 54, 55, 56, 57, 58, 59, 60, 61, 62, 254, 255};
 static_assert(std::size(kBodyPartCodes) == std::size(hjif::detail::kBodyParts));
 constexpr double kMaxFloat = 10000.0;
+// A reference device's optional numbers in the order of their presence mask, all over [0, 10000].
+constexpr auto kDeviceFields = [] {
+  std::array<std::string_view, std::size(hjif::detail::kDeviceNumbers) + 1> a{};
+  std::copy(std::begin(hjif::detail::kDeviceNumbers), std::end(hjif::detail::kDeviceNumbers), a.begin());
+  a.back() = "custom";
+  return a;
+}();
 constexpr std::uint32_t kNominalDuration = 128;  // the reference writer's packet duration
 constexpr std::size_t kMaxPayload = (std::size_t{1} << 17) - 1;
 constexpr std::int64_t kMaxRelative = 65535;  // 16-bit keyframe positions
@@ -452,7 +447,7 @@ class Decoder {
       d["body_part_mask"] = r.get(32, "a reference device's body part mask");
       const auto mask = r.get(12, "a reference device's field mask");
       for (std::size_t f = 0; f < std::size(kDeviceFields); ++f)
-        if (mask & (0x800U >> f)) d[std::string(kDeviceFields[f])] = r.real(0.0, kMaxFloat, 32, kDeviceFields[f]);
+        if (mask & (0x800U >> f)) d[std::string(kDeviceFields[f])] = r.real(0.0, kMaxFloat, 32, "a reference device's number");
       if (mask & 1U) d["type"] = r.code(4, kDeviceTypeCodes, "a reference device's type");
       devices.push_back(std::move(d));
     }
@@ -585,7 +580,7 @@ class Decoder {
       e["position"] = r.get(25, "an effect's position");
       if (ref->type == "VectorialWave") {
         e["phase"] = r.real(0.0, 6.28318, 16, "an effect's phase");
-        e["base_signal"] = r.code(4, kBaseSignalCodes, "an effect's base signal");
+        e["base_signal"] = r.code(4, hjif::detail::kBaseSignals, "an effect's base signal");
       }
       const std::size_t min_bits = ref->type == "Transient" ? 40 : ref->type == "Curve" ? 24 : 18;
       const std::size_t k = r.count(16, min_bits, "an effect's keyframe count");

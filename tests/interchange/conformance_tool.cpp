@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../support/specs.hpp"
+#include "interchange_support.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
@@ -33,17 +34,7 @@ int write_cases(const std::string& dir) {
   TexelSpec quantized = fine(12, -3, 0.25, 11);
   quantized.quantization_db = 3.0;
   docs.emplace_back("quantized", make_document(tpad, quantized));
-  Document regions = make_document(tpad, fine(6, -6, 0.25, 5));
-  const double half = tpad.length().value() / 2;
-  regions.regions.front().name = "left";
-  regions.regions.front().length = Millimetres(half);
-  RegionSpec right;
-  right.name = "right";
-  right.start = Millimetres(half);
-  right.length = Millimetres(half);
-  right.texel = fine(14, -10, 1.0, 9);
-  regions.regions.push_back(right);
-  docs.emplace_back("two-regions", regions);
+  docs.emplace_back("two-regions", test_support::two_region_document(tpad));
   ReferenceSpec ref;
   ref.name = "4sin";
   docs.emplace_back("reference", make_reference_document(tpad, ref));

@@ -19,6 +19,7 @@
 #include "../support/json_mutation.hpp"
 #include "../support/specs.hpp"
 #include "../support/temp_dir.hpp"
+#include "interchange_support.hpp"
 #include "texel/bitstream.hpp"
 #include "texel/codec.hpp"
 #include "texel/document.hpp"
@@ -58,16 +59,7 @@ std::vector<Case> cases(const DeviceProfile& device, double shift = 0.0) {
   TexelSpec quantized = fine(12 + shift, -3, 0.25, 11);
   quantized.quantization_db = 3.0;
   out.push_back({"quantized", make_document(device, quantized), true});
-  Document regions = make_document(device, fine(6 + shift, -6, 0.25, 5));
-  const double half = device.length().value() / 2;
-  regions.regions.front().name = "left";
-  regions.regions.front().length = Millimetres(half);
-  RegionSpec right;
-  right.name = "right";
-  right.start = Millimetres(half);
-  right.length = Millimetres(half);
-  right.texel = fine(14 + shift, -10, 1.0, 9);
-  regions.regions.push_back(right);
+  const Document regions = test_support::two_region_document(device, shift);
   out.push_back({"regions", regions, false});
   if (shift == 0.0) {  // 4sin's components reach 11 cpm
     ReferenceSpec ref;
@@ -90,16 +82,7 @@ std::string without_carried(const std::string& text) {
   return j.dump();
 }
 
-double max_error(const hjif::Experience& e, const Document& doc) {
-  const Surface s = prepare_surface(doc);
-  const std::vector<double> map = s.render();
-  std::vector<double> x(map.size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = s.grid().position(static_cast<std::int64_t>(i)).value();
-  const std::vector<double> got = hjif::evaluate(e, x);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < map.size(); ++i) worst = std::max(worst, std::fabs(got[i] - map[i]));
-  return worst;
-}
+double max_error(const hjif::Experience& e, const Document& doc) { return test_support::max_map_error(e, doc); }
 
 // --- conformance, checked here from the format's rules (not by the reader) ---
 

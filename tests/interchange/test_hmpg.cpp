@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/specs.hpp"
+#include "interchange_support.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
@@ -37,16 +38,7 @@ hjif::ExportOptions options() {
   return o;
 }
 
-double map_error(const hjif::Experience& e, const Document& doc) {
-  const Surface s = prepare_surface(doc);
-  const std::vector<double> map = s.render();
-  std::vector<double> x(map.size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = s.grid().position(static_cast<std::int64_t>(i)).value();
-  const std::vector<double> got = hjif::evaluate(e, x);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < map.size(); ++i) worst = std::max(worst, std::fabs(got[i] - map[i]));
-  return worst;
-}
+double map_error(const hjif::Experience& e, const Document& doc) { return test_support::max_map_error(e, doc); }
 
 std::string refusal(const std::vector<std::byte>& bytes) {
   try {
@@ -79,15 +71,7 @@ TEST(Hmpg, WriteReadWriteIsBitExactAndTheMapComesBackWithinTheStatedTolerance) {
 }
 
 TEST(Hmpg, EveryModalityAndRegionLayoutTexelWritesRoundTrips) {
-  Document regions = fine_doc();
-  const double half = regions.device.length().value() / 2;
-  regions.regions.front().length = Millimetres(half);
-  RegionSpec right;
-  right.name = "right";
-  right.start = Millimetres(half);
-  right.length = Millimetres(half);
-  right.texel = test_support::fine_spec(14, -10, 1.0, 9);
-  regions.regions.push_back(right);
+  const Document regions = test_support::two_region_document(load_device("tpad"));
   hjif::ExportOptions v = options();
   v.modality = hjif::Modality::vibrotactile_texture;
   for (const auto& [doc, o] : {std::pair{regions, options()}, std::pair{fine_doc(), v}}) {
@@ -152,8 +136,7 @@ TEST(Hmpg, MalformedStreamsAreRefusedWithOneLine) {
   EXPECT_NE(refusal(bad).find("packet's type is 63"), std::string::npos) << refusal(bad);
   // A unit declaring 2^32 - 1 bytes.
   bad = good;
-  for (int i = 4; i <= 8; ++i)
-    bad[static_cast<std::size_t>(i)] |= static_cast<std::byte>(i == 4 ? 0x0F : i == 8 ? 0xF0 : 0xFF);
+  for (int i = 4; i <= 8; ++i) bad[static_cast<std::size_t>(i)] |= static_cast<std::byte>(i == 4 ? 0x0F : i == 8 ? 0xF0 : 0xFF);
   EXPECT_NE(refusal(bad).find("declares"), std::string::npos) << refusal(bad);
   // Mutations: only texel errors escape.
   const CounterRng rng(24, 0);

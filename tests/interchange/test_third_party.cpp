@@ -13,6 +13,7 @@
 #include <iostream>
 #include <string>
 
+#include "interchange_support.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
@@ -42,14 +43,7 @@ double error_against_original(const hjif::Experience& e, const std::string& dir)
   const hjif::Experience original = hjif::load_hjif(dir + "/texel-fine-seed7-id1.hjif");
   EXPECT_TRUE(original.carried.has_value()) << original.carried_rejected;
   if (!original.carried) return 1.0;
-  const Surface s = prepare_surface(*original.carried);
-  const std::vector<double> map = s.render();
-  std::vector<double> x(map.size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = s.grid().position(static_cast<std::int64_t>(i)).value();
-  const std::vector<double> got = hjif::evaluate(e, x);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < map.size(); ++i) worst = std::max(worst, std::fabs(got[i] - map[i]));
-  return worst;
+  return test_support::max_map_error(e, *original.carried);
 }
 
 }  // namespace
