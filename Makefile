@@ -76,8 +76,11 @@ test: test-unit test-browser test-asan test-determinism
 
 # The glTF-Validator test (tests/interchange) runs Khronos' validator from
 # web/node_modules: the same one `npm ci` as the web build.
+# Third-party test data (MPEG-I Haptics schemas and reference-software files)
+# is read from $(TEXEL_THIRD_PARTY) when given (.ci/run sets it); the tests
+# that need it are skipped, saying so, without it.
 test-unit: build web/node_modules/.package-lock.json
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+	TEXEL_THIRD_PARTY="$(TEXEL_THIRD_PARTY)" ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 # End-to-end browser tests of Texel Studio: headless Debian chromium driven by
 # playwright-core against `texel studio` on loopback. Screenshots and the
@@ -92,7 +95,7 @@ test-asan: deps web/node_modules/.package-lock.json
 	@cmake --preset asan >/dev/null
 	@cmake --build build-asan -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp \
-	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 TEXEL_THIRD_PARTY="$(TEXEL_THIRD_PARTY)" \
 	  ctest --test-dir build-asan --output-on-failure -j $(JOBS) -LE slow
 
 test-determinism: build
@@ -113,7 +116,7 @@ bench: build web web-test
 # target for FUZZ_SECONDS of wall time, two at a time. Their seed corpora are
 # replayed by `make test` (ctest fuzz.*.replay) under any compiler.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := fuzz_document fuzz_npy fuzz_csv fuzz_serial fuzz_mat fuzz_wav fuzz_bitstream fuzz_experiment
+FUZZ_TARGETS := fuzz_document fuzz_npy fuzz_csv fuzz_serial fuzz_mat fuzz_wav fuzz_bitstream fuzz_experiment fuzz_hmpg
 
 fuzz: deps
 	@cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTEXEL_FUZZ=ON \

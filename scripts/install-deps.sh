@@ -21,10 +21,11 @@ packages=(
   # tests and benchmarks
   libgtest-dev librapidcheck-dev libbenchmark-dev
   # the Python package and the Python-side checks (pytest, the statistics
-  # oracle, the protocol schema, reading .mat v5/v7.3 files); pip, setuptools,
+  # oracle, the protocol schema and the MPEG-I Haptics schemas with RFC 3339
+  # date-time checking, reading .mat v5/v7.3 files); pip, setuptools,
   # wheel and venv build and install it as a Python package, offline
   # (python/README.md)
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-h5py
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-jsonschema python3-rfc3339 python3-h5py
   python3-pip python3-setuptools python3-wheel python3-venv
   # Texel Studio's browser tests
   chromium firefox-esr

@@ -57,8 +57,9 @@ struct ExportOptions {
   /// Largest |curve − rendered map| allowed at any grid sample, full scale
   /// (0 < tolerance ≤ 0.5) [1/512].
   double tolerance = default_tolerance;
-  /// The file's date (ISO 8601, YYYY-MM-DD). Empty: $SOURCE_DATE_EPOCH if
-  /// set (reproducible builds), else today (UTC).
+  /// The file's date: RFC 3339 (2026-11-26T14:06:29Z), or a day
+  /// (YYYY-MM-DD, written as its midnight UTC). Empty: $SOURCE_DATE_EPOCH if
+  /// set (reproducible builds), else now (UTC, whole seconds).
   std::string date;
 };
 
@@ -95,15 +96,37 @@ struct CurveEffect {
   std::vector<Keyframe> keyframes;  ///< strictly increasing positions, ≥ 1
 };
 
+/// One keyframe of a VectorialWave or Transient effect (temporal perceptions).
+struct WaveKeyframe {
+  std::int64_t position = 0;        ///< relative_position, ticks from the effect's position
+  std::optional<double> amplitude;  ///< amplitude_modulation
+  std::optional<double> frequency;  ///< frequency_modulation, Hz
+};
+
+/// A VectorialWave effect (a base signal whose amplitude and frequency are
+/// interpolated linearly between keyframes, its phase the integral of the
+/// frequency) or a Transient effect (each keyframe a burst of two sine
+/// periods over 22 ms), as the reference software evaluates them.
+struct WaveEffect {
+  enum class Kind { vectorial, transient };
+  Kind kind = Kind::vectorial;
+  std::int64_t position = 0;            ///< ticks
+  double phase = 0.0;                   ///< radians (VectorialWave)
+  std::string base_signal = "Sine";     ///< Sine, Square, Triangle, SawToothUp, SawToothDown
+  double gain = 1.0;                    ///< the channel's gain
+  std::vector<WaveKeyframe> keyframes;  ///< ascending positions
+};
+
 /// A perception this reader can sample.
 struct Perception {
   std::int64_t id = 0;
   std::string description;
   std::string modality;                             ///< as written, e.g. "Friction"
-  bool spatial = false;                             ///< Friction / Vibrotactile Texture (else temporal Vibrotactile)
+  bool spatial = false;                             ///< Friction / Vibrotactile Texture (else temporal Vibrotactile or Other)
   int unit_exponent = -3;                           ///< spatial unit = 10^unit_exponent m [−3 when absent, choice]
   double gain = 1.0;                                ///< product of the channel gains applied
   std::vector<CurveEffect> effects;                 ///< every Curve effect of every channel and band
+  std::vector<WaveEffect> waves;                    ///< VectorialWave and Transient effects (temporal perceptions only)
   std::optional<std::string> reference_device;      ///< first reference device's name
   std::optional<std::uint32_t> frequency_sampling;  ///< first channel's, if given
 };
@@ -140,9 +163,17 @@ Experience parse_hjif(std::string_view text, std::string_view origin = "hjif", c
 /// Reads and parses a .hjif file; a file over limits.max_bytes is refused before it is read.
 Experience load_hjif(const std::string& path, const ImportLimits& limits = {});
 
-/// Every rule of the format this reader checks, applied to a JSON text: the
-/// list of violations (empty: conformant). parse_hjif throws on the first.
+/// Conformance of a JSON text: every keyword of the published JSON schemas
+/// (date-time checked as RFC 3339), the field dependencies their
+/// descriptions state, and the reference software's loader rules
+/// (docs/interchange.md lists each). One line per violation, starting with
+/// the JSON path; empty: conformant. parse_hjif is more liberal (dates in
+/// other common forms, the reference software's rules not enforced).
 std::vector<std::string> conformance_errors(std::string_view text);
+
+/// The published JSON schemas alone (every keyword, date-time as RFC 3339):
+/// what a format-checking schema validator reports. A subset of conformance_errors.
+std::vector<std::string> schema_errors(std::string_view text);
 
 /// Value of the sampled perceptions at `positions_mm` (each perception's
 /// effects summed, times its gain; 0 where no effect has keyframes). Spatial
@@ -185,3 +216,43 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& options, C
 std::vector<std::byte> png_row16(std::span<const double> amplitudes);
 
 }  // namespace texel::gltf
+
+// --- binary MPEG-I Haptics stream (.hmpg) ---------------------------------------
+//
+// The MIHS units and packets of the public reference software's stream writer,
+// for the spatial data Texel writes (docs/interchange.md "Binary .hmpg" states
+// exactly which parts of the syntax are implemented). Amplitudes travel as
+// 8-bit codes over [−1, 1] (step 2/255), keyframe positions as 16 bits
+// relative to their effect (Texel splits longer effects), effect positions as
+// 25 bits; the description is at most 255 bytes (the carried Texel document
+// does not fit: a .hmpg gives the samples only).
+namespace texel::hmpg {
+
+/// Encodes a conformant .hjif text (hjif::conformance_errors empty) as .hmpg
+/// bytes. Throws InvalidArgument naming the field the binary syntax cannot
+/// carry (temporal perceptions, effect libraries, counts past their field
+/// widths).
+std::vector<std::byte> encode(std::string_view hjif_text);
+
+/// Decodes .hmpg bytes into .hjif text (the experience the stream carries;
+/// hjif::parse_hjif reads it). Throws FormatError (one line: `origin`, what,
+/// the byte offset) for truncated streams, codes outside the syntax, counts
+/// past what remains, and the parts of the syntax Texel does not read.
+std::string decode(std::span<const std::byte> bytes, std::string_view origin = "hmpg", const hjif::ImportLimits& limits = {});
+
+/// Reads a .hmpg file (refused past limits.max_bytes before it is read) and parses it as parse_hjif does.
+hjif::Experience load(const std::string& path, const hjif::ImportLimits& limits = {});
+
+/// Amplitude step of the binary syntax: 8-bit codes over [−1, 1].
+inline constexpr double amplitude_step = 2.0 / 255.0;
+
+struct Exported {
+  std::vector<std::byte> bytes;
+  hjif::ExportStats stats;  ///< max_error: measured after decoding, on the device grid
+};
+
+/// Exports a document as .hmpg: export_hjif, then encode; the error is
+/// measured on the decoded stream (≤ tolerance + amplitude_step / 2).
+Exported export_hmpg(const Document& doc, const hjif::ExportOptions& options = {});
+
+}  // namespace texel::hmpg

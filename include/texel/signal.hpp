@@ -45,12 +45,13 @@ enum class SignalFormat {
   document,    ///< .texel.json: rendered on its device (or on `device`)
   bitstream,   ///< .texel: decoded and rendered on `device`
   hjif,        ///< .hjif: MPEG-I Haptics curves sampled on a grid (texel/interchange.hpp); temporal ones need `swipe_speed`
+  hmpg,        ///< .hmpg: the binary MPEG-I Haptics stream, read as .hjif (spatial data; texel/interchange.hpp)
 };
 
-/// "device-map", "npy", "csv", "wav", "mat", "document", "bitstream", "hjif".
+/// "device-map", "npy", "csv", "wav", "mat", "document", "bitstream", "hjif", "hmpg".
 std::string_view to_string(SignalFormat format);
 /// The format a path's extension names (.bin .npy .csv .wav .mat .texel.json
-/// .json .texel .hjif); throws InvalidArgument naming the extension and the allowed ones.
+/// .json .texel .hjif .hmpg); throws InvalidArgument naming the extension and the allowed ones.
 SignalFormat signal_format_of(const std::string& path);
 
 /// What to do with a recording of more than one channel.

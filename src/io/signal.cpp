@@ -264,7 +264,8 @@ Signal render_document(Document doc, const SignalOptions& o, std::string_view or
 /// sampling rate at the swipe speed) from 0 to the last keyframe.
 Signal decode_hjif(std::string_view text, const SignalOptions& o, std::string_view origin) {
   if (o.region && !o.region->name.empty())
-    throw FieldError("region", "'" + o.region->name + "' is a name; a part of " + in_quotes(origin) + " is chosen as START:END in mm");
+    throw FieldError("region",
+                     "'" + o.region->name + "' is a name; a part of " + in_quotes(origin) + " is chosen as START:END in mm");
   hjif::ImportLimits limits;
   limits.max_keyframes = std::min<std::size_t>(limits.max_keyframes, o.max_samples);
   const hjif::Experience e = hjif::parse_hjif(text, origin, limits);
@@ -369,6 +370,7 @@ std::string_view to_string(SignalFormat f) {
     case SignalFormat::document: return "document";
     case SignalFormat::bitstream: return "bitstream";
     case SignalFormat::hjif: return "hjif";
+    case SignalFormat::hmpg: return "hmpg";
   }
   return "?";
 }
@@ -383,8 +385,10 @@ SignalFormat signal_format_of(const std::string& path) {
   if (ext == ".texel.json" || ext == ".json") return SignalFormat::document;
   if (ext == ".texel") return SignalFormat::bitstream;
   if (ext == ".hjif") return SignalFormat::hjif;
+  if (ext == ".hmpg") return SignalFormat::hmpg;
   throw InvalidArgument("input '" + path + "' has extension '" + ext +
-                        "'; allowed: .bin (device map), .npy, .csv (position or time), .wav, .mat, .texel.json, .texel, .hjif");
+                        "'; allowed: .bin (device map), .npy, .csv (position or time), .wav, .mat, .texel.json, .texel, .hjif, "
+                        ".hmpg");
 }
 
 Recording decode_recording(std::span<const std::byte> bytes, const SignalOptions& o, std::string_view origin) {
@@ -432,6 +436,12 @@ Signal decode_signal(std::span<const std::byte> bytes, SignalFormat format, cons
       break;
     }
     case SignalFormat::hjif: s = decode_hjif(text, o, origin); break;
+    case SignalFormat::hmpg: {
+      hjif::ImportLimits limits;
+      limits.max_keyframes = std::min<std::size_t>(limits.max_keyframes, o.max_samples);
+      s = decode_hjif(hmpg::decode(bytes, origin, limits), o, origin);
+      break;
+    }
     case SignalFormat::mat:
       throw InvalidArgument(in_quotes(origin) + ": .mat maps are read from files only (libmatio opens by name)");
     case SignalFormat::bitstream:
@@ -474,10 +484,10 @@ Signal load_signal(const std::string& path, const SignalOptions& o) {
   // CSV row rarely takes more than 64.
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
-  const std::uintmax_t limit = format == SignalFormat::csv        ? o.max_samples * 64 + 4096
-                               : format == SignalFormat::document ? std::uintmax_t{64} << 20
-                               : format == SignalFormat::hjif     ? std::uintmax_t{256} << 20
-                                                                  : o.max_samples * 8 + 65536;
+  const std::uintmax_t limit = format == SignalFormat::csv                                    ? o.max_samples * 64 + 4096
+                               : format == SignalFormat::document                             ? std::uintmax_t{64} << 20
+                               : format == SignalFormat::hjif || format == SignalFormat::hmpg ? std::uintmax_t{256} << 20
+                                                                                              : o.max_samples * 8 + 65536;
   if (!ec && size > limit)
     throw FieldError("max_samples", "is " + std::to_string(o.max_samples) + "; " + in_quotes(path) + " has " +
                                         std::to_string(size) + " bytes, more than that many samples can take");

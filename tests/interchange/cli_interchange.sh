@@ -25,7 +25,7 @@ run "$texel" spectrum a.hjif --json
 # Export options; a bitstream as input; glTF with its .hjif beside it.
 run "$texel" export a.texel.json -o v.hjif --modality vibrotactile-texture --tolerance 0.01 --date 2026-01-02
 grep -q '"perception_modality":"Vibrotactile Texture"' v.hjif || fail "modality not written"
-grep -q '"date":"2026-01-02"' v.hjif || fail "date not written"
+grep -q '"date":"2026-01-02T00:00:00Z"' v.hjif || fail "date not written"
 run "$texel" export b.texel --device tpad -o fromstream.hjif
 run "$texel" export a.texel.json -o scene.gltf
 [ -s scene.gltf ] && [ -s scene.hjif ] || fail "glTF export did not write scene.gltf and scene.hjif"
@@ -51,4 +51,39 @@ bad deep.hjif "$(printf '[%.0s' $(seq 1 500))"
 grep -q -- "--tolerance" err.txt || fail "the error does not name --tolerance"
 "$texel" export a.texel.json -o bad.txt >/dev/null 2>err.txt
 [ $? -eq 2 ] || fail "output extension .txt accepted"
+
+# No silent overwrite: the .hjif beside a glTF asset is replaced only with --force.
+cp scene2.hjif keep.hjif
+"$texel" export a.texel.json -o scene2.glb >/dev/null 2>err.txt
+[ $? -eq 2 ] || fail "GLB export replaced an existing scene2.hjif without --force"
+[ "$(wc -l < err.txt)" -eq 1 ] && grep -q -- "--force" err.txt || fail "the refusal is not one line naming --force"
+cmp -s scene2.hjif keep.hjif || fail "scene2.hjif changed although the export was refused"
+run "$texel" export a.texel.json -o scene2.glb --force
+
+# Binary .hmpg: written, read wherever .hjif is (spectrum), and bit-exact through Texel.
+run "$texel" export a.texel.json -o a.hmpg --json
+run "$texel" spectrum a.hmpg --json
+run "$texel" encode a.hmpg --estimate -o fromhmpg.texel
+# Malformed .hmpg: exit 2, one line, nothing written.
+badbin() {
+  local name=$1
+  "$texel" spectrum "$name" --json >/dev/null 2>err.txt
+  local rc=$?
+  [ $rc -eq 2 ] || fail "$name: exit status $rc, expected 2"
+  [ "$(wc -l < err.txt)" -eq 1 ] || { cat err.txt >&2; fail "$name: not one line"; }
+}
+head -c 100 a.hmpg > truncated.hmpg; badbin truncated.hmpg
+printf '\377\377\377\377\377\377\377\377\377\377\377\377' > codes.hmpg; badbin codes.hmpg
+# A unit declaring 2^32-1 bytes.
+printf '\000\000\000\000\017\377\377\377\360' > huge.hmpg; badbin huge.hmpg
+: > empty.hmpg; badbin empty.hmpg
+
+# The reference software's files (third-party, through TEXEL_THIRD_PARTY; skipped visibly without it).
+if [ -n "${TEXEL_THIRD_PARTY:-}" ] && [ -d "$TEXEL_THIRD_PARTY/mpeg-haptics-rm-outputs" ]; then
+  rm_dir="$TEXEL_THIRD_PARTY/mpeg-haptics-rm-outputs"
+  for f in texel-fine-seed7-id1.hjif rm-reencoded.hjif rm-binary.hmpg; do run "$texel" spectrum "$rm_dir/$f" --json; done
+  run "$texel" spectrum "$rm_dir/rm-from-ahap.hjif" --swipe-speed 100 --json
+else
+  echo "SKIPPED: the reference software's files (set TEXEL_THIRD_PARTY to the third-party folder)"
+fi
 echo "interchange CLI checks passed"

@@ -25,7 +25,8 @@ DOC
 assets=()
 for doc in a halves; do
   for ext in gltf glb; do
-    "$texel" export $doc.texel.json -o $doc-friction.$ext >/dev/null || fail "export $doc .$ext"
+    # .gltf and .glb of one stem share the .hjif beside them: the second replaces it (--force).
+    "$texel" export $doc.texel.json -o $doc-friction.$ext --force >/dev/null || fail "export $doc .$ext"
     assets+=("$doc-friction.$ext")
   done
 done
