@@ -12,7 +12,6 @@
 #include <chrono>
 #include <thread>
 
-#include <nlohmann/json.hpp>
 
 #include "common.hpp"
 #include "texel/error.hpp"
@@ -70,7 +69,7 @@ class PySession {
   void close() { active_.reset(); }
   [[nodiscard]] bool closed() const { return !active_; }
 
-  py::object question() { return from_json(active().session.question().to_json().dump()); }
+  py::object question() { return from_json(active().session.question().to_json()); }
 
   Document stimulus(std::size_t i) {
     const Question& q = active().session.question();
@@ -90,12 +89,12 @@ class PySession {
   py::object simulated_response() {
     ActiveSession& a = active();
     if (a.simulate.empty()) throw InvalidArgument("simulated_response: the session was opened without simulate=");
-    return from_json(simulated_participant(a).respond(a.session).to_json().dump());
+    return from_json(simulated_participant(a).respond(a.session).to_json());
   }
 
   py::dict record(const py::object& response) {
     ActiveSession& a = active();
-    Response r = Response::from_json(nlohmann::json::parse(to_json(response)));
+    Response r = Response::from_json(to_json(response));
     if (r.answered_at.empty()) r.answered_at = utc_timestamp();
     if (r.shown_at.empty()) r.shown_at = shown_at_.empty() ? r.answered_at : shown_at_;
     const StoredTrial t = experiment::record(store_->get(), a, r);  // committed before it returns
