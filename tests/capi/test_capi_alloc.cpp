@@ -15,51 +15,15 @@
 
 #include "texel.h"
 
-// The replacements below pair malloc with free on purpose.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#include "../support/alloc_counter.hpp"  // the one counting allocator (defines operator new/delete)
 
 namespace {
-thread_local bool counting = false;
-thread_local bool fail_allocations = false;
-std::atomic<std::uint64_t> counted_allocations{0};
-std::atomic<std::uint64_t> counted_frees{0};
+using texel::test_support::alloc::counted_allocations;
+using texel::test_support::alloc::counted_frees;
+using texel::test_support::alloc::counting;
+// This thread's allocations throw std::bad_alloc while it is set.
+using texel::test_support::alloc::fail;
 }  // namespace
-
-void* operator new(std::size_t n) {
-  if (fail_allocations) throw std::bad_alloc();
-  if (counting) counted_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return operator new(n);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return operator new(n, std::nothrow); }
-void operator delete(void* p) noexcept {
-  if (p && counting) counted_frees.fetch_add(1, std::memory_order_relaxed);
-  std::free(p);
-}
-void operator delete[](void* p) noexcept { operator delete(p); }
-void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
-void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
-// Over-aligned types (the player's queues are cache-line aligned).
-void* operator new(std::size_t n, std::align_val_t a) {
-  if (fail_allocations) throw std::bad_alloc();
-  if (counting) counted_allocations.fetch_add(1, std::memory_order_relaxed);
-  const auto align = static_cast<std::size_t>(a);
-  if (void* p = std::aligned_alloc(align, (n + align - 1) / align * align)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n, std::align_val_t a) { return operator new(n, a); }
-void operator delete(void* p, std::align_val_t) noexcept { operator delete(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { operator delete(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { operator delete(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { operator delete(p); }
 
 namespace {
 
@@ -125,10 +89,10 @@ TEST(CApiAlloc, OutOfMemoryIsAStatus) {
   texel_player_config config = texel_player_config_default();
   texel_status a, b;
   {
-    fail_allocations = true;
+    fail = true;
     a = texel_surface_from_params("tpad", &params, &surface);
     b = texel_player_create(&config, &player);
-    fail_allocations = false;
+    fail = false;
   }
   EXPECT_EQ(a, TEXEL_OUT_OF_MEMORY);
   EXPECT_EQ(b, TEXEL_OUT_OF_MEMORY);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/expect.hpp"
 #include "texel/bitstream.hpp"
 #include "texel/codec.hpp"
 #include "texel/error.hpp"
@@ -42,12 +43,7 @@ std::vector<std::byte> bytes_of(std::initializer_list<unsigned> octets) {
 }
 
 std::string message_of(const std::vector<std::byte>& bytes) {
-  try {
-    (void)parse_bitstream(bytes);
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "";
+  return texel::test_support::message_of<FormatError>([&] { (void)parse_bitstream(bytes); });
 }
 
 TEST(Bitstream, FineOnlyFitsIn16Bytes) {
