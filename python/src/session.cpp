@@ -12,7 +12,6 @@
 #include <chrono>
 #include <thread>
 
-
 #include "common.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/presenter.hpp"
