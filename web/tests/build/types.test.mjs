@@ -55,13 +55,13 @@ test('a request key renamed in the schema fails the build', () => {
 });
 
 test('a reply field dropped from the schema fails the build', () => {
-  // The designer shows the match reply's model_distance.
+  // The designer shows the match reply's distance_jnd.
   const r = check((s) => {
-    delete s.$defs.MatchReply.properties.model_distance;
-    s.$defs.MatchReply.required = s.$defs.MatchReply.required.filter((k) => k !== 'model_distance');
+    delete s.$defs.MatchReply.properties.distance_jnd;
+    s.$defs.MatchReply.required = s.$defs.MatchReply.required.filter((k) => k !== 'distance_jnd');
   });
-  assert.ok(!r.ok, 'tsc passed although the schema dropped match.model_distance');
-  assert.match(r.out, /src\/designer\.ts.*model_distance/);
+  assert.ok(!r.ok, 'tsc passed although the schema dropped match.distance_jnd');
+  assert.match(r.out, /src\/designer\.ts.*distance_jnd/);
 });
 
 test('a message type dropped from the schema fails the build', () => {
