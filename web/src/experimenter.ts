@@ -178,7 +178,7 @@ export function mountExperimenter(root: HTMLElement): void {
         'section',
         { 'aria-label': 'Sessions' },
         h('h2', {}, 'Sessions'),
-        h('table', { class: 'sessions', 'data-testid': 'sessions' }, h('thead', {}, h('tr', {}, ...['#', 'Participant', 'Protocol', 'Trials', 'State', ''].map((c) => h('th', { scope: 'col' }, c)))), sessionsBody),
+        h('table', { class: 'sessions', 'data-testid': 'sessions' }, h('thead', {}, h('tr', {}, ...['#', 'Participant', 'Protocol', 'Trials', 'State', 'Actions'].map((c) => h('th', { scope: 'col' }, c)))), sessionsBody),
       ),
       status,
     ),

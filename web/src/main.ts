@@ -21,11 +21,18 @@ function route(): void {
   const root = document.createElement('div');
   root.className = `page page-${page}`;
   root.dataset.page = page;
-  main.replaceChildren(root);
+  // Every page has one level-one heading naming it (for screen readers'
+  // heading lists; visually the navigation says where one is). Participants
+  // see the study, not the studio's page names.
+  const title = page === 'participant' ? 'Study' : `${page[0].toUpperCase()}${page.slice(1)}`;
+  const h1 = document.createElement('h1');
+  h1.className = 'visually-hidden';
+  h1.textContent = title;
+  main.replaceChildren(h1, root);
   document.body.dataset.page = page;
   for (const a of document.querySelectorAll<HTMLAnchorElement>('nav a'))
     a.setAttribute('aria-current', a.dataset.route === page ? 'page' : 'false');
-  document.title = `Texel Studio – ${page[0].toUpperCase()}${page.slice(1)}`;
+  document.title = page === 'participant' ? 'Study' : `Texel Studio – ${title}`;
   routes[page](root);
 }
 
