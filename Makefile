@@ -43,14 +43,14 @@ web: $(WEB_OUT)/index.html
 web/node_modules/.package-lock.json: web/package-lock.json | deps
 	cd web && npm ci --no-audit --no-fund --loglevel=error
 
-$(WEB_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json
+$(WEB_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json docs/schema/texel-protocol.schema.json
 	cd web && TEXEL_WEB_OUT=$(CURDIR)/$(WEB_OUT) npm run --silent build
 
 # The test build: the same front end plus the browser tests' hooks
 # (window.__texelStats); only the browser tests and the latency bench serve it.
 WEB_TEST_OUT := $(BUILD)/web-test
 web-test: $(WEB_TEST_OUT)/index.html
-$(WEB_TEST_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json
+$(WEB_TEST_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json docs/schema/texel-protocol.schema.json
 	cd web && TEXEL_WEB_OUT=$(CURDIR)/$(WEB_TEST_OUT) npm run --silent build:test
 
 # The studies (issue #8): a simulated cohort of 8 participants through every

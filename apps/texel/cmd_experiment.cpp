@@ -20,6 +20,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
+#include "texel/experiment/export_mat.hpp"
 #include "texel/experiment/presenter.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/records.hpp"
@@ -218,33 +219,6 @@ void status(const std::string& db, bool as_json, const std::optional<std::string
   }
 }
 
-/// The export as MATLAB variables (docs/format.md "MATLAB .mat"): a 1×1
-/// struct `trials` with one N×1 field per TrialRow column, in CSV order
-/// (struct2table(trials) gives a table). Values go through the one CSV
-/// serializer, so the .mat and the .csv cannot disagree: text fields (and
-/// any column that is not all numbers) become N×1 cell arrays of char,
-/// the others doubles with NaN for missing (MATLAB's missing).
-std::vector<texel::mat::Variable> trials_variables(const std::vector<ex::TrialRow>& rows) {
-  static const std::vector<std::string> text = {"participant", "protocol",       "study",     "block",
-                                                "task",        "condition",      "reference", "variable",
-                                                "response",    "correct_answer", "shown_at",  "answered_at"};
-  const ex::Table table = ex::parse_csv_table(ex::trials_csv(rows), "export");
-  texel::mat::Struct trials;
-  for (const auto& name : table.columns) {
-    const bool is_text = std::find(text.begin(), text.end(), name) != text.end();
-    std::optional<std::vector<double>> numbers;
-    if (!is_text) try {
-        numbers = table.numbers(name);
-      } catch (const texel::FormatError&) {
-      }
-    if (numbers)
-      trials.add(name, texel::mat::Matrix::column(std::move(*numbers)));
-    else
-      trials.add(name, texel::mat::StringColumn{table.strings(name)});
-  }
-  return {{"trials", std::move(trials)}};
-}
-
 }  // namespace
 
 void register_experiment(CLI::App& app) {
@@ -345,7 +319,7 @@ void register_experiment(CLI::App& app) {
     if (e->session) (void)store.session(*e->session);
     const auto rows = store.rows(e->session);
     if (ext == ".mat")
-      texel::mat::write_mat(e->output, trials_variables(rows), {.version = mat_version});  // atomic
+      texel::mat::write_mat(e->output, ex::trials_mat_variables(rows), {.version = mat_version});  // atomic
     else
       write_file_atomic(e->output, ex::trials_csv(rows));
     std::cerr << "wrote " << rows.size() << " trials to " << e->output << "\n";

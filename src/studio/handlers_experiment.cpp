@@ -1,11 +1,19 @@
 // Experiment messages (FIFO lane, one session at a time): thin calls into the
 // experiment engine's step-wise API (experiment/runner.hpp) and its store;
 // every rule of a study lives there.
+#include <stdlib.h>
+
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
+#include "base64.hpp"
 #include "messages.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/analysis.hpp"
+#include "texel/experiment/export_mat.hpp"
+#include "texel/matfile.hpp"
 
 namespace texel::studio::detail {
 
@@ -94,8 +102,8 @@ std::optional<ex::Protocol> chosen_protocol(const State& s, const json& p) {
     for (auto& sh : shipped_protocols(s))
       if (sh.protocol.name == p.get_ref<const std::string&>()) found = std::move(sh.protocol);
     if (found) return found;
-    throw Reject{"not_found", "experiment.start: protocol " + clipped(p.get<std::string>()) +
-                                  " is not a shipped protocol (see experiment.list)"};
+    throw Reject{"not_found",
+                 "experiment.start: protocol " + clipped(p.get<std::string>()) + " is not one of the studio's protocols"};
   }
   if (p.is_object()) {
     if (p.contains("device") && p["device"].is_string())
@@ -103,6 +111,45 @@ std::optional<ex::Protocol> chosen_protocol(const State& s, const json& p) {
     return ex::parse_protocol(p.dump(), "protocol");
   }
   throw Reject{"bad_message", std::string("experiment.start: protocol must be a name or an object, got ") + p.type_name()};
+}
+
+// A scratch folder removed with everything in it when the scope ends.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    std::string t = (std::filesystem::temp_directory_path() / "texel-studio-XXXXXX").string();
+    if (!mkdtemp(t.data())) throw IoError("cannot create a temporary folder for the export");
+    path = t;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
+std::string read_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  if (!in && !in.eof()) throw IoError(p.filename().string() + ": cannot read the exported file");
+  return os.str();
+}
+
+ojson file_json(const std::string& name, const char* mime, const std::string& data) {
+  return ojson{{"name", name}, {"mime", mime}, {"bytes", data.size()}, {"data_base64", base64_encode(data)}};
+}
+
+std::optional<std::int64_t> session_field(State& s, const Fields& f, const std::string& type, bool required) {
+  if (!required && !f.has("session")) return std::nullopt;
+  const std::int64_t id = f.integer("session", 1, std::int64_t{1} << 52);
+  try {
+    (void)the_store(s).session(id);
+  } catch (const InvalidArgument&) {
+    throw Reject{"not_found", type + ": there is no session " + std::to_string(id)};
+  }
+  return id;
 }
 
 }  // namespace
@@ -135,14 +182,14 @@ void on_experiment_start(State& s, Client& c, const Job& job) {
     if (s.active->info.participant != o.participant || s.active->info.protocol != protocol->name || !o.resume)
       throw Reject{"conflict", "experiment.start: session " + std::to_string(s.active->info.id) + " (participant " +
                                    s.active->info.participant + ", " + s.active->info.protocol +
-                                   ") is running; stop it first (experiment.stop)"};
+                                   ") is running; suspend it first"};
   } else {
     s.active.reset();
     ex::Store& st = the_store(s);
     const bool unfinished = st.unfinished_session(o.participant, protocol->name).has_value();
     if (unfinished && !o.resume)
       throw Reject{"conflict", "experiment.start: participant " + clipped(o.participant) + " has an unfinished " +
-                                   protocol->name + " session; resume it (resume: true)"};
+                                   protocol->name + " session; resume it instead of starting a new one"};
     if (!unfinished && o.resume)
       throw Reject{"not_found", "experiment.start: participant " + clipped(o.participant) + " has no unfinished " +
                                     protocol->name + " session to resume"};
@@ -224,6 +271,80 @@ void on_experiment_stop(State& s, Client& c, const Job& job) {
   s.active.reset();
   new_trial(s);
   send(c, reply("experiment.idle", job.id));
+}
+
+}  // namespace texel::studio::detail
+
+// ------------------------------------------------------- experimenter side
+
+namespace texel::studio::detail {
+
+void on_experiment_trials(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const std::int64_t id = *session_field(s, f, job.type, true);
+  ojson r = reply("experiment.trials", job.id);
+  r["session"] = ojson::parse(ex::to_json(the_store(s).session(id)));
+  r["rows"] = ojson::array();
+  for (const auto& row : the_store(s).rows(id)) r["rows"].push_back(ojson::parse(ex::row_json(row)));
+  send(c, r);
+}
+
+void on_experiment_export(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const std::string as = f.string("as", 16);
+  const std::optional<std::int64_t> session = session_field(s, f, job.type, false);
+  const auto rows = the_store(s).rows(session);
+  const std::string stem = session ? "session-" + std::to_string(*session) : "trials";
+  ojson r = reply("experiment.exported", job.id);
+  r["as"] = as;
+  r["trials"] = rows.size();
+  r["files"] = ojson::array();
+  if (as == "csv") {
+    r["files"].push_back(file_json(stem + ".csv", "text/csv", ex::trials_csv(rows)));
+  } else if (as == "mat") {
+    const TempDir dir;
+    const auto path = dir.path / (stem + ".mat");
+    texel::mat::write_mat(path.string(), ex::trials_mat_variables(rows));
+    r["files"].push_back(file_json(path.filename().string(), "application/x-matlab-data", read_bytes(path)));
+  } else if (as == "figures") {
+    if (rows.empty()) throw Reject{"invalid", "experiment.export: there are no answered trials to draw"};
+    const TempDir dir;
+    ex::AnalysisOptions o;
+    o.out_dir = dir.path.string();
+    o.format = "png";
+    const ex::AnalysisReport report = ex::analyze(rows, o);
+    for (const auto& fig : report.figures) {
+      const std::filesystem::path p(fig);
+      r["files"].push_back(file_json(p.filename().string(), "image/png", read_bytes(p)));
+    }
+    r["summary"] = report.text;
+  } else {
+    throw Reject{"invalid", "experiment.export: as is " + clipped(as) + "; allowed: csv, mat, figures"};
+  }
+  send(c, r);
+}
+
+void on_experiment_protocol(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const std::string name = f.string("name", max_name_chars);
+  std::optional<std::string> file;  // the last file of that name, as the list shows them
+  for (const auto& sh : shipped_protocols(s))
+    if (sh.protocol.name == name) file = sh.file;
+  if (!file) throw Reject{"not_found", "experiment.protocol: " + clipped(name) + " is not one of the studio's protocols"};
+  ojson r = reply("experiment.protocol", job.id);
+  r["file"] = *file;
+  r["protocol"] = ojson::parse(read_bytes(std::filesystem::path(s.options.protocols_dir) / *file));
+  send(c, r);
+}
+
+void on_experiment_validate(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const std::optional<ex::Protocol> p = chosen_protocol(s, f.object("protocol"));
+  ojson r = reply("experiment.validated", job.id);
+  r["name"] = p->name;
+  r["study"] = p->study;
+  r["trials_planned"] = p->planned_trials();
+  send(c, r);
 }
 
 }  // namespace texel::studio::detail

@@ -14,7 +14,7 @@ namespace texel::studio::detail {
 namespace {
 
 // The order is the one error messages list ("unknown message type …; allowed: …").
-const std::array<MessageSpec, 15> table{{
+const std::array<MessageSpec, 19> table{{
     {"hello", Lane::now, {}, on_hello},
     {"design", Lane::design, {"document", "region", "bins"}, on_design},
     {"match", Lane::fifo, {"document", "region", "into"}, on_match},
@@ -30,6 +30,10 @@ const std::array<MessageSpec, 15> table{{
     {"experiment.preview", Lane::fifo, {"trial", "slider_p", "slider_i"}, on_experiment_preview},
     {"experiment.answer", Lane::fifo, {"trial", "response", "simulated"}, on_experiment_answer},
     {"experiment.stop", Lane::fifo, {}, on_experiment_stop},
+    {"experiment.trials", Lane::fifo, {"session"}, on_experiment_trials},
+    {"experiment.export", Lane::fifo, {"as", "session"}, on_experiment_export},
+    {"experiment.protocol", Lane::fifo, {"name"}, on_experiment_protocol},
+    {"experiment.validate", Lane::fifo, {"protocol"}, on_experiment_validate},
 }};
 
 std::string num(double v) {

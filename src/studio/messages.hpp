@@ -170,5 +170,9 @@ void on_experiment_select(State&, Client&, const Job&);
 void on_experiment_preview(State&, Client&, const Job&);
 void on_experiment_answer(State&, Client&, const Job&);
 void on_experiment_stop(State&, Client&, const Job&);
+void on_experiment_trials(State&, Client&, const Job&);
+void on_experiment_export(State&, Client&, const Job&);
+void on_experiment_protocol(State&, Client&, const Job&);
+void on_experiment_validate(State&, Client&, const Job&);
 
 }  // namespace texel::studio::detail

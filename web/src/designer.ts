@@ -4,6 +4,7 @@
 
 import { studio, StudioError } from './ws';
 import { h, decodeF32, download, base64ToBytes, bytesToBase64, fmt, stats, checksum } from './util';
+import { stimulusSaver } from './stimuli';
 import { MapPlot, HistogramPlot, SpectrumPlot } from './plots';
 import { FeelStrip } from './feel';
 import { hearIt } from './audio';
@@ -568,7 +569,8 @@ export function mountDesigner(root: HTMLElement): void {
         h('button', { type: 'button', onclick: () => void exportAs('document'), 'data-testid': 'export-document' }, 'Export .texel.json'),
         h('button', { type: 'button', onclick: () => void exportAs('bitstream'), 'data-testid': 'export-bitstream' }, 'Export .texel'),
         h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin')),
-      h('p', { class: 'hint' }, 'Or drop a file anywhere on the page.')),
+      h('p', { class: 'hint' }, 'Or drop a file anywhere on the page.'),
+      stimulusSaver(() => buildDocument(store.get()))),
   );
 
   const summary = h('div', { class: 'summary' }, h('div', { class: 'size' }, h('span', { class: 'label' }, 'Encoded size'), bytesEl), h('div', { class: 'meta' }, texelsEl, ' · ', elapsedEl), hexEl);
