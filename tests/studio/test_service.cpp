@@ -18,6 +18,7 @@
 #include "../support/temp_dir.hpp"
 #include "base64.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/records.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/studio/service.hpp"
@@ -520,4 +521,84 @@ TEST(Service, ManyThreadsAtOnce) {
       if (t % 2) s.disconnect(c.id);
     });
   for (auto& th : threads) th.join();
+}
+
+// The experimenter view's messages: a session's trials (staircase values,
+// reversals, correctness, times), the exports the library writes (CSV, .mat,
+// analysis figures), a shipped protocol as a template, and the engine's own
+// validation of an edited one; refusals in plain words.
+TEST(Service, ExperimenterTrialsExportsAndProtocols) {
+  texel::test_support::TempDir dir("studio");
+  Service s(options(dir.at("db")));
+  Client c(s);
+  ASSERT_EQ(c.ask({{"type", "experiment.start"},
+                   {"protocol", "texel-length"},
+                   {"participant", "X1"},
+                   {"simulate", "threshold=6mm"}})["type"],
+            "experiment.started");
+  for (int t = 0; t < 12; ++t)
+    ASSERT_EQ(c.ask({{"type", "experiment.answer"}, {"trial", t}, {"simulated", true}}, 60s)["type"], "experiment.question");
+
+  const json tr = c.ask({{"type", "experiment.trials"}, {"session", 1}});
+  ASSERT_EQ(tr["type"], "experiment.trials") << tr.dump();
+  EXPECT_EQ(tr["session"]["participant"], "X1");
+  ASSERT_EQ(tr["rows"].size(), 12u);
+  EXPECT_EQ(tr["rows"][0]["variable"], "texel_length_mm");
+  EXPECT_EQ(std::stod(tr["rows"][0]["intensity"].get<std::string>()), 26.0);
+  EXPECT_TRUE(tr["rows"][11]["correct"] == "1" || tr["rows"][11]["correct"] == "0") << tr["rows"][11].dump();
+  EXPECT_FALSE(tr["rows"][11]["answered_at"].get<std::string>().empty());
+  expect_error(c.ask({{"type", "experiment.trials"}, {"session", 99}}), "not_found");
+  expect_error(c.ask({{"type", "experiment.trials"}}), "bad_message");
+
+  // Exports: the same bytes the CLI writes for CSV; a MATLAB v5 file; PNG figures.
+  const json csv = c.ask({{"type", "experiment.export"}, {"as", "csv"}, {"session", 1}});
+  ASSERT_EQ(csv["type"], "experiment.exported") << csv.dump();
+  EXPECT_EQ(csv["trials"], 12);
+  ASSERT_EQ(csv["files"].size(), 1u);
+  EXPECT_EQ(csv["files"][0]["name"], "session-1.csv");
+  const auto csv_bytes = texel::studio::detail::base64_decode(csv["files"][0]["data_base64"].get<std::string>());
+  ASSERT_TRUE(csv_bytes);
+  ex::Store store = ex::Store::open(dir.at("db"), ex::StoreMode::read_only);
+  EXPECT_EQ(std::string(csv_bytes->begin(), csv_bytes->end()), ex::trials_csv(store.rows(1)));
+  const json mat = c.ask({{"type", "experiment.export"}, {"as", "mat"}});
+  ASSERT_EQ(mat["type"], "experiment.exported") << mat.dump().substr(0, 300);
+  const auto mat_bytes = texel::studio::detail::base64_decode(mat["files"][0]["data_base64"].get<std::string>());
+  ASSERT_TRUE(mat_bytes && mat_bytes->size() > 128);
+  EXPECT_EQ(std::string(mat_bytes->begin(), mat_bytes->begin() + 10), "MATLAB 5.0");
+  const json figs = c.ask({{"type", "experiment.export"}, {"as", "figures"}}, 120s);
+  ASSERT_EQ(figs["type"], "experiment.exported") << figs.dump().substr(0, 300);
+  ASSERT_GE(figs["files"].size(), 1u);
+  for (const auto& f : figs["files"]) {
+    EXPECT_EQ(f["mime"], "image/png");
+    const auto png = texel::studio::detail::base64_decode(f["data_base64"].get<std::string>());
+    ASSERT_TRUE(png && png->size() > 8);
+    EXPECT_EQ(std::string(png->begin() + 1, png->begin() + 4), "PNG") << f["name"];
+  }
+  EXPECT_FALSE(figs["summary"].get<std::string>().empty());
+  expect_error(c.ask({{"type", "experiment.export"}, {"as", "xlsx"}}), "invalid");
+  expect_error(c.ask({{"type", "experiment.export"}, {"as", "csv"}, {"session", 7}}), "not_found");
+
+  // A template, edited, validated by the engine; refusals name the field.
+  const json tpl = c.ask({{"type", "experiment.protocol"}, {"name", "texel-length"}});
+  ASSERT_EQ(tpl["type"], "experiment.protocol") << tpl.dump();
+  EXPECT_EQ(tpl["file"], "texel-length.json");
+  json p = tpl["protocol"];
+  p["name"] = "texel-length-lab";
+  const json ok = c.ask({{"type", "experiment.validate"}, {"protocol", p}});
+  EXPECT_EQ(ok["type"], "experiment.validated") << ok.dump();
+  EXPECT_EQ(ok["name"], "texel-length-lab");
+  p["blocks"][0]["time_limit_s"] = -3;
+  const json bad = c.ask({{"type", "experiment.validate"}, {"protocol", p}});
+  expect_error(bad, "invalid");
+  EXPECT_NE(bad["message"].get<std::string>().find("blocks[0].time_limit_s"), std::string::npos) << bad.dump();
+  expect_error(c.ask({{"type", "experiment.protocol"}, {"name", "nope"}}), "not_found");
+
+  // Plain words: no message names or keys in what the experimenter reads.
+  const json busy = c.ask({{"type", "experiment.start"}, {"protocol", "quantization"}, {"participant", "X2"}});
+  expect_error(busy, "conflict");
+  EXPECT_EQ(busy["message"].get<std::string>().find("(experiment.stop)"), std::string::npos) << busy.dump();
+  c.ask({{"type", "experiment.stop"}});
+  const json again = c.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "X1"}});
+  expect_error(again, "conflict");
+  EXPECT_EQ(again["message"].get<std::string>().find("resume: true"), std::string::npos) << again.dump();
 }
