@@ -3,7 +3,9 @@
 // running session, with the session table), and every participant screen
 // state the shipped protocols reach: idle ("please wait"), the first question
 // of each task kind (oddity, practice oddity, two-alternative, match, guided,
-// rating, same-different in both of its phases) and finished. Each page is
+// rating, same-different in both of its phases) and finished; the
+// experimenter view also with a session's staircase track, the exported
+// figures and the protocol editor open. Each page is
 // its own subtest: 0 critical and 0 serious findings. Every finding (any
 // impact) is printed by page, so a failure names the rule and the element.
 import { test } from 'node:test';
@@ -11,7 +13,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths } from './studio.mjs';
+import { withStudio, screenshot, paths, startStudio, launchFirefox } from './studio.mjs';
 
 const axeSource = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
 
@@ -33,10 +35,10 @@ async function audit(page) {
 }
 
 const findings = new Map();
-async function check(page, label) {
+async function check(page, label, shot = true) {
   const v = await audit(page);
   findings.set(label, v);
-  await screenshot(page, `a11y-${label}`);
+  if (shot) await screenshot(page, `a11y-${label}`);
   const lines = v.map((f) => `  [${f.impact}] ${f.id} (${f.count}): ${f.help} — ${f.nodes.join(', ')}`);
   console.log(`axe ${label}: ${v.length ? `${v.length} rule(s)\n${lines.join('\n')}` : 'no findings'}`);
   return v;
@@ -144,6 +146,28 @@ test('axe-core: no critical or serious finding on any page', { timeout: 600_000 
     await page.waitForFunction(() => /A11Y-run/.test(document.querySelector('[data-testid=active-session]')?.textContent ?? ''), null, { timeout: 30_000 });
     await audited(page, 'experimenter-running');
 
+    // …with the followed session's track and trials, exports and the protocol editor open.
+    await page.evaluate(async () => {
+      const ws = new WebSocket(`ws://${location.host}/ws`);
+      await new Promise((r) => (ws.onopen = r));
+      const call = (msg) =>
+        new Promise((res) => {
+          ws.onmessage = (e) => res(JSON.parse(e.data));
+          ws.send(JSON.stringify({ id: 1, ...msg }));
+        });
+      await call({ type: 'experiment.stop' });
+      await call({ type: 'experiment.start', protocol: 'texel-length', participant: 'A11Y-sim', simulate: 'threshold=6mm' });
+      for (let t = 0; t < 8; t++) await call({ type: 'experiment.answer', trial: t, simulated: true });
+      ws.close();
+    });
+    await page.waitForSelector('[data-testid=staircase-plot] canvas', { timeout: 30_000 });
+    await page.click('[data-testid=export-figures]');
+    await page.waitForSelector('[data-testid=exports] figure img', { timeout: 120_000 });
+    await page.selectOption('#template', 'working-memory');
+    await page.click('[data-testid=load-template]');
+    await page.waitForSelector('[data-testid=protocol-block]');
+    await audited(page, 'experimenter-track-exports-editor');
+
     for (const [label, v] of pages)
       await t.test(label, () => {
         assert.deepEqual(
@@ -153,4 +177,42 @@ test('axe-core: no critical or serious finding on any page', { timeout: 600_000 
         );
       });
   });
+});
+
+// The same audit in Firefox ESR (puppeteer-core over WebDriver BiDi) on the
+// designer, the experimenter view and a participant question and idle screen.
+test('axe-core in Firefox ESR: no critical or serious finding', { timeout: 300_000 }, async (t) => {
+  const studio = await startStudio({ hardTimeoutMs: 330_000 });
+  let ff;
+  const pages = [];
+  try {
+    ff = await launchFirefox({ hardTimeoutMs: 330_000 });
+    const page = await ff.browser.newPage();
+    await page.goto(`${studio.url}#/designer`);
+    await page.waitForFunction(() => window.__texelStats && window.__texelStats.designsDrawn >= 1, { timeout: 60_000 });
+    pages.push(['firefox-designer', await check(page, 'firefox-designer', false)]);
+    await page.goto(`${studio.url}#/participant`);
+    await page.waitForSelector('[data-testid=waiting]', { timeout: 30_000 });
+    pages.push(['firefox-participant-idle', await check(page, 'firefox-participant-idle', false)]);
+    await page.goto(`${studio.url}#/experimenter`);
+    await page.waitForSelector('.page-experimenter[data-ready=true]', { timeout: 30_000 });
+    const r = await start(page, 'texel-length', 'FFA11Y');
+    assert.equal(r.type, 'experiment.started', JSON.stringify(r));
+    await page.waitForSelector('[data-testid=staircase-plot], [data-testid=session-detail]:not([hidden])', { timeout: 30_000 });
+    pages.push(['firefox-experimenter', await check(page, 'firefox-experimenter', false)]);
+    await page.goto(`${studio.url}#/participant`);
+    await page.waitForSelector('.question[data-task=oddity]', { timeout: 60_000 });
+    pages.push(['firefox-participant-oddity', await check(page, 'firefox-participant-oddity', false)]);
+  } finally {
+    await ff?.close();
+    await studio.stop();
+  }
+  for (const [label, v] of pages)
+    await t.test(label, () => {
+      assert.deepEqual(
+        severe(v).map((f) => `${f.impact} ${f.id}: ${f.nodes.join(', ')}`),
+        [],
+        `${label}: axe-core critical/serious findings`,
+      );
+    });
 });
