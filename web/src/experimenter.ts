@@ -10,7 +10,7 @@
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import { studio } from './ws';
-import { h, base64ToBytes } from './util';
+import { h, base64ToBytes, download } from './util';
 import { protocolEditor } from './protocol-editor';
 import type { ExperimentListReply, ExperimentStartRequest, ExportedFile, StoredSession } from './generated/messages';
 
@@ -454,10 +454,7 @@ export function mountExperimenter(root: HTMLElement): void {
         onclick: async () => {
           const p = await validate();
           if (!p) return;
-          const a = h('a', { href: URL.createObjectURL(new Blob([JSON.stringify(p, null, 2) + '\n'], { type: 'application/json' })), download: `${String(p.name)}.json` });
-          document.body.append(a);
-          a.click();
-          a.remove();
+          download(`${String(p.name)}.json`, 'application/json', new TextEncoder().encode(JSON.stringify(p, null, 2) + '\n'));
         },
       }, 'Download .json'),
     ),

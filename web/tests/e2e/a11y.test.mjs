@@ -13,7 +13,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths, startStudio, launchFirefox } from './studio.mjs';
+import { withStudio, screenshot, paths, startStudio, launchFirefox, askStudio } from './studio.mjs';
 
 const axeSource = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
 
@@ -52,24 +52,10 @@ function protocol(name, edit = (p) => p) {
   return edit(JSON.parse(readFileSync(join(paths.protocols, `${name}.json`), 'utf8')));
 }
 
-/** Starts `proto` (object or shipped name) for `participant` over a WebSocket of its own. */
-async function start(page, proto, participant) {
-  return page.evaluate(
-    async ([proto, participant]) => {
-      const ws = new WebSocket(`ws://${location.host}/ws`);
-      await new Promise((r) => (ws.onopen = r));
-      const call = (msg) =>
-        new Promise((res) => {
-          ws.onmessage = (e) => res(JSON.parse(e.data));
-          ws.send(JSON.stringify({ id: 1, ...msg }));
-        });
-      await call({ type: 'experiment.stop' });
-      const r = await call({ type: 'experiment.start', protocol: proto, participant });
-      ws.close();
-      return r;
-    },
-    [proto, participant],
-  );
+/** Suspends whatever runs and starts `proto` (object or shipped name) for `participant`; returns the start reply. */
+async function start(page, proto, participant, extra = {}) {
+  const replies = await askStudio(page, [{ type: 'experiment.stop' }, { type: 'experiment.start', protocol: proto, participant, ...extra }]);
+  return replies[1];
 }
 
 test('axe-core: no critical or serious finding on any page', { timeout: 600_000 }, async (t) => {
@@ -147,19 +133,8 @@ test('axe-core: no critical or serious finding on any page', { timeout: 600_000 
     await audited(page, 'experimenter-running');
 
     // …with the followed session's track and trials, exports and the protocol editor open.
-    await page.evaluate(async () => {
-      const ws = new WebSocket(`ws://${location.host}/ws`);
-      await new Promise((r) => (ws.onopen = r));
-      const call = (msg) =>
-        new Promise((res) => {
-          ws.onmessage = (e) => res(JSON.parse(e.data));
-          ws.send(JSON.stringify({ id: 1, ...msg }));
-        });
-      await call({ type: 'experiment.stop' });
-      await call({ type: 'experiment.start', protocol: 'texel-length', participant: 'A11Y-sim', simulate: 'threshold=6mm' });
-      for (let t = 0; t < 8; t++) await call({ type: 'experiment.answer', trial: t, simulated: true });
-      ws.close();
-    });
+    await start(page, 'texel-length', 'A11Y-sim', { simulate: 'threshold=6mm' });
+    await askStudio(page, [], { simulated: 8 });
     await page.waitForSelector('[data-testid=staircase-plot] canvas', { timeout: 30_000 });
     await page.click('[data-testid=export-figures]');
     await page.waitForSelector('[data-testid=exports] figure img', { timeout: 120_000 });

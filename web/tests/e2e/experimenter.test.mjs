@@ -9,28 +9,9 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { withStudio, screenshot, openDesigner } from './studio.mjs';
+import { withStudio, screenshot, openDesigner, askStudio } from './studio.mjs';
 
 const rowOf = (page, code) => page.locator(`[data-testid=sessions] tbody tr:has(td:text-is("${code}"))`);
-
-/** Lets the engine's simulated participant answer `n` trials (over a WebSocket of its own). */
-function answerSimulated(page, n) {
-  return page.evaluate(async (n) => {
-    const ws = new WebSocket(`ws://${location.host}/ws`);
-    await new Promise((r) => (ws.onopen = r));
-    const call = (msg) =>
-      new Promise((res) => {
-        ws.onmessage = (e) => res(JSON.parse(e.data));
-        ws.send(JSON.stringify({ id: 1, ...msg }));
-      });
-    for (let i = 0; i < n; i++) {
-      const cur = await call({ type: 'experiment.current' });
-      if (cur.type !== 'experiment.question') break;
-      await call({ type: 'experiment.answer', trial: cur.question.trial, simulated: true });
-    }
-    ws.close();
-  }, n);
-}
 
 async function download(page, locator) {
   const [d] = await Promise.all([page.waitForEvent('download'), locator.click()]);
@@ -60,7 +41,7 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     assert.match(await run.locator('td').nth(4).textContent(), /^\d{4}-\d\d-\d\d \d\d:\d\d$/, 'start date');
 
     // Simulated answers for a while: the track and the trial table follow.
-    await answerSimulated(page, 15);
+    await askStudio(page, [], { simulated: 15 });
     await page.waitForFunction(() => Number(document.querySelector('.page-experimenter')?.dataset.trialsShown ?? 0) >= 15, null, { timeout: 60_000 });
     await page.waitForSelector('[data-testid=staircase-plot] canvas');
     const caption = await page.textContent('[data-testid=staircase-caption]');

@@ -355,3 +355,33 @@ export async function mapChanged(page, prev) {
   await page.waitForFunction((p) => window.__texelStats.lastMapChecksum !== p, prev, { timeout: 30_000 });
   return stats(page);
 }
+
+/**
+ * Sends `msgs` in order over a WebSocket of the page's own (not the page's
+ * client) and returns their replies; then lets the engine's simulated
+ * participant answer up to `simulated` trials (sessions started with
+ * `simulate`). For tests that set the studio up behind the page's back.
+ */
+export function askStudio(page, msgs, { simulated = 0 } = {}) {
+  return page.evaluate(
+    async ([msgs, simulated]) => {
+      const ws = new WebSocket(`ws://${location.host}/ws`);
+      await new Promise((r) => (ws.onopen = r));
+      const call = (msg) =>
+        new Promise((res) => {
+          ws.onmessage = (e) => res(JSON.parse(e.data));
+          ws.send(JSON.stringify({ id: 1, ...msg }));
+        });
+      const replies = [];
+      for (const m of msgs) replies.push(await call(m));
+      for (let i = 0; i < simulated; i++) {
+        const cur = await call({ type: 'experiment.current' });
+        if (cur.type !== 'experiment.question') break;
+        await call({ type: 'experiment.answer', trial: cur.question.trial, simulated: true });
+      }
+      ws.close();
+      return replies;
+    },
+    [msgs, simulated],
+  );
+}
