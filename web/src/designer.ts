@@ -501,7 +501,7 @@ export function mountDesigner(root: HTMLElement): void {
   store.subscribe(render);
 
   // --- import / export, drag and drop
-  const fileIn = h('input', { type: 'file', id: 'import-file', 'data-testid': 'import-file', accept: '.json,.texel,.bin,.npy,.csv,.wav', class: 'visually-hidden' }) as HTMLInputElement;
+  const fileIn = h('input', { type: 'file', id: 'import-file', 'aria-label': 'Import a file', 'data-testid': 'import-file', accept: '.json,.texel,.bin,.npy,.csv,.wav', class: 'visually-hidden' }) as HTMLInputElement;
   fileIn.addEventListener('change', () => {
     if (fileIn.files?.[0]) void importFile(fileIn.files[0]);
     fileIn.value = '';
