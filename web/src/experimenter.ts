@@ -205,8 +205,9 @@ export function mountExperimenter(root: HTMLElement): void {
   const trialsBody = h('tbody', {});
   const detailTitle = h('h3', { 'data-testid': 'detail-title' });
   const detail = h(
-    'div',
-    { class: 'detail', 'data-testid': 'session-detail', hidden: true },
+    'section',
+    { class: 'detail', 'data-testid': 'session-detail', 'aria-label': 'Session details', hidden: true },
+    h('h2', {}, 'Session details'),
     detailTitle,
     timesEl,
     track.el,
@@ -466,7 +467,8 @@ export function mountExperimenter(root: HTMLElement): void {
       'div',
       { class: 'experimenter' },
       h('section', { 'aria-label': 'Start a protocol' }, h('h2', {}, 'Start a protocol'), form),
-      h('section', { 'aria-label': 'Active session' }, h('h2', {}, 'Active session'), active, detail),
+      h('section', { 'aria-label': 'Active session' }, h('h2', {}, 'Active session'), active),
+      detail,
       h(
         'section',
         { 'aria-label': 'Sessions' },
