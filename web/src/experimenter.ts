@@ -89,7 +89,7 @@ class Track {
           height: 220,
           scales: { x: { time: false } },
           legend: { live: false },
-          axes: [{ label: 'trial in block' }, { label: variable }],
+          axes: [{ label: 'trial in block', incrs: [1, 2, 5, 10, 20, 50, 100, 200, 500] }, { label: variable }],
           series: [
             {},
             { label: variable, stroke: '#2a6fdb', width: 1.5 },
