@@ -299,8 +299,8 @@ std::string how_to_answer(const ex::Question& q) {
   if (q.sliders.size() >= 2) {
     const auto& p = q.sliders[0];
     const auto& i = q.sliders[1];
-    out += "  Adjust: 'p NUMBER' sets " + lower(p.label) + " (" + detail::num(p.min) + " to " + detail::num(p.max) +
-           "), 'i NUMBER' sets " + lower(i.label) + " (" + detail::num(i.min) + " to " + detail::num(i.max) + ").\n";
+    out += "  Adjust: 'p NUMBER' sets " + p.label + " (" + detail::num(p.min) + " to " + detail::num(p.max) +
+           "), 'i NUMBER' sets " + i.label + " (" + detail::num(i.min) + " to " + detail::num(i.max) + ").\n";
     out += "  When it feels the same: type 'a' to accept.\n";
   }
   if (!q.choices.empty()) {
@@ -352,10 +352,11 @@ void wait_pumping(ex::Presenter* presenter, double seconds) {
 void tell_participant(const std::string& text) { std::cout << text << "\n" << std::flush; }
 
 std::string stimulus_name(const std::string& label) {
-  if (label == "Reference | Rendering") return "the reference (left half) and your rendering (right half)";
+  if (label == "Reference | Rendering") return "the reference (left half) and the rendering (right half)";
   if (label == "Test") return "the test texture";
   if (label == "Reference") return "the reference";
   if (label.size() <= 2) return "texture " + label;
+  if (label.rfind("Texture ", 0) == 0) return "t" + label.substr(1);  // "Texture 1" → "texture 1"
   return label;
 }
 

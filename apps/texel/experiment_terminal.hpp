@@ -67,7 +67,7 @@ std::optional<texel::experiment::Response> ask_terminal(const texel::experiment:
 void tell_participant(const std::string& text);
 
 /// The participant's name for a stimulus label: "texture 2", "texture A",
-/// "the test texture", "the reference (left half) and your rendering (right half)".
+/// "the test texture", "the reference (left half) and the rendering (right half)".
 std::string stimulus_name(const std::string& label);
 
 }  // namespace texel::cli
