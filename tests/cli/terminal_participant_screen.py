@@ -195,6 +195,26 @@ def main():
     check(len(monitor_events(mon, "play")) >= len(rows), "the monitor logs every stimulus played")
     check(len(monitor_events(mon, "suspend")) == 1, "the monitor logs the suspend")
 
+    # Not a terminal (answers piped in, output to a file): the same words, the
+    # countdown as lines, still nothing of the procedure on stdout or stderr.
+    if USE_MONITOR:
+        piped = subprocess.run([TEXEL, "experiment", "run", protocol, "--participant", "TM2", "--db", db, "--monitor",
+                                os.path.join(WORK, "piped.log")], input="f 2\na 1\na 3\nq\n", capture_output=True,
+                               text=True, timeout=60)
+        both = piped.stdout + piped.stderr
+        check(piped.returncode == 0, f"a piped run exits 0 ({piped.returncode}): {piped.stderr}")
+        check("Time left: 30 s" in piped.stdout and "Now playing: texture 2" in piped.stdout and "> f 2" in piped.stdout,
+              "a piped run shows the countdown line, the confirmation and the echoed input")
+        for word in ("narrow", "texel_length", "Hz", "late", "→", "28.5", "23.5"):
+            check(word not in both, f"a piped run never shows '{word}'")
+        # A monitor that cannot be opened: exit 2, one line, nothing created.
+        bad = subprocess.run([TEXEL, "experiment", "run", protocol, "--participant", "TM3", "--db", os.path.join(WORK, "none.db"),
+                              "--monitor", os.path.join(WORK, "no", "such", "dir.log")], input="", capture_output=True,
+                             text=True, timeout=60)
+        check(bad.returncode == 2 and bad.stderr.count("\n") == 1 and "--monitor" in bad.stderr,
+              f"an unopenable --monitor is one line, exit 2: {bad.returncode} {bad.stderr!r}")
+        check(not os.path.exists(os.path.join(WORK, "none.db")), "an unopenable --monitor leaves no database")
+
 
 try:
     main()
