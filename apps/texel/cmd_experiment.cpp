@@ -142,6 +142,7 @@ void run(const RunArgs& a) {
     const ex::Question& q = session.question();
     ex::Response r;
     if (sim) {
+      report_question(monitor, session);
       // Present as a participant would: each stimulus in turn (the pace
       // shared among them), then answer.
       for (const auto& s : q.stimuli) {

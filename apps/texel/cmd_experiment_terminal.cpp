@@ -362,11 +362,29 @@ std::string stimulus_name(const std::string& label) {
 
 // ------------------------------------------------------------- terminal UI
 
-std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Presenter* presenter, Monitor& monitor,
-                                         StopReason& stop) {
+void report_question(Monitor& monitor, const ex::Session& session) {
   const ex::Question& q = session.question();
   const ex::TrialTruth& truth = session.truth();
   const ex::Block* block = session.protocol().block(q.block);
+  const std::string trial_number = std::to_string(q.trial + 1);
+  monitor.event("question", {{"trial_number", trial_number},
+                             {"trial", std::to_string(q.trial)},
+                             {"block", q.block},
+                             {"practice", q.practice ? "1" : "0"},
+                             {"task", q.task},
+                             {"trial_in_block", std::to_string(q.trial_in_block + 1)},
+                             {"block_trials", q.block_trials ? std::to_string(*q.block_trials) : "adaptive"},
+                             {"variable", block ? block->variable : std::string()},
+                             {"value", num(truth.intensity)},
+                             {"reference", truth.reference},
+                             {"condition", truth.condition},
+                             {"correct_answer", truth.correct_answer},
+                             {"time_limit_s", num(q.time_limit_s)}});
+}
+
+std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Presenter* presenter, Monitor& monitor,
+                                         StopReason& stop) {
+  const ex::Question& q = session.question();
   const std::string trial_number = std::to_string(q.trial + 1);  // the export's trial_number
   stop = StopReason::none;
   ex::Response r;
@@ -392,19 +410,7 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
                            {"t_s", detail::fixed(seconds_since(t0), 3)}});
     std::cout << "  Now playing: " << stimulus_name(s.label) << "\n";
   };
-  monitor.event("question", {{"trial_number", trial_number},
-                             {"trial", std::to_string(q.trial)},
-                             {"block", q.block},
-                             {"practice", q.practice ? "1" : "0"},
-                             {"task", q.task},
-                             {"trial_in_block", std::to_string(q.trial_in_block + 1)},
-                             {"block_trials", q.block_trials ? std::to_string(*q.block_trials) : "adaptive"},
-                             {"variable", block ? block->variable : std::string()},
-                             {"value", num(truth.intensity)},
-                             {"reference", truth.reference},
-                             {"condition", truth.condition},
-                             {"correct_answer", truth.correct_answer},
-                             {"time_limit_s", num(q.time_limit_s)}});
+  report_question(monitor, session);
 
   const int planned = session.trials_planned();
   std::cout << "\n────────────────────────────────────────\n"

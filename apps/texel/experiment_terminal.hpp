@@ -49,6 +49,10 @@ class Monitor {
   bool owned_ = false;
 };
 
+/// Tells the monitor the session's current question: trial_number, block,
+/// the value presented, the correct answer, … (the "question" event).
+void report_question(Monitor& monitor, const texel::experiment::Session& session);
+
 /// Why the terminal runner stopped asking.
 enum class StopReason { none, quit, end_of_input, interrupt };
 std::string_view to_string(StopReason r);
