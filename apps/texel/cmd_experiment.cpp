@@ -343,8 +343,9 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_option("--response", a->response,
                       "The stimuli's display frequency response (the protocol's device profile): limit (never drive "
                       "what the display attenuates by 20 dB or more) or off [limit]");
-  run_cmd->add_flag("--json", a->json, "Print the run summary as JSON");
-  run_cmd->add_flag("--quiet", a->quiet, "No progress or summary text");
+  run_cmd->add_flag("--json", a->json,
+                    "Print the run summary as JSON (with the output's figures: for scripts, not a participant's screen)");
+  run_cmd->add_flag("--quiet", a->quiet, "No welcome, end, progress or summary text");
   run_cmd->add_option("--monitor", a->monitor,
                       "The experimenter's stream: one line per event (question, stimulus played, answer, correctness, "
                       "staircase value, reversals, audio, suspend/finish) appended to a file or FIFO, or '-' for stderr; "
