@@ -69,7 +69,7 @@ def wait_for(pattern, timeout=20.0):
     raise RuntimeError(f"timed out after {timeout} s waiting for /{pattern}/ on the screen:\n{screens[-1]}")
 
 
-def soft_wait(pattern, what, timeout=5.0):
+def soft_wait(pattern, what, timeout=10.0):
     """wait_for that records a failed check instead of ending the test."""
     try:
         return wait_for(pattern, timeout)[0]
@@ -78,7 +78,7 @@ def soft_wait(pattern, what, timeout=5.0):
         return screens[-1]
 
 
-def new_line_after(keys, line, what, timeout=3.0):
+def new_line_after(keys, line, what, timeout=10.0):
     """Sends keys and waits until one more `line` is on the screen than before."""
     before = capture().count(line)
     send(keys)
