@@ -29,6 +29,8 @@ packages=(
   python3-pip python3-setuptools python3-wheel python3-venv
   # Texel Studio's browser tests
   chromium firefox-esr
+  # the terminal runner's participant-screen test drives a pseudo-terminal (tests/cli)
+  tmux
   # GNU Octave runs examples/matlab/*.m in the examples.matlab_* ctests: a
   # test-only tool (GPL, never linked); 74 MB download, 243 MB installed.
   octave

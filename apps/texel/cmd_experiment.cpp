@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 
 #include "commands.hpp"
@@ -53,7 +54,10 @@ struct RunArgs {
   std::string response = "limit";
   bool json = false;
   bool quiet = false;
+  std::optional<std::string> monitor;
 };
+
+std::string count_text(int n) { return n >= 0 ? std::to_string(n) : std::string("adaptive"); }
 
 void run(const RunArgs& a) {
   if (!(a.pace >= 0 && a.pace <= 3600)) throw InvalidArgument("--pace is " + detail::num(a.pace) + "; allowed: 0 … 3600 s");
@@ -67,6 +71,10 @@ void run(const RunArgs& a) {
   po.audio_device = a.audio_device;
   po.response_handling = parse_response_handling(a.response, "--response");
   ex::Presenter presenter(po);
+  // The experimenter's stream: opened before the database, removed again
+  // (if this command created it) when the session cannot start.
+  Monitor monitor;
+  const bool monitor_created = a.monitor && monitor.open(*a.monitor);
   const bool existed = std::filesystem::exists(a.db);
   std::optional<ex::Store> opened;
   std::optional<ex::ActiveSession> started;
@@ -79,6 +87,8 @@ void run(const RunArgs& a) {
     started.emplace(ex::open_session(*opened, protocol_file, oo));
   } catch (const Error&) {
     opened.reset();
+    monitor.close();
+    if (monitor_created) std::filesystem::remove(*a.monitor);
     if (!existed)
       for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(a.db + suffix);
     throw;
@@ -95,8 +105,34 @@ void run(const RunArgs& a) {
   experiment_interrupted = false;
   auto old_int = std::signal(SIGINT, on_experiment_signal);
   auto old_term = std::signal(SIGTERM, on_experiment_signal);
+  auto old_pipe = std::signal(SIGPIPE, SIG_IGN);  // a monitor FIFO whose reader left ends the stream, not the run
   const bool tty = ::isatty(STDERR_FILENO) == 1;
-  if (!a.quiet)
+  const std::string resume_command =
+      "texel experiment run " + a.protocol + " --participant " + a.participant + " --db " + a.db + " --resume";
+  monitor.event("start", {{"session", std::to_string(info.id)},
+                          {"participant", a.participant},
+                          {"protocol", protocol.name},
+                          {"study", protocol.study},
+                          {"resume", a.resume ? "1" : "0"},
+                          {"trials_stored", std::to_string(session.trials_done())},
+                          {"trials_planned", count_text(session.trials_planned())},
+                          {"simulated", sim ? (simulate.empty() ? std::string("default") : simulate) : std::string()},
+                          {"db", a.db}});
+  monitor.event("audio", {{"backend", presenter.describe()},
+                          {"response", std::string(to_string(po.response_handling))},
+                          {"block_ms", detail::fixed(presenter.block_period_s() * 1e3, 3)}});
+  // Reversals so far per block (a resumed session counts its stored trials).
+  std::map<std::string, int> reversals;
+  for (const auto& row : store.rows(info.id))
+    if (row.reversal) ++reversals[row.block];
+  std::uint64_t late_blocks = presenter.stats().underruns;
+  // The participant's terminal (no --simulate) shows only what does not
+  // depend on the answers or the procedure's state; the rest goes to the
+  // monitor. A simulated run has no participant and reports on stderr.
+  if (!sim && !a.quiet)
+    tell_participant(a.resume ? "Welcome back. The study continues where it stopped."
+                              : "Welcome, and thank you for taking part. Each trial explains what to do; type 'h' for help.");
+  if (sim && !a.quiet)
     std::cerr << (a.resume ? "resuming" : "starting") << " session " << info.id << ": " << protocol.name << " for "
               << a.participant
               << (sim ? " (simulated: " + (simulate.empty() ? std::string("default") : simulate) + ")" : std::string()) << ", "
@@ -107,6 +143,7 @@ void run(const RunArgs& a) {
     const ex::Question& q = session.question();
     ex::Response r;
     if (sim) {
+      report_question(monitor, session);
       // Present as a participant would: each stimulus in turn (the pace
       // shared among them), then answer.
       for (const auto& s : q.stimuli) {
@@ -118,32 +155,67 @@ void run(const RunArgs& a) {
       r = sim->respond(session);
       r.shown_at = r.answered_at = ex::utc_timestamp();
     } else {
-      auto answer = ask_terminal(session, &presenter);
+      StopReason stop = StopReason::none;
+      auto answer = ask_terminal(session, &presenter, monitor, stop);
       if (!answer) break;  // 'q', end of input or Ctrl-C: everything answered is stored
       r = std::move(*answer);
     }
+    const ex::TrialTruth truth = session.truth();
     ex::StoredTrial t;
     try {
       t = ex::record(store, active, r);  // committed (fsync) before the next question appears
     } catch (const InvalidArgument& e) {
       if (sim) throw;
-      std::cout << "  not a valid answer: " << e.what() << "\n";
+      monitor.event("refused", {{"trial_number", std::to_string(q.trial + 1)}, {"reason", e.what()}});
+      tell_participant("  That is not a valid answer; the trial starts again.");
       continue;
     }
     presenter.blank();
-    if (tty && !a.quiet)
+    if (t.row.reversal) ++reversals[t.row.block];
+    monitor.event("result",
+                  {{"trial_number", std::to_string(t.trial + 1)},
+                   {"block", t.row.block},
+                   {"response", t.row.response},
+                   {"correct_answer", truth.correct_answer},
+                   {"correct", std::isfinite(t.row.correct) ? detail::num(t.row.correct) : std::string()},
+                   {"variable", t.row.variable},
+                   {"value", std::isfinite(t.row.intensity) ? detail::num(t.row.intensity) : std::string()},
+                   {"next_value", std::isfinite(t.row.next_intensity) ? detail::num(t.row.next_intensity) : std::string()},
+                   {"reversal", t.row.reversal ? "1" : "0"},
+                   {"reversals", std::to_string(reversals[t.row.block])},
+                   {"rt_ms", std::isfinite(t.row.rt_ms) ? detail::num(t.row.rt_ms) : std::string()},
+                   {"trials_stored", std::to_string(session.trials_done())},
+                   {"trials_planned", count_text(planned)}});
+    if (const std::uint64_t late = presenter.stats().underruns; late != late_blocks) {
+      monitor.event("late_blocks", {{"total", std::to_string(late)}, {"new", std::to_string(late - late_blocks)}});
+      late_blocks = late;
+    }
+    if (!sim && !a.quiet) tell_participant(session.finished() ? "  Answer saved." : "  Answer saved. Next trial.");
+    if (sim && tty && !a.quiet)
       std::fprintf(
           stderr, "\rtrial %d%s  block %s  %s   ", session.trials_done(),
           planned > 0 ? ("/" + std::to_string(planned)).c_str() : "", t.row.block.c_str(),
           std::isfinite(t.row.next_intensity) ? (t.row.variable + " → " + detail::num(t.row.next_intensity)).c_str() : "");
   }
-  if (tty && !a.quiet) std::fprintf(stderr, "\n");
+  if (sim && tty && !a.quiet) std::fprintf(stderr, "\n");
   std::signal(SIGINT, old_int);
   std::signal(SIGTERM, old_term);
   presenter.stop();
+  std::signal(SIGPIPE, old_pipe);
   const bool finished = session.finished();
 
   const BackendStats s = presenter.stats();
+  monitor.event("audio_stats", {{"backend", presenter.describe()},
+                                {"blocks", std::to_string(s.blocks)},
+                                {"worst_block_ms", detail::fixed(s.worst_block_s * 1e3, 3)},
+                                {"late_blocks", std::to_string(s.underruns)},
+                                {"stimuli_shown", std::to_string(presenter.shown())}});
+  if (finished)
+    monitor.event("finish", {{"session", std::to_string(info.id)}, {"trials_stored", std::to_string(session.trials_done())}});
+  else
+    monitor.event("suspend", {{"session", std::to_string(info.id)},
+                              {"trials_stored", std::to_string(session.trials_done())},
+                              {"resume", resume_command}});
   ordered_json j;
   j["session"] = info.id;
   j["participant"] = a.participant;
@@ -161,6 +233,11 @@ void run(const RunArgs& a) {
   j["stimuli_shown"] = presenter.shown();
   if (a.json) {
     print_json(j);
+  } else if (!sim && !a.quiet) {
+    // The participant's screen: no figures; the experimenter's line last.
+    tell_participant(finished ? "\nThe study is complete. Thank you for taking part!"
+                              : "\nThe study is paused and your answers are saved. Please tell the experimenter.");
+    if (!finished) tell_participant("(experimenter: continue with " + resume_command + ")");
   } else if (!a.quiet) {
     std::cout << (finished ? "finished" : "stopped") << " session " << info.id << " (" << protocol.name << ", " << a.participant
               << "): " << session.trials_done() << " trials stored in " << a.db << "\n"
@@ -240,8 +317,13 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_option("--response", a->response,
                       "The stimuli's display frequency response (the protocol's device profile): limit (never drive "
                       "what the display attenuates by 20 dB or more) or off [limit]");
-  run_cmd->add_flag("--json", a->json, "Print the run summary as JSON");
-  run_cmd->add_flag("--quiet", a->quiet, "No progress or summary text");
+  run_cmd->add_flag("--json", a->json,
+                    "Print the run summary as JSON (with the output's figures: for scripts, not a participant's screen)");
+  run_cmd->add_flag("--quiet", a->quiet, "No welcome, end, progress or summary text");
+  run_cmd->add_option("--monitor", a->monitor,
+                      "The experimenter's stream: one line per event (question, stimulus played, answer, correctness, "
+                      "staircase value, reversals, audio, suspend/finish) appended to a file or FIFO, or '-' for stderr; "
+                      "the participant's terminal shows none of it (watch it with tail -f PATH)");
   run_cmd->callback([a] { run(*a); });
 
   struct CohortArgs {

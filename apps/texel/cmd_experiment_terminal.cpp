@@ -1,20 +1,32 @@
-// The terminal runner of `texel experiment run` (docs/experiments.md): one
-// question at a time on stdout, answers typed on stdin, the stimuli fed to
-// the Presenter meanwhile. It only presents and collects; the engine
-// (libtexel_experiment's Session) validates and scores.
+// The terminal runner of `texel experiment run` (docs/experiments.md "The
+// terminal runner"): one question at a time on stdout in plain words, answers
+// typed on stdin, the stimuli fed to the Presenter meanwhile. The participant
+// sees nothing that depends on correctness or on the procedure's state; what
+// the experimenter needs goes to the Monitor stream (--monitor). It only
+// presents and collects; the engine (libtexel_experiment's Session)
+// validates and scores.
 #include "experiment_terminal.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
 #include "texel/detail/format.hpp"
+#include "texel/error.hpp"
 #include "texel/experiment/records.hpp"
 
 namespace texel::cli {
@@ -25,13 +37,101 @@ using Clock = std::chrono::steady_clock;
 std::atomic<bool> experiment_interrupted{false};
 extern "C" void on_experiment_signal(int) { experiment_interrupted = true; }
 
+std::string_view to_string(StopReason r) {
+  switch (r) {
+    case StopReason::quit: return "quit";
+    case StopReason::end_of_input: return "end-of-input";
+    case StopReason::interrupt: return "interrupt";
+    case StopReason::none: break;
+  }
+  return "none";
+}
+
+// ------------------------------------------------------------------ monitor
+
+Monitor::~Monitor() { close(); }
+
+bool Monitor::open(const std::string& path) {
+  close();
+  if (path == "-") {
+    fd_ = STDERR_FILENO;
+    owned_ = false;
+    return false;
+  }
+  struct stat st {};
+  const bool existed = ::stat(path.c_str(), &st) == 0;
+  if (existed && S_ISFIFO(st.st_mode)) {
+    // A FIFO: wait for its reader (the experimenter's `cat PATH`), then
+    // write without ever blocking the participant's run.
+    int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0 && errno == ENXIO) {
+      std::cerr << "waiting for a reader on the monitor FIFO " << path << " (e.g. 'cat " << path << "' in another pane)\n";
+      fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+      if (fd >= 0) ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK);
+    }
+    if (fd < 0) throw IoError("--monitor " + path + ": cannot open the FIFO (" + std::strerror(errno) + ")");
+    fd_ = fd;
+  } else {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) throw IoError("--monitor " + path + ": cannot open for appending (" + std::strerror(errno) + ")");
+    fd_ = fd;
+  }
+  owned_ = true;
+  return !existed;
+}
+
+void Monitor::close() {
+  if (owned_ && fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  owned_ = false;
+}
+
+void Monitor::event(std::string_view name, std::initializer_list<Field> fields) {
+  if (fd_ < 0) return;
+  std::string line = ex::utc_timestamp();
+  line += ' ';
+  line += name;
+  for (const auto& [key, value] : fields) {
+    if (value.empty()) continue;  // a field the event does not have
+    const bool plain = !value.empty() && std::none_of(value.begin(), value.end(), [](char c) {
+      return std::isspace(static_cast<unsigned char>(c)) || c == '"' || c == '=' || c == '\\' ||
+             static_cast<unsigned char>(c) < 0x20;
+    });
+    line += ' ';
+    line += key;
+    line += '=';
+    line += plain ? value : nlohmann::json(value).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  }
+  line += '\n';
+  const ssize_t n = ::write(fd_, line.data(), line.size());
+  if (n < 0 && errno != EAGAIN && errno != EINTR) close();  // the reader went away (EPIPE): the run goes on
+}
+
+// ------------------------------------------------------------------ helpers
+
 namespace {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// Reads one line from stdin, pumping the presenter meanwhile. nullopt on
-// end of input, Ctrl-C or timeout (timeout_s <= 0: none).
-std::optional<std::string> read_line(ex::Presenter* presenter, double timeout_s, bool* timed_out = nullptr) {
+std::string num(double v) { return std::isfinite(v) ? detail::num(v) : std::string(); }
+
+// Whether the participant types on the terminal that shows the questions, so
+// lines can be redrawn in place (the countdown).
+bool interactive() {
+  static const bool on = ::isatty(STDOUT_FILENO) == 1 && ::isatty(STDIN_FILENO) == 1;
+  return on;
+}
+
+int terminal_columns() {
+  winsize w{};
+  if (::ioctl(STDOUT_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0) return w.ws_col;
+  return 80;
+}
+
+// Reads one line from stdin, pumping the presenter and calling `tick`
+// meanwhile. nullopt on end of input, Ctrl-C or timeout (timeout_s <= 0: none).
+std::optional<std::string> read_line(ex::Presenter* presenter, double timeout_s, bool* timed_out = nullptr,
+                                     const std::function<void()>& tick = {}) {
   static std::string buffer;
   const auto t0 = Clock::now();
   if (timed_out) *timed_out = false;
@@ -48,6 +148,7 @@ std::optional<std::string> read_line(ex::Presenter* presenter, double timeout_s,
       return std::nullopt;
     }
     if (presenter) presenter->pump();
+    if (tick) tick();
     pollfd p{STDIN_FILENO, POLLIN, 0};
     const int r = ::poll(&p, 1, 20);
     if (r > 0) {
@@ -74,6 +175,168 @@ std::string trim(std::string s) {
   return s.substr(i);
 }
 
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// "1, 2 or 3"
+std::string spoken_list(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i == 0 ? "" : i + 1 == items.size() ? " or " : ", ") + items[i];
+  return out;
+}
+
+std::optional<int> whole_number(const std::string& s) {
+  if (s.empty() || s.size() > 9 ||
+      !std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+    return std::nullopt;
+  return std::stoi(s);
+}
+
+std::optional<double> number(const std::string& s) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(s, &used);
+    if (used == s.size() && std::isfinite(v)) return v;
+  } catch (...) {
+  }
+  return std::nullopt;
+}
+
+// The time left to answer, on the line above the prompt: redrawn in place
+// on an interactive terminal, a line every 10 s (and at 5 s) otherwise.
+class Countdown {
+ public:
+  Countdown(double limit_s, Clock::time_point t0) : limit_s_(limit_s), t0_(t0) {}
+  [[nodiscard]] bool active() const { return limit_s_ > 0; }
+  [[nodiscard]] double left_s() const { return limit_s_ - seconds_since(t0_); }
+  void time_up() {
+    up_ = true;
+    redraw();
+  }
+  // The countdown line, then the prompt (the participant types after "> ").
+  void prompt() {
+    if (active() && (interactive() || seconds() != shown_ || up_)) {
+      shown_ = seconds();
+      std::cout << "  " << text() << "\n";
+    }
+    std::cout << "> " << std::flush;
+  }
+  void tick() {
+    if (!active() || up_ || seconds() == shown_) return;
+    shown_ = seconds();
+    if (interactive())
+      redraw();
+    else if (shown_ > 0 && (shown_ % 10 == 0 || shown_ == 5))
+      std::cout << "\n  " << text() << "\n> " << std::flush;
+  }
+  // After the participant pressed Enter: on an interactive terminal the
+  // countdown line and the echoed input are replaced by the input alone, so
+  // one countdown stays on screen; elsewhere the input is echoed.
+  void entered(const std::string& raw) const {
+    if (!interactive()) {
+      std::cout << raw << "\n";  // no terminal echo: keep the transcript readable
+      return;
+    }
+    if (!active()) return;
+    const int rows = 1 + static_cast<int>(2 + raw.size()) / terminal_columns();
+    std::cout << "\033[" << rows + 1 << "A\r\033[J> " << raw << "\n";
+  }
+
+ private:
+  [[nodiscard]] int seconds() const { return std::max(0, static_cast<int>(std::ceil(left_s()))); }
+  [[nodiscard]] std::string text() const {
+    return up_ ? "Time is up: please answer now." : "Time left: " + std::to_string(shown_) + " s";
+  }
+  void redraw() {
+    if (interactive())
+      std::cout << "\0337\033[1A\r\033[2K  " << text() << "\0338" << std::flush;  // save, up, rewrite, restore
+    else
+      std::cout << "\n  " << text() << "\n> " << std::flush;
+  }
+  double limit_s_;
+  Clock::time_point t0_;
+  int shown_ = -1;
+  bool up_ = false;
+};
+
+// A timed phase (working memory): a countdown redrawn in place, no input.
+void countdown_phase(ex::Presenter* presenter, double seconds) {
+  const auto t0 = Clock::now();
+  int shown = -1;
+  while (!experiment_interrupted && seconds_since(t0) < seconds) {
+    if (presenter) presenter->pump();
+    const int left = std::max(0, static_cast<int>(std::ceil(seconds - seconds_since(t0))));
+    if (left != shown && interactive()) {
+      std::cout << "\r\033[2K  Time left: " << left << " s" << std::flush;
+      shown = left;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (presenter) presenter->pump();
+  if (interactive()) std::cout << "\r\033[2K";
+}
+
+std::string how_to_answer(const ex::Question& q) {
+  std::string out;
+  const std::size_t n = q.stimuli.size();
+  if (q.phases.empty() && n > 1) {
+    std::vector<std::string> numbers;
+    for (std::size_t i = 1; i <= n; ++i) numbers.push_back(std::to_string(i));
+    out += "  Feel a texture: type its number (" + spoken_list(numbers) + ") and press Enter.\n";
+    bool numbered = true;
+    for (std::size_t i = 0; i < n; ++i) numbered = numbered && q.stimuli[i].label == std::to_string(i + 1);
+    if (!numbered) {
+      std::string legend;
+      for (std::size_t i = 0; i < n; ++i)
+        legend += (i ? ", " : "") + std::to_string(i + 1) + " = " + stimulus_name(q.stimuli[i].label);
+      out += "    (" + legend + ")\n";
+    }
+  } else if (q.phases.empty() && n == 1) {
+    out += "  Feel the display; type 1 to play it again.\n";
+  }
+  if (q.sliders.size() >= 2) {
+    const auto& p = q.sliders[0];
+    const auto& i = q.sliders[1];
+    out += "  Adjust: 'p NUMBER' sets " + p.label + " (" + detail::num(p.min) + " to " + detail::num(p.max) +
+           "), 'i NUMBER' sets " + i.label + " (" + detail::num(i.min) + " to " + detail::num(i.max) + ").\n";
+    out += "  When it feels the same: type 'a' to accept.\n";
+  }
+  if (!q.choices.empty()) {
+    std::vector<std::string> examples;
+    for (const auto& c : q.choices) examples.push_back("'a " + c + "'");
+    out += "  Answer: type 'a' and your answer: " + spoken_list(examples) + ".\n";
+  }
+  if (q.rating_scale)
+    out += "  Answer: type 'a' and a whole number from " + detail::num((*q.rating_scale)[0]) + " to " +
+           detail::num((*q.rating_scale)[1]) + ", e.g. 'a " +
+           detail::num(std::round(((*q.rating_scale)[0] + (*q.rating_scale)[1]) / 2)) + "'.\n";
+  out += "  Help: 'h'.  Pause and quit (your answers are kept): 'q'.\n";
+  return out;
+}
+
+// Asks a follow-up number (confidence, digit) until it is a whole number in
+// [lo, hi]; nullopt when the participant quits.
+std::optional<int> ask_number(ex::Presenter* presenter, const std::string& question, int lo, int hi, StopReason& stop) {
+  std::cout << "  " << question << "\n> " << std::flush;
+  for (;;) {
+    const auto line = read_line(presenter, 0);
+    if (!line) {
+      stop = experiment_interrupted ? StopReason::interrupt : StopReason::end_of_input;
+      return std::nullopt;
+    }
+    if (!interactive()) std::cout << *line << "\n";
+    const std::string s = trim(*line);
+    if (s == "q" || s == "quit") {
+      stop = StopReason::quit;
+      return std::nullopt;
+    }
+    if (const auto v = whole_number(s); v && *v >= lo && *v <= hi) return *v;
+    std::cout << "  Please type a whole number from " << lo << " to " << hi << ".\n> " << std::flush;
+  }
+}
+
 }  // namespace
 
 // Waits `seconds` while keeping the presenter fed; returns early on Ctrl-C.
@@ -86,25 +349,73 @@ void wait_pumping(ex::Presenter* presenter, double seconds) {
   if (presenter) presenter->pump();
 }
 
+void tell_participant(const std::string& text) { std::cout << text << "\n" << std::flush; }
+
+std::string stimulus_name(const std::string& label) {
+  if (label == "Reference | Rendering") return "the reference (left half) and the rendering (right half)";
+  if (label == "Test") return "the test texture";
+  if (label == "Reference") return "the reference";
+  if (label.size() <= 2) return "texture " + label;
+  if (label.rfind("Texture ", 0) == 0) return "t" + label.substr(1);  // "Texture 1" → "texture 1"
+  return label;
+}
+
 // ------------------------------------------------------------- terminal UI
 
-// Presents one question on the terminal and collects a valid answer.
-// Returns nullopt when the participant quits (q, end of input, Ctrl-C).
-std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Presenter* presenter) {
+void report_question(Monitor& monitor, const ex::Session& session) {
   const ex::Question& q = session.question();
+  const ex::TrialTruth& truth = session.truth();
+  const ex::Block* block = session.protocol().block(q.block);
+  const std::string trial_number = std::to_string(q.trial + 1);
+  monitor.event("question", {{"trial_number", trial_number},
+                             {"trial", std::to_string(q.trial)},
+                             {"block", q.block},
+                             {"practice", q.practice ? "1" : "0"},
+                             {"task", q.task},
+                             {"trial_in_block", std::to_string(q.trial_in_block + 1)},
+                             {"block_trials", q.block_trials ? std::to_string(*q.block_trials) : "adaptive"},
+                             {"variable", block ? block->variable : std::string()},
+                             {"value", num(truth.intensity)},
+                             {"reference", truth.reference},
+                             {"condition", truth.condition},
+                             {"correct_answer", truth.correct_answer},
+                             {"time_limit_s", num(q.time_limit_s)}});
+}
+
+std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Presenter* presenter, Monitor& monitor,
+                                         StopReason& stop) {
+  const ex::Question& q = session.question();
+  const std::string trial_number = std::to_string(q.trial + 1);  // the export's trial_number
+  stop = StopReason::none;
   ex::Response r;
   r.shown_at = ex::utc_timestamp();
   const auto t0 = Clock::now();
   auto event = [&](const std::string& kind, const std::string& detail) {
     r.events.push_back({seconds_since(t0), kind, detail, ex::utc_timestamp()});
   };
-  auto feel = [&](int i) {
-    if (presenter) presenter->show(q.stimuli[static_cast<std::size_t>(i)].document_json);
-    event("select", q.stimuli[static_cast<std::size_t>(i)].label);
+  auto ended = [&](StopReason why) {
+    stop = why;
+    monitor.event(
+        "quit",
+        {{"trial_number", trial_number}, {"reason", std::string(to_string(why))}, {"t_s", detail::fixed(seconds_since(t0), 3)}});
+    return std::nullopt;
   };
-  std::cout << "\n── trial " << q.trial + 1 << (q.practice ? " (practice)" : "") << " · " << q.block << " "
-            << q.trial_in_block + 1
-            << (q.block_trials && *q.block_trials > 0 ? " of " + std::to_string(*q.block_trials) : std::string()) << " ──\n"
+  auto feel = [&](int i) {
+    const auto& s = q.stimuli[static_cast<std::size_t>(i)];
+    if (presenter) presenter->show(s.document_json);
+    event("select", s.label);
+    monitor.event("play", {{"trial_number", trial_number},
+                           {"stimulus", std::to_string(i + 1)},
+                           {"label", s.label},
+                           {"t_s", detail::fixed(seconds_since(t0), 3)}});
+    std::cout << "  Now playing: " << stimulus_name(s.label) << "\n";
+  };
+  report_question(monitor, session);
+
+  const int planned = session.trials_planned();
+  std::cout << "\n────────────────────────────────────────\n"
+            << "Trial " << trial_number << (planned > 0 ? " of " + std::to_string(planned) : std::string())
+            << (q.practice ? " (practice)" : "") << "\n"
             << q.prompt << "\n";
   event("show", "trial " + std::to_string(q.trial));
 
@@ -112,13 +423,13 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   for (const auto& ph : q.phases) {
     if (ph.kind == ex::PhaseKind::stimulus && ph.stimulus) {
       feel(*ph.stimulus);
-      std::cout << "  feeling " << q.stimuli[static_cast<std::size_t>(*ph.stimulus)].label << " for "
-                << detail::num(ph.duration_s) << " s ...\n";
-      std::cout.flush();
+      std::cout << "  Feel it for " << detail::num(ph.duration_s) << " s.\n" << std::flush;
+      countdown_phase(presenter, ph.duration_s);
     } else {
       if (presenter) presenter->blank();
       event("matrix", "");
-      std::cout << "  remember this matrix (" << detail::num(ph.duration_s) << " s):\n";
+      monitor.event("matrix", {{"trial_number", trial_number}, {"t_s", detail::fixed(seconds_since(t0), 3)}});
+      std::cout << "  Remember this matrix (" << detail::num(ph.duration_s) << " s):\n";
       for (int row = 0; row < 4; ++row) {
         std::cout << "      ";
         for (int col = 0; col < 4; ++col) {
@@ -128,121 +439,148 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
         std::cout << "\n";
       }
       std::cout.flush();
+      countdown_phase(presenter, ph.duration_s);
+      if (interactive()) std::cout << "\033[5A\033[J" << std::flush;  // hide the matrix again
     }
-    wait_pumping(presenter, ph.duration_s);
-    if (ph.kind == ex::PhaseKind::matrix && ::isatty(STDOUT_FILENO)) std::cout << "\033[6A\033[J";  // hide the matrix again
-    if (experiment_interrupted) return std::nullopt;
+    if (experiment_interrupted) return ended(StopReason::interrupt);
   }
   if (!q.phases.empty() && presenter) presenter->blank();
 
-  std::string labels;
-  for (std::size_t i = 0; i < q.stimuli.size(); ++i) labels += "  [f " + std::to_string(i + 1) + "] " + q.stimuli[i].label;
-  if (q.phases.empty() && !q.stimuli.empty()) {
-    std::cout << "  feel:" << labels << "\n";
-    feel(0);
-  }
-  double slider_p = q.sliders.empty() ? 0 : q.sliders[0].start, slider_i = q.sliders.empty() ? 0 : q.sliders[1].start;
-  if (!q.sliders.empty())
-    std::cout << "  sliders: 'p VALUE' (" << q.sliders[0].label << ", " << detail::num(q.sliders[0].min) << " … "
-              << detail::num(q.sliders[0].max) << "), 'i VALUE' (" << q.sliders[1].label << ", " << detail::num(q.sliders[1].min)
-              << " … " << detail::num(q.sliders[1].max) << "), 'a' to accept\n";
-  if (!q.choices.empty()) {
-    std::string c;
-    for (const auto& x : q.choices) c += (c.empty() ? "" : " | ") + x;
-    std::cout << "  answer: 'a CHOICE' with CHOICE one of " << c << "\n";
-  }
-  if (q.rating_scale)
-    std::cout << "  answer: 'a N' with N from " << (*q.rating_scale)[0] << " to " << (*q.rating_scale)[1] << "\n";
-  if (q.time_limit_s > 0) std::cout << "  (" << detail::num(q.time_limit_s) << " s to explore)\n";
-  std::cout << "  ('q' saves and quits; the session resumes with --resume)\n";
+  std::cout << how_to_answer(q);
+  if (q.phases.empty() && !q.stimuli.empty()) feel(0);
 
-  bool time_up = false;
+  double slider_p = q.sliders.empty() ? 0 : q.sliders[0].start, slider_i = q.sliders.size() < 2 ? 0 : q.sliders[1].start;
+  Countdown countdown(q.time_limit_s, t0);
+  bool time_up = false, need_prompt = true;
   for (;;) {
-    std::cout << "> " << std::flush;
-    const double remaining = q.time_limit_s > 0 && !time_up ? q.time_limit_s - seconds_since(t0) : 0.0;
+    if (need_prompt) countdown.prompt();
+    need_prompt = true;
     bool timed_out = false;
-    const auto line = read_line(presenter, remaining > 0 ? remaining : (q.time_limit_s > 0 && !time_up ? 1e-3 : 0.0), &timed_out);
+    const double remaining = countdown.active() && !time_up ? std::max(1e-3, countdown.left_s()) : 0.0;
+    const auto line = read_line(presenter, remaining, &timed_out, [&] { countdown.tick(); });
     if (timed_out) {
       time_up = true;
+      need_prompt = false;  // the participant may be typing on this prompt
       if (presenter) presenter->blank();
       event("timeout", "");
-      std::cout << "\n  time is up: answer now\n";
+      monitor.event("timeout", {{"trial_number", trial_number}, {"t_s", detail::fixed(seconds_since(t0), 3)}});
+      countdown.time_up();
       continue;
     }
-    if (!line) return std::nullopt;
+    if (!line) return ended(experiment_interrupted ? StopReason::interrupt : StopReason::end_of_input);
+    countdown.entered(*line);
     const std::string cmd = trim(*line);
-    if (cmd == "q" || cmd == "quit") return std::nullopt;
+    if (cmd.empty()) continue;
+    if (cmd == "q" || cmd == "quit") return ended(StopReason::quit);
+    if (cmd == "h" || cmd == "help" || cmd == "?") {
+      std::cout << how_to_answer(q);
+      continue;
+    }
     std::istringstream in(cmd);
-    std::string verb, arg;
-    in >> verb >> arg;
-    if (verb == "f" && !time_up) {
-      int i = 0;
-      try {
-        i = std::stoi(arg);
-      } catch (...) {
-        i = 0;
-      }
-      if (i >= 1 && i <= static_cast<int>(q.stimuli.size()) && q.phases.empty())
-        feel(i - 1);
+    std::string verb, arg, extra;
+    in >> verb >> arg >> extra;
+    auto refuse = [&](const std::string& reason, const std::string& tell) {
+      monitor.event("refused", {{"trial_number", trial_number}, {"input", cmd}, {"reason", reason}});
+      std::cout << "  " << tell << "\n";
+    };
+    // Feel: a bare number, or 'f N' / 'feel N' (N a number or a label).
+    std::optional<int> pick;
+    if (whole_number(verb)) {
+      pick = *whole_number(verb);
+      arg = verb;
+    } else if (verb == "f" || verb == "feel") {
+      pick = whole_number(arg).value_or(0);
+      for (std::size_t i = 0; i < q.stimuli.size() && !whole_number(arg); ++i)
+        if (lower(q.stimuli[i].label) == lower(arg)) pick = static_cast<int>(i + 1);
+    }
+    if (pick) {
+      if (!q.phases.empty())
+        refuse("feel during recall", "The textures of this trial have been played; please answer.");
+      else if (time_up)
+        refuse("feel after time-out", "Time is up: please answer now.");
+      else if (*pick >= 1 && *pick <= static_cast<int>(q.stimuli.size()) && extra.empty())
+        feel(*pick - 1);
       else
-        std::cout << "  feel which? 1 … " << q.stimuli.size() << "\n";
-    } else if ((verb == "p" || verb == "i") && !q.sliders.empty()) {
-      try {
-        (verb == "p" ? slider_p : slider_i) = std::stod(arg);
-      } catch (...) {
-        std::cout << "  '" << verb << "' needs a number\n";
+        refuse("no such stimulus", "There is no texture '" + arg + "'. Type 'h' for help.");
+      continue;
+    }
+    if ((verb == "p" || verb == "i") && q.sliders.size() >= 2) {
+      const auto& spec = q.sliders[verb == "p" ? 0 : 1];
+      const auto v = number(arg);
+      if (!v || *v < spec.min || *v > spec.max) {
+        refuse("slider out of range",
+               "'" + verb + "' needs a number from " + detail::num(spec.min) + " to " + detail::num(spec.max) + ".");
         continue;
       }
+      (verb == "p" ? slider_p : slider_i) = *v;
       event("slider", verb + "=" + arg);
-      if (presenter) presenter->show(session.preview_document(slider_p, slider_i));
-    } else if (verb == "a") {
-      r.choice.clear();
-      if (!q.choices.empty()) r.choice = arg;
-      if (q.rating_scale) {
-        try {
-          r.rating = std::stod(arg);
-        } catch (...) {
-          r.rating.reset();
-        }
-      }
-      if (!q.sliders.empty()) {
-        r.slider_p = slider_p;
-        r.slider_i = slider_i;
-      }
-      const double rt = seconds_since(t0) * 1000.0;
-      if (q.confidence) {
-        std::cout << "  how confident are you in this match? 1 (not at all) … 5 (very)\n> " << std::flush;
-        const auto c = read_line(presenter, 0);
-        if (!c) return std::nullopt;
-        try {
-          r.confidence = std::stod(trim(*c));
-        } catch (...) {
-          r.confidence.reset();
-        }
-      }
-      if (q.recall) {
-        if (q.recall->cell)
-          std::cout << "  which digit was in row " << *q.recall->cell / 4 + 1 << ", column " << *q.recall->cell % 4 + 1
-                    << "? (1 … 9)\n> ";
-        else
-          std::cout << "  which digit was in the cells? (1 … 9)\n> ";
-        std::cout << std::flush;
-        const auto d = read_line(presenter, 0);
-        if (!d) return std::nullopt;
-        try {
-          r.digit = std::stoi(trim(*d));
-        } catch (...) {
-          r.digit.reset();
-        }
-      }
-      r.rt_ms = std::round(rt);
-      r.answered_at = ex::utc_timestamp();
-      event("answer", arg);
-      return r;
-    } else if (!cmd.empty()) {
-      std::cout << "  commands: 'f N' feel stimulus N, 'a ANSWER', " << (q.sliders.empty() ? "" : "'p V', 'i V', ")
-                << "'q' quit\n";
+      monitor.event("slider", {{"trial_number", trial_number}, {"name", spec.name}, {"value", detail::num(*v)}});
+      if (presenter && !time_up) presenter->show(session.preview_document(slider_p, slider_i));
+      std::cout << "  " << spec.label << " set to " << detail::num(*v) << (time_up ? "." : "; now playing your rendering.")
+                << "\n";
+      continue;
     }
+    if (verb != "a" && verb != "answer") {
+      refuse("unknown command", "Sorry, '" + cmd + "' is not a command. Type 'h' for help.");
+      continue;
+    }
+    // An answer: checked against the question here, so a typo costs nothing.
+    r.choice.clear();
+    r.rating.reset();
+    if (!q.choices.empty()) {
+      std::string found;
+      for (const auto& c : q.choices)
+        if (lower(c) == lower(arg)) found = c;
+      std::vector<std::string> examples;
+      for (const auto& c : q.choices) examples.push_back("'a " + c + "'");
+      if (found.empty() || !extra.empty()) {
+        refuse("not a choice", "That is not a valid answer: answer with " + spoken_list(examples) + ".");
+        continue;
+      }
+      r.choice = found;
+    }
+    if (q.rating_scale) {
+      const auto v = whole_number(arg);
+      if (!v || *v < (*q.rating_scale)[0] || *v > (*q.rating_scale)[1] || !extra.empty()) {
+        refuse("not on the scale", "That is not a valid answer: type 'a' and a whole number from " +
+                                       detail::num((*q.rating_scale)[0]) + " to " + detail::num((*q.rating_scale)[1]) + ".");
+        continue;
+      }
+      r.rating = *v;
+    }
+    if (!q.sliders.empty()) {
+      r.slider_p = slider_p;
+      r.slider_i = slider_i;
+    }
+    const double rt = seconds_since(t0) * 1000.0;  // from the first stimulus onset (shown with the question)
+    if (presenter) presenter->blank();
+    if (q.confidence) {
+      const auto c = ask_number(presenter, "How confident are you in this match? 1 (not at all) to 5 (very)", 1, 5, stop);
+      if (!c) return ended(stop);
+      r.confidence = *c;
+    }
+    if (q.recall) {
+      const std::string question = q.recall->cell ? "Which digit was in row " + std::to_string(*q.recall->cell / 4 + 1) +
+                                                        ", column " + std::to_string(*q.recall->cell % 4 + 1) + "? (1 to 9)"
+                                                  : std::string("Which digit was in the cells? (1 to 9)");
+      const auto d = ask_number(presenter, question, 1, 9, stop);
+      if (!d) return ended(stop);
+      r.digit = *d;
+    }
+    r.rt_ms = std::round(rt);
+    r.answered_at = ex::utc_timestamp();
+    event("answer", arg);
+    monitor.event("answer", {{"trial_number", trial_number},
+                             {"response", !q.choices.empty() ? r.choice
+                                          : r.rating         ? detail::num(*r.rating)
+                                                             : std::string()},
+                             {"slider_p", r.slider_p ? detail::num(*r.slider_p) : std::string()},
+                             {"slider_i", r.slider_i ? detail::num(*r.slider_i) : std::string()},
+                             {"confidence", r.confidence ? detail::num(*r.confidence) : std::string()},
+                             {"digit", r.digit ? std::to_string(*r.digit) : std::string()},
+                             {"rt_ms", detail::num(r.rt_ms)},
+                             {"after_time_limit", time_up ? "1" : "0"}});
+    return r;
   }
 }
 
