@@ -4,16 +4,21 @@
 // replay); responses are validated; questions never reveal the answer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "texel/device.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/simulate.hpp"
+#include "texel/io.hpp"
 #include "texel/texture.hpp"
 
 namespace ex = texel::experiment;
@@ -382,5 +387,55 @@ TEST(ProtocolVersions, WideConditionFrequencyFloorRemovesTheDrawsBelowOneCpm) {
     } else {
       EXPECT_EQ(below, 0u);
     }
+  }
+}
+
+TEST(ProtocolVersions, EffectOfTheStaircaseRulesOnASimulatedCohort) {
+  // The figures of docs/procedures.md §2 ("End value and start rule"): each
+  // staircase study run by simulated participants (the protocol's observer)
+  // under the four combinations of the two rules. The docs' figures are from
+  // TEXEL_COHORT=200; the default keeps the test short.
+  const char* env = std::getenv("TEXEL_COHORT");
+  const int participants = env ? std::max(1, std::atoi(env)) : 30;
+  for (const std::string name : {"texel-length", "texel-length-wide", "coarse-features"}) {
+    const std::string text = texel::read_file((protocols / (name + ".json")).string());
+    std::map<std::pair<bool, bool>, std::pair<double, double>> result;  // (initial rule, last) → (mean threshold, mean trials)
+    for (const bool initial : {true, false})
+      for (const bool last : {true, false}) {
+        auto j = nlohmann::json::parse(text);
+        for (auto& b : j["blocks"])
+          if (b.contains("staircase")) {
+            b["staircase"]["apply_initial_rule"] = initial;
+            b["staircase"]["end_value"] = last ? "last-presented" : "next";
+          }
+        const ex::Protocol p = ex::parse_protocol(j.dump());
+        double sum = 0, trials = 0, runs = 0;
+        for (int i = 0; i < participants; ++i) {
+          ex::SessionContext c;
+          c.participant = "P" + std::to_string(i);
+          c.session_id = 1;
+          c.seed = ex::session_seed(p.seed, c.participant);
+          ex::Session s(p, c);
+          for (const auto& t : simulate(s, "default")) {
+            if (t.row.practice) continue;
+            trials += 1;
+            if (!t.row.procedure_finished) continue;
+            // The end rule decides only what the finishing row reports:
+            // the last value shown, or one step from it.
+            if (last) {
+              EXPECT_EQ(t.row.next_intensity, t.row.intensity);
+            } else {
+              EXPECT_NE(t.row.next_intensity, t.row.intensity);
+            }
+            sum += t.row.next_intensity;
+            runs += 1;
+          }
+        }
+        result[{initial, last}] = {sum / runs, trials / runs};
+        std::printf("%s: initial rule %s, end value %s: mean threshold %.3f, %.1f trials per staircase (%g runs)\n", name.c_str(),
+                    initial ? "on " : "off", last ? "last-presented" : "next          ", sum / runs, trials / runs, runs);
+      }
+    // Without the initial rule the staircase needs more trials to its reversals.
+    EXPECT_GT(result[std::pair(false, true)].second, result[std::pair(true, true)].second) << name;
   }
 }
