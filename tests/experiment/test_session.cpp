@@ -236,7 +236,7 @@ TEST(Session, MatchingStudiesRunAndMapSliders) {
     }
   }
   EXPECT_EQ(matches, 9);
-  EXPECT_EQ(ratings, 9);
+  EXPECT_EQ(ratings, 25);  // 25 of the 81 pairs: 9 own-match, 16 cross
 }
 
 // ------------------------------------------------------------ versions and the source's designs (issue #23)
