@@ -45,7 +45,7 @@ void check_texture(const json& texture, const std::string& device, const std::st
   }
 }
 
-Block parse_block(JsonObject o, const std::string& device) {
+Block parse_block(JsonObject o, const std::string& device, int version) {
   Block b;
   b.name = o.string("name");
   if (b.name.empty() || b.name.size() > 64) throw FormatError(o.field("name") + " must be 1 … 64 characters");
@@ -55,7 +55,7 @@ Block parse_block(JsonObject o, const std::string& device) {
   b.condition = o.string_or("condition", "");
   b.prompt = o.string_or("prompt", "");
   b.shuffle = o.boolean_or("shuffle", true);
-  BlockInput in{o, device};
+  BlockInput in{o, device, version};
   type.parse(in, b);
   // A key another kind reads does not apply here; any other unknown key is
   // reported by finish().
@@ -174,7 +174,7 @@ Protocol parse_protocol(std::string_view json_text, std::string_view origin) {
     throw FormatError("blocks must be an array of 1 … " + std::to_string(max_blocks) + " blocks");
   std::set<std::string> names;
   for (std::size_t i = 0; i < blocks.size(); ++i) {
-    Block b = parse_block(JsonObject(blocks[i], "blocks[" + std::to_string(i) + "]"), p.device);
+    Block b = parse_block(JsonObject(blocks[i], "blocks[" + std::to_string(i) + "]"), p.device, p.version);
     if (!names.insert(b.name).second)
       throw FormatError("blocks[" + std::to_string(i) + "].name '" + b.name + "' is used twice; block names must be unique");
     // References to earlier blocks must exist and come earlier.

@@ -40,6 +40,14 @@ std::string_view to_string(StepType t) {
   return "lin";
 }
 
+EndValue parse_end_value(std::string_view text, std::string_view field) {
+  if (text == "next") return EndValue::next;
+  if (text == "last-presented") return EndValue::last_presented;
+  throw InvalidArgument(std::string(field) + ": '" + std::string(text) + "' is not an end value (allowed: next, last-presented)");
+}
+
+std::string_view to_string(EndValue e) { return e == EndValue::next ? "next" : "last-presented"; }
+
 void validate(const StaircaseConfig& c) {
   if (!std::isfinite(c.start_value))
     throw InvalidArgument("start_value: " + num(c.start_value) + " is not finite (allowed: a finite number)");
@@ -123,6 +131,11 @@ void Staircase::answer(bool correct) {
   if (move == Direction::down && config_.min_value) value_ = std::max(value_, *config_.min_value);
 }
 
+double Staircase::convergent_value() const {
+  if (config_.end_value == EndValue::last_presented && !intensities_.empty()) return intensities_.back();
+  return value_;
+}
+
 double Staircase::mean_last_reversals(std::size_t k) const {
   if (k == 0) throw Error("mean_last_reversals: k = 0 (allowed: >= 1)");
   const auto& r = reversal_intensities_;
@@ -153,6 +166,9 @@ std::string Staircase::state_json() const {
   c["min_value"] = config_.min_value ? nlohmann::ordered_json(*config_.min_value) : nlohmann::ordered_json();
   c["max_value"] = config_.max_value ? nlohmann::ordered_json(*config_.max_value) : nlohmann::ordered_json();
   c["apply_initial_rule"] = config_.apply_initial_rule;
+  // Only when not the default, so the stored state of a version-1 protocol's
+  // staircase keeps its bytes.
+  if (config_.end_value != EndValue::next) c["end_value"] = std::string(to_string(config_.end_value));
   j["config"] = c;
   j["trials"] = trials();
   j["value"] = value_;

@@ -106,6 +106,9 @@ class TaskBlock {
 struct BlockInput {
   detail::JsonObject& o;
   const std::string& device;
+  /// The protocol's format version: a key's default may depend on it (a
+  /// version-1 protocol keeps its old meaning; docs/experiments.md "Versions").
+  int version = Protocol::current_version;
   /// The texture object at `key`, validated (FormatError naming the path).
   [[nodiscard]] TextureTemplate texture(std::string_view key) const;
 };

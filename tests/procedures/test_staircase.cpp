@@ -189,6 +189,29 @@ TEST(Staircase, WithoutInitialRuleUsesNupNdownFromTheStart) {
   EXPECT_NEAR(s.convergent_value(), 10, tol);
 }
 
+TEST(Staircase, EndValueLastPresentedReportsTheFinalValueShown) {
+  StaircaseConfig c;
+  c.start_value = 10;
+  c.step_sizes = {1};
+  c.n_reversals = 1;
+  const Staircase next = run(c, {1, 0});  // down (initial rule), then up: a reversal, finished
+  ASSERT_TRUE(next.finished());
+  EXPECT_NEAR(next.computed_value(), 10, tol);
+  EXPECT_NEAR(next.convergent_value(), 10, tol);  // next: the value computed after the last answer
+  c.end_value = EndValue::last_presented;
+  const Staircase last = run(c, {1, 0});
+  EXPECT_NEAR(last.computed_value(), 10, tol);
+  EXPECT_NEAR(last.convergent_value(), 9, tol);  // the last intensity presented
+  EXPECT_NE(last.state_json().find("\"end_value\":\"last-presented\""), std::string::npos);
+  // The default's state has no end_value key (stored states keep their bytes).
+  EXPECT_EQ(next.state_json().find("end_value"), std::string::npos);
+  // Before any answer both report the start value.
+  EXPECT_NEAR(Staircase(c).convergent_value(), 10, tol);
+  EXPECT_EQ(parse_end_value("last-presented"), EndValue::last_presented);
+  EXPECT_EQ(to_string(EndValue::next), "next");
+  EXPECT_THROW((void)parse_end_value("final"), texel::InvalidArgument);
+}
+
 TEST(Staircase, NTrialsIsAMinimumAndNReversalsIsRaised) {
   StaircaseConfig c;
   c.start_value = 0;

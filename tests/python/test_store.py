@@ -60,7 +60,8 @@ def test_store_sessions_and_trials(database):
     (session,) = s.sessions()
     assert session["protocol"] == "texel-length" and session["trials_done"] == len(expected)
     trials = s.trials(session["id"])
-    assert trials[0]["trial"] == 0 and trials[0]["state_json"]
+    assert trials[0]["trial"] == 0
+    assert any(t["state_json"] for t in trials)  # the staircase's state (the practice trials have none)
     assert repr(texel.Store(str(db)).rows(session["id"])) == repr(texel.read_trials(str(db)))  # NaN-aware
 
 

@@ -85,6 +85,12 @@ struct MemoryStimulus {
   TextureTemplate different;  ///< texture 2 on "different" trials
 };
 
+/// A named texture of a familiarisation block.
+struct NamedTexture {
+  std::string name;  ///< the button's label
+  TextureTemplate texture;
+};
+
 struct Block {
   std::string name;
   std::string task = "oddity";  ///< a name of task_names()
@@ -128,13 +134,21 @@ struct Block {
   double texture_s = 10.0, matrix_s = 10.0;
   int matrix_cells = 5;
   bool recall_question = true;
+  bool balance_order = false;  ///< draw per trial which stimulus texture comes first (and is repeated on "same")
+
+  // Familiarisation.
+  std::vector<NamedTexture> textures;
+  double duration_s = 300.0;  ///< the suggested time, shown in the prompt (untimed)
 
   /// A kind's own settings (nullptr for the built-in kinds).
   std::shared_ptr<const TaskSettings> settings;
 };
 
 struct Protocol {
-  static constexpr int current_version = 1;
+  /// 1: the first format (its defaults kept exactly, so stored sessions
+  /// replay); 2: the source-faithful defaults (staircase end value and start
+  /// rule) and checks (docs/experiments.md "Protocol versions").
+  static constexpr int current_version = 2;
   int version = current_version;
   std::string name;
   std::string study;

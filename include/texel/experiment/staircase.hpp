@@ -29,6 +29,15 @@ enum class StepType { lin, log, db };
 StepType parse_step_type(std::string_view text, std::string_view field = "step_type");
 std::string_view to_string(StepType t);
 
+/// Which value a finished staircase reports as its threshold ("convergent
+/// value"): the value computed after the last answer, never presented
+/// (PsychoPy's reading), or the last value presented (the source's reading
+/// for its two studies; docs/procedures.md §2).
+enum class EndValue { next, last_presented };
+/// "next" | "last-presented"; throws InvalidArgument naming `field`.
+EndValue parse_end_value(std::string_view text, std::string_view field = "end_value");
+std::string_view to_string(EndValue e);
+
 struct StaircaseConfig {
   double start_value = 0;               ///< first intensity presented (never clamped); > 0 for log/db
   std::vector<double> step_sizes{1.0};  ///< non-empty, each finite and > 0 (units of step_type)
@@ -39,6 +48,7 @@ struct StaircaseConfig {
   StepType step_type = StepType::lin;
   std::optional<double> min_value, max_value;  ///< clamps after moves down / up; min <= max
   bool apply_initial_rule = true;              ///< 1-up/1-down until the first reversal
+  EndValue end_value = EndValue::next;         ///< what convergent_value() reports
 };
 
 /// Throws InvalidArgument naming the field, the value and what is allowed.
@@ -68,9 +78,13 @@ class Staircase {
   [[nodiscard]] bool last_was_reversal() const { return last_was_reversal_; }
   /// The step size in force (units of step_type).
   [[nodiscard]] double current_step() const { return step_; }
-  /// The thesis' "convergent value": the value computed after the last
-  /// answer (what next() would present), also when finished.
-  [[nodiscard]] double convergent_value() const { return value_; }
+  /// The value computed after the last answer (what next() would present),
+  /// also when finished.
+  [[nodiscard]] double computed_value() const { return value_; }
+  /// The threshold by the config's end_value: computed_value() (next), or
+  /// the last intensity presented (last_presented; computed_value() before
+  /// the first answer).
+  [[nodiscard]] double convergent_value() const;
   /// The effective number of reversals required (config, raised to len(step_sizes)).
   [[nodiscard]] int n_reversals() const { return n_reversals_; }
 

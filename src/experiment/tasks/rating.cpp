@@ -20,7 +20,7 @@ constexpr std::size_t max_list = 4096;
 RenderingSource parse_rendering(BlockInput& block, JsonObject o) {
   RenderingSource r;
   if (o.has("texture")) {
-    BlockInput in{o, block.device};
+    BlockInput in{o, block.device, block.version};
     r.texture = in.texture("texture");
   } else {
     o.skip("texture");
@@ -37,6 +37,19 @@ RenderingSource parse_rendering(BlockInput& block, JsonObject o) {
   if (!r.from_protocol.empty() && r.texture.empty())
     throw FormatError(o.where() +
                       ": \"from_protocol\" needs a fallback \"texture\" (used when the participant has no such match)");
+  // Version 2: a fallback rendering stands for a match, so it must be one a
+  // participant could have made: inside the device's slider ranges.
+  if (block.version >= 2 && !r.from_protocol.empty()) {
+    const GuidedConfig range;  // the device's full ranges (docs/procedures.md §3)
+    const auto check = [&](const char* key, double lo, double hi) {
+      const auto v = r.texture.number(key);
+      if (v && (*v < lo || *v > hi))
+        throw FormatError(o.field("texture") + "." + key + " is " + detail::num(*v) + "; allowed: " + detail::num(lo) + " … " +
+                          detail::num(hi) + " dB (the device's range: a fallback stands for a match)");
+    };
+    check("central_pitch_db", range.pitch_min_db, range.pitch_max_db);
+    check("irregularity_db", range.irregularity_min_db, range.irregularity_max_db);
+  }
   return r;
 }
 

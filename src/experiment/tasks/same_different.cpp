@@ -34,8 +34,11 @@ class SameDifferentBlock : public TaskBlock {
     const MemoryStimulus& ms =
         *std::find_if(b.memory_stimuli.begin(), b.memory_stimuli.end(), [&](const auto& m) { return m.name == cond.stimulus; });
     const std::uint64_t seed = s.seed_draw(0);
-    const json first = texel_texture(texture_of(ms.texture), seed);
-    const json second = same ? first : texel_texture(texture_of(ms.different), seed);
+    // balance_order: which of the pair comes first (and is repeated on a
+    // "same" trial) is drawn per trial; otherwise always `texture`.
+    const bool swapped = b.balance_order && s.trial_below(64, 2) == 1;
+    const json first = texel_texture(texture_of(swapped ? ms.different : ms.texture), seed);
+    const json second = same ? first : texel_texture(texture_of(swapped ? ms.texture : ms.different), seed);
     q.stimuli.push_back({"Texture 1", s.single(first)});
     q.stimuli.push_back({"Texture 2", s.single(second)});
     std::array<int, 16> m{};
@@ -91,7 +94,8 @@ class SameDifferentTask : public TaskType {
  public:
   std::string_view name() const override { return "same-different"; }
   std::vector<std::string_view> keys() const override {
-    return {"stimuli", "conditions", "trials_per_condition", "texture_s", "matrix_s", "matrix_cells", "recall_question"};
+    return {"stimuli",  "conditions",   "trials_per_condition", "texture_s",
+            "matrix_s", "matrix_cells", "recall_question",      "balance_order"};
   }
 
   void parse(BlockInput& in, Block& b) const override {
@@ -101,7 +105,7 @@ class SameDifferentTask : public TaskType {
       throw FormatError(o.field("stimuli") + " must be an object of named stimuli {\"texture\", \"different\"}");
     for (auto it = stimuli.begin(); it != stimuli.end(); ++it) {
       JsonObject s(it.value(), o.field("stimuli") + "." + it.key());
-      BlockInput sin{s, in.device};
+      BlockInput sin{s, in.device, in.version};
       MemoryStimulus ms;
       ms.name = it.key();
       ms.texture = sin.texture("texture");
@@ -128,6 +132,7 @@ class SameDifferentTask : public TaskType {
     b.matrix_s = o.number_or("matrix_s", 10.0, 0.0, 600.0);
     b.matrix_cells = static_cast<int>(o.has("matrix_cells") ? o.integer("matrix_cells", 1, 9) : (o.skip("matrix_cells"), 5));
     b.recall_question = o.boolean_or("recall_question", true);
+    b.balance_order = o.boolean_or("balance_order", false);
   }
 
   std::optional<int> planned_trials(const Block& b) const override {

@@ -15,7 +15,8 @@ namespace texel::experiment {
   X(match)                  \
   X(rating)                 \
   X(guided)                 \
-  X(same_different)
+  X(same_different)         \
+  X(familiarisation)
 
 #define TEXEL_DECLARE_TASK(kind) std::unique_ptr<TaskType> make_##kind##_task();
 TEXEL_TASK_TABLE(TEXEL_DECLARE_TASK)

@@ -34,7 +34,10 @@ const Variable& find_variable(const JsonObject& o, const std::string& key) {
   throw FormatError(o.field("variable") + " is '" + key + "'; allowed: " + names);
 }
 
-StaircaseConfig parse_staircase(JsonObject o, Block& b) {
+// Version 1 kept PsychoPy's defaults (initial 1-up/1-down rule; the value
+// computed after the last answer as the threshold); version 2 defaults to the
+// source's reading (no initial rule; the last value presented).
+StaircaseConfig parse_staircase(JsonObject o, Block& b, int version) {
   StaircaseConfig c;
   b.variable = o.string("variable");
   const Variable& var = find_variable(o, b.variable);
@@ -61,7 +64,10 @@ StaircaseConfig parse_staircase(JsonObject o, Block& b) {
   c.step_type = parse_step_type(o.string_or("step_type", "lin"), o.field("step_type"));
   c.min_value = o.number_or("min", var.lo, var.lo, var.hi);
   c.max_value = o.number_or("max", var.hi, var.lo, var.hi);
-  c.apply_initial_rule = o.boolean_or("apply_initial_rule", true);
+  const bool v1 = version < 2;
+  c.apply_initial_rule = o.boolean_or("apply_initial_rule", v1);
+  c.end_value = o.has("end_value") ? parse_end_value(o.string("end_value"), o.field("end_value"))
+                                   : (o.skip("end_value"), v1 ? EndValue::next : EndValue::last_presented);
   o.finish();
   try {
     validate(c);
@@ -133,8 +139,9 @@ class ThresholdBlock : public TaskBlock {
     }
     staircase_->answer(correct);
     row.reversal = staircase_->last_was_reversal();
-    row.next_intensity = staircase_->convergent_value();
     row.procedure_finished = staircase_->finished();
+    // The finishing row carries the threshold by the protocol's end rule.
+    row.next_intensity = row.procedure_finished ? staircase_->convergent_value() : staircase_->computed_value();
     return staircase_->state_json();
   }
 
@@ -167,7 +174,7 @@ class ThresholdTask : public TaskType {
     b.time_limit_s = o.number_or("time_limit_s", two_alternative_ ? 0.0 : 30.0, 0.0, 3600.0);
     b.show_maps = o.boolean_or("show_maps", false);
     if (o.has("staircase")) {
-      b.staircase = parse_staircase(JsonObject(o.raw("staircase"), o.field("staircase")), b);
+      b.staircase = parse_staircase(JsonObject(o.raw("staircase"), o.field("staircase")), b, in.version);
       for (std::string_view k : {"trials", "variable", "value"}) {
         if (o.has(k)) throw FormatError(o.field(k) + " does not apply to task '" + std::string(name()) + "'");
         o.skip(k);
