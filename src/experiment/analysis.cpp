@@ -86,9 +86,7 @@ std::string fmt_p(double p) {
 }
 
 /// A number of a JSON summary (null → NaN).
-double val(const json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : missing;
-}
+double val(const json& j, const char* key) { return j.contains(key) && j[key].is_number() ? j[key].get<double>() : missing; }
 /// Degrees of freedom: whole numbers as such, Welch's to two decimals.
 std::string fmt_df(double df) { return std::abs(df - std::round(df)) < 1e-9 ? fmt(df, 0) : fmt(df, 2); }
 std::string fmt_ci(const json& j, const char* lo = "ci_low", const char* hi = "ci_high") {
@@ -169,10 +167,10 @@ json between_groups(const std::vector<std::string>& groups,
   json out{{"groups", groups}, {"participants_in_several_groups", several}};
   out["anova"] = guarded([&] { return stats::view(stats::anova_one_way(values)); });
   if (out["anova"].contains("f"))
-    text += "  between groups (one-way ANOVA): " +
-            f_text(val(out["anova"], "df_between"), val(out["anova"], "df_within"), val(out["anova"], "f"),
-                   val(out["anova"], "p")) +
-            ", η² = " + fmt(val(out["anova"], "eta2")) + "\n";
+    text +=
+        "  between groups (one-way ANOVA): " +
+        f_text(val(out["anova"], "df_between"), val(out["anova"], "df_within"), val(out["anova"], "f"), val(out["anova"], "p")) +
+        ", η² = " + fmt(val(out["anova"], "eta2")) + "\n";
   json tests = json::array();
   for (std::size_t i = 0; i < groups.size(); ++i)
     for (std::size_t j = i + 1; j < groups.size(); ++j) {
@@ -183,7 +181,8 @@ json between_groups(const std::vector<std::string>& groups,
       tests.push_back(json{{"comparison", cmp}, {"student", t}, {"welch", w}});
     }
   out["t_tests"] = tests;
-  if (!several.empty()) text += "  " + std::to_string(several.size()) + " participant(s) in several groups left out of the group tests\n";
+  if (!several.empty())
+    text += "  " + std::to_string(several.size()) + " participant(s) in several groups left out of the group tests\n";
   return out;
 }
 
@@ -229,8 +228,7 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     // The source's end value is the last one presented; "next" takes the one
     // computed after the last answer (falling back to the last presented
     // when it was not stored).
-    const double convergent =
-        o.convergent == "next" && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
+    const double convergent = o.convergent == "next" && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
     const std::size_t used = std::min(o.reversals_k, rev.size());
     std::vector<double> tail(rev.end() - static_cast<std::ptrdiff_t>(used), rev.end());
     const double threshold = mean_of(tail);
@@ -451,13 +449,11 @@ json similarity_matrix(const Rows& ratings, Ordered names, const AnalysisOptions
     }
     if (!d.empty() && !f.empty()) diag.push_back(mean_of(d)), off.push_back(mean_of(f));
   }
-  json sim{{"references", names.names},
-           {"renderings", rendering_names.names},
-           {"pairs_rated", rated},
-           {"pairs_possible", nr * nc},
-           {"mean_rating", mean},
-           {"participants", count}};
-  text += "  similarity ratings: " + std::to_string(rated) + " of " + std::to_string(nr * nc) + " reference/rendering pairs rated\n";
+  json sim{{"references", names.names}, {"renderings", rendering_names.names},
+           {"pairs_rated", rated},      {"pairs_possible", nr * nc},
+           {"mean_rating", mean},       {"participants", count}};
+  text +=
+      "  similarity ratings: " + std::to_string(rated) + " of " + std::to_string(nr * nc) + " reference/rendering pairs rated\n";
   if (diag.empty()) {
     sim["own_vs_other_t_test"] = skipped("no participant rated both own and other renderings");
   } else {
@@ -852,7 +848,8 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   out.update(tests);
   // What each rule excludes, and what the interaction test becomes under it.
   json rules = json::array();
-  for (const auto& [name, ex] : {std::pair<std::string, const Excluded*>{"source", &by_source}, {"recall-accuracy", &by_recall}}) {
+  for (const auto& [name, ex] :
+       {std::pair<std::string, const Excluded*>{"source", &by_source}, {"recall-accuracy", &by_recall}}) {
     json r{{"rule", name}, {"excluded", excluded_list(*ex)}, {"included", people.size() - ex->size()}};
     if (name == "source") r["thresholds"] = source_stats;
     r["rm_anova"] = memory_tests(people, conditions.names, *ex, o)["rm_anova"];

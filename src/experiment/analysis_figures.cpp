@@ -400,8 +400,8 @@ Figure rating_boxes(const std::string& title, const Rows& rows, const std::strin
   for (const TrialRow* r : rows) {
     if (r->task != "rating") continue;
     // The own-match ratings (the similarity matrix holds the others).
-    const bool own = r->condition.empty() || r->condition == "match" || r->condition == "own" ||
-                     r->condition == "rendering:" + r->reference;
+    const bool own =
+        r->condition.empty() || r->condition == "match" || r->condition == "own" || r->condition == "rendering:" + r->reference;
     if (!own) continue;
     if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
     v[r->reference][r->participant].push_back(r->rating);
@@ -489,8 +489,7 @@ Figure quantization_figure(const json& s, const Rows& rows) {
       const std::string cat = texel::detail::num(d(c["quantization_db"])) + " dB";
       const double x = static_cast<double>(std::find(cats.begin(), cats.end(), cat) - cats.begin()) + offset;
       const double m = d(c["change"]["mean"]);
-      const double half =
-          c["t_test"].contains("ci_high") ? (d(c["t_test"]["ci_high"]) - d(c["t_test"]["ci_low"])) / 2 : missing;
+      const double half = c["t_test"].contains("ci_high") ? (d(c["t_test"]["ci_high"]) - d(c["t_test"]["ci_low"])) / 2 : missing;
       eb.x.push_back(x);
       eb.y.push_back(m);
       eb.error.push_back(half);
@@ -545,7 +544,8 @@ Figure similarity_heatmap(const json& sim, const std::string& title, double lo, 
   h.max = hi;
   h.decimals = 2;
   h.scale_label = "mean similarity rating (" + texel::detail::num(lo) + " … " + texel::detail::num(hi) + ")";
-  Figure f = figure(title, std::max(760, 90 * static_cast<int>(rend.size()) + 300), std::max(600, 60 * static_cast<int>(refs.size()) + 200));
+  Figure f = figure(title, std::max(760, 90 * static_cast<int>(rend.size()) + 300),
+                    std::max(600, 60 * static_cast<int>(refs.size()) + 200));
   Panel p;
   p.x.label = column_label;
   p.y.label = "reference felt";
@@ -672,15 +672,15 @@ std::vector<std::string> study_figures(const Study& study, const nlohmann::order
       // Beyond the own-match pairs (the source rated 25 of the 81): the matrix.
       if (study.design == StudyDesign::matching && summary.contains("similarity") &&
           summary["similarity"]["pairs_rated"].get<std::size_t>() > summary["similarity"]["references"].size())
-        w.save(similarity_heatmap(summary["similarity"], title + ": similarity of references and matches", 0.0, 10.0,
-                                  "match of"),
+        w.save(similarity_heatmap(summary["similarity"], title + ": similarity of references and matches", 0.0, 10.0, "match of"),
                "similarity");
       if (study.design == StudyDesign::guided) {
         w.save(guided_convergence(rows), "convergence");
         if (summary.contains("similarity"))
-          w.save(similarity_heatmap(summary["similarity"], "Guided exploration: similarity of references and optimized renderings",
-                                    1.0, 5.0, "optimized rendering of"),
-                 "similarity");
+          w.save(
+              similarity_heatmap(summary["similarity"], "Guided exploration: similarity of references and optimized renderings",
+                                 1.0, 5.0, "optimized rendering of"),
+              "similarity");
       }
       break;
     case StudyDesign::quantization: w.save(quantization_figure(summary, rows), "rating-change"); break;

@@ -320,8 +320,8 @@ TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const doub
   check_level(fn, level);
   const std::vector<double> x = finite(a), y = finite(b);
   if (x.size() < 2 || y.size() < 2)
-    throw InvalidArgument(std::string(fn) + ": the groups have " + std::to_string(x.size()) + " and " +
-                          std::to_string(y.size()) + " usable value(s); at least 2 each are needed");
+    throw InvalidArgument(std::string(fn) + ": the groups have " + std::to_string(x.size()) + " and " + std::to_string(y.size()) +
+                          " usable value(s); at least 2 each are needed");
   TwoSampleTTest r;
   r.n1 = x.size();
   r.n2 = y.size();
@@ -333,7 +333,8 @@ TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const doub
   r.sd2 = sd_of(y, r.mean2);
   const double n1 = static_cast<double>(r.n1), n2 = static_cast<double>(r.n2);
   const double v1 = r.sd1 * r.sd1, v2 = r.sd2 * r.sd2;
-  if (!(v1 > 0.0 || v2 > 0.0)) throw InvalidArgument(std::string(fn) + ": both groups are constant; the t statistic is undefined");
+  if (!(v1 > 0.0 || v2 > 0.0))
+    throw InvalidArgument(std::string(fn) + ": both groups are constant; the t statistic is undefined");
   const double pooled = ((n1 - 1) * v1 + (n2 - 1) * v2) / (n1 + n2 - 2);
   r.diff = r.mean1 - r.mean2;
   if (welch) {
@@ -356,7 +357,8 @@ TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const doub
 
 OneWayAnova anova_one_way(const std::vector<std::vector<double>>& groups) {
   constexpr const char* fn = "anova_one_way";
-  if (groups.size() < 2) throw InvalidArgument(std::string(fn) + ": " + std::to_string(groups.size()) + " group(s); at least 2 are needed");
+  if (groups.size() < 2)
+    throw InvalidArgument(std::string(fn) + ": " + std::to_string(groups.size()) + " group(s); at least 2 are needed");
   OneWayAnova a;
   std::vector<std::vector<double>> g;
   std::vector<double> all;
@@ -575,9 +577,9 @@ nlohmann::ordered_json view(const OneWayAnova& a) {
 }
 
 nlohmann::ordered_json view(const Correlation& c) {
-  return {{"n", c.n},           {"r", jnum(c.r)},   {"r2", jnum(c.r2)},         {"t", jnum(c.t)},
-          {"df", jnum(c.df)},   {"p", jnum(c.p)},   {"level", c.level},          {"ci_low", jnum(c.ci_low)},
-          {"ci_high", jnum(c.ci_high)}};
+  return {{"n", c.n},         {"r", jnum(c.r)},           {"r2", jnum(c.r2)},
+          {"t", jnum(c.t)},   {"df", jnum(c.df)},         {"p", jnum(c.p)},
+          {"level", c.level}, {"ci_low", jnum(c.ci_low)}, {"ci_high", jnum(c.ci_high)}};
 }
 
 std::string to_json(const Descriptive& d) { return view(d).dump(); }

@@ -69,8 +69,7 @@ struct TwoSampleTTest {
   double cohen_d = 0;
 };
 /// a, b: the two groups (NaNs skipped; each ≥ 2 finite values; not both constant).
-TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const double> b, bool welch = false,
-                                 double level = 0.95);
+TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const double> b, bool welch = false, double level = 0.95);
 
 /// One-way between-subjects ANOVA: F = MS_between / MS_within with
 /// df = (k − 1, N − k); eta2 = SS_between / SS_total.
