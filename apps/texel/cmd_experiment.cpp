@@ -410,6 +410,18 @@ void register_experiment(CLI::App& app) {
     if (!(an->level > 0 && an->level < 1))
       throw InvalidArgument("--level is " + detail::num(an->level) + "; allowed: 0 … 1 (exclusive)");
     o.level = an->level;
+    const auto one_of = [](const std::string& flag, const std::string& v, std::initializer_list<const char*> allowed) {
+      std::string list;
+      for (const char* a : allowed) {
+        if (v == a) return;
+        list += (list.empty() ? "" : ", ") + std::string(a);
+      }
+      throw InvalidArgument(flag + " is '" + v + "'; allowed: " + list);
+    };
+    one_of("--convergent", an->convergent, {"last-presented", "next"});
+    one_of("--memory-rule", an->memory_rule, {"source", "recall-accuracy", "none"});
+    one_of("--confidence-distance", an->confidence_distance, {"rater", "group-mean"});
+    if (!(an->errors_sd > 0)) throw InvalidArgument("--memory-errors-sd is " + detail::num(an->errors_sd) + "; allowed: > 0");
     o.convergent = an->convergent;
     o.memory_rule = an->memory_rule;
     o.memory_errors_sd = an->errors_sd;

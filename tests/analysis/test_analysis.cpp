@@ -332,7 +332,9 @@ TEST(Analysis, TexelLengthConvergentValuesAndReversalMeans) {
 }
 
 TEST(Analysis, CoarseFeaturesAnovaOverFineStrength) {
-  const json s = summary_of(analyze(coarse_rows(), {}))["coarse-features"];
+  AnalysisOptions o;
+  o.convergent = "next";  // the rows' stored convergent values
+  const json s = summary_of(analyze(coarse_rows(), o))["coarse-features"];
   ASSERT_EQ(s["blocks"].size(), 3u);
   EXPECT_DOUBLE_EQ(s["blocks"][2]["fine_strength"].get<double>(), 1.0);
   EXPECT_NEAR(s["blocks"][2]["convergent"]["mean"].get<double>(), (0.55 + 0.60 + 0.70) / 3, 1e-12);
@@ -371,7 +373,8 @@ TEST(Analysis, FreeExplorationConfidenceAgainstDistanceToTheRater) {
   // √2, √2, 3, √2, √2, 3 with confidences 5, 4, 2, 3, 5, 1. SciPy 1.10
   // pearsonr: r = −0.8696263565, p = 0.02438793125, Fisher CI
   // [−0.9855973211, −0.1973358711].
-  EXPECT_DOUBLE_EQ(s["matches"][2]["distance_to_rater_db"].get<double>(), 3.0);
+  EXPECT_EQ(s["matches"][4]["participant"], "S03");  // matches in participant order
+  EXPECT_DOUBLE_EQ(s["matches"][4]["distance_to_rater_db"].get<double>(), 3.0);
   EXPECT_NEAR(c["r"].get<double>(), -0.8696263565, 1e-9);
   EXPECT_NEAR(c["p"].get<double>(), 0.02438793125, 1e-9);
   EXPECT_NEAR(c["ci_low"].get<double>(), -0.9855973211, 1e-9);
