@@ -166,11 +166,12 @@ json between_groups(const std::vector<std::string>& groups,
   }
   json out{{"groups", groups}, {"participants_in_several_groups", several}};
   out["anova"] = guarded([&] { return stats::view(stats::anova_one_way(values)); });
-  if (out["anova"].contains("f"))
-    text +=
-        "  between groups (one-way ANOVA): " +
-        f_text(val(out["anova"], "df_between"), val(out["anova"], "df_within"), val(out["anova"], "f"), val(out["anova"], "p")) +
-        ", η² = " + fmt(val(out["anova"], "eta2")) + "\n";
+  const json& an = out["anova"];
+  text += "  between groups (one-way ANOVA): " +
+          (an.contains("skipped") ? "skipped: " + an["skipped"].get<std::string>()
+                                  : f_text(val(an, "df_between"), val(an, "df_within"), val(an, "f"), val(an, "p")) +
+                                        ", η² = " + fmt(val(an, "eta2"))) +
+          "\n";
   json tests = json::array();
   for (std::size_t i = 0; i < groups.size(); ++i)
     for (std::size_t j = i + 1; j < groups.size(); ++j) {

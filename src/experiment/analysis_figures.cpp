@@ -484,7 +484,7 @@ Figure quantization_figure(const json& s, const Rows& rows) {
     ErrorBarSeries eb;
     eb.colour = palette_colour(k);
     eb.label = t["reference"].get<std::string>() + " (mean ± 95 % CI)";
-    const double offset = (static_cast<double>(k) - (textures - 1) / 2) * 0.18;
+    const double offset = (static_cast<double>(k) - (textures - 1) / 2) * 0.25;
     for (const auto& c : t["changes"]) {
       const std::string cat = texel::detail::num(d(c["quantization_db"])) + " dB";
       const double x = static_cast<double>(std::find(cats.begin(), cats.end(), cat) - cats.begin()) + offset;
@@ -496,14 +496,15 @@ Figure quantization_figure(const json& s, const Rows& rows) {
       const double top = m + (std::isfinite(half) ? half : 0);
       if (std::isfinite(m)) {
         lo = std::min(lo, m - (std::isfinite(half) ? half : 0)), hi = std::max(hi, top);
-        a.notes.push_back(TextNote{x, top, p_text(c["t_test"]), palette_colour(k), -12.0});
+        // Staggered per texture so neighbouring labels do not overlap.
+        a.notes.push_back(TextNote{x, top, p_text(c["t_test"]), palette_colour(k), -12.0 - 13.0 * static_cast<double>(k)});
       }
     }
     a.error_bars.push_back(std::move(eb));
     ++k;
   }
   // Room above the highest bar for its p value.
-  if (hi > lo) a.y.max = hi + (hi - lo) * 0.15;
+  if (hi > lo) a.y.max = hi + (hi - lo) * (0.15 + 0.08 * textures);
   f.panels.push_back(std::move(a));
 
   // Ratings per condition (per-participant means over references).
