@@ -393,6 +393,23 @@ std::optional<Figure> confidence_vs_distance(const std::string& title, const jso
   return f;
 }
 
+/// A panel of box plots per reference (categories in `names`' order) of each
+/// participant's mean value; `v`: reference → participant → values.
+Panel reference_boxes(const std::vector<std::string>& names,
+                      std::map<std::string, std::map<std::string, std::vector<double>>>& v) {
+  Panel p;
+  p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
+  BoxSeries box;
+  box.show_points = true;
+  for (const auto& n : names) {
+    std::vector<double> g;
+    for (const auto& [pp, x] : v[n]) g.push_back(mean_of(x));
+    box.groups.push_back(std::move(g));
+  }
+  p.boxes.push_back(std::move(box));
+  return p;
+}
+
 /// Rating per reference (box plots of per-participant ratings).
 Figure rating_boxes(const std::string& title, const Rows& rows, const std::string& scale) {
   std::vector<std::string> names;
@@ -407,17 +424,8 @@ Figure rating_boxes(const std::string& title, const Rows& rows, const std::strin
     v[r->reference][r->participant].push_back(r->rating);
   }
   Figure f = figure(title + ": similarity of match and reference", category_width(names, 640), 460);
-  Panel p;
-  p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
+  Panel p = reference_boxes(names, v);
   p.y.label = "similarity rating (" + scale + ")";
-  BoxSeries box;
-  box.show_points = true;
-  for (const auto& n : names) {
-    std::vector<double> g;
-    for (const auto& [pp, x] : v[n]) g.push_back(mean_of(x));
-    box.groups.push_back(std::move(g));
-  }
-  p.boxes.push_back(std::move(box));
   f.panels.push_back(std::move(p));
   return f;
 }
@@ -445,17 +453,8 @@ std::optional<Figure> irregularity_normalised_figure(const json& s, const Rows& 
     if (hi > lo && std::isfinite(x)) v[r->reference][r->participant].push_back((x - lo) / (hi - lo));
   }
   Figure f = figure("Parameter mapping: Irregularity normalised per participant", category_width(names, 700), 480);
-  Panel p;
-  p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
+  Panel p = reference_boxes(names, v);
   p.y = Axis{"normalised Irregularity (0 = participant's lowest match, 1 = highest)", AxisScale::linear, -0.05, 1.05, false};
-  BoxSeries box;
-  box.show_points = true;
-  for (const auto& n : names) {
-    std::vector<double> g;
-    for (const auto& [pp, x] : v[n]) g.push_back(mean_of(x));
-    box.groups.push_back(std::move(g));
-  }
-  p.boxes.push_back(std::move(box));
   f.panels.push_back(std::move(p));
   return f;
 }
