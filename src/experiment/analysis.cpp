@@ -457,6 +457,7 @@ json similarity_matrix(const Rows& ratings, Ordered names, const AnalysisOptions
       "  similarity ratings: " + std::to_string(rated) + " of " + std::to_string(nr * nc) + " reference/rendering pairs rated\n";
   if (diag.empty()) {
     sim["own_vs_other_t_test"] = skipped("no participant rated both own and other renderings");
+    text += "  own vs other renderings: skipped (no participant rated both own and other renderings)\n";
   } else {
     json t = guarded([&] { return ttest_json(stats::t_test_paired(diag, off, o.level)); });
     t["comparison"] = "own rendering − other renderings";
