@@ -76,7 +76,8 @@ struct AnalysisReport {
   std::string summary = "{}";
   /// Paths of the figures written, in the order written.
   std::vector<std::string> figures;
-  /// Human-readable summary (a few lines per study).
+  /// Human-readable summary, a few lines per study, every test in the
+  /// source's form: t(df) = …, p = …, 95 % CI; F(df1, df2) = …, p = …; r = …, p = ….
   std::string text;
 };
 
