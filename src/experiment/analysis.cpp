@@ -192,10 +192,10 @@ json between_groups(const std::vector<std::string>& groups,
 json swipe_correlations(const std::vector<std::pair<std::string, std::vector<double>>>& measures,
                         const std::vector<double>& convergent, const AnalysisOptions& o, std::string& text) {
   json out = json::array();
-  for (const auto& [name, x] : measures) {
-    json c = guarded([&] { return stats::view(stats::pearson(x, convergent, o.level)); });
-    text += "  " + name + " vs convergent: " + r_text(c) + "\n";
-    out.push_back(json{{"measure", name}, {"correlation", c}});
+  for (const auto& m : measures) {
+    json c = guarded([&] { return stats::view(stats::pearson(m.second, convergent, o.level)); });
+    text += "  " + m.first + " vs convergent: " + r_text(c) + "\n";
+    out.push_back(json{{"measure", m.first}, {"correlation", c}});
   }
   return out;
 }
