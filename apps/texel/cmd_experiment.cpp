@@ -414,8 +414,12 @@ void register_experiment(CLI::App& app) {
     std::string format = "png";
     std::size_t reversals = 6;
     double level = 0.95;
+    std::string convergent = "last-presented";
+    std::string memory_rule = "source";
+    double errors_sd = 2.0;
     double recall_chance = 1.0 / 9.0;
     double accuracy_sd = 2.5;
+    std::string confidence_distance = "rater";
     bool json = false;
   };
   auto an = std::make_shared<AnalyzeArgs>();
@@ -426,10 +430,19 @@ void register_experiment(CLI::App& app) {
   analyze_cmd->add_option("--format", an->format, "Figure format: png or svg [png]");
   analyze_cmd->add_option("--reversals", an->reversals, "Threshold = mean of the last K reversals [6]");
   analyze_cmd->add_option("--level", an->level, "Confidence level of t-test intervals and ellipses, 0 … 1 [0.95]");
+  analyze_cmd->add_option("--convergent", an->convergent,
+                          "Staircase end value: last-presented (the source's final value) or next [last-presented]");
+  analyze_cmd->add_option("--memory-rule", an->memory_rule,
+                          "Working-memory outliers: source (errors > mean + k SD without more distraction errors), "
+                          "recall-accuracy (the earlier rule) or none [source]");
+  analyze_cmd->add_option("--memory-errors-sd", an->errors_sd, "Working memory, source rule: k [2]");
   analyze_cmd->add_option("--memory-recall-chance", an->recall_chance,
-                          "Working memory: exclude participants whose digit recall is at or below this; negative = off [1/9]");
+                          "Working memory, recall-accuracy rule: digit recall at or below this; negative = off [1/9]");
   analyze_cmd->add_option("--memory-accuracy-sd", an->accuracy_sd,
-                          "Working memory: exclude participants this many SD from the group's accuracy; 0 = off [2.5]");
+                          "Working memory, recall-accuracy rule: this many SD from the group's accuracy; 0 = off [2.5]");
+  analyze_cmd->add_option("--confidence-distance", an->confidence_distance,
+                          "Free exploration: confidence against the distance to the rater's match (the encoder's "
+                          "estimate) or to the group-mean match [rater]");
   analyze_cmd->add_flag("--json", an->json, "Print the summary as JSON");
   analyze_cmd->callback([an] {
     if (an->db.has_value() == an->csv.has_value()) throw InvalidArgument("analyze: give exactly one of --db FILE or --csv FILE");
@@ -453,8 +466,24 @@ void register_experiment(CLI::App& app) {
     if (!(an->level > 0 && an->level < 1))
       throw InvalidArgument("--level is " + detail::num(an->level) + "; allowed: 0 … 1 (exclusive)");
     o.level = an->level;
+    const auto one_of = [](const std::string& flag, const std::string& v, std::initializer_list<const char*> allowed) {
+      std::string list;
+      for (const char* a : allowed) {
+        if (v == a) return;
+        list += (list.empty() ? "" : ", ") + std::string(a);
+      }
+      throw InvalidArgument(flag + " is '" + v + "'; allowed: " + list);
+    };
+    one_of("--convergent", an->convergent, {"last-presented", "next"});
+    one_of("--memory-rule", an->memory_rule, {"source", "recall-accuracy", "none"});
+    one_of("--confidence-distance", an->confidence_distance, {"rater", "group-mean"});
+    if (!(an->errors_sd > 0)) throw InvalidArgument("--memory-errors-sd is " + detail::num(an->errors_sd) + "; allowed: > 0");
+    o.convergent = an->convergent;
+    o.memory_rule = an->memory_rule;
+    o.memory_errors_sd = an->errors_sd;
     o.memory_recall_chance = an->recall_chance;
     o.memory_accuracy_sd = an->accuracy_sd;
+    o.confidence_distance = an->confidence_distance;
     const ex::AnalysisReport report = ex::analyze(rows, o);
     if (an->json)
       print_json(ordered_json::parse(report.summary));

@@ -85,6 +85,44 @@ std::string fmt_p(double p) {
   return p < 0.001 ? std::string("p < 0.001") : "p = " + texel::detail::fixed(p, 3);
 }
 
+/// A number of a JSON summary (null → NaN).
+double val(const json& j, const char* key) { return j.contains(key) && j[key].is_number() ? j[key].get<double>() : missing; }
+/// Degrees of freedom: whole numbers as such, Welch's to two decimals.
+std::string fmt_df(double df) { return std::abs(df - std::round(df)) < 1e-9 ? fmt(df, 0) : fmt(df, 2); }
+std::string fmt_ci(const json& j, const char* lo = "ci_low", const char* hi = "ci_high") {
+  const double level = j.contains("level") ? val(j, "level") : 0.95;
+  return fmt(level * 100, 0) + " % CI [" + fmt(val(j, lo)) + ", " + fmt(val(j, hi)) + "]";
+}
+/// The source's forms: "t(df) = …, p = …, 95 % CI […]", "F(df1, df2) = …,
+/// p = …", "r = …, p = …, 95 % CI […]"; "skipped: why" for a test that
+/// could not run.
+std::string t_text(const json& t) {
+  if (t.contains("skipped")) return "skipped: " + t["skipped"].get<std::string>();
+  return "t(" + fmt_df(val(t, "df")) + ") = " + fmt(val(t, "t")) + ", " + fmt_p(val(t, "p")) + ", " + fmt_ci(t);
+}
+std::string f_text(double df1, double df2, double f, double p) {
+  return "F(" + fmt_df(df1) + ", " + fmt_df(df2) + ") = " + fmt(f) + ", " + fmt_p(p);
+}
+std::string r_text(const json& c) {
+  if (c.contains("skipped")) return "skipped: " + c["skipped"].get<std::string>();
+  return "r = " + fmt(val(c, "r")) + ", " + fmt_p(val(c, "p")) + " (n = " + std::to_string(c["n"].get<std::size_t>()) + "), " +
+         fmt_ci(c);
+}
+/// One line per effect of an RM-ANOVA summary ("  effect: F(…) = …, p = …,
+/// partial η² = …", Greenhouse–Geisser p where sphericity applies).
+std::string anova_lines(const json& a, const std::string& indent) {
+  if (a.contains("skipped")) return indent + "RM-ANOVA skipped: " + a["skipped"].get<std::string>() + "\n";
+  std::string out;
+  for (const auto& e : a["effects"]) {
+    out += indent + e["effect"].get<std::string>() + ": " + f_text(val(e, "df"), val(e, "df_error"), val(e, "f"), val(e, "p")) +
+           ", partial η² = " + fmt(val(e, "partial_eta2"));
+    if (e["sphericity_applies"].get<bool>())
+      out += " (Greenhouse–Geisser ε = " + fmt(val(e, "gg_epsilon")) + ", " + fmt_p(val(e, "p_gg")) + ")";
+    out += "\n";
+  }
+  return out;
+}
+
 // --------------------------------------------------------------- staircases
 
 /// One staircase run: one participant's block in one session.
@@ -107,20 +145,79 @@ std::vector<Run> staircase_runs(const Rows& rows) {
   return runs;
 }
 
+/// Texel length between groups: each participant belongs to the group of
+/// their runs (the main block's condition). A participant found in more
+/// than one group is listed and left out of the group tests, which assume
+/// independent groups.
+json between_groups(const std::vector<std::string>& groups,
+                    const std::map<std::string, std::map<std::string, double>>& per_participant, const AnalysisOptions& o,
+                    std::string& text) {
+  std::map<std::string, std::vector<std::string>> groups_of;
+  for (const auto& [g, m] : per_participant)
+    for (const auto& [p, v] : m) groups_of[p].push_back(g);
+  json several = json::array();
+  for (const auto& [p, gs] : groups_of)
+    if (gs.size() > 1) several.push_back(p);
+  std::vector<std::vector<double>> values;
+  for (const auto& g : groups) {
+    values.emplace_back();
+    for (const auto& [p, v] : per_participant.at(g))
+      if (groups_of[p].size() == 1) values.back().push_back(v);
+  }
+  json out{{"groups", groups}, {"participants_in_several_groups", several}};
+  out["anova"] = guarded([&] { return stats::view(stats::anova_one_way(values)); });
+  const json& an = out["anova"];
+  text += "  between groups (one-way ANOVA): " +
+          (an.contains("skipped") ? "skipped: " + an["skipped"].get<std::string>()
+                                  : f_text(val(an, "df_between"), val(an, "df_within"), val(an, "f"), val(an, "p")) +
+                                        ", η² = " + fmt(val(an, "eta2"))) +
+          "\n";
+  json tests = json::array();
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    for (std::size_t j = i + 1; j < groups.size(); ++j) {
+      json t = guarded([&] { return stats::view(stats::t_test_two_sample(values[i], values[j], false, o.level)); });
+      json w = guarded([&] { return stats::view(stats::t_test_two_sample(values[i], values[j], true, o.level)); });
+      const std::string cmp = groups[i] + " − " + groups[j];
+      text += "  " + cmp + " (independent t-test): " + t_text(t) + "\n";
+      tests.push_back(json{{"comparison", cmp}, {"student", t}, {"welch", w}});
+    }
+  out["t_tests"] = tests;
+  if (!several.empty())
+    text += "  " + std::to_string(several.size()) + " participant(s) in several groups left out of the group tests\n";
+  return out;
+}
+
+/// Swipe behaviour against the result: each participant's mean of the swipe
+/// measure over their trials against their convergent texel length, Pearson's r.
+json swipe_correlations(const std::vector<std::pair<std::string, std::vector<double>>>& measures,
+                        const std::vector<double>& convergent, const AnalysisOptions& o, std::string& text) {
+  json out = json::array();
+  for (const auto& m : measures) {
+    json c = guarded([&] { return stats::view(stats::pearson(m.second, convergent, o.level)); });
+    text += "  " + m.first + " vs convergent: " + r_text(c) + "\n";
+    out.push_back(json{{"measure", m.first}, {"correlation", c}});
+  }
+  return out;
+}
+
 json staircase_summary(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
   const bool coarse = find_study(study)->blocks_by_fine_strength;
   json out;
   out["variable"] = rows.empty() ? std::string() : rows.front()->variable;
   out["reversals_k"] = o.reversals_k;
+  out["convergent_rule"] = o.convergent;
   json runs = json::array();
   Ordered blocks;
-  // block → participant → values (averaged over that participant's runs)
+  // group (block, or for texel length the block's condition) → participant → values
   std::map<std::string, std::map<std::string, std::vector<double>>> conv, thr;
+  std::map<std::string, std::map<std::string, std::vector<double>>> swipe[3];
   std::map<std::string, double> block_fine;
   for (const Run& run : staircase_runs(rows)) {
-    blocks.add(run.block);
+    const TrialRow& last = *run.rows.back();
+    // Texel length: the group is the block's condition (one group per participant).
+    const std::string group = !coarse && !last.condition.empty() ? last.condition : run.block;
+    blocks.add(group);
     std::vector<double> rev;
-    double dir = 0, speed = 0, speed_sd = 0;
     std::vector<double> dirs, speeds, sds;
     for (const TrialRow* r : run.rows) {
       if (r->reversal) rev.push_back(r->intensity);
@@ -128,11 +225,11 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
       speeds.push_back(r->swipe_mean_speed_mm_s);
       sds.push_back(r->swipe_sd_speed_mm_s);
     }
-    dir = mean_of(dirs), speed = mean_of(speeds), speed_sd = mean_of(sds);
-    const TrialRow& last = *run.rows.back();
-    // The convergent value is the one computed after the last answer; a run
-    // stopped before that was stored falls back to the last presented value.
-    const double convergent = std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
+    const double dir = mean_of(dirs), speed = mean_of(speeds), speed_sd = mean_of(sds);
+    // The source's end value is the last one presented; "next" takes the one
+    // computed after the last answer (falling back to the last presented
+    // when it was not stored).
+    const double convergent = o.convergent == "next" && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
     const std::size_t used = std::min(o.reversals_k, rev.size());
     std::vector<double> tail(rev.end() - static_cast<std::ptrdiff_t>(used), rev.end());
     const double threshold = mean_of(tail);
@@ -140,6 +237,8 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     if (coarse) {
       j["fine_strength"] = num(last.fine_strength);
       block_fine[run.block] = last.fine_strength;
+    } else {
+      j["group"] = group;
     }
     j["trials"] = run.rows.size();
     j["finished"] = last.procedure_finished;
@@ -152,16 +251,19 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
       j["directional_proportion"] = num(dir);
       j["swipe_mean_speed_mm_s"] = num(speed);
       j["swipe_sd_speed_mm_s"] = num(speed_sd);
+      swipe[0][group][run.participant].push_back(speed);
+      swipe[1][group][run.participant].push_back(speed_sd);
+      swipe[2][group][run.participant].push_back(dir);
     }
     runs.push_back(std::move(j));
-    conv[run.block][run.participant].push_back(convergent);
-    thr[run.block][run.participant].push_back(threshold);
+    conv[group][run.participant].push_back(convergent);
+    thr[group][run.participant].push_back(threshold);
   }
   out["runs"] = runs;
   json bj = json::array();
   std::vector<stats::Observation> obs;
-  std::map<std::string, std::map<std::string, double>> per_participant;  // block → participant → convergent
-  text += study + ": " + std::to_string(runs.size()) + " staircase runs\n";
+  std::map<std::string, std::map<std::string, double>> per_participant;  // group → participant → convergent
+  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + o.convergent + ")\n";
   for (const std::string& b : blocks.names) {
     std::vector<double> cv, tv;
     for (const auto& [p, v] : conv[b]) {
@@ -176,32 +278,36 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     e["convergent"] = describe_json(cv);
     e["threshold_last_k"] = describe_json(tv);
     const auto d = stats::describe(cv);
-    text += "  " + b + ": convergent " + fmt(d.mean) + " ± " + fmt(d.sd) + " (mean ± SD, n = " + std::to_string(d.n) + ")\n";
+    text += "  " + b + ": convergent " + fmt(d.mean) + " ± " + fmt(d.sd) + " (mean ± SD, n = " + std::to_string(d.n) + ", " +
+            fmt(0.95 * 100, 0) + " % CI [" + fmt(d.ci95_low) + ", " + fmt(d.ci95_high) + "])\n";
     bj.push_back(std::move(e));
   }
   out["blocks"] = bj;
-  // Group test across blocks: a paired t-test for two blocks (narrow vs
-  // wide), a one-factor RM-ANOVA for more (fine strength 0/50/100 %).
-  if (blocks.names.size() == 2) {
-    const std::string &a = blocks.names[0], &b = blocks.names[1];
-    std::vector<double> va, vb;
-    for (const auto& [p, v] : per_participant[a])
-      if (per_participant[b].count(p)) va.push_back(v), vb.push_back(per_participant[b][p]);
-    json t = guarded([&] { return ttest_json(stats::t_test_paired(va, vb, o.level)); });
-    t["comparison"] = a + " − " + b;
-    out["paired_t_test"] = t;
-    if (t.contains("p"))
-      text += "  paired t-test " + a + " − " + b + ": " + fmt_p(t["p"].is_null() ? missing : t["p"].get<double>()) + "\n";
-  } else if (blocks.names.size() > 2) {
-    // Only participants with every block enter the ANOVA.
-    std::vector<stats::Observation> complete;
-    for (const auto& ob : obs) {
-      bool all = true;
-      for (const auto& b : blocks.names) all = all && per_participant[b].count(ob.subject);
-      if (all) complete.push_back(ob);
-    }
-    out["rm_anova"] = guarded([&] { return anova_json(stats::rm_anova(complete, {coarse ? "fine_strength" : "block"})); });
+  if (!coarse) {
+    // Texel length: separate groups of participants (narrow, wide, wide with
+    // visual practice), so the tests are between groups, never paired.
+    if (blocks.names.size() >= 2) out["between_groups"] = between_groups(blocks.names, per_participant, o, text);
+    std::vector<double> cv;
+    std::vector<std::pair<std::string, std::vector<double>>> m{
+        {"swipe_mean_speed_mm_s", {}}, {"swipe_sd_speed_mm_s", {}}, {"directional_proportion", {}}};
+    for (const auto& b : blocks.names)
+      for (const auto& [p, v] : per_participant[b]) {
+        cv.push_back(v);
+        for (int k = 0; k < 3; ++k) m[static_cast<std::size_t>(k)].second.push_back(mean_of(swipe[k][b][p]));
+      }
+    out["swipe_vs_convergent"] = swipe_correlations(m, cv, o, text);
+    return out;
   }
+  // Coarse features: one-factor RM-ANOVA over the fine strengths on the
+  // participants who completed every block.
+  std::vector<stats::Observation> complete;
+  for (const auto& ob : obs) {
+    bool all = true;
+    for (const auto& b : blocks.names) all = all && per_participant[b].count(ob.subject);
+    if (all) complete.push_back(ob);
+  }
+  out["rm_anova"] = guarded([&] { return anova_json(stats::rm_anova(complete, {"fine_strength"})); });
+  text += anova_lines(out["rm_anova"], "  ");
   return out;
 }
 
@@ -260,9 +366,12 @@ void matching_summary(const Rows& matches, const AnalysisOptions& o, json& out, 
   out["references"] = rj;
   json mj = json::array();
   std::vector<double> dist, conf;
+  const bool to_rater = o.confidence_distance == "rater";
   for (const TrialRow* r : matches) {
     const auto [cp, ci] = centre[r->reference];
     const double d = std::hypot(r->pitch_db - cp, r->irregularity_db - ci);
+    // The trained rater's match: the encoder's estimate of the reference stands in ([choice]).
+    const double d_rater = std::hypot(r->pitch_db - r->reference_pitch_db, r->irregularity_db - r->reference_irregularity_db);
     json m{{"participant", r->participant},
            {"session_id", r->session_id},
            {"reference", r->reference},
@@ -270,51 +379,135 @@ void matching_summary(const Rows& matches, const AnalysisOptions& o, json& out, 
            {"irregularity_db", num(r->irregularity_db)},
            {"reference_pitch_db", num(r->reference_pitch_db)},
            {"reference_irregularity_db", num(r->reference_irregularity_db)},
-           {"distance_db", num(d)}};
+           {"distance_db", num(d)},
+           {"distance_to_rater_db", num(d_rater)}};
     if (std::isfinite(r->slider_p)) m["slider_p"] = r->slider_p;
     if (std::isfinite(r->slider_i)) m["slider_i"] = r->slider_i;
     if (std::isfinite(r->confidence)) {
       m["confidence"] = r->confidence;
-      if (std::isfinite(d)) dist.push_back(d), conf.push_back(r->confidence);
+      const double x = to_rater ? d_rater : d;
+      if (std::isfinite(x)) dist.push_back(x), conf.push_back(r->confidence);
     }
     mj.push_back(std::move(m));
   }
   out["matches"] = mj;
   if (!conf.empty()) {
-    // Pearson r of confidence with distance, t-test of r = 0 (n − 2 df).
-    json c{{"n", conf.size()}};
-    const double mc = mean_of(conf), md = mean_of(dist);
-    double sxy = 0, sxx = 0, syy = 0;
-    for (std::size_t k = 0; k < conf.size(); ++k) {
-      sxy += (conf[k] - mc) * (dist[k] - md);
-      sxx += (conf[k] - mc) * (conf[k] - mc);
-      syy += (dist[k] - md) * (dist[k] - md);
-    }
-    if (conf.size() < 3 || sxx <= 0 || syy <= 0) {
-      c["skipped"] = "needs at least 3 matches with varying confidence and distance; got " + std::to_string(conf.size());
-    } else {
-      const double r = std::clamp(sxy / std::sqrt(sxx * syy), -1.0, 1.0);
-      const double df = static_cast<double>(conf.size() - 2);
-      c["pearson_r"] = r;
-      if (std::abs(r) < 1) {
-        const double t = r * std::sqrt(df / (1 - r * r));
-        const boost::math::students_t dist_t(df);
-        c["t"] = t;
-        c["df"] = df;
-        c["p"] = 2 * boost::math::cdf(boost::math::complement(dist_t, std::abs(t)));
-      } else {
-        c["p"] = 0.0;
-      }
-      text += "  confidence vs distance: r = " + fmt(r) + ", " + fmt_p(c["p"].get<double>()) + "\n";
-    }
+    // Pearson r of confidence with the distance (from the rater's match by
+    // default), t-test of r = 0 (n − 2 df), Fisher-z CI.
+    json c{{"distance_to", to_rater ? "rater" : "group-mean"}};
+    c.update(guarded([&] { return stats::view(stats::pearson(conf, dist, o.level)); }));
+    text += "  confidence vs distance to the " + std::string(to_rater ? "rater's match" : "mean match") + ": " + r_text(c) + "\n";
     out["confidence_vs_distance"] = c;
   }
+}
+
+/// The rendering a rating row shows: "rendering:<name>" = the match of
+/// reference <name>; "match", "own" or empty = the participant's match of
+/// the reference felt.
+std::string rendering_of(const TrialRow& r) {
+  const std::string prefix = "rendering:";
+  if (r.condition.rfind(prefix, 0) == 0) return r.condition.substr(prefix.size());
+  if (r.condition.empty() || r.condition == "match" || r.condition == "own") return r.reference;
+  return r.condition;
+}
+
+/// Similarity matrix of rating rows: rows = reference felt, columns = whose
+/// rendering was shown; mean over participants of each participant's mean;
+/// own (diagonal) vs other renderings, paired per participant.
+json similarity_matrix(const Rows& ratings, Ordered names, const AnalysisOptions& o, std::string& text) {
+  Ordered rendering_names = names;
+  for (const TrialRow* r : ratings) {
+    names.add(r->reference);
+    rendering_names.add(rendering_of(*r));
+  }
+  std::map<std::string, std::map<std::pair<std::size_t, std::size_t>, std::vector<double>>> cell;  // participant → (row, col)
+  for (const TrialRow* r : ratings)
+    cell[r->participant][{names.add(r->reference), rendering_names.add(rendering_of(*r))}].push_back(r->rating);
+  const std::size_t nr = names.names.size(), nc = rendering_names.names.size();
+  json mean = json::array(), count = json::array();
+  std::size_t rated = 0;
+  for (std::size_t i = 0; i < nr; ++i) {
+    json mrow = json::array(), crow = json::array();
+    for (std::size_t j = 0; j < nc; ++j) {
+      std::vector<double> m;
+      for (auto& [p, c] : cell)
+        if (c.count({i, j})) m.push_back(mean_of(c[{i, j}]));
+      mrow.push_back(num(mean_of(m)));
+      crow.push_back(m.size());
+      rated += m.empty() ? 0 : 1;
+    }
+    mean.push_back(mrow);
+    count.push_back(crow);
+  }
+  // Does a reference's own rendering feel more like it than the others' do?
+  // Per participant: mean diagonal vs mean off-diagonal rating.
+  std::vector<double> diag, off;
+  for (auto& [p, c] : cell) {
+    std::vector<double> d, f;
+    for (auto& [ij, x] : c) {
+      const bool same = names.names[ij.first] == rendering_names.names[ij.second];
+      (same ? d : f).push_back(mean_of(x));
+    }
+    if (!d.empty() && !f.empty()) diag.push_back(mean_of(d)), off.push_back(mean_of(f));
+  }
+  json sim{{"references", names.names}, {"renderings", rendering_names.names},
+           {"pairs_rated", rated},      {"pairs_possible", nr * nc},
+           {"mean_rating", mean},       {"participants", count}};
+  text +=
+      "  similarity ratings: " + std::to_string(rated) + " of " + std::to_string(nr * nc) + " reference/rendering pairs rated\n";
+  if (diag.empty()) {
+    sim["own_vs_other_t_test"] = skipped("no participant rated both own and other renderings");
+    text += "  own vs other renderings: skipped (no participant rated both own and other renderings)\n";
+  } else {
+    json t = guarded([&] { return ttest_json(stats::t_test_paired(diag, off, o.level)); });
+    t["comparison"] = "own rendering − other renderings";
+    sim["own_vs_other_t_test"] = t;
+    text += "  own rendering " + fmt(mean_of(diag)) + " vs others " + fmt(mean_of(off)) + " (paired): " + t_text(t) + "\n";
+  }
+  return sim;
+}
+
+/// Irregularity normalised per participant: each participant's matched
+/// Irregularity (slider position where the rows have one, else dB) rescaled
+/// to 0 … 1 over that participant's own matches (min → 0, max → 1), so
+/// participants who used different parts of the slider compare.
+json irregularity_normalised(const Rows& matches, std::string& text) {
+  std::map<std::string, std::vector<const TrialRow*>> by_participant;
+  Ordered refs;
+  for (const TrialRow* r : matches) {
+    by_participant[r->participant].push_back(r);
+    refs.add(r->reference);
+  }
+  std::map<std::string, std::map<std::string, std::vector<double>>> v;  // reference → participant → values
+  bool sliders = true;
+  for (const TrialRow* r : matches) sliders = sliders && std::isfinite(r->slider_i);
+  for (auto& [p, rs] : by_participant) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (const TrialRow* r : rs) {
+      const double x = sliders ? r->slider_i : r->irregularity_db;
+      if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+    }
+    for (const TrialRow* r : rs) {
+      const double x = sliders ? r->slider_i : r->irregularity_db;
+      v[r->reference][p].push_back(hi > lo ? (x - lo) / (hi - lo) : missing);
+    }
+  }
+  json per = json::array();
+  for (const auto& name : refs.names) {
+    std::vector<double> m;
+    for (const auto& [p, x] : v[name]) m.push_back(mean_of(x));
+    per.push_back(json{{"reference", name}, {"irregularity_normalised", describe_json(m)}});
+  }
+  text += "  Irregularity normalised per participant (0 = their lowest match, 1 = their highest; from " +
+          std::string(sliders ? "slider positions" : "dB") + ")\n";
+  return json{{"from", sliders ? "slider_i" : "irregularity_db"}, {"references", per}};
 }
 
 json ratings_by_reference(const Rows& ratings) {
   Ordered refs;
   std::map<std::string, std::map<std::string, std::vector<double>>> v;  // reference → participant → ratings
   for (const TrialRow* r : ratings) {
+    if (rendering_of(*r) != r->reference) continue;  // own match only; the matrix has the rest
     refs.add(r->reference);
     v[r->reference][r->participant].push_back(r->rating);
   }
@@ -335,7 +528,13 @@ json match_study(const std::string& study, const Rows& rows, const AnalysisOptio
   }
   json out = json::object();
   matching_summary(matches, o, out, text, study);
-  if (!ratings.empty()) out["ratings"] = ratings_by_reference(ratings);
+  if (study == "parameter-mapping" && !matches.empty()) out["irregularity_normalised"] = irregularity_normalised(matches, text);
+  if (!ratings.empty()) {
+    out["ratings"] = ratings_by_reference(ratings);
+    Ordered names;
+    for (const TrialRow* r : matches) names.add(r->reference);
+    out["similarity"] = similarity_matrix(ratings, names, o, text);
+  }
   return out;
 }
 
@@ -373,8 +572,7 @@ json quantization_summary(const Rows& rows, const AnalysisOptions& o, std::strin
     cj.push_back(json{{"condition", c}, {"quantization_db", num(level_db[c])}, {"rating", describe_json(m)}});
   }
   out["conditions"] = cj;
-  // Change = rating(level) − rating(unquantized) per participant × reference,
-  // averaged over references per participant, tested against 0.
+  // Pooled over references, described only: the tests are per texture (below).
   json ch = json::array();
   json pj = json::array();
   std::map<std::string, json> per_participant;
@@ -389,18 +587,57 @@ json quantization_summary(const Rows& rows, const AnalysisOptions& o, std::strin
       changes.push_back(mean_of(x));
       per_participant[p][c] = num(changes.back());
     }
-    json e{{"condition", c}, {"quantization_db", num(level_db[c])}, {"change", describe_json(changes)}};
-    e["t_test"] = guarded([&] { return ttest_json(stats::t_test_one_sample(changes, 0.0, o.level)); });
-    std::string line = "  " + c + " vs unquantized: change " + fmt(mean_of(changes));
-    if (e["t_test"].contains("p") && !e["t_test"]["p"].is_null())
-      line += ", t(" + fmt(e["t_test"]["df"].get<double>(), 0) + ") = " + fmt(e["t_test"]["t"].get<double>()) + ", " +
-              fmt_p(e["t_test"]["p"].get<double>());
-    text += line + "\n";
-    ch.push_back(std::move(e));
+    ch.push_back(json{{"condition", c}, {"quantization_db", num(level_db[c])}, {"change", describe_json(changes)}});
   }
   out["changes"] = ch;
   for (auto& [p, j] : per_participant) pj.push_back(json{{"participant", p}, {"changes", j}});
   out["participants"] = pj;
+
+  // Per texture (a reference rated quantized): repeated-measures ANOVA of
+  // the rating over the levels (unquantized first), on the participants who
+  // rated every level of it, and per level a one-sample t-test of the change
+  // rating(level) − rating(unquantized) against 0.
+  Ordered textures;
+  for (const TrialRow* r : rows)
+    if (r->task == "rating" && r->condition != "unquantized") textures.add(r->reference);
+  json tj = json::array();
+  for (const auto& tex : textures.names) {
+    std::vector<std::string> tex_levels;
+    for (const auto& c : levels)
+      for (auto& [p, refs] : v)
+        if (refs.count(tex) && refs[tex].count(c)) {
+          tex_levels.push_back(c);
+          break;
+        }
+    std::vector<std::string> all_levels{"unquantized"};
+    all_levels.insert(all_levels.end(), tex_levels.begin(), tex_levels.end());
+    std::vector<stats::Observation> obs;
+    for (auto& [p, refs] : v) {
+      if (!refs.count(tex)) continue;
+      auto& conds = refs[tex];
+      bool complete = true;
+      for (const auto& c : all_levels) complete = complete && conds.count(c);
+      if (!complete) continue;
+      for (const auto& c : all_levels) obs.push_back({p, {c}, mean_of(conds[c])});
+    }
+    json e{{"reference", tex}, {"levels", all_levels}};
+    e["rm_anova"] = guarded([&] { return anova_json(stats::rm_anova(obs, {"quantization"})); });
+    text += "  " + tex + ":\n" + anova_lines(e["rm_anova"], "    ");
+    json lc = json::array();
+    for (const auto& c : tex_levels) {
+      std::vector<double> changes;
+      for (auto& [p, refs] : v)
+        if (refs.count(tex) && refs[tex].count(c) && refs[tex].count("unquantized"))
+          changes.push_back(mean_of(refs[tex][c]) - mean_of(refs[tex]["unquantized"]));
+      json l{{"condition", c}, {"quantization_db", num(level_db[c])}, {"change", describe_json(changes)}};
+      l["t_test"] = guarded([&] { return ttest_json(stats::t_test_one_sample(changes, 0.0, o.level)); });
+      text += "    " + c + " − unquantized: change " + fmt(mean_of(changes)) + ", " + t_text(l["t_test"]) + "\n";
+      lc.push_back(std::move(l));
+    }
+    e["changes"] = lc;
+    tj.push_back(std::move(e));
+  }
+  out["textures"] = tj;
   return out;
 }
 
@@ -435,94 +672,156 @@ json guided_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   if (!unfinished.empty()) out["unfinished"] = unfinished;
   if (ratings.empty()) return out;
 
-  // Similarity matrix: rows = reference felt, columns = whose optimized
-  // rendering was shown; a participant's repeated ratings are averaged first.
-  const std::string prefix = "rendering:";
-  Ordered rendering_names = names;
-  for (const TrialRow* r : ratings) {
-    names.add(r->reference);
-    rendering_names.add(r->condition.rfind(prefix, 0) == 0 ? r->condition.substr(prefix.size()) : r->condition);
-  }
-  std::map<std::string, std::map<std::pair<std::size_t, std::size_t>, std::vector<double>>> cell;  // participant → (row, col)
-  for (const TrialRow* r : ratings) {
-    const std::string rend = r->condition.rfind(prefix, 0) == 0 ? r->condition.substr(prefix.size()) : r->condition;
-    cell[r->participant][{names.add(r->reference), rendering_names.add(rend)}].push_back(r->rating);
-  }
-  const std::size_t nr = names.names.size(), nc = rendering_names.names.size();
-  json mean = json::array(), count = json::array();
-  for (std::size_t i = 0; i < nr; ++i) {
-    json mrow = json::array(), crow = json::array();
-    for (std::size_t j = 0; j < nc; ++j) {
-      std::vector<double> m;
-      for (auto& [p, c] : cell)
-        if (c.count({i, j})) m.push_back(mean_of(c[{i, j}]));
-      mrow.push_back(num(mean_of(m)));
-      crow.push_back(m.size());
-    }
-    mean.push_back(mrow);
-    count.push_back(crow);
-  }
-  // Does a reference's own optimized rendering feel more like it than the
-  // others' do? Per participant: mean diagonal vs mean off-diagonal rating.
-  std::vector<double> diag, off;
-  for (auto& [p, c] : cell) {
-    std::vector<double> d, f;
-    for (auto& [ij, x] : c) {
-      const bool same = names.names[ij.first] == rendering_names.names[ij.second];
-      (same ? d : f).push_back(mean_of(x));
-    }
-    if (!d.empty() && !f.empty()) diag.push_back(mean_of(d)), off.push_back(mean_of(f));
-  }
-  json sim{{"references", names.names}, {"renderings", rendering_names.names}, {"mean_rating", mean}, {"participants", count}};
-  json t = guarded([&] { return ttest_json(stats::t_test_paired(diag, off, o.level)); });
-  t["comparison"] = "own rendering − other renderings";
-  sim["own_vs_other_t_test"] = t;
-  out["similarity"] = sim;
-  text += "  similarity: own rendering " + fmt(mean_of(diag)) + " vs others " + fmt(mean_of(off));
-  if (t.contains("p") && !t["p"].is_null()) text += ", paired " + fmt_p(t["p"].get<double>());
-  text += "\n";
+  out["similarity"] = similarity_matrix(ratings, names, o, text);
   return out;
 }
 
 // ----------------------------------------------------------- working memory
 
-json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& text) {
-  struct Person {
-    std::vector<double> all, recall;
-    std::map<std::string, std::vector<double>> cond;
-  };
-  std::map<std::string, Person> people;
-  Ordered conditions;
-  for (const TrialRow* r : rows) {
-    if (r->task != "same-different") continue;
-    Person& p = people[r->participant];
-    conditions.add(r->condition);
-    p.all.push_back(r->correct);
-    p.cond[r->condition].push_back(r->correct);
-    if (r->condition.ends_with("-distractor")) p.recall.push_back(r->digit_correct);
+struct MemoryPerson {
+  std::vector<double> all, recall;
+  std::map<std::string, std::vector<double>> cond;
+  double main_errors = 0, distraction_errors = 0;
+};
+using Excluded = std::map<std::string, std::string>;  // participant → reason
+
+/// The source's rule: main-task (same/different) errors more than k SDs
+/// above the group's mean, without any increase in distraction-task (digit
+/// recall) errors — read as: their distraction errors are not above the
+/// group's mean. Mean and SD over every participant, computed once.
+Excluded source_rule(const std::map<std::string, MemoryPerson>& people, double k, json& stats_out) {
+  std::vector<double> main, distraction;
+  for (const auto& [id, p] : people) {
+    main.push_back(p.main_errors);
+    if (!p.recall.empty()) distraction.push_back(p.distraction_errors);
   }
-  json out = json::object();
-  out["outlier_rule"] = json{{"recall_chance", o.memory_recall_chance}, {"accuracy_sd", o.memory_accuracy_sd}};
-  // Rule 1: distractor recall at or below chance → the distractor was ignored.
-  std::map<std::string, std::string> excluded;
-  for (auto& [id, p] : people) {
+  const auto dm = stats::describe(main), dd = stats::describe(distraction);
+  const double limit = dm.mean + k * dm.sd;
+  stats_out = json{{"main_errors_mean", num(dm.mean)},
+                   {"main_errors_sd", num(dm.sd)},
+                   {"main_errors_limit", num(limit)},
+                   {"distraction_errors_mean", num(dd.mean)}};
+  Excluded out;
+  if (!(dm.sd > 0)) return out;
+  for (const auto& [id, p] : people) {
+    if (!(p.main_errors > limit)) continue;
+    // No recall data: no increase can be shown, so the main-task errors stand alone.
+    const bool increase = !p.recall.empty() && std::isfinite(dd.mean) && p.distraction_errors > dd.mean;
+    if (increase) continue;
+    out[id] = fmt(p.main_errors, 0) + " main-task errors > mean + " + fmt(k, 1) + " SD = " + fmt(limit) +
+              " without more distraction errors (" + fmt(p.distraction_errors, 0) + ") than the mean (" + fmt(dd.mean) + ")";
+  }
+  return out;
+}
+
+/// The earlier [choice]: digit recall at or below chance, then overall
+/// accuracy beyond k SD of the remaining participants (one pass).
+Excluded recall_accuracy_rule(const std::map<std::string, MemoryPerson>& people, const AnalysisOptions& o) {
+  Excluded excluded;
+  for (const auto& [id, p] : people) {
     const double rec = mean_of(p.recall);
     if (o.memory_recall_chance >= 0 && std::isfinite(rec) && rec <= o.memory_recall_chance + 1e-12)
       excluded[id] = "distractor recall " + fmt(rec) + " <= chance " + fmt(o.memory_recall_chance, 3);
   }
-  // Rule 2: overall accuracy beyond k SD of the remaining group (one pass).
   if (o.memory_accuracy_sd > 0) {
     std::vector<double> acc;
-    for (auto& [id, p] : people)
+    for (const auto& [id, p] : people)
       if (!excluded.count(id)) acc.push_back(mean_of(p.all));
     const auto d = stats::describe(acc);
     if (d.n >= 3 && d.sd > 0)
-      for (auto& [id, p] : people) {
+      for (const auto& [id, p] : people) {
         const double z = (mean_of(p.all) - d.mean) / d.sd;
         if (!excluded.count(id) && std::abs(z) > o.memory_accuracy_sd)
           excluded[id] = "accuracy " + fmt(mean_of(p.all)) + " is " + fmt(z) + " SD from the group mean";
       }
   }
+  return excluded;
+}
+
+std::pair<std::string, std::string> split_condition(const std::string& c) {
+  const auto dash = c.rfind('-');
+  return dash == std::string::npos ? std::pair{c, std::string()} : std::pair{c.substr(0, dash), c.substr(dash + 1)};
+}
+
+/// The 2 × 2 analysis on the participants a rule keeps: RM-ANOVA (Type III),
+/// per spacing a paired t-test distractor − control, and R².
+json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::vector<std::string>& conditions,
+                  const Excluded& excluded, const AnalysisOptions& o) {
+  std::vector<stats::Observation> obs;
+  std::map<std::string, std::map<std::string, std::map<std::string, double>>> by;  // spacing → kind → participant → accuracy
+  for (const auto& c : conditions) {
+    const auto [spacing, kind] = split_condition(c);
+    for (const auto& [id, p] : people)
+      if (!excluded.count(id) && p.cond.count(c)) {
+        const double acc = mean_of(p.cond.at(c));
+        obs.push_back({id, {spacing, kind}, acc});
+        by[spacing][kind][id] = acc;
+      }
+  }
+  json out;
+  out["rm_anova"] = guarded([&] { return anova_json(stats::rm_anova(obs, {"spacing", "distractor"})); });
+  // R² [choice]: share of the variance of the participant × condition scores
+  // explained by the 2 × 2 effects (SS_effects / SS_total, as a univariate
+  // model of the four cell means reports it); with_subjects adds the
+  // participants' own levels to the model.
+  if (out["rm_anova"].contains("effects")) {
+    std::vector<double> all;
+    std::map<std::string, std::vector<double>> per;
+    for (const auto& ob : obs) all.push_back(ob.value), per[ob.subject].push_back(ob.value);
+    const double grand = mean_of(all);
+    double ss_total = 0, ss_effects = 0, ss_subjects = 0;
+    for (double x : all) ss_total += (x - grand) * (x - grand);
+    for (const auto& e : out["rm_anova"]["effects"]) ss_effects += val(e, "ss");
+    for (const auto& [id, v] : per) ss_subjects += static_cast<double>(v.size()) * (mean_of(v) - grand) * (mean_of(v) - grand);
+    out["r2"] = json{{"r2", num(ss_total > 0 ? ss_effects / ss_total : missing)},
+                     {"r2_with_subjects", num(ss_total > 0 ? (ss_effects + ss_subjects) / ss_total : missing)}};
+  } else {
+    out["r2"] = skipped("the ANOVA did not run");
+  }
+  json tests = json::array();
+  for (auto& [spacing, kinds] : by) {
+    std::vector<double> d, c;
+    if (kinds.count("distractor") && kinds.count("control"))
+      for (const auto& [id, x] : kinds["distractor"])
+        if (kinds["control"].count(id)) d.push_back(x), c.push_back(kinds["control"][id]);
+    json t = guarded([&] { return ttest_json(stats::t_test_paired(d, c, o.level)); });
+    t["comparison"] = "distractor − control";
+    tests.push_back(json{{"spacing", spacing}, {"t_test", t}});
+  }
+  out["spacing_t_tests"] = tests;
+  return out;
+}
+
+json excluded_list(const Excluded& e) {
+  json out = json::array();
+  for (const auto& [id, why] : e) out.push_back(json{{"participant", id}, {"reason", why}});
+  return out;
+}
+
+json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& text) {
+  std::map<std::string, MemoryPerson> people;
+  Ordered conditions;
+  for (const TrialRow* r : rows) {
+    if (r->task != "same-different") continue;
+    MemoryPerson& p = people[r->participant];
+    conditions.add(r->condition);
+    p.all.push_back(r->correct);
+    p.cond[r->condition].push_back(r->correct);
+    if (r->correct == 0) p.main_errors += 1;
+    if (r->condition.ends_with("-distractor") && std::isfinite(r->digit_correct)) {
+      p.recall.push_back(r->digit_correct);
+      if (r->digit_correct == 0) p.distraction_errors += 1;
+    }
+  }
+  json out = json::object();
+  json source_stats;
+  const Excluded by_source = source_rule(people, o.memory_errors_sd, source_stats);
+  const Excluded by_recall = recall_accuracy_rule(people, o);
+  const Excluded& excluded = o.memory_rule == "source" ? by_source : o.memory_rule == "none" ? Excluded{} : by_recall;
+  out["outlier_rule"] = json{{"rule", o.memory_rule},
+                             {"errors_sd", o.memory_errors_sd},
+                             {"recall_chance", o.memory_recall_chance},
+                             {"accuracy_sd", o.memory_accuracy_sd}};
   json pj = json::array();
   for (auto& [id, p] : people) {
     json c = json::object();
@@ -531,43 +830,56 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
                       {"trials", p.all.size()},
                       {"accuracy", num(mean_of(p.all))},
                       {"recall_accuracy", num(mean_of(p.recall))},
+                      {"main_errors", p.main_errors},
+                      {"distraction_errors", p.recall.empty() ? json(nullptr) : json(p.distraction_errors)},
                       {"conditions", c},
-                      {"excluded", excluded.count(id) ? json(excluded[id]) : json(false)}});
+                      {"excluded", excluded.count(id) ? json(excluded.at(id)) : json(false)}});
   }
   out["participants"] = pj;
   out["included"] = people.size() - excluded.size();
-  // Conditions in a fixed 2 × 2 order where they are the standard labels.
-  std::vector<std::string> cnames = conditions.names;
-  const auto split = [](const std::string& c) {
-    const auto dash = c.rfind('-');
-    return dash == std::string::npos ? std::pair{c, std::string()} : std::pair{c.substr(0, dash), c.substr(dash + 1)};
-  };
   json cj = json::array();
-  std::vector<stats::Observation> obs;
-  for (const auto& c : cnames) {
+  for (const auto& c : conditions.names) {
     std::vector<double> v;
     for (auto& [id, p] : people)
-      if (!excluded.count(id) && p.cond.count(c)) {
-        v.push_back(mean_of(p.cond[c]));
-        const auto [spacing, distractor] = split(c);
-        obs.push_back({id, {spacing, distractor}, v.back()});
-      }
-    const auto [spacing, distractor] = split(c);
+      if (!excluded.count(id) && p.cond.count(c)) v.push_back(mean_of(p.cond[c]));
+    const auto [spacing, distractor] = split_condition(c);
     cj.push_back(json{{"condition", c}, {"spacing", spacing}, {"distractor", distractor}, {"accuracy", describe_json(v)}});
   }
   out["conditions"] = cj;
-  out["rm_anova"] = guarded([&] { return anova_json(stats::rm_anova(obs, {"spacing", "distractor"})); });
-  text +=
-      "working-memory: " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) + " excluded\n";
+  const json tests = memory_tests(people, conditions.names, excluded, o);
+  out.update(tests);
+  // What each rule excludes, and what the interaction test becomes under it.
+  json rules = json::array();
+  for (const auto& [name, ex] :
+       {std::pair<std::string, const Excluded*>{"source", &by_source}, {"recall-accuracy", &by_recall}}) {
+    json r{{"rule", name}, {"excluded", excluded_list(*ex)}, {"included", people.size() - ex->size()}};
+    if (name == "source") r["thresholds"] = source_stats;
+    r["rm_anova"] = memory_tests(people, conditions.names, *ex, o)["rm_anova"];
+    rules.push_back(std::move(r));
+  }
+  out["rules_compared"] = rules;
+
+  text += "working-memory: " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) +
+          " excluded (rule: " + o.memory_rule + ")\n";
+  for (const auto& [id, why] : excluded) text += "  excluded " + id + ": " + why + "\n";
   for (const auto& c : cj)
-    text += "  " + c["condition"].get<std::string>() + ": " +
-            fmt(c["accuracy"]["mean"].is_null() ? missing : c["accuracy"]["mean"].get<double>()) + " correct\n";
-  if (out["rm_anova"].contains("effects"))
-    for (const auto& e : out["rm_anova"]["effects"])
-      text += "  " + e["effect"].get<std::string>() + ": F(" + fmt(e["df"].is_null() ? missing : e["df"].get<double>(), 0) +
-              ", " + fmt(e["df_error"].is_null() ? missing : e["df_error"].get<double>(), 0) +
-              ") = " + fmt(e["f"].is_null() ? missing : e["f"].get<double>()) + ", " +
-              fmt_p(e["p"].is_null() ? missing : e["p"].get<double>()) + "\n";
+    text += "  " + c["condition"].get<std::string>() + ": " + fmt(val(c["accuracy"], "mean")) + " correct (SEM " +
+            fmt(val(c["accuracy"], "sem")) + ")\n";
+  text += anova_lines(out["rm_anova"], "  ");
+  if (out["r2"].contains("r2"))
+    text += "  R² = " + fmt(val(out["r2"], "r2")) + " (with participants: " + fmt(val(out["r2"], "r2_with_subjects")) + ")\n";
+  for (const auto& t : out["spacing_t_tests"])
+    text += "  " + t["spacing"].get<std::string>() + " spacing, distractor − control (paired): " + t_text(t["t_test"]) + "\n";
+  for (const auto& r : rules) {
+    std::string ids;
+    for (const auto& e : r["excluded"]) ids += (ids.empty() ? "" : ", ") + e["participant"].get<std::string>();
+    text += "  rule " + r["rule"].get<std::string>() + " excludes " + (ids.empty() ? std::string("nobody") : ids);
+    if (r["rm_anova"].contains("effects"))
+      for (const auto& e : r["rm_anova"]["effects"])
+        if (e["effect"].get<std::string>().find(':') != std::string::npos)
+          text += "; interaction " + f_text(val(e, "df"), val(e, "df_error"), val(e, "f"), val(e, "p"));
+    text += "\n";
+  }
   return out;
 }
 
@@ -576,12 +888,46 @@ void check_options(const AnalysisOptions& o) {
   if (o.reversals_k < 1) throw InvalidArgument("analysis reversals_k is 0; must be >= 1");
   if (!(o.level > 0 && o.level < 1))
     throw InvalidArgument("analysis level is " + texel::detail::num(o.level) + "; allowed (0, 1)");
+  if (o.convergent != "last-presented" && o.convergent != "next")
+    throw InvalidArgument("analysis convergent is '" + o.convergent + "'; allowed: last-presented, next");
+  if (o.memory_rule != "source" && o.memory_rule != "recall-accuracy" && o.memory_rule != "none")
+    throw InvalidArgument("analysis memory_rule is '" + o.memory_rule + "'; allowed: source, recall-accuracy, none");
+  if (!(o.memory_errors_sd > 0) || !std::isfinite(o.memory_errors_sd))
+    throw InvalidArgument("analysis memory_errors_sd is " + texel::detail::num(o.memory_errors_sd) + "; allowed > 0");
   if (!std::isfinite(o.memory_recall_chance) || o.memory_recall_chance >= 1)
     throw InvalidArgument("analysis memory_recall_chance is " + texel::detail::num(o.memory_recall_chance) +
                           "; allowed < 1 (negative = rule off)");
   if (!(o.memory_accuracy_sd >= 0) || !std::isfinite(o.memory_accuracy_sd))
     throw InvalidArgument("analysis memory_accuracy_sd is " + texel::detail::num(o.memory_accuracy_sd) +
                           "; allowed >= 0 (0 = rule off)");
+  if (o.confidence_distance != "rater" && o.confidence_distance != "group-mean")
+    throw InvalidArgument("analysis confidence_distance is '" + o.confidence_distance + "'; allowed: rater, group-mean");
+}
+
+/// Free vs guided exploration: for each reference matched in both studies,
+/// the spread of the matches — each match's distance (dB) from its study's
+/// mean match of that reference — compared between the studies (Welch's
+/// t-test: the studies may have different participants and spreads).
+json spread_comparison(const json& free, const json& guided, const AnalysisOptions& o, std::string& text) {
+  std::map<std::string, std::vector<double>> f, g;
+  for (const auto& m : free["matches"]) f[m["reference"].get<std::string>()].push_back(val(m, "distance_db"));
+  json out = json::array();
+  Ordered refs;
+  for (const auto& m : guided["matches"]) {
+    const std::string ref = m["reference"].get<std::string>();
+    refs.add(ref);
+    g[ref].push_back(val(m, "distance_db"));
+  }
+  text += "  spread of the matches, guided − free exploration (distance from the mean match, dB):\n";
+  for (const auto& ref : refs.names) {
+    if (!f.count(ref)) continue;
+    json e{{"reference", ref}, {"free_distance_db", describe_json(f[ref])}, {"guided_distance_db", describe_json(g[ref])}};
+    e["welch_t_test"] = guarded([&] { return stats::view(stats::t_test_two_sample(g[ref], f[ref], true, o.level)); });
+    e["welch_t_test"]["comparison"] = "guided − free";
+    text += "    " + ref + ": " + fmt(mean_of(g[ref])) + " vs " + fmt(mean_of(f[ref])) + ", " + t_text(e["welch_t_test"]) + "\n";
+    out.push_back(std::move(e));
+  }
+  return out;
 }
 
 }  // namespace
@@ -624,6 +970,8 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       head["rt_ms_median"] = describe_json(medians);
     }
     head.update(s);
+    if (st.design == StudyDesign::guided && summary.contains("free-exploration") && head.contains("matches"))
+      head["spread_vs_free_exploration"] = spread_comparison(summary["free-exploration"], head, options, report.text);
     summary[study] = std::move(head);
     if (!options.out_dir.empty()) {
       std::error_code ec;

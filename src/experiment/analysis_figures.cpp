@@ -158,7 +158,8 @@ Figure convergent_boxes(const Study& study, const json& s) {
   std::vector<std::string> cats;
   std::map<std::string, std::map<std::string, std::vector<double>>> per;  // block → participant → values
   for (const auto& r : s["runs"])
-    per[r["block"].get<std::string>()][r["participant"].get<std::string>()].push_back(d(r["convergent"]));
+    per[r.contains("group") ? r["group"].get<std::string>() : r["block"].get<std::string>()][r["participant"].get<std::string>()]
+        .push_back(d(r["convergent"]));
   BoxSeries box;
   box.colour = palette_colour(0);
   box.label = "participants";
@@ -180,14 +181,13 @@ Figure convergent_boxes(const Study& study, const json& s) {
     ci.y.push_back(d(c["mean"]));
     ci.error.push_back((d(c["ci95_high"]) - d(c["ci95_low"])) / 2);
   }
-  Figure f =
-      figure(coarse ? "Convergent coarse strength per fine strength" : "Convergent texel length per distribution", 640, 480);
+  Figure f = figure(coarse ? "Convergent coarse strength per fine strength" : "Convergent texel length per group", 640, 480);
   Panel p;
   // The group test beside the boxes it is about.
-  if (s.contains("paired_t_test") && s["paired_t_test"].contains("p"))
-    p.title = "paired t-test " + s["paired_t_test"]["comparison"].get<std::string>() + ": " + p_text(s["paired_t_test"]);
+  if (s.contains("between_groups") && s["between_groups"]["anova"].contains("p"))
+    p.title = "between groups, one-way ANOVA: " + p_text(s["between_groups"]["anova"]);
   if (s.contains("rm_anova") && s["rm_anova"].contains("effects")) p.title = "RM-ANOVA p: " + anova_text(s["rm_anova"]);
-  p.x = Axis{coarse ? "fine-texture strength" : "frequency distribution (Irregularity)",
+  p.x = Axis{coarse ? "fine-texture strength" : "group (frequency distribution, practice)",
              AxisScale::linear,
              std::nullopt,
              std::nullopt,
@@ -208,7 +208,7 @@ std::optional<Figure> directional_scatter(const json& s) {
   for (const auto& r : s["runs"]) {
     const double x = d(r["convergent"]), y = d(r["directional_proportion"]);
     if (!std::isfinite(x) || !std::isfinite(y)) continue;
-    const std::string b = r["block"].get<std::string>();
+    const std::string b = r.contains("group") ? r["group"].get<std::string>() : r["block"].get<std::string>();
     if (!series.count(b)) order.push_back(b);
     auto& st = series[b];
     st.stems = false;
@@ -372,34 +372,33 @@ std::optional<Figure> confidence_vs_distance(const std::string& title, const jso
   StemSeries pts;
   pts.stems = false;
   pts.marker_radius_px = 4.0;
-  for (const auto& m : matches_of(s))
-    if (std::isfinite(m.confidence) && std::isfinite(m.distance)) pts.x.push_back(m.distance), pts.y.push_back(m.confidence);
+  if (!s.contains("confidence_vs_distance")) return std::nullopt;
+  const json& c = s["confidence_vs_distance"];
+  const bool rater = c["distance_to"] == "rater";
+  for (const auto& m : s["matches"]) {
+    const double x = d(m[rater ? "distance_to_rater_db" : "distance_db"]);
+    const double y = m.contains("confidence") ? d(m["confidence"]) : missing;
+    if (std::isfinite(x) && std::isfinite(y)) pts.x.push_back(x), pts.y.push_back(y);
+  }
   if (pts.x.empty()) return std::nullopt;
   std::string sub;
-  if (s.contains("confidence_vs_distance") && s["confidence_vs_distance"].contains("pearson_r"))
-    sub = " (r = " + texel::detail::fixed(d(s["confidence_vs_distance"]["pearson_r"]), 2) + ")";
-  Figure f = figure(title + ": confidence against distance from the mean match" + sub, 700, 480);
+  if (c.contains("r")) sub = " (r = " + texel::detail::fixed(d(c["r"]), 2) + ", " + p_text(c) + ")";
+  const std::string from = rater ? "the trained rater's match (encoder estimate)" : "the reference's mean match";
+  Figure f = figure(title + ": confidence against distance" + sub, 700, 480);
   Panel p;
-  p.x.label = "distance from the reference's mean match (dB)";
+  p.x.label = "distance from " + from + " (dB)";
   p.y = Axis{"confidence (1 … 5)", AxisScale::linear, 0.5, 5.5, false};
   p.stems.push_back(std::move(pts));
   f.panels.push_back(std::move(p));
   return f;
 }
 
-/// Rating per reference (box plots of per-participant ratings).
-Figure rating_boxes(const std::string& title, const Rows& rows, const std::string& scale) {
-  std::vector<std::string> names;
-  std::map<std::string, std::map<std::string, std::vector<double>>> v;
-  for (const TrialRow* r : rows) {
-    if (r->task != "rating") continue;
-    if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
-    v[r->reference][r->participant].push_back(r->rating);
-  }
-  Figure f = figure(title + ": similarity of match and reference", category_width(names, 640), 460);
+/// A panel of box plots per reference (categories in `names`' order) of each
+/// participant's mean value; `v`: reference → participant → values.
+Panel reference_boxes(const std::vector<std::string>& names,
+                      std::map<std::string, std::map<std::string, std::vector<double>>>& v) {
   Panel p;
   p.x = Axis{"reference", AxisScale::linear, std::nullopt, std::nullopt, false, names};
-  p.y.label = "similarity rating (" + scale + ")";
   BoxSeries box;
   box.show_points = true;
   for (const auto& n : names) {
@@ -408,6 +407,54 @@ Figure rating_boxes(const std::string& title, const Rows& rows, const std::strin
     box.groups.push_back(std::move(g));
   }
   p.boxes.push_back(std::move(box));
+  return p;
+}
+
+/// Rating per reference (box plots of per-participant ratings).
+Figure rating_boxes(const std::string& title, const Rows& rows, const std::string& scale) {
+  std::vector<std::string> names;
+  std::map<std::string, std::map<std::string, std::vector<double>>> v;
+  for (const TrialRow* r : rows) {
+    if (r->task != "rating") continue;
+    // The own-match ratings (the similarity matrix holds the others).
+    const bool own =
+        r->condition.empty() || r->condition == "match" || r->condition == "own" || r->condition == "rendering:" + r->reference;
+    if (!own) continue;
+    if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
+    v[r->reference][r->participant].push_back(r->rating);
+  }
+  Figure f = figure(title + ": similarity of match and reference", category_width(names, 640), 460);
+  Panel p = reference_boxes(names, v);
+  p.y.label = "similarity rating (" + scale + ")";
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+/// Parameter mapping: each participant's Irregularity normalised to their
+/// own range (0 … 1), box plots per reference.
+std::optional<Figure> irregularity_normalised_figure(const json& s, const Rows& rows) {
+  if (!s.contains("irregularity_normalised")) return std::nullopt;
+  const bool sliders = s["irregularity_normalised"]["from"] == "slider_i";
+  std::vector<std::string> names;
+  for (const auto& r : s["irregularity_normalised"]["references"]) names.push_back(r["reference"].get<std::string>());
+  std::map<std::string, std::pair<double, double>> range;  // participant → (min, max)
+  for (const TrialRow* r : rows) {
+    if (r->task != "match") continue;
+    const double x = sliders ? r->slider_i : r->irregularity_db;
+    if (!std::isfinite(x)) continue;
+    auto [it, fresh] = range.try_emplace(r->participant, x, x);
+    it->second = {std::min(it->second.first, x), std::max(it->second.second, x)};
+  }
+  std::map<std::string, std::map<std::string, std::vector<double>>> v;  // reference → participant → values
+  for (const TrialRow* r : rows) {
+    if (r->task != "match" || !range.count(r->participant)) continue;
+    const auto [lo, hi] = range[r->participant];
+    const double x = sliders ? r->slider_i : r->irregularity_db;
+    if (hi > lo && std::isfinite(x)) v[r->reference][r->participant].push_back((x - lo) / (hi - lo));
+  }
+  Figure f = figure("Parameter mapping: Irregularity normalised per participant", category_width(names, 700), 480);
+  Panel p = reference_boxes(names, v);
+  p.y = Axis{"normalised Irregularity (0 = participant's lowest match, 1 = highest)", AxisScale::linear, -0.05, 1.05, false};
   f.panels.push_back(std::move(p));
   return f;
 }
@@ -415,36 +462,48 @@ Figure rating_boxes(const std::string& title, const Rows& rows, const std::strin
 // ------------------------------------------------------------ quantization
 
 Figure quantization_figure(const json& s, const Rows& rows) {
+  // Per texture: mean change ± 95 % CI per quantization step, its p value above.
   std::vector<std::string> cats;
-  ErrorBarSeries eb;
-  eb.colour = palette_colour(0);
-  eb.label = "mean change ± 95 % CI";
-  double lo = 0, hi = 0;
-  for (const auto& c : s["changes"]) {
-    const double m = d(c["change"]["mean"]);
-    const double half = c["t_test"].contains("ci_high") ? (d(c["t_test"]["ci_high"]) - d(c["t_test"]["ci_low"])) / 2 : missing;
-    cats.push_back(texel::detail::num(d(c["quantization_db"])) + " dB");
-    eb.x.push_back(static_cast<double>(eb.x.size()));
-    eb.y.push_back(m);
-    eb.error.push_back(half);
-    if (std::isfinite(m))
-      lo = std::min(lo, m - (std::isfinite(half) ? half : 0)), hi = std::max(hi, m + (std::isfinite(half) ? half : 0));
-  }
-  Figure f = figure("Quantization: similarity rating change against unquantized", 1100, 480, 2);
+  for (const auto& t : s["textures"])
+    for (const auto& c : t["changes"]) {
+      const std::string cat = texel::detail::num(d(c["quantization_db"])) + " dB";
+      if (std::find(cats.begin(), cats.end(), cat) == cats.end()) cats.push_back(cat);
+    }
+  Figure f = figure("Quantization: similarity rating change against unquantized, per texture", 1100, 480, 2);
   Panel a;
-  a.title = "Change per quantization step";
+  a.title = "Change per quantization step and texture";
   a.x = Axis{"quantization step", AxisScale::linear, std::nullopt, std::nullopt, false, cats};
   a.y.label = "rating change (rating points, 1 … 5 scale)";
   const double n = static_cast<double>(cats.size());
   a.lines.push_back(LineSeries{{-0.5, n - 0.5}, {0, 0}, Rgb{0.45, 0.45, 0.45}, 1.0, {}, true});
-  for (std::size_t i = 0; i < eb.x.size(); ++i) {
-    const double top = eb.y[i] + (std::isfinite(eb.error[i]) ? eb.error[i] : 0);
-    if (std::isfinite(top))
-      a.notes.push_back(TextNote{eb.x[i], top, p_text(s["changes"][i]["t_test"]), Rgb{0.1, 0.1, 0.1}, -12.0});
+  double lo = 0, hi = 0;
+  const double textures = static_cast<double>(s["textures"].size());
+  std::size_t k = 0;
+  for (const auto& t : s["textures"]) {
+    ErrorBarSeries eb;
+    eb.colour = palette_colour(k);
+    eb.label = t["reference"].get<std::string>() + " (mean ± 95 % CI)";
+    const double offset = (static_cast<double>(k) - (textures - 1) / 2) * 0.25;
+    for (const auto& c : t["changes"]) {
+      const std::string cat = texel::detail::num(d(c["quantization_db"])) + " dB";
+      const double x = static_cast<double>(std::find(cats.begin(), cats.end(), cat) - cats.begin()) + offset;
+      const double m = d(c["change"]["mean"]);
+      const double half = c["t_test"].contains("ci_high") ? (d(c["t_test"]["ci_high"]) - d(c["t_test"]["ci_low"])) / 2 : missing;
+      eb.x.push_back(x);
+      eb.y.push_back(m);
+      eb.error.push_back(half);
+      const double top = m + (std::isfinite(half) ? half : 0);
+      if (std::isfinite(m)) {
+        lo = std::min(lo, m - (std::isfinite(half) ? half : 0)), hi = std::max(hi, top);
+        // Staggered per texture so neighbouring labels do not overlap.
+        a.notes.push_back(TextNote{x, top, p_text(c["t_test"]), palette_colour(k), -12.0 - 13.0 * static_cast<double>(k)});
+      }
+    }
+    a.error_bars.push_back(std::move(eb));
+    ++k;
   }
   // Room above the highest bar for its p value.
-  if (hi > lo) a.y.max = hi + (hi - lo) * 0.15;
-  a.error_bars.push_back(std::move(eb));
+  if (hi > lo) a.y.max = hi + (hi - lo) * (0.15 + 0.08 * textures);
   f.panels.push_back(std::move(a));
 
   // Ratings per condition (per-participant means over references).
@@ -471,7 +530,7 @@ Figure quantization_figure(const json& s, const Rows& rows) {
 
 // ------------------------------------------------------ guided exploration
 
-Figure similarity_heatmap(const json& sim) {
+Figure similarity_heatmap(const json& sim, const std::string& title, double lo, double hi, const std::string& column_label) {
   const auto refs = sim["references"].get<std::vector<std::string>>();
   const auto rend = sim["renderings"].get<std::vector<std::string>>();
   HeatmapSeries h;
@@ -481,13 +540,14 @@ Figure similarity_heatmap(const json& sim) {
     for (const auto& v : row) h.values.push_back(d(v));
   h.row_labels = refs;
   h.column_labels = rend;
-  h.min = 1.0;
-  h.max = 5.0;
+  h.min = lo;
+  h.max = hi;
   h.decimals = 2;
-  h.scale_label = "mean similarity rating (1 … 5)";
-  Figure f = figure("Guided exploration: similarity of references and optimized renderings", 760, 600);
+  h.scale_label = "mean similarity rating (" + texel::detail::num(lo) + " … " + texel::detail::num(hi) + ")";
+  Figure f = figure(title, std::max(760, 90 * static_cast<int>(rend.size()) + 300),
+                    std::max(600, 60 * static_cast<int>(refs.size()) + 200));
   Panel p;
-  p.x.label = "optimized rendering of";
+  p.x.label = column_label;
   p.y.label = "reference felt";
   p.heatmap = std::move(h);
   f.panels.push_back(std::move(p));
@@ -608,9 +668,19 @@ std::vector<std::string> study_figures(const Study& study, const nlohmann::order
       }
       if (auto f = confidence_vs_distance(title, summary)) w.save(*f, "confidence");
       if (study.ratings_figure && summary.contains("ratings")) w.save(rating_boxes(title, rows, "0 … 10"), "ratings");
+      if (auto f = irregularity_normalised_figure(summary, rows)) w.save(*f, "irregularity-normalised");
+      // Beyond the own-match pairs (the source rated 25 of the 81): the matrix.
+      if (study.design == StudyDesign::matching && summary.contains("similarity") &&
+          summary["similarity"]["pairs_rated"].get<std::size_t>() > summary["similarity"]["references"].size())
+        w.save(similarity_heatmap(summary["similarity"], title + ": similarity of references and matches", 0.0, 10.0, "match of"),
+               "similarity");
       if (study.design == StudyDesign::guided) {
         w.save(guided_convergence(rows), "convergence");
-        if (summary.contains("similarity")) w.save(similarity_heatmap(summary["similarity"]), "similarity");
+        if (summary.contains("similarity"))
+          w.save(
+              similarity_heatmap(summary["similarity"], "Guided exploration: similarity of references and optimized renderings",
+                                 1.0, 5.0, "optimized rendering of"),
+              "similarity");
       }
       break;
     case StudyDesign::quantization: w.save(quantization_figure(summary, rows), "rating-change"); break;

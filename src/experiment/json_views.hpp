@@ -39,6 +39,9 @@ nlohmann::ordered_json view(const Descriptive& d);
 nlohmann::ordered_json view(const TTest& t);
 nlohmann::ordered_json view(const AnovaTable& a);
 nlohmann::ordered_json view(const Ellipse& e);
+nlohmann::ordered_json view(const TwoSampleTTest& t);
+nlohmann::ordered_json view(const OneWayAnova& a);
+nlohmann::ordered_json view(const Correlation& c);
 }  // namespace stats
 
 }  // namespace texel::experiment

@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 #include "texel/error.hpp"
@@ -314,6 +315,123 @@ AnovaTable rm_anova(std::span<const Observation> data, const std::vector<std::st
   return t;
 }
 
+TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const double> b, bool welch, double level) {
+  constexpr const char* fn = "t_test_two_sample";
+  check_level(fn, level);
+  const std::vector<double> x = finite(a), y = finite(b);
+  if (x.size() < 2 || y.size() < 2)
+    throw InvalidArgument(std::string(fn) + ": the groups have " + std::to_string(x.size()) + " and " + std::to_string(y.size()) +
+                          " usable value(s); at least 2 each are needed");
+  TwoSampleTTest r;
+  r.n1 = x.size();
+  r.n2 = y.size();
+  r.welch = welch;
+  r.level = level;
+  r.mean1 = mean_of(x);
+  r.mean2 = mean_of(y);
+  r.sd1 = sd_of(x, r.mean1);
+  r.sd2 = sd_of(y, r.mean2);
+  const double n1 = static_cast<double>(r.n1), n2 = static_cast<double>(r.n2);
+  const double v1 = r.sd1 * r.sd1, v2 = r.sd2 * r.sd2;
+  if (!(v1 > 0.0 || v2 > 0.0))
+    throw InvalidArgument(std::string(fn) + ": both groups are constant; the t statistic is undefined");
+  const double pooled = ((n1 - 1) * v1 + (n2 - 1) * v2) / (n1 + n2 - 2);
+  r.diff = r.mean1 - r.mean2;
+  if (welch) {
+    r.se = std::sqrt(v1 / n1 + v2 / n2);
+    const double a1 = v1 / n1, a2 = v2 / n2;
+    r.df = (a1 + a2) * (a1 + a2) / (a1 * a1 / (n1 - 1) + a2 * a2 / (n2 - 1));
+  } else {
+    r.se = std::sqrt(pooled * (1 / n1 + 1 / n2));
+    r.df = n1 + n2 - 2;
+  }
+  r.t = r.diff / r.se;
+  boost::math::students_t dist(r.df);
+  r.p = 2.0 * boost::math::cdf(boost::math::complement(dist, std::abs(r.t)));
+  const double q = t_quantile(r.df, level);
+  r.ci_low = r.diff - q * r.se;
+  r.ci_high = r.diff + q * r.se;
+  r.cohen_d = r.diff / std::sqrt(pooled);
+  return r;
+}
+
+OneWayAnova anova_one_way(const std::vector<std::vector<double>>& groups) {
+  constexpr const char* fn = "anova_one_way";
+  if (groups.size() < 2)
+    throw InvalidArgument(std::string(fn) + ": " + std::to_string(groups.size()) + " group(s); at least 2 are needed");
+  OneWayAnova a;
+  std::vector<std::vector<double>> g;
+  std::vector<double> all;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    g.push_back(finite(groups[i]));
+    if (g.back().empty()) throw InvalidArgument(std::string(fn) + ": group " + std::to_string(i + 1) + " has no usable value");
+    a.n.push_back(g.back().size());
+    all.insert(all.end(), g.back().begin(), g.back().end());
+  }
+  const double k = static_cast<double>(g.size()), n = static_cast<double>(all.size());
+  if (!(n > k))
+    throw InvalidArgument(std::string(fn) + ": " + std::to_string(all.size()) + " values in " + std::to_string(g.size()) +
+                          " groups; more values than groups are needed");
+  const double grand = mean_of(all);
+  for (const auto& v : g) {
+    const double m = mean_of(v);
+    a.ss_between += static_cast<double>(v.size()) * (m - grand) * (m - grand);
+    for (double d : v) a.ss_within += (d - m) * (d - m);
+  }
+  if (!(a.ss_within > 0.0)) throw InvalidArgument(std::string(fn) + ": no variance within the groups; F is undefined");
+  a.df_between = k - 1;
+  a.df_within = n - k;
+  a.f = (a.ss_between / a.df_between) / (a.ss_within / a.df_within);
+  a.p = f_upper(a.f, a.df_between, a.df_within);
+  a.eta2 = a.ss_between / (a.ss_between + a.ss_within);
+  return a;
+}
+
+Correlation pearson(std::span<const double> x, std::span<const double> y, double level) {
+  constexpr const char* fn = "pearson";
+  check_level(fn, level);
+  if (x.size() != y.size())
+    throw InvalidArgument(std::string(fn) + ": x has " + std::to_string(x.size()) + " values, y " + std::to_string(y.size()) +
+                          "; they must pair up");
+  std::vector<double> a, b;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!std::isnan(x[i]) && !std::isnan(y[i])) a.push_back(x[i]), b.push_back(y[i]);
+  if (a.size() < 3)
+    throw InvalidArgument(std::string(fn) + ": " + std::to_string(a.size()) + " complete pair(s); at least 3 are needed");
+  const double ma = mean_of(a), mb = mean_of(b);
+  double sxy = 0, sxx = 0, syy = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    sxy += (a[i] - ma) * (b[i] - mb);
+    sxx += (a[i] - ma) * (a[i] - ma);
+    syy += (b[i] - mb) * (b[i] - mb);
+  }
+  if (!(sxx > 0.0) || !(syy > 0.0)) throw InvalidArgument(std::string(fn) + ": x or y is constant; r is undefined");
+  Correlation c;
+  c.n = a.size();
+  c.level = level;
+  c.r = std::clamp(sxy / std::sqrt(sxx * syy), -1.0, 1.0);
+  c.r2 = c.r * c.r;
+  c.df = static_cast<double>(c.n - 2);
+  if (std::abs(c.r) < 1.0) {
+    c.t = c.r * std::sqrt(c.df / (1.0 - c.r2));
+    boost::math::students_t dist(c.df);
+    c.p = 2.0 * boost::math::cdf(boost::math::complement(dist, std::abs(c.t)));
+  } else {
+    c.t = std::copysign(std::numeric_limits<double>::infinity(), c.r);
+    c.p = 0.0;
+  }
+  if (c.n >= 4 && std::abs(c.r) < 1.0) {
+    const boost::math::normal z;
+    const double q = boost::math::quantile(boost::math::complement(z, (1.0 - level) / 2.0));
+    const double h = q / std::sqrt(static_cast<double>(c.n) - 3.0);
+    c.ci_low = std::tanh(std::atanh(c.r) - h);
+    c.ci_high = std::tanh(std::atanh(c.r) + h);
+  } else {
+    c.ci_low = c.ci_high = nan;
+  }
+  return c;
+}
+
 std::vector<std::array<double, 2>> Ellipse::outline(std::size_t points) const {
   std::vector<std::array<double, 2>> r;
   r.reserve(points);
@@ -428,9 +546,48 @@ nlohmann::ordered_json view(const Ellipse& e) {
           {"angle_deg", jnum(e.angle_deg)}};
 }
 
+nlohmann::ordered_json view(const TwoSampleTTest& t) {
+  return {{"test", t.welch ? "welch" : "student"},
+          {"n1", t.n1},
+          {"n2", t.n2},
+          {"mean1", jnum(t.mean1)},
+          {"mean2", jnum(t.mean2)},
+          {"sd1", jnum(t.sd1)},
+          {"sd2", jnum(t.sd2)},
+          {"diff", jnum(t.diff)},
+          {"se", jnum(t.se)},
+          {"t", jnum(t.t)},
+          {"df", jnum(t.df)},
+          {"p", jnum(t.p)},
+          {"level", t.level},
+          {"ci_low", jnum(t.ci_low)},
+          {"ci_high", jnum(t.ci_high)},
+          {"cohen_d", jnum(t.cohen_d)}};
+}
+
+nlohmann::ordered_json view(const OneWayAnova& a) {
+  return {{"n", a.n},
+          {"ss_between", jnum(a.ss_between)},
+          {"df_between", jnum(a.df_between)},
+          {"ss_within", jnum(a.ss_within)},
+          {"df_within", jnum(a.df_within)},
+          {"f", jnum(a.f)},
+          {"p", jnum(a.p)},
+          {"eta2", jnum(a.eta2)}};
+}
+
+nlohmann::ordered_json view(const Correlation& c) {
+  return {{"n", c.n},         {"r", jnum(c.r)},           {"r2", jnum(c.r2)},
+          {"t", jnum(c.t)},   {"df", jnum(c.df)},         {"p", jnum(c.p)},
+          {"level", c.level}, {"ci_low", jnum(c.ci_low)}, {"ci_high", jnum(c.ci_high)}};
+}
+
 std::string to_json(const Descriptive& d) { return view(d).dump(); }
 std::string to_json(const TTest& t) { return view(t).dump(); }
 std::string to_json(const AnovaTable& a) { return view(a).dump(); }
 std::string to_json(const Ellipse& e) { return view(e).dump(); }
+std::string to_json(const TwoSampleTTest& t) { return view(t).dump(); }
+std::string to_json(const OneWayAnova& a) { return view(a).dump(); }
+std::string to_json(const Correlation& c) { return view(c).dump(); }
 
 }  // namespace texel::experiment::stats

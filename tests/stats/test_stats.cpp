@@ -99,6 +99,49 @@ TEST(Textbook, WinerDrugsOneFactor) {
 }
 
 // Type 7 quartiles by hand (Hyndman & Fan 1996): for 1..4, h = 3p.
+// R documentation of t.test on the same data, unpaired: Welch t = -1.8608,
+// df = 17.776, p-value = 0.07939, 95 % CI -3.3654832 0.2054832; with
+// var.equal = TRUE, df = 18, p = 0.07919, CI -3.363874 0.203874. SciPy 1.10
+// ttest_ind: t = -1.860813467, p = 0.07918671422 (Student), 0.07939414019 (Welch).
+TEST(Textbook, SleepTwoSampleT) {
+  const st::TwoSampleTTest w = st::t_test_two_sample(sleep1, sleep2, true);
+  EXPECT_TRUE(w.welch);
+  EXPECT_NEAR(w.t, -1.860813467, 1e-9);
+  EXPECT_NEAR(w.df, 17.776, 5e-4);
+  EXPECT_NEAR(w.p, 0.07939414019, 1e-10);
+  EXPECT_NEAR(w.ci_low, -3.3654832, 5e-8);
+  EXPECT_NEAR(w.ci_high, 0.2054832, 5e-8);
+  const st::TwoSampleTTest s = st::t_test_two_sample(sleep1, sleep2, false);
+  EXPECT_EQ(s.df, 18.0);
+  EXPECT_NEAR(s.p, 0.07918671422, 1e-10);
+  EXPECT_NEAR(s.ci_low, -3.363874, 5e-7);
+  EXPECT_NEAR(s.ci_high, 0.203874, 5e-7);
+  EXPECT_NEAR(s.diff, -1.58, 1e-12);
+  EXPECT_THROW(st::t_test_two_sample(std::vector<double>{1.0}, sleep2), texel::InvalidArgument);
+}
+
+// SciPy 1.10: pearsonr(sleep1, sleep2) r = 0.7951702058, p = 0.005964995797,
+// Fisher-z 95 % CI [0.3315254742, 0.9494465336] (R's cor.test gives the same
+// interval); f_oneway(sleep1, sleep2, [2.1, 1.5, 3.0, 2.2, 0.4]) F = 2.058672651,
+// p = 0.1515061102.
+TEST(Textbook, SleepPearsonAndOneWayAnova) {
+  const st::Correlation c = st::pearson(sleep1, sleep2);
+  EXPECT_EQ(c.n, 10u);
+  EXPECT_EQ(c.df, 8.0);
+  EXPECT_NEAR(c.r, 0.7951702058, 1e-10);
+  EXPECT_NEAR(c.p, 0.005964995797, 1e-12);
+  EXPECT_NEAR(c.ci_low, 0.3315254742, 1e-10);
+  EXPECT_NEAR(c.ci_high, 0.9494465336, 1e-10);
+  EXPECT_THROW(st::pearson(std::vector<double>{1, 2}, std::vector<double>{1, 2}), texel::InvalidArgument);
+  EXPECT_THROW(st::pearson(std::vector<double>{1, 1, 1}, std::vector<double>{1, 2, 3}), texel::InvalidArgument);
+  const st::OneWayAnova a = st::anova_one_way({sleep1, sleep2, {2.1, 1.5, 3.0, 2.2, 0.4}});
+  EXPECT_EQ(a.df_between, 2.0);
+  EXPECT_EQ(a.df_within, 22.0);
+  EXPECT_NEAR(a.f, 2.058672651, 1e-9);
+  EXPECT_NEAR(a.p, 0.1515061102, 1e-10);
+  EXPECT_THROW(st::anova_one_way({sleep1}), texel::InvalidArgument);
+}
+
 TEST(Describe, QuartilesType7ByHand) {
   const std::vector<double> x{4, NaN, 1, 3, 2};
   const st::Descriptive d = st::describe(x);

@@ -2,8 +2,10 @@
 // summaries and figures the thesis reports for each perceptual study
 // (staircase tracks and convergent values, matched parameters with 95 %
 // confidence ellipses, similarity matrices, rating changes under
-// quantization with one-sample t-tests, the working-memory 2 × 2
-// repeated-measures ANOVA). docs/analysis.md lists, per study, what each
+// quantization per texture (repeated-measures ANOVA, one-sample t-tests),
+// texel length between groups with the swipe correlations, the
+// working-memory 2 × 2 repeated-measures ANOVA with the source's outlier
+// rule). docs/analysis.md lists, per study, what each
 // summary and figure answers and the [choice]s made where the source is
 // silent (threshold estimate, outlier rule).
 //
@@ -36,15 +38,34 @@ struct AnalysisOptions {
   /// Confidence level of the CIs, t-tests and ellipses, in (0, 1).
   double level = 0.95;
 
-  // -- working-memory outlier rule [choice], docs/analysis.md
-  /// Exclude participants whose distractor digit-recall accuracy is at or
-  /// below this proportion (chance = 1/9: they ignored the distractor).
-  /// Negative = rule off.
+  /// Staircase end value (docs/analysis.md): "last-presented" (default, the
+  /// source's "final value": the intensity of the run's last trial) or
+  /// "next" (the value computed after the last answer, never presented).
+  std::string convergent = "last-presented";
+
+  // -- working-memory outlier rule, docs/analysis.md
+  /// "source" (default): main-task errors more than memory_errors_sd SDs
+  /// above the group mean without more distraction-task errors than the
+  /// group mean. "recall-accuracy": the earlier [choice] (recall at or below
+  /// memory_recall_chance, then |z| of accuracy > memory_accuracy_sd).
+  /// "none": nobody is excluded. Every rule's exclusions are reported.
+  std::string memory_rule = "source";
+  /// Source rule: how many SDs above the group's mean main-task error count (> 0).
+  double memory_errors_sd = 2.0;
+  /// "recall-accuracy" rule: exclude participants whose distractor
+  /// digit-recall accuracy is at or below this proportion (chance = 1/9).
+  /// Negative = that part off.
   double memory_recall_chance = 1.0 / 9.0;
-  /// Exclude participants whose overall same/different accuracy lies more
-  /// than this many SDs from the group mean (computed once, on the
-  /// participants left after the recall rule). 0 = rule off.
+  /// "recall-accuracy" rule: overall same/different accuracy more than this
+  /// many SDs from the group mean (after the recall part). 0 = that part off.
   double memory_accuracy_sd = 2.5;
+
+  // -- free exploration
+  /// Confidence is related to the distance of each match from "rater"
+  /// (default [choice]: the trained rater's match, for which the encoder's
+  /// estimate of the reference stands in) or "group-mean" (the reference's
+  /// mean match over participants).
+  std::string confidence_distance = "rater";
 };
 
 /// The result of analyze().
@@ -55,7 +76,8 @@ struct AnalysisReport {
   std::string summary = "{}";
   /// Paths of the figures written, in the order written.
   std::vector<std::string> figures;
-  /// Human-readable summary (a few lines per study).
+  /// Human-readable summary, a few lines per study, every test in the
+  /// source's form: t(df) = …, p = …, 95 % CI; F(df1, df2) = …, p = …; r = …, p = ….
   std::string text;
 };
 
@@ -63,7 +85,8 @@ struct AnalysisReport {
 /// practice rows are skipped) and, when options.out_dir is set, draws its
 /// figures. A study with too few participants for a test reports that in
 /// its summary ("<test>": {"skipped": "<reason>"}) instead of throwing.
-/// Throws InvalidArgument for bad options (format, reversals_k, level) and
+/// Throws InvalidArgument for bad options (format, reversals_k, level, the
+/// rule names and thresholds) and
 /// IoError if a figure cannot be written.
 AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions& options);
 

@@ -1,7 +1,8 @@
 // The statistics the perceptual studies report: descriptive summaries,
-// one-sample and paired t-tests, one- and two-factor repeated-measures ANOVA
-// with the Greenhouse–Geisser correction, and the confidence ellipse of a
-// bivariate mean (Hotelling's T²). Formulas, conventions and sources are in
+// one-sample, paired and two-sample t-tests, one-way between-subjects
+// ANOVA, Pearson's r, one- and two-factor repeated-measures ANOVA with the
+// Greenhouse–Geisser correction, and the confidence ellipse of a bivariate
+// mean (Hotelling's T²). Formulas, conventions and sources are in
 // docs/statistics.md.
 //
 // Distribution functions come from Boost.Math (students_t, fisher_f), never
@@ -54,6 +55,42 @@ TTest t_test_one_sample(std::span<const double> x, double mu = 0.0, double level
 /// Paired test of a − b (same length; a pair with a NaN on either side is
 /// dropped). The result's mean/sd/se describe the differences; mu = 0.
 TTest t_test_paired(std::span<const double> a, std::span<const double> b, double level = 0.95);
+
+/// Two independent samples (between-groups designs): Student's test with the
+/// pooled variance (df = n1 + n2 − 2) or Welch's (Welch–Satterthwaite df).
+/// diff = mean1 − mean2; [ci_low, ci_high] is its `level` interval;
+/// cohen_d = diff / pooled SD (either test).
+struct TwoSampleTTest {
+  std::size_t n1 = 0, n2 = 0;
+  double mean1 = 0, mean2 = 0, sd1 = 0, sd2 = 0;
+  bool welch = false;
+  double diff = 0, se = 0, t = 0, df = 0, p = 0;
+  double level = 0.95, ci_low = 0, ci_high = 0;
+  double cohen_d = 0;
+};
+/// a, b: the two groups (NaNs skipped; each ≥ 2 finite values; not both constant).
+TwoSampleTTest t_test_two_sample(std::span<const double> a, std::span<const double> b, bool welch = false, double level = 0.95);
+
+/// One-way between-subjects ANOVA: F = MS_between / MS_within with
+/// df = (k − 1, N − k); eta2 = SS_between / SS_total.
+struct OneWayAnova {
+  std::vector<std::size_t> n;  ///< per group
+  double ss_between = 0, df_between = 0, ss_within = 0, df_within = 0;
+  double f = 0, p = 0, eta2 = 0;
+};
+/// groups: ≥ 2 groups, each with ≥ 1 finite value, N > k, not every group constant.
+OneWayAnova anova_one_way(const std::vector<std::vector<double>>& groups);
+
+/// Pearson's product-moment correlation of paired data (pairs with a NaN
+/// dropped): t = r·√((n−2)/(1−r²)) with n − 2 df, p two-sided; the `level`
+/// interval from Fisher's z (tanh(atanh r ± z_q/√(n−3)); NaN below 4 pairs).
+struct Correlation {
+  std::size_t n = 0;
+  double r = 0, r2 = 0, t = 0, df = 0, p = 0;
+  double level = 0.95, ci_low = 0, ci_high = 0;
+};
+/// x, y: same length, ≥ 3 complete pairs, neither constant.
+Correlation pearson(std::span<const double> x, std::span<const double> y, double level = 0.95);
 
 /// One measurement in long format for the repeated-measures ANOVA.
 struct Observation {
@@ -116,5 +153,8 @@ std::string to_json(const Descriptive& d);
 std::string to_json(const TTest& t);
 std::string to_json(const AnovaTable& a);  ///< factors, subjects, effects
 std::string to_json(const Ellipse& e);     ///< without the outline
+std::string to_json(const TwoSampleTTest& t);
+std::string to_json(const OneWayAnova& a);
+std::string to_json(const Correlation& c);
 
 }  // namespace texel::experiment::stats
