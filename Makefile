@@ -57,13 +57,17 @@ $(WEB_TEST_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/
 # shipped protocol (free exploration before the quantization test that uses
 # its matches), then each study's summaries and figures.
 PROTOCOLS := $(addprefix examples/protocols/,free-exploration.json quantization.json parameter-mapping.json \
-  guided-exploration.json coarse-features.json texel-length.json texel-length-wide.json working-memory.json)
+  guided-exploration.json coarse-features.json working-memory.json)
+# Texel length is a between-groups study: each group has its own participants.
+TEXEL_LENGTH_GROUPS := N:texel-length W:texel-length-wide V:texel-length-visual-practice
 
 demo: build web
 	$(BUILD)/bin/texel demo --out out/demo
 	$(BUILD)/bin/texel atlas --out out/demo/references
 	rm -rf out/demo/experiments && mkdir -p out/demo/experiments
 	$(BUILD)/bin/texel experiment cohort $(PROTOCOLS) --participants 8 --db out/demo/experiments/cohort.db
+	for g in $(TEXEL_LENGTH_GROUPS); do $(BUILD)/bin/texel experiment cohort examples/protocols/$${g#*:}.json \
+	  --participants 8 --prefix $${g%%:*} --db out/demo/experiments/cohort.db || exit 1; done
 	$(BUILD)/bin/texel experiment export --db out/demo/experiments/cohort.db -o out/demo/experiments/trials.csv
 	$(BUILD)/bin/texel experiment analyze --db out/demo/experiments/cohort.db -o out/demo/experiments > out/demo/experiments/summary.txt
 	@cat out/demo/experiments/summary.txt

@@ -140,8 +140,11 @@ class ThresholdBlock : public TaskBlock {
     staircase_->answer(correct);
     row.reversal = staircase_->last_was_reversal();
     row.procedure_finished = staircase_->finished();
-    // The finishing row carries the threshold by the protocol's end rule.
-    row.next_intensity = row.procedure_finished ? staircase_->convergent_value() : staircase_->computed_value();
+    // next_intensity is always the value computed after this answer (on the
+    // finishing row: the one that would come next); the threshold by the
+    // protocol's end rule is Staircase::convergent_value(), and the analysis
+    // takes the end value it is asked for from the stored rows.
+    row.next_intensity = staircase_->computed_value();
     return staircase_->state_json();
   }
 
