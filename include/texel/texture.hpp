@@ -88,6 +88,9 @@ struct TexelSpec {
   CoarseProfile coarse = ConstantProfile{};
 };
 
+/// Longest texel validate() accepts (mm); the studio's hello sends it.
+inline constexpr double texel_length_mm_max = 1000.0;
+
 /// Validates every field; throws InvalidArgument naming field, value and range.
 void validate(const TexelSpec& spec);
 

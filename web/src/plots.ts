@@ -43,7 +43,7 @@ export class MapPlot {
 
   constructor(height = 220) {
     const mainHost = h('div', { class: 'plot', 'data-testid': 'map-plot', 'aria-label': 'Friction map: amplitude over position (mm)', role: 'img' });
-    const detailHost = h('div', { class: 'plot detail', 'data-testid': 'detail-plot', 'aria-label': '6 mm detail of the friction map', role: 'img' });
+    const detailHost = h('div', { class: 'plot detail', 'data-testid': 'detail-plot', 'aria-label': '6 mm detail of the friction map: drive 0…1 over position (mm)', role: 'img' });
     this.el = h('div', { class: 'map-plots' }, mainHost, h('div', { class: 'plot-caption' }, '6 mm detail (follows the cursor on the map)'), detailHost);
     const regionsHook = (u: uPlot) => {
       const ctx = u.ctx;
@@ -73,7 +73,7 @@ export class MapPlot {
         cursor: { drag: { x: true, y: false }, points: { show: false } },
         legend: { show: false },
         scales: { x: { time: false }, y: { range: [0, 1] } },
-        axes: [{ label: 'position (mm)' }, { label: 'amplitude' }],
+        axes: [{ label: 'position on the surface (mm)' }, { label: 'friction drive (0…1 = full)' }],
         series: [{}, { stroke: '#2a6fdb', width: 1, points: { show: false } }],
         hooks: {
           draw: [regionsHook],
@@ -94,7 +94,7 @@ export class MapPlot {
         cursor: { drag: { x: false, y: false }, points: { show: false } },
         legend: { show: false },
         scales: { x: { time: false, auto: false }, y: { range: [0, 1] } },
-        axes: [{ label: 'position (mm)' }, {}],
+        axes: [{ label: 'position on the surface (mm)' }, { label: 'drive (0…1)' }],
         series: [{}, { stroke: '#2a6fdb', width: 1.5, points: { show: false } }],
       },
       [[], []],
@@ -201,7 +201,7 @@ export class HistogramPlot {
         legend: { show: true },
         cursor: { drag: { x: true, y: false } },
         scales: { x: { time: false } },
-        axes: [{ label: 'texel frequency (cycles/mm)' }, { label: 'texels' }],
+        axes: [{ label: 'texel frequency (cycles/mm)' }, { label: 'texels (count)' }],
         series: [
           { label: 'cpm' },
           { label: 'texels', stroke: '#2a6fdb', fill: 'rgba(42,111,219,0.35)', paths: uPlot.paths.bars!({ size: [0.95, 100] }), points: { show: false } },
@@ -243,7 +243,7 @@ export class SpectrumPlot {
   private u: uPlot;
 
   constructor(height = 200) {
-    this.el = h('div', { class: 'plot', 'data-testid': 'spectrum-plot', role: 'img', 'aria-label': 'Spectrum: magnitude (dB) over frequency (cycles/mm, log)' });
+    this.el = h('div', { class: 'plot', 'data-testid': 'spectrum-plot', role: 'img', 'aria-label': 'Spectrum: magnitude (dB re amplitude 1, a full-scale sine) over spatial frequency (cycles/mm, log)' });
     this.u = new uPlot(
       {
         width: 400,
@@ -251,13 +251,16 @@ export class SpectrumPlot {
         legend: { show: true },
         cursor: { drag: { x: true, y: false } },
         scales: { x: { time: false, distr: 3 } },
-        axes: [{ label: 'frequency (cycles/mm)' }, { label: 'dB' }],
+        axes: [{ label: 'spatial frequency (cycles/mm, log)' }, { label: 'magnitude (dB re amplitude 1)' }],
+        // Drawn in this order: the match as a wide pale band under the design's
+        // thin line, so the two stay visible when they coincide.
         series: [
-          { label: 'cpm' },
-          { label: 'design', stroke: '#2a6fdb', width: 1.5, points: { show: false } },
-          { label: 'reference (target)', stroke: '#c44', width: 1.5, points: { show: false }, show: true },
-          { label: 'match', stroke: '#2a9d3f', width: 1.5, dash: [6, 3], points: { show: false } },
+          { label: 'cycles/mm' },
+          { label: 'match (decoded)', stroke: 'rgba(42,157,63,0.45)', width: 6, points: { show: false } },
+          { label: 'reference (target)', stroke: '#c44', width: 1.5, dash: [6, 3], points: { show: false } },
+          { label: 'design', stroke: '#1b3f8f', width: 1.25, points: { show: false } },
         ],
+        hooks: { draw: [(u) => this.drawCorner(u)] },
       },
       [[1], [null], [null], [null]],
       this.el,
@@ -277,6 +280,33 @@ export class SpectrumPlot {
       }
     }
     const over = (s?: Spectrum | null) => xs.map((f) => (s ? interpLog(s.frequency_cpm, s.magnitude_db, f) : null));
-    this.u.setData([xs, ys, over(target), over(match)]);
+    this.u.setData([xs, over(match), over(target), ys]);
+  }
+
+  /** Marks the spatial frequency at which the drive reaches the display's corner (corner Hz / swipe speed). */
+  setCorner(cpm: number | null, label: string): void {
+    this.corner = cpm !== null && Number.isFinite(cpm) && cpm > 0 ? { cpm, label } : null;
+    this.u.redraw(false, false);
+  }
+
+  private corner: { cpm: number; label: string } | null = null;
+
+  private drawCorner(u: uPlot): void {
+    if (!this.corner) return;
+    const px = u.valToPos(this.corner.cpm, 'x', true);
+    if (!(px >= u.bbox.left && px <= u.bbox.left + u.bbox.width)) return;
+    const ctx = u.ctx;
+    ctx.save();
+    ctx.strokeStyle = '#b3261e';
+    ctx.fillStyle = '#b3261e';
+    ctx.setLineDash([3, 3]);
+    ctx.beginPath();
+    ctx.moveTo(px, u.bbox.top);
+    ctx.lineTo(px, u.bbox.top + u.bbox.height);
+    ctx.stroke();
+    ctx.font = `${Math.round(11 * devicePixelRatio)}px sans-serif`;
+    ctx.textAlign = px > u.bbox.left + u.bbox.width * 0.6 ? 'right' : 'left';
+    ctx.fillText(this.corner.label, px + (ctx.textAlign === 'right' ? -4 : 4) * devicePixelRatio, u.bbox.top + 12 * devicePixelRatio);
+    ctx.restore();
   }
 }
