@@ -440,6 +440,9 @@ export function mountDesigner(root: HTMLElement): void {
         applying = true;
         store.update(p.prev);
         applying = false;
+        // The refused value is no step to undo.
+        if (undoStack.length && lasting(undoStack[undoStack.length - 1]) === lasting(p.prev)) undoStack.pop();
+        undoBtn.disabled = !undoStack.length;
         p.ctl.refuse(message(e));
         return;
       }
