@@ -874,9 +874,17 @@ export function mountDesigner(root: HTMLElement): void {
       const device = store.get().device;
       const dev = typeof device === 'string' ? device : device.name;
       const r = await client.call('import', { name: f.name, data_base64: bytesToBase64(bytes), device: dev }, 120000);
+      const doc = r.document as TextureDocument;
+      const next = stateFromDocument(doc, store.get());
       status.textContent = `imported ${f.name}`;
       status.dataset.imported = f.name;
-      store.update(stateFromDocument(r.document as TextureDocument, store.get()));
+      store.update(next);
+      // The page edits one texture, or a reference beside one: say so when a file holds more.
+      const had = doc.regions?.length ?? 1;
+      const kept = buildDocument(next).regions?.length ?? 1;
+      if (kept < had)
+        showError(`${f.name} has ${had} regions; the designer shows ${kept} of them (the reference and the last Texel region). ` +
+          'Exporting from here writes only those.', filesErr);
     } catch (e) {
       status.textContent = '';
       showError(`${f.name} was not imported: ${message(e)}`, filesErr);

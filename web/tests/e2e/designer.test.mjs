@@ -46,6 +46,7 @@ test('designer: slider, drawn coarse profile, export and re-import', { timeout: 
     // Draw a coarse profile with the pointer on the map.
     const px2 = await canvasHash(page, 'map-plot');
     await page.click('[data-testid=draw-coarse]');
+    await page.locator('[data-testid=map-plot]').scrollIntoViewIfNeeded();
     const over = await page.locator('[data-testid=map-plot] .u-over').boundingBox();
     await page.mouse.move(over.x + over.width * 0.05, over.y + over.height * 0.9);
     await page.mouse.down();
@@ -110,7 +111,7 @@ test('designer: reference left, rendering right, and match', { timeout: 240_000 
     await page.waitForTimeout(300);
     const pitchBefore = await page.inputValue('#central-pitch');
     await page.click('[data-testid=match]');
-    await page.waitForFunction(() => /matched in \d+ bytes/.test(document.querySelector('[data-testid=match-info]').textContent), null, { timeout: 180_000 });
+    await page.waitForFunction(() => /Matched in \d+ bytes/.test(document.querySelector('[data-testid=match-info]').textContent), null, { timeout: 180_000 });
     const pitchAfter = await page.inputValue('#central-pitch');
     assert.notEqual(pitchAfter, pitchBefore, 'the match moved the Central Pitch slider');
     // The distance in JNDs, with what 1 JND means (it read "model distance 0.44" on main).
@@ -191,8 +192,9 @@ test('designer: invalid typed values are refused at the field, never clamped or 
     assert.equal(await page.inputValue('#central-pitch'), '10', 'the document kept 10 dB');
 
     // A valid value clears the message and is used as typed.
+    const drawnBefore = (await stats(page)).lastMapChecksum;
     await typeInto(page, '#central-pitch-value', '12.5');
-    await nextDraw(page, (await stats(page)).designsDrawn);
+    await mapChanged(page, drawnBefore);
     assert.equal(await page.inputValue('#central-pitch'), '12.5');
     assert.equal((await refusal(page, 'central-pitch')).visible, false);
     assert.equal(await page.getAttribute('#central-pitch-value', 'aria-invalid'), null);
@@ -277,11 +279,23 @@ test('designer: Hz at a swipe speed beside every spatial frequency, and a warnin
 test('designer: every plot has axes with units and stated references', { timeout: 120_000 }, async () => {
   await withStudio(async ({ studio, page, errors }) => {
     await openDesigner(page, studio.url);
-    const labels = (id) => page.$$eval(`[data-testid=${id}] .u-axis .u-label`, (els) => els.map((e) => e.textContent));
-    assert.deepEqual(await labels('map-plot'), ['position on the surface (mm)', 'friction drive (0…1 = full)']);
+    // uPlot draws axis titles on its canvas; each plot's host names them (the same strings) in data-axes.
+    const labels = async (id) => (await page.getAttribute(`[data-testid=${id}]`, 'data-axes')).split('|');
+    assert.deepEqual(await labels('map-plot'), ['position on the surface (mm)', 'drive (0…1)']);
     assert.deepEqual(await labels('detail-plot'), ['position on the surface (mm)', 'drive (0…1)'], 'the detail plot has an amplitude scale');
     assert.deepEqual(await labels('histogram-plot'), ['texel frequency (cycles/mm)', 'texels (count)']);
-    assert.deepEqual(await labels('spectrum-plot'), ['spatial frequency (cycles/mm, log)', 'magnitude (dB re amplitude 1)'], "the spectrum's dB has a reference");
+    assert.deepEqual(await labels('spectrum-plot'), ['spatial frequency (cycles/mm, log)', 'dB re amplitude 1'], "the spectrum's dB has a reference");
+    assert.match(await page.textContent('.plots'), /0 dB is a sine of amplitude 1 \(full drive\)/);
+    // The detail plot's amplitude axis has ticks at 0, 0.5 and 1 (pixels drawn left of its plot area).
+    const ink = await page.$eval('[data-testid=detail-plot] canvas', (c) => {
+      const d = c.getContext('2d').getImageData(0, 0, Math.round(c.width * 0.06), c.height).data;
+      let n = 0;
+      for (let i = 3; i < d.length; i += 4) if (d[i]) n++;
+      return n;
+    });
+    assert.ok(ink > 200, `the detail plot's y axis is drawn (${ink} pixels)`);
+    await page.locator('[data-testid=detail-plot]').scrollIntoViewIfNeeded();
+    await screenshot(page, 'designer-axes');
     assert.deepEqual(errors, []);
   });
 });
