@@ -88,7 +88,9 @@ struct TexelSpec {
   CoarseProfile coarse = ConstantProfile{};
 };
 
-/// Longest texel validate() accepts (mm); the studio's hello sends it.
+/// Texel lengths a document may give (mm; validate() needs > 0 and at most
+/// the maximum). The studio's hello sends them.
+inline constexpr double texel_length_mm_min = 1e-6;
 inline constexpr double texel_length_mm_max = 1000.0;
 
 /// Validates every field; throws InvalidArgument naming field, value and range.

@@ -538,7 +538,7 @@ export function mountDesigner(root: HTMLElement): void {
   // --- controls: each writes the store; render() shows the store in them
   const lim = (k: keyof NonNullable<HelloReply['texture_limits']>, fallback: Rule): (() => Rule) => () => {
     const r = hello?.texture_limits?.[k];
-    return r ? { min: r.min, max: r.max, exclusiveMin: r.exclusive_min } : fallback;
+    return r ? { min: r.min, max: r.max } : fallback;
   };
   /** Commits a value; a typed one stays pending until the engine accepts it (design() refuses it otherwise). */
   const commitTexel = (ctl: () => FieldCtl, p: Partial<TexelParams>, typed: boolean) => {
@@ -551,7 +551,7 @@ export function mountDesigner(root: HTMLElement): void {
     (v, typed) => commitTexel(() => pitch, { central_pitch_db: v }, typed), pitchCpm);
   const irr: FieldCtl = field('irregularity', 'Irregularity', { min: -30, max: 20, step: 0.1 }, lim('irregularity_db', { min: -60, max: 40 }), t.irregularity_db, 'dB',
     (v, typed) => commitTexel(() => irr, { irregularity_db: v }, typed), irrCpm);
-  const length: FieldCtl = field('texel-length', 'Texel length', { min: 0.05, max: 100, step: 0.01 }, lim('texel_length_mm', { min: 0, max: 1000, exclusiveMin: true }), t.texel_length_mm, 'mm',
+  const length: FieldCtl = field('texel-length', 'Texel length', { min: 0.05, max: 100, step: 0.01 }, lim('texel_length_mm', { min: 1e-6, max: 1000 }), t.texel_length_mm, 'mm',
     (v, typed) => commitTexel(() => length, { texel_length_mm: v }, typed));
   const seedErr = h('p', { class: 'field-error', id: 'seed-error', 'data-testid': 'seed-error', hidden: true });
   const seedIn = h('input', { type: 'text', inputmode: 'numeric', id: 'seed', value: t.seed, 'data-testid': 'seed', class: 'num', 'aria-describedby': 'seed-error' }) as HTMLInputElement;
