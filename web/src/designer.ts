@@ -372,6 +372,7 @@ export function mountDesigner(root: HTMLElement): void {
   const irrCpm = h('span', { class: 'cpm', 'data-testid': 'irregularity-cpm' });
   const periodCpm = h('span', { class: 'cpm', 'data-testid': 'sine-period-cpm' });
   const driveWarn = h('p', { class: 'drive-warning', 'data-testid': 'drive-warning', hidden: true });
+  const hzNote = h('p', { class: 'hint', 'data-testid': 'hz-note' });
   const texelsEl = h('span', { 'data-testid': 'texels' });
   const elapsedEl = h('span', { 'data-testid': 'elapsed' });
 
@@ -522,6 +523,8 @@ export function mountDesigner(root: HTMLElement): void {
     const dev = deviceProfile(s.device);
     const corner = dev?.response?.corner_hz;
     spec.setCorner(corner ? corner / v : null, corner ? `${dev!.name} corner ${corner} Hz at ${v} mm/s` : '');
+    hzNote.textContent =
+      `At ${v} mm/s, 1 cycle/mm is ${v} Hz` + (corner ? `; ${dev!.name}'s ${corner} Hz corner is ${fmt(corner / v, 2)} cycles/mm.` : '.');
     const warnings: string[] = [];
     if (corner && pitch !== null && pitch * v > corner)
       warnings.push(
@@ -960,7 +963,7 @@ export function mountDesigner(root: HTMLElement): void {
     h('h2', {}, 'Feel it'),
     strip.el,
     h('label', { class: 'inline' }, hear, ' Hear it (browser audio, when no display is attached)'),
-    h('div', { class: 'two' }, h('div', {}, h('h2', {}, 'Texel frequencies'), hist.el),
+    h('div', { class: 'two' }, h('div', {}, h('h2', {}, 'Texel frequencies'), hist.el, hzNote),
       h('div', {}, h('h2', {}, 'Spectrum'), spec.el,
         h('p', { class: 'hint' }, 'Amplitude spectrum of the analysed region: 0 dB is a sine of amplitude 1 (full drive); −20 dB is amplitude 0.1.'))),
   );

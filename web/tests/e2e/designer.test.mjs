@@ -263,9 +263,11 @@ test('designer: Hz at a swipe speed beside every spatial frequency, and a warnin
     await page.locator('[data-testid=drive-warning]').scrollIntoViewIfNeeded();
     await screenshot(page, 'designer-drive-warning');
     // At 30 mm/s the same texture drives 300 Hz: no warning.
+    assert.match(await page.textContent('[data-testid=hz-note]'), /At 100 mm\/s, 1 cycle\/mm is 100 Hz; tpad's 400 Hz corner is 4\.00 cycles\/mm/);
     await typeInto(page, '#swipe-speed-value', '30');
     await page.waitForFunction(() => document.querySelector('[data-testid=drive-warning]').hidden);
     assert.match(await page.textContent('[data-testid=pitch-cpm]'), /= 300 Hz at 30 mm\/s/);
+    assert.match(await page.textContent('[data-testid=hz-note]'), /At 30 mm\/s, 1 cycle\/mm is 30 Hz/);
     // The sine period's frequency too.
     await page.selectOption('#coarse-kind', 'sine');
     assert.match(await page.textContent('[data-testid=sine-period-cpm]'), /0\.200 cycles\/mm = 6\.0 Hz at 30 mm\/s/);
