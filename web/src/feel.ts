@@ -246,8 +246,12 @@ export class FeelStrip {
     if (!ctx) return;
     ctx.clearRect(0, 0, w, ht);
     if (!m || !(L > 0) || !m.values.length) return;
-    // Per pixel column: the min … max of the samples under it (a dense texture reads as a band).
-    ctx.fillStyle = 'rgba(42, 111, 219, 0.45)';
+    // Per pixel column: the min … max of the samples under it (a dense texture reads as a band)
+    // and their mean (a line: where the drive is strong on average).
+    ctx.fillStyle = 'rgba(42, 111, 219, 0.3)';
+    ctx.strokeStyle = '#1b3f8f';
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
     const n = m.values.length;
     for (let px = 0; px < w; px++) {
       const a = Math.max(0, Math.floor(((px / w) * L - m.origin_mm) / m.spacing_mm));
@@ -255,15 +259,19 @@ export class FeelStrip {
       if (a >= b) continue;
       let lo = Infinity;
       let hi = -Infinity;
+      let sum = 0;
       for (let i = a; i < b; i++) {
         const v = m.values[i];
+        sum += v;
         if (v < lo) lo = v;
         if (v > hi) hi = v;
       }
-      const y0 = ht - 4 - Math.min(1, Math.max(0, hi)) * (ht - 8);
-      const y1 = ht - 4 - Math.min(1, Math.max(0, lo)) * (ht - 8);
-      ctx.fillRect(px, y0, 1, Math.max(1, y1 - y0));
+      const y = (v: number) => ht - 4 - Math.min(1, Math.max(0, v)) * (ht - 8);
+      ctx.fillRect(px, y(hi), 1, Math.max(1, y(lo) - y(hi)));
+      if (px === 0) ctx.moveTo(px, y(sum / (b - a)));
+      else ctx.lineTo(px, y(sum / (b - a)));
     }
+    ctx.stroke();
   }
 
   private startPolling(): void {
