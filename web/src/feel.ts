@@ -247,29 +247,33 @@ export class FeelStrip {
     ctx.clearRect(0, 0, w, ht);
     if (!m || !(L > 0) || !m.values.length) return;
     // Per pixel column: the min … max of the samples under it (a dense texture reads as a band)
-    // and their mean (a line: where the drive is strong on average).
+    // and the mean drive over the millimetre around it (a line; a shorter window would alias).
     ctx.fillStyle = 'rgba(42, 111, 219, 0.3)';
     ctx.strokeStyle = '#1b3f8f';
     ctx.lineWidth = 1.5;
     ctx.beginPath();
     const n = m.values.length;
+    const prefix = new Float64Array(n + 1);
+    for (let i = 0; i < n; i++) prefix[i + 1] = prefix[i] + m.values[i];
+    const half = Math.max(1, Math.round(0.5 / m.spacing_mm));
     for (let px = 0; px < w; px++) {
       const a = Math.max(0, Math.floor(((px / w) * L - m.origin_mm) / m.spacing_mm));
       const b = Math.min(n, Math.ceil((((px + 1) / w) * L - m.origin_mm) / m.spacing_mm) + 1);
       if (a >= b) continue;
       let lo = Infinity;
       let hi = -Infinity;
-      let sum = 0;
       for (let i = a; i < b; i++) {
         const v = m.values[i];
-        sum += v;
         if (v < lo) lo = v;
         if (v > hi) hi = v;
       }
+      const c = (a + b) >> 1;
+      const [ma, mb] = [Math.max(0, c - half), Math.min(n, c + half + 1)];
+      const mean = (prefix[mb] - prefix[ma]) / (mb - ma);
       const y = (v: number) => ht - 4 - Math.min(1, Math.max(0, v)) * (ht - 8);
       ctx.fillRect(px, y(hi), 1, Math.max(1, y(lo) - y(hi)));
-      if (px === 0) ctx.moveTo(px, y(sum / (b - a)));
-      else ctx.lineTo(px, y(sum / (b - a)));
+      if (px === 0) ctx.moveTo(px, y(mean));
+      else ctx.lineTo(px, y(mean));
     }
     ctx.stroke();
   }
