@@ -30,6 +30,14 @@ std::string_view to_string(OutOfBand o);
 Parameterization parse_parameterization(std::string_view text, std::string_view field = "parameterization");
 OutOfBand parse_out_of_band(std::string_view text, std::string_view field = "out_of_band");
 
+/// The ranges PitchDistribution accepts (the one place for each rule; the
+/// studio's hello sends them to the designer's fields).
+inline constexpr double central_pitch_db_min = -40.0;
+inline constexpr double central_pitch_db_max = 40.0;
+inline constexpr double irregularity_db_min = -60.0;  ///< moments; log needs >= 0 (see the constructor)
+inline constexpr double irregularity_db_max = 40.0;
+inline constexpr double quantization_db_max = 20.0;
+
 struct PitchDistributionConfig {
   Decibels central_pitch{10.0};  ///< dB re 1 cpm; -20 … 19.7 dB on the reference device
   Decibels irregularity{-5.0};   ///< dB re 1 cpm (moments) or dB of log-spread (log, >= 0)

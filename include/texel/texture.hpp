@@ -88,6 +88,11 @@ struct TexelSpec {
   CoarseProfile coarse = ConstantProfile{};
 };
 
+/// Texel lengths a document may give (mm; validate() needs > 0 and at most
+/// the maximum). The studio's hello sends them.
+inline constexpr double texel_length_mm_min = 1e-6;
+inline constexpr double texel_length_mm_max = 1000.0;
+
 /// Validates every field; throws InvalidArgument naming field, value and range.
 void validate(const TexelSpec& spec);
 

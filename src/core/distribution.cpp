@@ -162,12 +162,15 @@ PitchDistribution::PitchDistribution(const PitchDistributionConfig& config) : co
   if (!(std::isfinite(hi) && hi > lo))
     throw InvalidArgument("band_max_cpm is " + num(hi) + " cpm; it must be finite and above band_min_cpm (" + num(lo) + " cpm)");
   const double q = config.quantization_db;
-  if (!(std::isfinite(q) && q >= 0.0 && q <= 20.0))
-    throw InvalidArgument("quantization_db is " + num(q) + " dB; allowed: 0 (off) or a step in (0, 20] dB");
-  if (p_db < -40.0 || p_db > 40.0)
-    throw InvalidArgument("central_pitch_db is " + num(p_db) + " dB; allowed: -40 … 40 dB (0.0001 … 10000 cpm)");
-  if (i_db > 40.0 || (config.parameterization == Parameterization::moments && i_db < -60.0))
-    throw InvalidArgument("irregularity_db is " + num(i_db) + " dB; allowed: -60 … 40 dB");
+  if (!(std::isfinite(q) && q >= 0.0 && q <= quantization_db_max))
+    throw InvalidArgument("quantization_db is " + num(q) + " dB; allowed: 0 (off) or a step in (0, " + num(quantization_db_max) +
+                          "] dB");
+  if (p_db < central_pitch_db_min || p_db > central_pitch_db_max)
+    throw InvalidArgument("central_pitch_db is " + num(p_db) + " dB; allowed: " + num(central_pitch_db_min) + " … " +
+                          num(central_pitch_db_max) + " dB (0.0001 … 10000 cpm)");
+  if (i_db > irregularity_db_max || (config.parameterization == Parameterization::moments && i_db < irregularity_db_min))
+    throw InvalidArgument("irregularity_db is " + num(i_db) + " dB; allowed: " + num(irregularity_db_min) + " … " +
+                          num(irregularity_db_max) + " dB");
 
   const double lo_db = db_of(lo);
   const double hi_db = db_of(hi);

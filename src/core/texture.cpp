@@ -120,7 +120,8 @@ void validate(const TexelSpec& spec) {
   const double L = spec.texel_length.value();
   if (!(std::isfinite(L) && L > 0.0))
     throw InvalidArgument("texel_length_mm is " + num(L) + " mm; it must be a finite number > 0");
-  if (L > 1000.0) throw InvalidArgument("texel_length_mm is " + num(L) + " mm; allowed: up to 1000 mm");
+  if (L > texel_length_mm_max)
+    throw InvalidArgument("texel_length_mm is " + num(L) + " mm; allowed: up to " + num(texel_length_mm_max) + " mm");
   check_fraction(spec.coarse_strength, "coarse_strength");
   check_fraction(spec.fine_strength, "fine_strength");
   if (!std::isfinite(spec.band_max.value()) || spec.band_max.value() < 0.0)

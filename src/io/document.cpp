@@ -187,15 +187,15 @@ void parse_texture(const json& j, const std::string& path, RegionSpec& region) {
   }
   if (kind != "texel") throw FormatError(o.field("kind") + " is '" + kind + "'; allowed: texel, reference");
   TexelSpec s;
-  s.central_pitch = Decibels(o.number("central_pitch_db", -40.0, 40.0));
-  s.irregularity = Decibels(o.number("irregularity_db", -60.0, 40.0));
-  s.texel_length = Millimetres(o.number("texel_length_mm", 1e-6, 1000.0));
+  s.central_pitch = Decibels(o.number("central_pitch_db", central_pitch_db_min, central_pitch_db_max));
+  s.irregularity = Decibels(o.number("irregularity_db", irregularity_db_min, irregularity_db_max));
+  s.texel_length = Millimetres(o.number("texel_length_mm", texel_length_mm_min, texel_length_mm_max));
   s.seed = o.uint64("seed");
   s.parameterization = enum_field(o, "parameterization", s.parameterization, parse_parameterization);
   s.out_of_band = enum_field(o, "out_of_band", s.out_of_band, parse_out_of_band);
   s.band_min = CyclesPerMm(o.number_or("band_min_cpm", s.band_min.value(), 1e-12, 1e12));
   s.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, 1e12));
-  s.quantization_db = o.number_or("quantization_db", 0.0, 0.0, 20.0);
+  s.quantization_db = o.number_or("quantization_db", 0.0, 0.0, quantization_db_max);
   s.phase = enum_field(o, "phase", s.phase, parse_phase_mode);
   s.fill = enum_field(o, "fill", s.fill, parse_fill);
   s.coarse_strength = o.number_or("coarse_strength", 0.0, 0.0, 1.0);

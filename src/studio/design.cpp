@@ -295,6 +295,12 @@ ExportFile export_file(const Document& doc, ExportFormat as, std::optional<std::
   }
   const Surface surface = prepare_surface(doc);
   if (as == ExportFormat::bitstream) {
+    // A .texel holds one Texel texture over the whole device: writing one
+    // region of several would silently drop the others.
+    if (!region && doc.regions.size() > 1)
+      throw InvalidArgument("a .texel bitstream holds one Texel texture; this document has " +
+                            std::to_string(doc.regions.size()) +
+                            " regions: export it as .texel.json to keep every region (or name the region to write)");
     const std::optional<std::size_t> i = region ? region : last_texel_region(doc);
     if (!i) throw InvalidArgument("the document has no Texel region to write as a bitstream");
     check_region(doc, *i, "region");

@@ -9,8 +9,10 @@
 #include "base64.hpp"
 #include "messages.hpp"
 #include "texel/device.hpp"
+#include "texel/distribution.hpp"
 #include "texel/error.hpp"
 #include "texel/reference.hpp"
+#include "texel/texture.hpp"
 
 #ifndef TEXEL_VERSION
 #define TEXEL_VERSION "unknown"
@@ -130,6 +132,15 @@ ojson make_hello(const State& s) {
                  {"max_queued_jobs", max_queued_jobs},
                  {"max_map_samples", s.options.max_map_samples},
                  {"max_name_chars", max_name_chars}};
+  // The library's own ranges of a Texel texture's fields (the designer's typed
+  // values are checked against them; the renderable band is the document's).
+  auto range = [](double lo, double hi) { return ojson{{"min", lo}, {"max", hi}}; };
+  h["texture_limits"] = {{"central_pitch_db", range(central_pitch_db_min, central_pitch_db_max)},
+                         {"irregularity_db", range(irregularity_db_min, irregularity_db_max)},
+                         {"texel_length_mm", range(texel_length_mm_min, texel_length_mm_max)},
+                         {"quantization_db", range(0.0, quantization_db_max)},
+                         {"coarse_strength", range(0.0, 1.0)},
+                         {"fine_strength", range(0.0, 1.0)}};
   return h;
 }
 

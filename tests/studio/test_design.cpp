@@ -139,7 +139,15 @@ TEST(ImportExport, DocumentAndBitstreamRoundTrip) {
   EXPECT_EQ(back.kind, ImportKind::document);
   EXPECT_EQ(document_json(back.document), document_json(doc));
 
-  const ExportFile bits = export_file(doc, ExportFormat::bitstream);
+  // A .texel holds one texture: a two-region document is refused rather than
+  // written as its last region; naming the region writes that one.
+  try {
+    (void)export_file(doc, ExportFormat::bitstream);
+    ADD_FAILURE() << "a two-region document exported as one .texel";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find(".texel.json to keep every region"), std::string::npos) << e.what();
+  }
+  const ExportFile bits = export_file(doc, ExportFormat::bitstream, 1);
   const ImportResult decoded = import_file("x.texel", byte_view(bits.data), {});
   EXPECT_EQ(decoded.kind, ImportKind::bitstream);
   EXPECT_EQ(decoded.document.regions.size(), 1u);

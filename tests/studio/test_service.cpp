@@ -300,8 +300,16 @@ TEST(Service, MatchImportExport) {
   EXPECT_FALSE(m["target_spectrum"]["frequency_cpm"].empty());
   EXPECT_FALSE(m["match_spectrum"]["frequency_cpm"].empty());
 
+  // A .texel holds one texture: the two-region document is refused, not cut to its last region.
+  const json refused = c.ask({{"type", "export"}, {"document", doc}, {"as", "bitstream"}});
+  ASSERT_EQ(refused["type"], "error") << refused.dump();
+  EXPECT_EQ(refused["code"], "invalid");
+  EXPECT_NE(refused["message"].get<std::string>().find("keep every region"), std::string::npos) << refused.dump();
+
   for (const std::string as : {"document", "bitstream", "device", "npy", "csv"}) {
-    const json e = c.ask({{"type", "export"}, {"document", doc}, {"as", as}});
+    json ask{{"type", "export"}, {"document", doc}, {"as", as}};
+    if (as == "bitstream") ask["region"] = 1;
+    const json e = c.ask(ask);
     ASSERT_EQ(e["type"], "export") << e.dump();
     const auto data = texel::studio::detail::base64_decode(e["data_base64"].get<std::string>());
     ASSERT_TRUE(data);

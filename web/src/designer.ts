@@ -11,6 +11,7 @@ import { hearIt } from './audio';
 import { Store } from './store';
 import type { CoarseProfile, RegionDoc, TexelTexture, TextureDocument } from './document';
 import type { DesignReply, DeviceProfile, ExportRequest, HelloReply, Spectrum } from './generated/messages';
+import './designer.css';
 
 interface TexelParams {
   central_pitch_db: number;
@@ -43,6 +44,15 @@ interface DesignerState {
   extra: Record<string, unknown>;
   /** The last match's target and matched spectra, drawn over the spectrum. */
   overlays: { target?: Spectrum; match?: Spectrum };
+  /** Swipe speed (mm/s) at which spatial frequencies are also shown in Hz (not part of the document). */
+  speed_mm_s: number;
+}
+
+/** Where the page keeps the design between visits (this browser only). */
+const SAVED_KEY = 'texel.designer.v1';
+interface Saved {
+  document: TextureDocument;
+  speed_mm_s: number;
 }
 
 const defaults = (): TexelParams => ({
@@ -186,45 +196,116 @@ function applyTexel(s: DesignerState, t: TexelTexture): void {
 
 // ---------------------------------------------------------------- controls
 
-interface SliderCtl {
-  row: HTMLElement;
-  input: HTMLInputElement;
-  set(v: number): void;
+/** A typed value's allowed range (the library's, from hello) and whether it must be a whole number. */
+interface Rule {
+  min: number;
+  max: number;
+  exclusiveMin?: boolean;
+  integer?: boolean;
 }
 
-function slider(
+/**
+ * Reads a typed value: a number inside `rule`, or the reason it is refused
+ * (never clamped, never read as 0).
+ */
+export function parseTyped(text: string, rule: Rule, unit: string): { value: number } | { error: string } {
+  const t = text.trim().replace(/\u2212/g, '-');
+  if (t === '') return { error: 'enter a number' };
+  const v = Number(t);
+  if (!Number.isFinite(v) || !/^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$/i.test(t)) return { error: `"${text.trim()}" is not a number` };
+  const u = unit ? ` ${unit}` : '';
+  if (rule.integer && !Number.isInteger(v)) return { error: `${t} is not a whole number` };
+  const low = rule.exclusiveMin ? v <= rule.min : v < rule.min;
+  if (low || v > rule.max)
+    return { error: `${t}${u} is outside the allowed range ${rule.exclusiveMin ? 'above ' : ''}${rule.min} … ${rule.max}${u}` };
+  return { value: v };
+}
+
+interface FieldCtl {
+  row: HTMLElement;
+  input: HTMLInputElement;
+  num: HTMLInputElement;
+  /** Shows the document's value (the only way the field changes). */
+  set(v: number): void;
+  /** Shows why a typed value was refused, at the field. */
+  refuse(message: string): void;
+  clear(): void;
+}
+
+/**
+ * A range slider and a typed value for one parameter. The slider covers a
+ * useful range (every shipped protocol's values); the typed value may be
+ * anything the library accepts (`rule()`, from hello). A refused typed value
+ * leaves the document unchanged and says why next to the field.
+ */
+function field(
   id: string,
   label: string,
-  min: number,
-  max: number,
-  step: number,
+  slider: { min: number; max: number; step: number },
+  rule: () => Rule,
   value: number,
   unit: string,
-  onInput: (v: number) => void,
+  onValue: (v: number, typed: boolean) => void,
   extra?: HTMLElement,
-): SliderCtl {
-  const input = h('input', { type: 'range', id, min, max, step, value, 'data-testid': id }) as HTMLInputElement;
-  const num = h('input', { type: 'number', min, max, step, value, 'aria-label': `${label} (${unit})`, class: 'num' }) as HTMLInputElement;
-  input.addEventListener('input', () => {
-    num.value = input.value;
-    onInput(Number(input.value));
-  });
-  num.addEventListener('change', () => {
-    const v = Math.min(max, Math.max(min, Number(num.value)));
-    if (!Number.isFinite(v)) return;
-    input.value = String(v);
-    num.value = String(v);
-    onInput(v);
-  });
-  const row = h('div', { class: 'ctl' }, h('label', { for: id }, label, ' ', h('span', { class: 'unit' }, `(${unit})`)), h('div', { class: 'ctl-row' }, input, num), extra ?? null);
-  return {
-    row,
+): FieldCtl {
+  const input = h('input', { type: 'range', id, min: slider.min, max: slider.max, step: slider.step, value, 'data-testid': id }) as HTMLInputElement;
+  const err = h('p', { class: 'field-error', id: `${id}-error`, 'data-testid': `${id}-error`, hidden: true });
+  const num = h('input', {
+    type: 'text',
+    inputmode: 'decimal',
+    id: `${id}-value`,
+    value,
+    'aria-label': `${label} (${unit}), typed`,
+    'aria-describedby': `${id}-error`,
+    'data-testid': `${id}-value`,
+    class: 'num',
+  }) as HTMLInputElement;
+  let shownValue = value;
+  const ctl: FieldCtl = {
+    row: h('div', { class: 'ctl' }, h('label', { for: id }, label, ' ', h('span', { class: 'unit' }, `(${unit})`)), h('div', { class: 'ctl-row' }, input, num), err, extra ?? null),
     input,
+    num,
     set(v: number) {
+      shownValue = v;
       input.value = String(v);
-      num.value = String(v);
+      if (document.activeElement !== num || num.getAttribute('aria-invalid') === 'true') num.value = String(v);
+    },
+    refuse(message: string) {
+      num.value = String(shownValue);
+      num.setAttribute('aria-invalid', 'true');
+      err.textContent = `${label}: ${message}. The design keeps ${shownValue} ${unit}.`;
+      err.hidden = false;
+      err.scrollIntoView({ block: 'nearest' });
+    },
+    clear() {
+      num.removeAttribute('aria-invalid');
+      err.hidden = true;
+      err.textContent = '';
     },
   };
+  input.addEventListener('input', () => {
+    ctl.clear();
+    num.value = input.value;
+    onValue(Number(input.value), false);
+  });
+  const commit = () => {
+    if (num.value.trim() === String(shownValue) && num.getAttribute('aria-invalid') !== 'true') return;
+    const r = parseTyped(num.value, rule(), unit.startsWith('dB') ? 'dB' : unit === 'mm' || unit === 'degrees' || unit === 'mm/s' ? unit : '');
+    if ('error' in r) {
+      ctl.refuse(r.error);
+      return;
+    }
+    ctl.clear();
+    onValue(r.value, true);
+  };
+  num.addEventListener('change', commit);
+  num.addEventListener('keydown', (e) => {
+    if (e.key === 'Enter') {
+      e.preventDefault();
+      commit();
+    }
+  });
+  return ctl;
 }
 
 function select(id: string, label: string, options: [string, string][], value: string, onChange: (v: string) => void): { row: HTMLElement; el: HTMLSelectElement } {
@@ -237,9 +318,8 @@ function select(id: string, label: string, options: [string, string][], value: s
 
 // ---------------------------------------------------------------- page
 
-export function mountDesigner(root: HTMLElement): void {
-  // The page's one state: controls write it, render() (below) reads it.
-  const store = new Store<DesignerState>({
+function initialState(): DesignerState {
+  return {
     device: 'tpad',
     split: false,
     reference: '4sin',
@@ -248,7 +328,31 @@ export function mountDesigner(root: HTMLElement): void {
     texel: defaults(),
     extra: {},
     overlays: {},
-  });
+    speed_mm_s: 100,
+  };
+}
+
+function loadSaved(): Saved | null {
+  try {
+    const text = localStorage.getItem(SAVED_KEY);
+    if (!text) return null;
+    const s = JSON.parse(text) as Saved;
+    return s && typeof s === 'object' && s.document?.format === 'texel-document' ? s : null;
+  } catch {
+    return null;
+  }
+}
+
+/** The state without what belongs to one moment (match overlays): what undo, redo and saving keep. */
+function lasting(s: DesignerState): string {
+  return JSON.stringify(buildDocument(s)) + `|${s.speed_mm_s}`;
+}
+
+export function mountDesigner(root: HTMLElement): void {
+  // The page's one state: controls write it, render() (below) reads it.
+  const saved = loadSaved();
+  const start = initialState();
+  const store = new Store<DesignerState>(saved ? { ...stateFromDocument(saved.document, start), speed_mm_s: saved.speed_mm_s || 100 } : start);
   const setTexel = (p: Partial<TexelParams>) => store.update((st) => ({ texel: { ...st.texel, ...p } }));
   const client = studio();
 
@@ -256,14 +360,20 @@ export function mountDesigner(root: HTMLElement): void {
   const hist = new HistogramPlot();
   const spec = new SpectrumPlot();
   let lastSpectrum: Spectrum | null = null;
+  let lastReply: DesignReply | null = null;
   let lastSelectedKey = '';
   let stripActiveUntil = 0;
 
-  const status = h('div', { class: 'status', role: 'status', 'aria-live': 'polite', 'data-testid': 'designer-status' });
+  // Errors: a status bar that stays in view (role=alert), or a message at the control concerned.
+  const status = h('div', { class: 'status designer-status', role: 'status', 'aria-live': 'polite', 'data-testid': 'designer-status' });
+  const alertBox = h('div', { class: 'designer-alert', role: 'alert', 'data-testid': 'designer-alert', hidden: true });
   const bytesEl = h('span', { class: 'bytes', 'data-testid': 'encoded-bytes', id: 'encoded-bytes' }, '–');
   const hexEl = h('code', { class: 'hex', 'data-testid': 'encoded-hex' });
   const pitchCpm = h('span', { class: 'cpm', 'data-testid': 'pitch-cpm' });
   const irrCpm = h('span', { class: 'cpm', 'data-testid': 'irregularity-cpm' });
+  const periodCpm = h('span', { class: 'cpm', 'data-testid': 'sine-period-cpm' });
+  const driveWarn = h('p', { class: 'drive-warning', 'data-testid': 'drive-warning', hidden: true });
+  const hzNote = h('p', { class: 'hint', 'data-testid': 'hz-note' });
   const texelsEl = h('span', { 'data-testid': 'texels' });
   const elapsedEl = h('span', { 'data-testid': 'elapsed' });
 
@@ -271,6 +381,8 @@ export function mountDesigner(root: HTMLElement): void {
   let gen = 0;
   let drawnGen = 0;
   const t0s: { g: number; t0: number }[] = [];
+  /** A typed value the engine has yet to accept: refused (and undone) if its design fails. */
+  let pending: { g: number; ctl: FieldCtl; prev: DesignerState } | null = null;
   // Its length comes from the device's profile (hello) and each design reply's grid.
   const strip = new FeelStrip({ length_mm: NaN, onEnter: () => {
     stripActiveUntil = performance.now() + 30000;
@@ -290,10 +402,26 @@ export function mountDesigner(root: HTMLElement): void {
     }
   }
 
-  function showError(e: unknown): void {
-    status.textContent = e instanceof Error ? e.message : String(e);
-    status.classList.add('error');
+  function message(e: unknown): string {
+    return e instanceof Error ? e.message : String(e);
   }
+
+  /** Shows an error next to `near` when given (else in the alert bar, which stays in view). */
+  function showError(e: unknown, near?: HTMLElement): void {
+    const text = message(e);
+    status.textContent = '';
+    if (near) {
+      near.textContent = text;
+      near.hidden = false;
+      near.scrollIntoView({ block: 'nearest' });
+      return;
+    }
+    alertText.textContent = text;
+    alertBox.hidden = false;
+  }
+  const alertText = h('span', { 'data-testid': 'designer-alert-text' });
+  const alertClose = h('button', { type: 'button', class: 'link', 'aria-label': 'Dismiss the message', onclick: () => (alertBox.hidden = true) }, '×');
+  alertBox.append(alertText, alertClose);
 
   async function design(): Promise<void> {
     const g = ++gen;
@@ -307,10 +435,24 @@ export function mountDesigner(root: HTMLElement): void {
       reply = await client.request('design', { document: buildDocument(store.get()) }, { lane: 'design', timeoutMs: 60000 });
     } catch (e) {
       if (e instanceof StudioError && e.code === 'superseded') return;
+      if (pending && g >= pending.g) {
+        // The engine refused a typed value: say so at its field and keep the design as it was.
+        const p = pending;
+        pending = null;
+        applying = true;
+        store.update(p.prev);
+        applying = false;
+        // The refused value is no step to undo.
+        if (undoStack.length && lasting(undoStack[undoStack.length - 1]) === lasting(p.prev)) undoStack.pop();
+        undoBtn.disabled = !undoStack.length;
+        p.ctl.refuse(message(e));
+        return;
+      }
       if (g >= drawnGen) showError(e);
       return;
     }
     if (!reply || g < drawnGen) return; // superseded or stale
+    if (pending && g >= pending.g) pending = null;
     drawnGen = g;
     draw(reply);
     await Promise.resolve(); // uPlot commits its redraw in a microtask queued by setData
@@ -328,8 +470,8 @@ export function mountDesigner(root: HTMLElement): void {
   }
 
   function draw(r: DesignReply): void {
-    status.textContent = '';
-    status.classList.remove('error');
+    lastReply = r;
+    alertBox.hidden = true;
     const values = decodeF32(r.map_f32);
     const analysed = [...r.regions].reverse().find((x) => x.kind === 'texel') ?? r.regions[r.regions.length - 1];
     mapPlot.setMap(r.grid.origin_mm, r.grid.spacing_mm, values, r.regions, analysed ? analysed.start_mm + Math.min(3, analysed.length_mm / 2) : undefined);
@@ -356,32 +498,113 @@ export function mountDesigner(root: HTMLElement): void {
       bytesEl.dataset.bytes = '';
       hexEl.textContent = r.encoded?.error ?? '';
     }
-    pitchCpm.textContent = typeof r.central_pitch_cpm === 'number' ? `= ${fmt(r.central_pitch_cpm, 3)} cycles/mm` : '';
-    irrCpm.textContent = typeof r.irregularity_cpm === 'number' ? `= ${fmt(r.irregularity_cpm, 3)} cycles/mm` : '';
     texelsEl.textContent = r.texels !== undefined ? `${r.texels} texels` : '';
     elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
     strip.setLength(r.grid.count * r.grid.spacing_mm);
+    strip.setMap(values, r.grid.origin_mm, r.grid.spacing_mm);
+    showFrequencies();
+  }
+
+  /**
+   * Spatial frequencies in Hz at the chosen swipe speed (f = cycles/mm × mm/s),
+   * and a warning when the drive lies above the display's response corner
+   * (the device profile's response, from hello).
+   */
+  function showFrequencies(): void {
+    const s = store.get();
+    const v = s.speed_mm_s;
+    const hz = (cpm: number) => `${fmt(cpm * v, cpm * v >= 100 ? 0 : 1)} Hz`;
+    const r = lastReply;
+    const pitch = r && typeof r.central_pitch_cpm === 'number' ? r.central_pitch_cpm : null;
+    const irrV = r && typeof r.irregularity_cpm === 'number' ? r.irregularity_cpm : null;
+    pitchCpm.textContent = pitch !== null ? `= ${fmt(pitch, 3)} cycles/mm = ${hz(pitch)} at ${v} mm/s` : '';
+    irrCpm.textContent = irrV !== null ? `= ${fmt(irrV, 3)} cycles/mm = ${hz(irrV)} at ${v} mm/s` : '';
+    const period = s.texel.sine_period_mm;
+    periodCpm.textContent = period > 0 ? `= ${fmt(1 / period, 3)} cycles/mm = ${hz(1 / period)} at ${v} mm/s` : '';
+    const dev = deviceProfile(s.device);
+    const corner = dev?.response?.corner_hz;
+    spec.setCorner(corner ? corner / v : null, corner ? `${dev!.name} corner ${corner} Hz at ${v} mm/s` : '');
+    hzNote.textContent =
+      `At ${v} mm/s, 1 cycle/mm is ${v} Hz` + (corner ? `; ${dev!.name}'s ${corner} Hz corner is ${fmt(corner / v, 2)} cycles/mm.` : '.');
+    const warnings: string[] = [];
+    if (corner && pitch !== null && pitch * v > corner)
+      warnings.push(
+        `At ${v} mm/s the Central Pitch drives ${hz(pitch)}, above ${dev!.name}'s response corner of ${corner} Hz ` +
+          `(order ${dev!.response!.order ?? 1} low-pass): the display renders it weaker than drawn. ` +
+          `Slower swipes or a lower Central Pitch stay within its response.`,
+      );
+    if (dev && pitch !== null && pitch * v > dev.refresh_hz / 2)
+      warnings.push(`It also lies above half of ${dev.name}'s ${dev.refresh_hz} Hz refresh rate, so it aliases.`);
+    driveWarn.textContent = warnings.join(' ');
+    driveWarn.hidden = !warnings.length;
   }
 
   // --- controls: each writes the store; render() shows the store in them
+  const lim = (k: keyof NonNullable<HelloReply['texture_limits']>, fallback: Rule): (() => Rule) => () => {
+    const r = hello?.texture_limits?.[k];
+    return r ? { min: r.min, max: r.max } : fallback;
+  };
+  /** Commits a value; a typed one stays pending until the engine accepts it (design() refuses it otherwise). */
+  const commitTexel = (ctl: () => FieldCtl, p: Partial<TexelParams>, typed: boolean) => {
+    const prev = store.get();
+    setTexel(p);
+    if (typed) pending = { g: gen, ctl: ctl(), prev };
+  };
   const t = store.get().texel;
-  const pitch = slider('central-pitch', 'Central Pitch', -10, 19.5, 0.1, t.central_pitch_db, 'dB re 1 cycle/mm', (v) => setTexel({ central_pitch_db: v }), pitchCpm);
-  const irr = slider('irregularity', 'Irregularity', -30, 20, 0.1, t.irregularity_db, 'dB', (v) => setTexel({ irregularity_db: v }), irrCpm);
-  const length = slider('texel-length', 'Texel length', 0.05, 10, 0.01, t.texel_length_mm, 'mm', (v) => setTexel({ texel_length_mm: v }));
-  const seedIn = h('input', { type: 'number', id: 'seed', min: 0, step: 1, value: t.seed, 'data-testid': 'seed', class: 'num' }) as HTMLInputElement;
-  seedIn.addEventListener('change', () => setTexel({ seed: Math.max(0, Math.floor(Number(seedIn.value) || 0)) }));
-  const newDraw = h('button', { type: 'button', 'data-testid': 'new-draw', onclick: () => setTexel({ seed: Math.floor(Math.random() * 2 ** 31) }) }, 'New draw');
+  const pitch: FieldCtl = field('central-pitch', 'Central Pitch', { min: -10, max: 19.5, step: 0.1 }, lim('central_pitch_db', { min: -40, max: 40 }), t.central_pitch_db, 'dB re 1 cycle/mm',
+    (v, typed) => commitTexel(() => pitch, { central_pitch_db: v }, typed), pitchCpm);
+  const irr: FieldCtl = field('irregularity', 'Irregularity', { min: -30, max: 20, step: 0.1 }, lim('irregularity_db', { min: -60, max: 40 }), t.irregularity_db, 'dB',
+    (v, typed) => commitTexel(() => irr, { irregularity_db: v }, typed), irrCpm);
+  const length: FieldCtl = field('texel-length', 'Texel length', { min: 0.05, max: 100, step: 0.01 }, lim('texel_length_mm', { min: 1e-6, max: 1000 }), t.texel_length_mm, 'mm',
+    (v, typed) => commitTexel(() => length, { texel_length_mm: v }, typed));
+  const seedErr = h('p', { class: 'field-error', id: 'seed-error', 'data-testid': 'seed-error', hidden: true });
+  const seedIn = h('input', { type: 'text', inputmode: 'numeric', id: 'seed', value: t.seed, 'data-testid': 'seed', class: 'num', 'aria-describedby': 'seed-error' }) as HTMLInputElement;
+  const seedCtl: FieldCtl = {
+    row: h('div'),
+    input: seedIn,
+    num: seedIn,
+    set(v: number) {
+      seedIn.value = String(v);
+    },
+    refuse(msg: string) {
+      seedIn.value = String(store.get().texel.seed);
+      seedIn.setAttribute('aria-invalid', 'true');
+      seedErr.textContent = `Seed: ${msg}. The design keeps seed ${store.get().texel.seed}.`;
+      seedErr.hidden = false;
+      seedErr.scrollIntoView({ block: 'nearest' });
+    },
+    clear() {
+      seedIn.removeAttribute('aria-invalid');
+      seedErr.hidden = true;
+    },
+  };
+  seedIn.addEventListener('change', () => {
+    // A seed is a whole number 0 … 2^53 − 1 (exact in the page's numbers and the document's JSON).
+    const r = parseTyped(seedIn.value, { min: 0, max: Number.MAX_SAFE_INTEGER, integer: true }, '');
+    if ('error' in r) return seedCtl.refuse(r.error);
+    seedCtl.clear();
+    commitTexel(() => seedCtl, { seed: r.value }, true);
+  });
+  const newDraw = h('button', { type: 'button', 'data-testid': 'new-draw', onclick: () => { seedCtl.clear(); setTexel({ seed: Math.floor(Math.random() * 2 ** 31) }); } }, 'New draw');
   const param = select('parameterization', 'Parameterization', [['moments', 'moments (mean, SD)'], ['log', 'log (lognormal μ, σ)']], t.parameterization, (v) => {
     const irregularity = v === 'log' && store.get().texel.irregularity_db < 0 ? { irregularity_db: 0 } : {};
     setTexel({ parameterization: v as 'moments' | 'log', ...irregularity });
   });
-  const quant = slider('quantization', 'Quantization', 0, 20, 0.5, t.quantization_db, 'dB, 0 = off', (v) => setTexel({ quantization_db: v }));
-  const cStrength = slider('coarse-strength', 'Coarse strength C', 0, 1, 0.01, t.coarse_strength, '0…1', (v) => setTexel({ coarse_strength: v }));
-  const fStrength = slider('fine-strength', 'Fine strength F', 0, 1, 0.01, t.fine_strength, '0…1', (v) => setTexel({ fine_strength: v }));
+  const quant: FieldCtl = field('quantization', 'Quantization', { min: 0, max: 20, step: 0.5 }, lim('quantization_db', { min: 0, max: 20 }), t.quantization_db, 'dB, 0 = off',
+    (v, typed) => commitTexel(() => quant, { quantization_db: v }, typed));
+  const cStrength: FieldCtl = field('coarse-strength', 'Coarse strength C', { min: 0, max: 1, step: 0.01 }, lim('coarse_strength', { min: 0, max: 1 }), t.coarse_strength, '0…1',
+    (v, typed) => commitTexel(() => cStrength, { coarse_strength: v }, typed));
+  const fStrength: FieldCtl = field('fine-strength', 'Fine strength F', { min: 0, max: 1, step: 0.01 }, lim('fine_strength', { min: 0, max: 1 }), t.fine_strength, '0…1',
+    (v, typed) => commitTexel(() => fStrength, { fine_strength: v }, typed));
 
-  const constVal = slider('coarse-value', 'Constant value', 0, 1, 0.01, t.coarse_value, '0…1', (v) => setTexel({ coarse_value: v }));
-  const sinePeriod = slider('sine-period', 'Sine period', 0.5, 50, 0.1, t.sine_period_mm, 'mm', (v) => setTexel({ sine_period_mm: v }));
-  const sinePhase = slider('sine-phase', 'Sine phase', 0, 360, 1, t.sine_phase_deg, 'degrees', (v) => setTexel({ sine_phase_deg: v }));
+  const constVal: FieldCtl = field('coarse-value', 'Constant value', { min: 0, max: 1, step: 0.01 }, () => ({ min: 0, max: 1 }), t.coarse_value, '0…1',
+    (v, typed) => commitTexel(() => constVal, { coarse_value: v }, typed));
+  const sinePeriod: FieldCtl = field('sine-period', 'Sine period', { min: 0.5, max: 100, step: 0.1 }, () => ({ min: 0, max: 1e6, exclusiveMin: true }), t.sine_period_mm, 'mm',
+    (v, typed) => commitTexel(() => sinePeriod, { sine_period_mm: v }, typed), periodCpm);
+  const sinePhase: FieldCtl = field('sine-phase', 'Sine phase', { min: 0, max: 360, step: 1 }, () => ({ min: -1e6, max: 1e6 }), t.sine_phase_deg, 'degrees',
+    (v, typed) => commitTexel(() => sinePhase, { sine_phase_deg: v }, typed));
+  const speed: FieldCtl = field('swipe-speed', 'Swipe speed', { min: 10, max: 500, step: 1 }, () => ({ min: 0, max: 10000, exclusiveMin: true }), store.get().speed_mm_s, 'mm/s',
+    (v) => store.update({ speed_mm_s: v }));
   const pointsInfo = h('p', { class: 'hint', 'data-testid': 'points-info' });
   const drawBtn = h('button', { type: 'button', 'aria-pressed': 'false', 'data-testid': 'draw-coarse' }, 'Draw on the map') as HTMLButtonElement;
   const coarseSel = select('coarse-kind', 'Coarse profile', [['constant', 'constant'], ['sine', 'sine'], ['points', 'drawn on the map']], t.coarse, (v) => {
@@ -436,10 +659,12 @@ export function mountDesigner(root: HTMLElement): void {
   refRow.hidden = true;
 
   const matchBtn = h('button', { type: 'button', 'data-testid': 'match', disabled: true }, 'Match a reference') as HTMLButtonElement;
-  const matchInfo = h('span', { class: 'hint', 'data-testid': 'match-info' });
+  const matchInfo = h('p', { class: 'hint match-info', 'data-testid': 'match-info', 'aria-live': 'polite' });
+  const matchErr = h('p', { class: 'field-error', role: 'alert', 'data-testid': 'match-error', hidden: true });
   matchBtn.addEventListener('click', async () => {
     matchBtn.disabled = true;
-    matchInfo.textContent = 'encoding…';
+    matchErr.hidden = true;
+    matchInfo.textContent = 'encoding the reference…';
     try {
       // Region 0 is the reference on the left; the service puts the match into the last Texel region.
       const r = await client.call('match', { document: buildDocument(store.get()), region: 0 }, 120000);
@@ -450,10 +675,18 @@ export function mountDesigner(root: HTMLElement): void {
         est.at_bound.central_pitch ? 'Central Pitch at the edge of the search range' : '',
         est.at_bound.irregularity ? 'Irregularity at the edge of the search range' : '',
       ].filter(Boolean);
-      // 1 JND: the smallest difference in felt pitch or noisiness a person notices (docs/encoder.md).
-      matchInfo.textContent =
-        `matched in ${r.encoded.bytes} bytes; felt distance ${fmt(r.distance_jnd, 2)} JND (model ${r.encoded.result.model.version}; ` +
-        `below 1 JND the two feel alike)` + (flags.length ? ` — ${flags.join('; ')}` : '');
+      const d = r.distance_jnd;
+      const verdict = d < 1 ? 'below 1 JND: the model predicts the two feel alike' : `${fmt(d, 1)} times what a person just notices: the two should feel different`;
+      // The model's JND (docs/encoder.md, "distance"): 1 dB of felt pitch or of noisiness.
+      matchInfo.replaceChildren(
+        h('strong', { 'data-testid': 'match-distance' }, `Felt distance ${fmt(d, 2)} JND`),
+        ` (${verdict}). Matched in ${r.encoded.bytes} bytes. `,
+        h('span', { 'data-testid': 'jnd-meaning' },
+          `1 JND (just-noticeable difference) is a 1 dB change in felt pitch (about 25 % in vibration frequency) or 1 dB in noisiness, ` +
+          `the smallest change a person reliably feels; the distance combines both (perception model ${r.encoded.result.model.version}). `),
+        'The spectrum shows the reference (dashed), the match (wide pale band) and the design (line).',
+        flags.length ? ` Note: ${flags.join('; ')}.` : '',
+      );
       store.update((st) => {
         const ns: DesignerState = { ...st, overlays: { target: r.target_spectrum, match: r.match_spectrum } };
         if (reg?.texture?.kind === 'texel') applyTexel(ns, reg.texture);
@@ -461,7 +694,7 @@ export function mountDesigner(root: HTMLElement): void {
       });
     } catch (e) {
       matchInfo.textContent = '';
-      showError(e);
+      showError(e, matchErr);
     } finally {
       matchBtn.disabled = !store.get().split;
     }
@@ -471,8 +704,79 @@ export function mountDesigner(root: HTMLElement): void {
     return Math.round(v * 1e4) / 1e4;
   }
 
+  // --- undo / redo and the design saved in this browser
+  const undoStack: DesignerState[] = [];
+  const redoStack: DesignerState[] = [];
+  let applying = false;
+  let lastPush = 0;
+  const undoBtn = h('button', { type: 'button', 'data-testid': 'undo', disabled: true, 'aria-keyshortcuts': 'Control+Z', onclick: () => undo() }, 'Undo') as HTMLButtonElement;
+  const redoBtn = h('button', { type: 'button', 'data-testid': 'redo', disabled: true, 'aria-keyshortcuts': 'Control+Shift+Z', onclick: () => redo() }, 'Redo') as HTMLButtonElement;
+  const savedNote = h('span', { class: 'hint', 'data-testid': 'saved-note' }, saved ? 'Restored the design saved in this browser.' : '');
+  function history(s: DesignerState, prev: DesignerState): void {
+    if (applying || lasting(s) === lasting(prev)) return;
+    const now = performance.now();
+    // A slider drag is one step: changes less than 0.5 s apart join the step before.
+    if (now - lastPush > 500 || !undoStack.length) undoStack.push({ ...prev, overlays: {} });
+    if (undoStack.length > 200) undoStack.shift();
+    lastPush = now;
+    redoStack.length = 0;
+  }
+  function restore(s: DesignerState): void {
+    applying = true;
+    pending = null;
+    for (const c of [pitch, irr, length, quant, cStrength, fStrength, constVal, sinePeriod, sinePhase, speed, seedCtl]) c.clear();
+    store.update({ ...s, overlays: {} });
+    applying = false;
+    lastPush = 0;
+  }
+  function undo(): void {
+    const s = undoStack.pop();
+    if (!s) return;
+    redoStack.push(store.get());
+    restore(s);
+  }
+  function redo(): void {
+    const s = redoStack.pop();
+    if (!s) return;
+    undoStack.push(store.get());
+    restore(s);
+  }
+  root.addEventListener('keydown', (e) => {
+    if (!(e.ctrlKey || e.metaKey) || e.altKey) return;
+    const k = e.key.toLowerCase();
+    const target = e.target as HTMLElement;
+    // Typing in a text field keeps the field's own undo.
+    if (target instanceof HTMLInputElement && target.type === 'text') return;
+    if (k === 'z' && !e.shiftKey) undo();
+    else if ((k === 'z' && e.shiftKey) || k === 'y') redo();
+    else return;
+    e.preventDefault();
+  });
+  let saveTimer: ReturnType<typeof setTimeout> | null = null;
+  function save(s: DesignerState): void {
+    if (saveTimer) clearTimeout(saveTimer);
+    saveTimer = setTimeout(() => {
+      try {
+        const v: Saved = { document: buildDocument(s), speed_mm_s: s.speed_mm_s };
+        localStorage.setItem(SAVED_KEY, JSON.stringify(v));
+        root.dataset.saved = 'true';
+      } catch (e) {
+        showError(`The design could not be saved in this browser: ${message(e)}`);
+      }
+    }, 250);
+  }
+  const freshBtn = h('button', { type: 'button', 'data-testid': 'new-design', onclick: () => {
+    if (saveTimer) clearTimeout(saveTimer);
+    localStorage.removeItem(SAVED_KEY);
+    undoStack.push(store.get());
+    redoStack.length = 0;
+    restore(initialState());
+    savedNote.textContent = 'Started a new design (Undo brings the last one back).';
+  } }, 'New design');
+
   /** Shows the store's state in every control (the only way controls change). */
   function render(s: DesignerState, prev: DesignerState): void {
+    history(s, prev);
     const t = s.texel;
     pitch.set(shown(t.central_pitch_db));
     irr.set(shown(t.irregularity_db));
@@ -485,49 +789,123 @@ export function mountDesigner(root: HTMLElement): void {
     constVal.set(shown(t.coarse_value));
     sinePeriod.set(shown(t.sine_period_mm));
     sinePhase.set(shown(t.sine_phase_deg));
+    speed.set(s.speed_mm_s);
     coarseSel.el.value = t.coarse;
     splitSel.el.value = s.split ? 'split' : 'single';
     refRow.hidden = !s.split;
     matchBtn.disabled = !s.split;
+    // A .texel holds one texture: with two regions the document file is the one that keeps both.
+    exportBits.disabled = s.split;
+    bitsNote.hidden = !s.split;
     if (typeof s.device === 'string') {
       if (![...deviceSel.el.options].some((o) => o.value === s.device)) deviceSel.el.append(h('option', { value: s.device as string }, s.device as string));
       deviceSel.el.value = s.device;
     }
     refSel.el.value = s.reference;
     showCoarse(t);
+    undoBtn.disabled = !undoStack.length;
+    redoBtn.disabled = !redoStack.length;
     if (s.overlays !== prev.overlays && lastSpectrum) spec.set(lastSpectrum, s.overlays.target, s.overlays.match);
-    void design();
+    if (s.speed_mm_s !== prev.speed_mm_s) showFrequencies();
+    if (lasting(s) !== lasting(prev)) save(s);
+    if (JSON.stringify(buildDocument(s)) !== JSON.stringify(buildDocument(prev))) void design();
   }
   store.subscribe(render);
 
   // --- import / export, drag and drop
-  const fileIn = h('input', { type: 'file', id: 'import-file', 'aria-label': 'Import a file', 'data-testid': 'import-file', accept: '.json,.texel,.bin,.npy,.csv,.wav', class: 'visually-hidden' }) as HTMLInputElement;
+  const filesErr = h('p', { class: 'field-error', role: 'alert', 'data-testid': 'files-error', hidden: true });
+  const fileIn = h('input', {
+    type: 'file',
+    id: 'import-file',
+    'data-testid': 'import-file',
+    accept: '.json,.texel,.bin,.npy,.csv,.wav',
+    class: 'visually-hidden',
+    tabindex: -1,
+    'aria-label': 'Import a file (.texel.json, .texel, device .bin, .npy, .csv, .wav)',
+  }) as HTMLInputElement;
   fileIn.addEventListener('change', () => {
     if (fileIn.files?.[0]) void importFile(fileIn.files[0]);
     fileIn.value = '';
   });
+
+  // Raw device maps carry no header: say how the bytes will be read and ask first.
+  const confirmText = h('p', { 'data-testid': 'import-confirm-text', id: 'import-confirm-text' });
+  const confirmDlg = h('dialog', { class: 'confirm', 'data-testid': 'import-confirm', 'aria-labelledby': 'import-confirm-title', 'aria-describedby': 'import-confirm-text' },
+    h('h2', { id: 'import-confirm-title' }, 'Import a raw device map?'), confirmText,
+    h('div', { class: 'btn-row' },
+      h('button', { type: 'button', class: 'primary', 'data-testid': 'import-confirm-yes', value: 'yes' }, 'Import and replace the design'),
+      h('button', { type: 'button', 'data-testid': 'import-confirm-no', value: 'no' }, 'Cancel'))) as HTMLDialogElement;
+  function confirmRaw(f: File, bytes: number): Promise<boolean> {
+    const s = store.get();
+    const dev = deviceProfile(s.device);
+    if (!dev) return Promise.resolve(true);
+    const width = /(^|[^0-9])8$/.test(dev.format) ? 1 : /32|f32/.test(dev.format) ? 4 : 2;
+    const n = bytes / width;
+    const whole = Number.isInteger(n);
+    confirmText.textContent =
+      `"${f.name}" has no header: it will be read as a map of device ${dev.name} — ${bytes} bytes` +
+      (whole ? ` = ${n} ${dev.format} samples, ${dev.spacing_mm} mm apart (${fmt(n * dev.spacing_mm, 2)} mm)` : ` (not a whole number of ${dev.format} samples)`) +
+      `; ${dev.name} holds ${dev.samples} samples over ${fmt(dev.samples * dev.spacing_mm, 2)} mm, played at ${dev.refresh_hz} Hz. ` +
+      (whole && n !== dev.samples ? 'It is not a whole device map. ' : '') +
+      'The engine encodes it as a Texel texture, replacing the current design (Undo brings it back).';
+    return new Promise((resolve) => {
+      const yes = confirmDlg.querySelector('[value=yes]') as HTMLButtonElement;
+      const no = confirmDlg.querySelector('[value=no]') as HTMLButtonElement;
+      const done = (ok: boolean) => {
+        yes.onclick = no.onclick = null;
+        confirmDlg.onclose = null;
+        if (confirmDlg.open) confirmDlg.close();
+        resolve(ok);
+      };
+      yes.onclick = () => done(true);
+      no.onclick = () => done(false);
+      confirmDlg.onclose = () => done(false);
+      confirmDlg.showModal();
+      no.focus();
+    });
+  }
+
   async function importFile(f: File): Promise<void> {
-    status.textContent = `importing ${f.name}…`;
+    filesErr.hidden = true;
+    delete status.dataset.imported;
     try {
       const bytes = new Uint8Array(await f.arrayBuffer());
+      if (/\.bin$/i.test(f.name) && !(await confirmRaw(f, bytes.length))) {
+        status.textContent = `Import of ${f.name} cancelled; the design is unchanged.`;
+        return;
+      }
+      status.textContent = `importing ${f.name}…`;
       const device = store.get().device;
       const dev = typeof device === 'string' ? device : device.name;
       const r = await client.call('import', { name: f.name, data_base64: bytesToBase64(bytes), device: dev }, 120000);
+      const doc = r.document as TextureDocument;
+      const next = stateFromDocument(doc, store.get());
       status.textContent = `imported ${f.name}`;
       status.dataset.imported = f.name;
-      store.update(stateFromDocument(r.document as TextureDocument, store.get()));
+      store.update(next);
+      // The page edits one texture, or a reference beside one: say so when a file holds more.
+      const had = doc.regions?.length ?? 1;
+      const kept = buildDocument(next).regions?.length ?? 1;
+      if (kept < had)
+        showError(`${f.name} has ${had} regions; the designer shows ${kept} of them (the reference and the last Texel region). ` +
+          'Exporting from here writes only those.', filesErr);
     } catch (e) {
-      showError(e);
+      status.textContent = '';
+      showError(`${f.name} was not imported: ${message(e)}`, filesErr);
     }
   }
   async function exportAs(as: ExportRequest['as']): Promise<void> {
+    filesErr.hidden = true;
     try {
       const r = await client.call('export', { document: buildDocument(store.get()), as }, 60000);
       download(r.name, r.mime, base64ToBytes(r.data_base64));
     } catch (e) {
-      showError(e);
+      showError(e, filesErr);
     }
   }
+  const exportBits = h('button', { type: 'button', onclick: () => void exportAs('bitstream'), 'data-testid': 'export-bitstream' }, 'Export .texel') as HTMLButtonElement;
+  const bitsNote = h('p', { class: 'hint', 'data-testid': 'bitstream-note', hidden: true },
+    'A .texel holds one texture: export .texel.json to keep both regions.');
   const dropHint = h('div', { class: 'drop-hint', 'aria-hidden': 'true' }, 'Drop a .texel.json, .texel or device file to import it');
   root.addEventListener('dragover', (e) => {
     e.preventDefault();
@@ -557,19 +935,22 @@ export function mountDesigner(root: HTMLElement): void {
   const controls = h(
     'form',
     { class: 'controls', 'aria-label': 'Texture parameters', onsubmit: (e: Event) => e.preventDefault() },
+    h('div', { class: 'btn-row history' }, undoBtn, redoBtn, freshBtn, savedNote),
     h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row,
-      h('div', { class: 'ctl' }, h('label', { for: 'seed' }, 'Seed'), h('div', { class: 'ctl-row' }, seedIn, newDraw)),
+      h('div', { class: 'ctl' }, h('label', { for: 'seed' }, 'Seed ', h('span', { class: 'unit' }, '(whole number ≥ 0)')), h('div', { class: 'ctl-row' }, seedIn, newDraw), seedErr),
       param.row, quant.row, fStrength.row),
+    h('fieldset', {}, h('legend', {}, 'Swipe speed'), speed.row, driveWarn),
     h('fieldset', {}, h('legend', {}, 'Coarse profile'), coarseSel.row, coarseParams, drawBtn, cStrength.row),
-    h('fieldset', {}, h('legend', {}, 'Device and regions'), deviceSel.row, splitSel.row, refRow, h('div', { class: 'ctl-row' }, matchBtn, matchInfo)),
+    h('fieldset', {}, h('legend', {}, 'Device and regions'), deviceSel.row, splitSel.row, refRow, h('div', { class: 'ctl-row' }, matchBtn), matchInfo, matchErr),
     h('fieldset', {}, h('legend', {}, 'Files'),
       h('div', { class: 'btn-row' },
         h('button', { type: 'button', onclick: () => fileIn.click(), 'data-testid': 'import' }, 'Import…'),
         fileIn,
         h('button', { type: 'button', onclick: () => void exportAs('document'), 'data-testid': 'export-document' }, 'Export .texel.json'),
-        h('button', { type: 'button', onclick: () => void exportAs('bitstream'), 'data-testid': 'export-bitstream' }, 'Export .texel'),
+        exportBits,
         h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin')),
-      h('p', { class: 'hint' }, 'Or drop a file anywhere on the page.'),
+      bitsNote, filesErr,
+      h('p', { class: 'hint' }, 'Or drop a file anywhere on the page. The design is also kept in this browser.'),
       stimulusSaver(() => buildDocument(store.get()))),
   );
 
@@ -579,15 +960,18 @@ export function mountDesigner(root: HTMLElement): void {
     { class: 'plots' },
     summary,
     h('h2', {}, 'Friction map'),
-    h('p', { class: 'hint' }, 'Drag to zoom, double-click to reset.'),
+    h('p', { class: 'hint' }, 'Drag to zoom, double-click to reset. Drive 0…1: 1 is the display’s full friction change.'),
     mapPlot.el,
     h('h2', {}, 'Feel it'),
     strip.el,
     h('label', { class: 'inline' }, hear, ' Hear it (browser audio, when no display is attached)'),
-    h('div', { class: 'two' }, h('div', {}, h('h2', {}, 'Texel frequencies'), hist.el), h('div', {}, h('h2', {}, 'Spectrum'), spec.el)),
+    h('div', { class: 'two' }, h('div', {}, h('h2', {}, 'Texel frequencies'), hist.el, hzNote),
+      h('div', {}, h('h2', {}, 'Spectrum'), spec.el,
+        h('p', { class: 'hint' }, 'Amplitude spectrum of the analysed region: 0 dB is a sine of amplitude 1 (full drive); −20 dB is amplitude 0.1.'))),
   );
-  root.replaceChildren(h('div', { class: 'designer' }, controls, plots), status, dropHint);
+  root.replaceChildren(h('div', { class: 'designer' }, controls, plots), status, alertBox, dropHint, confirmDlg);
   showCoarse(store.get().texel);
+  render(store.get(), store.get());
 
   void getHello()
     .then((hi) => {
@@ -600,5 +984,5 @@ export function mountDesigner(root: HTMLElement): void {
       root.dataset.ready = 'true';
       void design();
     })
-    .catch(showError);
+    .catch((e) => showError(e));
 }

@@ -87,6 +87,9 @@ export interface StripOptions {
 export class FeelStrip {
   readonly el: HTMLElement;
   private strip: HTMLElement;
+  private texture: HTMLCanvasElement;
+  private scale: HTMLElement;
+  private map: { values: Float32Array; origin_mm: number; spacing_mm: number } | null = null;
   private finger: HTMLElement;
   private playerMark: HTMLElement;
   private posText: HTMLElement;
@@ -101,6 +104,9 @@ export class FeelStrip {
     this.hoverTouches = opts.hoverTouches ?? true;
     this.finger = h('div', { class: 'finger', 'aria-hidden': 'true' });
     this.playerMark = h('div', { class: 'player-mark', 'aria-hidden': 'true' });
+    // The texture under the finger (the friction map drawn across the strip) and a mm scale below it.
+    this.texture = h('canvas', { class: 'strip-texture', 'aria-hidden': 'true', 'data-testid': 'strip-texture' });
+    this.scale = h('div', { class: 'strip-scale', 'aria-hidden': 'true', 'data-testid': 'strip-scale' });
     this.strip = h(
       'div',
       {
@@ -113,6 +119,7 @@ export class FeelStrip {
         'aria-valuenow': 0,
         'data-testid': 'feel-strip',
       },
+      this.texture,
       this.finger,
       this.playerMark,
     );
@@ -123,6 +130,7 @@ export class FeelStrip {
       'section',
       { class: 'feel', 'aria-label': 'Feel it' },
       this.strip,
+      this.scale,
       h(
         'div',
         { class: 'feel-status' },
@@ -199,8 +207,75 @@ export class FeelStrip {
   }
 
   setLength(length_mm: number): void {
+    if (length_mm === this.length_mm) return;
     this.length_mm = length_mm;
     this.strip.setAttribute('aria-valuemax', String(Math.round(length_mm)));
+    this.drawScale();
+    this.drawTexture();
+  }
+
+  /** The friction map to draw on the strip (the same samples the plots show). */
+  setMap(values: Float32Array, origin_mm: number, spacing_mm: number): void {
+    this.map = { values, origin_mm, spacing_mm };
+    this.drawTexture();
+  }
+
+  private drawScale(): void {
+    const L = this.length_mm;
+    this.scale.replaceChildren();
+    if (!(L > 0)) return;
+    const step = L > 200 ? 50 : L > 50 ? 10 : L > 10 ? 5 : 1;
+    for (let x = 0; x <= L + 1e-9; x += step) {
+      const tick = h('span', { class: 'tick', style: `left: ${(100 * x) / L}%` }, `${x}`);
+      this.scale.append(tick);
+    }
+    this.scale.append(h('span', { class: 'scale-unit' }, `mm (surface ${fmt(L, 2)} mm)`));
+  }
+
+  private drawTexture(): void {
+    const c = this.texture;
+    const m = this.map;
+    const L = this.length_mm;
+    const w = Math.max(200, Math.round(this.strip.clientWidth || 800));
+    const ht = Math.max(40, Math.round(this.strip.clientHeight || 96));
+    if (c.width !== w || c.height !== ht) {
+      c.width = w;
+      c.height = ht;
+    }
+    const ctx = c.getContext('2d');
+    if (!ctx) return;
+    ctx.clearRect(0, 0, w, ht);
+    if (!m || !(L > 0) || !m.values.length) return;
+    // Per pixel column: the min … max of the samples under it (a dense texture reads as a band)
+    // and the mean drive over the millimetre around it (a line; a shorter window would alias).
+    ctx.fillStyle = 'rgba(42, 111, 219, 0.3)';
+    ctx.strokeStyle = '#1b3f8f';
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    const n = m.values.length;
+    const prefix = new Float64Array(n + 1);
+    for (let i = 0; i < n; i++) prefix[i + 1] = prefix[i] + m.values[i];
+    const half = Math.max(1, Math.round(0.5 / m.spacing_mm));
+    for (let px = 0; px < w; px++) {
+      const a = Math.max(0, Math.floor(((px / w) * L - m.origin_mm) / m.spacing_mm));
+      const b = Math.min(n, Math.ceil((((px + 1) / w) * L - m.origin_mm) / m.spacing_mm) + 1);
+      if (a >= b) continue;
+      let lo = Infinity;
+      let hi = -Infinity;
+      for (let i = a; i < b; i++) {
+        const v = m.values[i];
+        if (v < lo) lo = v;
+        if (v > hi) hi = v;
+      }
+      const c = (a + b) >> 1;
+      const [ma, mb] = [Math.max(0, c - half), Math.min(n, c + half + 1)];
+      const mean = (prefix[mb] - prefix[ma]) / (mb - ma);
+      const y = (v: number) => ht - 4 - Math.min(1, Math.max(0, v)) * (ht - 8);
+      ctx.fillRect(px, y(hi), 1, Math.max(1, y(lo) - y(hi)));
+      if (px === 0) ctx.moveTo(px, y(mean));
+      else ctx.lineTo(px, y(mean));
+    }
+    ctx.stroke();
   }
 
   private startPolling(): void {
@@ -226,9 +301,13 @@ export class FeelStrip {
       this.posText.textContent = '–';
       this.posText.dataset.mm = '';
     } else {
-      this.posText.textContent = `${fmt(p, 2)} mm${st.touching ? ' (touching)' : ''}`;
-      this.posText.dataset.mm = String(p);
-      this.playerMark.style.transform = `translateX(${(100 * p) / this.length_mm}%)`;
+      // The player extrapolates the finger up to 30 ms ahead (PlayerConfig::extrapolate_s), which may
+      // run past an end of the surface: the position shown is the point of the surface under the finger.
+      const onSurface = Number.isFinite(this.length_mm) ? Math.min(Math.max(p, 0), this.length_mm) : p;
+      this.posText.textContent = `${fmt(onSurface, 2)} mm${st.touching ? ' (touching)' : ''}`;
+      this.posText.dataset.mm = String(onSurface);
+      this.posText.dataset.rawMm = String(p);
+      this.playerMark.style.transform = `translateX(${(100 * onSurface) / this.length_mm}%)`;
     }
     this.posText.dataset.touching = String(!!st.touching);
     this.playerMark.classList.toggle('touching', !!st.touching);

@@ -20,6 +20,13 @@ function autoResize(u: uPlot, host: HTMLElement, height: number): void {
   ro.observe(host);
 }
 
+// Axis titles (uPlot draws them on its canvas; each plot's host also carries
+// them as data-axes, x|y, for tests and assistive text).
+const MAP_AXES = ['position on the surface (mm)', 'drive (0…1)'] as const;
+const HIST_AXES = ['texel frequency (cycles/mm)', 'texels (count)'] as const;
+const SPECTRUM_AXES = ['spatial frequency (cycles/mm, log)', 'dB re amplitude 1'] as const;
+const axesAttr = (a: readonly string[]) => a.join('|');
+
 export interface RegionMark {
   name: string;
   start_mm: number;
@@ -42,8 +49,8 @@ export class MapPlot {
   onDrawn: (points: [number, number][]) => void = () => {};
 
   constructor(height = 220) {
-    const mainHost = h('div', { class: 'plot', 'data-testid': 'map-plot', 'aria-label': 'Friction map: amplitude over position (mm)', role: 'img' });
-    const detailHost = h('div', { class: 'plot detail', 'data-testid': 'detail-plot', 'aria-label': '6 mm detail of the friction map', role: 'img' });
+    const mainHost = h('div', { class: 'plot', 'data-testid': 'map-plot', 'data-axes': axesAttr(MAP_AXES), 'aria-label': 'Friction map: drive 0…1 (1 = full friction change) over position (mm)', role: 'img' });
+    const detailHost = h('div', { class: 'plot detail', 'data-testid': 'detail-plot', 'data-axes': axesAttr(MAP_AXES), 'aria-label': '6 mm detail of the friction map: drive 0…1 over position (mm)', role: 'img' });
     this.el = h('div', { class: 'map-plots' }, mainHost, h('div', { class: 'plot-caption' }, '6 mm detail (follows the cursor on the map)'), detailHost);
     const regionsHook = (u: uPlot) => {
       const ctx = u.ctx;
@@ -73,7 +80,7 @@ export class MapPlot {
         cursor: { drag: { x: true, y: false }, points: { show: false } },
         legend: { show: false },
         scales: { x: { time: false }, y: { range: [0, 1] } },
-        axes: [{ label: 'position (mm)' }, { label: 'amplitude' }],
+        axes: [{ label: MAP_AXES[0] }, { label: MAP_AXES[1] }],
         series: [{}, { stroke: '#2a6fdb', width: 1, points: { show: false } }],
         hooks: {
           draw: [regionsHook],
@@ -90,11 +97,11 @@ export class MapPlot {
     this.detail = new uPlot(
       {
         width: 800,
-        height: 120,
+        height: 170,
         cursor: { drag: { x: false, y: false }, points: { show: false } },
         legend: { show: false },
         scales: { x: { time: false, auto: false }, y: { range: [0, 1] } },
-        axes: [{ label: 'position (mm)' }, {}],
+        axes: [{ label: MAP_AXES[0] }, { label: MAP_AXES[1], splits: () => [0, 0.5, 1] }],
         series: [{}, { stroke: '#2a6fdb', width: 1.5, points: { show: false } }],
       },
       [[], []],
@@ -102,10 +109,10 @@ export class MapPlot {
     );
     requestAnimationFrame(() => {
       this.main.setSize({ width: widthOf(mainHost, 800), height });
-      this.detail.setSize({ width: widthOf(detailHost, 800), height: 120 });
+      this.detail.setSize({ width: widthOf(detailHost, 800), height: 170 });
     });
     autoResize(this.main, mainHost, height);
-    autoResize(this.detail, detailHost, 120);
+    autoResize(this.detail, detailHost, 170);
 
     // Drawing a coarse profile: a canvas over the plot area shows the stroke.
     this.drawCanvas = h('canvas', { class: 'draw-overlay', 'aria-hidden': 'true' });
@@ -193,7 +200,7 @@ export class HistogramPlot {
   private u: uPlot;
 
   constructor(height = 200) {
-    this.el = h('div', { class: 'plot', 'data-testid': 'histogram-plot', role: 'img', 'aria-label': 'Histogram of texel frequencies (cycles/mm) over the distribution density' });
+    this.el = h('div', { class: 'plot', 'data-testid': 'histogram-plot', 'data-axes': axesAttr(HIST_AXES), role: 'img', 'aria-label': 'Histogram of texel frequencies (cycles/mm) over the distribution density' });
     this.u = new uPlot(
       {
         width: 400,
@@ -201,7 +208,7 @@ export class HistogramPlot {
         legend: { show: true },
         cursor: { drag: { x: true, y: false } },
         scales: { x: { time: false } },
-        axes: [{ label: 'texel frequency (cycles/mm)' }, { label: 'texels' }],
+        axes: [{ label: HIST_AXES[0] }, { label: HIST_AXES[1] }],
         series: [
           { label: 'cpm' },
           { label: 'texels', stroke: '#2a6fdb', fill: 'rgba(42,111,219,0.35)', paths: uPlot.paths.bars!({ size: [0.95, 100] }), points: { show: false } },
@@ -243,7 +250,7 @@ export class SpectrumPlot {
   private u: uPlot;
 
   constructor(height = 200) {
-    this.el = h('div', { class: 'plot', 'data-testid': 'spectrum-plot', role: 'img', 'aria-label': 'Spectrum: magnitude (dB) over frequency (cycles/mm, log)' });
+    this.el = h('div', { class: 'plot', 'data-testid': 'spectrum-plot', 'data-axes': axesAttr(SPECTRUM_AXES), role: 'img', 'aria-label': 'Spectrum: magnitude (dB re amplitude 1, a full-scale sine) over spatial frequency (cycles/mm, log)' });
     this.u = new uPlot(
       {
         width: 400,
@@ -251,13 +258,16 @@ export class SpectrumPlot {
         legend: { show: true },
         cursor: { drag: { x: true, y: false } },
         scales: { x: { time: false, distr: 3 } },
-        axes: [{ label: 'frequency (cycles/mm)' }, { label: 'dB' }],
+        axes: [{ label: SPECTRUM_AXES[0] }, { label: SPECTRUM_AXES[1] }],
+        // Drawn in this order: the match as a wide pale band under the design's
+        // thin line, so the two stay visible when they coincide.
         series: [
-          { label: 'cpm' },
-          { label: 'design', stroke: '#2a6fdb', width: 1.5, points: { show: false } },
-          { label: 'reference (target)', stroke: '#c44', width: 1.5, points: { show: false }, show: true },
-          { label: 'match', stroke: '#2a9d3f', width: 1.5, dash: [6, 3], points: { show: false } },
+          { label: 'cycles/mm' },
+          { label: 'match (decoded)', stroke: 'rgba(42,157,63,0.45)', width: 6, points: { show: false } },
+          { label: 'reference (target)', stroke: '#c44', width: 1.5, dash: [6, 3], points: { show: false } },
+          { label: 'design', stroke: '#1b3f8f', width: 1.25, points: { show: false } },
         ],
+        hooks: { draw: [(u) => this.drawCorner(u)] },
       },
       [[1], [null], [null], [null]],
       this.el,
@@ -277,6 +287,33 @@ export class SpectrumPlot {
       }
     }
     const over = (s?: Spectrum | null) => xs.map((f) => (s ? interpLog(s.frequency_cpm, s.magnitude_db, f) : null));
-    this.u.setData([xs, ys, over(target), over(match)]);
+    this.u.setData([xs, over(match), over(target), ys]);
+  }
+
+  /** Marks the spatial frequency at which the drive reaches the display's corner (corner Hz / swipe speed). */
+  setCorner(cpm: number | null, label: string): void {
+    this.corner = cpm !== null && Number.isFinite(cpm) && cpm > 0 ? { cpm, label } : null;
+    this.u.redraw(false, false);
+  }
+
+  private corner: { cpm: number; label: string } | null = null;
+
+  private drawCorner(u: uPlot): void {
+    if (!this.corner) return;
+    const px = u.valToPos(this.corner.cpm, 'x', true);
+    if (!(px >= u.bbox.left && px <= u.bbox.left + u.bbox.width)) return;
+    const ctx = u.ctx;
+    ctx.save();
+    ctx.strokeStyle = '#b3261e';
+    ctx.fillStyle = '#b3261e';
+    ctx.setLineDash([3, 3]);
+    ctx.beginPath();
+    ctx.moveTo(px, u.bbox.top);
+    ctx.lineTo(px, u.bbox.top + u.bbox.height);
+    ctx.stroke();
+    ctx.font = `${Math.round(11 * devicePixelRatio)}px sans-serif`;
+    ctx.textAlign = px > u.bbox.left + u.bbox.width * 0.6 ? 'right' : 'left';
+    ctx.fillText(this.corner.label, px + (ctx.textAlign === 'right' ? -4 : 4) * devicePixelRatio, u.bbox.top + 12 * devicePixelRatio);
+    ctx.restore();
   }
 }

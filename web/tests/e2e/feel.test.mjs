@@ -99,3 +99,41 @@ test('feel: a touch sweep reaches the player', { timeout: 120_000 }, async () =>
     { contextOptions: { hasTouch: true, viewport: { width: 1024, height: 1366 } } },
   );
 });
+
+// Issue #22: the strip showed no texture or mm scale, and a sweep ending near
+// 100.7 mm left the player at 105.37 mm on a 101.76 mm surface.
+test('feel: the strip shows the texture and a mm scale; the player stays on the surface', { timeout: 120_000 }, async () => {
+  await withStudio(async ({ studio, page, errors }) => {
+    await openDesigner(page, studio.url);
+    const b = await stripBox(page);
+    const ticks = await page.$$eval('[data-testid=strip-scale] .tick', (els) => els.map((e) => e.textContent));
+    assert.deepEqual(ticks, ['0', '10', '20', '30', '40', '50', '60', '70', '80', '90', '100']);
+    assert.match(await page.textContent('[data-testid=strip-scale]'), /mm \(surface 101\.76 mm\)/);
+    const ink = await page.$eval('[data-testid=strip-texture]', (c) => {
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let n = 0;
+      for (let i = 3; i < d.length; i += 4) if (d[i]) n++;
+      return { n, of: d.length / 4 };
+    });
+    assert.ok(ink.n > ink.of * 0.05, `the texture is drawn on the strip (${ink.n} of ${ink.of} pixels)`);
+    // A fast sweep that ends at the right edge: the player's 30 ms extrapolation overshoots the surface.
+    const y = b.y + b.height / 2;
+    await page.mouse.move(b.x + 2 + 0.5 * (b.width - 4), y);
+    for (let k = 1; k <= 20; k++) {
+      await page.mouse.move(b.x + 2 + (0.5 + (0.4995 * k) / 20) * (b.width - 4), y);
+      await page.waitForTimeout(8);
+    }
+    await page.waitForFunction(() => Number(document.querySelector('#player-position').dataset.mm) > 95, null, { timeout: 10_000 });
+    let raw = 0;
+    for (let i = 0; i < 10; i++) {
+      const mm = Number(await page.getAttribute('#player-position', 'data-mm'));
+      raw = Math.max(raw, Number(await page.getAttribute('#player-position', 'data-raw-mm')));
+      assert.ok(mm >= 0 && mm <= TPAD_MM + 1e-9, `player at ${mm} mm on a ${TPAD_MM} mm surface`);
+      await page.waitForTimeout(30);
+    }
+    console.log(`player's own report reached ${raw.toFixed(2)} mm; shown at most ${TPAD_MM} mm`);
+    assert.match(await page.textContent('#player-position'), /^\d+\.\d\d mm/);
+    await screenshot(page, 'feel-strip-scale');
+    assert.deepEqual(errors, []);
+  });
+});
