@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <memory>
@@ -109,6 +110,9 @@ struct State {
 
   std::optional<experiment::Store> store;
   std::optional<experiment::ActiveSession> active;
+  /// Sends `msg` (no id) to every connected client but `except` (set by the
+  /// service): participant screens follow suspend, stop, switch and answers.
+  std::function<void(const ojson& msg, std::uint64_t except)> broadcast;
 };
 
 inline double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -170,5 +174,7 @@ void on_experiment_select(State&, Client&, const Job&);
 void on_experiment_preview(State&, Client&, const Job&);
 void on_experiment_answer(State&, Client&, const Job&);
 void on_experiment_stop(State&, Client&, const Job&);
+void on_experiment_suspend(State&, Client&, const Job&);
+void on_experiment_resume(State&, Client&, const Job&);
 
 }  // namespace texel::studio::detail
