@@ -272,11 +272,8 @@ ActiveSession open_session(Store& store, const Protocol& protocol, const OpenOpt
   ctx.prior_matches = prior_matches(store, run, o.participant);
   Session session(std::move(run), std::move(ctx));
   for (const auto& t : store.trials(info.id)) session.replay(t);
-  ActiveSession a{std::move(info), std::move(lock), std::move(session), simulate};
-  a.database = database_identity(store);
-  a.opening = random_opening();
-  a.resumed = o.resume;
-  return a;
+  return ActiveSession{std::move(info), std::move(lock), std::move(session), simulate, database_identity(store), random_opening(),
+                       o.resume,        false,           TrialClock{},       {}};
 }
 
 StoredTrial record(Store& store, ActiveSession& a, const Response& r) {

@@ -245,10 +245,10 @@ export function mountParticipant(root: HTMLElement): void {
       parts.push(countdown);
       // The server's clock: what is left of the limit since onset (a reload or a pause does not reset it).
       const end = shownPerf + (handout.time_limit_s - handout.elapsed_s) * 1000;
-      countdown.dataset.endsIn = String(handout.time_limit_s - handout.elapsed_s);
       const tick = () => {
         if (!current()) return;
         const left = Math.max(0, (end - performance.now()) / 1000);
+        countdown.dataset.left = left.toFixed(2); // seconds left (tests read it)
         countdown.textContent = `${Math.ceil(left)} s left to feel`;
         if (left <= 0) {
           trial.update({ timedOut: true });
@@ -381,8 +381,8 @@ export function mountParticipant(root: HTMLElement): void {
           // Refused by the token rule (or the connection was lost): say so on this
           // screen, then show what the engine holds now.
           showNotice(e.code === 'disconnected' ? 'The connection was lost before the answer arrived; it was not stored.' : e.message);
-          leaveQuestion();
-          setTimeout(() => alive() && void load(), 1500);
+          wait('refused', 'The next step follows in a moment.');
+          idleTimer = setTimeout(() => alive() && void load(), 1500);
         } else {
           msg.textContent = e instanceof Error ? e.message : String(e);
           msg.classList.add('error');
