@@ -225,8 +225,9 @@ void check_token(const Store& store, const ActiveSession* a, std::string_view te
     if (mine->status == "finished")
       throw AnswerRefused(Refusal::session_finished, "The session this question belonged to has finished; nothing was stored.");
     if (a)
-      throw AnswerRefused(Refusal::other_session, "This question belonged to session " + std::to_string(tok->session) +
-                                                      ", which was stopped; another session is running now. Nothing was stored.");
+      throw AnswerRefused(Refusal::other_session,
+                          "This question belonged to a session that was stopped; another session is running now. "
+                          "Nothing was stored.");
     throw AnswerRefused(
         Refusal::session_stopped,
         "The session this question belonged to was stopped; nothing was stored. Please wait for the experimenter.");

@@ -89,7 +89,13 @@ export function mountParticipant(root: HTMLElement): void {
 
   const screen = h('div', { class: 'participant-screen' });
   // A refused answer's reason stays visible over whatever comes next.
-  const notice = h('p', { class: 'notice', role: 'alert', 'data-testid': 'participant-notice', hidden: true });
+  const notice = h('p', {
+    class: 'notice',
+    role: 'alert',
+    'data-testid': 'participant-notice',
+    hidden: true,
+    style: 'background:#fff4d6;border-left:4px solid #8a5a00;padding:0.6rem 0.9rem;color:#1d1d1d',
+  });
   let noticeTimer: ReturnType<typeof setTimeout> | null = null;
   const showNotice = (text: string) => {
     notice.textContent = text;
@@ -266,7 +272,10 @@ export function mountParticipant(root: HTMLElement): void {
     const answerArea = h('div', { class: 'answers' });
     if (q.phases.length === 0) {
       if (stimulusButtons.length)
-        parts.push(h('section', { class: 'stimuli', 'aria-labelledby': 'feel-heading' }, h('h2', { id: 'feel-heading', class: 'group-label' }, 'Feel each texture'), h('div', { class: 'stimulus-row' }, ...stimulusButtons)));
+        parts.push(
+          h('h2', { id: 'feel-heading', class: 'group-label' }, 'Feel each texture'),
+          h('div', { class: 'stimuli', role: 'group', 'aria-labelledby': 'feel-heading' }, ...stimulusButtons),
+        );
       if (q.show_maps) {
         const maps = h('div', { class: 'maps' });
         parts.push(maps);
