@@ -8,6 +8,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { startStudio, launchFirefox, artifact } from './studio.mjs';
+import { control, STALE_HOOK } from './participant-helpers.mjs';
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const until = (page, fn, arg, timeout = 30_000) => page.waitForFunction(fn, { timeout, polling: 50 }, arg);
@@ -15,43 +16,7 @@ const shot = (page, name) => page.screenshot({ path: artifact(`firefox-participa
 const text = (page, sel) => page.$eval(sel, (el) => el.textContent);
 const endsIn = (page) => page.$eval('[data-testid=countdown]', (el) => Number(el.dataset.left));
 
-/** Messages from `page` over its own WebSocket, one after another; their replies (pushes skipped). */
-function control(page, ...msgs) {
-  return page.evaluate(async (msgs) => {
-    const ws = new WebSocket(`ws://${location.host}/ws`);
-    await new Promise((r) => (ws.onopen = r));
-    const out = [];
-    for (const [i, m] of msgs.entries()) {
-      out.push(
-        await new Promise((res) => {
-          ws.onmessage = (e) => {
-            const r = JSON.parse(e.data);
-            if (r.id === 1000 + i) res(r);
-          };
-          ws.send(JSON.stringify({ id: 1000 + i, ...m }));
-        }),
-      );
-    }
-    ws.close();
-    return out;
-  }, msgs);
-}
 
-// window.__dropPushes makes the screen miss the service's pushes (a stale screen).
-const STALE_HOOK = `(() => {
-  const Native = window.WebSocket;
-  window.WebSocket = class extends Native {
-    set onmessage(fn) {
-      super.onmessage = (ev) => {
-        if (window.__dropPushes) {
-          try { if (JSON.parse(ev.data).id === null) return; } catch {}
-        }
-        fn(ev);
-      };
-    }
-    get onmessage() { return super.onmessage; }
-  };
-})();`;
 
 test('firefox: the participant screen follows the session; a stale answer is refused', { timeout: 300_000 }, async () => {
   const studio = await startStudio({ hardTimeoutMs: 330_000 });

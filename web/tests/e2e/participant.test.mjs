@@ -22,11 +22,12 @@
 // Screenshots: $TEXEL_ARTIFACTS/participant-*.png.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import { readFileSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths, launchBrowser, checkFrames } from './studio.mjs';
+import { withStudio, screenshot, paths, launchBrowser, checkFrames, startStudio } from './studio.mjs';
+import { control, STALE_HOOK } from './participant-helpers.mjs';
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
@@ -38,64 +39,16 @@ function texelLength(limit_s) {
   return p;
 }
 
-/**
- * Sends messages one after another from `page` over its own WebSocket (the
- * experimenter's side); resolves their replies (matched by id, pushes skipped).
- */
-function control(page, ...msgs) {
-  return page.evaluate(async (msgs) => {
-    const ws = new WebSocket(`ws://${location.host}/ws`);
-    await new Promise((r) => (ws.onopen = r));
-    const out = [];
-    for (const [i, m] of msgs.entries()) {
-      out.push(
-        await new Promise((res) => {
-          ws.onmessage = (e) => {
-            const r = JSON.parse(e.data);
-            if (r.id === 1000 + i) res(r);
-          };
-          ws.send(JSON.stringify({ id: 1000 + i, ...m }));
-        }),
-      );
-    }
-    ws.close();
-    return out;
-  }, msgs);
-}
 
-// Lets a test make a screen stale: with window.__dropPushes set, the page's
-// WebSocket drops the service's pushes (messages with id null) — a screen
-// that missed them, the situation of the issue.
-const STALE_HOOK = () => {
-  const Native = window.WebSocket;
-  window.WebSocket = class extends Native {
-    set onmessage(fn) {
-      super.onmessage = (ev) => {
-        if (window.__dropPushes) {
-          try {
-            if (JSON.parse(ev.data).id === null) return;
-          } catch {
-            /* not JSON: pass on */
-          }
-        }
-        fn(ev);
-      };
-    }
-    get onmessage() {
-      return super.onmessage;
-    }
-  };
-};
 
 async function participantPage(context, url, errors) {
   const p = await context.newPage();
   p.on('pageerror', (e) => errors.push(String(e)));
-  await p.addInitScript(STALE_HOOK);
+  await p.addInitScript({ content: STALE_HOOK });
   await p.goto(`${url}#/participant`);
   return p;
 }
 
-const trialOnScreen = (p) => p.locator('.question').getAttribute('data-trial').then(Number);
 const endsIn = (p) => p.locator('[data-testid=countdown]').getAttribute('data-left').then(Number);
 
 /** Picks the first choice and submits by clicking. */
@@ -241,39 +194,10 @@ test('participant screen: wrong session, stale screens, paused answer, reload, t
   });
 });
 
-/** `texel studio` on a given database and port (a restart keeps both). */
-async function studioOn(db, port) {
-  const args = ['studio', '--port', String(port), '--web', paths.web, '--db', db, '--backend', 'null', '--protocols', paths.protocols];
-  const proc = spawn(paths.bin, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-  let log = '';
-  proc.stderr.on('data', (d) => (log += d));
-  const url = await new Promise((res, rej) => {
-    let out = '';
-    const timer = setTimeout(() => rej(new Error(`no address within 20 s: ${log}`)), 20_000);
-    proc.stdout.on('data', (d) => {
-      out += d;
-      const m = out.match(/Texel Studio at (http:\/\/[^\s/]+\/)/);
-      if (m) {
-        clearTimeout(timer);
-        res(m[1]);
-      }
-    });
-    proc.on('exit', (code) => rej(new Error(`texel studio exited (${code}): ${log}`)));
-  });
-  const stop = async () => {
-    if (proc.exitCode !== null) return;
-    const gone = new Promise((r) => proc.once('exit', r));
-    proc.kill('SIGTERM');
-    await Promise.race([gone, sleep(5000)]);
-    if (proc.exitCode === null) proc.kill('SIGKILL');
-  };
-  return { url, stop };
-}
-
 test('participant screen: a server restart shows "Please wait", then the same trial', { timeout: 300_000 }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'texel-restart-'));
   const db = join(dir, 's.db');
-  let server = await studioOn(db, 0);
+  let server = await startStudio({ db });
   const port = Number(new URL(server.url).port);
   const browser = await launchBrowser();
   const frames = [];
@@ -300,7 +224,7 @@ test('participant screen: a server restart shows "Please wait", then the same tr
     assert.equal(await p.locator('[data-testid=countdown]').count(), 0);
     await screenshot(p, 'participant-server-gone');
 
-    server = await studioOn(db, port);
+    server = await startStudio({ db, port });
     const [r] = await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'R1', resume: true });
     assert.equal(r.type, 'experiment.started', JSON.stringify(r));
     await p.waitForSelector('.question[data-trial="1"]', { timeout: 30_000 });
