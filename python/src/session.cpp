@@ -223,7 +223,8 @@ later Session(..., resume=True) continues where it stopped.)doc")
           "finished", [](PySession& s) { return s.active().session.finished(); }, "True when every trial is recorded.")
       .def_property_readonly(
           "question", &PySession::question,
-          "The current question as a dict (participant-safe: never the answer); raises texel.Error when finished.")
+          "The current question as a dict (participant-safe: never the answer); raises texel.Error when finished.\n"
+          "The first read of a trial's question is its onset: the library's clock (handout) starts there.")
       .def_property_readonly(
           "trials_done", [](PySession& s) { return s.active().session.trials_done(); }, "Trials recorded.")
       .def_property_readonly(

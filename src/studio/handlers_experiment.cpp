@@ -187,7 +187,10 @@ void on_experiment_start(State& s, Client& c, const Job& job) {
 
 void on_experiment_current(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
-  send(c, current_state(s, job.id, f.boolean("reload", false)));
+  const bool reload = f.boolean("reload", false);
+  send(c, current_state(s, job.id, reload));
+  // Under on_reload "restart_trial" the reload started the trial again: other screens get its new token.
+  if (reload && s.active && ex::reload_rule(s.active->session.protocol()) == ex::ReloadRule::restart_trial) tell_everyone(s, c);
 }
 
 void on_experiment_select(State& s, Client& c, const Job& job) {
