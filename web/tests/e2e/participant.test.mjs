@@ -13,7 +13,9 @@
 //   reload          the countdown continues after a reload;
 //   timing          a trial over its limit and one spanning a suspend are
 //                   flagged in the export (over_time_limit, interrupted,
-//                   suspended_ms; rt_ms without the pause);
+//                   suspended_ms; rt_ms without the pause); and the issue's
+//                   case as it was: 43 s on the wall against a 30 s limit,
+//                   38 s of it suspended → rt_ms ≈ 5 s, interrupted, not over;
 //   restart         the server stops: "Please wait"; a new server on the
 //                   same database, session resumed: the same trial again;
 //   labels + keys   "Feel texture N" vs "Answer: the odd one is …", every
@@ -242,4 +244,33 @@ test('participant screen: a server restart shows "Please wait", then the same tr
     rmSync(dir, { recursive: true, force: true });
   }
   checkFrames(frames);
+});
+
+test('participant screen: the issue\'s 43 s trial against a 30 s limit, spanning a suspend, is flagged and timed without the pause', { timeout: 300_000 }, async () => {
+  await withStudio(async ({ studio, context, page, errors }) => {
+    await page.goto(`${studio.url}#/experimenter`);
+    const p = await participantPage(context, studio.url, errors);
+    await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'L43' });
+    await p.waitForSelector('.question[data-trial="0"]');
+    await sleep(2500);
+    await control(page, { type: 'experiment.suspend' });
+    await p.waitForSelector('[data-testid=waiting]');
+    await sleep(38_000);
+    await control(page, { type: 'experiment.resume' });
+    await p.waitForSelector('.question[data-trial="0"]');
+    const left = await endsIn(p);
+    assert.ok(left > 26 && left < 28.5, `after the pause the countdown shows what was left (${left} s)`);
+    await sleep(2500);
+    await pickAndSubmit(p);
+    await p.waitForSelector('.question[data-trial="1"]');
+    const [row] = exportRows(join(studio.dir, 's.db'));
+    const wall = (Date.parse(row.answered_at) - Date.parse(row.shown_at)) / 1000;
+    assert.ok(wall > 42, `the trial took ${wall} s on the wall clock`);
+    assert.ok(Number(row.rt_ms) > 4500 && Number(row.rt_ms) < 7000, `rt_ms without the pause: ${row.rt_ms}`);
+    assert.ok(Number(row.suspended_ms) >= 37_900, row.suspended_ms);
+    assert.equal(row.interrupted, '1');
+    assert.equal(row.over_time_limit, '0');
+    assert.equal(row.time_limit_s, '30');
+    assert.deepEqual(errors, []);
+  });
 });
