@@ -67,11 +67,11 @@ struct Token {
   std::uint64_t opening = 0;
 };
 
-std::string token_text(const ActiveSession& a) {
+std::string token_text(const ActiveSession& a, int trial, int attempt) {
   char opening[17];
   std::snprintf(opening, sizeof opening, "%016" PRIx64, a.opening);
-  return "q1." + a.database + "." + std::to_string(a.info.id) + "." + std::to_string(a.clock.trial) + "." +
-         std::to_string(a.clock.attempt) + "." + opening;
+  return "q1." + a.database + "." + std::to_string(a.info.id) + "." + std::to_string(trial) + "." + std::to_string(attempt) +
+         "." + opening;
 }
 
 std::optional<Token> parse_token(std::string_view text) {
@@ -166,16 +166,25 @@ std::string_view to_string(Refusal r) {
 Handout hand_out(ActiveSession& a) {
   if (a.session.finished()) throw Error("the session is finished; there is no question to hand out");
   if (!handed_out(a)) start_clock(a, 0, nullptr);
-  const double t = now_s(a);
+  return peek(a);
+}
+
+Handout peek(const ActiveSession& a) {
+  if (a.session.finished()) throw Error("the session is finished; there is no question to hand out");
   Handout h;
-  h.token = token_text(a);
-  h.trial = a.clock.trial;
-  h.trial_number = a.clock.trial + 1;
+  h.trial = a.session.question().trial;
+  h.trial_number = h.trial + 1;
+  h.time_limit_s = a.session.question().time_limit_s;
+  h.suspended = a.suspended;
+  if (!handed_out(a)) {  // not shown yet: attempt 0 is the token the first hand-out gives
+    h.token = token_text(a, h.trial, 0);
+    return h;
+  }
+  const double t = now_s(a);
+  h.token = token_text(a, a.clock.trial, a.clock.attempt);
   h.attempt = a.clock.attempt;
   h.onset_at = a.clock.onset_at;
   h.elapsed_s = t - a.clock.onset_s - a.clock.suspended_s - (a.clock.suspended_since ? t - *a.clock.suspended_since : 0.0);
-  h.time_limit_s = a.session.question().time_limit_s;
-  h.suspended = a.suspended;
   return h;
 }
 
@@ -239,7 +248,8 @@ void check_token(const Store& store, const ActiveSession* a, std::string_view te
   if (a->session.finished()) throw AnswerRefused(Refusal::session_finished, "The session has finished; nothing was stored.");
   if (a->suspended)
     throw AnswerRefused(Refusal::session_suspended, "The session is paused; your answer was not stored. Please wait.");
-  if (!handed_out(*a) || tok->trial != a->clock.trial || tok->attempt != a->clock.attempt)
+  const int attempt = handed_out(*a) ? a->clock.attempt : 0;  // not handed out yet: peek()'s token
+  if (tok->trial != a->session.question().trial || tok->attempt != attempt)
     throw AnswerRefused(Refusal::stale_trial, "This question (trial " + std::to_string(tok->trial + 1) +
                                                   ") is no longer the current one; nothing was stored.");
 }
@@ -289,11 +299,14 @@ StoredTrial record(Store& store, ActiveSession& a, const Response& r) {
 StoredTrial record(Store& store, ActiveSession* active, std::string_view token, Response r) {
   check_token(store, active, token);
   ActiveSession& a = *active;
+  // Answered from a peek(), before any screen was handed the question: no onset to time it from.
+  const bool shown = handed_out(a);
+  if (!shown) start_clock(a, 0, nullptr);
   const double t = now_s(a);
   const TrialClock& c = a.clock;
   const double limit_s = a.session.question().time_limit_s;
   // A front end that measured its own reaction time (PsychoPy's frame clock) keeps it.
-  if (!std::isfinite(r.rt_ms)) r.rt_ms = std::max(0.0, t - c.onset_s - c.suspended_s) * 1000.0;
+  if (!std::isfinite(r.rt_ms) && shown) r.rt_ms = std::max(0.0, t - c.onset_s - c.suspended_s) * 1000.0;
   if (r.shown_at.empty()) r.shown_at = c.onset_at;
   if (r.answered_at.empty()) r.answered_at = utc_timestamp();
   std::vector<TrialEvent> events = c.events;

@@ -62,8 +62,9 @@ ojson handout_json(const ex::Handout& h) {
 }
 
 // The state participant screens show: the question (with its token and
-// clock), suspended, finished or idle. `reload`: a screen was (re)loaded.
-ojson current_state(State& s, const json& id, bool reload = false) {
+// clock), suspended, finished or idle. `screen`: for a participant screen
+// (the hand-out starts the trial's clock); `reload`: that screen was (re)loaded.
+ojson current_state(State& s, const json& id, bool screen, bool reload = false) {
   if (!s.active) return reply("experiment.idle", id);
   const char* type = s.active->session.finished() ? "experiment.finished"
                      : s.active->suspended        ? "experiment.suspended"
@@ -73,14 +74,14 @@ ojson current_state(State& s, const json& id, bool reload = false) {
   r["progress"] = progress_json(s);
   if (!s.active->session.finished() && !s.active->suspended) {
     r["question"] = participant_question(s.active->session.question());
-    r["handout"] = handout_json(reload ? ex::reload(*s.active) : ex::hand_out(*s.active));
+    r["handout"] = handout_json(!screen ? ex::peek(*s.active) : reload ? ex::reload(*s.active) : ex::hand_out(*s.active));
   }
   return r;
 }
 
 // Every other screen follows the session (the requester has its reply).
 void tell_everyone(State& s, const Client& requester) {
-  if (s.broadcast) s.broadcast(current_state(s, json(nullptr)), requester.id);
+  if (s.broadcast) s.broadcast([&](bool screen) { return current_state(s, json(nullptr), screen); }, requester.id);
 }
 
 const ex::Question& current_question(const State& s, const Fields& f, const std::string& type) {
@@ -188,7 +189,8 @@ void on_experiment_start(State& s, Client& c, const Job& job) {
 void on_experiment_current(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
   const bool reload = f.boolean("reload", false);
-  send(c, current_state(s, job.id, reload));
+  if (f.boolean("screen", false)) c.participant_screen = true;
+  send(c, current_state(s, job.id, c.participant_screen, reload));
   // Under on_reload "restart_trial" the reload started the trial again: other screens get its new token.
   if (reload && s.active && ex::reload_rule(s.active->session.protocol()) == ex::ReloadRule::restart_trial) tell_everyone(s, c);
 }
@@ -264,7 +266,7 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
     return;
   }
   new_trial(s);
-  send(c, current_state(s, job.id));
+  send(c, current_state(s, job.id, /*screen=*/true));  // the answering screen (or simulation) sees the next question now
   tell_everyone(s, c);
 }
 
@@ -283,14 +285,14 @@ void on_experiment_suspend(State& s, Client& c, const Job& job) {
     std::lock_guard lock(s.feel_mutex);
     s.presenter->blank();  // nothing to feel while paused
   }
-  send(c, current_state(s, job.id));
+  send(c, current_state(s, job.id, c.participant_screen));
   tell_everyone(s, c);
 }
 
 void on_experiment_resume(State& s, Client& c, const Job& job) {
   if (!s.active) throw Reject{"not_found", "experiment.resume: no session is running; start or resume one first"};
   ex::resume(*s.active);
-  send(c, current_state(s, job.id));
+  send(c, current_state(s, job.id, c.participant_screen));
   tell_everyone(s, c);
 }
 

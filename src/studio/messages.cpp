@@ -25,7 +25,7 @@ const std::array<MessageSpec, 17> table{{
     {"feel.state", Lane::now, {}, on_feel_state},
     {"experiment.list", Lane::fifo, {}, on_experiment_list},
     {"experiment.start", Lane::fifo, {"protocol", "participant", "resume", "simulate"}, on_experiment_start},
-    {"experiment.current", Lane::fifo, {"reload"}, on_experiment_current},
+    {"experiment.current", Lane::fifo, {"reload", "screen"}, on_experiment_current},
     {"experiment.select", Lane::fifo, {"trial", "stimulus"}, on_experiment_select},
     {"experiment.preview", Lane::fifo, {"trial", "slider_p", "slider_i"}, on_experiment_preview},
     {"experiment.answer", Lane::fifo, {"trial", "token", "response", "simulated"}, on_experiment_answer},

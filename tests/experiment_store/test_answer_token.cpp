@@ -310,3 +310,25 @@ TEST(AnswerToken, RowsStoredBeforeTheFlagsResumeAndExport) {
   EXPECT_NE(csv.find("trial_number"), std::string::npos);
   EXPECT_EQ(ex::parse_trials_csv(csv, "export").size(), 4u);
 }
+
+TEST(AnswerToken, PeekingDoesNotStartTheClock) {
+  // The experimenter's view peeks; the clock starts when a screen is handed the question.
+  TempDir dir("token");
+  auto st = ex::Store::open(dir.at("exp.db"), ex::StoreMode::read_write);
+  FakeClock clock;
+  auto a = open(st, "S01", clock);
+  const ex::Handout seen = ex::peek(a);
+  EXPECT_TRUE(seen.onset_at.empty());
+  clock.t += 100.0;  // the participant's screen opens late
+  const ex::Handout h = ex::hand_out(a);
+  EXPECT_EQ(h.token, seen.token);
+  EXPECT_NEAR(h.elapsed_s, 0.0, 1e-9);
+  clock.t += 2.0;
+  EXPECT_NEAR(ex::peek(a).elapsed_s, 2.0, 1e-9);
+  EXPECT_NEAR(ex::record(st, &a, h.token, answer_of(a)).row.rt_ms, 2000.0, 1e-6);
+  // Answered with a peeked token before any screen had it: stored, without a reaction time.
+  const ex::Handout next = ex::peek(a);
+  const auto t = ex::record(st, &a, next.token, answer_of(a));
+  EXPECT_TRUE(std::isnan(t.row.rt_ms));
+  EXPECT_EQ(t.row.trial, 1);
+}

@@ -490,9 +490,13 @@ TEST(Service, ScreensFollowTheSessionAndTheTokenRuleHolds) {
   const auto pushed = [&](const char* type) {
     return screen.inbox.take([&](const json& j) { return j["id"].is_null() && j["type"] == type; });
   };
+  EXPECT_EQ(screen.ask({{"type", "experiment.current"}, {"screen", true}})["type"], "experiment.idle");
   ASSERT_EQ(experimenter.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "Z1"}})["type"],
             "experiment.started");
   const json z1 = pushed("experiment.question");
+  EXPECT_FALSE(z1["handout"]["onset_at"].get<std::string>().empty());  // handed to a screen: its clock runs
+  const json peeked = experimenter.ask({{"type", "experiment.current"}});
+  EXPECT_EQ(peeked["handout"]["token"], z1["handout"]["token"]);
   const std::string z1_token = z1["handout"]["token"];
   EXPECT_EQ(screen.ask({{"type", "experiment.current"}})["handout"]["token"], z1_token);
 

@@ -111,7 +111,7 @@ export function mountParticipant(root: HTMLElement): void {
   async function load(reload = false): Promise<void> {
     if (idleTimer) clearTimeout(idleTimer);
     try {
-      const cur = await client.call('experiment.current', reload ? { reload: true } : {}, 60000);
+      const cur = await client.call('experiment.current', { screen: true, ...(reload ? { reload: true } : {}) }, 60000);
       show(cur);
     } catch (e) {
       if (e instanceof StudioError && e.code === 'disconnected') return; // onState shows the wait screen and reloads

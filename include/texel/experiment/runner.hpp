@@ -116,6 +116,10 @@ struct Handout {
 /// trial (onset), later calls return the same token and onset. Throws Error
 /// when the session is finished.
 Handout hand_out(ActiveSession& active);
+/// The hand-out as it stands, without starting the clock (for a view that
+/// is not the participant's, e.g. the experimenter's): before the first
+/// hand-out the token is the one it will give, onset_at empty, elapsed 0.
+Handout peek(const ActiveSession& active);
 /// A screen was reloaded: under ReloadRule::restart_trial the trial starts
 /// again (new attempt, token and onset; the old token is refused), under
 /// keep_clock it is hand_out(). Returns the hand-out in force.
