@@ -69,12 +69,17 @@ struct Columns {
       {"digit_correct", &TrialRow::digit_correct},
       {"swipe_mean_speed_mm_s", &TrialRow::swipe_mean_speed_mm_s},
       {"swipe_sd_speed_mm_s", &TrialRow::swipe_sd_speed_mm_s},
-      {"directional_proportion", &TrialRow::directional_proportion}};
+      {"directional_proportion", &TrialRow::directional_proportion},
+      {"time_limit_s", &TrialRow::time_limit_s},
+      {"over_time_limit", &TrialRow::over_time_limit},
+      {"interrupted", &TrialRow::interrupted},
+      {"suspended_ms", &TrialRow::suspended_ms}};
 
   // Cell of `row` in column `name` as a Python value: str, int, bool, float
   // (NaN = missing; iteration −1 = missing).
   [[nodiscard]] py::object cell(const TrialRow& row, const std::string& name) const {
     if (name == "session_id") return py::int_(row.session_id);
+    if (name == "trial_number") return py::int_(row.trial + 1);
     if (name == "iteration") return py::float_(row.iteration >= 0 ? row.iteration : std::nan(""));
     for (const auto& [n, p] : strings)
       if (name == n) return py::str(row.*p);

@@ -68,7 +68,26 @@ class PySession {
   void close() { active_.reset(); }
   [[nodiscard]] bool closed() const { return !active_; }
 
-  py::object question() { return from_json(active().session.question().to_json()); }
+  // Reading the question hands it out: its clock starts (onset) on the first read.
+  py::object question() {
+    ActiveSession& a = active();
+    if (!a.session.finished()) (void)hand_out(a);
+    return from_json(a.session.question().to_json());
+  }
+
+  py::dict handout() {
+    const Handout h = hand_out(active());
+    py::dict d;
+    d["token"] = h.token;
+    d["trial"] = h.trial;
+    d["trial_number"] = h.trial_number;
+    d["attempt"] = h.attempt;
+    d["onset_at"] = h.onset_at;
+    d["elapsed_s"] = h.elapsed_s;
+    d["time_limit_s"] = h.time_limit_s;
+    d["suspended"] = h.suspended;
+    return d;
+  }
 
   Document stimulus(std::size_t i) {
     const Question& q = active().session.question();
@@ -91,12 +110,13 @@ class PySession {
     return from_json(simulated_participant(a).respond(a.session).to_json());
   }
 
-  py::dict record(const py::object& response) {
+  // The token path (runner.hpp): without a token, the current question's.
+  py::dict record(const py::object& response, const std::optional<std::string>& token) {
     ActiveSession& a = active();
     Response r = Response::from_json(to_json(response));
-    if (r.answered_at.empty()) r.answered_at = utc_timestamp();
-    if (r.shown_at.empty()) r.shown_at = shown_at_.empty() ? r.answered_at : shown_at_;
-    const StoredTrial t = experiment::record(store_->get(), a, r);  // committed before it returns
+    if (r.shown_at.empty()) r.shown_at = shown_at_;
+    const std::string t_token = token ? *token : hand_out(a).token;
+    const StoredTrial t = experiment::record(store_->get(), &a, t_token, std::move(r));  // committed before it returns
     shown_at_.clear();
     return rows_records({t.row})[0].cast<py::dict>();
   }
@@ -203,7 +223,8 @@ later Session(..., resume=True) continues where it stopped.)doc")
           "finished", [](PySession& s) { return s.active().session.finished(); }, "True when every trial is recorded.")
       .def_property_readonly(
           "question", &PySession::question,
-          "The current question as a dict (participant-safe: never the answer); raises texel.Error when finished.")
+          "The current question as a dict (participant-safe: never the answer); raises texel.Error when finished.\n"
+          "The first read of a trial's question is its onset: the library's clock (handout) starts there.")
       .def_property_readonly(
           "trials_done", [](PySession& s) { return s.active().session.trials_done(); }, "Trials recorded.")
       .def_property_readonly(
@@ -224,10 +245,21 @@ later Session(..., resume=True) continues where it stopped.)doc")
            "Plays stimulus `index` of the current question on a Presenter (the first call stamps shown_at).")
       .def("simulated_response", &PySession::simulated_response,
            "The simulated participant's answer to the current question (sessions opened with simulate=).")
-      .def("record", &PySession::record, py::arg("response"),
+      .def("record", &PySession::record, py::arg("response"), py::arg("token") = py::none(),
            "Answers the current question — a dict with the fields it asks for: choice, rating, confidence,\n"
            "slider_p, slider_i, digit, rt_ms, events, shown_at, answered_at — stores the trial durably and\n"
-           "returns its long-format row. Raises InvalidArgument (nothing stored) for an answer that does not fit.")
+           "returns its long-format row. Raises InvalidArgument (nothing stored) for an answer that does not fit.\n"
+           "token: the handout's token of the question answered (default: the current one); an answer whose\n"
+           "token is stale, or given while suspended, is refused (InvalidArgument, nothing stored). rt_ms\n"
+           "defaults to the library's clock: from the first read of the question, without suspended time.")
+      .def_property_readonly("handout", &PySession::handout,
+                             "The current question's token and clock: token, trial, trial_number (1-based), attempt,\n"
+                             "onset_at, elapsed_s (without suspended time), time_limit_s, suspended.")
+      .def(
+          "suspend", [](PySession& s) { suspend(s.active()); },
+          "Pauses the session: answers are refused and the trial's clock stops until resume().")
+      .def(
+          "resume", [](PySession& s) { resume(s.active()); }, "Continues a paused session (the same trial, its clock intact).")
       .def("close", &PySession::close, "Releases the session (again: nothing).")
       .def_property_readonly("closed", &PySession::closed)
       .def("__enter__", [](py::object self) { return self; })

@@ -163,6 +163,9 @@ Protocol parse_protocol(std::string_view json_text, std::string_view origin) {
     throw FormatError(std::string("device: ") + e.what());
   }
   p.seed = o.uint64_or("seed", 1);
+  p.on_reload = o.string_or("on_reload", "keep_clock");
+  if (p.on_reload != "keep_clock" && p.on_reload != "restart_trial")
+    throw FormatError("on_reload is '" + p.on_reload + "'; allowed: keep_clock, restart_trial");
   if (o.has("observer")) {
     validate_observer_object(o.raw("observer"));
     p.observer = o.raw("observer").dump();

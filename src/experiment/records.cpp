@@ -132,6 +132,15 @@ const std::vector<Field>& fields() {
       TEXEL_NUMBER(directional_proportion),
       TEXEL_STRING(shown_at),
       TEXEL_STRING(answered_at),
+      // Derived from `trial`; read back only to check it is a whole number.
+      Field{"trial_number", [](const TrialRow& r) { return std::to_string(r.trial + 1); },
+            [](TrialRow&, const std::string& v) {
+              if (!v.empty()) (void)parse_whole<int>(v);
+            }},
+      TEXEL_NUMBER(time_limit_s),
+      TEXEL_NUMBER(over_time_limit),
+      TEXEL_NUMBER(interrupted),
+      TEXEL_NUMBER(suspended_ms),
   };
   return f;
 }

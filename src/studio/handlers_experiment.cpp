@@ -64,19 +64,38 @@ ojson progress_json(const State& s) {
 // What participant screens may see of a question (the library's participant view).
 ojson participant_question(const ex::Question& q) { return ojson::parse(q.participant_json()); }
 
-// The state participant screens show: the question, finished or idle.
-ojson current_state(State& s, const json& id) {
+ojson handout_json(const ex::Handout& h) {
+  return ojson{{"token", h.token},         {"trial_number", h.trial_number}, {"attempt", h.attempt},    {"onset_at", h.onset_at},
+               {"elapsed_s", h.elapsed_s}, {"time_limit_s", h.time_limit_s}, {"suspended", h.suspended}};
+}
+
+// The state participant screens show: the question (with its token and
+// clock), suspended, finished or idle. `screen`: for a participant screen
+// (the hand-out starts the trial's clock); `reload`: that screen was (re)loaded.
+ojson current_state(State& s, const json& id, bool screen, bool reload = false) {
   if (!s.active) return reply("experiment.idle", id);
-  ojson r = reply(s.active->session.finished() ? "experiment.finished" : "experiment.question", id);
+  const char* type = s.active->session.finished() ? "experiment.finished"
+                     : s.active->suspended        ? "experiment.suspended"
+                                                  : "experiment.question";
+  ojson r = reply(type, id);
   r["session"] = session_json(s);
   r["progress"] = progress_json(s);
-  if (!s.active->session.finished()) r["question"] = participant_question(s.active->session.question());
+  if (!s.active->session.finished() && !s.active->suspended) {
+    r["question"] = participant_question(s.active->session.question());
+    r["handout"] = handout_json(!screen ? ex::peek(*s.active) : reload ? ex::reload(*s.active) : ex::hand_out(*s.active));
+  }
   return r;
+}
+
+// Every other screen follows the session (the requester has its reply).
+void tell_everyone(State& s, const Client& requester) {
+  if (s.broadcast) s.broadcast([&](bool screen) { return current_state(s, json(nullptr), screen); }, requester.id);
 }
 
 const ex::Question& current_question(const State& s, const Fields& f, const std::string& type) {
   if (!s.active) throw Reject{"not_found", type + ": no session is running; start one in the experimenter view"};
   if (s.active->session.finished()) throw Reject{"conflict", type + ": the session is finished"};
+  if (s.active->suspended) throw Reject{"conflict", "The session is paused; please wait."};
   const ex::Question& q = s.active->session.question();
   const std::int64_t trial = f.integer("trial", 0, 1 << 30);
   if (trial != q.trial)
@@ -211,9 +230,17 @@ void on_experiment_start(State& s, Client& c, const Job& job) {
   r["progress"] = progress_json(s);
   r["resumed"] = o.resume;
   send(c, r);
+  tell_everyone(s, c);
 }
 
-void on_experiment_current(State& s, Client& c, const Job& job) { send(c, current_state(s, job.id)); }
+void on_experiment_current(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const bool reload = f.boolean("reload", false);
+  if (f.boolean("screen", false)) c.participant_screen = true;
+  send(c, current_state(s, job.id, c.participant_screen, reload));
+  // Under on_reload "restart_trial" the reload started the trial again: other screens get its new token.
+  if (reload && s.active && ex::reload_rule(s.active->session.protocol()) == ex::ReloadRule::restart_trial) tell_everyone(s, c);
+}
 
 void on_experiment_select(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
@@ -244,15 +271,27 @@ void on_experiment_preview(State& s, Client& c, const Job& job) {
 
 void on_experiment_answer(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
-  (void)current_question(s, f, job.type);
+  const std::int64_t trial = f.integer("trial", 0, 1 << 30);
   ex::Response response;
+  std::string token;
   if (f.boolean("simulated", false)) {
+    // The experimenter's simulated participant answers the question in force.
+    (void)current_question(s, f, job.type);
     if (s.active->simulate.empty())
       throw Reject{"invalid", "experiment.answer: simulated answers need a session started with 'simulate'"};
     response = ex::simulated_participant(*s.active).respond(s.active->session);
+    token = ex::hand_out(*s.active).token;
   } else {
+    if (!f.has("token"))
+      throw Reject{"bad_message", "experiment.answer: a response needs the question's token (handout.token); reload the page"};
+    token = f.string("token", 128);
     response = ex::Response::from_json(f.object("response").dump());
+    // The server's clock (per token) times the trial, not the page's (a reload restarts a page's clock).
+    response.rt_ms = ex::missing;
+    response.shown_at.clear();
+    response.answered_at.clear();
   }
+  (void)trial;  // the token names the trial; `trial` stays for older clients' messages
   if (!response.swipe_mean_speed_mm_s) {
     std::lock_guard lock(s.feel_mutex);
     const SwipeMeasures m = swipe_measures(s.trace);
@@ -262,15 +301,46 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
       response.directional_proportion = m.directional_proportion;
     }
   }
-  (void)ex::record(the_store(s), *s.active, response);  // committed before the next question goes out
+  try {
+    // The token rule (docs/studio.md): committed before the next question goes out, or refused.
+    (void)ex::record(the_store(s), s.active ? &*s.active : nullptr, token, std::move(response));
+  } catch (const ex::AnswerRefused& e) {
+    ojson r = reply("error", job.id);
+    r["code"] = "conflict";
+    r["message"] = e.what();
+    r["reason"] = std::string(ex::to_string(e.reason()));
+    send(c, r);
+    return;
+  }
   new_trial(s);
-  send(c, current_state(s, job.id));
+  send(c, current_state(s, job.id, /*screen=*/true));  // the answering screen (or simulation) sees the next question now
+  tell_everyone(s, c);
 }
 
 void on_experiment_stop(State& s, Client& c, const Job& job) {
   s.active.reset();
   new_trial(s);
   send(c, reply("experiment.idle", job.id));
+  tell_everyone(s, c);
+}
+
+void on_experiment_suspend(State& s, Client& c, const Job& job) {
+  if (!s.active || s.active->session.finished())
+    throw Reject{"not_found", "experiment.suspend: no session is running; nothing to pause"};
+  ex::suspend(*s.active);
+  {
+    std::lock_guard lock(s.feel_mutex);
+    s.presenter->blank();  // nothing to feel while paused
+  }
+  send(c, current_state(s, job.id, c.participant_screen));
+  tell_everyone(s, c);
+}
+
+void on_experiment_resume(State& s, Client& c, const Job& job) {
+  if (!s.active) throw Reject{"not_found", "experiment.resume: no session is running; start or resume one first"};
+  ex::resume(*s.active);
+  send(c, current_state(s, job.id, c.participant_screen));
+  tell_everyone(s, c);
 }
 
 }  // namespace texel::studio::detail

@@ -14,7 +14,7 @@ namespace texel::studio::detail {
 namespace {
 
 // The order is the one error messages list ("unknown message type …; allowed: …").
-const std::array<MessageSpec, 19> table{{
+const std::array<MessageSpec, 21> table{{
     {"hello", Lane::now, {}, on_hello},
     {"design", Lane::design, {"document", "region", "bins"}, on_design},
     {"match", Lane::fifo, {"document", "region", "into"}, on_match},
@@ -25,15 +25,17 @@ const std::array<MessageSpec, 19> table{{
     {"feel.state", Lane::now, {}, on_feel_state},
     {"experiment.list", Lane::fifo, {}, on_experiment_list},
     {"experiment.start", Lane::fifo, {"protocol", "participant", "resume", "simulate"}, on_experiment_start},
-    {"experiment.current", Lane::fifo, {}, on_experiment_current},
+    {"experiment.current", Lane::fifo, {"reload", "screen"}, on_experiment_current},
     {"experiment.select", Lane::fifo, {"trial", "stimulus"}, on_experiment_select},
     {"experiment.preview", Lane::fifo, {"trial", "slider_p", "slider_i"}, on_experiment_preview},
-    {"experiment.answer", Lane::fifo, {"trial", "response", "simulated"}, on_experiment_answer},
+    {"experiment.answer", Lane::fifo, {"trial", "token", "response", "simulated"}, on_experiment_answer},
     {"experiment.stop", Lane::fifo, {}, on_experiment_stop},
     {"experiment.trials", Lane::fifo, {"session"}, on_experiment_trials},
     {"experiment.export", Lane::fifo, {"as", "session"}, on_experiment_export},
     {"experiment.protocol", Lane::fifo, {"name"}, on_experiment_protocol},
     {"experiment.validate", Lane::fifo, {"protocol"}, on_experiment_validate},
+    {"experiment.suspend", Lane::fifo, {}, on_experiment_suspend},
+    {"experiment.resume", Lane::fifo, {}, on_experiment_resume},
 }};
 
 std::string num(double v) {

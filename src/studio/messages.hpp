@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <memory>
@@ -92,6 +93,8 @@ struct Client {
   Clock::time_point refilled = Clock::now();
   std::map<std::string, std::pair<std::uint64_t, Job>> slots;  // design lane: type → (order, newest job)
   std::size_t fifo_jobs = 0;
+  // Touched by the FIFO worker only:
+  bool participant_screen = false;  // asked experiment.current with screen: true (its hand-outs start trial clocks)
 };
 
 /// What the handlers share: the options, the display (one Presenter behind
@@ -109,6 +112,10 @@ struct State {
 
   std::optional<experiment::Store> store;
   std::optional<experiment::ActiveSession> active;
+  /// Sends `make(participant_screen)` (no id) to every connected client but
+  /// `except` (set by the service; runs on the FIFO worker): participant
+  /// screens follow suspend, stop, switch and answers.
+  std::function<void(const std::function<ojson(bool participant_screen)>& make, std::uint64_t except)> broadcast;
 };
 
 inline double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -174,5 +181,7 @@ void on_experiment_trials(State&, Client&, const Job&);
 void on_experiment_export(State&, Client&, const Job&);
 void on_experiment_protocol(State&, Client&, const Job&);
 void on_experiment_validate(State&, Client&, const Job&);
+void on_experiment_suspend(State&, Client&, const Job&);
+void on_experiment_resume(State&, Client&, const Job&);
 
 }  // namespace texel::studio::detail

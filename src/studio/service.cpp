@@ -130,6 +130,7 @@ struct Service::Impl {
     po.response_handling = parse_response_handling(options.response, "response");
     state.presenter = std::make_unique<experiment::Presenter>(po);
     state.hello = make_hello(state);
+    state.broadcast = [this](const std::function<ojson(bool)>& make, std::uint64_t except) { broadcast(make, except); };
     design_worker = std::thread([this] { run_design_lane(); });
     fifo_worker = std::thread([this] { run_fifo_lane(); });
   }
@@ -274,6 +275,22 @@ struct Service::Impl {
   }
 
   // ------------------------------------------------------------- clients
+
+  // Sends to every open client but `except` (runs on the FIFO worker): participant
+  // screens' message first (handing a question to a screen starts its clock).
+  void broadcast(const std::function<ojson(bool)>& make, std::uint64_t except) {
+    std::vector<std::shared_ptr<Client>> to;
+    {
+      std::lock_guard lock(mutex);
+      for (const auto& [id, c] : clients)
+        if (id != except) to.push_back(c);
+    }
+    std::optional<ojson> screens, others;
+    for (const auto& c : to)
+      if (c->participant_screen) send(*c, screens ? *screens : *(screens = make(true)));
+    for (const auto& c : to)
+      if (!c->participant_screen) send(*c, others ? *others : *(others = make(false)));
+  }
 
   std::uint64_t connect(Sink sink) {
     auto c = std::make_shared<Client>();

@@ -122,3 +122,23 @@ def test_a_session_needs_a_writable_store(protocol, tmp_path):
     texel.Store(tmp_path / "w.db", mode="rw").close()
     with texel.Store(tmp_path / "w.db") as store, pytest.raises(texel.InvalidArgument, match="rw"):
         Session(store, protocol, "P06")
+
+
+def test_answers_are_bound_to_the_question_token(protocol, tmp_path):
+    # The token rule (docs/studio.md): a stale token or a paused session stores nothing.
+    with texel.Store(tmp_path / "t.db", mode="rw") as store, Session(store, protocol, "P06") as s:
+        q = s.question
+        first = s.handout
+        assert first["trial_number"] == 1 and first["time_limit_s"] == 30 and not first["suspended"]
+        s.suspend()
+        assert s.handout["suspended"] and s.handout["token"] == first["token"]
+        with pytest.raises(texel.InvalidArgument, match="paused"):
+            s.record({"choice": q["choices"][0]}, token=first["token"])
+        s.resume()
+        row = s.record({"choice": q["choices"][0]}, token=first["token"])
+        assert row["trial_number"] == 1 and row["interrupted"] == 1 and row["rt_ms"] >= 0
+        with pytest.raises(texel.InvalidArgument, match="no longer the current one"):
+            s.record({"choice": q["choices"][0]}, token=first["token"])  # replayed
+        assert s.trials_done == 1
+        row = s.record({"choice": s.question["choices"][0]})  # the current token by default
+        assert row["trial_number"] == 2 and row["interrupted"] == 0

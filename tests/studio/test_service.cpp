@@ -426,7 +426,11 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
     EXPECT_EQ(c.ask({{"type", "experiment.select"}, {"trial", 0}, {"stimulus", 1}})["type"], "experiment.selected");
     expect_error(c.ask({{"type", "experiment.select"}, {"trial", 0}, {"stimulus", 9}}), "invalid");
     expect_error(c.ask({{"type", "experiment.preview"}, {"trial", 0}, {"slider_p", 50}, {"slider_i", 50}}), "invalid");
-    expect_error(c.ask({{"type", "experiment.answer"}, {"trial", 0}, {"response", {{"choice", "banana"}}}}), "invalid");
+    const std::string token0 = q["handout"]["token"];
+    EXPECT_EQ(q["handout"]["trial_number"], 1);
+    expect_error(c.ask({{"type", "experiment.answer"}, {"trial", 0}, {"token", token0}, {"response", {{"choice", "banana"}}}}),
+                 "invalid");
+    expect_error(c.ask({{"type", "experiment.answer"}, {"trial", 0}, {"response", {{"choice", "1"}}}}), "bad_message");
     expect_error(c.ask({{"type", "experiment.answer"}, {"trial", 0}, {"simulated", true}}), "invalid");
 
     // Each next question is sent only once its answer is in the store.
@@ -439,12 +443,19 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
     for (int i = 0; i < 30; ++i) c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 20.0 + i}, {"touch", true}});
     for (trial = 0; trial < 3; ++trial) {
       const std::string choice = q["question"]["choices"][0];
-      q = c.ask({{"type", "experiment.answer"}, {"trial", trial}, {"response", {{"choice", choice}, {"rt_ms", 900}}}});
+      const std::string token = q["handout"]["token"];
+      q = c.ask({{"type", "experiment.answer"},
+                 {"trial", trial},
+                 {"token", token},
+                 {"response", {{"choice", choice}, {"rt_ms", 900}}}});
       ASSERT_EQ(q["type"], "experiment.question") << q.dump();
       EXPECT_EQ(q["question"]["trial"], trial + 1);
       EXPECT_EQ(q["progress"]["done"], trial + 1);
       // The same answer again is stale: refused, nothing changes.
-      expect_error(c.ask({{"type", "experiment.answer"}, {"trial", trial}, {"response", {{"choice", choice}}}}), "conflict");
+      const json stale =
+          c.ask({{"type", "experiment.answer"}, {"trial", trial}, {"token", token}, {"response", {{"choice", choice}}}});
+      expect_error(stale, "conflict");
+      EXPECT_EQ(stale["reason"], "stale_trial");
     }
     c.inbox.on_reply = nullptr;
     {
@@ -475,6 +486,50 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
   ASSERT_EQ(list["sessions"].size(), 1u);
   EXPECT_EQ(list["sessions"][0]["trials_done"], trial);
   EXPECT_EQ(list["active"]["id"], session_id);
+}
+
+// Screens follow the session: a second screen gets every change pushed (no
+// id), an answer of a stopped session is refused with its reason and stored
+// nowhere (issue #22's reproduction), a paused session refuses answers.
+TEST(Service, ScreensFollowTheSessionAndTheTokenRuleHolds) {
+  texel::test_support::TempDir dir("studio");
+  const std::string db = dir.at("db");
+  Service s(options(db));
+  Client experimenter(s), screen(s);
+  const auto pushed = [&](const char* type) {
+    return screen.inbox.take([&](const json& j) { return j["id"].is_null() && j["type"] == type; });
+  };
+  EXPECT_EQ(screen.ask({{"type", "experiment.current"}, {"screen", true}})["type"], "experiment.idle");
+  ASSERT_EQ(experimenter.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "Z1"}})["type"],
+            "experiment.started");
+  const json z1 = pushed("experiment.question");
+  EXPECT_FALSE(z1["handout"]["onset_at"].get<std::string>().empty());  // handed to a screen: its clock runs
+  const json peeked = experimenter.ask({{"type", "experiment.current"}});
+  EXPECT_EQ(peeked["handout"]["token"], z1["handout"]["token"]);
+  const std::string z1_token = z1["handout"]["token"];
+  EXPECT_EQ(screen.ask({{"type", "experiment.current"}})["handout"]["token"], z1_token);
+
+  EXPECT_EQ(experimenter.ask({{"type", "experiment.suspend"}})["type"], "experiment.suspended");
+  EXPECT_FALSE(pushed("experiment.suspended").contains("question"));
+  const json paused =
+      screen.ask({{"type", "experiment.answer"}, {"trial", 0}, {"token", z1_token}, {"response", {{"choice", "1"}}}});
+  expect_error(paused, "conflict");
+  EXPECT_EQ(paused["reason"], "session_suspended");
+  EXPECT_EQ(experimenter.ask({{"type", "experiment.resume"}})["type"], "experiment.question");
+  EXPECT_EQ(pushed("experiment.question")["handout"]["token"], z1_token);  // the same trial, the same clock
+
+  EXPECT_EQ(experimenter.ask({{"type", "experiment.stop"}})["type"], "experiment.idle");
+  (void)pushed("experiment.idle");
+  ASSERT_EQ(experimenter.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "Z2"}})["type"],
+            "experiment.started");
+  const json z2 = pushed("experiment.question");
+  EXPECT_NE(z2["handout"]["token"], z1_token);
+  const json wrong =
+      screen.ask({{"type", "experiment.answer"}, {"trial", 0}, {"token", z1_token}, {"response", {{"choice", "1"}}}});
+  expect_error(wrong, "conflict");
+  EXPECT_EQ(wrong["reason"], "other_session");
+  const ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
+  EXPECT_TRUE(st.rows().empty());
 }
 
 TEST(Service, SimulatedSessionRunsToTheEnd) {

@@ -4,26 +4,35 @@
 // digit recall) is shown, and nothing else — the question never carries the
 // answer, and this page shows no maps unless the question says `show_maps`.
 //
-// Timing: rt_ms runs from the moment the question is first shown on this
-// page to the press of Submit (performance.now(), monotonic); events carry
-// t_s on the same clock plus the wall time (ISO UTC). After a reload the
-// clock restarts with the re-shown question.
+// The screen follows the session (docs/studio.md "The token rule"): the
+// service pushes every change — a suspend, stop, session switch, the next
+// question after another screen's answer — and a lost connection (a server
+// restart) shows the same neutral "Please wait" screen, without countdown.
+// Answers carry the question's token; one the engine refuses (stale trial,
+// stopped, paused or another session) shows its plain reason here and the
+// screen then shows what is current.
+//
+// Timing is the server's: the trial's onset and clock are kept per token, so
+// the countdown continues where it was after a reload or a pause (handout
+// elapsed_s), and the stored reaction time runs from onset without paused
+// time. The page's own events (select, choice, …) are sent with the answer,
+// t_s from when this page showed the question.
 
 import { studio, StudioError } from './ws';
 import { h, isoNow, decodeF32 } from './util';
 import { FeelStrip } from './feel';
 import { getHello, deviceLength } from './designer';
 import { Store } from './store';
-import type { ExperimentQuestionReply, Question, Replies, Response, TrialEvent } from './generated/messages';
+import type { ExperimentQuestionReply, Question, Response, ServerMessages, TrialEvent } from './generated/messages';
 
 const niceChoice: Record<string, string> = { unsure: 'Unsure', same: 'Same', different: 'Different' };
 
-function radioGroup(label: string, options: { value: string; text: string }[], onPick: (v: string) => void, testid: string): { el: HTMLElement; value: () => string | null } {
+function radioGroup(label: string, options: { value: string; text: string }[], onPick: (v: string) => void, testid: string, labelledBy?: string): { el: HTMLElement; value: () => string | null } {
   let picked: string | null = null;
   const buttons = options.map((o) =>
     h('button', { type: 'button', role: 'radio', 'aria-checked': 'false', class: 'big choice', 'data-value': o.value, 'aria-label': `${label}: ${o.text}` }, o.text),
   );
-  const el = h('div', { role: 'radiogroup', 'aria-label': label, class: 'choices', 'data-testid': testid }, ...buttons);
+  const el = h('div', { role: 'radiogroup', 'aria-label': labelledBy ? undefined : label, 'aria-labelledby': labelledBy, class: 'choices', 'data-testid': testid }, ...buttons);
   buttons.forEach((b, i) => {
     b.tabIndex = i === 0 ? 0 : -1;
     b.addEventListener('click', () => {
@@ -38,6 +47,7 @@ function radioGroup(label: string, options: { value: string; text: string }[], o
       const n = buttons[(i + d + buttons.length) % buttons.length];
       buttons.forEach((x) => (x.tabIndex = x === n ? 0 : -1));
       n.focus();
+      n.click(); // arrows select, as in a native radio group
     });
   });
   return { el, value: () => picked };
@@ -65,46 +75,109 @@ function drawMiniMap(canvas: HTMLCanvasElement, values: Float32Array): void {
   ctx.stroke();
 }
 
+// "1" → "texture 1"; named stimuli ("Reference", "A", "Test") keep their name.
+const stimulusName = (label: string) => (/^\d+$/.test(label) ? `texture ${label}` : label);
+
+type StateMessage = ServerMessages['experiment.question'] | ServerMessages['experiment.idle'] | ServerMessages['experiment.suspended'] | ServerMessages['experiment.finished'];
+
 export function mountParticipant(root: HTMLElement): void {
   const client = studio();
   let idleTimer: ReturnType<typeof setTimeout> | null = null;
+  let shownToken: string | null = null; // token of the question on screen
+  let endQuestion: (() => void) | null = null; // stops the timers of the question on screen
   const alive = () => document.body.contains(root) && !!root.querySelector('.participant');
 
   const screen = h('div', { class: 'participant-screen' });
+  // A refused answer's reason stays visible over whatever comes next.
+  const notice = h('p', {
+    class: 'notice',
+    role: 'alert',
+    'data-testid': 'participant-notice',
+    hidden: true,
+    style: 'background:#fff4d6;border-left:4px solid #8a5a00;padding:0.6rem 0.9rem;color:#1d1d1d',
+  });
+  let noticeTimer: ReturnType<typeof setTimeout> | null = null;
+  const showNotice = (text: string) => {
+    notice.textContent = text;
+    notice.hidden = false;
+    if (noticeTimer) clearTimeout(noticeTimer);
+    noticeTimer = setTimeout(() => (notice.hidden = true), 10_000);
+  };
   const strip = new FeelStrip({ length_mm: NaN, label: 'Feel the selected texture here: move a finger or the pointer along the strip' });
-  root.replaceChildren(h('div', { class: 'participant' }, screen));
+  // The player's position in mm is an engineering figure: not for a participant's eyes.
+  strip.el.querySelectorAll<HTMLElement>('.feel-status > span, #player-position').forEach((e) => (e.hidden = true));
+  root.replaceChildren(h('div', { class: 'participant' }, notice, screen));
 
-  async function load(): Promise<void> {
+  async function load(reload = false): Promise<void> {
     if (idleTimer) clearTimeout(idleTimer);
     try {
-      const cur = await client.call('experiment.current', {}, 60000);
+      const cur = await client.call('experiment.current', { screen: true, ...(reload ? { reload: true } : {}) }, 60000);
       show(cur);
     } catch (e) {
+      if (e instanceof StudioError && e.code === 'disconnected') return; // onState shows the wait screen and reloads
       screen.replaceChildren(h('p', { class: 'status error', role: 'alert' }, e instanceof Error ? e.message : String(e)));
       idleTimer = setTimeout(() => alive() && void load(), 2000);
     }
   }
 
-  function show(cur: Replies['experiment.current']): void {
-    root.dataset.state = cur.type;
-    if (cur.type === 'experiment.question') void renderQuestion(cur);
-    else if (cur.type === 'experiment.finished') {
+  function leaveQuestion(): void {
+    endQuestion?.();
+    endQuestion = null;
+    shownToken = null;
+  }
+
+  function wait(state: string, detail: string): void {
+    leaveQuestion();
+    root.dataset.state = state;
+    screen.replaceChildren(h('div', { class: 'waiting', 'data-testid': 'waiting', role: 'status' }, h('h1', {}, 'Please wait'), h('p', {}, detail)));
+  }
+
+  function show(cur: StateMessage): void {
+    if (!alive()) return;
+    if (idleTimer) clearTimeout(idleTimer);
+    if (cur.type === 'experiment.question') {
+      // The same question again (this screen's own reply and the push): keep it as it is.
+      if (cur.handout.token === shownToken) return;
+      leaveQuestion();
+      root.dataset.state = cur.type;
+      shownToken = cur.handout.token;
+      void renderQuestion(cur);
+    } else if (cur.type === 'experiment.finished') {
+      leaveQuestion();
+      root.dataset.state = cur.type;
       screen.replaceChildren(h('div', { class: 'thanks', 'data-testid': 'thank-you', role: 'status' }, h('h1', {}, 'Thank you'), h('p', {}, 'The session is complete.')));
+    } else if (cur.type === 'experiment.suspended') {
+      wait(cur.type, 'The session is paused. It will continue shortly.');
     } else {
-      screen.replaceChildren(h('div', { class: 'waiting', 'data-testid': 'waiting', role: 'status' }, h('h1', {}, 'Please wait'), h('p', {}, 'The experimenter will start the session shortly.')));
-      idleTimer = setTimeout(() => alive() && void load(), 1500);
+      wait(cur.type, 'The experimenter will start the session shortly.');
+      idleTimer = setTimeout(() => alive() && void load(), 5000); // pushes do the work; this is a fallback
     }
   }
 
+  // Pushed by the service whenever the session changes.
+  const off = [
+    client.on('experiment.question', (m) => m.id === null && show(m)),
+    client.on('experiment.idle', (m) => m.id === null && show(m)),
+    client.on('experiment.suspended', (m) => m.id === null && show(m)),
+    client.on('experiment.finished', (m) => m.id === null && show(m)),
+    client.onState((st) => {
+      if (!alive()) return off.forEach((o) => o());
+      if (st === 'closed') wait('disconnected', 'The connection to the studio was lost; reconnecting.');
+      else if (st === 'open') void load();
+    }),
+  ];
+
   async function renderQuestion(reply: ExperimentQuestionReply): Promise<void> {
     const q: Question = reply.question;
+    const handout = reply.handout;
     const shownPerf = performance.now();
-    const shownAt = isoNow();
     const events: TrialEvent[] = [];
     const ev = (kind: string, detail: string) => events.push({ t_s: (performance.now() - shownPerf) / 1000, kind, detail, at: isoNow() });
-    ev('show', `trial ${q.trial}`);
+    ev('show', `trial ${handout.trial_number}`);
     const timers: ReturnType<typeof setTimeout>[] = [];
     const clearTimers = () => timers.forEach((t) => clearTimeout(t));
+    endQuestion = clearTimers;
+    const current = () => alive() && shownToken === handout.token;
 
     try {
       const hi = await getHello();
@@ -114,6 +187,7 @@ export function mountParticipant(root: HTMLElement): void {
     } catch {
       /* keep the default length */
     }
+    if (!current()) return; // the session moved on while the device was looked up
 
     // ---- the trial's one state: inputs write it, render() enables Submit from it
     type Answer = Pick<Response, 'choice' | 'rating' | 'confidence' | 'digit' | 'slider_p' | 'slider_i'>;
@@ -144,7 +218,7 @@ export function mountParticipant(root: HTMLElement): void {
 
     // ---- stimuli
     const stimulusButtons = q.stimuli.map((s, i) => {
-      const b = h('button', { type: 'button', class: 'big stimulus', 'aria-pressed': 'false', 'data-stimulus': i, 'aria-label': `Feel ${s.label}` }, s.label) as HTMLButtonElement;
+      const b = h('button', { type: 'button', class: 'big stimulus', 'aria-pressed': 'false', 'data-stimulus': i }, `Feel ${stimulusName(s.label)}`) as HTMLButtonElement;
       b.addEventListener('click', () => void selectStimulus(i));
       return b;
     });
@@ -166,19 +240,21 @@ export function mountParticipant(root: HTMLElement): void {
       reply.progress && reply.progress.planned > 0 ? `${Math.min(reply.progress.done + 1, reply.progress.planned)} of ${reply.progress.planned}` : '';
     parts.push(
       h('header', { class: 'q-head' },
-        h('span', { class: 'trial', 'data-testid': 'trial-number', 'data-trial': q.trial }, `Trial ${q.trial + 1}`),
+        h('h1', { class: 'trial', 'data-testid': 'trial-number', 'data-trial': q.trial }, `Trial ${handout.trial_number}`),
         progress ? h('span', { class: 'progress', 'data-testid': 'progress' }, progress) : null,
         q.practice ? h('span', { class: 'badge' }, 'practice') : null),
     );
     if (q.prompt) parts.push(h('p', { class: 'prompt', id: 'prompt' }, q.prompt));
 
     const countdown = h('div', { class: 'countdown', 'data-testid': 'countdown', 'aria-live': 'off' });
-    if (q.time_limit_s > 0 && q.phases.length === 0) {
+    if (handout.time_limit_s > 0 && q.phases.length === 0) {
       parts.push(countdown);
-      const end = shownPerf + q.time_limit_s * 1000;
+      // The server's clock: what is left of the limit since onset (a reload or a pause does not reset it).
+      const end = shownPerf + (handout.time_limit_s - handout.elapsed_s) * 1000;
       const tick = () => {
-        if (!alive()) return;
+        if (!current()) return;
         const left = Math.max(0, (end - performance.now()) / 1000);
+        countdown.dataset.left = left.toFixed(2); // seconds left (tests read it)
         countdown.textContent = `${Math.ceil(left)} s left to feel`;
         if (left <= 0) {
           trial.update({ timedOut: true });
@@ -195,7 +271,11 @@ export function mountParticipant(root: HTMLElement): void {
     const phaseArea = h('div', { class: 'phase', 'data-testid': 'phase', 'aria-live': 'polite' });
     const answerArea = h('div', { class: 'answers' });
     if (q.phases.length === 0) {
-      if (stimulusButtons.length) parts.push(h('div', { class: 'stimuli', role: 'group', 'aria-label': 'Textures to feel' }, ...stimulusButtons));
+      if (stimulusButtons.length)
+        parts.push(
+          h('h2', { id: 'feel-heading', class: 'group-label' }, 'Feel each texture'),
+          h('div', { class: 'stimuli', role: 'group', 'aria-labelledby': 'feel-heading' }, ...stimulusButtons),
+        );
       if (q.show_maps) {
         const maps = h('div', { class: 'maps' });
         parts.push(maps);
@@ -255,11 +335,13 @@ export function mountParticipant(root: HTMLElement): void {
       });
     }
     if (needs.choice) {
-      const g = radioGroup('Your answer', q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? c })), (v) => {
+      // Visibly different from the row above: a heading says this row answers.
+      const question = q.task === 'oddity' ? 'Answer: the odd one is …' : q.task === 'two-alternative' ? 'Answer: the test texture is like …' : 'Your answer';
+      const g = radioGroup(question, q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? (q.task === 'oddity' ? stimulusName(c) : c) })), (v) => {
         ev('choice', v);
         setAnswer({ choice: v });
-      }, 'choices');
-      answerArea.append(g.el);
+      }, 'choices', 'answer-heading');
+      answerArea.append(h('h2', { id: 'answer-heading', class: 'group-label' }, question), g.el);
     }
     if (q.rating_scale) {
       const [lo, hi] = q.rating_scale;
@@ -295,27 +377,24 @@ export function mountParticipant(root: HTMLElement): void {
       trial.update({ saving: true });
       submit.textContent = 'Saving…';
       const answer = trial.get().answer;
-      const answeredPerf = performance.now();
       ev('answer', answer.choice ?? (answer.rating !== undefined ? String(answer.rating) : 'sliders'));
-      const response: Response = {
-        ...answer,
-        rt_ms: Math.round((answeredPerf - shownPerf) * 10) / 10,
-        shown_at: shownAt,
-        answered_at: isoNow(),
-        events,
-      };
+      // rt_ms, shown_at and answered_at are the server's (its onset per token).
+      const response: Response = { ...answer, events };
       try {
-        const next = await client.call('experiment.answer', { trial: q.trial, response }, 60000);
-        clearTimers();
+        const next = await client.call('experiment.answer', { trial: q.trial, token: handout.token, response }, 60000);
+        notice.hidden = true;
         show(next);
       } catch (e) {
         submit.textContent = 'Submit';
-        msg.textContent = e instanceof Error ? e.message : String(e);
-        msg.classList.add('error');
         if (e instanceof StudioError && (e.code === 'conflict' || e.code === 'not_found' || e.code === 'disconnected')) {
-          // A stale trial or a lost connection: show what the engine holds now.
-          setTimeout(() => alive() && void load(), 500);
+          // Refused by the token rule (or the connection was lost): say so on this
+          // screen, then show what the engine holds now.
+          showNotice(e.code === 'disconnected' ? 'The connection was lost before the answer arrived; it was not stored.' : e.message);
+          wait('refused', 'The next step follows in a moment.');
+          idleTimer = setTimeout(() => alive() && void load(), 1500);
         } else {
+          msg.textContent = e instanceof Error ? e.message : String(e);
+          msg.classList.add('error');
           trial.update({ saving: false });
         }
       }
@@ -328,7 +407,7 @@ export function mountParticipant(root: HTMLElement): void {
     if (q.phases.length) {
       answerArea.hidden = true;
       const runPhase = (k: number) => {
-        if (!alive()) return;
+        if (!current()) return;
         if (k >= q.phases.length) {
           phaseArea.replaceChildren(h('p', {}, 'Now answer the questions.'));
           answerArea.hidden = false;
@@ -351,7 +430,7 @@ export function mountParticipant(root: HTMLElement): void {
           phaseArea.replaceChildren(h('p', {}, 'Please wait.'), left);
         }
         const tick = () => {
-          if (!alive()) return;
+          if (!current()) return;
           const s = Math.max(0, (end - performance.now()) / 1000);
           left.textContent = `${Math.ceil(s)} s`;
           if (s <= 0) runPhase(k + 1);
@@ -363,5 +442,5 @@ export function mountParticipant(root: HTMLElement): void {
     }
   }
 
-  void load();
+  void load(true);
 }

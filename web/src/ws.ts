@@ -18,6 +18,8 @@ export class StudioError extends Error {
   constructor(
     public code: string,
     message: string,
+    /** Why the token rule refused an answer (error replies with code conflict; docs/studio.md). */
+    public reason?: string,
   ) {
     super(message);
     this.name = 'StudioError';
@@ -109,7 +111,7 @@ export class StudioClient {
           }
       }
       if (msg.type === 'error') {
-        p.reject(new StudioError(msg.code, msg.message));
+        p.reject(new StudioError(msg.code, msg.message, msg.reason));
       } else {
         p.resolve(msg);
       }

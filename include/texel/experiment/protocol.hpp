@@ -156,6 +156,9 @@ struct Protocol {
   std::string description;
   std::string device = "tpad";
   std::uint64_t seed = 1;
+  /// What a reload of a participant screen does to the trial on it:
+  /// "keep_clock" (default: same token, onset kept) or "restart_trial" (runner.hpp ReloadRule).
+  std::string on_reload = "keep_clock";
   std::string observer = "{}";  ///< simulated observer for `--simulate default` (JSON object text)
   std::vector<Block> blocks;
   std::string json;  ///< the validated source (stored with every session)

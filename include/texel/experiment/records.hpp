@@ -82,6 +82,13 @@ struct TrialRow {
   // -- time stamps (UTC, ISO 8601 with milliseconds)
   std::string shown_at;
   std::string answered_at;
+
+  // -- timing flags (docs/session-store.md "The export CSV"); missing in rows stored before them.
+  // The CSV's trial_number column (1-based, what participants are shown) is trial + 1.
+  double time_limit_s = missing;     ///< the trial's time limit (s), missing when none
+  double over_time_limit = missing;  ///< 1 when rt_ms exceeded the time limit, 0 when not
+  double interrupted = missing;      ///< 1 when the trial spanned a suspend, a stop/resume, a restart or a reload-restart
+  double suspended_ms = missing;     ///< time the session was suspended during the trial (not in rt_ms)
 };
 
 /// The current time, UTC, ISO 8601 with milliseconds ("2026-11-23T14:02:08.123Z"):

@@ -63,12 +63,16 @@ for (const sig of ['SIGINT', 'SIGTERM'])
     process.exit(130);
   });
 
-/** Starts `texel studio --port 0`; resolves {url, stop, log} once it printed its address. */
-export async function startStudio({ hardTimeoutMs = 600_000 } = {}) {
+/**
+ * Starts `texel studio --port 0` (or `port`) on a fresh database (or `db`,
+ * e.g. to restart a server on the same one); resolves {url, stop, log} once
+ * it printed its address.
+ */
+export async function startStudio({ hardTimeoutMs = 600_000, db = null, port = 0 } = {}) {
   for (const [what, p] of [['TEXEL_BIN', paths.bin], ['TEXEL_WEB', join(paths.web, 'index.html')]])
     if (!existsSync(p)) throw new Error(`${what}: ${p} does not exist (build it first; see web/tests/e2e/studio.mjs)`);
   const dir = mkdtempSync(join(tmpdir(), 'texel-e2e-'));
-  const args = ['studio', '--port', '0', '--web', paths.web, '--db', join(dir, 's.db'), '--backend', 'null', '--protocols', paths.protocols];
+  const args = ['studio', '--port', String(port), '--web', paths.web, '--db', db ?? join(dir, 's.db'), '--backend', 'null', '--protocols', paths.protocols];
   const proc = spawn(paths.bin, args, { stdio: ['ignore', 'pipe', 'pipe'] });
   live.add(proc);
   let log = '';
