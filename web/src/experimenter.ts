@@ -162,17 +162,32 @@ export function mountExperimenter(root: HTMLElement): void {
     void start(protoSel.value, participant.value.trim(), resume.checked, simulate.value.trim());
   });
 
+  // Stop: the session is closed for now (writer lock released) and resumes
+  // later from the sessions table. Pause: the session stays open, every
+  // participant screen shows "Please wait" and the trial's clock stops until
+  // Continue (docs/studio.md, the token rule).
   async function suspend(): Promise<void> {
     try {
       const finished = active.dataset.state === 'experiment.finished';
       await client.call('experiment.stop', {}, 30000);
-      say(finished ? 'Session closed.' : 'Session suspended: resume it from the sessions table.');
+      say(finished ? 'Session closed.' : 'Session stopped: resume it from the sessions table.');
     } catch (e) {
       say(plain(e), true);
     }
     await refresh();
   }
-  const stopBtn = h('button', { type: 'button', 'data-testid': 'stop', onclick: () => void suspend() }, 'Suspend');
+  const stopBtn = h('button', { type: 'button', 'data-testid': 'stop', onclick: () => void suspend() }, 'Stop');
+  async function pauseOrContinue(): Promise<void> {
+    const paused = active.dataset.state === 'experiment.suspended';
+    try {
+      await client.call(paused ? 'experiment.resume' : 'experiment.suspend', {}, 30000);
+      say(paused ? 'Session continues: the participant sees the same trial.' : 'Session paused: the participant sees "Please wait".');
+    } catch (e) {
+      say(plain(e), true);
+    }
+    await refresh();
+  }
+  const pauseBtn = h('button', { type: 'button', 'data-testid': 'pause', onclick: () => void pauseOrContinue() }, 'Pause');
 
   // Sessions started with a simulate spec can be answered by the engine's
   // simulated participant (experiment.answer {trial, simulated: true}).
@@ -272,7 +287,7 @@ export function mountExperimenter(root: HTMLElement): void {
     const actions = h('div', { class: 'btn-row' });
     if (state === 'suspended')
       actions.append(h('button', { type: 'button', 'aria-label': `Resume ${who}`, onclick: () => void start(s.protocol, s.participant, true, '') }, 'Resume'));
-    if (state === 'running') actions.append(h('button', { type: 'button', 'aria-label': `Suspend ${who}`, onclick: () => void suspend() }, 'Suspend'));
+    if (state === 'running') actions.append(h('button', { type: 'button', 'aria-label': `Stop ${who}`, onclick: () => void suspend() }, 'Stop'));
     actions.append(
       h('button', { type: 'button', 'aria-label': `Show ${who}`, 'data-testid': 'show-session', onclick: () => ((watched = s.id), (shownKey = ''), void refresh()) }, 'Show'),
       h('button', { type: 'button', 'aria-label': `Download ${who} as CSV`, onclick: () => void exportAs('csv', s.id) }, 'CSV'),
@@ -332,7 +347,10 @@ export function mountExperimenter(root: HTMLElement): void {
           say(`${l.active.protocol} finished for ${l.active.participant}`);
         }
         // A finished session still holds the participant screen until it is closed.
-        stopBtn.textContent = finished ? 'Close the session' : 'Suspend';
+        stopBtn.textContent = finished ? 'Close the session' : 'Stop';
+        pauseBtn.textContent = cur.type === 'experiment.suspended' ? 'Continue' : 'Pause';
+        pauseBtn.hidden = finished;
+        if (cur.type === 'experiment.suspended') progress += ', paused';
         active.dataset.state = cur.type;
       } catch {
         /* the list is enough */
@@ -345,6 +363,8 @@ export function mountExperimenter(root: HTMLElement): void {
           h('strong', {}, `Session ${l.active.id}: ${l.active.participant}, ${l.active.protocol}`),
           ' ',
           h('span', { 'data-testid': 'active-progress' }, progress),
+          ' ',
+          pauseBtn,
           ' ',
           stopBtn,
           ' ',

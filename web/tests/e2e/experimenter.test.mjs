@@ -1,7 +1,7 @@
 // The experimenter view a lab can use (issue #22 item 5): a simulated
 // texel-length session followed live (staircase track with reversals,
 // correctness per trial, progress with times), the session list with dates
-// and states (a running session offers Suspend, never Resume), plain-word
+// and states (a running session offers Stop, never Resume), plain-word
 // errors, exports (CSV, .mat, analysis figures) as download links, and the
 // protocol editor: a shipped template as a form, refused by the engine's
 // validation with the field named, a designed texture put into a block as a
@@ -33,11 +33,11 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     await page.fill('#simulate', 'threshold=6mm');
     await page.click('[data-testid=start]');
 
-    // Running: the row offers Suspend, not Resume.
+    // Running: the row offers Stop, not Resume.
     const run = rowOf(page, 'SIM1');
     await run.locator('[data-testid=session-state]:text-is("running")').waitFor({ timeout: 30_000 });
     assert.equal(await run.getByRole('button', { name: /^Resume/ }).count(), 0, 'a running session offers no Resume');
-    assert.equal(await run.getByRole('button', { name: /^Suspend/ }).count(), 1);
+    assert.equal(await run.getByRole('button', { name: /^Stop/ }).count(), 1);
     assert.match(await run.locator('td').nth(4).textContent(), /^\d{4}-\d\d-\d\d \d\d:\d\d$/, 'start date');
 
     // Simulated answers for a while: the track and the trial table follow.
@@ -53,7 +53,7 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     assert.match(await page.textContent('[data-testid=active-progress]'), /^\d+ trials \(adaptive\)|^\d+ \/ \d+ trials/);
     await screenshot(page, 'experimenter-live-track');
 
-    // Suspend: the row becomes suspended and offers Resume.
+    // Stop: the row becomes suspended (resumable) and offers Resume.
     await page.click('[data-testid=stop]');
     await run.locator('[data-testid=session-state]:text-is("suspended")').waitFor({ timeout: 30_000 });
     assert.equal(await run.getByRole('button', { name: /^Resume/ }).count(), 1);
