@@ -23,6 +23,7 @@ kills only that; every wait has a deadline.
 """
 
 import csv
+import json
 import os
 import re
 import shutil
@@ -116,7 +117,14 @@ def main():
     shutil.rmtree(WORK, ignore_errors=True)
     os.makedirs(WORK)
     db, mon, csv_path = (os.path.join(WORK, n) for n in ("s.db", "monitor.log", "trials.csv"))
-    protocol = os.path.join(PROTOCOLS, "texel-length.json")
+    # The shipped texel-length protocol without its untimed practice block,
+    # so the first trial is a timed staircase trial.
+    with open(os.path.join(PROTOCOLS, "texel-length.json")) as f:
+        shipped = json.load(f)
+    shipped["blocks"] = [b for b in shipped["blocks"] if not b.get("practice")]
+    protocol = os.path.join(WORK, "texel-length.json")
+    with open(protocol, "w") as f:
+        json.dump(shipped, f)
     cmd = f"'{TEXEL}' experiment run '{protocol}' --participant TM1 --db '{db}' --backend null"
     if USE_MONITOR:
         cmd += f" --monitor '{mon}'"

@@ -298,7 +298,11 @@ TEST(ProtocolVersions, VersionTwoStaircaseHasNoInitialRuleAndEndsOnTheLastValueS
   }
   const auto& last = main.back()->row;
   EXPECT_TRUE(last.procedure_finished);
-  EXPECT_EQ(last.next_intensity, last.intensity);  // the threshold is the last length presented
+  EXPECT_NE(last.next_intensity, last.intensity);  // the row keeps the value computed after the last answer
+  // The protocol's end rule (what the engine reports as the threshold) is the last length presented.
+  const auto state = nlohmann::json::parse(main.back()->state_json);
+  EXPECT_EQ(state["config"]["end_value"], "last-presented");
+  EXPECT_EQ(state["config"]["apply_initial_rule"], false);
   EXPECT_EQ(last.condition, "narrow");
 }
 
@@ -420,14 +424,11 @@ TEST(ProtocolVersions, EffectOfTheStaircaseRulesOnASimulatedCohort) {
             if (t.row.practice) continue;
             trials += 1;
             if (!t.row.procedure_finished) continue;
-            // The end rule decides only what the finishing row reports:
-            // the last value shown, or one step from it.
-            if (last) {
-              EXPECT_EQ(t.row.next_intensity, t.row.intensity);
-            } else {
-              EXPECT_NE(t.row.next_intensity, t.row.intensity);
-            }
-            sum += t.row.next_intensity;
+            // The stored row keeps both readings: the last value shown
+            // (intensity) and the one computed after the answer, one step
+            // from it (next_intensity); the end rule picks one.
+            EXPECT_NE(t.row.next_intensity, t.row.intensity);
+            sum += last ? t.row.intensity : t.row.next_intensity;
             runs += 1;
           }
         }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
 
 #include <cmath>
 #include <filesystem>
@@ -30,11 +31,14 @@ namespace {
 
 const fs::path protocols = fs::path(TEXEL_TEST_SOURCE_DIR) / "examples" / "protocols";
 
+// The shipped texel-length protocol without its untimed practice block, so
+// the first question is a timed (30 s) staircase trial.
 ex::Protocol texel_length(const std::string& on_reload = "") {
-  ex::Protocol p = ex::load_protocol((protocols / "texel-length.json").string());
-  if (on_reload.empty()) return p;
-  auto j = nlohmann::json::parse(p.json);
-  j["on_reload"] = on_reload;
+  auto j = nlohmann::json::parse(ex::load_protocol((protocols / "texel-length.json").string()).json);
+  auto& blocks = j["blocks"];
+  blocks.erase(std::remove_if(blocks.begin(), blocks.end(), [](const auto& b) { return b.value("practice", false); }),
+               blocks.end());
+  if (!on_reload.empty()) j["on_reload"] = on_reload;
   return ex::parse_protocol(j.dump(), "test protocol");
 }
 

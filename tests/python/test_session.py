@@ -129,7 +129,8 @@ def test_answers_are_bound_to_the_question_token(protocol, tmp_path):
     with texel.Store(tmp_path / "t.db", mode="rw") as store, Session(store, protocol, "P06") as s:
         q = s.question
         first = s.handout
-        assert first["trial_number"] == 1 and first["time_limit_s"] == 30 and not first["suspended"]
+        # texel-length opens with untimed practice trials (no time limit)
+        assert first["trial_number"] == 1 and first["time_limit_s"] == 0 and not first["suspended"]
         s.suspend()
         assert s.handout["suspended"] and s.handout["token"] == first["token"]
         with pytest.raises(texel.InvalidArgument, match="paused"):
