@@ -82,6 +82,8 @@ export interface StripOptions {
   hoverTouches?: boolean;
   onEnter?: () => void;
   label?: string;
+  /** Draw the mm scale under the strip (default true; a participant's strip has none). */
+  scale?: boolean;
 }
 
 export class FeelStrip {
@@ -223,7 +225,7 @@ export class FeelStrip {
   private drawScale(): void {
     const L = this.length_mm;
     this.scale.replaceChildren();
-    if (!(L > 0)) return;
+    if (!(L > 0) || this.opts.scale === false) return;
     const step = L > 200 ? 50 : L > 50 ? 10 : L > 10 ? 5 : 1;
     for (let x = 0; x <= L + 1e-9; x += step) {
       const tick = h('span', { class: 'tick', style: `left: ${(100 * x) / L}%` }, `${x}`);

@@ -103,7 +103,9 @@ export function mountParticipant(root: HTMLElement): void {
     if (noticeTimer) clearTimeout(noticeTimer);
     noticeTimer = setTimeout(() => (notice.hidden = true), 10_000);
   };
-  const strip = new FeelStrip({ length_mm: NaN, label: 'Feel the selected texture here: move a finger or the pointer along the strip' });
+  // No mm scale and no texture drawing: a participant feels, never sees, the stimuli (the
+  // texture's layout would give the odd one away; visual-practice maps are drawn separately).
+  const strip = new FeelStrip({ length_mm: NaN, scale: false, label: 'Feel the selected texture here: move a finger or the pointer along the strip' });
   // The player's position in mm is an engineering figure: not for a participant's eyes.
   strip.el.querySelectorAll<HTMLElement>('.feel-status > span, #player-position').forEach((e) => (e.hidden = true));
   root.replaceChildren(h('div', { class: 'participant' }, notice, screen));

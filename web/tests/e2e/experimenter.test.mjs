@@ -30,7 +30,7 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     await page.waitForSelector('#protocol option[value="texel-length"]', { state: 'attached' });
     await page.selectOption('#protocol', 'texel-length');
     await page.fill('#participant', 'SIM1');
-    await page.fill('#simulate', 'threshold=6mm');
+    await page.fill('#simulate', 'threshold=20mm'); // near the start (26 mm): reversals within the first staircase trials
     await page.click('[data-testid=start]');
 
     // Running: the row offers Stop, not Resume.
@@ -41,8 +41,9 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     assert.match(await run.locator('td').nth(4).textContent(), /^\d{4}-\d\d-\d\d \d\d:\d\d$/, 'start date');
 
     // Simulated answers for a while: the track and the trial table follow.
-    await askStudio(page, [], { simulated: 15 });
-    await page.waitForFunction(() => Number(document.querySelector('.page-experimenter')?.dataset.trialsShown ?? 0) >= 15, null, { timeout: 60_000 });
+    // (ten untimed practice trials first, then the staircase)
+    await askStudio(page, [], { simulated: 25 });
+    await page.waitForFunction(() => Number(document.querySelector('.page-experimenter')?.dataset.trialsShown ?? 0) >= 25, null, { timeout: 60_000 });
     await page.waitForSelector('[data-testid=staircase-plot] canvas');
     const caption = await page.textContent('[data-testid=staircase-caption]');
     assert.match(caption, /texel_length_mm per trial \(\d+ trials, \d+ reversals/);
@@ -73,7 +74,7 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     assert.equal(f.name, 'trials.csv');
     const csv = f.data.toString('utf8').split('\n');
     assert.match(csv[0], /(^|,)participant(,|$)/);
-    assert.equal(csv.filter((l) => l.includes('SIM1')).length, 15);
+    assert.equal(csv.filter((l) => l.includes('SIM1')).length, 25);
 
     await page.click('[data-testid=export-mat]');
     link = page.locator('[data-testid=export-link]:has-text("trials.mat")');

@@ -7,7 +7,9 @@
 // Screenshots: $TEXEL_ARTIFACTS/firefox-participant-*.png.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { startStudio, launchFirefox, artifact } from './studio.mjs';
+import { startStudio, launchFirefox, artifact, withoutPractice } from './studio.mjs';
+
+const TL = withoutPractice('texel-length'); // the first question is a timed staircase trial
 import { control, STALE_HOOK } from './participant-helpers.mjs';
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -33,7 +35,7 @@ test('firefox: the participant screen follows the session; a stale answer is ref
     await p.goto(`${studio.url}#/participant`);
     await p.waitForSelector('[data-testid=waiting]');
 
-    let [r] = await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'FZ1' });
+    let [r] = await control(page, { type: 'experiment.start', protocol: TL, participant: 'FZ1' });
     assert.equal(r.type, 'experiment.started', JSON.stringify(r));
     await p.waitForSelector('.question[data-task=oddity]', { timeout: 60_000 });
     assert.equal(await text(p, '#answer-heading'), 'Answer: the odd one is …');
@@ -41,7 +43,7 @@ test('firefox: the participant screen follows the session; a stale answer is ref
 
     // A stale screen answers Z1's trial after the switch to Z2: refused, nothing stored.
     await p.evaluate(() => (window.__dropPushes = true));
-    await control(page, { type: 'experiment.stop' }, { type: 'experiment.start', protocol: 'texel-length', participant: 'FZ2' });
+    await control(page, { type: 'experiment.stop' }, { type: 'experiment.start', protocol: TL, participant: 'FZ2' });
     await p.click('[data-testid=choices] button');
     await until(p, () => !document.querySelector('[data-testid=submit]').disabled);
     await p.click('[data-testid=submit]');

@@ -28,14 +28,15 @@ import { spawnSync } from 'node:child_process';
 import { readFileSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths, launchBrowser, checkFrames, startStudio } from './studio.mjs';
+import { withStudio, screenshot, paths, launchBrowser, checkFrames, startStudio, withoutPractice } from './studio.mjs';
 import { control, STALE_HOOK } from './participant-helpers.mjs';
 
+const TL = withoutPractice('texel-length'); // the first question is a timed staircase trial
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 /** texel-length with the first block's time limit changed (a short limit keeps the test quick). */
 function texelLength(limit_s) {
-  const p = JSON.parse(readFileSync(join(paths.protocols, 'texel-length.json'), 'utf8'));
+  const p = withoutPractice('texel-length');
   p.name = `texel-length-${limit_s}s`;
   for (const b of p.blocks) if ('time_limit_s' in b || b.task === 'oddity') b.time_limit_s = limit_s;
   return p;
@@ -76,12 +77,12 @@ test('participant screen: wrong session, stale screens, paused answer, reload, t
     await screenshot(p, 'participant-idle');
 
     // ---- The issue's reproduction: a stale Z1 screen answers after Z1 was stopped and Z2 started.
-    let [r] = await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'Z1' });
+    let [r] = await control(page, { type: 'experiment.start', protocol: TL, participant: 'Z1' });
     assert.equal(r.type, 'experiment.started', JSON.stringify(r));
     await p.waitForSelector('.question[data-task=oddity]');
     await screenshot(p, 'participant-oddity');
     await p.evaluate(() => (window.__dropPushes = true));
-    [r] = await control(page, { type: 'experiment.stop' }, { type: 'experiment.start', protocol: 'texel-length', participant: 'Z2' }).then((x) => x.slice(1));
+    [r] = await control(page, { type: 'experiment.stop' }, { type: 'experiment.start', protocol: TL, participant: 'Z2' }).then((x) => x.slice(1));
     assert.equal(r.type, 'experiment.started');
     await pickAndSubmit(p);
     const notice = p.locator('[data-testid=participant-notice]');
@@ -215,7 +216,7 @@ test('participant screen: a server restart shows "Please wait", then the same tr
     const page = await context.newPage();
     await page.goto(`${server.url}#/experimenter`);
     const p = await participantPage(context, server.url, errors);
-    await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'R1' });
+    await control(page, { type: 'experiment.start', protocol: TL, participant: 'R1' });
     await p.waitForSelector('.question[data-trial="0"]');
     await pickAndSubmit(p);
     await p.waitForSelector('.question[data-trial="1"]');
@@ -227,7 +228,7 @@ test('participant screen: a server restart shows "Please wait", then the same tr
     await screenshot(p, 'participant-server-gone');
 
     server = await startStudio({ db, port });
-    const [r] = await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'R1', resume: true });
+    const [r] = await control(page, { type: 'experiment.start', protocol: TL, participant: 'R1', resume: true });
     assert.equal(r.type, 'experiment.started', JSON.stringify(r));
     await p.waitForSelector('.question[data-trial="1"]', { timeout: 30_000 });
     assert.equal(await p.locator('[data-testid=trial-number]').textContent(), 'Trial 2');
@@ -250,7 +251,7 @@ test('participant screen: the issue\'s 43 s trial against a 30 s limit, spanning
   await withStudio(async ({ studio, context, page, errors }) => {
     await page.goto(`${studio.url}#/experimenter`);
     const p = await participantPage(context, studio.url, errors);
-    await control(page, { type: 'experiment.start', protocol: 'texel-length', participant: 'L43' });
+    await control(page, { type: 'experiment.start', protocol: TL, participant: 'L43' });
     await p.waitForSelector('.question[data-trial="0"]');
     await sleep(2500);
     await control(page, { type: 'experiment.suspend' });

@@ -10,7 +10,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths } from './studio.mjs';
+import { withStudio, screenshot, paths, withoutPractice } from './studio.mjs';
 
 function protocol(name, edit = (p) => p) {
   return edit(JSON.parse(readFileSync(join(paths.protocols, `${name}.json`), 'utf8')));
@@ -71,7 +71,7 @@ test('participant screens: oddity, match + confidence, two-alternative, working 
     p.on('pageerror', (e) => errors.push(String(e)));
 
     // Oddity: three stimuli, choices 1–3, the countdown of time_limit_s.
-    let r = await start(page, 'texel-length', 'S-odd');
+    let r = await start(page, withoutPractice('texel-length'), 'S-odd');
     assert.equal(r.type, 'experiment.started', JSON.stringify(r));
     await p.goto(`${studio.url}#/participant`);
     await p.waitForSelector('.question[data-task=oddity]');
@@ -102,6 +102,8 @@ test('participant screens: oddity, match + confidence, two-alternative, working 
     // Working memory with 1 s phases: the matrix appears, then the questions.
     const wm = protocol('working-memory', (x) => {
       x.name = 'working-memory-fast';
+      // The familiarisation (untimed, first) is audited on its own; here the timed trials.
+      x.blocks = x.blocks.filter((b) => b.task !== 'familiarisation');
       for (const b of x.blocks) Object.assign(b, { texture_s: 1, matrix_s: 1 });
       return x;
     });

@@ -15,7 +15,7 @@
 //                    WebDriver BiDi)
 
 import { spawn, spawnSync } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync, existsSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, existsSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -68,6 +68,16 @@ for (const sig of ['SIGINT', 'SIGTERM'])
  * e.g. to restart a server on the same one); resolves {url, stop, log} once
  * it printed its address.
  */
+/**
+ * A shipped protocol without its practice blocks (texel-length's ten untimed
+ * practice trials), so the first question is a timed test trial.
+ */
+export function withoutPractice(name) {
+  const p = JSON.parse(readFileSync(join(paths.protocols, `${name}.json`), 'utf8'));
+  p.blocks = p.blocks.filter((b) => !b.practice);
+  return p;
+}
+
 export async function startStudio({ hardTimeoutMs = 600_000, db = null, port = 0 } = {}) {
   for (const [what, p] of [['TEXEL_BIN', paths.bin], ['TEXEL_WEB', join(paths.web, 'index.html')]])
     if (!existsSync(p)) throw new Error(`${what}: ${p} does not exist (build it first; see web/tests/e2e/studio.mjs)`);
