@@ -13,7 +13,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths, startStudio, launchFirefox, askStudio } from './studio.mjs';
+import { withStudio, screenshot, paths, startStudio, launchFirefox, askStudio, startSession } from './studio.mjs';
 
 const axeSource = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
 
@@ -52,11 +52,7 @@ function protocol(name, edit = (p) => p) {
   return edit(JSON.parse(readFileSync(join(paths.protocols, `${name}.json`), 'utf8')));
 }
 
-/** Suspends whatever runs and starts `proto` (object or shipped name) for `participant`; returns the start reply. */
-async function start(page, proto, participant, extra = {}) {
-  const replies = await askStudio(page, [{ type: 'experiment.stop' }, { type: 'experiment.start', protocol: proto, participant, ...extra }]);
-  return replies[1];
-}
+const start = startSession;
 
 test('axe-core: no critical or serious finding on any page', { timeout: 600_000 }, async (t) => {
   await withStudio(async ({ studio, context, page }) => {

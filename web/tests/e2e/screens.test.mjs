@@ -10,31 +10,13 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths, withoutPractice } from './studio.mjs';
+import { withStudio, screenshot, paths, withoutPractice, startSession } from './studio.mjs';
 
 function protocol(name, edit = (p) => p) {
   return edit(JSON.parse(readFileSync(join(paths.protocols, `${name}.json`), 'utf8')));
 }
 
-/** Starts `proto` (object or shipped name) for `participant` from the page's own client. */
-async function start(page, proto, participant, extra = {}) {
-  return page.evaluate(
-    async ([proto, participant, extra]) => {
-      const ws = new WebSocket(`ws://${location.host}/ws`);
-      await new Promise((r) => (ws.onopen = r));
-      const call = (msg) =>
-        new Promise((res) => {
-          ws.onmessage = (e) => res(JSON.parse(e.data));
-          ws.send(JSON.stringify({ id: 1, ...msg }));
-        });
-      await call({ type: 'experiment.stop' });
-      const r = await call({ type: 'experiment.start', protocol: proto, participant, ...extra });
-      ws.close();
-      return r;
-    },
-    [proto, participant, extra],
-  );
-}
+const start = startSession;
 
 /** Answers the question on screen by clicking; returns the task answered. */
 async function answer(p) {

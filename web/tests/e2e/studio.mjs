@@ -381,9 +381,13 @@ export function askStudio(page, msgs, { simulated = 0 } = {}) {
     async ([msgs, simulated]) => {
       const ws = new WebSocket(`ws://${location.host}/ws`);
       await new Promise((r) => (ws.onopen = r));
+      // Replies carry the request's id; state pushes (id null) are skipped.
       const call = (msg) =>
         new Promise((res) => {
-          ws.onmessage = (e) => res(JSON.parse(e.data));
+          ws.onmessage = (e) => {
+            const m = JSON.parse(e.data);
+            if (m.id !== null && m.id !== undefined) res(m);
+          };
           ws.send(JSON.stringify({ id: 1, ...msg }));
         });
       const replies = [];
@@ -398,4 +402,10 @@ export function askStudio(page, msgs, { simulated = 0 } = {}) {
     },
     [msgs, simulated],
   );
+}
+
+/** Stops whatever runs and starts `proto` (object or shipped name) for `participant`; returns the start reply. */
+export async function startSession(page, proto, participant, extra = {}) {
+  const replies = await askStudio(page, [{ type: 'experiment.stop' }, { type: 'experiment.start', protocol: proto, participant, ...extra }]);
+  return replies[1];
 }
