@@ -97,6 +97,7 @@ void register_staircase(CLI::App& app) {
     std::string step_type = "lin";
     std::optional<double> min_value, max_value;
     bool no_initial_rule = false;
+    std::string end_value = "next";
     std::string responses;
     bool json = false;
   };
@@ -112,6 +113,8 @@ void register_staircase(CLI::App& app) {
   cmd->add_option("--min", a->min_value, "Lowest value after a move down");
   cmd->add_option("--max", a->max_value, "Highest value after a move up");
   cmd->add_flag("--no-initial-rule", a->no_initial_rule, "No 1-up/1-down rule before the first reversal");
+  cmd->add_option("--end-value", a->end_value,
+                  "The staircase's result: next (computed after the last answer) | last-presented (default next)");
   cmd->add_option("--responses", a->responses, "Answers, comma-separated: 1 correct, 0 wrong")->required();
   cmd->add_flag("--json", a->json, "Print JSON");
   cmd->callback([a] {
@@ -126,6 +129,7 @@ void register_staircase(CLI::App& app) {
     c.min_value = a->min_value;
     c.max_value = a->max_value;
     c.apply_initial_rule = !a->no_initial_rule;
+    c.end_value = experiment::parse_end_value(a->end_value, "--end-value");
     const std::vector<bool> answers = parse_responses(a->responses);
     std::optional<experiment::Staircase> s;
     try {
@@ -144,7 +148,9 @@ void register_staircase(CLI::App& app) {
       j["reversal_intensities"] = s->reversal_intensities();
       j["n_reversals"] = s->n_reversals();
       j["finished"] = s->finished();
-      j["next_value"] = s->convergent_value();
+      j["next_value"] = s->computed_value();
+      j["end_value"] = std::string(experiment::to_string(c.end_value));
+      j["convergent_value"] = s->convergent_value();
       j["current_step"] = s->current_step();
       if (!s->reversal_intensities().empty()) {
         const std::size_t n = s->reversal_intensities().size();
@@ -164,7 +170,8 @@ void register_staircase(CLI::App& app) {
     }
     std::printf("reversals: %zu of %d (trials", rt.size(), s->n_reversals());
     for (std::size_t t : rt) std::printf(" %zu", t);
-    std::printf(")\nfinished: %s\nnext value (convergent value): %.6g\n", s->finished() ? "yes" : "no", s->convergent_value());
+    std::printf(")\nfinished: %s\nnext value: %.6g\nconvergent value (end value %s): %.6g\n", s->finished() ? "yes" : "no",
+                s->computed_value(), std::string(experiment::to_string(c.end_value)).c_str(), s->convergent_value());
   });
 }
 

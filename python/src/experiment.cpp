@@ -167,7 +167,8 @@ std::vector<std::string> choice_names(const std::vector<MatchChoice>& cs) {
 
 StaircaseConfig staircase_config(double start_value, std::vector<double> step_sizes, int n_up, int n_down,
                                  std::optional<int> n_reversals, int n_trials, const std::string& step_type,
-                                 std::optional<double> min_value, std::optional<double> max_value, bool apply_initial_rule) {
+                                 std::optional<double> min_value, std::optional<double> max_value, bool apply_initial_rule,
+                                 const std::string& end_value) {
   StaircaseConfig c;
   c.start_value = start_value;
   c.step_sizes = std::move(step_sizes);
@@ -179,6 +180,7 @@ StaircaseConfig staircase_config(double start_value, std::vector<double> step_si
   c.min_value = min_value;
   c.max_value = max_value;
   c.apply_initial_rule = apply_initial_rule;
+  c.end_value = parse_end_value(end_value, "end_value");
   return c;
 }
 
@@ -186,7 +188,7 @@ StaircaseConfig staircase_config(double start_value, std::vector<double> step_si
   py::arg("start_value"), py::arg("step_sizes"), py::kw_only(),                                                 \
       py::arg("n_up") = 1, py::arg("n_down") = 3, py::arg("n_reversals") = py::none(), py::arg("n_trials") = 0, \
       py::arg("step_type") = "lin", py::arg("min_value") = py::none(), py::arg("max_value") = py::none(),       \
-      py::arg("apply_initial_rule") = true
+      py::arg("apply_initial_rule") = true, py::arg("end_value") = "next"
 
 #define TEXEL_BOX_ARGS                                                                                     \
   py::arg("pitch_min_db") = -20.0, py::arg("pitch_max_db") = 19.7, py::arg("irregularity_min_db") = -30.0, \
@@ -270,21 +272,23 @@ n_reversals        reversals to finish (default and minimum: len(step_sizes))
 n_trials           minimum number of trials [0]
 step_type          'lin' (add), 'log' (×10^step) or 'db' (×10^(step/20)) ['lin']
 min_value, max_value  clamps after moves down / up
-apply_initial_rule 1-up/1-down until the first reversal [True])doc")
+apply_initial_rule 1-up/1-down until the first reversal [True]
+end_value          the result (convergent_value): 'next' (computed after the last answer) or
+                   'last-presented' (the source studies' "final value") ['next'])doc")
       .def(py::init([](double start_value, std::vector<double> step_sizes, int n_up, int n_down, std::optional<int> n_reversals,
                        int n_trials, const std::string& step_type, std::optional<double> min_value,
-                       std::optional<double> max_value, bool apply_initial_rule) {
+                       std::optional<double> max_value, bool apply_initial_rule, const std::string& end_value) {
              return Staircase(staircase_config(start_value, std::move(step_sizes), n_up, n_down, n_reversals, n_trials, step_type,
-                                               min_value, max_value, apply_initial_rule));
+                                               min_value, max_value, apply_initial_rule, end_value));
            }),
            TEXEL_STAIRCASE_ARGS)
       .def_static(
           "replay",
           [](const std::vector<bool>& answers, double start_value, std::vector<double> step_sizes, int n_up, int n_down,
              std::optional<int> n_reversals, int n_trials, const std::string& step_type, std::optional<double> min_value,
-             std::optional<double> max_value, bool apply_initial_rule) {
+             std::optional<double> max_value, bool apply_initial_rule, const std::string& end_value) {
             return Staircase::replay(staircase_config(start_value, std::move(step_sizes), n_up, n_down, n_reversals, n_trials,
-                                                      step_type, min_value, max_value, apply_initial_rule),
+                                                      step_type, min_value, max_value, apply_initial_rule, end_value),
                                      answers);
           },
           py::arg("answers"), TEXEL_STAIRCASE_ARGS,
@@ -304,6 +308,9 @@ apply_initial_rule 1-up/1-down until the first reversal [True])doc")
       .def_property_readonly("last_was_reversal", &Staircase::last_was_reversal)
       .def_property_readonly("current_step", &Staircase::current_step, "Step size in force (units of step_type).")
       .def_property_readonly("convergent_value", &Staircase::convergent_value,
+                             "The staircase's result by end_value: next_value ('next') or the last intensity presented "
+                             "('last-presented').")
+      .def_property_readonly("next_value", &Staircase::computed_value,
                              "The value computed after the last answer (what next() would present).")
       .def_property_readonly("n_reversals", &Staircase::n_reversals, "Effective number of reversals required.")
       .def("mean_last_reversals", &Staircase::mean_last_reversals, py::arg("k"),

@@ -48,7 +48,8 @@ def test_stepped_staircase_equals_cli(cli_json, case):
     assert s.reversal_trials == j["reversal_trials"]
     assert s.reversal_intensities == j["reversal_intensities"]
     assert s.finished == j["finished"]
-    assert s.convergent_value == j["next_value"]
+    assert s.next_value == j["next_value"]
+    assert s.convergent_value == j["convergent_value"] == j["next_value"]  # end_value 'next', the default
     assert s.current_step == j["current_step"]
     if "mean_last_reversals" in j:
         assert s.mean_last_reversals(j["mean_last_reversals_k"]) == j["mean_last_reversals"]
@@ -56,6 +57,19 @@ def test_stepped_staircase_equals_cli(cli_json, case):
                                n_up=case["n_up"], n_down=case["n_down"], step_type=case["step_type"],
                                min_value=case["min_value"], max_value=case["max_value"])
     assert r.state_json() == s.state_json()
+
+
+def test_end_value_last_presented_equals_cli(cli_json):
+    # The source studies' reading: the result is the last value presented, not the next one.
+    case = dict(STAIR_CASES[0], answers=STAIR_CASES[0]["answers"][:7])  # the 7th answer moves the value
+    s = texel.Staircase.replay([bool(a) for a in case["answers"]], case["start"], case["steps"], n_up=1, n_down=3,
+                               min_value=0.0, max_value=1.0, apply_initial_rule=False, end_value="last-presented")
+    j = cli_json("staircase", *_flags(case), "--no-initial-rule", "--end-value", "last-presented")
+    assert j["end_value"] == "last-presented"
+    assert s.convergent_value == j["convergent_value"] == j["intensities"][-1] == s.intensities[-1]
+    assert s.next_value == j["next_value"] != s.convergent_value
+    with pytest.raises(texel.InvalidArgument, match="end_value"):
+        texel.Staircase(0.5, [0.1], end_value="final")
 
 
 def _stored_match_sessions(cli, tmp_path, source_dir, kind):
