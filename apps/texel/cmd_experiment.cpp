@@ -468,9 +468,9 @@ void register_experiment(CLI::App& app) {
     o.level = an->level;
     const auto one_of = [](const std::string& flag, const std::string& v, std::initializer_list<const char*> allowed) {
       std::string list;
-      for (const char* a : allowed) {
-        if (v == a) return;
-        list += (list.empty() ? "" : ", ") + std::string(a);
+      for (const char* name : allowed) {
+        if (v == name) return;
+        list += (list.empty() ? "" : ", ") + std::string(name);
       }
       throw InvalidArgument(flag + " is '" + v + "'; allowed: " + list);
     };

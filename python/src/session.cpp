@@ -77,15 +77,8 @@ class PySession {
 
   py::dict handout() {
     const Handout h = hand_out(active());
-    py::dict d;
-    d["token"] = h.token;
-    d["trial"] = h.trial;
-    d["trial_number"] = h.trial_number;
-    d["attempt"] = h.attempt;
-    d["onset_at"] = h.onset_at;
-    d["elapsed_s"] = h.elapsed_s;
-    d["time_limit_s"] = h.time_limit_s;
-    d["suspended"] = h.suspended;
+    py::dict d = from_json(texel::experiment::to_json(h));
+    d["trial"] = h.trial;  // the 0-based index too, for scripts that key trials by it
     return d;
   }
 

@@ -11,6 +11,8 @@
 #include <random>
 #include <set>
 
+#include <nlohmann/json.hpp>
+
 #include "texel/error.hpp"
 
 namespace texel::experiment {
@@ -147,6 +149,13 @@ void flag_time_limit(TrialRow& row, double limit_s) {
 
 ReloadRule reload_rule(const Protocol& p) {
   return p.on_reload == "restart_trial" ? ReloadRule::restart_trial : ReloadRule::keep_clock;
+}
+
+std::string to_json(const Handout& h) {
+  return nlohmann::ordered_json{{"token", h.token},        {"trial_number", h.trial_number}, {"attempt", h.attempt},
+                                {"onset_at", h.onset_at},  {"elapsed_s", h.elapsed_s},       {"time_limit_s", h.time_limit_s},
+                                {"suspended", h.suspended}}
+      .dump();
 }
 
 std::string_view to_string(Refusal r) {

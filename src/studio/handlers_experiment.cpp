@@ -64,10 +64,7 @@ ojson progress_json(const State& s) {
 // What participant screens may see of a question (the library's participant view).
 ojson participant_question(const ex::Question& q) { return ojson::parse(q.participant_json()); }
 
-ojson handout_json(const ex::Handout& h) {
-  return ojson{{"token", h.token},         {"trial_number", h.trial_number}, {"attempt", h.attempt},    {"onset_at", h.onset_at},
-               {"elapsed_s", h.elapsed_s}, {"time_limit_s", h.time_limit_s}, {"suspended", h.suspended}};
-}
+ojson handout_json(const ex::Handout& h) { return ojson::parse(ex::to_json(h)); }
 
 // The state participant screens show: the question (with its token and
 // clock), suspended, finished or idle. `screen`: for a participant screen

@@ -111,6 +111,9 @@ struct Handout {
   double time_limit_s = 0.0;  ///< 0 = none
   bool suspended = false;
 };
+/// A screen's view of a hand-out (JSON text: token, trial_number, attempt,
+/// onset_at, elapsed_s, time_limit_s, suspended — the studio's `handout`).
+std::string to_json(const Handout& h);
 
 /// Hands the current question out: starts its clock on the first call for a
 /// trial (onset), later calls return the same token and onset. Throws Error
