@@ -228,7 +228,8 @@ void check_token(const Store& store, const ActiveSession* a, std::string_view te
   if (!tok)
     throw AnswerRefused(Refusal::malformed,
                         "This answer does not carry a valid question token; nothing was stored. Reload the page.");
-  if (tok->database != database_identity(store))
+  // The running session's identity was taken when it opened: no path lookup per answer.
+  if (tok->database != (a ? a->database : database_identity(store)))
     throw AnswerRefused(Refusal::other_database,
                         "This answer belongs to a question of another experiment database; nothing was stored.");
   if (!a || a->info.id != tok->session) {

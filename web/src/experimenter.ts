@@ -166,7 +166,7 @@ export function mountExperimenter(root: HTMLElement): void {
   // later from the sessions table. Pause: the session stays open, every
   // participant screen shows "Please wait" and the trial's clock stops until
   // Continue (docs/studio.md, the token rule).
-  async function suspend(): Promise<void> {
+  async function stop(): Promise<void> {
     try {
       const finished = active.dataset.state === 'experiment.finished';
       await client.call('experiment.stop', {}, 30000);
@@ -176,7 +176,7 @@ export function mountExperimenter(root: HTMLElement): void {
     }
     await refresh();
   }
-  const stopBtn = h('button', { type: 'button', 'data-testid': 'stop', onclick: () => void suspend() }, 'Stop');
+  const stopBtn = h('button', { type: 'button', 'data-testid': 'stop', onclick: () => void stop() }, 'Stop');
   async function pauseOrContinue(): Promise<void> {
     const paused = active.dataset.state === 'experiment.suspended';
     try {
@@ -287,7 +287,7 @@ export function mountExperimenter(root: HTMLElement): void {
     const actions = h('div', { class: 'btn-row' });
     if (state === 'suspended')
       actions.append(h('button', { type: 'button', 'aria-label': `Resume ${who}`, onclick: () => void start(s.protocol, s.participant, true, '') }, 'Resume'));
-    if (state === 'running') actions.append(h('button', { type: 'button', 'aria-label': `Stop ${who}`, onclick: () => void suspend() }, 'Stop'));
+    if (state === 'running') actions.append(h('button', { type: 'button', 'aria-label': `Stop ${who}`, onclick: () => void stop() }, 'Stop'));
     actions.append(
       h('button', { type: 'button', 'aria-label': `Show ${who}`, 'data-testid': 'show-session', onclick: () => ((watched = s.id), (shownKey = ''), void refresh()) }, 'Show'),
       h('button', { type: 'button', 'aria-label': `Download ${who} as CSV`, onclick: () => void exportAs('csv', s.id) }, 'CSV'),
