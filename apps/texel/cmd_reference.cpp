@@ -184,7 +184,7 @@ void register_atlas(CLI::App& app) {
       sig.description = "device " + device.name;
       AnalysisOptions opt;
       opt.peaks.max_peaks = 12;
-      const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing.value(), opt);
+      const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing, opt);
       const SpectrumPlot plot = make_spectrum_plot(info.name + ": " + info.description, sig, r, std::nullopt);
       plot_spectrum(plot, stem + "-spectrum.png");
       for (std::size_t i = 0; i < overview_names.size(); ++i)

@@ -28,7 +28,7 @@ using ordered = nlohmann::ordered_json;
 
 double db_of(double cpm) { return 10.0 * std::log10(cpm); }
 
-std::pair<double, double> parse_band(const std::string& text) {
+std::pair<CyclesPerMm, CyclesPerMm> parse_band(const std::string& text) {
   const auto colon = text.find(':');
   auto number = [&](std::string_view t) {
     double v = 0.0;
@@ -42,7 +42,7 @@ std::pair<double, double> parse_band(const std::string& text) {
   const double hi = number(std::string_view(text).substr(colon + 1));
   if (!(lo >= 0.0 && hi > lo && std::isfinite(hi)))
     throw InvalidArgument("--band '" + text + "' needs 0 <= LOW < HIGH (cycles/mm)");
-  return {lo, hi};
+  return {CyclesPerMm(lo), CyclesPerMm(hi)};
 }
 
 struct Args {
@@ -76,7 +76,7 @@ ordered report_json(const Args& a, const Signal& sig, const SpectralReport& r) {
   j["spacing_mm"] = sig.spacing.value();
   j["length_mm"] = static_cast<double>(sig.samples.size()) * sig.spacing.value();
   j["nyquist_cpm"] = 0.5 / sig.spacing.value();
-  j["resolution_cpm"] = r.spectrum.resolution_cpm;
+  j["resolution_cpm"] = r.spectrum.resolution.value();
   j["window"] = std::string(to_string(r.spectrum.window));
   j["nfft"] = r.spectrum.nfft;
   if (v) j["swipe_speed_mm_s"] = v->value();
@@ -99,7 +99,7 @@ ordered report_json(const Args& a, const Signal& sig, const SpectralReport& r) {
   sj["log_centroid_db"] = s.log_centroid.value();
   sj["log_centroid_cpm"] = std::pow(10.0, s.log_centroid.value() / 10.0);
   sj["spread_cpm"] = s.spread.value();
-  sj["log_spread_db"] = s.log_spread_db;
+  sj["log_spread_db"] = s.log_spread.value();
   if (v) {
     sj["centroid_hz"] = temporal(s.centroid, *v).value();
     sj["log_centroid_hz"] = temporal(CyclesPerMm(std::pow(10.0, s.log_centroid.value() / 10.0)), *v).value();
@@ -108,16 +108,17 @@ ordered report_json(const Args& a, const Signal& sig, const SpectralReport& r) {
   j["summary"] = sj;
   j["bands"] = ordered::array();
   for (const auto& b : r.bands) {
-    ordered bj{{"lo_cpm", b.lo_cpm}, {"hi_cpm", b.hi_cpm}};
+    ordered bj{{"lo_cpm", b.lo.value()}, {"hi_cpm", b.hi.value()}};
     if (v) {
-      bj["lo_hz"] = b.lo_cpm * v->value();
-      bj["hi_hz"] = b.hi_cpm * v->value();
+      bj["lo_hz"] = b.lo.value() * v->value();
+      bj["hi_hz"] = b.hi.value() * v->value();
     }
     bj["mean_square"] = b.mean_square;
     bj["fraction"] = b.fraction;
     j["bands"].push_back(bj);
   }
-  j["welch"] = {{"window", "hann"}, {"segment_samples", r.psd.segment}, {"segments", r.psd.segments}, {"bin_cpm", r.psd.bin_cpm}};
+  j["welch"] = {
+      {"window", "hann"}, {"segment_samples", r.psd.segment}, {"segments", r.psd.segments}, {"bin_cpm", r.psd.bin.value()}};
   return j;
 }
 
@@ -125,7 +126,7 @@ void print_report(const Args& a, const Signal& sig, const SpectralReport& r) {
   const std::optional<double> v = a.input.swipe_speed;
   std::cout << a.file << ": " << sig.samples.size() << " samples × " << num(sig.spacing.value()) << " mm ("
             << fixed(static_cast<double>(sig.samples.size()) * sig.spacing.value(), 2) << " mm), " << sig.description << "\n";
-  std::cout << "resolution " << num(r.spectrum.resolution_cpm) << " cpm, Nyquist " << fixed(0.5 / sig.spacing.value(), 2)
+  std::cout << "resolution " << num(r.spectrum.resolution.value()) << " cpm, Nyquist " << fixed(0.5 / sig.spacing.value(), 2)
             << " cpm, window " << to_string(r.spectrum.window) << "\n";
   std::cout << "peaks (within " << num(a.threshold_db) << " dB of the highest):\n";
   std::cout << "  frequency_cpm      dB re 1 cpm   amplitude   level_dB" << (v ? "   frequency_Hz" : "") << "\n";
@@ -140,11 +141,12 @@ void print_report(const Args& a, const Signal& sig, const SpectralReport& r) {
             << (v ? " (" + fixed(s.centroid.value() * *v, 2) + " Hz)" : "") << ", log-frequency centroid "
             << fixed(s.log_centroid.value(), 2) << " dB re 1 cpm (" << fixed(std::pow(10.0, s.log_centroid.value() / 10.0), 4)
             << " cpm)\n";
-  std::cout << "spectral spread " << fixed(s.spread.value(), 4) << " cpm, log spread " << fixed(s.log_spread_db, 2) << " dB\n";
+  std::cout << "spectral spread " << fixed(s.spread.value(), 4) << " cpm, log spread " << fixed(s.log_spread.value(), 2)
+            << " dB\n";
   std::cout << "band energy (mean-square amplitude, share):\n";
   for (const auto& b : r.bands)
-    std::cout << "  " << std::setw(8) << num(b.lo_cpm) << " … " << std::setw(8) << fixed(b.hi_cpm, 4) << " cpm  " << std::setw(12)
-              << num(b.mean_square) << "  " << fixed(100.0 * b.fraction, 2) << " %\n";
+    std::cout << "  " << std::setw(8) << num(b.lo.value()) << " … " << std::setw(8) << fixed(b.hi.value(), 4) << " cpm  "
+              << std::setw(12) << num(b.mean_square) << "  " << fixed(100.0 * b.fraction, 2) << " %\n";
 }
 
 }  // namespace
@@ -182,7 +184,7 @@ std::vector<mat::Variable> spectrum_variables(const std::string& source, const S
       .add("samples", Matrix::scalar(static_cast<double>(sig.samples.size())))
       .add("window", mat::Text{std::string(to_string(r.spectrum.window))})
       .add("nfft", Matrix::scalar(static_cast<double>(r.spectrum.nfft)))
-      .add("bin_cpm", Matrix::scalar(r.spectrum.bin_cpm))
+      .add("bin_cpm", Matrix::scalar(r.spectrum.bin.value()))
       .add("psd_segment", Matrix::scalar(static_cast<double>(r.psd.segment)))
       .add("mean", Matrix::scalar(r.mean))
       .add("rms", Matrix::scalar(r.rms));
@@ -252,7 +254,7 @@ void register_spectrum(CLI::App& app) {
     if (sig.samples.size() < 16)
       throw InvalidArgument("'" + a->file + "' holds " + std::to_string(sig.samples.size()) +
                             " samples; a spectrum needs at least 16");
-    const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing.value(), opt);
+    const SpectralReport r = analyse_spectrum(sig.samples, sig.spacing, opt);
 
     std::vector<PendingFile> files;
     if (a->spectrum_csv)

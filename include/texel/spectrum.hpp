@@ -49,21 +49,21 @@ struct SpectrumOptions {
   bool remove_mean = true;
 };
 
-/// One-sided spectrum on bins k·bin_cpm, k = 0 … nfft/2.
+/// One-sided spectrum on bins k·bin, k = 0 … nfft/2.
 struct Spectrum {
-  double bin_cpm = 0.0;         ///< bin spacing, cycles/mm
-  double resolution_cpm = 0.0;  ///< 1 / signal length: the unpadded bin spacing
-  std::size_t samples = 0;      ///< signal length (samples)
-  std::size_t nfft = 0;         ///< transform length
+  CyclesPerMm bin;          ///< bin spacing
+  CyclesPerMm resolution;   ///< 1 / signal length: the unpadded bin spacing
+  std::size_t samples = 0;  ///< signal length (samples)
+  std::size_t nfft = 0;     ///< transform length
   Window window = Window::blackman_harris;
-  std::vector<double> frequency_cpm;  ///< k·bin_cpm
+  std::vector<double> frequency_cpm;  ///< k·bin, cycles/mm
   std::vector<double> magnitude;      ///< amplitude-calibrated |X_k|
   std::vector<double> power;          ///< mean-square amplitude per bin (sums to the variance)
 };
 
-/// Throws InvalidArgument for fewer than 4 samples, non-finite values or a
-/// bad spacing/option.
-Spectrum magnitude_spectrum(std::span<const double> samples, double spacing_mm, const SpectrumOptions& options = {});
+/// Samples are `spacing` apart. Throws InvalidArgument for fewer than 4
+/// samples, non-finite values or a bad spacing/option.
+Spectrum magnitude_spectrum(std::span<const double> samples, Millimetres spacing, const SpectrumOptions& options = {});
 
 struct WelchOptions {
   Window window = Window::hann;
@@ -75,14 +75,14 @@ struct WelchOptions {
 };
 
 struct Psd {
-  double bin_cpm = 0.0;
+  CyclesPerMm bin;                    ///< bin spacing
   std::size_t segment = 0;            ///< segment length used (samples)
   std::size_t segments = 0;           ///< number averaged
-  std::vector<double> frequency_cpm;  ///< k·bin_cpm, k = 0 … segment/2
+  std::vector<double> frequency_cpm;  ///< k·bin (cycles/mm), k = 0 … segment/2
   std::vector<double> density;        ///< a²/(cycle/mm), one-sided
 };
 
-Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOptions& options = {});
+Psd welch_psd(std::span<const double> samples, Millimetres spacing, const WelchOptions& options = {});
 
 struct Peak {
   CyclesPerMm frequency;   ///< interpolated peak frequency
@@ -104,16 +104,17 @@ std::vector<Peak> find_peaks(const Spectrum& spectrum, const PeakOptions& option
 
 /// Power-weighted summary over the bins in [lo, hi] (DC excluded).
 struct SpectralSummary {
-  CyclesPerMm centroid;        ///< Σ f·P / Σ P
-  Decibels log_centroid;       ///< Σ 10·log10(f)·P / Σ P, dB re 1 cycle/mm
-  CyclesPerMm spread;          ///< sqrt(Σ (f − centroid)²·P / Σ P)
-  double log_spread_db = 0.0;  ///< the same in dB of log-frequency
-  double total_power = 0.0;    ///< Σ P: mean-square amplitude in the band (a²)
+  CyclesPerMm centroid;      ///< Σ f·P / Σ P
+  Decibels log_centroid;     ///< Σ 10·log10(f)·P / Σ P, dB re 1 cycle/mm
+  CyclesPerMm spread;        ///< sqrt(Σ (f − centroid)²·P / Σ P)
+  Decibels log_spread;       ///< the same in dB of log-frequency
+  double total_power = 0.0;  ///< Σ P: mean-square amplitude in the band (a²)
 };
-SpectralSummary summarize(const Spectrum& spectrum, double lo_cpm = 0.0, double hi_cpm = std::numeric_limits<double>::infinity());
+SpectralSummary summarize(const Spectrum& spectrum, CyclesPerMm lo = CyclesPerMm(0.0),
+                          CyclesPerMm hi = CyclesPerMm(std::numeric_limits<double>::infinity()));
 
-/// Mean-square amplitude (a²) in [lo, hi) cycles/mm.
-double band_energy(const Spectrum& spectrum, double lo_cpm, double hi_cpm);
+/// Mean-square amplitude (a²) in [lo, hi).
+double band_energy(const Spectrum& spectrum, CyclesPerMm lo, CyclesPerMm hi);
 
 /// Temporal frequencies (Hz) felt at swipe speed v for spatial frequencies (cpm).
 std::vector<double> temporal_frequencies(std::span<const double> frequency_cpm, MmPerSecond speed);
@@ -123,13 +124,13 @@ std::vector<double> to_db_axis(std::span<const double> frequency_cpm);
 
 /// Least-squares slope of 10·log10(y) against log10(f) over bins in [lo, hi]
 /// (dB per decade); pink noise gives −10, blue +10.
-double spectral_slope_db_per_decade(std::span<const double> frequency_cpm, std::span<const double> y, double lo_cpm,
-                                    double hi_cpm);
+double spectral_slope_db_per_decade(std::span<const double> frequency_cpm, std::span<const double> y, CyclesPerMm lo,
+                                    CyclesPerMm hi);
 
 /// Mean-square amplitude in one band and its share of the whole.
 struct BandEnergy {
-  double lo_cpm = 0.0;
-  double hi_cpm = 0.0;
+  CyclesPerMm lo;
+  CyclesPerMm hi;
   double mean_square = 0.0;  ///< a²
   double fraction = 0.0;     ///< of the total (DC excluded), 0 … 1
 };
@@ -140,7 +141,7 @@ struct AnalysisOptions {
   WelchOptions welch;
   PeakOptions peaks;
   /// Bands for band energy; empty = decades 0.01, 0.1, 1, 10, 100 … cpm up to Nyquist.
-  std::vector<std::pair<double, double>> bands;
+  std::vector<std::pair<CyclesPerMm, CyclesPerMm>> bands;
 };
 
 struct SpectralReport {
@@ -155,6 +156,6 @@ struct SpectralReport {
 
 /// Magnitude spectrum, Welch PSD, peaks, summary and band energies of one
 /// signal. Throws InvalidArgument for bad input or options.
-SpectralReport analyse_spectrum(std::span<const double> samples, double spacing_mm, const AnalysisOptions& options = {});
+SpectralReport analyse_spectrum(std::span<const double> samples, Millimetres spacing, const AnalysisOptions& options = {});
 
 }  // namespace texel

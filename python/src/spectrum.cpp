@@ -21,8 +21,10 @@ SpectrumOptions spectrum_options(const std::string& window, int zero_pad, bool r
 void register_spectrum(py::module_& m) {
   // ---------------------------------------------------------------- spectrum
   py::class_<Spectrum>(m, "Spectrum", "One-sided magnitude spectrum on bins k·bin_cpm.")
-      .def_readonly("bin_cpm", &Spectrum::bin_cpm, "Bin spacing (cycles/mm).")
-      .def_readonly("resolution_cpm", &Spectrum::resolution_cpm, "1 / signal length (cycles/mm).")
+      .def_property_readonly(
+          "bin_cpm", [](const Spectrum& s) { return s.bin.value(); }, "Bin spacing (cycles/mm).")
+      .def_property_readonly(
+          "resolution_cpm", [](const Spectrum& s) { return s.resolution.value(); }, "1 / signal length (cycles/mm).")
       .def_readonly("samples", &Spectrum::samples)
       .def_readonly("nfft", &Spectrum::nfft)
       .def_property_readonly(
@@ -40,7 +42,7 @@ void register_spectrum(py::module_& m) {
         const auto x = as_doubles(samples, "samples");
         const auto o = spectrum_options(window, zero_pad, remove_mean);
         py::gil_scoped_release release;
-        return magnitude_spectrum(x, spacing_mm, o);
+        return magnitude_spectrum(x, Millimetres(spacing_mm), o);
       },
       py::arg("samples"), py::arg("spacing_mm"), py::kw_only(), py::arg("window") = "blackman-harris", py::arg("zero_pad") = 4,
       py::arg("remove_mean") = true,
@@ -53,12 +55,12 @@ void register_spectrum(py::module_& m) {
         SpectralReport r;
         {
           py::gil_scoped_release release;
-          r = analyse_spectrum(x, spacing_mm);
+          r = analyse_spectrum(x, Millimetres(spacing_mm));
         }
         py::dict d;
         d["spectrum"] = py::cast(std::move(r.spectrum));
         py::dict psd;
-        psd["bin_cpm"] = r.psd.bin_cpm;
+        psd["bin_cpm"] = r.psd.bin.value();
         psd["segment"] = r.psd.segment;
         psd["segments"] = r.psd.segments;
         psd["frequency_cpm"] = to_numpy(std::move(r.psd.frequency_cpm));
@@ -77,14 +79,14 @@ void register_spectrum(py::module_& m) {
         s["centroid_cpm"] = r.summary.centroid.value();
         s["log_centroid_db"] = r.summary.log_centroid.value();
         s["spread_cpm"] = r.summary.spread.value();
-        s["log_spread_db"] = r.summary.log_spread_db;
+        s["log_spread_db"] = r.summary.log_spread.value();
         s["total_power"] = r.summary.total_power;
         d["summary"] = s;
         py::list bands;
         for (const BandEnergy& b : r.bands) {
           py::dict bd;
-          bd["lo_cpm"] = b.lo_cpm;
-          bd["hi_cpm"] = b.hi_cpm;
+          bd["lo_cpm"] = b.lo.value();
+          bd["hi_cpm"] = b.hi.value();
           bd["mean_square"] = b.mean_square;
           bd["fraction"] = b.fraction;
           bands.append(bd);

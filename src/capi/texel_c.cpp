@@ -626,7 +626,7 @@ texel_status texel_spectrum_analyse(const double* amplitudes, std::size_t count,
     a.welch.segment = o.welch_segment;
     a.welch.overlap = o.welch_overlap;
     auto s = std::make_unique<texel_spectrum>();
-    s->report = texel::analyse_spectrum(std::span<const double>(amplitudes, count), spacing_mm, a);
+    s->report = texel::analyse_spectrum(std::span<const double>(amplitudes, count), texel::Millimetres(spacing_mm), a);
     s->samples = count;
     s->spacing_mm = spacing_mm;
     return s;
@@ -641,17 +641,17 @@ texel_status texel_spectrum_get_summary(const texel_spectrum* spectrum, texel_sp
     m.samples = s.samples;
     m.spacing_mm = s.spacing_mm;
     m.nfft = r.spectrum.nfft;
-    m.bin_cpm = r.spectrum.bin_cpm;
-    m.resolution_cpm = r.spectrum.resolution_cpm;
+    m.bin_cpm = r.spectrum.bin.value();
+    m.resolution_cpm = r.spectrum.resolution.value();
     m.mean_amplitude = r.mean;
     m.rms_amplitude = r.rms;
     m.centroid_cpm = r.summary.centroid.value();
     m.log_centroid_db = r.summary.log_centroid.value();
     m.spread_cpm = r.summary.spread.value();
-    m.log_spread_db = r.summary.log_spread_db;
+    m.log_spread_db = r.summary.log_spread.value();
     m.welch_segment = r.psd.segment;
     m.welch_segments = r.psd.segments;
-    m.psd_bin_cpm = r.psd.bin_cpm;
+    m.psd_bin_cpm = r.psd.bin.value();
     need(out, "out") = m;
   });
 }
@@ -677,10 +677,10 @@ texel_status texel_spectrum_get_series(const texel_spectrum* spectrum, texel_spe
         for (const auto& p : r.peaks) picked.push_back(p.level.value());
         break;
       case TEXEL_SERIES_BAND_LO_CPM:
-        for (const auto& b : r.bands) picked.push_back(b.lo_cpm);
+        for (const auto& b : r.bands) picked.push_back(b.lo.value());
         break;
       case TEXEL_SERIES_BAND_HI_CPM:
-        for (const auto& b : r.bands) picked.push_back(b.hi_cpm);
+        for (const auto& b : r.bands) picked.push_back(b.hi.value());
         break;
       case TEXEL_SERIES_BAND_MEAN_SQUARE:
         for (const auto& b : r.bands) picked.push_back(b.mean_square);

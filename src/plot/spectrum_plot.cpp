@@ -37,7 +37,7 @@ Panel spectrum_panel(const SpectrumPlot& p, bool temporal) {
   double top = -std::numeric_limits<double>::infinity();
   // Bins below the resolution 1/length are leakage of the DC removal.
   for (std::size_t i = 1; i < s.magnitude.size(); ++i) {
-    if (s.frequency_cpm[i] < s.resolution_cpm) continue;
+    if (s.frequency_cpm[i] < s.resolution.value()) continue;
     const double db = 20.0 * std::log10(std::max(s.magnitude[i], 1e-15));
     line.x.push_back(s.frequency_cpm[i] * k);
     line.y.push_back(db);

@@ -81,7 +81,8 @@ std::vector<double> window_coefficients(Window w, std::size_t n) {
   return c;
 }
 
-Spectrum magnitude_spectrum(std::span<const double> samples, double spacing_mm, const SpectrumOptions& options) {
+Spectrum magnitude_spectrum(std::span<const double> samples, Millimetres spacing, const SpectrumOptions& options) {
+  const double spacing_mm = spacing.value();
   check_signal(samples, spacing_mm, 4);
   if (options.zero_pad < 1 || options.zero_pad > 16)
     throw InvalidArgument("zero padding is " + std::to_string(options.zero_pad) + "; allowed: 1 … 16");
@@ -109,8 +110,8 @@ Spectrum magnitude_spectrum(std::span<const double> samples, double spacing_mm, 
   s.samples = n;
   s.nfft = nfft;
   s.window = options.window;
-  s.bin_cpm = 1.0 / (static_cast<double>(nfft) * spacing_mm);
-  s.resolution_cpm = 1.0 / (static_cast<double>(n) * spacing_mm);
+  s.bin = CyclesPerMm(1.0 / (static_cast<double>(nfft) * spacing_mm));
+  s.resolution = CyclesPerMm(1.0 / (static_cast<double>(n) * spacing_mm));
   const std::size_t bins = nfft / 2 + 1;
   s.frequency_cpm.resize(bins);
   s.magnitude.resize(bins);
@@ -119,14 +120,15 @@ Spectrum magnitude_spectrum(std::span<const double> samples, double spacing_mm, 
   for (std::size_t k = 0; k < bins; ++k) {
     const bool edge = k == 0 || k == nfft / 2;
     const double m2 = std::norm(X[k]);
-    s.frequency_cpm[k] = static_cast<double>(k) * s.bin_cpm;
+    s.frequency_cpm[k] = static_cast<double>(k) * s.bin.value();
     s.magnitude[k] = (edge ? 1.0 : 2.0) * std::sqrt(m2) / sum_w;
     s.power[k] = (edge ? 1.0 : 2.0) * m2 * pnorm;
   }
   return s;
 }
 
-Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOptions& options) {
+Psd welch_psd(std::span<const double> samples, Millimetres spacing, const WelchOptions& options) {
+  const double spacing_mm = spacing.value();
   check_signal(samples, spacing_mm, 4);
   if (!(options.overlap >= 0.0 && options.overlap <= 0.95))
     throw InvalidArgument("Welch overlap is " + num(options.overlap) + "; allowed: 0 … 0.95");
@@ -151,7 +153,7 @@ Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOpt
   std::vector<std::complex<double>> X(seg / 2 + 1);
   Psd p;
   p.segment = seg;
-  p.bin_cpm = 1.0 / (static_cast<double>(seg) * spacing_mm);
+  p.bin = CyclesPerMm(1.0 / (static_cast<double>(seg) * spacing_mm));
   p.frequency_cpm.resize(seg / 2 + 1);
   p.density.assign(seg / 2 + 1, 0.0);
   for (std::size_t start = 0; start + seg <= n; start += step) {
@@ -166,7 +168,7 @@ Psd welch_psd(std::span<const double> samples, double spacing_mm, const WelchOpt
   for (std::size_t k = 0; k < p.density.size(); ++k) {
     const bool edge = k == 0 || k == seg / 2;
     p.density[k] *= (edge ? 1.0 : 2.0) * norm;
-    p.frequency_cpm[k] = static_cast<double>(k) * p.bin_cpm;
+    p.frequency_cpm[k] = static_cast<double>(k) * p.bin.value();
   }
   return p;
 }
@@ -175,7 +177,7 @@ std::vector<Peak> find_peaks(const Spectrum& s, const PeakOptions& options) {
   const std::size_t bins = s.magnitude.size();
   std::vector<Peak> peaks;
   if (bins < 3) return peaks;
-  const double pad = s.resolution_cpm / s.bin_cpm;  // padded bins per unpadded bin
+  const double pad = s.resolution / s.bin;  // padded bins per unpadded bin
   const auto half = static_cast<std::size_t>(std::ceil(main_lobe_half_width(s.window) * pad));
   auto db = [&](std::size_t k) { return 20.0 * std::log10(std::max(s.magnitude[k], 1e-300)); };
   struct Candidate {
@@ -207,7 +209,7 @@ std::vector<Peak> find_peaks(const Spectrum& s, const PeakOptions& options) {
         level = std::min(b - 0.25 * (a - c) * p, b + 3.92);
       }
     }
-    cands.push_back({(static_cast<double>(k) + p) * s.bin_cpm, std::pow(10.0, level / 20.0)});
+    cands.push_back({(static_cast<double>(k) + p) * s.bin.value(), std::pow(10.0, level / 20.0)});
   }
   if (cands.empty()) return peaks;
   const double top = std::max_element(cands.begin(), cands.end(), [](auto& x, auto& y) { return x.amp < y.amp; })->amp;
@@ -221,7 +223,8 @@ std::vector<Peak> find_peaks(const Spectrum& s, const PeakOptions& options) {
   return peaks;
 }
 
-SpectralSummary summarize(const Spectrum& s, double lo, double hi) {
+SpectralSummary summarize(const Spectrum& s, CyclesPerMm lo_cpm, CyclesPerMm hi_cpm) {
+  const double lo = lo_cpm.value(), hi = hi_cpm.value();
   double p_sum = 0.0, f_sum = 0.0, l_sum = 0.0;
   for (std::size_t k = 1; k < s.power.size(); ++k) {
     const double f = s.frequency_cpm[k];
@@ -246,11 +249,12 @@ SpectralSummary summarize(const Spectrum& s, double lo, double hi) {
   r.centroid = CyclesPerMm(fc);
   r.log_centroid = Decibels(lc);
   r.spread = CyclesPerMm(std::sqrt(v / p_sum));
-  r.log_spread_db = std::sqrt(lv / p_sum);
+  r.log_spread = Decibels(std::sqrt(lv / p_sum));
   return r;
 }
 
-double band_energy(const Spectrum& s, double lo, double hi) {
+double band_energy(const Spectrum& s, CyclesPerMm lo_cpm, CyclesPerMm hi_cpm) {
+  const double lo = lo_cpm.value(), hi = hi_cpm.value();
   double e = 0.0;
   for (std::size_t k = 1; k < s.power.size(); ++k)
     if (s.frequency_cpm[k] >= lo && s.frequency_cpm[k] < hi) e += s.power[k];
@@ -269,7 +273,9 @@ std::vector<double> to_db_axis(std::span<const double> f) {
   return d;
 }
 
-double spectral_slope_db_per_decade(std::span<const double> f, std::span<const double> y, double lo, double hi) {
+double spectral_slope_db_per_decade(std::span<const double> f, std::span<const double> y, CyclesPerMm lo_cpm,
+                                    CyclesPerMm hi_cpm) {
+  const double lo = lo_cpm.value(), hi = hi_cpm.value();
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < f.size() && i < y.size(); ++i) {
@@ -287,10 +293,11 @@ double spectral_slope_db_per_decade(std::span<const double> f, std::span<const d
   return (nd * sxy - sx * sy) / (nd * sxx - sx * sx);
 }
 
-SpectralReport analyse_spectrum(std::span<const double> samples, double spacing_mm, const AnalysisOptions& options) {
+SpectralReport analyse_spectrum(std::span<const double> samples, Millimetres spacing, const AnalysisOptions& options) {
+  const double spacing_mm = spacing.value();
   SpectralReport r;
-  r.spectrum = magnitude_spectrum(samples, spacing_mm, options.spectrum);
-  r.psd = welch_psd(samples, spacing_mm, options.welch);
+  r.spectrum = magnitude_spectrum(samples, spacing, options.spectrum);
+  r.psd = welch_psd(samples, spacing, options.welch);
   r.peaks = find_peaks(r.spectrum, options.peaks);
   r.summary = summarize(r.spectrum);
   r.mean = mean_of(samples);
@@ -298,12 +305,13 @@ SpectralReport analyse_spectrum(std::span<const double> samples, double spacing_
   for (double x : samples) v += (x - r.mean) * (x - r.mean);
   r.rms = std::sqrt(v / static_cast<double>(samples.size()));
   const double nyquist = 0.5 / spacing_mm;
-  std::vector<std::pair<double, double>> bands = options.bands;
+  std::vector<std::pair<CyclesPerMm, CyclesPerMm>> bands = options.bands;
   if (bands.empty())
-    for (double lo = 0.01; lo < nyquist; lo *= 10.0) bands.emplace_back(lo, std::min(lo * 10.0, nyquist * (1.0 + 1e-12)));
+    for (double lo = 0.01; lo < nyquist; lo *= 10.0)
+      bands.emplace_back(CyclesPerMm(lo), CyclesPerMm(std::min(lo * 10.0, nyquist * (1.0 + 1e-12))));
   for (const auto& [lo, hi] : bands) {
-    if (!(lo >= 0.0 && hi > lo && std::isfinite(hi)))
-      throw InvalidArgument("band " + num(lo) + " … " + num(hi) + " cpm: it needs 0 <= low < high, both finite");
+    if (!(lo.value() >= 0.0 && hi > lo && std::isfinite(hi.value())))
+      throw InvalidArgument("band " + num(lo.value()) + " … " + num(hi.value()) + " cpm: it needs 0 <= low < high, both finite");
     const double e = band_energy(r.spectrum, lo, hi);
     r.bands.push_back({lo, hi, e, r.summary.total_power > 0.0 ? e / r.summary.total_power : 0.0});
   }

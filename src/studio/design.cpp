@@ -119,10 +119,10 @@ std::string stem(std::string_view description, std::string_view fallback) {
 
 }  // namespace
 
-SpectrumView spectrum_view(std::span<const double> samples, double spacing_mm, std::size_t points) {
+SpectrumView spectrum_view(std::span<const double> samples, Millimetres spacing, std::size_t points) {
   if (points < 16 || points > 2048)
     throw InvalidArgument("spectrum points is " + std::to_string(points) + "; allowed: 16 … 2048");
-  const Spectrum s = magnitude_spectrum(samples, spacing_mm);
+  const Spectrum s = magnitude_spectrum(samples, spacing);
   SpectrumView v;
   if (s.frequency_cpm.size() < 2) return v;
   // Log-spaced bands from the first non-DC bin to Nyquist; each point is the
@@ -166,13 +166,13 @@ DesignView design_view(const Document& doc, const DesignOptions& options) {
     const Region& sr = surface_region(surface, spec);
     v.regions.push_back({spec.name, spec.reference ? "reference" : "texel", sr.start, sr.length});
   }
-  if (samples.size() >= 4) v.spectrum = spectrum_view(samples, v.grid.spacing.value(), options.spectrum_points);
+  if (samples.size() >= 4) v.spectrum = spectrum_view(samples, v.grid.spacing, options.spectrum_points);
 
   if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
     v.texels = t->texel_count();
     v.histogram = histogram_of(*t, options.histogram_bins);
-    v.central_pitch_cpm = to_cpm(t->spec().central_pitch).value();
-    v.irregularity_cpm = to_cpm(t->spec().irregularity).value();
+    v.central_pitch = to_cpm(t->spec().central_pitch);
+    v.irregularity = to_cpm(t->spec().irregularity);
     try {
       v.encoded = region_bitstream(*t, r);
     } catch (const InvalidArgument& e) {
@@ -215,8 +215,8 @@ MatchView match_region(const Document& doc, const MatchOptions& options) {
   m.document.version = required_version(m.document);
   const Surface matched = prepare_surface(m.document);
   const std::vector<double> rendered = render_region(matched, surface_region(matched, dst));
-  m.target = spectrum_view(target, signal.spacing.value(), options.spectrum_points);
-  if (rendered.size() >= 4) m.match = spectrum_view(rendered, signal.spacing.value(), options.spectrum_points);
+  m.target = spectrum_view(target, signal.spacing, options.spectrum_points);
+  if (rendered.size() >= 4) m.match = spectrum_view(rendered, signal.spacing, options.spectrum_points);
   return m;
 }
 

@@ -172,8 +172,8 @@ void on_design(State& s, Client& c, const Job& job) {
     r["histogram"] = {{"edges_cpm", v.histogram.edges_cpm}, {"counts", v.histogram.counts}, {"pdf", v.histogram.expected}};
     r["encoded"] = v.encoded_error.empty() ? ojson{{"bytes", v.encoded.size()}, {"hex", hex(v.encoded)}}
                                            : ojson{{"bytes", nullptr}, {"error", v.encoded_error}};
-    r["central_pitch_cpm"] = v.central_pitch_cpm;
-    r["irregularity_cpm"] = v.irregularity_cpm;
+    r["central_pitch_cpm"] = v.central_pitch.value();
+    r["irregularity_cpm"] = v.irregularity.value();
   } else {
     r["histogram"] = nullptr;
     r["encoded"] = nullptr;

@@ -929,7 +929,7 @@ TEST(CApi, SpectrumEqualsTheLibrarys) {
   texel::AnalysisOptions a;
   a.spectrum.window = texel::Window::hann;
   a.peaks.threshold = texel::DecibelsLevel{-30.0};
-  const texel::SpectralReport r = texel::analyse_spectrum(map, spacing, a);
+  const texel::SpectralReport r = texel::analyse_spectrum(map, texel::Millimetres(spacing), a);
   texel_spectrum_summary m{};
   ASSERT_EQ(texel_spectrum_get_summary(s.get(), &m), TEXEL_OK);
   EXPECT_EQ(m.samples, map.size());
@@ -948,7 +948,8 @@ TEST(CApi, SpectrumEqualsTheLibrarys) {
   // Defaults (NULL options) are texel spectrum's.
   ASSERT_EQ(texel_spectrum_analyse(map.data(), map.size(), spacing, nullptr, &raw), TEXEL_OK);
   const Spec d(raw);
-  EXPECT_EQ(series_of(d.get(), TEXEL_SERIES_MAGNITUDE), texel::analyse_spectrum(map, spacing).spectrum.magnitude);
+  EXPECT_EQ(series_of(d.get(), TEXEL_SERIES_MAGNITUDE),
+            texel::analyse_spectrum(map, texel::Millimetres(spacing)).spectrum.magnitude);
 }
 
 TEST(CApi, SpectrumErrors) {

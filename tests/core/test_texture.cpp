@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/expect.hpp"
 #include "../support/grids.hpp"
 #include "texel/device.hpp"
 #include "texel/error.hpp"
@@ -324,14 +325,7 @@ TEST(Texture, OutsideTheTexturedSpanIsAtRest) {
 }
 
 TEST(Texture, RejectsBadSpecsNamingTheField) {
-  auto message = [](const TexelSpec& s) {
-    try {
-      make(s);
-    } catch (const InvalidArgument& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no InvalidArgument)");
-  };
+  auto message = [](const TexelSpec& s) { return texel::test_support::message_of<InvalidArgument>([&] { make(s); }); };
   TexelSpec s;
   s.texel_length = Millimetres(-0.25);
   EXPECT_NE(message(s).find("texel_length_mm"), std::string::npos);

@@ -5,12 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <condition_variable>
-#include <mutex>
 
 #include <nlohmann/json.hpp>
 
 #include "../support/cli_run.hpp"
+#include "../support/service_client.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/io.hpp"
@@ -43,20 +42,7 @@ TEST(ResultJson, SessionIsTheSameFromCliStudioAndLibrary) {
   texel::studio::ServiceOptions o;
   o.db_path = db;
   texel::studio::Service service(o);
-  std::mutex m;
-  std::condition_variable cv;
-  json reply;
-  const auto client = service.connect([&](std::string text) {
-    std::lock_guard lock(m);
-    reply = json::parse(text);
-    cv.notify_all();
-  });
-  service.handle(client, R"({"type": "experiment.list", "id": 1})");
-  {
-    std::unique_lock lock(m);
-    ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(60), [&] { return reply.contains("id"); }));
-  }
-  service.disconnect(client);
+  const json reply = texel::test_support::Client(service).ask({{"type", "experiment.list"}}, std::chrono::seconds(60));
   ASSERT_EQ(reply["type"], "experiment.list") << reply.dump();
   ASSERT_EQ(reply["sessions"].size(), 1u);
   EXPECT_EQ(reply["sessions"][0], cli);

@@ -1,18 +1,22 @@
 // A task kind added the way docs/experiments.md "Adding a task kind" says —
-// one type (below) and one registration — runs end to end: validated in a
-// protocol, run by simulated participants and stored (the library path
-// `texel experiment run --simulate` takes), exported as CSV, and run through
-// the studio's experiment messages (texel::studio::Service). The built-in
-// kinds' declared export columns all exist.
+// one type and one registration (press_side_task.cpp) — runs end to end:
+// validated in a protocol, run by simulated participants and stored,
+// exported as CSV, and run through the studio's experiment messages
+// (texel::studio::Service); then through the real CLI, `texel_with_test_kind`
+// (the shipped CLI's objects plus press_side_task.cpp): `experiment run
+// --simulate`, `experiment export` and `experiment list`, while the shipped
+// `texel` does not know the kind. The built-in kinds' declared export columns
+// all exist.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
-#include <condition_variable>
-#include <mutex>
+#include <filesystem>
 
 #include <nlohmann/json.hpp>
 
+#include "../support/cli_run.hpp"
+#include "../support/expect.hpp"
+#include "../support/service_client.hpp"
 #include "../support/temp_dir.hpp"
 #include "task.hpp"
 #include "texel/error.hpp"
@@ -20,84 +24,22 @@
 #include "texel/experiment/runner.hpp"
 #include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
+#include "texel/io.hpp"
 #include "texel/studio/service.hpp"
 
 namespace ex = texel::experiment;
 using json = nlohmann::json;
+using namespace std::chrono_literals;
 
 namespace {
 
-// ------------------------------------------------- the test-only task kind
-// "press-side": a texture on the left or the right half; which side is it?
-// Its one setting ("presses", the trial count) lives in its own settings type.
-
-struct PressSettings : ex::TaskSettings {
-  int presses = 0;
-};
-
-int presses(const ex::Block& b) { return static_cast<const PressSettings&>(*b.settings).presses; }
-
-class PressBlock : public ex::TaskBlock {
- public:
-  void prepare(const ex::SessionCore& s, ex::Question& q, ex::TrialTruth& t) override {
-    const ex::Block& b = s.block();
-    q.block_trials = presses(b);
-    const bool left = s.trial_below(0, 2) == 0;
-    const json texture = ex::texel_texture(ex::texture_of(b.texture), s.seed_draw(1));
-    const json flat = {
-        {"kind", "texel"}, {"seed", 1}, {"texel_length_mm", 5.0}, {"central_pitch_db", 0.0}, {"irregularity_db", -20.0}};
-    q.stimuli.push_back({"Surface", s.halves(left ? texture : flat, left ? flat : texture)});
-    q.choices = {"left", "right"};
-    q.prompt = "Which half is textured?";
-    t.correct_answer = left ? "left" : "right";
-  }
-  std::string answer(ex::SessionCore&, const ex::Question&, const ex::TrialTruth& t, const ex::Response& r,
-                     ex::TrialRow& row) override {
-    row.correct = r.choice == t.correct_answer ? 1.0 : 0.0;
-    return "{}";
-  }
-  bool finished(const ex::SessionCore& s) const override { return s.trial_in_block >= presses(s.block()); }
-};
-
-class PressTask : public ex::TaskType {
- public:
-  std::string_view name() const override { return "press-side"; }
-  std::vector<std::string_view> keys() const override { return {"texture", "presses"}; }
-  void parse(ex::BlockInput& in, ex::Block& b) const override {
-    b.texture = in.texture("texture");
-    auto settings = std::make_shared<PressSettings>();
-    settings->presses = static_cast<int>(in.o.integer("presses", 1, 100));
-    b.settings = std::move(settings);
-  }
-  std::optional<int> planned_trials(const ex::Block& b) const override { return presses(b); }
-  std::unique_ptr<ex::TaskBlock> start(const ex::SessionCore&) const override { return std::make_unique<PressBlock>(); }
-  void simulate(const ex::SimulatedParticipant& who, const ex::Session& session, ex::Response& r) const override {
-    const auto trial = static_cast<std::uint64_t>(session.question().trial);
-    const bool ok = who.behaviour().uniform(trial * 8 + 2) < 0.9;
-    r.choice = ok ? session.truth().correct_answer : who.wrong_choice(session.question(), session.truth().correct_answer);
-  }
-  std::vector<std::string_view> columns() const override { return {"response", "correct_answer", "correct"}; }
-};
-
-// The one registration (a library kind is one row in tasks/table.cpp instead).
-const bool registered = [] {
-  ex::register_task(std::make_unique<PressTask>());
-  return true;
-}();
-
-const std::string protocol_text = R"({
-  "format": "texel-protocol", "version": 1, "name": "press-side-test", "study": "working-memory",
-  "device": "tpad", "seed": 7,
-  "blocks": [
-    {"name": "warm-up", "task": "press-side", "practice": true, "presses": 2,
-     "texture": {"kind": "texel", "texel_length_mm": 4, "central_pitch_db": 6, "irregularity_db": -6}},
-    {"name": "main", "task": "press-side", "presses": 5,
-     "texture": {"kind": "texel", "texel_length_mm": 6, "central_pitch_db": 6, "irregularity_db": -6}}
-  ]
-})";
+// The test-only kind "press-side" (press_side_task.cpp, linked into this
+// program) and its protocol.
+const std::string protocol_path = std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/experiment/data/press-side.json";
+const std::string protocol_text = texel::read_file(protocol_path);
 
 TEST(TaskKind, TestOnlyKindIsValidatedLikeABuiltInOne) {
-  ASSERT_TRUE(registered);
+  ASSERT_NE(ex::find_task_type("press-side"), nullptr);
   const auto names = ex::task_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "press-side"), names.end());
   const ex::Protocol p = ex::parse_protocol(protocol_text);
@@ -105,12 +47,7 @@ TEST(TaskKind, TestOnlyKindIsValidatedLikeABuiltInOne) {
   auto message = [](const std::string& from, const std::string& to) {
     std::string text = protocol_text;
     text.replace(text.find(from), from.size(), to);
-    try {
-      (void)ex::parse_protocol(text);
-    } catch (const texel::FormatError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return texel::test_support::message_of<texel::FormatError>([&] { (void)ex::parse_protocol(text); });
   };
   EXPECT_NE(message("\"presses\": 5", "\"presses\": 500").find("blocks[1].presses is 500"), std::string::npos);
   EXPECT_NE(message("\"presses\": 5", "\"presses\": 5, \"staircase\": {}")
@@ -155,46 +92,13 @@ TEST(TaskKind, TestOnlyKindRunsSimulatedStoredAndExported) {
   EXPECT_TRUE(again.finished());
 }
 
-// Replies of a Service client.
-struct Inbox {
-  std::mutex m;
-  std::condition_variable cv;
-  std::vector<json> replies;
-  json wait_for(int id) {
-    std::unique_lock lock(m);
-    json out;
-    const bool found = cv.wait_for(lock, std::chrono::seconds(60), [&] {
-      for (auto it = replies.begin(); it != replies.end(); ++it)
-        if (it->contains("id") && (*it)["id"] == id) {
-          out = *it;
-          replies.erase(it);
-          return true;
-        }
-      return false;
-    });
-    if (!found) ADD_FAILURE() << "no reply to message " << id;
-    return out;
-  }
-};
-
 TEST(TaskKind, TestOnlyKindRunsThroughTheStudio) {
   texel::test_support::TempDir dir("task-kind-studio");
   texel::studio::ServiceOptions o;
   o.db_path = dir.at("s.db");
   texel::studio::Service service(o);
-  Inbox inbox;
-  const auto client = service.connect([&](std::string text) {
-    std::lock_guard lock(inbox.m);
-    inbox.replies.push_back(json::parse(text));
-    inbox.cv.notify_all();
-  });
-  int next = 1;
-  auto ask = [&](json msg) {
-    const int id = next++;
-    msg["id"] = id;
-    service.handle(client, msg.dump());
-    return inbox.wait_for(id);
-  };
+  texel::test_support::Client client(service);
+  auto ask = [&](json msg) { return client.ask(std::move(msg), 60s); };
   const json started = ask(
       {{"type", "experiment.start"}, {"protocol", json::parse(protocol_text)}, {"participant", "P01"}, {"simulate", "default"}});
   ASSERT_EQ(started["type"], "experiment.started") << started.dump();
@@ -212,7 +116,45 @@ TEST(TaskKind, TestOnlyKindRunsThroughTheStudio) {
   const json list = ask({{"type", "experiment.list"}});
   ASSERT_EQ(list["sessions"].size(), 1u);
   EXPECT_EQ(list["sessions"][0]["status"], "finished");
-  service.disconnect(client);
+}
+
+// The real CLI with the kind: a simulated run stores it, the export CSV has
+// the kind's columns filled on every row, the session is listed finished.
+TEST(TaskKind, TestOnlyKindRunsThroughTheCliBinary) {
+  texel::test_support::TempDir dir("task-kind-cli");
+  const std::string db = dir.at("s.db"), csv_path = dir.at("trials.csv");
+  auto cli = [](const std::string& args) { return texel::test_support::run_cli(TEXEL_WITH_TEST_KIND, args); };
+  for (const char* who : {"P01", "P02"}) {
+    const auto run =
+        cli("experiment run " + protocol_path + " --participant " + who + " --db " + db + " --simulate default --quiet");
+    ASSERT_EQ(run.status, 0) << run.out;
+  }
+  const auto exported = cli("experiment export --db " + db + " -o " + csv_path);
+  ASSERT_EQ(exported.status, 0) << exported.out;
+  const std::string csv = texel::read_file(csv_path);
+  const auto rows = ex::parse_trials_csv(csv, "export");
+  ASSERT_EQ(rows.size(), 14u);
+  // The CSV's header names every column the kind declares, and its rows fill them.
+  const std::string header = csv.substr(0, csv.find('\n'));
+  for (std::string_view c : ex::find_task_type("press-side")->columns())
+    EXPECT_NE(("," + header + ",").find("," + std::string(c) + ","), std::string::npos) << c;
+  int correct = 0;
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.task, "press-side");
+    EXPECT_TRUE(r.response == "left" || r.response == "right") << r.response;
+    EXPECT_TRUE(r.correct_answer == "left" || r.correct_answer == "right") << r.correct_answer;
+    correct += r.correct == 1.0;
+  }
+  EXPECT_GT(correct, 7);
+  const auto list = cli("experiment list --db " + db);
+  ASSERT_EQ(list.status, 0) << list.out;
+  EXPECT_NE(list.out.find("press-side-test"), std::string::npos) << list.out;
+  // The shipped CLI does not have the kind: one line, exit 2, no database.
+  const auto shipped = texel::test_support::run_cli(
+      TEXEL_CLI, "experiment run " + protocol_path + " --participant P01 --db " + dir.at("shipped.db") + " --simulate default");
+  EXPECT_EQ(shipped.status, 2) << shipped.out;
+  EXPECT_NE(shipped.out.find("task is 'press-side'; allowed: "), std::string::npos) << shipped.out;
+  EXPECT_FALSE(std::filesystem::exists(dir.at("shipped.db")));
 }
 
 TEST(TaskKind, BuiltInKindsDeclareExistingExportColumns) {

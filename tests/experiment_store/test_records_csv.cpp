@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "../support/expect.hpp"
+
 #include "fixtures.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/records.hpp"
@@ -128,12 +130,7 @@ TEST(TrialCsv, ColumnsInAnyOrderUnknownIgnoredMissingStayMissing) {
 
 TEST(TrialCsv, BadInputNamesLineAndColumn) {
   const auto msg = [](const std::string& text) {
-    try {
-      (void)ex::parse_trials_csv(text, "r.csv");
-    } catch (const texel::FormatError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no FormatError");
+    return texel::test_support::message_of<texel::FormatError>([&] { (void)ex::parse_trials_csv(text, "r.csv"); });
   };
   EXPECT_EQ(msg("participant,rt_ms\nS1,12\nS2,fast\n"), "r.csv: line 3, column rt_ms: 'fast' is not a number");
   EXPECT_EQ(msg("participant,trial\nS1,1.5\n"), "r.csv: line 2, column trial: '1.5' is not a whole number");

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/expect.hpp"
+
 #include "texel/error.hpp"
 #include "texel/experiment/bayes_match.hpp"
 #include "texel/experiment/guided.hpp"
@@ -175,18 +177,13 @@ TEST(Guided, DeterministicFromSeedAndReplayable) {
 
 TEST(Guided, BadConfigNamesTheField) {
   auto message = [](GuidedConfig c) {
-    try {
-      GuidedOptimizer g(c);
-    } catch (const texel::InvalidArgument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return texel::test_support::message_of<texel::InvalidArgument>([&] { GuidedOptimizer g(c); });
   };
   EXPECT_NE(message(GuidedConfig{.iterations = 0}).find("iterations"), std::string::npos);
   EXPECT_NE(message(GuidedConfig{.shrink_rate = 0}).find("shrink_rate"), std::string::npos);
   EXPECT_NE(message(GuidedConfig{.iterations = 6}).find("shrink_rate"), std::string::npos);  // 6 × 0.2 > 1
   EXPECT_NE(message(GuidedConfig{.pitch_min_db = 30}).find("pitch_min_db"), std::string::npos);
-  EXPECT_EQ(message(GuidedConfig{.iterations = 4}), "no error");  // a box that ends at 20 % of the initial size
+  EXPECT_EQ(message(GuidedConfig{.iterations = 4}), "(no exception)");  // a box that ends at 20 % of the initial size
 }
 
 TEST(Guided, ConvergesNearANoiseFreeTarget) {
@@ -315,12 +312,7 @@ TEST(Factory, BuildsBothKindsWithParameters) {
 
 TEST(Factory, BadParametersNameTheKey) {
   auto message = [](const std::string& kind, const nlohmann::json& p) {
-    try {
-      (void)make(kind, p);
-    } catch (const texel::InvalidArgument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return texel::test_support::message_of<texel::InvalidArgument>([&] { (void)make(kind, p); });
   };
   EXPECT_NE(message("simplex", {}).find("kind"), std::string::npos);
   EXPECT_NE(message("guided", {{"itterations", 5}}).find("itterations"), std::string::npos);

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "../support/expect.hpp"
+
 #include "texel/error.hpp"
 #include "texel/experiment/observer.hpp"
 
@@ -57,12 +59,7 @@ TEST(Psychometric, ResponseRateMatchesPAndIsAFunctionOfSeedAndTrial) {
 
 TEST(Psychometric, BadConfigNamesTheField) {
   auto message = [](PsychometricConfig c) {
-    try {
-      PsychometricObserver o(c);
-    } catch (const texel::InvalidArgument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return texel::test_support::message_of<texel::InvalidArgument>([&] { PsychometricObserver o(c); });
   };
   EXPECT_NE(message({.threshold = 0}).find("threshold"), std::string::npos);
   EXPECT_NE(message({.slope = -1}).find("slope"), std::string::npos);

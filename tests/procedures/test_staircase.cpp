@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "../support/expect.hpp"
+
 #include "texel/error.hpp"
 #include "texel/experiment/observer.hpp"
 #include "texel/experiment/staircase.hpp"
@@ -281,12 +283,7 @@ TEST(Staircase, ReversalMeansNeedReversals) {
 
 TEST(Staircase, BadConfigNamesTheField) {
   auto message = [](StaircaseConfig c) {
-    try {
-      Staircase s(c);
-    } catch (const texel::InvalidArgument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return texel::test_support::message_of<texel::InvalidArgument>([&] { Staircase s(c); });
   };
   StaircaseConfig c;
   c.step_sizes = {};

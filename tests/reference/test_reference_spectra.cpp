@@ -28,11 +28,11 @@ TEST(SinusoidReferences, PeaksAtTheirFrequenciesWithEqualHeights) {
       {"2sin", {2.5, 6}}, {"3sin", {2.5, 6, 8.5}}, {"4sin", {2.5, 6, 8.5, 11}}};
   for (const auto& [name, freqs] : cases) {
     const auto a = render_reference(spec(name), tpad);
-    const Spectrum s = magnitude_spectrum(a, tpad.spacing.value());
+    const Spectrum s = magnitude_spectrum(a, tpad.spacing);
     const auto peaks = find_peaks(s, {.threshold = DecibelsLevel(-40.0)});
     ASSERT_EQ(peaks.size(), freqs.size()) << name;
     for (std::size_t i = 0; i < freqs.size(); ++i) {
-      EXPECT_NEAR(peaks[i].frequency.value(), freqs[i], 0.1 * s.resolution_cpm) << name;
+      EXPECT_NEAR(peaks[i].frequency.value(), freqs[i], 0.1 * s.resolution.value()) << name;
       EXPECT_NEAR(peaks[i].level.value(), 0.0, 0.1) << name;
     }
   }
@@ -44,7 +44,7 @@ TEST(SinusoidReferences, RandomPhasesKeepTheSpectrum) {
   s.params["phase"] = std::string("random");
   const auto a = render_reference(s, tpad);
   EXPECT_NE(a, render_reference(spec("4sin"), tpad));
-  const auto peaks = find_peaks(magnitude_spectrum(a, tpad.spacing.value()));
+  const auto peaks = find_peaks(magnitude_spectrum(a, tpad.spacing));
   ASSERT_EQ(peaks.size(), 4u);
   for (const auto& p : peaks) EXPECT_NEAR(p.level.value(), 0.0, 0.1);
 }
@@ -56,7 +56,7 @@ Psd mean_psd(const std::string& name, int seeds) {
   Psd mean;
   for (int seed = 1; seed <= seeds; ++seed) {
     const auto a = render_reference(spec(name, static_cast<std::uint64_t>(seed)), g);
-    Psd p = welch_psd(a, g.spacing.value(), {.segment = 2000});
+    Psd p = welch_psd(a, g.spacing, {.segment = 2000});
     if (seed == 1)
       mean = p;
     else
@@ -74,7 +74,8 @@ TEST(NoiseColours, SlopesAndFlatness) {
   const std::map<std::string, double> slopes{{"white", 0.0}, {"pink", -10.0}, {"blue", 10.0}};
   for (const auto& [name, slope] : slopes) {
     const Psd p = mean_psd(name, 12);
-    EXPECT_NEAR(spectral_slope_db_per_decade(p.frequency_cpm, p.density, 1.0, 40.0), slope, 1.5) << name;
+    EXPECT_NEAR(spectral_slope_db_per_decade(p.frequency_cpm, p.density, CyclesPerMm(1.0), CyclesPerMm(40.0)), slope, 1.5)
+        << name;
     // Flatness after removing the nominal slope: every third-octave band
     // average within ±1.5 dB of the overall mean.
     std::vector<double> level;
@@ -112,7 +113,7 @@ TEST(Waveforms, HarmonicRatiosAndNoAliasing) {
   // synthesised component below Nyquist and the next harmonic above it.
   for (const std::string name : {"square", "tri", "saw"}) {
     const auto a = render_reference(spec(name), tpad);
-    const Spectrum s = magnitude_spectrum(a, tpad.spacing.value(), {.zero_pad = 4});
+    const Spectrum s = magnitude_spectrum(a, tpad.spacing, {.zero_pad = 4});
     const auto peaks = find_peaks(s, {.threshold = DecibelsLevel(-120.0), .max_peaks = 1000});
     auto level_at = [&](double f) {
       for (const auto& p : peaks)
@@ -166,7 +167,7 @@ TEST(BandpassNoise, CentreAndMinus3dBWidth) {
         s.params["band_min_cpm"] = f1 / 4;
         s.params["band_max_cpm"] = std::min(49.0, f2 * 4);
         const auto a = render_reference(s, g);
-        const Spectrum sp = magnitude_spectrum(a, g.spacing.value(), {.window = Window::rectangular, .zero_pad = 1});
+        const Spectrum sp = magnitude_spectrum(a, g.spacing, {.window = Window::rectangular, .zero_pad = 1});
         if (power.empty()) {
           power = sp.power;
           freq = sp.frequency_cpm;

@@ -35,11 +35,11 @@ TEST(MagnitudeSpectrum, CalibratedForOffBinSinusoids) {
   // amplitude, not frequency).
   for (Window w : {Window::blackman_harris, Window::hann, Window::flat_top}) {
     const auto x = sine(10007, 0.01, 7.77, 0.3);
-    const Spectrum s = magnitude_spectrum(x, 0.01, {.window = w});
+    const Spectrum s = magnitude_spectrum(x, Millimetres(0.01), {.window = w});
     const auto peaks = find_peaks(s);
     ASSERT_EQ(peaks.size(), 1u) << to_string(w);
     EXPECT_NEAR(db20(peaks[0].amplitude / 0.3), 0.0, 0.05) << to_string(w);
-    const double tol = (w == Window::flat_top ? 0.25 : 0.05) * s.resolution_cpm;
+    const double tol = (w == Window::flat_top ? 0.25 : 0.05) * s.resolution.value();
     EXPECT_NEAR(peaks[0].frequency.value(), 7.77, tol) << to_string(w);
   }
 }
@@ -47,18 +47,18 @@ TEST(MagnitudeSpectrum, CalibratedForOffBinSinusoids) {
 TEST(MagnitudeSpectrum, PowerSumsToTheVariance) {
   // Σ power = variance of the signal (0.3²/2 for a sinusoid) within 1 %.
   const auto x = sine(8000, 0.01, 3.3, 0.3);
-  const Spectrum s = magnitude_spectrum(x, 0.01);
+  const Spectrum s = magnitude_spectrum(x, Millimetres(0.01));
   const double total = summarize(s).total_power;
   EXPECT_NEAR(total / (0.09 / 2), 1.0, 0.01);
-  EXPECT_NEAR(band_energy(s, 3.0, 3.6) / total, 1.0, 1e-3);  // all of it around 3.3 cpm (0.1 %)
+  EXPECT_NEAR(band_energy(s, CyclesPerMm(3.0), CyclesPerMm(3.6)) / total, 1.0, 1e-3);  // all of it around 3.3 cpm (0.1 %)
 }
 
 TEST(WelchPsd, IntegratesToTheVariance) {
   // ∫ PSD df = variance within 2 %.
   const auto x = sine(20000, 0.005, 12.5, 0.2);
-  const Psd p = welch_psd(x, 0.005);
+  const Psd p = welch_psd(x, Millimetres(0.005));
   double sum = 0;
-  for (double d : p.density) sum += d * p.bin_cpm;
+  for (double d : p.density) sum += d * p.bin.value();
   EXPECT_NEAR(sum / (0.04 / 2), 1.0, 0.02);
   EXPECT_GE(p.segments, 7u);  // auto: quarter-length segments, 50 % overlap
 }
@@ -69,7 +69,7 @@ TEST(Summary, CentroidsAndTemporalView) {
   auto x = sine(16000, 0.005, 2.0, 0.2);
   const auto y = sine(16000, 0.005, 8.0, 0.2, 0.1);
   for (std::size_t i = 0; i < x.size(); ++i) x[i] += y[i] - 0.5;
-  const SpectralSummary s = summarize(magnitude_spectrum(x, 0.005));
+  const SpectralSummary s = summarize(magnitude_spectrum(x, Millimetres(0.005)));
   EXPECT_NEAR(s.centroid.value(), 5.0, 0.05);
   EXPECT_NEAR(s.log_centroid.value(), 10 * std::log10(4.0), 0.06);
   EXPECT_NEAR(s.spread.value(), 3.0, 0.03);
@@ -82,11 +82,11 @@ TEST(Summary, CentroidsAndTemporalView) {
 
 TEST(SpectrumErrors, BadInputIsNamed) {
   std::vector<double> x(100, 0.5);
-  EXPECT_THROW(magnitude_spectrum(std::vector<double>(2, 0.0), 0.01), InvalidArgument);
-  EXPECT_THROW(magnitude_spectrum(x, 0.0), InvalidArgument);
-  EXPECT_THROW(magnitude_spectrum(x, 0.01, {.zero_pad = 0}), InvalidArgument);
+  EXPECT_THROW(magnitude_spectrum(std::vector<double>(2, 0.0), Millimetres(0.01)), InvalidArgument);
+  EXPECT_THROW(magnitude_spectrum(x, Millimetres(0.0)), InvalidArgument);
+  EXPECT_THROW(magnitude_spectrum(x, Millimetres(0.01), {.zero_pad = 0}), InvalidArgument);
   x[3] = std::nan("");
-  EXPECT_THROW(magnitude_spectrum(x, 0.01), InvalidArgument);
+  EXPECT_THROW(magnitude_spectrum(x, Millimetres(0.01)), InvalidArgument);
   EXPECT_THROW(parse_window("kaiser"), InvalidArgument);
 }
 
@@ -125,10 +125,8 @@ TEST(TexelProperty, PeaksMatchTheEqualWeightSumOfSinusoids) {
       sum[i] = 0.5 + 0.5 * y / static_cast<double>(N);
     }
     const SpectrumOptions opt{.window = Window::rectangular, .zero_pad = 16};
-    const auto pt =
-        find_peaks(magnitude_spectrum(texel, g.spacing.value(), opt), {.threshold = DecibelsLevel(-60), .max_peaks = 1000});
-    const auto ps =
-        find_peaks(magnitude_spectrum(sum, g.spacing.value(), opt), {.threshold = DecibelsLevel(-60), .max_peaks = 1000});
+    const auto pt = find_peaks(magnitude_spectrum(texel, g.spacing, opt), {.threshold = DecibelsLevel(-60), .max_peaks = 1000});
+    const auto ps = find_peaks(magnitude_spectrum(sum, g.spacing, opt), {.threshold = DecibelsLevel(-60), .max_peaks = 1000});
     const double wide = static_cast<double>(N) / L;
     for (const auto& x : t->texels()) {
       auto best = [&](const std::vector<Peak>& peaks, double span) {
@@ -157,7 +155,7 @@ TEST(TexelLogCentroid, WithinHalfADecibelOfTheMedianForNarrowDistributions) {
     spec.irregularity = Decibels(0.5);
     const Document doc = make_document(load_device("tpad"), spec);
     const auto map = prepare_surface(doc).render();
-    const SpectralReport r = analyse_spectrum(map, doc.device.spacing.value());
+    const SpectralReport r = analyse_spectrum(map, doc.device.spacing);
     EXPECT_NEAR(r.summary.log_centroid.value(), pitch, 0.5) << "pitch " << pitch;
   }
 }

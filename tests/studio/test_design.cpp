@@ -60,8 +60,8 @@ TEST(DesignView, HistogramCountsTheDrawnTexels) {
   const double expected = std::accumulate(v.histogram.expected.begin(), v.histogram.expected.end(), 0.0);
   EXPECT_GT(expected, 0.95 * static_cast<double>(v.texels));
   EXPECT_LE(expected, static_cast<double>(v.texels) * (1 + 1e-9));
-  EXPECT_NEAR(v.central_pitch_cpm, 10.0, 1e-9);
-  EXPECT_NEAR(v.irregularity_cpm, std::pow(10.0, -0.5), 1e-9);
+  EXPECT_NEAR(v.central_pitch.value(), 10.0, 1e-9);
+  EXPECT_NEAR(v.irregularity.value(), std::pow(10.0, -0.5), 1e-9);
 }
 
 TEST(DesignView, EncodedSizeAndNumbersFollowTheParameters) {

@@ -25,6 +25,7 @@
 #include "../support/temp_dir.hpp"
 #include "client.hpp"
 #include "texel/experiment/store.hpp"
+#include "texel/io.hpp"
 
 extern char** environ;
 
@@ -43,7 +44,8 @@ struct Studio {
   std::uint16_t port = 0;
   std::string first_line;
 
-  explicit Studio(const std::vector<std::string>& args) {
+  // `program` is the texel CLI to run (TEXEL_CLI, or a test build of it).
+  explicit Studio(const std::vector<std::string>& args, const char* program = TEXEL_CLI) {
     int out_pipe[2], err_pipe[2];
     if (::pipe(out_pipe) != 0 || ::pipe(err_pipe) != 0) return;
     posix_spawn_file_actions_t actions;
@@ -52,12 +54,12 @@ struct Studio {
     posix_spawn_file_actions_adddup2(&actions, err_pipe[1], STDERR_FILENO);
     posix_spawn_file_actions_addclose(&actions, out_pipe[0]);
     posix_spawn_file_actions_addclose(&actions, err_pipe[0]);
-    std::vector<std::string> all{TEXEL_CLI, "studio"};
+    std::vector<std::string> all{program, "studio"};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (auto& a : all) argv.push_back(a.data());
     argv.push_back(nullptr);
-    if (::posix_spawn(&pid, TEXEL_CLI, &actions, nullptr, argv.data(), environ) != 0) pid = -1;
+    if (::posix_spawn(&pid, program, &actions, nullptr, argv.data(), environ) != 0) pid = -1;
     posix_spawn_file_actions_destroy(&actions);
     ::close(out_pipe[1]);
     ::close(err_pipe[1]);
@@ -297,5 +299,55 @@ TEST(StudioCli, AbuseDuringASessionLeavesTheStoredTrialsIntact) {
   experimenter.close();
   EXPECT_EQ(again.terminate(), 0);
 }
+
+#ifdef TEXEL_WITH_TEST_KIND
+// The test-only task kind (tests/experiment/press_side_task.cpp) through the
+// real studio: `texel_with_test_kind studio` (the shipped CLI's objects plus
+// that one file) runs its protocol over the WebSocket to the end, and the
+// same program's `experiment export` writes its trials.
+TEST(StudioCli, TestOnlyTaskKindRunsThroughTheStudioProgram) {
+  TempDir dir("texel-studio-task-kind");
+  const std::string db = dir.at("s.db");
+  const json protocol =
+      json::parse(texel::read_file(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/experiment/data/press-side.json"));
+  Studio studio({"--port", "0", "--web", web_root(dir), "--db", db}, TEXEL_WITH_TEST_KIND);
+  ASSERT_NE(studio.port, 0) << studio.first_line;
+  WsClient client;
+  ASSERT_TRUE(client.connect(studio.port));
+  int next_id = 1;
+  auto ask = [&](json msg) {
+    const int id = next_id++;
+    msg["id"] = id;
+    EXPECT_TRUE(client.send_text(msg.dump()));
+    while (true) {
+      const json j = read_json(client, 30s);
+      if (!j.is_object() || j.value("id", json()) == json(id)) return j;
+    }
+  };
+  const json started =
+      ask({{"type", "experiment.start"}, {"protocol", protocol}, {"participant", "P01"}, {"simulate", "default"}});
+  ASSERT_EQ(started.value("type", ""), "experiment.started") << started.dump().substr(0, 300);
+  EXPECT_EQ(started["progress"]["planned"], 7);
+  json q = ask({{"type", "experiment.current"}});
+  int answered = 0;
+  while (q.value("type", "") == "experiment.question" && answered < 20) {
+    EXPECT_EQ(q["question"]["task"], "press-side");
+    EXPECT_EQ(q["question"]["choices"], json({"left", "right"}));
+    q = ask({{"type", "experiment.answer"}, {"trial", q["question"]["trial"]}, {"simulated", true}});
+    ++answered;
+  }
+  EXPECT_EQ(q.value("type", ""), "experiment.finished") << q.dump().substr(0, 300);
+  EXPECT_EQ(answered, 7);
+  client.close();
+  EXPECT_EQ(studio.terminate(), 0);
+  const auto exported =
+      texel::test_support::run_cli(TEXEL_WITH_TEST_KIND, "experiment export --db " + db + " -o " + dir.at("t.csv"));
+  ASSERT_EQ(exported.status, 0) << exported.out;
+  const std::string text = texel::read_file(dir.at("t.csv"));
+  std::size_t rows = 0;
+  for (std::size_t at = text.find(",press-side,"); at != std::string::npos; at = text.find(",press-side,", at + 1)) ++rows;
+  EXPECT_EQ(rows, 7u);
+}
+#endif
 
 }  // namespace

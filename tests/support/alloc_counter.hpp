@@ -46,6 +46,17 @@ inline void release(void* p) noexcept {
   std::free(p);
 }
 
+/// Whether this program's operator new/delete are the counting ones: one
+/// counted allocation and one counted free for a `new int` (the counters are
+/// reset after). Each test program that includes this header checks it once.
+inline bool counter_works() {
+  counting = true;
+  auto* volatile p = new int(3);
+  delete p;
+  counting = false;
+  return counted_allocations.exchange(0) == 1 && counted_frees.exchange(0) == 1;
+}
+
 }  // namespace texel::test_support::alloc
 
 // The replacements pair malloc/aligned_alloc with free on purpose.

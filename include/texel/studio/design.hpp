@@ -28,6 +28,7 @@
 #include "texel/codec.hpp"
 #include "texel/document.hpp"
 #include "texel/grid.hpp"
+#include "texel/units.hpp"
 
 namespace texel::studio {
 
@@ -75,18 +76,18 @@ struct DesignView {
   HistogramView histogram;
   std::vector<std::byte> encoded;  ///< the region's .texel bitstream
   std::string encoded_error;       ///< why `encoded` is empty for a Texel region (not representable)
-  double central_pitch_cpm = 0.0;  ///< the Central Pitch in cycles/mm
-  double irregularity_cpm = 0.0;   ///< the Irregularity's dB value in cycles/mm
+  CyclesPerMm central_pitch;       ///< the Central Pitch in cycles/mm
+  CyclesPerMm irregularity;        ///< the Irregularity's dB value in cycles/mm
 };
 
 /// Renders and analyses a document. Throws InvalidArgument for a bad region
 /// index or option.
 DesignView design_view(const Document& doc, const DesignOptions& options = {});
 
-/// The spectrum of `samples` (spacing in mm) reduced to ≤ `points`
+/// The spectrum of `samples` (`spacing` apart) reduced to ≤ `points`
 /// log-spaced points (16 … 2048). Throws InvalidArgument for fewer than 4
 /// samples.
-SpectrumView spectrum_view(std::span<const double> samples, double spacing_mm, std::size_t points = 2048);
+SpectrumView spectrum_view(std::span<const double> samples, Millimetres spacing, std::size_t points = 2048);
 
 // --- match ------------------------------------------------------------------
 
