@@ -3,7 +3,8 @@
 // addresses → exit 2; and the real server abused (malformed JSON, unknown
 // types, binary and oversized frames, floods, resets) while an experiment
 // session runs, after which the store holds exactly the answered trials
-// and the session resumes at the next one.
+// and the session resumes at the next one. The CLI built with a test-only
+// task kind (texel_with_test_kind) runs that kind through its studio.
 #include <poll.h>
 #include <spawn.h>
 #include <sys/wait.h>
