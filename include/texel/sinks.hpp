@@ -59,12 +59,12 @@ class Backend : private PlayerDriver {
   /// backend's real-time thread; stops a previous run first. Throws
   /// InvalidArgument if another backend drives `player`, IoError if the
   /// device cannot start.
-  void start(Player& player);
+  void start(PlayerBase& player);
   /// Stops (joins the thread, stops the stream) and detaches; safe to call
   /// twice, and called by ~Player if the player goes first.
   void stop() noexcept;
   /// The player being driven, or null (stopped, or its player went away).
-  [[nodiscard]] const Player* player() const noexcept { return attachment_.player(); }
+  [[nodiscard]] const PlayerBase* player() const noexcept { return attachment_.player(); }
   /// A one-line description ("null 48000 Hz, 64 frames").
   [[nodiscard]] virtual std::string describe() const = 0;
   /// An error the real-time side met (e.g. the serial link dropped); empty if none.
@@ -77,7 +77,7 @@ class Backend : private PlayerDriver {
   Backend() : attachment_(*this) {}
   /// Implementations: begin calling player.process(); `player` outlives the
   /// run (until do_stop() returns).
-  virtual void do_start(Player& player) = 0;
+  virtual void do_start(PlayerBase& player) = 0;
   /// Implementations: return only once no process() call is running or can
   /// start; idempotent. Derived destructors call stop().
   virtual void do_stop() noexcept = 0;

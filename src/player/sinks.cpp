@@ -81,7 +81,7 @@ BackendStats Backend::stats() {
   return s;
 }
 
-void Backend::start(Player& player) {
+void Backend::start(PlayerBase& player) {
   stop();
   attachment_.attach(player);  // throws if another backend drives the player
   try {
@@ -134,10 +134,10 @@ class PacedBackend : public Backend {
   PacedBackend(double period_s, bool count_late) : period_(period_s), count_late_(count_late) {}
   // One period's work. process() inside it stays real-time safe; the tick
   // itself may do I/O (it runs on this backend's thread, not an audio one).
-  virtual void tick(Player& player) = 0;
+  virtual void tick(PlayerBase& player) = 0;
 
  private:
-  void do_start(Player& player) final {
+  void do_start(PlayerBase& player) final {
     {
       std::lock_guard lock(error_mutex_);
       error_.clear();
@@ -149,7 +149,7 @@ class PacedBackend : public Backend {
     running_ = false;
     if (thread_.joinable()) thread_.join();
   }
-  void loop(Player& player) {
+  void loop(PlayerBase& player) {
     const auto t0 = Clock::now();
     const auto late = std::chrono::duration_cast<Clock::duration>(period_);
     try {
@@ -190,7 +190,7 @@ class NullBackend final : public PacedBackend {
       throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
     return static_cast<double>(block) / rate;
   }
-  void tick(Player& player) override {
+  void tick(PlayerBase& player) override {
     const auto b0 = Clock::now();
     const BlockInfo info = player.process(buffer_);
     record(info, seconds_since(b0));
@@ -316,7 +316,7 @@ class AudioBackend final : public Backend {
   }
 
  private:
-  void do_start(Player& player) override {
+  void do_start(PlayerBase& player) override {
     player_ = &player;
     pa_check(portaudio().Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
   }
@@ -339,7 +339,7 @@ class AudioBackend final : public Backend {
   PaSession session_;  // initialised before the stream, terminated after it
   AudioOptions options_;
   PaStream* stream_ = nullptr;
-  Player* player_ = nullptr;
+  PlayerBase* player_ = nullptr;
   std::string device_name_;
 };
 
@@ -371,7 +371,7 @@ class SerialBackend final : public PacedBackend {
   }
   // The streaming thread does I/O by nature; process() itself stays
   // real-time safe.
-  void tick(Player& player) override {
+  void tick(PlayerBase& player) override {
     float out[1];
     float pos[1];
     const auto b0 = Clock::now();
