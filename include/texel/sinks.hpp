@@ -38,6 +38,8 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
 
 /// "time_s,position_mm,output" with one row per output sample.
 std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output);
+/// "time_s,x_mm,y_mm,output" (2-D players).
+std::string signal_csv(double rate_hz, std::span<const float> x_mm, std::span<const float> y_mm, std::span<const float> output);
 
 /// Live statistics of a running backend.
 struct BackendStats {
@@ -67,6 +69,10 @@ class Backend : private PlayerDriver {
   [[nodiscard]] const PlayerBase* player() const noexcept { return attachment_.player(); }
   /// A one-line description ("null 48000 Hz, 64 frames").
   [[nodiscard]] virtual std::string describe() const = 0;
+  /// How the real-time thread is scheduled, once started: "SCHED_FIFO
+  /// priority 70 (real-time)", "SCHED_OTHER (real-time not permitted: ...)",
+  /// or what the sound system chose ("set by PortAudio").
+  [[nodiscard]] virtual std::string scheduling() const { return "set by the sound system"; }
   /// An error the real-time side met (e.g. the serial link dropped); empty if none.
   [[nodiscard]] virtual std::string error() const { return {}; }
 
