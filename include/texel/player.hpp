@@ -246,6 +246,7 @@ class PlayerAttachment {
 /// What a driver drives: the 1-D Player or the 2-D Player2D (player2d.hpp).
 class PlayerBase {
  public:
+  virtual ~PlayerBase() = default;
   PlayerBase(const PlayerBase&) = delete;
   PlayerBase& operator=(const PlayerBase&) = delete;
 
@@ -253,6 +254,8 @@ class PlayerBase {
   /// `position_mm` is not empty (same size as out), the finger position used
   /// for each (2-D: x). Real-time safe (see Player::process).
   virtual BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept = 0;
+  /// Control thread: frees maps process() has retired. Returns how many.
+  virtual std::size_t collect() = 0;
 
   /// True while a driver (a started Backend) is attached. Control thread.
   [[nodiscard]] bool attached() const { return attachment_ != nullptr; }
@@ -262,7 +265,6 @@ class PlayerBase {
 
  protected:
   explicit PlayerBase(double rate_hz) : rate_hz_(rate_hz) {}
-  ~PlayerBase() = default;
   /// Derived destructors call this first: an attached driver may be inside
   /// process() right now; it is stopped and waited for before anything is freed.
   void stop_driver() noexcept;
@@ -284,7 +286,7 @@ class Player final : public PlayerBase {
   explicit Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map = nullptr);
   /// Stops an attached driver first (see "Lifetime"), then frees every map.
   /// A real-time thread that is not an attached driver must have stopped.
-  ~Player();
+  ~Player() override;
 
   [[nodiscard]] const PlayerConfig& config() const { return config_; }
   /// Capacity of the event queue (config().event_capacity).
@@ -301,7 +303,7 @@ class Player final : public PlayerBase {
   /// Queues a carrier-frequency change (clamped to [0, rate/2]).
   bool set_carrier(double hz);
   /// Frees maps process() has retired. Returns how many.
-  std::size_t collect() { return maps_.collect(); }
+  std::size_t collect() override { return maps_.collect(); }
   /// Free slots in the event queue (approximate while process() runs).
   [[nodiscard]] std::size_t event_space() const { return events_.capacity() - events_.size(); }
 

@@ -59,6 +59,8 @@
 
 namespace texel {
 
+struct Document;
+
 /// One finger sample on a 2-D surface.
 struct FingerSample2D {
   double t_s = 0.0;   ///< time (s) on the player's clock
@@ -82,6 +84,14 @@ struct Extent2D {
 /// The extent a raster's samples cover: origin … origin + count·pitch on each axis.
 Extent2D extent_of(const Raster2D& raster);
 
+/// A raster from a 2-D .npy (rows along y, columns along x, C order; dtypes
+/// as parse_npy, integers scaled to [0, 1]) with the given pitch and origin.
+/// Throws FormatError naming the file for anything but a 2-D array.
+Raster2D parse_raster_npy(std::string_view bytes, std::string_view origin, Millimetres pitch,
+                          Millimetres origin_x = Millimetres(0.0), Millimetres origin_y = Millimetres(0.0));
+Raster2D load_raster_npy(const std::string& path, Millimetres pitch, Millimetres origin_x = Millimetres(0.0),
+                         Millimetres origin_y = Millimetres(0.0));
+
 /// Bilinear interpolation of a raster at (x, y); positions beyond the edges
 /// take the nearest edge value. Real-time safe.
 float sample_bilinear(const Raster2D& raster, double x_mm, double y_mm) noexcept;
@@ -102,6 +112,13 @@ class PlayerMap2D {
                                                          std::optional<Raster2D> coarse, std::optional<Extent2D> extent,
                                                          double strip_mm = 10000.0,
                                                          std::optional<FrequencyResponse> response = std::nullopt);
+  /// Path-indexed from a 1-D texture document, until 2-D documents exist:
+  /// the fine texture of its first Texel region (prepared for the device's
+  /// grid, so the same seed gives the 1-D document's texels), `coarse` and
+  /// `extent` as above (no coarse raster and no extent: a surface without
+  /// edges), the device's frequency response.
+  static std::unique_ptr<const PlayerMap2D> path_indexed(const Document& doc, std::optional<Raster2D> coarse,
+                                                         std::optional<Extent2D> extent = std::nullopt);
   /// Bitmap: a friction raster, values in [0, 1], covering extent_of(friction).
   static std::unique_ptr<const PlayerMap2D> bitmap(Raster2D friction, std::optional<FrequencyResponse> response = std::nullopt);
 
@@ -143,7 +160,7 @@ class Player2D final : public PlayerBase {
   /// prepare: validates `config` and allocates all state; `map` may be null.
   explicit Player2D(const PlayerConfig& config, std::unique_ptr<const PlayerMap2D> map = nullptr,
                     PathAtLift at_lift = PathAtLift::keep);
-  ~Player2D();
+  ~Player2D() override;
 
   [[nodiscard]] const PlayerConfig& config() const { return config_; }
   [[nodiscard]] PathAtLift path_at_lift() const { return at_lift_; }
@@ -155,7 +172,7 @@ class Player2D final : public PlayerBase {
   bool push(const FingerSample2D& s);
   bool set_gain(double gain);
   bool set_carrier(double hz);
-  std::size_t collect() { return maps_.collect(); }
+  std::size_t collect() override { return maps_.collect(); }
   [[nodiscard]] std::size_t event_space() const { return events_.capacity() - events_.size(); }
 
   // ------------------------------------------------------- real-time thread
@@ -214,5 +231,15 @@ std::vector<FingerSample2D> simulate_path_2d(const Path2DConfig& config);
 /// non-decreasing. Throws FormatError naming the line.
 std::vector<FingerSample2D> parse_trace_2d_csv(std::string_view text, std::string_view origin);
 std::vector<FingerSample2D> load_trace_2d_csv(const std::string& path);
+
+/// Speeds of a 2-D trace between consecutive touching samples: |Δ(x, y)|/Δt.
+struct PathMeasures {
+  std::size_t intervals = 0;
+  double mean_speed_mm_s = 0.0;
+  double sd_speed_mm_s = 0.0;  ///< sample standard deviation (n−1)
+  double touched_s = 0.0;
+  double path_mm = 0.0;  ///< total path length
+};
+PathMeasures path_measures(std::span<const FingerSample2D> trace);
 
 }  // namespace texel

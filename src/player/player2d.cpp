@@ -7,6 +7,7 @@
 #include <string>
 
 #include "texel/detail/format.hpp"
+#include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -123,6 +124,37 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const TexelSpec& fi
     }
   });
   return m;
+}
+
+std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const Document& doc, std::optional<Raster2D> coarse,
+                                                             std::optional<Extent2D> extent) {
+  const auto region = std::find_if(doc.regions.begin(), doc.regions.end(), [](const RegionSpec& r) { return !r.reference; });
+  if (region == doc.regions.end())
+    throw InvalidArgument("2-D player map: the document has no Texel region (a reference has no texels to lay along the path)");
+  if (!extent && !coarse) extent = Extent2D{-1e7, -1e7, 2e7, 2e7};  // no edges
+  return path_indexed(region->texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)}, std::move(coarse), extent, 10000.0,
+                      doc.device.response);
+}
+
+Raster2D parse_raster_npy(std::string_view bytes, std::string_view origin, Millimetres pitch, Millimetres origin_x,
+                          Millimetres origin_y) {
+  std::vector<std::size_t> shape;
+  const std::vector<double> v = parse_npy(bytes, origin, &shape);
+  if (shape.size() != 2 || shape[0] < 1 || shape[1] < 1 || shape[0] > (1u << 20) || shape[1] > (1u << 20))
+    throw FormatError(std::string(origin) +
+                      ": a raster must be a 2-D array (rows along y, columns along x) of 1 … 2^20 per side");
+  Raster2D r;
+  r.height = static_cast<int>(shape[0]);
+  r.width = static_cast<int>(shape[1]);
+  r.pitch = pitch;
+  r.origin_x = origin_x;
+  r.origin_y = origin_y;
+  r.values.assign(v.begin(), v.end());
+  return r;
+}
+
+Raster2D load_raster_npy(const std::string& path, Millimetres pitch, Millimetres origin_x, Millimetres origin_y) {
+  return parse_raster_npy(read_file(path), path, pitch, origin_x, origin_y);
 }
 
 std::unique_ptr<const PlayerMap2D> PlayerMap2D::bitmap(Raster2D friction, std::optional<FrequencyResponse> response) {
@@ -368,6 +400,29 @@ std::vector<FingerSample2D> parse_trace_2d_csv(std::string_view text, std::strin
   });
   if (trace.empty()) throw FormatError(where + ": no samples; expected rows of " + expected);
   return trace;
+}
+
+PathMeasures path_measures(std::span<const FingerSample2D> trace) {
+  PathMeasures m;
+  double sum = 0, sum2 = 0;
+  for (std::size_t i = 1; i < trace.size(); ++i) {
+    const FingerSample2D& a = trace[i - 1];
+    const FingerSample2D& b = trace[i];
+    const double dt = b.t_s - a.t_s;
+    if (!a.touch || !b.touch || !(dt > 0)) continue;
+    const double d = std::hypot(b.x_mm - a.x_mm, b.y_mm - a.y_mm);
+    const double v = d / dt;
+    ++m.intervals;
+    sum += v, sum2 += v * v;
+    m.touched_s += dt;
+    m.path_mm += d;
+  }
+  if (m.intervals) m.mean_speed_mm_s = sum / static_cast<double>(m.intervals);
+  if (m.intervals > 1) {
+    const double n = static_cast<double>(m.intervals);
+    m.sd_speed_mm_s = std::sqrt(std::max(0.0, (sum2 - sum * sum / n) / (n - 1)));
+  }
+  return m;
 }
 
 std::vector<FingerSample2D> load_trace_2d_csv(const std::string& path) { return parse_trace_2d_csv(read_file(path), path); }
