@@ -24,8 +24,11 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <numbers>
+#include <span>
+#include <string_view>
 
 #include "texel/device.hpp"
 #include "texel/spsc_queue.hpp"
@@ -36,6 +39,16 @@ struct PlayerConfig;
 double response_limit_hz(const PlayerConfig& config, const FrequencyResponse& response) noexcept;
 
 namespace player_parts {
+
+/// validate(config), then config: for the players' member initialisers.
+const PlayerConfig& validated(const PlayerConfig& config);
+
+/// Reads the rows of a finger-trace CSV: time_s, `positions` coordinates
+/// (mm), optional touch (0/1, default 1); times finite and non-decreasing.
+/// Calls row(t, coordinates, touch); throws FormatError naming the line, or
+/// when there are no rows (`expected` names the columns).
+void read_trace_rows(std::string_view text, std::string_view origin, std::size_t positions, const char* expected,
+                     const std::function<void(double t, std::span<const double> position, bool touch)>& row);
 
 struct Biquad {
   double b0 = 1, b1 = 0, b2 = 0, a1 = 0, a2 = 0;

@@ -233,12 +233,12 @@ double OutputStage::step(double a, bool touching) noexcept {
 
 }  // namespace player_parts
 
-namespace {
+namespace player_parts {
 const PlayerConfig& validated(const PlayerConfig& c) {
   validate(c);
   return c;
 }
-}  // namespace
+}  // namespace player_parts
 
 // ----------------------------------------------------------- PlayerAttachment
 
@@ -269,7 +269,7 @@ void PlayerBase::stop_driver() noexcept {
 
 // prepare: the only allocations a Player makes are its two rings, here.
 Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
-    : PlayerBase(validated(config).rate_hz),
+    : PlayerBase(player_parts::validated(config).rate_hz),
       config_(config),
       events_(config_.event_capacity),
       maps_(std::move(map), 1.0 / (config_.crossfade_s * config_.rate_hz)),

@@ -189,15 +189,8 @@ double PlayerMap2D::value(double x_mm, double y_mm, double s_mm, double speed_mm
 
 // ------------------------------------------------------------------- Player2D
 
-namespace {
-const PlayerConfig& validated(const PlayerConfig& c) {
-  validate(c);
-  return c;
-}
-}  // namespace
-
 Player2D::Player2D(const PlayerConfig& config, std::unique_ptr<const PlayerMap2D> map, PathAtLift at_lift)
-    : PlayerBase(validated(config).rate_hz),
+    : PlayerBase(player_parts::validated(config).rate_hz),
       config_(config),
       at_lift_(at_lift),
       events_(config_.event_capacity),
@@ -386,19 +379,10 @@ std::vector<FingerSample2D> simulate_path_2d(const Path2DConfig& c) {
 
 std::vector<FingerSample2D> parse_trace_2d_csv(std::string_view text, std::string_view origin) {
   std::vector<FingerSample2D> trace;
-  const std::string where(origin);
-  const char* expected = "time_s,x_mm,y_mm[,touch]";
-  read_numeric_csv(text, origin, 3, 4, expected, [&](std::size_t line, std::span<const double> cols) {
-    const std::string at = where + ":" + std::to_string(line) + ": ";
-    if (!std::isfinite(cols[0]) || !std::isfinite(cols[1]) || !std::isfinite(cols[2]))
-      throw FormatError(at + "time and position must be finite");
-    if (!trace.empty() && cols[0] < trace.back().t_s)
-      throw FormatError(at + "time " + num(cols[0]) + " s is earlier than the previous " + num(trace.back().t_s) +
-                        " s; times must not decrease");
-    if (cols.size() == 4 && cols[3] != 0 && cols[3] != 1) throw FormatError(at + "touch is " + num(cols[3]) + "; allowed 0 or 1");
-    trace.push_back(FingerSample2D{cols[0], cols[1], cols[2], cols.size() < 4 || cols[3] != 0});
-  });
-  if (trace.empty()) throw FormatError(where + ": no samples; expected rows of " + expected);
+  player_parts::read_trace_rows(text, origin, 2, "time_s,x_mm,y_mm[,touch]",
+                                [&](double t, std::span<const double> p, bool touch) {
+                                  trace.push_back({t, p[0], p[1], touch});
+                                });
   return trace;
 }
 
