@@ -9,12 +9,14 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "../support/alloc_counter.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
+#include "texel/io.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/spectrum.hpp"
@@ -251,6 +253,33 @@ TEST(Player2D, InputsAreValidated) {
   EXPECT_FALSE(t[1].touch);
   EXPECT_THROW(parse_trace_2d_csv("0,1,2\n-1,1,2\n", "t.csv"), FormatError);
   EXPECT_THROW(parse_trace_2d_csv("0,1\n", "t.csv"), FormatError);
+}
+
+std::string npy(const std::string& shape, std::size_t count) {
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape + ", }";
+  header.append(128 - 10 - header.size() - 1, ' ');
+  header.push_back('\n');
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  bytes.push_back(static_cast<char>(header.size()));
+  bytes.push_back('\0');
+  bytes += header;
+  for (std::size_t k = 0; k < count; ++k) {
+    const float v = 0.1f * static_cast<float>(k);
+    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  return bytes;
+}
+
+TEST(Player2D, RasterFromNpyRowsAlongY) {
+  const Raster2D r = parse_raster_npy(npy("(2, 3)", 6), "r.npy", Millimetres(0.5), Millimetres(1.0), Millimetres(2.0));
+  EXPECT_EQ(r.width, 3);
+  EXPECT_EQ(r.height, 2);
+  EXPECT_FLOAT_EQ(r.at(2, 1), 0.5f);                                       // row 1 (y), column 2 (x): element 5
+  EXPECT_NEAR(sample_bilinear(r, 1.0 + 2 * 0.5, 2.0 + 0.25), 0.35, 1e-6);  // halfway between rows at x = column 2
+  EXPECT_THROW(parse_raster_npy(npy("(2, 2, 2)", 8), "r.npy", Millimetres(0.5)), FormatError);
+  EXPECT_THROW(parse_raster_npy(npy("(6,)", 6), "r.npy", Millimetres(0.5)), FormatError);
+  EXPECT_THROW(parse_raster_npy(npy("(4, 3)", 6), "r.npy", Millimetres(0.5)), FormatError);  // data short
+  EXPECT_THROW(parse_npy(npy("(2, 3)", 6), "r.npy"), FormatError);                           // the 1-D reader still wants 1-D
 }
 
 // process() allocates and frees nothing while another thread streams finger
