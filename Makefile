@@ -109,6 +109,7 @@ bench: build web web-test
 	$(BUILD)/bin/texel_bench --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
+	$(BUILD)/bin/texel_bench_player_paced --json $(BUILD)/bench_player_paced.json
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
 	$(BUILD)/bin/texel_bench_encode --json $(BUILD)/bench_encode.json
 	$(PY) bench/render_to_file.py $(BUILD)/bin/texel

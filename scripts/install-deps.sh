@@ -20,6 +20,9 @@ packages=(
   libcli11-dev
   # tests and benchmarks
   libgtest-dev librapidcheck-dev libbenchmark-dev
+  # the paced player benchmark: a JACK server with its dummy driver, and
+  # stress-ng to busy every core (bench/bench_player_paced.cpp)
+  jackd2 libjack-jackd2-dev stress-ng
   # the Python package and the Python-side checks (pytest, the statistics
   # oracle, the protocol schema and the MPEG-I Haptics schemas with RFC 3339
   # date-time checking, reading .mat v5/v7.3 files); pip, setuptools,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -19,6 +20,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
 #include "texel/sinks.hpp"
 
 namespace texel::cli {
@@ -32,6 +34,7 @@ struct PlayArgs {
   DeviceOptions device;
   TextureOptions texture;
   FingerOptions finger;
+  Surface2DOptions surface;
   std::string backend = "null";
   std::size_t block = 64;
   std::string audio_device;
@@ -48,6 +51,16 @@ std::string meter(float peak) {
          (db > -100 ? detail::fixed(db, 1) : std::string("-inf")) + " dBFS";
 }
 
+// Queues `trace` into `player` up to a time (like a sensor with some
+// buffering); returns false once all of it is queued.
+template <class P, class Sample>
+std::function<bool(double)> feeder(P& player, std::vector<Sample> trace) {
+  return [&player, trace = std::move(trace), next = std::size_t{0}](double horizon) mutable {
+    while (next < trace.size() && trace[next].t_s <= horizon && player.push(trace[next])) ++next;
+    return next < trace.size();
+  };
+}
+
 void run(const PlayArgs& a) {
   if (a.list_devices) {
     for (const auto& d : audio_output_devices()) std::cout << d << "\n";
@@ -56,8 +69,13 @@ void run(const PlayArgs& a) {
   if (a.document.empty()) throw InvalidArgument("play: a document is required (or --list-devices)");
   if (a.block < 1 || a.block > 8192) throw InvalidArgument("--block is " + std::to_string(a.block) + "; allowed 1 … 8192 frames");
   const Document doc = build_document(a.document, a.device, a.texture);
+  const bool two_d = a.surface.active();
   const Surface surface = prepare_surface(doc);
-  const auto map = PlayerMap::from_surface(surface);
+  // A 2-D surface has no 1-D map; the backends other than serial position
+  // streaming never read it, so they get a one-sample stand-in.
+  const auto map = two_d
+                       ? std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f})
+                       : PlayerMap::from_surface(surface);
 
   const BackendChoice choice = parse_backend(a.backend);
   BackendOptions bo;
@@ -72,6 +90,8 @@ void run(const PlayArgs& a) {
       bo.stream = SerialStream::drive;
     else
       throw InvalidArgument("--stream is '" + a.stream + "'; allowed: position, drive");
+    if (two_d && bo.stream == SerialStream::position)
+      throw InvalidArgument("--stream is 'position', but a 2-D surface has no 1-D map to upload; use --stream drive");
     FingerOptions f = a.finger;
     if (!f.rate_hz) f.rate_hz = 1000.0;  // one frame per millisecond, like a position sensor
     if (bo.stream == SerialStream::drive && f.output == "vibration")
@@ -81,30 +101,38 @@ void run(const PlayArgs& a) {
     config = player_config(a.finger, 48000.0, doc.device.response);
   }
   bo.rate_hz = config.rate_hz;
-  const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
-
   double duration = 5.0;
-  const auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
-  Player player(config, PlayerMap::from_surface(surface));
+  // Everything from the command line is read and checked before the device opens.
+  std::unique_ptr<PlayerBase> player;
+  std::function<bool(double)> feed_until;  // queues the trace up to a time; false once it is all queued
+  if (two_d) {
+    auto trace = finger_trace_2d(a.finger, a.surface, duration);
+    auto p = std::make_unique<Player2D>(config, player_map_2d(a.surface, doc),
+                                        parse_path_at_lift(a.surface.path_at_lift, "--path-at-lift"));
+    feed_until = feeder(*p, std::move(trace));
+    player = std::move(p);
+  } else {
+    auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
+    auto p = std::make_unique<Player>(config, PlayerMap::from_surface(surface));
+    feed_until = feeder(*p, std::move(trace));
+    player = std::move(p);
+  }
+  const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
 
   interrupted = false;
   auto old_handler = std::signal(SIGINT, on_sigint);
   const bool tty = ::isatty(STDERR_FILENO) == 1;
-  std::size_t next = 0;
   // Feed the finger like a sensor with 50 ms of buffering: samples are queued
   // shortly before their time, so the player interpolates between them.
-  auto feed = [&] {
-    const double horizon = player.time_s() + 0.05;
-    while (next < trace.size() && trace[next].t_s <= horizon && player.push(trace[next])) ++next;
-  };
+  auto feed = [&] { feed_until(player->time_s() + 0.05); };
   feed();
-  backend->start(player);
+  backend->start(*player);
   const auto t0 = std::chrono::steady_clock::now();
   std::string error;
-  while (!interrupted && player.time_s() < duration) {
+  while (!interrupted && player->time_s() < duration) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     feed();
-    player.collect();
+    player->collect();
     error = backend->error();
     if (!error.empty()) break;
     if (std::chrono::steady_clock::now() - t0 > std::chrono::duration<double>(duration + 5.0)) {
@@ -113,7 +141,7 @@ void run(const PlayArgs& a) {
     }
     if (tty) {
       const BackendStats s = backend->stats();
-      std::fprintf(stderr, "\rplay %6.2f/%.2f s  x %7.2f mm %s  %s  blocks %llu  worst %.3f ms ", player.time_s(), duration,
+      std::fprintf(stderr, "\rplay %6.2f/%.2f s  x %7.2f mm %s  %s  blocks %llu  worst %.3f ms ", player->time_s(), duration,
                    s.position_mm, s.touching ? "touch" : "lift ", meter(s.peak).c_str(),
                    static_cast<unsigned long long>(s.blocks), s.worst_block_s * 1e3);
       std::fflush(stderr);
@@ -129,7 +157,9 @@ void run(const PlayArgs& a) {
       a.backend.rfind("serial:", 0) == 0 ? 1.0 / config.rate_hz : static_cast<double>(a.block) / config.rate_hz;
   nlohmann::ordered_json j;
   j["backend"] = backend->describe();
-  j["played_s"] = player.time_s();
+  j["played_s"] = player->time_s();
+  j["surface"] = two_d ? "2d" : "1d";
+  j["scheduling"] = backend->scheduling();
   j["blocks"] = s.blocks;
   j["block_period_ms"] = block_s * 1e3;
   j["worst_block_ms"] = s.worst_block_s * 1e3;
@@ -140,7 +170,9 @@ void run(const PlayArgs& a) {
   if (a.json) {
     print_json(j);
   } else {
-    std::cout << "played " << detail::fixed(player.time_s(), 3) << " s on " << backend->describe() << "\n"
+    std::cout << "played " << detail::fixed(player->time_s(), 3) << " s on " << backend->describe()
+              << (two_d ? ", 2-D surface" : "") << "\n"
+              << "scheduling: " << backend->scheduling() << "\n"
               << "blocks processed: " << s.blocks << ", worst block " << detail::fixed(s.worst_block_s * 1e3, 4) << " ms ("
               << detail::fixed(100.0 * s.worst_block_s / block_s, 2) << " % of the " << detail::fixed(block_s * 1e3, 3)
               << " ms period), mean " << detail::fixed(j["mean_block_ms"].get<double>(), 4) << " ms, underruns " << s.underruns
@@ -164,6 +196,7 @@ void register_play(CLI::App& app) {
   cmd->add_option("--baud", a->baud, "Serial baud rate [921600]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
   add_player_options(*cmd, a->finger, a->device, a->texture);
+  add_surface2d_options(*cmd, a->surface);
   cmd->callback([a] { run(*a); });
 }
 

@@ -12,6 +12,7 @@
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
 #include "texel/sinks.hpp"
 #include "texel/swipe_plot.hpp"
 
@@ -23,6 +24,7 @@ struct SwipeArgs {
   DeviceOptions device;
   TextureOptions texture;
   FingerOptions finger;
+  Surface2DOptions surface;
   std::string output;
   std::optional<std::string> plot;
   std::string wav_format = "pcm16";
@@ -47,23 +49,38 @@ void run(const SwipeArgs& a) {
 
   const Document doc = build_document(a.document, a.device, a.texture);
   const PlayerConfig config = player_config(a.finger, 48000.0, doc.device.response);
-  const Surface surface = prepare_surface(doc);
-  const auto map = PlayerMap::from_surface(surface);
   double duration = 2.0;
-  const auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
-  const double frames_d = std::round(duration * config.rate_hz);
-  if (frames_d > 2e9) throw InvalidArgument("--duration × --rate is " + detail::num(frames_d) + " samples; at most 2e9");
-  const auto frames = static_cast<std::size_t>(frames_d);
-
-  std::vector<float> positions;
-  const std::vector<float> out = render_trace(*map, config, trace, frames, &positions);
+  std::vector<float> positions, y_positions, out;
+  double mean_speed = 0, sd_speed = 0, directional = 0, touched = 0;
+  const auto frame_count = [&] {
+    const double frames_d = std::round(duration * config.rate_hz);
+    if (frames_d > 2e9) throw InvalidArgument("--duration × --rate is " + detail::num(frames_d) + " samples; at most 2e9");
+    return static_cast<std::size_t>(frames_d);
+  };
+  if (a.surface.active()) {  // the 2-D player (issue #26)
+    const auto map = player_map_2d(a.surface, doc);
+    const auto trace = finger_trace_2d(a.finger, a.surface, duration);
+    out = render_trace_2d(*map, config, trace, frame_count(), &positions, &y_positions, 64,
+                          parse_path_at_lift(a.surface.path_at_lift, "--path-at-lift"));
+    const PathMeasures m = path_measures(trace);
+    mean_speed = m.mean_speed_mm_s, sd_speed = m.sd_speed_mm_s, touched = m.touched_s;
+  } else {
+    const Surface surface = prepare_surface(doc);
+    const auto map = PlayerMap::from_surface(surface);
+    const auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
+    out = render_trace(*map, config, trace, frame_count(), &positions);
+    const SwipeMeasures m = swipe_measures(trace);
+    mean_speed = m.mean_speed_mm_s, sd_speed = m.sd_speed_mm_s, directional = m.directional_proportion, touched = m.touched_s;
+  }
+  const std::size_t frames = out.size();
   const SignalSpectrum spectrum = signal_spectrum(out, config.rate_hz);
   const double peak = spectrum.peak_hz(config.mode == OutputMode::amplitude ? 1.0 : 0.0);
-  const SwipeMeasures m = swipe_measures(trace);
 
   // Prepare every output before writing any, so a failure leaves none.
   std::vector<PendingFile> files;
-  if (ext == ".csv") files.push_back({a.output, signal_csv(config.rate_hz, positions, out)});
+  if (ext == ".csv")
+    files.push_back({a.output, a.surface.active() ? signal_csv(config.rate_hz, positions, y_positions, out)
+                                                  : signal_csv(config.rate_hz, positions, out)});
   if (a.plot) {
     SwipePlot p;
     p.title = "Swipe: " + std::string(to_string(config.mode)) + " at " + detail::num(config.rate_hz) + " Hz";
@@ -93,18 +110,21 @@ void run(const SwipeArgs& a) {
   j["duration_s"] = static_cast<double>(frames) / config.rate_hz;
   j["peak_frequency_hz"] = peak;
   j["spectrum_bin_hz"] = spectrum.frequency_hz.size() > 1 ? spectrum.frequency_hz[1] : 0.0;
-  j["swipe"] = {{"mean_speed_mm_s", m.mean_speed_mm_s},
-                {"sd_speed_mm_s", m.sd_speed_mm_s},
-                {"directional_proportion", m.directional_proportion},
-                {"touched_s", m.touched_s}};
+  j["swipe"] = {{"mean_speed_mm_s", mean_speed}, {"sd_speed_mm_s", sd_speed}, {"touched_s", touched}};
+  if (a.surface.active())
+    j["surface"] = "2d";
+  else
+    j["swipe"]["directional_proportion"] = directional;
   if (a.json) {
     print_json(j);
   } else {
     std::cout << a.output << ": " << frames << " samples at " << detail::num(config.rate_hz) << " Hz ("
               << detail::fixed(static_cast<double>(frames) / config.rate_hz, 3) << " s), " << to_string(config.mode)
               << ", spectrum peak " << detail::fixed(peak, 1) << " Hz\n"
-              << "swipe: mean speed " << detail::fixed(m.mean_speed_mm_s, 2) << " mm/s, SD " << detail::fixed(m.sd_speed_mm_s, 2)
-              << " mm/s, directional proportion " << detail::fixed(m.directional_proportion, 3) << "\n";
+              << "swipe" << (a.surface.active() ? " (2-D)" : "") << ": mean speed " << detail::fixed(mean_speed, 2)
+              << " mm/s, SD " << detail::fixed(sd_speed, 2) << " mm/s";
+    if (!a.surface.active()) std::cout << ", directional proportion " << detail::fixed(directional, 3);
+    std::cout << "\n";
   }
 }
 
@@ -119,6 +139,7 @@ void register_swipe(CLI::App& app) {
   cmd->add_option("--wav-format", a->wav_format, "WAV sample encoding: pcm16, pcm24 or float [pcm16]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
   add_player_options(*cmd, a->finger, a->device, a->texture);
+  add_surface2d_options(*cmd, a->surface);
   cmd->callback([a] { run(*a); });
 }
 

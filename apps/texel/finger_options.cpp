@@ -1,8 +1,11 @@
 #include "finger_options.hpp"
 
 #include <cmath>
+#include <cstring>
+#include <utility>
 
 #include "texel/detail/format.hpp"
+#include "texel/document.hpp"
 #include "texel/error.hpp"
 
 namespace texel::cli {
@@ -68,6 +71,78 @@ std::vector<FingerSample> finger_trace(const FingerOptions& o, double surface_mm
   if (!(std::isfinite(o.speed_mm_s) && o.speed_mm_s > 0))
     throw InvalidArgument("--speed is " + detail::num(o.speed_mm_s) + "; it must be > 0 mm/s");
   return simulate_swipe(s);
+}
+
+void add_surface2d_options(CLI::App& cmd, Surface2DOptions& o) {
+  const char* g = "2-D surface";
+  cmd.add_option("--path", o.path, "2-D finger path: line, circle or zigzag (switches to the 2-D player)")->group(g);
+  cmd.add_option("--angle", o.angle_deg, "Direction of a line or zigzag, degrees from +x [0]")->group(g);
+  cmd.add_option("--radius", o.radius_mm, "Circle radius (mm) [20]; the circle is centred on (--start, --start-y)")->group(g);
+  cmd.add_option("--leg", o.leg_mm, "Zigzag leg length (mm) [10]")->group(g);
+  cmd.add_option("--zigzag-angle", o.zigzag_deg, "Angle between zigzag legs, degrees [90]")->group(g);
+  cmd.add_option("--start-y", o.start_y_mm, "y where the 2-D finger lands (mm) [0]")->group(g);
+  cmd.add_option("--trace-2d", o.trace_2d, "Recorded 2-D finger trace, CSV of time_s,x_mm,y_mm[,touch]")->group(g);
+  cmd.add_option("--coarse-raster", o.coarse_raster,
+                 "2-D coarse profile c(x, y) in [0, 1]: .npy, rows along y; mixed by the document's coarse and fine strength")
+      ->group(g);
+  cmd.add_option("--bitmap", o.bitmap, "Friction bitmap in [0, 1] (.npy, rows along y) played instead of the document's texture")
+      ->group(g);
+  cmd.add_option("--raster-pitch", o.raster_pitch_mm, "Sample spacing of --coarse-raster / --bitmap (mm) [0.1]")->group(g);
+  cmd.add_option("--raster-origin", o.raster_origin_mm, "Position of the raster's first sample: X Y (mm) [0 0]")
+      ->expected(2)
+      ->group(g);
+  cmd.add_option("--path-at-lift", o.path_at_lift,
+                 "Path-indexed texture at a lift: keep (continue the path) or reset (each stroke starts over) [keep]")
+      ->group(g);
+}
+
+std::unique_ptr<const PlayerMap2D> player_map_2d(const Surface2DOptions& o, const Document& doc) {
+  if (o.coarse_raster && o.bitmap) throw InvalidArgument("--coarse-raster and --bitmap exclude each other");
+  if (!(std::isfinite(o.raster_pitch_mm) && o.raster_pitch_mm > 0))
+    throw InvalidArgument("--raster-pitch is " + detail::num(o.raster_pitch_mm) + "; it must be > 0 mm");
+  const Millimetres x0(o.raster_origin_mm.empty() ? 0.0 : o.raster_origin_mm[0]);
+  const Millimetres y0(o.raster_origin_mm.size() < 2 ? 0.0 : o.raster_origin_mm[1]);
+  const Millimetres pitch(o.raster_pitch_mm);
+  if (o.bitmap) return PlayerMap2D::bitmap(load_raster_npy(*o.bitmap, pitch, x0, y0), doc.device.response);
+  std::optional<Raster2D> coarse;
+  if (o.coarse_raster) coarse = load_raster_npy(*o.coarse_raster, pitch, x0, y0);
+  return PlayerMap2D::path_indexed(doc, std::move(coarse));
+}
+
+std::vector<FingerSample2D> finger_trace_2d(const FingerOptions& f, const Surface2DOptions& o, double& duration_s) {
+  if (f.duration_s && !(std::isfinite(*f.duration_s) && *f.duration_s > 0 && *f.duration_s <= 86400))
+    throw InvalidArgument("--duration is " + detail::num(*f.duration_s) + "; allowed > 0 … 86400 s");
+  if (f.trace) throw InvalidArgument("--trace is a 1-D trace; give a 2-D one with --trace-2d");
+  if (o.trace_2d) {
+    if (o.path) throw InvalidArgument("--path and --trace-2d exclude each other");
+    auto trace = load_trace_2d_csv(*o.trace_2d);
+    duration_s = f.duration_s.value_or(trace.back().t_s);
+    if (!(duration_s > 0)) throw InvalidArgument("--trace-2d '" + *o.trace_2d + "' lasts 0 s; give --duration");
+    return trace;
+  }
+  duration_s = f.duration_s.value_or(duration_s);
+  Path2DConfig p;
+  p.shape = parse_path_shape(o.path.value_or("line"), "--path");
+  p.speed_mm_s = f.speed_mm_s;
+  p.angle_deg = o.angle_deg;
+  p.start_x_mm = f.start_mm.value_or(0.0);
+  p.start_y_mm = o.start_y_mm.value_or(0.0);
+  p.radius_mm = o.radius_mm;
+  p.leg_mm = o.leg_mm;
+  p.zigzag_deg = o.zigzag_deg;
+  p.duration_s = duration_s;
+  try {
+    return simulate_path_2d(p);
+  } catch (const InvalidArgument& e) {  // name the flags, not the struct's fields
+    std::string m = e.what();
+    for (const auto& [field, flag] : {std::pair{"speed_mm_s", "--speed"},
+                                      {"duration_s", "--duration"},
+                                      {"radius_mm", "--radius"},
+                                      {"leg_mm", "--leg"},
+                                      {"zigzag_deg", "--zigzag-angle"}})
+      if (const auto at = m.find(field); at != std::string::npos) m.replace(at, std::strlen(field), flag);
+    throw InvalidArgument(m);
+  }
 }
 
 }  // namespace texel::cli

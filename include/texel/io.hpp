@@ -62,6 +62,9 @@ std::string npy_bytes(std::span<const double> values);
 std::string npy_header(std::size_t count);
 /// Reads a 1-D or single-column .npy of float64/float32/int16/uint16 (little-endian).
 std::vector<double> parse_npy(std::string_view bytes, std::string_view origin);
+/// The same for an array of any shape in C order (row-major), its dimensions
+/// written to `shape` (e.g. {rows, columns} for a 2-D raster).
+std::vector<double> parse_npy(std::string_view bytes, std::string_view origin, std::vector<std::size_t>* shape);
 
 /// Two-column CSV with a header: "position_mm,amplitude" and one row per sample.
 std::string csv_columns(std::string_view header_a, std::string_view header_b, std::span<const double> a,

@@ -86,6 +86,7 @@
 // attachment, so the handshake puts no lock or atomic on the audio path.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -98,6 +99,7 @@
 #include "texel/device.hpp"
 #include "texel/finger.hpp"
 #include "texel/grid.hpp"
+#include "texel/player_parts.hpp"
 #include "texel/spsc_queue.hpp"
 
 namespace texel {
@@ -184,30 +186,28 @@ double response_limit_hz(const PlayerConfig& config, const FrequencyResponse& re
 void validate(const PlayerConfig& config);
 
 /// A command for process(): a finger sample or a parameter change.
-struct PlayerEvent {
-  enum class Kind : std::uint8_t { finger, gain, carrier };
-  Kind kind = Kind::finger;
-  FingerSample finger{};
-  double value = 0.0;  ///< gain or carrier frequency
-};
+using PlayerEvent = player_parts::Event<FingerSample>;
+/// The coordinates a FingerTrack follows (player_parts.hpp).
+inline std::array<double, 1> coords(const FingerSample& s) noexcept { return {s.x_mm}; }
 
 /// What process() reports for one block.
 struct BlockInfo {
-  float peak = 0.0f;         ///< largest |output| in the block
-  double position_mm = 0.0;  ///< finger position at the block's end (after prediction)
-  bool touching = false;     ///< finger down at the block's end
+  float peak = 0.0f;           ///< largest |output| in the block
+  double position_mm = 0.0;    ///< finger position at the block's end (after prediction); 2-D: x
+  double position_y_mm = 0.0;  ///< 2-D players: y at the block's end
+  bool touching = false;       ///< finger down at the block's end
   bool crossfading = false;
 };
 
-class Player;
+class PlayerBase;
 
-/// Whatever calls Player::process() from its own real-time thread (the
+/// Whatever calls PlayerBase::process() from its own real-time thread (the
 /// backends of sinks.hpp). See "Lifetime" above.
 class PlayerDriver {
  public:
-  /// Control thread, called by ~Player while this driver is still attached:
-  /// stop calling process() and return only when no call is in progress
-  /// (join the thread, stop the stream), then detach.
+  /// Control thread, called by a player's destructor while this driver is
+  /// still attached: stop calling process() and return only when no call is
+  /// in progress (join the thread, stop the stream), then detach.
   virtual void stop_driving() noexcept = 0;
 
  protected:
@@ -231,41 +231,71 @@ class PlayerAttachment {
   /// Before the driver's first process() call. Detaches from a previous
   /// player first. Throws InvalidArgument if another driver is attached to
   /// `player` (one real-time thread per player).
-  void attach(Player& player);
+  void attach(PlayerBase& player);
   /// After the driver's last process() call has returned. Safe to call twice.
   void detach() noexcept;
   /// The player driven, or null.
-  [[nodiscard]] Player* player() const noexcept { return player_; }
+  [[nodiscard]] PlayerBase* player() const noexcept { return player_; }
 
  private:
-  friend class Player;
+  friend class PlayerBase;
   PlayerDriver* driver_;
-  Player* player_ = nullptr;
+  PlayerBase* player_ = nullptr;
 };
 
-class Player {
+/// What a driver drives: the 1-D Player or the 2-D Player2D (player2d.hpp).
+class PlayerBase {
  public:
-  static constexpr std::size_t retire_capacity = 16;
+  virtual ~PlayerBase() = default;
+  PlayerBase(const PlayerBase&) = delete;
+  PlayerBase& operator=(const PlayerBase&) = delete;
+
+  /// Real-time thread: fills `out` with the next out.size() samples and, if
+  /// `position_mm` is not empty (same size as out), the finger position used
+  /// for each (2-D: x). Real-time safe (see Player::process).
+  virtual BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept = 0;
+  /// Control thread: frees maps process() has retired. Returns how many.
+  virtual std::size_t collect() = 0;
+
+  /// True while a driver (a started Backend) is attached. Control thread.
+  [[nodiscard]] bool attached() const { return attachment_ != nullptr; }
+  /// Output samples produced so far (any thread).
+  [[nodiscard]] std::uint64_t samples() const { return samples_done_.load(std::memory_order_relaxed); }
+  [[nodiscard]] double time_s() const { return static_cast<double>(samples()) / rate_hz_; }
+
+ protected:
+  explicit PlayerBase(double rate_hz) : rate_hz_(rate_hz) {}
+  /// Derived destructors call this first: an attached driver may be inside
+  /// process() right now; it is stopped and waited for before anything is freed.
+  void stop_driver() noexcept;
+  void publish_samples(std::uint64_t n) noexcept { samples_done_.store(n, std::memory_order_relaxed); }
+
+ private:
+  friend class PlayerAttachment;
+  PlayerAttachment* attachment_ = nullptr;  // the driver's link; control thread only
+  std::atomic<std::uint64_t> samples_done_{0};
+  double rate_hz_;
+};
+
+class Player final : public PlayerBase {
+ public:
+  static constexpr std::size_t retire_capacity = player_parts::MapExchange<PlayerMap>::retire_capacity;
 
   /// prepare: validates `config` and allocates all state (the event and
   /// retire rings included); `map` may be null (silence until set_map).
   explicit Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map = nullptr);
   /// Stops an attached driver first (see "Lifetime"), then frees every map.
   /// A real-time thread that is not an attached driver must have stopped.
-  ~Player();
-  Player(const Player&) = delete;
-  Player& operator=(const Player&) = delete;
+  ~Player() override;
 
   [[nodiscard]] const PlayerConfig& config() const { return config_; }
   /// Capacity of the event queue (config().event_capacity).
   [[nodiscard]] std::size_t event_capacity() const { return events_.capacity(); }
-  /// True while a driver (a started Backend) is attached. Control thread.
-  [[nodiscard]] bool attached() const { return attachment_ != nullptr; }
 
   // -------------------------------------------------------- control thread
   /// Swaps in a new map; process() crossfades to it. If a previous map was
   /// still waiting (never seen by process) it is freed here. Also collect()s.
-  void set_map(std::unique_ptr<const PlayerMap> map);
+  void set_map(std::unique_ptr<const PlayerMap> map) { maps_.set(std::move(map)); }
   /// Queues a finger sample (time-ordered); false if the queue is full.
   bool push(const FingerSample& s) { return events_.try_push(PlayerEvent{PlayerEvent::Kind::finger, s, 0.0}); }
   /// Queues a gain change (clamped to [0, 1], ramped over one block).
@@ -273,7 +303,7 @@ class Player {
   /// Queues a carrier-frequency change (clamped to [0, rate/2]).
   bool set_carrier(double hz);
   /// Frees maps process() has retired. Returns how many.
-  std::size_t collect();
+  std::size_t collect() override { return maps_.collect(); }
   /// Free slots in the event queue (approximate while process() runs).
   [[nodiscard]] std::size_t event_space() const { return events_.capacity() - events_.size(); }
 
@@ -284,66 +314,17 @@ class Player {
   /// Real-time safe: never allocates, frees, locks, logs, throws or does
   /// I/O; bounded work per sample. Out-of-range parameters were clamped when
   /// queued.
-  BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept;
-
-  // ------------------------------------------------------------ any thread
-  /// Output samples produced so far.
-  [[nodiscard]] std::uint64_t samples() const { return samples_done_.load(std::memory_order_relaxed); }
-  [[nodiscard]] double time_s() const { return static_cast<double>(samples()) / config_.rate_hz; }
+  BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept override;
 
  private:
-  struct Biquad {
-    double b0 = 1, b1 = 0, b2 = 0, a1 = 0, a2 = 0;
-    double z1 = 0, z2 = 0;
-    double operator()(double x) noexcept {
-      const double y = b0 * x + z1;
-      z1 = b1 * x - a1 * y + z2;
-      z2 = b2 * x - a2 * y;
-      return y;
-    }
-    /// Steady state for a constant input x (DC gain 1): no transient on touch-down.
-    void settle(double x) noexcept {
-      z2 = (b2 - a2) * x;
-      z1 = (b1 - a1) * x + z2;
-    }
-    /// RBJ cookbook low-pass, Q = 1/√2 (Butterworth): flat pass band, −3 dB at fc.
-    static Biquad lowpass(double fc, double rate) noexcept;
-  };
-
-  friend class PlayerAttachment;
-
-  void take_events(double tau) noexcept;
   void use_response_of(const PlayerMap* map) noexcept;
-  double finger_position(double tau) noexcept;
 
   PlayerConfig config_;
   SpscQueue<PlayerEvent> events_;
-  SpscQueue<const PlayerMap*> retired_;
-  PlayerAttachment* attachment_ = nullptr;  // the driver's link; control thread only
-  std::atomic<const PlayerMap*> pending_{nullptr};
-  std::atomic<std::uint64_t> samples_done_{0};
-
+  player_parts::MapExchange<PlayerMap> maps_;
   // Real-time state (touched only by process()).
-  const PlayerMap* current_ = nullptr;
-  const PlayerMap* fading_ = nullptr;          // the map being faded out (null: from silence)
-  const PlayerMap* retire_waiting_ = nullptr;  // retired while the retire queue was full
-  bool crossfading_ = false;
-  double fade_pos_ = 1.0;  // 0 → 1 over crossfade_s
-  double fade_step_ = 0.0;
-  FingerSample last_{};  // newest consumed sample
-  bool have_last_ = false;
-  double velocity_ = 0.0;     // smoothed mm/s
-  double touch_level_ = 0.0;  // 0 … 1 before shaping
-  double touch_step_ = 0.0;
-  double gain_ = 1.0, gain_target_ = 1.0;
-  double carrier_inc_ = 0.0, carrier_inc_target_ = 0.0;  // cycles per sample
-  double carrier_phase_ = 0.0;                           // cycles [0, 1)
-  double dc_x1_ = 0.0, dc_y1_ = 0.0, dc_r_ = 0.0;
-  Biquad lowpass_{};
-  Biquad display_lp_{};  // response limit (see above)
-  bool display_limit_ = false;
-  bool display_settle_ = false;    // limit just switched on: start settled
-  double display_limit_hz_ = 0.0;  // the limit in force (0: none)
+  player_parts::FingerTrack<FingerSample, 1> finger_;
+  player_parts::OutputStage stage_;
   std::uint64_t n_ = 0;
 };
 

@@ -38,6 +38,8 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
 
 /// "time_s,position_mm,output" with one row per output sample.
 std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output);
+/// "time_s,x_mm,y_mm,output" (2-D players).
+std::string signal_csv(double rate_hz, std::span<const float> x_mm, std::span<const float> y_mm, std::span<const float> output);
 
 /// Live statistics of a running backend.
 struct BackendStats {
@@ -59,14 +61,18 @@ class Backend : private PlayerDriver {
   /// backend's real-time thread; stops a previous run first. Throws
   /// InvalidArgument if another backend drives `player`, IoError if the
   /// device cannot start.
-  void start(Player& player);
+  void start(PlayerBase& player);
   /// Stops (joins the thread, stops the stream) and detaches; safe to call
   /// twice, and called by ~Player if the player goes first.
   void stop() noexcept;
   /// The player being driven, or null (stopped, or its player went away).
-  [[nodiscard]] const Player* player() const noexcept { return attachment_.player(); }
+  [[nodiscard]] const PlayerBase* player() const noexcept { return attachment_.player(); }
   /// A one-line description ("null 48000 Hz, 64 frames").
   [[nodiscard]] virtual std::string describe() const = 0;
+  /// How the real-time thread is scheduled, once started: "SCHED_FIFO
+  /// priority 70 (real-time)", "SCHED_OTHER (real-time not permitted: ...)",
+  /// or what the sound system chose ("set by PortAudio").
+  [[nodiscard]] virtual std::string scheduling() const { return "set by the sound system"; }
   /// An error the real-time side met (e.g. the serial link dropped); empty if none.
   [[nodiscard]] virtual std::string error() const { return {}; }
 
@@ -77,7 +83,7 @@ class Backend : private PlayerDriver {
   Backend() : attachment_(*this) {}
   /// Implementations: begin calling player.process(); `player` outlives the
   /// run (until do_stop() returns).
-  virtual void do_start(Player& player) = 0;
+  virtual void do_start(PlayerBase& player) = 0;
   /// Implementations: return only once no process() call is running or can
   /// start; idempotent. Derived destructors call stop().
   virtual void do_stop() noexcept = 0;

@@ -145,7 +145,9 @@ std::string npy_header(std::size_t count) {
   return out;
 }
 
-std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
+std::vector<double> parse_npy(std::string_view b, std::string_view origin) { return parse_npy(b, origin, nullptr); }
+
+std::vector<double> parse_npy(std::string_view b, std::string_view origin, std::vector<std::size_t>* shape_out) {
   const std::string where(origin);
   if (b.size() < 10 || b.substr(0, 6) != std::string_view("\x93NUMPY", 6))
     throw FormatError(where + ": not a .npy file (bad magic)");
@@ -208,9 +210,18 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
   for (auto d : dims) {
     if (d == 1) continue;
     ++non_unit;
-    n = d;  // the one dimension that is not 1 (at most data_bytes: no overflow below)
+    // Each factor is at most data_bytes, and so is the running product
+    // (checked before multiplying): no overflow.
+    if (non_unit > 1 && d != 0 && n > data_bytes / d)
+      throw FormatError(where + ": .npy shape " + shape + " holds more elements than the file's " + std::to_string(data_bytes) +
+                        " data bytes");
+    n = non_unit > 1 ? n * d : d;
   }
-  if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
+  if (dims.empty() || (non_unit > 1 && !shape_out))
+    throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
+  if (non_unit > 1 && value_of("fortran_order").find("True") != std::string::npos)
+    throw FormatError(where + ": .npy array of shape " + shape + " is in Fortran order; save it in C order");
+  if (shape_out) *shape_out = dims;
   std::size_t width = 0;
   if (descr == "<f8")
     width = 8;

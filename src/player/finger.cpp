@@ -8,6 +8,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/player_parts.hpp"
 
 namespace texel {
 
@@ -105,20 +106,38 @@ std::vector<FingerSample> simulate_swipe(const SwipeConfig& c) {
   return trace;
 }
 
+namespace player_parts {
+
+void read_trace_rows(std::string_view text, std::string_view origin, std::size_t positions, const char* expected,
+                     const std::function<void(double t, std::span<const double> position, bool touch)>& row) {
+  const std::string where(origin);
+  bool any = false;
+  double last_t = 0.0;
+  read_numeric_csv(text, origin, 1 + positions, 2 + positions, expected, [&](std::size_t line, std::span<const double> cols) {
+    const std::string at = where + ":" + std::to_string(line) + ": ";
+    for (std::size_t i = 0; i <= positions; ++i)
+      if (!std::isfinite(cols[i])) throw FormatError(at + "time and position must be finite");
+    if (any && cols[0] < last_t)
+      throw FormatError(at + "time " + num(cols[0]) + " s is earlier than the previous " + num(last_t) +
+                        " s; times must not decrease");
+    const bool has_touch = cols.size() == 2 + positions;
+    if (has_touch && cols[1 + positions] != 0 && cols[1 + positions] != 1)
+      throw FormatError(at + "touch is " + num(cols[1 + positions]) + "; allowed 0 or 1");
+    row(cols[0], cols.subspan(1, positions), !has_touch || cols[1 + positions] != 0);
+    any = true;
+    last_t = cols[0];
+  });
+  if (!any) throw FormatError(where + ": no samples; expected rows of " + expected);
+}
+
+}  // namespace player_parts
+
 std::vector<FingerSample> parse_trace_csv(std::string_view text, std::string_view origin) {
   std::vector<FingerSample> trace;
-  const std::string where(origin);
-  const char* expected = "time_s,position_mm[,touch]";
-  read_numeric_csv(text, origin, 2, 3, expected, [&](std::size_t line, std::span<const double> cols) {
-    const std::string at = where + ":" + std::to_string(line) + ": ";
-    if (!std::isfinite(cols[0]) || !std::isfinite(cols[1])) throw FormatError(at + "time and position must be finite");
-    if (!trace.empty() && cols[0] < trace.back().t_s)
-      throw FormatError(at + "time " + num(cols[0]) + " s is earlier than the previous " + num(trace.back().t_s) +
-                        " s; times must not decrease");
-    if (cols.size() == 3 && cols[2] != 0 && cols[2] != 1) throw FormatError(at + "touch is " + num(cols[2]) + "; allowed 0 or 1");
-    trace.push_back(FingerSample{cols[0], cols[1], cols.size() < 3 || cols[2] != 0});
-  });
-  if (trace.empty()) throw FormatError(where + ": no samples; expected rows of " + expected);
+  player_parts::read_trace_rows(text, origin, 1, "time_s,position_mm[,touch]",
+                                [&](double t, std::span<const double> p, bool touch) {
+                                  trace.push_back({t, p[0], touch});
+                                });
   return trace;
 }
 

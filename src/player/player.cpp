@@ -130,7 +130,9 @@ double response_limit_hz(const PlayerConfig& c, const FrequencyResponse& r) noex
 
 double response_limit_hz(const PlayerConfig& c) { return response_limit_hz(c, c.response); }
 
-Player::Biquad Player::Biquad::lowpass(double fc, double rate) noexcept {
+namespace player_parts {
+
+Biquad Biquad::lowpass(double fc, double rate) noexcept {
   Biquad q;
   const double w0 = 2.0 * std::numbers::pi * fc / rate;
   const double alpha = std::sin(w0) / std::numbers::sqrt2;
@@ -144,16 +146,103 @@ Player::Biquad Player::Biquad::lowpass(double fc, double rate) noexcept {
   return q;
 }
 
-namespace {
+OutputStage::OutputStage(const PlayerConfig& config) : config_(&config) {
+  const double rate = config.rate_hz;
+  touch_step_ = 1.0 / (config.touch_ramp_s * rate);
+  gain_ = gain_target_ = gain_end_ = config.gain;
+  carrier_inc_ = carrier_inc_target_ = inc_end_ = config.carrier_hz / rate;
+  dc_r_ = std::exp(-2.0 * std::numbers::pi * config.highpass_hz / rate);
+  lowpass_ = Biquad::lowpass(config.lowpass_hz > 0 ? config.lowpass_hz : 0.4 * rate, rate);
+}
+
+void OutputStage::set_carrier_target(double hz) noexcept { carrier_inc_target_ = hz / config_->rate_hz; }
+
+// The response limit for the map now playing (player.hpp): the map's own
+// response if it carries one, else the config's. Real-time safe: arithmetic
+// on members only; nothing changes while the limit stays the same, so maps
+// of one display never disturb the filter.
+void OutputStage::use_response(const FrequencyResponse* response) noexcept {
+  const FrequencyResponse& r = response ? *response : config_->response;
+  const double limit = response_limit_hz(*config_, r);
+  if (limit == display_limit_hz_) return;
+  display_limit_hz_ = limit;
+  if (!(limit > 0.0)) {
+    display_limit_ = false;
+    return;
+  }
+  const Biquad q = Biquad::lowpass(limit, config_->rate_hz);
+  display_lp_.b0 = q.b0;
+  display_lp_.b1 = q.b1;
+  display_lp_.b2 = q.b2;
+  display_lp_.a1 = q.a1;
+  display_lp_.a2 = q.a2;
+  if (!display_limit_) display_settle_ = true;  // stale state: start settled on the next value
+  display_limit_ = true;
+}
+
+double OutputStage::step(double a, bool touching) noexcept {
+  // Touch / lift ramp (raised cosine: the largest step per sample is
+  // π/2 · touch_step_ of the output, no click).
+  const bool was_silent = touch_level_ <= 0.0;
+  touch_level_ = touching ? std::min(1.0, touch_level_ + touch_step_) : std::max(0.0, touch_level_ - touch_step_);
+  const double env = 0.5 - 0.5 * std::cos(std::numbers::pi * touch_level_);
+
+  // The display's response limit (see player.hpp): what it cannot
+  // reproduce is not driven. Starts settled on touch-down from rest.
+  const OutputMode mode = config_->mode;
+  if (display_limit_) {
+    if ((was_silent && touching) || display_settle_) {
+      display_lp_.settle(a);
+      display_settle_ = false;
+    }
+    a = display_lp_(a);
+    if (mode == OutputMode::amplitude) a = std::clamp(a, 0.0, 1.0);  // the filter's overshoot at steps
+  }
+
+  gain_ += gain_step_;
+  double y = 0.0;
+  switch (mode) {
+    case OutputMode::amplitude: y = a; break;
+    case OutputMode::carrier: {
+      y = a * std::sin(2.0 * std::numbers::pi * carrier_phase_);
+      carrier_inc_ += inc_step_;
+      carrier_phase_ += carrier_inc_;
+      carrier_phase_ -= std::floor(carrier_phase_);
+      break;
+    }
+    case OutputMode::vibration: {
+      if (was_silent && touching) {
+        // Touch-down from rest: start the filters in their steady state for
+        // the value under the finger, so landing does not thump.
+        lowpass_.settle(a);
+        dc_x1_ = a;
+        dc_y1_ = 0.0;
+      }
+      const double lp = lowpass_(a);
+      const double hp = lp - dc_x1_ + dc_r_ * dc_y1_;
+      dc_x1_ = lp;
+      dc_y1_ = hp;
+      y = hp;
+      break;
+    }
+  }
+  y *= env * gain_;
+  if (mode != OutputMode::amplitude) y = std::clamp(y, -1.0, 1.0);
+  return y;
+}
+
+}  // namespace player_parts
+
+namespace player_parts {
 const PlayerConfig& validated(const PlayerConfig& c) {
   validate(c);
   return c;
 }
-}  // namespace
+}  // namespace player_parts
 
 // ----------------------------------------------------------- PlayerAttachment
 
-void PlayerAttachment::attach(Player& player) {
+void PlayerAttachment::attach(PlayerBase& player) {
   if (player_ == &player) return;
   if (player.attachment_)
     throw InvalidArgument("player: already driven by another backend; stop that one first (one real-time thread per player)");
@@ -168,67 +257,32 @@ void PlayerAttachment::detach() noexcept {
   player_ = nullptr;
 }
 
-// --------------------------------------------------------------------- Player
-
-// prepare: the only allocations a Player makes are its two rings, here.
-Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
-    : config_(validated(config)), events_(config_.event_capacity), retired_(retire_capacity) {
-  const double rate = config_.rate_hz;
-  current_ = map.release();
-  fade_step_ = 1.0 / (config_.crossfade_s * rate);
-  touch_step_ = 1.0 / (config_.touch_ramp_s * rate);
-  gain_ = gain_target_ = config_.gain;
-  carrier_inc_ = carrier_inc_target_ = config_.carrier_hz / rate;
-  dc_r_ = std::exp(-2.0 * std::numbers::pi * config_.highpass_hz / rate);
-  lowpass_ = Biquad::lowpass(config_.lowpass_hz > 0 ? config_.lowpass_hz : 0.4 * rate, rate);
-  use_response_of(current_);
-  display_settle_ = false;  // the first touch-down settles the filter anyway
-}
-
-// The response limit for the map now playing (player.hpp): the map's own
-// response if it carries one, else the config's. Real-time safe: arithmetic
-// on members only; nothing changes while the limit stays the same, so maps
-// of one display never disturb the filter.
-void Player::use_response_of(const PlayerMap* map) noexcept {
-  const FrequencyResponse& r = map && map->response() ? *map->response() : config_.response;
-  const double limit = response_limit_hz(config_, r);
-  if (limit == display_limit_hz_) return;
-  display_limit_hz_ = limit;
-  if (!(limit > 0.0)) {
-    display_limit_ = false;
-    return;
-  }
-  const Biquad q = Biquad::lowpass(limit, config_.rate_hz);
-  display_lp_.b0 = q.b0;
-  display_lp_.b1 = q.b1;
-  display_lp_.b2 = q.b2;
-  display_lp_.a1 = q.a1;
-  display_lp_.a2 = q.a2;
-  if (!display_limit_) display_settle_ = true;  // stale state: start settled on the next value
-  display_limit_ = true;
-}
-
-Player::~Player() {
-  // An attached driver may be inside process() right now: stop it and wait
-  // before anything is freed. stop_driving() detaches; detach() again in case
-  // a driver forgot to.
+void PlayerBase::stop_driver() noexcept {
+  // stop_driving() detaches; detach() again in case a driver forgot to.
   if (PlayerAttachment* a = attachment_) {
     a->driver_->stop_driving();
     a->detach();
   }
-  collect();
-  delete pending_.exchange(nullptr);
-  delete current_;
-  delete fading_;
-  delete retire_waiting_;
 }
 
-void Player::set_map(std::unique_ptr<const PlayerMap> map) {
-  // Whoever takes a pointer out of pending_ owns it: process() has never
-  // seen a map we get back here, so freeing it on this thread is safe.
-  delete pending_.exchange(map.release(), std::memory_order_acq_rel);
-  collect();
+// --------------------------------------------------------------------- Player
+
+// prepare: the only allocations a Player makes are its two rings, here.
+Player::Player(const PlayerConfig& config, std::unique_ptr<const PlayerMap> map)
+    : PlayerBase(player_parts::validated(config).rate_hz),
+      config_(config),
+      events_(config_.event_capacity),
+      maps_(std::move(map), 1.0 / (config_.crossfade_s * config_.rate_hz)),
+      stage_(config_) {
+  use_response_of(maps_.current());
+  stage_.clear_settle();  // the first touch-down settles the filter anyway
 }
+
+void Player::use_response_of(const PlayerMap* map) noexcept {
+  stage_.use_response(map && map->response() ? &*map->response() : nullptr);
+}
+
+Player::~Player() { stop_driver(); }
 
 bool Player::set_gain(double gain) {
   if (!std::isfinite(gain)) gain = 0.0;
@@ -240,84 +294,22 @@ bool Player::set_carrier(double hz) {
   return events_.try_push(PlayerEvent{PlayerEvent::Kind::carrier, {}, std::clamp(hz, 0.0, config_.rate_hz / 2)});
 }
 
-std::size_t Player::collect() {
-  std::size_t n = 0;
-  const PlayerMap* m = nullptr;
-  while (retired_.try_pop(m)) {
-    delete m;
-    ++n;
-  }
-  return n;
-}
-
-// Consumes every queued event up to time tau (parameter commands as they are
-// reached). Real-time safe.
-void Player::take_events(double tau) noexcept {
-  while (const PlayerEvent* e = events_.front()) {
-    switch (e->kind) {
-      case PlayerEvent::Kind::gain: gain_target_ = e->value; break;
-      case PlayerEvent::Kind::carrier: carrier_inc_target_ = e->value / config_.rate_hz; break;
-      case PlayerEvent::Kind::finger: {
-        const FingerSample& s = e->finger;
-        if (!(s.t_s <= tau)) return;  // a future sample: keep it for interpolation
-        if (have_last_ && last_.touch && s.touch && s.t_s > last_.t_s) {
-          const double dt = s.t_s - last_.t_s;
-          const double v = (s.x_mm - last_.x_mm) / dt;
-          const double k = std::min(1.0, dt / config_.velocity_smoothing_s);
-          velocity_ += k * (v - velocity_);
-        } else if (!s.touch || !have_last_ || !last_.touch) {
-          velocity_ = 0.0;
-        }
-        last_ = s;
-        have_last_ = true;
-        break;
-      }
-    }
-    events_.pop();
-  }
-}
-
-double Player::finger_position(double tau) noexcept {
-  if (!have_last_) return 0.0;
-  const PlayerEvent* e = events_.front();
-  if (last_.touch && e && e->kind == PlayerEvent::Kind::finger && e->finger.touch && e->finger.t_s > last_.t_s) {
-    const double f = (tau - last_.t_s) / (e->finger.t_s - last_.t_s);
-    return last_.x_mm + (e->finger.x_mm - last_.x_mm) * f;
-  }
-  if (!last_.touch) return last_.x_mm;
-  const double ahead = std::clamp(tau - last_.t_s, 0.0, config_.extrapolate_s);
-  return last_.x_mm + velocity_ * ahead;
-}
-
 // Real-time safe: never allocates, frees, locks, logs, throws or does I/O.
-// Maps are only exchanged (pending_) and handed back (retired_); events are
-// popped from a fixed-size ring; all arithmetic is on members.
+// Maps are only exchanged and handed back (MapExchange); events are popped
+// from a fixed-size ring; all arithmetic is on members.
 BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) noexcept {
   BlockInfo info;
   const std::size_t frames = out.size();
   if (frames == 0) return info;
   const bool want_positions = position_mm.size() >= frames;
 
-  // A map that could not be handed back last time (retire queue full) must
-  // go first; until then no new map is taken, so nothing is ever freed here.
-  if (retire_waiting_ && retired_.try_push(retire_waiting_)) retire_waiting_ = nullptr;
-  if (!crossfading_ && !retire_waiting_) {
-    if (const PlayerMap* next = pending_.exchange(nullptr, std::memory_order_acq_rel)) {
-      fading_ = current_;
-      current_ = next;
-      crossfading_ = true;
-      fade_pos_ = 0.0;
-      use_response_of(current_);
-    }
-  }
+  if (const PlayerMap* next = maps_.begin_block()) use_response_of(next);
 
   const double rate = config_.rate_hz;
   // Commands queued before this block take effect now, ramped over it.
-  take_events(static_cast<double>(n_) / rate + config_.prediction_s);
-  const double gain_step = (gain_target_ - gain_) / static_cast<double>(frames);
-  const double inc_step = (carrier_inc_target_ - carrier_inc_) / static_cast<double>(frames);
-  const double gain_end = gain_target_;
-  const double inc_end = carrier_inc_target_;
+  player_parts::take_events(events_, static_cast<double>(n_) / rate + config_.prediction_s, finger_, stage_,
+                            config_.velocity_smoothing_s);
+  stage_.begin_block(frames);
   float peak = 0.0f;
   double x = 0.0;
   bool touching = false;
@@ -325,83 +317,25 @@ BlockInfo Player::process(std::span<float> out, std::span<float> position_mm) no
   for (std::size_t i = 0; i < frames; ++i, ++n_) {
     const double t = static_cast<double>(n_) / rate;
     const double tau = t + config_.prediction_s;
-    take_events(tau);
-    x = finger_position(tau);
-    touching = have_last_ && last_.touch && (current_ == nullptr || current_->on_surface(x));
+    player_parts::take_events(events_, tau, finger_, stage_, config_.velocity_smoothing_s);
+    x = finger_.position(tau, player_parts::next_finger(events_), config_.extrapolate_s)[0];
+    const PlayerMap* current = maps_.current();
+    touching = finger_.touching() && (current == nullptr || current->on_surface(x));
 
     // Map value under the finger, crossfaded (raised cosine) during a swap.
-    double a = current_ ? current_->sample(x) : 0.0;
-    if (crossfading_) {
-      const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * fade_pos_);
-      const double old = fading_ ? fading_->sample(x) : 0.0;
-      a = old + (a - old) * w;
-      fade_pos_ += fade_step_;
-      if (fade_pos_ >= 1.0) {
-        crossfading_ = false;
-        if (fading_ && !retired_.try_push(fading_)) retire_waiting_ = fading_;
-        fading_ = nullptr;
-      }
-    }
-
-    // Touch / lift ramp (raised cosine: the largest step per sample is
-    // π/2 · touch_step_ of the output, no click).
-    const bool was_silent = touch_level_ <= 0.0;
-    touch_level_ = touching ? std::min(1.0, touch_level_ + touch_step_) : std::max(0.0, touch_level_ - touch_step_);
-    const double env = 0.5 - 0.5 * std::cos(std::numbers::pi * touch_level_);
-
-    // The display's response limit (see player.hpp): what it cannot
-    // reproduce is not driven. Starts settled on touch-down from rest.
-    if (display_limit_) {
-      if ((was_silent && touching) || display_settle_) {
-        display_lp_.settle(a);
-        display_settle_ = false;
-      }
-      a = display_lp_(a);
-      if (config_.mode == OutputMode::amplitude) a = std::clamp(a, 0.0, 1.0);  // the filter's overshoot at steps
-    }
-
-    gain_ += gain_step;
-    double y = 0.0;
-    switch (config_.mode) {
-      case OutputMode::amplitude: y = a; break;
-      case OutputMode::carrier: {
-        y = a * std::sin(2.0 * std::numbers::pi * carrier_phase_);
-        carrier_inc_ += inc_step;
-        carrier_phase_ += carrier_inc_;
-        carrier_phase_ -= std::floor(carrier_phase_);
-        break;
-      }
-      case OutputMode::vibration: {
-        if (was_silent && touching) {
-          // Touch-down from rest: start the filters in their steady state for
-          // the value under the finger, so landing does not thump.
-          lowpass_.settle(a);
-          dc_x1_ = a;
-          dc_y1_ = 0.0;
-        }
-        const double lp = lowpass_(a);
-        const double hp = lp - dc_x1_ + dc_r_ * dc_y1_;
-        dc_x1_ = lp;
-        dc_y1_ = hp;
-        y = hp;
-        break;
-      }
-    }
-    y *= env * gain_;
-    if (config_.mode != OutputMode::amplitude) y = std::clamp(y, -1.0, 1.0);
-    const auto yf = static_cast<float>(y);
+    const double a = maps_.value([x](const PlayerMap& m) -> double { return m.sample(x); });
+    const auto yf = static_cast<float>(stage_.step(a, touching));
     out[i] = yf;
     if (want_positions) position_mm[i] = static_cast<float>(x);
     peak = std::max(peak, std::fabs(yf));
   }
-  gain_ = gain_end;
-  carrier_inc_ = inc_end;
-  samples_done_.store(n_, std::memory_order_relaxed);
+  stage_.end_block();
+  publish_samples(n_);
 
   info.peak = peak;
   info.position_mm = x;
   info.touching = touching;
-  info.crossfading = crossfading_;
+  info.crossfading = maps_.crossfading();
   return info;
 }
 

@@ -12,9 +12,11 @@
 
 #include <portaudio.h>
 #include <sndfile.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/realtime.hpp"
 #include "texel/detail/shared_object.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -54,17 +56,32 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
   }
 }
 
-std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output) {
-  std::string out = "time_s,position_mm,output\n";
-  out.reserve(out.size() + output.size() * 32);
-  char buf[96];
+namespace {
+// One row per output sample: time, the given position columns, output.
+std::string signal_rows(const char* header, double rate_hz, std::span<const std::span<const float>> columns,
+                        std::span<const float> output) {
+  std::string out = header;
+  out.reserve(out.size() + output.size() * (16 + 16 * columns.size()));
+  char buf[64];
   for (std::size_t i = 0; i < output.size(); ++i) {
-    const int n =
-        std::snprintf(buf, sizeof buf, "%.9g,%.7g,%.7g\n", static_cast<double>(i) / rate_hz,
-                      i < positions_mm.size() ? static_cast<double>(positions_mm[i]) : 0.0, static_cast<double>(output[i]));
-    out.append(buf, static_cast<std::size_t>(n));
+    out.append(buf, static_cast<std::size_t>(std::snprintf(buf, sizeof buf, "%.9g", static_cast<double>(i) / rate_hz)));
+    for (const auto& c : columns)
+      out.append(
+          buf, static_cast<std::size_t>(std::snprintf(buf, sizeof buf, ",%.7g", i < c.size() ? static_cast<double>(c[i]) : 0.0)));
+    out.append(buf, static_cast<std::size_t>(std::snprintf(buf, sizeof buf, ",%.7g\n", static_cast<double>(output[i]))));
   }
   return out;
+}
+}  // namespace
+
+std::string signal_csv(double rate_hz, std::span<const float> positions_mm, std::span<const float> output) {
+  const std::span<const float> cols[] = {positions_mm};
+  return signal_rows("time_s,position_mm,output\n", rate_hz, cols, output);
+}
+
+std::string signal_csv(double rate_hz, std::span<const float> x_mm, std::span<const float> y_mm, std::span<const float> output) {
+  const std::span<const float> cols[] = {x_mm, y_mm};
+  return signal_rows("time_s,x_mm,y_mm,output\n", rate_hz, cols, output);
 }
 
 // --------------------------------------------------------------- Backend
@@ -81,7 +98,7 @@ BackendStats Backend::stats() {
   return s;
 }
 
-void Backend::start(Player& player) {
+void Backend::start(PlayerBase& player) {
   stop();
   attachment_.attach(player);  // throws if another backend drives the player
   try {
@@ -125,6 +142,8 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 // ends the loop and is reported by error() instead of escaping the thread.
 class PacedBackend : public Backend {
  public:
+  /// What the loop's thread got (after start()): real-time or normal.
+  [[nodiscard]] std::string scheduling() const override { return detail::describe(scheduling_.load(std::memory_order_relaxed)); }
   [[nodiscard]] std::string error() const override {
     std::lock_guard lock(error_mutex_);
     return error_;
@@ -134,10 +153,10 @@ class PacedBackend : public Backend {
   PacedBackend(double period_s, bool count_late) : period_(period_s), count_late_(count_late) {}
   // One period's work. process() inside it stays real-time safe; the tick
   // itself may do I/O (it runs on this backend's thread, not an audio one).
-  virtual void tick(Player& player) = 0;
+  virtual void tick(PlayerBase& player) = 0;
 
  private:
-  void do_start(Player& player) final {
+  void do_start(PlayerBase& player) final {
     {
       std::lock_guard lock(error_mutex_);
       error_.clear();
@@ -149,14 +168,26 @@ class PacedBackend : public Backend {
     running_ = false;
     if (thread_.joinable()) thread_.join();
   }
-  void loop(Player& player) {
-    const auto t0 = Clock::now();
-    const auto late = std::chrono::duration_cast<Clock::duration>(period_);
+  void loop(PlayerBase& player) {
+    scheduling_.store(detail::make_thread_realtime(), std::memory_order_relaxed);
+    // Absolute deadlines on CLOCK_MONOTONIC (clock_nanosleep TIMER_ABSTIME):
+    // lateness does not accumulate, and no relative sleep is stretched by
+    // the time spent computing it.
+    timespec t0{};
+    ::clock_gettime(CLOCK_MONOTONIC, &t0);
+    const auto ns_of = [](const timespec& t) { return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec; };
+    const std::int64_t start = ns_of(t0);
+    const auto period_ns = static_cast<std::int64_t>(std::llround(period_.count() * 1e9));
     try {
       for (std::uint64_t k = 0; running_.load(std::memory_order_relaxed); ++k) {
-        const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(period_ * static_cast<double>(k));
-        if (count_late_ && Clock::now() > deadline + late) record_underrun();
-        std::this_thread::sleep_until(deadline);
+        const std::int64_t deadline =
+            start + static_cast<std::int64_t>(std::llround(period_.count() * 1e9 * static_cast<double>(k)));
+        timespec now{};
+        ::clock_gettime(CLOCK_MONOTONIC, &now);
+        if (count_late_ && ns_of(now) > deadline + period_ns) record_underrun();
+        const timespec until{static_cast<time_t>(deadline / 1000000000), static_cast<long>(deadline % 1000000000)};
+        while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr) == EINTR) {
+        }
         tick(player);
       }
     } catch (const std::exception& e) {
@@ -166,6 +197,7 @@ class PacedBackend : public Backend {
   }
   std::chrono::duration<double> period_;
   bool count_late_;
+  std::atomic<detail::ThreadScheduling> scheduling_{detail::ThreadScheduling{}};
   std::atomic<bool> running_{false};
   std::thread thread_;
   mutable std::mutex error_mutex_;
@@ -190,7 +222,7 @@ class NullBackend final : public PacedBackend {
       throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
     return static_cast<double>(block) / rate;
   }
-  void tick(Player& player) override {
+  void tick(PlayerBase& player) override {
     const auto b0 = Clock::now();
     const BlockInfo info = player.process(buffer_);
     record(info, seconds_since(b0));
@@ -316,7 +348,7 @@ class AudioBackend final : public Backend {
   }
 
  private:
-  void do_start(Player& player) override {
+  void do_start(PlayerBase& player) override {
     player_ = &player;
     pa_check(portaudio().Pa_StartStream(stream_), "cannot start '" + device_name_ + "'");
   }
@@ -339,7 +371,7 @@ class AudioBackend final : public Backend {
   PaSession session_;  // initialised before the stream, terminated after it
   AudioOptions options_;
   PaStream* stream_ = nullptr;
-  Player* player_ = nullptr;
+  PlayerBase* player_ = nullptr;
   std::string device_name_;
 };
 
@@ -371,7 +403,7 @@ class SerialBackend final : public PacedBackend {
   }
   // The streaming thread does I/O by nature; process() itself stays
   // real-time safe.
-  void tick(Player& player) override {
+  void tick(PlayerBase& player) override {
     float out[1];
     float pos[1];
     const auto b0 = Clock::now();

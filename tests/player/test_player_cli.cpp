@@ -86,3 +86,75 @@ TEST_F(Cli, BadInputExitsTwoAndWritesNothing) {
   EXPECT_FALSE(fs::exists(wav));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), {}), 1);  // only the document
 }
+
+// Issue #26: `texel swipe` along 2-D paths feels the 1-D texture at the same
+// speed (spectrum peak at Central Pitch × speed on a line at an angle, a
+// circle and a zigzag); a 2-D trace CSV, a coarse raster (.npy) and a bitmap
+// play; `texel play` takes a 2-D path; bad 2-D input exits 2.
+TEST_F(Cli, SwipeAlong2dPathsPeaksAtCentralPitchTimesSpeed) {
+  for (const std::string path : {"--path line --angle 30", "--path circle --radius 10", "--path zigzag --leg 5"}) {
+    const std::string wav = (dir / "p.wav").string();
+    const CliRun r = run("swipe " + doc + " " + path + " --speed 100 --duration 1 -o " + wav);
+    ASSERT_EQ(r.status, 0) << path << "\n" << r.out;
+    const texel::Recording rec = texel::read_recording(wav);
+    const std::vector<float> s(rec.samples.begin(), rec.samples.end());
+    EXPECT_NEAR(texel::signal_spectrum(s, rec.rate.value()).peak_hz(1.0), 1000.0, 30.0) << path;
+  }
+}
+
+TEST_F(Cli, Swipe2dTraceRasterAndBitmap) {
+  // A 2 × 3 raster as .npy (float64, C order): rows along y.
+  const std::string npy = (dir / "r.npy").string();
+  {
+    std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }";
+    header.append(128 - 10 - header.size() - 1, ' ');  // NEP 1: data aligned to 64 bytes
+    header.push_back('\n');
+    std::string bytes("\x93NUMPY\x01\x00", 8);
+    bytes.push_back(static_cast<char>(header.size()));
+    bytes.push_back('\0');
+    bytes += header;
+    const double v[6] = {0.2, 0.4, 0.6, 0.8, 1.0, 0.0};
+    bytes.append(reinterpret_cast<const char*>(v), sizeof v);
+    std::FILE* f = std::fopen(npy.c_str(), "wb");
+    ASSERT_TRUE(f);
+    std::fwrite(bytes.data(), 1, bytes.size(), f);
+    std::fclose(f);
+  }
+  const std::string trace = (dir / "t.csv").string();
+  {
+    std::FILE* f = std::fopen(trace.c_str(), "w");
+    ASSERT_TRUE(f);
+    std::fputs("time_s,x_mm,y_mm,touch\n", f);
+    for (int i = 0; i <= 100; ++i) std::fprintf(f, "%g,%g,%g,1\n", i * 1e-3, 0.5 + 0.01 * i, 0.5);
+    std::fclose(f);
+  }
+  const std::string csv = (dir / "o.csv").string();
+  CliRun r = run("swipe " + doc + " --trace-2d " + trace + " --bitmap " + npy + " --raster-pitch 1 --output amplitude -o " + csv);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::FILE* in = std::fopen(csv.c_str(), "r");
+  ASSERT_TRUE(in);
+  char first[64] = {};
+  ASSERT_TRUE(std::fgets(first, sizeof first, in));
+  std::fclose(in);
+  EXPECT_STREQ(first, "time_s,x_mm,y_mm,output\n");
+  r = run("swipe " + doc + " --trace-2d " + trace + " --coarse-raster " + npy +
+          " --raster-pitch 1 --coarse-strength 1 --json -o " + (dir / "o.wav").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("\"surface\": \"2d\""), std::string::npos) << r.out;
+  r = run("play " + doc + " --path circle --radius 5 --backend null --duration 0.3 --block 16");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("2-D surface"), std::string::npos) << r.out;
+  fs::remove(csv);
+  fs::remove(dir / "o.wav");
+  for (const std::string& args : std::vector<std::string>{
+           "swipe " + doc + " --path spiral -o " + csv, "swipe " + doc + " --path circle --radius 0 -o " + csv,
+           "swipe " + doc + " --bitmap " + trace + " -o " + csv,
+           "swipe " + doc + " --coarse-raster " + npy + " --bitmap " + npy + " -o " + csv,
+           "swipe " + doc + " --path line --trace-2d " + trace + " -o " + csv,
+           "play " + doc + " --path line --backend serial:" + (dir / "tty").string()}) {
+    const CliRun bad = run(args);
+    EXPECT_EQ(bad.status, 2) << args << "\n" << bad.out;
+    EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;
+  }
+  EXPECT_FALSE(fs::exists(csv));
+}

@@ -1,0 +1,445 @@
+// texel_bench_player_paced: the players on a paced audio device — a JACK
+// server with its dummy driver (started and stopped here), 48 kHz, 16- and
+// 64-frame periods, the 1-D Player and the 2-D Player2D, idle and with every
+// core busy (stress-ng, started and stopped here). Reports per run:
+//   - block times (process() alone) p50 / p99 / p99.9 / max as % of the period;
+//   - end-to-end latency from a finger sample to the drive value that contains
+//     it: from the sample's push to the time JACK's driver plays the first
+//     output sample computed from it: the start of the callback that computes
+//     it (standing for its cycle's start) + the port's playback latency + the
+//     sample's offset in the block, all on CLOCK_MONOTONIC. Samples arrive from a 1 kHz sensor thread with
+//     no prediction and no extrapolation, so "contains" is exact: the output
+//     position equals the pushed position from that sample on;
+//   - allocations inside process() (the tests' counting allocator): must be 0;
+//   - xruns JACK reported, and the scheduling the process thread had;
+// then the null backend (texel play --backend null) under the same loads:
+// underruns in 5 s, worst block, and the scheduling its paced thread got.
+//
+// Usage: texel_bench_player_paced [--seconds S] [--json FILE]
+// Needs jackd (Debian jackd2) and stress-ng on PATH; a missing tool is
+// reported and its part skipped (exit 0), never faked.
+#include <fcntl.h>
+#include <jack/jack.h>
+#include <pthread.h>
+#include <sched.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/mman.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../tests/support/alloc_counter.hpp"
+#include "texel/player.hpp"
+#include "texel/player2d.hpp"
+#include "texel/sinks.hpp"
+
+extern char** environ;
+
+using namespace texel;
+namespace alloc = texel::test_support::alloc;
+
+namespace {
+
+constexpr double rate = 48000.0;
+constexpr double step_mm = 0.004;  // finger advance per sensor sample (4 mm/s … a marker, not a swipe)
+
+// ---------------------------------------------------------------- processes
+
+struct Child {
+  pid_t pid = -1;
+  bool own_group = false;
+};
+
+Child spawn(const std::vector<std::string>& args, const std::string& log, bool own_group) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  posix_spawnattr_t at;
+  posix_spawnattr_init(&at);
+  if (own_group) {
+    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&at, 0);
+  }
+  Child c;
+  if (posix_spawnp(&c.pid, argv[0], &fa, &at, argv.data(), environ) != 0) c.pid = -1;
+  c.own_group = own_group;
+  posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&at);
+  return c;
+}
+
+bool running(const Child& c) { return c.pid > 0 && ::waitpid(c.pid, nullptr, WNOHANG) == 0; }
+
+void stop(Child& c) {
+  if (c.pid <= 0) return;
+  ::kill(c.own_group ? -c.pid : c.pid, SIGTERM);  // the group we started: stress-ng and its workers
+  for (int i = 0; i < 50 && ::waitpid(c.pid, nullptr, WNOHANG) == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  if (::waitpid(c.pid, nullptr, WNOHANG) == 0) {
+    ::kill(c.own_group ? -c.pid : c.pid, SIGKILL);
+    ::waitpid(c.pid, nullptr, 0);
+  }
+  c.pid = -1;
+}
+
+bool on_path(const char* tool) {
+  const std::string cmd = std::string("command -v ") + tool + " >/dev/null 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
+
+// ------------------------------------------------------------------ one run
+
+struct Stats {
+  double p50 = 0, p99 = 0, p999 = 0, max = 0;  // % of the period
+};
+
+Stats percentiles(std::vector<double> v, double period) {
+  Stats s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    return 100.0 * v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))] / period;
+  };
+  s.p50 = at(0.5), s.p99 = at(0.99), s.p999 = at(0.999), s.max = 100.0 * v.back() / period;
+  return s;
+}
+
+struct Result {
+  std::string load, dim;
+  std::size_t block = 0;
+  std::size_t blocks = 0;
+  Stats block_time;  // % of the period
+  double lat_p50_ms = 0, lat_p99_ms = 0, lat_max_ms = 0;
+  std::size_t latencies = 0;
+  std::uint64_t allocations = 0;
+  std::uint64_t xruns = 0;
+  std::string scheduling;
+  double playback_latency_frames = 0;
+};
+
+struct Run {
+  jack_client_t* client = nullptr;
+  jack_port_t* port = nullptr;
+  PlayerBase* player = nullptr;
+  std::vector<double> block_s;
+  std::atomic<std::size_t> blocks{0};
+  std::vector<float> positions;
+  std::vector<double> push_us;     // per marker k: CLOCK_MONOTONIC at push (µs)
+  std::vector<double> latency_us;  // per marker k (0 = not yet played)
+  std::atomic<std::size_t> pushed{0};
+  long last_marker = -1;
+  std::atomic<jack_nframes_t> playback_latency{0};
+  std::atomic<std::uint64_t> xruns{0};
+  std::atomic<int> policy{-1}, priority{0};
+};
+
+int on_xrun(void* arg) {
+  static_cast<Run*>(arg)->xruns.fetch_add(1, std::memory_order_relaxed);
+  return 0;
+}
+
+// JACK's process thread: real-time safe (process(), clock reads, stores into
+// arrays sized before activation).
+int on_process(jack_nframes_t n, void* arg) {
+  auto& r = *static_cast<Run*>(arg);
+  auto* out = static_cast<float*>(jack_port_get_buffer(r.port, n));
+  if (r.policy.load(std::memory_order_relaxed) < 0) {
+    int pol = 0;
+    sched_param sp{};
+    pthread_getschedparam(pthread_self(), &pol, &sp);
+    r.priority.store(sp.sched_priority, std::memory_order_relaxed);
+    r.policy.store(pol, std::memory_order_relaxed);
+  }
+  const std::size_t frames = std::min<std::size_t>(n, r.positions.size());
+  timespec a{}, b{};
+  ::clock_gettime(CLOCK_MONOTONIC, &a);
+  const double cycle_us = 1e6 * static_cast<double>(a.tv_sec) + 1e-3 * static_cast<double>(a.tv_nsec);
+  alloc::counting = true;
+  r.player->process(std::span(out, frames), std::span(r.positions.data(), frames));
+  alloc::counting = false;
+  ::clock_gettime(CLOCK_MONOTONIC, &b);
+  const std::size_t k = r.blocks.load(std::memory_order_relaxed);
+  if (k < r.block_s.size()) {
+    r.block_s[k] = static_cast<double>(b.tv_sec - a.tv_sec) + 1e-9 * static_cast<double>(b.tv_nsec - a.tv_nsec);
+    r.blocks.store(k + 1, std::memory_order_relaxed);
+  }
+  // Which markers (pushed positions) appear first in this block, and when
+  // the driver plays them.
+  const double first_us = cycle_us + 1e6 * static_cast<double>(r.playback_latency.load(std::memory_order_relaxed)) / rate;
+  for (std::size_t i = 0; i < frames; ++i) {
+    // The newest marker this position has reached (a position between two
+    // markers has reached only the earlier one).
+    const auto m = static_cast<long>(std::floor((static_cast<double>(r.positions[i]) - 1.0) / step_mm + 1e-3));
+    if (m <= r.last_marker || m < 0 || static_cast<std::size_t>(m) >= r.latency_us.size()) continue;
+    const double played = first_us + 1e6 * static_cast<double>(i) / rate;
+    for (long q = r.last_marker + 1; q <= m; ++q)
+      r.latency_us[static_cast<std::size_t>(q)] = played - r.push_us[static_cast<std::size_t>(q)];
+    r.last_marker = m;
+  }
+  return 0;
+}
+
+template <class PushFn>
+Result run_client(const std::string& server, std::size_t block, double seconds, PlayerBase& player, PushFn push) {
+  Result res;
+  res.block = block;
+  Run r;
+  r.player = &player;
+  const auto max_blocks = static_cast<std::size_t>(seconds * rate / static_cast<double>(block)) + 1000;
+  r.block_s.assign(max_blocks, 0.0);
+  r.positions.assign(8192, 0.0f);
+  const auto markers = static_cast<std::size_t>(seconds * 1000.0) + 100;
+  r.push_us.assign(markers, 0.0);
+  r.latency_us.assign(markers, 0.0);
+  jack_status_t status{};
+  r.client =
+      jack_client_open("texel-bench", static_cast<jack_options_t>(JackNoStartServer | JackServerName), &status, server.c_str());
+  if (!r.client) {
+    res.scheduling = "JACK client failed to open";
+    return res;
+  }
+  r.port = jack_port_register(r.client, "out", JACK_DEFAULT_AUDIO_TYPE, JackPortIsOutput, 0);
+  jack_set_process_callback(r.client, on_process, &r);
+  jack_set_xrun_callback(r.client, on_xrun, &r);
+  // Warm the pages the callback touches (the tests' mlockall-less stand-in).
+  ::mlockall(MCL_CURRENT);
+  jack_activate(r.client);
+  const std::string me = std::string(jack_get_client_name(r.client)) + ":out";
+  jack_connect(r.client, me.c_str(), "system:playback_1");
+  jack_recompute_total_latencies(r.client);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  jack_latency_range_t range{};
+  jack_port_get_latency_range(r.port, JackPlaybackLatency, &range);
+  r.playback_latency = range.max;
+  res.playback_latency_frames = range.max;
+  const std::size_t warm_blocks = r.blocks.load();
+  const std::uint64_t xruns0 = r.xruns.load();
+  alloc::counted_allocations = 0;
+
+  // The finger: a 1 kHz sensor thread on absolute deadlines, each sample at
+  // the player's current time (live, no queued future).
+  timespec t{};
+  ::clock_gettime(CLOCK_MONOTONIC, &t);
+  for (std::size_t k = 0; k + 1 < markers && static_cast<double>(k) < seconds * 1000.0; ++k) {
+    t.tv_nsec += 1000000;
+    if (t.tv_nsec >= 1000000000) t.tv_nsec -= 1000000000, ++t.tv_sec;
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &t, nullptr) == EINTR) {
+    }
+    timespec now{};
+    ::clock_gettime(CLOCK_MONOTONIC, &now);
+    r.push_us[k] = 1e6 * static_cast<double>(now.tv_sec) + 1e-3 * static_cast<double>(now.tv_nsec);
+    push(player.time_s(), 1.0 + step_mm * static_cast<double>(k));
+    r.pushed = k + 1;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  jack_deactivate(r.client);
+  jack_client_close(r.client);
+
+  const std::size_t done = r.blocks.load();
+  std::vector<double> bs(r.block_s.begin() + static_cast<std::ptrdiff_t>(warm_blocks),
+                         r.block_s.begin() + static_cast<std::ptrdiff_t>(done));
+  res.blocks = bs.size();
+  res.block_time = percentiles(bs, static_cast<double>(block) / rate);
+  std::vector<double> lat;
+  for (std::size_t k = 0; k < r.pushed; ++k)
+    if (r.latency_us[k] != 0.0) lat.push_back(r.latency_us[k] / 1000.0);
+  res.latencies = lat.size();
+  if (!lat.empty()) {
+    std::sort(lat.begin(), lat.end());
+    res.lat_p50_ms = lat[lat.size() / 2];
+    res.lat_p99_ms = lat[std::min(lat.size() - 1, lat.size() * 99 / 100)];
+    res.lat_max_ms = lat.back();
+  }
+  res.allocations = alloc::counted_allocations.load();
+  res.xruns = r.xruns.load() - xruns0;
+  const int pol = r.policy.load();
+  res.scheduling = pol == SCHED_FIFO ? "SCHED_FIFO " + std::to_string(r.priority.load())
+                   : pol == SCHED_RR ? "SCHED_RR " + std::to_string(r.priority.load())
+                   : pol < 0         ? "no callback"
+                                     : "SCHED_OTHER (JACK not real-time)";
+  return res;
+}
+
+PlayerConfig live_config() {
+  PlayerConfig c;
+  c.rate_hz = rate;
+  c.mode = OutputMode::vibration;
+  c.prediction_s = 0.0;
+  c.extrapolate_s = 0.0;  // the output position is the newest sample's: "contains" is exact
+  return c;
+}
+
+std::unique_ptr<const PlayerMap> map_1d() {
+  std::vector<float> v(19200);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(0.5 + 0.5 * std::sin(0.37 * static_cast<double>(i)));
+  return std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, std::move(v));
+}
+
+std::unique_ptr<const PlayerMap2D> map_2d() {
+  Raster2D disc;
+  disc.width = disc.height = 512;
+  disc.pitch = Millimetres(0.25);
+  disc.values.resize(512 * 512);
+  for (int j = 0; j < 512; ++j)
+    for (int i = 0; i < 512; ++i)
+      disc.values[static_cast<std::size_t>(j * 512 + i)] = std::hypot(i - 256, j - 256) < 150 ? 1.0f : 0.3f;
+  TexelSpec spec;
+  spec.coarse_strength = 0.5;
+  return PlayerMap2D::path_indexed(spec, Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, {}}, disc, std::nullopt);
+}
+
+std::vector<Result> jack_runs(const std::string& load, std::size_t block, double seconds) {
+  std::vector<Result> out;
+  const std::string server = "texel-bench-" + std::to_string(::getpid());
+  const std::string log = "/tmp/" + server + "-jackd.log";
+  const std::string period = std::to_string(block);
+  // -P 80: JACK's clients run just below the server's priority, above anything else here.
+  Child jackd = spawn({"jackd", "-n", server, "-R", "-P", "80", "-d", "dummy", "-r", "48000", "-p", period}, log, false);
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  std::string mode = "jackd -R -P 80";
+  if (!running(jackd)) {  // real-time refused: run without it and say so
+    stop(jackd);
+    jackd = spawn({"jackd", "-n", server, "-r", "-d", "dummy", "-r", "48000", "-p", period}, log, false);
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    mode = "jackd -r (no real-time)";
+  }
+  if (!running(jackd)) {
+    std::fprintf(stderr, "jackd did not start (see %s); JACK runs skipped\n", log.c_str());
+    return out;
+  }
+  {
+    Player p(live_config(), map_1d());
+    Result r = run_client(server, block, seconds, p, [&](double t, double x) { p.push({t, x, true}); });
+    r.load = load, r.dim = "1-D", r.scheduling += ", " + mode;
+    out.push_back(r);
+  }
+  {
+    Player2D p(live_config(), map_2d());
+    Result r = run_client(server, block, seconds, p, [&](double t, double x) { p.push({t, x, 0.3 * x, true}); });
+    r.load = load, r.dim = "2-D", r.scheduling += ", " + mode;
+    out.push_back(r);
+  }
+  stop(jackd);
+  return out;
+}
+
+struct NullResult {
+  std::string load;
+  std::uint64_t blocks = 0, underruns = 0;
+  double worst_pct = 0;
+  std::string scheduling;
+};
+
+NullResult null_run(const std::string& load) {
+  NullResult n;
+  n.load = load;
+  Player p(live_config(), map_1d());
+  auto backend = make_null_backend(rate, 64);
+  backend->start(p);
+  for (int k = 0; k < 5000; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    p.push({p.time_s(), 1.0 + 0.01 * k, true});
+  }
+  backend->stop();
+  const BackendStats s = backend->stats();
+  n.blocks = s.blocks, n.underruns = s.underruns, n.worst_pct = 100.0 * s.worst_block_s / (64.0 / rate);
+  n.scheduling = backend->scheduling();
+  return n;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double seconds = 10.0;
+  std::string json;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--json" && i + 1 < argc)
+      json = argv[++i];
+    else if (a == "--seconds" && i + 1 < argc)
+      seconds = std::atof(argv[++i]);
+  }
+  const bool have_jack = on_path("jackd"), have_stress = on_path("stress-ng");
+  if (!have_jack) std::fprintf(stderr, "jackd not found (Debian jackd2): JACK runs skipped\n");
+  if (!have_stress) std::fprintf(stderr, "stress-ng not found: busy runs skipped\n");
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+
+  std::vector<Result> results;
+  std::vector<NullResult> nulls;
+  for (const char* load : {"idle", "busy"}) {
+    const bool busy = std::string(load) == "busy";
+    if (busy && !have_stress) continue;
+    Child stress;
+    if (busy) {
+      stress = spawn({"stress-ng", "--cpu", std::to_string(cores), "--timeout", "900"}, "/tmp/texel-bench-stress.log", true);
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    }
+    if (have_jack)
+      for (std::size_t block : {std::size_t{16}, std::size_t{64}})
+        for (auto& r : jack_runs(load, block, seconds)) results.push_back(r);
+    nulls.push_back(null_run(load));
+    stop(stress);
+  }
+
+  std::printf("texel_bench_player_paced: JACK dummy driver, 48 kHz, %.0f s per run, %u cores%s\n", seconds, cores,
+              have_stress ? "; busy = stress-ng --cpu <cores>" : "");
+  std::printf("%-5s %-4s %5s %8s | %8s %8s %8s %8s | %8s %8s %8s | %6s %5s | %s\n", "load", "dim", "block", "blocks", "p50 %",
+              "p99 %", "p99.9 %", "max %", "lat p50", "lat p99", "lat max", "allocs", "xruns", "scheduling");
+  for (const auto& r : results)
+    std::printf(
+        "%-5s %-4s %5zu %8zu | %8.3f %8.3f %8.3f %8.3f | %6.3fms %6.3fms %6.3fms | %6llu %5llu | %s (playback latency %.0f "
+        "frames)\n",
+        r.load.c_str(), r.dim.c_str(), r.block, r.blocks, r.block_time.p50, r.block_time.p99, r.block_time.p999, r.block_time.max,
+        r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms, static_cast<unsigned long long>(r.allocations),
+        static_cast<unsigned long long>(r.xruns), r.scheduling.c_str(), r.playback_latency_frames);
+  for (const auto& n : nulls)
+    std::printf(
+        "null backend (texel play --backend null), 64 frames, 5 s, %s: %llu blocks, %llu underruns, worst block %.2f %% of the "
+        "period; %s\n",
+        n.load.c_str(), static_cast<unsigned long long>(n.blocks), static_cast<unsigned long long>(n.underruns), n.worst_pct,
+        n.scheduling.c_str());
+  if (!json.empty()) {
+    if (std::FILE* f = std::fopen(json.c_str(), "w")) {
+      std::fprintf(f, "{\"seconds\": %.1f, \"cores\": %u, \"jack\": [", seconds, cores);
+      for (std::size_t i = 0; i < results.size(); ++i) {
+        const auto& r = results[i];
+        std::fprintf(
+            f,
+            "%s{\"load\": \"%s\", \"dim\": \"%s\", \"block\": %zu, \"blocks\": %zu, \"p50_pct\": %.4f, \"p99_pct\": %.4f, "
+            "\"p999_pct\": %.4f, \"max_pct\": %.4f, \"latency_p50_ms\": %.4f, \"latency_p99_ms\": %.4f, "
+            "\"latency_max_ms\": %.4f, \"allocations\": %llu, \"xruns\": %llu, \"scheduling\": \"%s\"}",
+            i ? ", " : "", r.load.c_str(), r.dim.c_str(), r.block, r.blocks, r.block_time.p50, r.block_time.p99,
+            r.block_time.p999, r.block_time.max, r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms,
+            static_cast<unsigned long long>(r.allocations), static_cast<unsigned long long>(r.xruns), r.scheduling.c_str());
+      }
+      std::fprintf(f, "], \"null\": [");
+      for (std::size_t i = 0; i < nulls.size(); ++i)
+        std::fprintf(f,
+                     "%s{\"load\": \"%s\", \"blocks\": %llu, \"underruns\": %llu, \"worst_pct\": %.3f, \"scheduling\": \"%s\"}",
+                     i ? ", " : "", nulls[i].load.c_str(), static_cast<unsigned long long>(nulls[i].blocks),
+                     static_cast<unsigned long long>(nulls[i].underruns), nulls[i].worst_pct, nulls[i].scheduling.c_str());
+      std::fprintf(f, "]}\n");
+      std::fclose(f);
+    }
+  }
+  std::uint64_t allocs = 0;
+  for (const auto& r : results) allocs += r.allocations;
+  return allocs == 0 ? 0 : 1;
+}
