@@ -38,7 +38,7 @@ double log_centroid_db(const std::vector<float>& y) {
   const std::vector<double> x(y.begin() + static_cast<std::ptrdiff_t>(skip), y.begin() + static_cast<std::ptrdiff_t>(end));
   WelchOptions o;
   o.segment = 4096;
-  const Psd p = welch_psd(x, 1.0 / rate, o);
+  const Psd p = welch_psd(x, Millimetres(1.0 / rate), o);
   double sw = 0, swd = 0;
   for (std::size_t k = 1; k < p.frequency_cpm.size(); ++k) {
     const double f = p.frequency_cpm[k];
