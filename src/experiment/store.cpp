@@ -366,8 +366,23 @@ Store Store::open(const std::string& path, StoreMode mode) {
 
   // An existing file is never created anew (no SQLITE_OPEN_CREATE), so a
   // path that vanishes between the check and the open is not recreated.
+  //
+  // A reader leaves no files behind. A WAL database read through a
+  // read-only connection gets a -wal and a -shm file that the reader cannot
+  // remove: only the last connection to close removes them, after a final
+  // checkpoint, and only if it can write (sqlite.org/wal.html). So when no
+  // -wal/-shm exists (no writer is connected and the last one closed
+  // cleanly), the reader opens the file read-write with query_only=1 (no
+  // statement can change it) and, if it is the last to close, removes the
+  // files its reading created; the checkpoint then moves at most frames a
+  // writer committed meanwhile, which changes no stored value. When they
+  // exist, a writer is running (or died): the reader opens read-only and
+  // leaves them to that writer, exactly as before.
+  const bool reader_may_clean = mode == StoreMode::read_only && !fs::exists(path + "-wal", ec) && !fs::exists(path + "-shm", ec);
   int flags = SQLITE_OPEN_FULLMUTEX;
-  if (mode == StoreMode::read_only)
+  if (reader_may_clean)
+    flags |= SQLITE_OPEN_READWRITE;
+  else if (mode == StoreMode::read_only)
     flags |= SQLITE_OPEN_READONLY;
   else
     flags |= SQLITE_OPEN_READWRITE | (exists ? 0 : SQLITE_OPEN_CREATE);
@@ -384,6 +399,7 @@ Store Store::open(const std::string& path, StoreMode mode) {
   if (mode == StoreMode::read_write && sqlite3_db_readonly(s->db, "main") == 1)
     throw IoError(path + " is read-only (no write permission); nothing was stored");
   s->writable = mode == StoreMode::read_write;
+  if (reader_may_clean) exec(*s, "PRAGMA query_only = 1", "opening the database for reading");
 
   // Identify the file before changing anything: garbage fails here with
   // SQLITE_NOTADB and is left byte-identical.
