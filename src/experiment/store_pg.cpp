@@ -1068,12 +1068,12 @@ std::vector<std::string> init_postgres(const std::string& db, const std::vector<
   };
   must("BEGIN", "starting the set-up");
   must("SELECT pg_advisory_xact_lock(1415071064)", "waiting for another set-up");  // 'TXEX'
-  must(
-      "DO $$ BEGIN "
-      "IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = 'texel_station') THEN CREATE ROLE texel_station NOLOGIN; END IF; "
-      "IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = 'texel_analyst') THEN CREATE ROLE texel_analyst NOLOGIN; END IF; "
-      "END $$",
-      "creating the roles texel_station and texel_analyst");
+  // Roles are the cluster's, shared by its databases: another database's
+  // set-up may create them at the same moment.
+  for (const char* group : {"texel_station", "texel_analyst"})
+    must(std::string("DO $$ BEGIN CREATE ROLE ") + group +
+             " NOLOGIN; EXCEPTION WHEN duplicate_object OR unique_violation THEN NULL; END $$",
+         std::string("creating the role ") + group);
   int v = pg::server_version(c, t.label);
   if (v > pg::current_server_schema)
     throw FormatError(t.label + " has schema version " + std::to_string(v) + ", newer than this build's " +
@@ -1089,13 +1089,13 @@ std::vector<std::string> init_postgres(const std::string& db, const std::vector<
   auto add_role = [&](const std::string& name, const char* group) {
     const std::string id = pg::ident(c, name);
     pg::Result exists = pg::run(c, "SELECT 1 FROM pg_roles WHERE rolname = $1", {name});
-    if (exists.ok() && exists.rows() == 0) {
-      must("CREATE ROLE " + id + " LOGIN IN ROLE " + group, "creating the role " + name);
+    must("DO $$ BEGIN CREATE ROLE " + id + " LOGIN IN ROLE " + group +
+             "; EXCEPTION WHEN duplicate_object OR unique_violation THEN GRANT " + group + " TO " + id + "; END $$",
+         "creating the role " + name);
+    if (exists.ok() && exists.rows() == 0)
       report.push_back("created login role " + name + " (" + group + "); set its password with psql's \\password " + name);
-    } else {
-      must("GRANT " + std::string(group) + " TO " + id, "granting " + std::string(group) + " to " + name);
+    else
       report.push_back("role " + name + " is a member of " + group);
-    }
   };
   for (const auto& s : stations) add_role(s, "texel_station");
   for (const auto& a : analysts) add_role(a, "texel_analyst");
