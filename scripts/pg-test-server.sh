@@ -6,6 +6,8 @@
 #
 #   scripts/pg-test-server.sh start ENV_FILE   start; write the connection to ENV_FILE
 #   scripts/pg-test-server.sh stop ENV_FILE    stop it and remove its directory
+#   scripts/pg-test-server.sh down ENV_FILE    stop it as a crash would (immediate), keeping its data
+#   scripts/pg-test-server.sh up ENV_FILE      start it again after down
 #
 # ENV_FILE (shell syntax) sets TEXEL_PG_DIR, TEXEL_PG_BIN, TEXEL_PG_SOCKET,
 # TEXEL_PG_PORT, TEXEL_PG_ADMIN (the superuser: trust on the socket only) and
@@ -15,7 +17,7 @@ set -euo pipefail
 
 cmd=${1:-}
 env_file=${2:-}
-[ -n "$cmd" ] && [ -n "$env_file" ] || { echo "usage: $0 start|stop ENV_FILE" >&2; exit 2; }
+[ -n "$cmd" ] && [ -n "$env_file" ] || { echo "usage: $0 start|stop|down|up ENV_FILE" >&2; exit 2; }
 
 pg_bin() {
   local d
@@ -44,8 +46,8 @@ local all texel_admin trust
 local all all scram-sha-256
 host all all 127.0.0.1/32 scram-sha-256
 EOF
-  "${as[@]}" "$bin/pg_ctl" -D "$dir/data" -l "$dir/server.log" -w -t 30 \
-    -o "-k $dir -c listen_addresses=127.0.0.1 -p $port -c max_connections=200 -c shared_buffers=32MB" start >/dev/null ||
+  opts="-k $dir -c listen_addresses=127.0.0.1 -p $port -c max_connections=200 -c shared_buffers=32MB"
+  "${as[@]}" "$bin/pg_ctl" -D "$dir/data" -l "$dir/server.log" -w -t 30 -o "$opts" start >/dev/null ||
     { cat "$dir/server.log" >&2; exit 1; }
   {
     echo "TEXEL_PG_DIR=$dir"
@@ -54,6 +56,7 @@ EOF
     echo "TEXEL_PG_PORT=$port"
     echo "TEXEL_PG_ADMIN=texel_admin"
     echo "TEXEL_PG_AS='${as[*]}'"
+    echo "TEXEL_PG_OPTS='$opts'"
   } >"$env_file"
   echo "pg-test-server: PostgreSQL at 127.0.0.1:$port and $dir (data $dir/data)"
   ;;
@@ -66,8 +69,18 @@ stop)
   case "$TEXEL_PG_DIR" in /tmp/texel-pg.*) rm -rf "$TEXEL_PG_DIR" ;; esac
   rm -f "$env_file"
   ;;
+down|up)
+  # shellcheck disable=SC1090
+  . "$env_file"
+  read -r -a as <<<"${TEXEL_PG_AS:-}"
+  if [ "$cmd" = down ]; then
+    "${as[@]}" "$TEXEL_PG_BIN/pg_ctl" -D "$TEXEL_PG_DIR/data" -m immediate -w stop >/dev/null
+  else
+    "${as[@]}" "$TEXEL_PG_BIN/pg_ctl" -D "$TEXEL_PG_DIR/data" -l "$TEXEL_PG_DIR/server.log" -w -t 60 -o "$TEXEL_PG_OPTS" start >/dev/null
+  fi
+  ;;
 *)
-  echo "usage: $0 start|stop ENV_FILE" >&2
+  echo "usage: $0 start|stop|down|up ENV_FILE" >&2
   exit 2
   ;;
 esac

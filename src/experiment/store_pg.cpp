@@ -142,8 +142,9 @@ bool is_outage(const std::string& why) {
   for (const char* s :
        {"Connection refused", "No such file or directory", "timeout expired", "could not translate host",
         "the database system is starting up", "the database system is shutting down", "the database system is in recovery",
-        "server closed the connection", "Network is unreachable", "No route to host", "Connection reset",
-        "could not receive data", "could not send data", "terminating connection", "no connection to the server", "SSL SYSCALL"})
+        "not yet accepting connections", "recovery mode", "too many connections", "server closed the connection",
+        "Network is unreachable", "No route to host", "Connection reset", "could not receive data", "could not send data",
+        "terminating connection", "no connection to the server", "SSL SYSCALL"})
     if (why.find(s) != std::string::npos) return true;
   return false;
 }

@@ -69,7 +69,8 @@ class PgStore : public ::testing::Test {
     return "postgresql://" + role + "@127.0.0.1:" + env_.at("TEXEL_PG_PORT") + "/" + db_;
   }
   void admin_sql(const std::string& db, const std::string& sql) {
-    const std::string ci = "host=" + env_["TEXEL_PG_SOCKET"] + " port=" + env_["TEXEL_PG_PORT"] + " user=texel_admin dbname=" + db;
+    const std::string ci =
+        "host=" + env_["TEXEL_PG_SOCKET"] + " port=" + env_["TEXEL_PG_PORT"] + " user=texel_admin dbname=" + db;
     PGconn* c = PQconnectdb(ci.c_str());
     ASSERT_EQ(PQstatus(c), CONNECTION_OK) << PQerrorMessage(c);
     PGresult* r = PQexec(c, sql.c_str());
@@ -96,8 +97,8 @@ class PgStore : public ::testing::Test {
   }
 
   std::int64_t run_session(ex::Store& s, const std::string& who, int trials, bool finish) {
-    const auto id = s.create_session(who, "texel-length", "texel-length", R"({"name":"texel-length"})", 18446744073709551615ull, "",
-                                     trials);
+    const auto id =
+        s.create_session(who, "texel-length", "texel-length", R"({"name":"texel-length"})", 18446744073709551615ull, "", trials);
     auto lock = s.acquire_writer(id);
     for (int i = 0; i < trials; ++i) s.append_trial(lock, full_trial(i));
     if (finish) s.finish_session(lock);
@@ -255,8 +256,9 @@ TEST_F(PgStore, RolesStationsInsertOnlyTheirOwnAnalystsOnlyRead) {
   EXPECT_NE(as("st1", "DROP TABLE texel.events").find("must be owner"), std::string::npos);
   EXPECT_NE(as("st1", "CREATE TABLE texel.mine (x integer)").find("permission denied"), std::string::npos);
   EXPECT_NE(as("st1", "TRUNCATE texel.trials").find("permission denied"), std::string::npos);
-  EXPECT_NE(as("st1", "INSERT INTO texel.sessions(station, uuid, local_id, participant, protocol, study, protocol_json, seed, "
-                      "created_at) VALUES ('st2', gen_random_uuid(), 1, 'X', 'p', 'p', '{}', '1', 'now')")
+  EXPECT_NE(as("st1",
+               "INSERT INTO texel.sessions(station, uuid, local_id, participant, protocol, study, protocol_json, seed, "
+               "created_at) VALUES ('st2', gen_random_uuid(), 1, 'X', 'p', 'p', '{}', '1', 'now')")
                 .find("row-level security"),
             std::string::npos);
   EXPECT_NE(as("st1", "DELETE FROM texel.leases").find("permission denied"), std::string::npos);
@@ -294,9 +296,9 @@ TEST_F(PgStore, BadInputIsOneLineAndLosesNothing) {
   admin_sql("postgres", "DROP DATABASE IF EXISTS " + db_ + "_empty WITH (FORCE)");
   admin_sql("postgres", "CREATE DATABASE " + db_ + "_empty");
   m = message_of<texel::FormatError>([&] {
-    (void)ex::Store::open("postgresql://texel_admin@/" + db_ + "_empty?host=" + env_["TEXEL_PG_SOCKET"] + "&port=" +
-                              env_["TEXEL_PG_PORT"],
-                          ex::StoreMode::read_only);
+    (void)ex::Store::open(
+        "postgresql://texel_admin@/" + db_ + "_empty?host=" + env_["TEXEL_PG_SOCKET"] + "&port=" + env_["TEXEL_PG_PORT"],
+        ex::StoreMode::read_only);
   });
   EXPECT_NE(m.find("no texel schema"), std::string::npos) << m;
   admin_sql("postgres", "DROP DATABASE " + db_ + "_empty WITH (FORCE)");
