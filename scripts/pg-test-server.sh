@@ -12,6 +12,7 @@
 # ENV_FILE (shell syntax) sets TEXEL_PG_DIR, TEXEL_PG_BIN, TEXEL_PG_SOCKET,
 # TEXEL_PG_PORT, TEXEL_PG_ADMIN (the superuser: trust on the socket only) and
 # TEXEL_PG_AS (the command prefix that runs a server binary as its user).
+# TEXEL_PG_EXTRA_OPTS adds server settings (the benchmark: -c track_commit_timestamp=on).
 # Over TCP every role authenticates with a SCRAM password.
 set -euo pipefail
 
@@ -46,7 +47,7 @@ local all texel_admin trust
 local all all scram-sha-256
 host all all 127.0.0.1/32 scram-sha-256
 EOF
-  opts="-k $dir -c listen_addresses=127.0.0.1 -p $port -c max_connections=200 -c shared_buffers=32MB"
+  opts="-k $dir -c listen_addresses=127.0.0.1 -p $port -c max_connections=200 -c shared_buffers=32MB ${TEXEL_PG_EXTRA_OPTS:-}"
   "${as[@]}" "$bin/pg_ctl" -D "$dir/data" -l "$dir/server.log" -w -t 30 -o "$opts" start >/dev/null ||
     { cat "$dir/server.log" >&2; exit 1; }
   {

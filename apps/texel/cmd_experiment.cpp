@@ -151,7 +151,8 @@ void run(const RunArgs& a) {
     monitor.close();
     if (monitor_created) std::filesystem::remove(*a.monitor);
     if (!existed)
-      for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(local + suffix);
+      for (const char* suffix : {"", "-wal", "-shm", "-journal", "-shipping.db", "-shipping.db-wal", "-shipping.db-shm"})
+        std::filesystem::remove(local + suffix);
     throw;
   }
   if (opened->is_station()) warn_if_offline(*opened);

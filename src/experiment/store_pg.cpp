@@ -561,12 +561,25 @@ std::string host_name() {
   return buf;
 }
 
-std::string new_uuid() {
-  std::random_device rd;
+// A session's uuid on the server: derived from what identifies it for good —
+// the station (its role), the journal's session id, creation time,
+// participant, protocol and seed — two FNV-1a 64-bit hashes, marked as an
+// RFC 9562 version 8 (custom) uuid. Nothing to store: a lost shipping
+// record only means shipping again under the same keys.
+std::string session_uuid(const std::vector<std::string>& parts) {
+  std::uint64_t h[2] = {14695981039346656037ull, 0x6a09e667f3bcc909ull};
+  for (auto& x : h)
+    for (const auto& p : parts) {
+      for (const char c : p) x = (x ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+      x = (x ^ 0x1f) * 1099511628211ull;  // separator
+    }
   std::array<unsigned char, 16> b{};
-  for (auto& x : b) x = static_cast<unsigned char>(rd());
-  b[6] = static_cast<unsigned char>((b[6] & 0x0f) | 0x40);  // version 4
-  b[8] = static_cast<unsigned char>((b[8] & 0x3f) | 0x80);  // RFC 4122 variant
+  for (int i = 0; i < 8; ++i) {
+    b[static_cast<std::size_t>(i)] = static_cast<unsigned char>(h[0] >> (56 - 8 * i));
+    b[static_cast<std::size_t>(i + 8)] = static_cast<unsigned char>(h[1] >> (56 - 8 * i));
+  }
+  b[6] = static_cast<unsigned char>((b[6] & 0x0f) | 0x80);  // version 8
+  b[8] = static_cast<unsigned char>((b[8] & 0x3f) | 0x80);  // RFC variant
   char out[37];
   std::snprintf(out, sizeof out, "%02x%02x%02x%02x-%02x%02x-%02x%02x-%02x%02x-%02x%02x%02x%02x%02x%02x", b[0], b[1], b[2], b[3],
                 b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15]);
@@ -587,23 +600,29 @@ double iso_seconds(const std::string& s) {
 
 double now_seconds() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
+std::string shipping_path(const std::string& journal) { return journal + "-shipping.db"; }
+
 // The journal, through the shipper's own SQLite connection.
 class Journal {
  public:
   explicit Journal(const std::string& path) : path_(path) {
-    if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_FULLMUTEX, nullptr) != SQLITE_OK) {
+    if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
+        SQLITE_OK) {  // CREATE: for the shipping record; the journal exists (the store opened it)
       const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
       sqlite3_close_v2(db_);
       throw IoError("cannot open the journal " + path + " (" + why + ")");
     }
     sqlite3_busy_timeout(db_, 5000);
-    exec("PRAGMA synchronous = FULL");
-    // The shipping record beside the store's schema (a journal is a Texel
-    // database with these two tables more; docs/session-store.md).
+    // The shipping record lives beside the journal (PATH-shipping.db), so
+    // that shipping never takes the journal's write lock: the journal stays
+    // a plain Texel database written only by the store, and a trial's commit
+    // never waits for the shipper. Losing the record only means shipping
+    // again, which the server ignores.
+    exec(("ATTACH DATABASE '" + shipping_path(path) + "' AS ship").c_str());
+    exec("PRAGMA ship.journal_mode = WAL; PRAGMA ship.synchronous = NORMAL");
     exec(
-        "CREATE TABLE IF NOT EXISTS journal_ship (session_id INTEGER PRIMARY KEY REFERENCES sessions(id), uuid TEXT NOT NULL "
-        "UNIQUE, session_shipped INTEGER NOT NULL DEFAULT 0, trials_shipped INTEGER NOT NULL DEFAULT 0, finished_shipped "
-        "INTEGER NOT NULL DEFAULT 0)");
+        "CREATE TABLE IF NOT EXISTS ship.journal_ship (session_id INTEGER PRIMARY KEY, session_shipped INTEGER NOT NULL DEFAULT "
+        "0, trials_shipped INTEGER NOT NULL DEFAULT 0, finished_shipped INTEGER NOT NULL DEFAULT 0)");
   }
   ~Journal() { sqlite3_close_v2(db_); }
   Journal(const Journal&) = delete;
@@ -629,6 +648,12 @@ class Journal {
     while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
       std::vector<std::string> row;
       for (int c = 0; c < sqlite3_column_count(st); ++c) {
+        if (sqlite3_column_type(st, c) == SQLITE_FLOAT) {  // every bit of a double, not SQLite's 15 digits
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%.17g", sqlite3_column_double(st, c));
+          row.emplace_back(buf);
+          continue;
+        }
         const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(st, c));
         row.emplace_back(p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(st, c))) : std::string());
       }
@@ -639,13 +664,11 @@ class Journal {
     if (rc != SQLITE_DONE) throw IoError("journal " + path_ + ": " + why);
     return out;
   }
-  // The session's uuid, assigned (durably) on first use.
-  std::string uuid(std::int64_t sid) {
-    const auto id = std::to_string(sid);
-    auto r = query("SELECT uuid FROM journal_ship WHERE session_id = ?", {id});
-    if (!r.empty()) return r[0][0];
-    (void)query("INSERT OR IGNORE INTO journal_ship(session_id, uuid) VALUES (?, ?)", {id, new_uuid()});
-    return query("SELECT uuid FROM journal_ship WHERE session_id = ?", {id})[0][0];
+  // The session's uuid for `station` (session_uuid()).
+  std::string uuid(std::int64_t sid, const std::string& station) {
+    const auto r = query("SELECT id, created_at, participant, protocol, seed FROM sessions WHERE id = ?", {std::to_string(sid)});
+    if (r.empty()) throw IoError("journal " + path_ + " has no session " + std::to_string(sid));
+    return session_uuid({station, r[0][0], r[0][1], r[0][2], r[0][3], r[0][4]});
   }
 
  private:
@@ -698,8 +721,9 @@ class StationImpl final : public Station {
 
   void take_lease(const SessionInfo& s) override {
     std::lock_guard<std::mutex> io(io_mu_);
-    Lease l{s.participant, s.protocol, journal_.uuid(s.id)};
+    Lease l{s.participant, s.protocol, ""};
     if (ensure_connected(false)) {
+      l.uuid = journal_.uuid(s.id, station_);
       const auto holder = lease_call(l);
       if (holder && !holder->empty())
         throw IoError("participant " + s.participant + "'s '" + s.protocol + "' session is being run by " + *holder +
@@ -713,7 +737,7 @@ class StationImpl final : public Station {
     std::lock_guard<std::mutex> io(io_mu_);
     const auto it = leases_.find(sid);
     if (it == leases_.end()) return;
-    releases_.push_back(it->second.uuid);
+    releases_.push_back(it->first);
     leases_.erase(it);
     poke();
   }
@@ -846,6 +870,7 @@ class StationImpl final : public Station {
     if (!ensure_connected(false)) return;
     // The study-wide locks: renew ours, take the ones asked for offline.
     for (auto& [sid, l] : leases_) {
+      if (l.uuid.empty()) l.uuid = journal_.uuid(sid, station_);  // asked for offline
       if (l.granted) {
         Result r = run(pg_, "SELECT texel.renew_lease($1)", {l.uuid});
         if (!r.ok()) return failed(r, "renewing the study-wide lock");
@@ -864,7 +889,7 @@ class StationImpl final : public Station {
       }
     }
     while (!releases_.empty()) {
-      Result r = run(pg_, "SELECT texel.release_lease($1)", {releases_.back()});
+      Result r = run(pg_, "SELECT texel.release_lease($1)", {journal_.uuid(releases_.back(), station_)});
       if (!r.ok()) return failed(r, "releasing the study-wide lock");
       releases_.pop_back();
     }
@@ -873,7 +898,7 @@ class StationImpl final : public Station {
         "SELECT s.id, s.participant, s.protocol, s.study, s.protocol_json, s.seed, s.simulate, s.status, s.trials_planned, "
         "s.created_at, s.updated_at, (SELECT COUNT(*) FROM trials t WHERE t.session_id = s.id), "
         "COALESCE(j.session_shipped, 0), COALESCE(j.trials_shipped, 0), COALESCE(j.finished_shipped, 0) "
-        "FROM sessions s LEFT JOIN journal_ship j ON j.session_id = s.id "
+        "FROM sessions s LEFT JOIN ship.journal_ship j ON j.session_id = s.id "
         "WHERE j.session_id IS NULL OR j.session_shipped = 0 OR j.trials_shipped < (SELECT COUNT(*) FROM trials t WHERE "
         "t.session_id = s.id) OR (s.status = 'finished' AND j.finished_shipped = 0) ORDER BY s.id");
     for (const auto& s : todo)
@@ -886,7 +911,7 @@ class StationImpl final : public Station {
   // journal. False when the pass must stop (server gone, refused).
   bool ship_session(const std::vector<std::string>& s) {
     const std::string sid = s[0];
-    const std::string uuid = journal_.uuid(std::stoll(sid));
+    const std::string uuid = journal_.uuid(std::stoll(sid), station_);
     const int total = std::stoi(s[11]);
     int shipped = std::stoi(s[13]);
     constexpr int batch = 200;
@@ -904,24 +929,16 @@ class StationImpl final : public Station {
           "SELECT trial, question_json, response_json, state_json, row_json, stored_at FROM trials WHERE session_id = ? AND "
           "trial >= ? AND trial < ? ORDER BY trial",
           {sid, std::to_string(shipped), std::to_string(upto)});
-      for (const auto& t : trials) {
-        Result r = run(pg_,
-                       "INSERT INTO texel.trials(station, session_uuid, trial, question_json, response_json, state_json, "
-                       "row_json, stored_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8) ON CONFLICT DO NOTHING",
-                       {station_, uuid, t[0], t[1], t[2], t[3], t[4], t[5]});
-        if (!r.ok()) return failed(r, "shipping trial " + t[0] + " of session " + sid), false;
-      }
+      Result r = insert_rows(
+          "INSERT INTO texel.trials(station, session_uuid, trial, question_json, response_json, state_json, row_json, stored_at)",
+          uuid, trials);
+      if (!r.ok()) return failed(r, "shipping the trials of session " + sid), false;
       const auto events = journal_.query(
           "SELECT trial, seq, t_s, kind, detail, at FROM events WHERE session_id = ? AND trial >= ? AND trial < ? "
           "ORDER BY trial, seq",
           {sid, std::to_string(shipped), std::to_string(upto)});
-      for (const auto& e : events) {
-        Result r = run(pg_,
-                       "INSERT INTO texel.events(station, session_uuid, trial, seq, t_s, kind, detail, at) VALUES ($1, $2, $3, "
-                       "$4, $5, $6, $7, $8) ON CONFLICT DO NOTHING",
-                       {station_, uuid, e[0], e[1], e[2], e[3], e[4], e[5]});
-        if (!r.ok()) return failed(r, "shipping the events of session " + sid), false;
-      }
+      Result ev = insert_rows("INSERT INTO texel.events(station, session_uuid, trial, seq, t_s, kind, detail, at)", uuid, events);
+      if (!ev.ok()) return failed(ev, "shipping the events of session " + sid), false;
       const bool complete = upto == total && s[7] == "finished";
       if (complete) {
         Result c = run(pg_,
@@ -937,13 +954,30 @@ class StationImpl final : public Station {
       // The server has it: record that (a crash before this line only means
       // shipping it again, which the server ignores).
       (void)journal_.query(
-          "UPDATE journal_ship SET session_shipped = 1, trials_shipped = max(trials_shipped, ?), finished_shipped = "
-          "max(finished_shipped, ?) WHERE "
-          "session_id = ?",
-          {std::to_string(upto), complete ? "1" : "0", sid});
+          "INSERT INTO ship.journal_ship(session_id, session_shipped, trials_shipped, finished_shipped) VALUES (?, 1, ?, ?) "
+          "ON CONFLICT(session_id) DO UPDATE SET session_shipped = 1, trials_shipped = max(trials_shipped, "
+          "excluded.trials_shipped), finished_shipped = max(finished_shipped, excluded.finished_shipped)",
+          {sid, std::to_string(upto), complete ? "1" : "0"});
       shipped = upto;
     } while (shipped < total);
     return true;
+  }
+
+  // One statement for many rows: (station, uuid) are $1, $2 of every row,
+  // the rows' own fields follow; ON CONFLICT DO NOTHING makes it idempotent.
+  Result insert_rows(const std::string& head, const std::string& uuid, const std::vector<std::vector<std::string>>& rows) {
+    if (rows.empty()) return run(pg_, "SELECT 1");
+    std::string sql = head + " VALUES ";
+    std::vector<std::string> params = {station_, uuid};
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      sql += r ? ", ($1, $2" : "($1, $2";
+      for (const auto& v : rows[r]) {
+        params.push_back(v);
+        sql += ", $" + std::to_string(params.size());
+      }
+      sql += ")";
+    }
+    return run(pg_, sql + " ON CONFLICT DO NOTHING", params);
   }
 
   // This station's row in texel.station_progress (the experimenter's view).
@@ -972,9 +1006,12 @@ class StationImpl final : public Station {
   void refresh_counts() {
     try {
       const auto c = journal_.query(
-          "SELECT (SELECT COUNT(*) FROM trials), (SELECT COALESCE(SUM(trials_shipped), 0) FROM journal_ship), (SELECT COUNT(*) "
-          "FROM sessions), (SELECT COUNT(*) FROM sessions s LEFT JOIN journal_ship j ON j.session_id = s.id WHERE s.status = "
-          "'finished' AND COALESCE(j.finished_shipped, 0) = 0), (SELECT MIN(t.stored_at) FROM trials t LEFT JOIN journal_ship "
+          "SELECT (SELECT COUNT(*) FROM trials), (SELECT COALESCE(SUM(trials_shipped), 0) FROM ship.journal_ship), (SELECT "
+          "COUNT(*) "
+          "FROM sessions), (SELECT COUNT(*) FROM sessions s LEFT JOIN ship.journal_ship j ON j.session_id = s.id WHERE s.status "
+          "= "
+          "'finished' AND COALESCE(j.finished_shipped, 0) = 0), (SELECT MIN(t.stored_at) FROM trials t LEFT JOIN "
+          "ship.journal_ship "
           "j ON j.session_id = t.session_id WHERE t.trial >= COALESCE(j.trials_shipped, 0))");
       std::lock_guard<std::mutex> st(state_mu_);
       state_.trials_local = std::stoll(c[0][0]);
@@ -994,7 +1031,7 @@ class StationImpl final : public Station {
   std::string host_, station_;
   PGconn* pg_ = nullptr;
   std::map<std::int64_t, Lease> leases_;
-  std::vector<std::string> releases_;
+  std::vector<std::int64_t> releases_;
   std::mutex io_mu_;  // pg_, journal_, leases_, releases_
   mutable std::mutex state_mu_;
   ShipStatus state_;

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <thread>
@@ -172,11 +173,14 @@ TEST_F(PgStore, RepeatedShippingStoresNothingTwice) {
   }
   // Forget what the server confirmed: everything is shipped again.
   sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(dir_.at("st1.db").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_open(dir_.at("st1.db-shipping.db").c_str(), &db), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db, "UPDATE journal_ship SET session_shipped = 0, trials_shipped = 0, finished_shipped = 0", nullptr,
                          nullptr, nullptr),
             SQLITE_OK);
   sqlite3_close(db);
+  // Even without its shipping record (lost, deleted) the journal ships under
+  // the same keys.
+  std::filesystem::remove(dir_.at("st1.db-shipping.db"));
   auto s = station("st1", "st1.db");
   ASSERT_TRUE(s.sync(20));
   std::string n;
