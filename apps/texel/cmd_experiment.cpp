@@ -91,19 +91,8 @@ void sync_command(const std::string& db, const std::string& journal, double time
   const bool done = store.sync(timeout_s);
   const ex::ShipStatus s = store.shipping();
   if (as_json) {
-    ordered_json j;
-    j["server"] = s.server;
-    j["station"] = s.station;
-    j["journal"] = s.journal;
-    j["connected"] = s.connected;
-    j["error"] = s.last_error;
-    j["trials_local"] = s.trials_local;
+    ordered_json j = ordered_json::parse(ex::to_json(s));
     j["trials_shipped_before"] = before.trials_shipped;
-    j["trials_shipped"] = s.trials_shipped;
-    j["sessions_local"] = s.sessions_local;
-    j["completions_pending"] = s.completions_pending;
-    j["lag_s"] = s.lag_s;
-    j["conflicts"] = s.conflicts;
     j["synced"] = done;
     print_json(j);
   } else {

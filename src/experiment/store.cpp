@@ -394,6 +394,12 @@ bool Store::sync(double timeout_s) {
   return impl_->station->sync(timeout_s);
 }
 
+std::string Store::station_rows_json() const {
+  if (impl_->reader) return impl_->reader->stations();
+  if (impl_->station) return impl_->station->stations();
+  return "[]";
+}
+
 Store Store::open(const std::string& path, StoreMode mode) {
   namespace fs = std::filesystem;
   if (is_postgres(path)) return open(path, mode, StoreOptions{});

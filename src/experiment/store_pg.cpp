@@ -255,6 +255,19 @@ void check_version(PGconn* c, const std::string& label) {
                       ": the migration owner runs texel store init --postgres URI to migrate it");
 }
 
+// Every station's progress as a JSON array (one statement, built by the server).
+std::string station_rows(PGconn* c, const std::string& label) {
+  Result r = run(c,
+                 "SELECT COALESCE(json_agg(json_build_object('station', station, 'host', host, 'trials_local', trials_local, "
+                 "'trials_shipped', trials_shipped, 'sessions', sessions_local, 'completions_pending', completions_pending, "
+                 "'lag_s', CASE WHEN trials_local > trials_shipped AND oldest_unshipped_at <> '' THEN round(extract(epoch FROM "
+                 "reported_at - oldest_unshipped_at::timestamptz)::numeric, 3) ELSE 0 END, 'last_report_s', "
+                 "round(extract(epoch FROM clock_timestamp() - reported_at)::numeric, 3)) ORDER BY station), '[]') FROM "
+                 "texel.station_progress");
+  if (!r.ok()) throw IoError(label + ": reading the stations' progress failed: " + r.error());
+  return r.text(0, 0);
+}
+
 // Server migrations, numbered like the SQLite ones: migrations[v] takes the
 // texel schema from version v to v + 1 in the owner's transaction. A
 // released entry is never edited. Version 0 is no texel schema.
@@ -511,6 +524,10 @@ class ReaderImpl final : public Reader {
     }
     return out;
   }
+  [[nodiscard]] std::string stations() const override {
+    std::lock_guard<std::mutex> hold(mu_);
+    return station_rows(c_, t_.label);
+  }
   [[nodiscard]] std::vector<TrialRow> rows(std::optional<std::int64_t> id) const override {
     std::string sql =
         "SELECT s.id, t.trial, t.row_json, s.participant, s.protocol, s.study FROM texel.trials t JOIN texel.sessions s ON "
@@ -750,6 +767,12 @@ class StationImpl final : public Station {
     return s;
   }
 
+  [[nodiscard]] std::string stations() override {
+    std::lock_guard<std::mutex> io(io_mu_);
+    if (!pg_ || PQstatus(pg_) != CONNECTION_OK) throw IoError(t_.label + " is not reachable: " + status().last_error);
+    return station_rows(pg_, t_.label);
+  }
+
   bool sync(double timeout_s) override {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
     for (;;) {
@@ -946,8 +969,8 @@ class StationImpl final : public Station {
                        "ON CONFLICT DO NOTHING",
                        {station_, uuid, std::to_string(total), s[10]});
         if (!c.ok()) return failed(c, "shipping the completion of session " + sid), false;
-        Result r = run(pg_, "SELECT texel.release_lease($1)", {uuid});
-        if (!r.ok()) return failed(r, "releasing the study-wide lock"), false;
+        Result rl = run(pg_, "SELECT texel.release_lease($1)", {uuid});
+        if (!rl.ok()) return failed(rl, "releasing the study-wide lock"), false;
       }
       Result e = run(pg_, "COMMIT");
       if (!e.ok()) return failed(e, "shipping session " + sid), false;

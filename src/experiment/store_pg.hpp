@@ -27,6 +27,8 @@ class Reader {
   [[nodiscard]] virtual std::vector<std::string> participants() const = 0;
   [[nodiscard]] virtual std::vector<StoredTrial> trials(std::int64_t session_id) const = 0;
   [[nodiscard]] virtual std::vector<TrialRow> rows(std::optional<std::int64_t> session_id) const = 0;
+  /// texel.station_progress as a JSON array text (stations_json()).
+  [[nodiscard]] virtual std::string stations() const = 0;
 };
 std::shared_ptr<Reader> open_reader(const std::string& db);
 
@@ -44,6 +46,8 @@ class Station {
   virtual void release_lease(std::int64_t session_id) = 0;
   [[nodiscard]] virtual ShipStatus status() const = 0;
   virtual bool sync(double timeout_s) = 0;
+  /// texel.station_progress as a JSON array text; throws IoError offline.
+  [[nodiscard]] virtual std::string stations() = 0;
 };
 /// Connects once (a server that cannot be reached is not an error);
 /// `journal` is open and migrated already.

@@ -178,6 +178,15 @@ TEST(Store, ReaderLeavesNoWalOrShmFiles) {
   EXPECT_EQ(file_bytes(path), before);
 }
 
+TEST(Store, AnSqliteFileIsNoStation) {
+  TempDir dir("store");
+  auto s = ex::Store::open(dir.at("exp.db"), ex::StoreMode::read_write);
+  EXPECT_FALSE(s.is_station());
+  EXPECT_FALSE(ex::is_postgres(dir.at("exp.db")));
+  EXPECT_EQ(ex::stations_json(s), R"({"multi_station":false,"this_station":null,"server_error":"","stations":[]})");
+  EXPECT_THROW((void)s.shipping(), texel::InvalidArgument);
+}
+
 TEST(Store, ReaderBesideARunningWriterSeesItsCommitsAndLeavesItsFiles) {
   TempDir dir("store");
   const auto path = dir.at("exp.db");

@@ -18,6 +18,8 @@
 #include <map>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "fixtures.hpp"
@@ -276,6 +278,18 @@ TEST_F(PgStore, RolesStationsInsertOnlyTheirOwnAnalystsOnlyRead) {
   // Every station's progress is visible to every station (no participant data in it).
   EXPECT_EQ(as("st1", "SELECT count(*) FROM texel.station_progress", &n), "");
   EXPECT_EQ(n, "2");
+  // The experimenter's view (the studio's experiment.stations) from a station.
+  auto a = station("st1", "st1.db");
+  const auto view = nlohmann::json::parse(ex::stations_json(a));
+  EXPECT_TRUE(view["multi_station"].get<bool>());
+  EXPECT_EQ(view["this_station"]["station"], "st1");
+  EXPECT_EQ(view["server_error"], "");
+  ASSERT_EQ(view["stations"].size(), 2u);
+  EXPECT_EQ(view["stations"][1]["station"], "st2");
+  EXPECT_EQ(view["stations"][1]["trials_local"], 3);
+  EXPECT_EQ(view["stations"][1]["trials_shipped"], 3);
+  EXPECT_EQ(view["stations"][1]["lag_s"], 0);
+  EXPECT_GE(view["stations"][1]["last_report_s"].get<double>(), 0.0);
 }
 
 TEST_F(PgStore, BadInputIsOneLineAndLosesNothing) {

@@ -103,6 +103,11 @@ struct ShipStatus {
   std::vector<std::string> conflicts;  ///< study-wide lock conflicts found when the server came back
 };
 
+/// The shipping state as JSON object text: station, server, journal,
+/// connected, error, trials_local, trials_shipped, sessions_local,
+/// completions_pending, lag_s, conflicts (CLI `sync --json`, the studio).
+std::string to_json(const ShipStatus& s);
+
 /// `texel store init --postgres URI`: as the migration owner (the role the
 /// URI logs in as), create or migrate the `texel` schema, the group roles
 /// texel_station and texel_analyst, and one login role per station and
@@ -167,6 +172,8 @@ class Store {
   /// Ships now and waits up to timeout_s for every stored trial and
   /// completion to be on the server; true when they are.
   bool sync(double timeout_s);
+  /// stations_json()'s list, read from the server (PostgreSQL only).
+  [[nodiscard]] std::string station_rows_json() const;
 
   /// Creates the participant if new (code: 1–32 of A–Z a–z 0–9 _ . -).
   std::int64_t create_session(const std::string& participant, const std::string& protocol, const std::string& study,
@@ -195,6 +202,16 @@ class Store {
   explicit Store(std::shared_ptr<StoreConnection> impl);
   std::shared_ptr<StoreConnection> impl_;
 };
+
+/// Every station's progress and shipping lag (the experimenter's view), as
+/// JSON object text: "multi_station" (false for an SQLite file: then
+/// "stations" is empty), "this_station" (shipping(), or null when this
+/// process is no station), "server_error" (why the list could not be read,
+/// or "") and "stations": per station of texel.station_progress its station,
+/// host, trials_local, trials_shipped, sessions, completions_pending,
+/// lag_s (age of its oldest unshipped trial at its last report) and
+/// last_report_s (seconds since that report).
+std::string stations_json(const Store& store);
 
 /// Where every session stands (`texel experiment status --json`), as JSON
 /// object text: database (the `database` label given), schema_version,
