@@ -224,9 +224,11 @@ Result run(PGconn* c, const std::string& sql, const std::vector<std::string>& pa
 // The Texel schema's version on the server, 0 when there is none.
 int server_version(PGconn* c, const std::string& label) {
   Result ns = run(c, "SELECT 1 FROM pg_namespace WHERE nspname = 'texel'");
-  if (!ns.ok()) throw IoError(label + ": reading the schema failed: " + ns.error());
+  if (!ns.ok()) throw IoError(label + ": reading the schema failed (" + ns.error() + ")");
   if (ns.rows() == 0) return 0;
   Result m = run(c, "SELECT key, value FROM texel.meta WHERE key IN ('application', 'schema_version')");
+  if (!m.ok() && PQstatus(c) != CONNECTION_OK)
+    throw IoError(label + ": lost the server while reading the schema (" + m.error() + ")");
   if (!m.ok()) {
     if (m.sqlstate() == "42501")
       throw IoError(label + ": the role " + std::string(PQuser(c)) +
@@ -812,10 +814,12 @@ class StationImpl final : public Station {
     try {
       check_version(pg_, t_.label);
     } catch (const Error& e) {
+      // The link dropping during the check is an outage like any other.
+      const bool outage = PQstatus(pg_) != CONNECTION_OK;
       PQfinish(pg_);
       pg_ = nullptr;
       set_error(e.what());
-      if (at_start) throw;
+      if (at_start && !outage) throw;
       return false;
     }
     Result who = run(pg_, "SELECT session_user");
