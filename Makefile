@@ -115,6 +115,9 @@ bench: build web web-test
 	$(PY) bench/render_to_file.py $(BUILD)/bin/texel
 	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null
 	$(PY) bench/studio_latency.py $(BUILD)/browser-artifacts/latency.json
+	TEXEL_PG_EXTRA_OPTS="-c track_commit_timestamp=on" scripts/pg-test-server.sh start $(BUILD)/bench-pg.env >/dev/null
+	$(BUILD)/bin/texel_bench_store_pg --env $(BUILD)/bench-pg.env --stations 50 --trials 1000 --json $(BUILD)/bench_store_pg.json; \
+	  rc=$$?; scripts/pg-test-server.sh stop $(BUILD)/bench-pg.env; exit $$rc
 
 # The libFuzzer targets of every parser of outside input (docs/fuzzing.md):
 # a clang build in build-fuzz with the whole library instrumented, then each

@@ -16,6 +16,10 @@ packages=(
   # codec (sndfile, zstd), experiment (sqlite, Boost.Math), studio (Boost.Beast)
   nlohmann-json3-dev libkissfft-dev libcairo2-dev libsndfile1-dev portaudio19-dev
   libmatio-dev libzstd-dev libsqlite3-dev libboost-dev
+  # experiment: the PostgreSQL store's client library (libpq); the server
+  # itself for the tests and `make bench` (initdb + pg_ctl in a temporary
+  # directory, scripts/pg-test-server.sh)
+  libpq-dev postgresql
   # the texel command line
   libcli11-dev
   # tests and benchmarks

@@ -46,6 +46,7 @@ struct RunArgs {
   std::string protocol;
   std::string participant;
   std::string db;
+  std::string journal;  // a station's local journal (--db names a PostgreSQL server)
   std::optional<std::string> simulate;
   double pace = 0.0;
   bool resume = false;
@@ -58,6 +59,53 @@ struct RunArgs {
 };
 
 std::string count_text(int n) { return n >= 0 ? std::to_string(n) : std::string("adaptive"); }
+
+// A station whose server is not there runs on its journal, and says so.
+void warn_if_offline(const ex::Store& store) {
+  const ex::ShipStatus s = store.shipping();
+  if (!s.connected)
+    std::cerr << "texel: " << s.server << " is not reachable (" << s.last_error << "); running on the local journal " << s.journal
+              << ": every trial is stored there and shipped when the server is back (texel experiment sync)\n";
+}
+
+// At the end of a station's run: a few seconds to ship what is left; what
+// is not shipped stays in the journal for the next run or `sync`.
+void finish_shipping(ex::Store& store) {
+  if (store.sync(5.0)) return;
+  const ex::ShipStatus s = store.shipping();
+  std::cerr << "texel: " << (s.trials_local - s.trials_shipped) << " trials and " << s.completions_pending
+            << " completion records are not on " << s.server << " yet"
+            << (s.last_error.empty() ? std::string() : " (" + s.last_error + ")") << "; they are kept in " << s.journal
+            << " and shipped by the next run or texel experiment sync\n";
+}
+
+// texel experiment sync: where shipping stands, then ship everything now.
+void sync_command(const std::string& db, const std::string& journal, double timeout_s, bool as_json) {
+  if (!ex::is_postgres(db)) throw InvalidArgument("sync: --db must name a PostgreSQL server (postgresql://… or service=NAME)");
+  if (!(timeout_s > 0 && timeout_s <= 3600))
+    throw InvalidArgument("--timeout is " + detail::num(timeout_s) + "; allowed: 0 … 3600 s");
+  const std::string local = journal.empty() ? ex::default_journal(db) : journal;
+  if (!std::filesystem::exists(local)) throw IoError("sync: no journal at " + local + " (nothing was run on this station)");
+  ex::Store store = ex::Store::open(db, ex::StoreMode::read_write, ex::StoreOptions{local});
+  const ex::ShipStatus before = store.shipping();
+  const bool done = store.sync(timeout_s);
+  const ex::ShipStatus s = store.shipping();
+  if (as_json) {
+    ordered_json j = ordered_json::parse(ex::to_json(s));
+    j["trials_shipped_before"] = before.trials_shipped;
+    j["synced"] = done;
+    print_json(j);
+  } else {
+    std::cout << "station " << s.station << " → " << s.server << " (journal " << s.journal << ")\n"
+              << "  trials: " << s.trials_local << " stored locally, " << before.trials_shipped << " on the server before, "
+              << s.trials_shipped << " now\n"
+              << "  sessions: " << s.sessions_local << ", completion records waiting: " << s.completions_pending << "\n";
+    for (const auto& c : s.conflicts) std::cout << "  CONFLICT: " << c << "\n";
+  }
+  if (!done)
+    throw IoError("sync: " + std::to_string(s.trials_local - s.trials_shipped) + " trials are not on " + s.server + " (" +
+                  (s.last_error.empty() ? std::string("timed out") : s.last_error) + "); they stay in " + s.journal);
+}
 
 void run(const RunArgs& a) {
   if (!(a.pace >= 0 && a.pace <= 3600)) throw InvalidArgument("--pace is " + detail::num(a.pace) + "; allowed: 0 … 3600 s");
@@ -75,11 +123,13 @@ void run(const RunArgs& a) {
   // (if this command created it) when the session cannot start.
   Monitor monitor;
   const bool monitor_created = a.monitor && monitor.open(*a.monitor);
-  const bool existed = std::filesystem::exists(a.db);
+  // With a PostgreSQL --db the file this command may create is the journal.
+  const std::string local = ex::is_postgres(a.db) ? (a.journal.empty() ? ex::default_journal(a.db) : a.journal) : a.db;
+  const bool existed = std::filesystem::exists(local);
   std::optional<ex::Store> opened;
   std::optional<ex::ActiveSession> started;
   try {
-    opened.emplace(ex::Store::open(a.db, ex::StoreMode::read_write));
+    opened.emplace(ex::Store::open(a.db, ex::StoreMode::read_write, ex::StoreOptions{a.journal}));
     ex::OpenOptions oo;
     oo.participant = a.participant;
     oo.resume = a.resume;
@@ -90,9 +140,11 @@ void run(const RunArgs& a) {
     monitor.close();
     if (monitor_created) std::filesystem::remove(*a.monitor);
     if (!existed)
-      for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(a.db + suffix);
+      for (const char* suffix : {"", "-wal", "-shm", "-journal", "-shipping.db", "-shipping.db-wal", "-shipping.db-shm"})
+        std::filesystem::remove(local + suffix);
     throw;
   }
+  if (opened->is_station()) warn_if_offline(*opened);
   ex::Store& store = *opened;
   ex::ActiveSession& active = *started;
   const ex::Session& session = active.session;
@@ -107,8 +159,8 @@ void run(const RunArgs& a) {
   auto old_term = std::signal(SIGTERM, on_experiment_signal);
   auto old_pipe = std::signal(SIGPIPE, SIG_IGN);  // a monitor FIFO whose reader left ends the stream, not the run
   const bool tty = ::isatty(STDERR_FILENO) == 1;
-  const std::string resume_command =
-      "texel experiment run " + a.protocol + " --participant " + a.participant + " --db " + a.db + " --resume";
+  const std::string resume_command = "texel experiment run " + a.protocol + " --participant " + a.participant + " --db " + a.db +
+                                     (a.journal.empty() ? std::string() : " --journal " + a.journal) + " --resume";
   monitor.event("start", {{"session", std::to_string(info.id)},
                           {"participant", a.participant},
                           {"protocol", protocol.name},
@@ -243,10 +295,9 @@ void run(const RunArgs& a) {
               << "): " << session.trials_done() << " trials stored in " << a.db << "\n"
               << "backend " << presenter.describe() << ": " << s.blocks << " blocks, worst "
               << detail::fixed(s.worst_block_s * 1e3, 3) << " ms, late blocks " << s.underruns << "\n";
-    if (!finished)
-      std::cout << "resume with: texel experiment run " << a.protocol << " --participant " << a.participant << " --db " << a.db
-                << " --resume\n";
+    if (!finished) std::cout << "resume with: " << resume_command << "\n";
   }
+  if (store.is_station()) finish_shipping(store);
   if (!presenter.error().empty()) throw IoError("experiment run: " + presenter.error());
 }
 
@@ -306,7 +357,12 @@ void register_experiment(CLI::App& app) {
   auto* run_cmd = cmd->add_subcommand("run", "Run a protocol for a participant (terminal or --simulate), storing every answer");
   run_cmd->add_option("protocol", a->protocol, "Protocol file (.json; examples/protocols/)")->required();
   run_cmd->add_option("--participant", a->participant, "Pseudonymous participant code (1–32 of A–Z a–z 0–9 _ . -)")->required();
-  run_cmd->add_option("--db", a->db, "Session database (SQLite; created if missing)")->required();
+  run_cmd
+      ->add_option("--db", a->db,
+                   "Session database (SQLite; created if missing), or a PostgreSQL server (postgresql://… or service=NAME)")
+      ->required();
+  run_cmd->add_option("--journal", a->journal,
+                      "With a PostgreSQL --db: this station's local journal (SQLite) [~/.local/state/texel/journal-….db]");
   run_cmd->add_option("--simulate", a->simulate,
                       "Answer with a simulated observer: 'default' or key=value pairs, e.g. threshold=6mm, target=4sin, "
                       "target=8dB/-3dB, noise=1dB, seed=3");
@@ -356,6 +412,7 @@ void register_experiment(CLI::App& app) {
       const auto ids = ex::simulate_cohort(store, p, codes, co->simulate);
       std::cerr << p.name << ": " << ids.size() << " simulated sessions in " << co->db << "\n";
     }
+    if (store.is_station()) finish_shipping(store);
   });
 
   struct DbArgs {
@@ -376,6 +433,19 @@ void register_experiment(CLI::App& app) {
   status_cmd->add_option("--participant", st->participant, "Only this participant");
   status_cmd->add_flag("--json", st->json, "JSON output");
   status_cmd->callback([st] { status(st->db, st->json, st->participant); });
+
+  struct SyncArgs {
+    std::string db, journal;
+    double timeout = 30.0;
+    bool json = false;
+  };
+  auto sy = std::make_shared<SyncArgs>();
+  auto* sync_cmd = cmd->add_subcommand("sync", "A station: show its shipping to the PostgreSQL server and ship everything now");
+  sync_cmd->add_option("--db", sy->db, "The PostgreSQL server (postgresql://… or service=NAME)")->required();
+  sync_cmd->add_option("--journal", sy->journal, "This station's journal [as experiment run]");
+  sync_cmd->add_option("--timeout", sy->timeout, "Seconds to wait for the server [30]");
+  sync_cmd->add_flag("--json", sy->json, "JSON output");
+  sync_cmd->callback([sy] { sync_command(sy->db, sy->journal, sy->timeout, sy->json); });
 
   struct ExportArgs {
     std::string db;

@@ -107,7 +107,10 @@ void register_studio(CLI::App& app) {
   cmd->add_flag("--allow-remote", args->allow_remote, "permit a non-loopback --address (no authentication!)");
   cmd->add_option("--allow-origin", args->allow_origins,
                   "another browser origin allowed to open the WebSocket, e.g. a dev server http://localhost:5173");
-  cmd->add_option("--db", args->db, "experiment store (SQLite; created on first use)")->capture_default_str();
+  cmd->add_option("--db", args->db,
+                  "experiment store (SQLite; created on first use), or a PostgreSQL server (postgresql://… or service=NAME): "
+                  "the studio is then a station with its journal at the default place (docs/session-store.md)")
+      ->capture_default_str();
   cmd->add_option("--backend", args->backend, "null, audio or serial:PATH")->capture_default_str();
   cmd->add_option("--audio-device", args->audio_device, "PortAudio output device for --backend audio (index or name)");
   cmd->add_option("--response", args->response,

@@ -22,6 +22,7 @@ void register_controller(CLI::App& app);
 void register_staircase(CLI::App& app);
 void register_stats(CLI::App& app);
 void register_experiment(CLI::App& app);
+void register_store(CLI::App& app);
 void register_studio(CLI::App& app);
 
 }  // namespace texel::cli

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   texel::cli::register_play(app);
   texel::cli::register_controller(app);
   texel::cli::register_experiment(app);
+  texel::cli::register_store(app);
   texel::cli::register_staircase(app);
   texel::cli::register_stats(app);
   texel::cli::register_studio(app);

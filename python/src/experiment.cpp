@@ -476,13 +476,17 @@ end_value          the result (convergent_value): 'next' (computed after the las
 
 mode  'r': read-only, never creates or writes (default); 'rw': read-write, created if missing
       (what experiment.Session records into). close() ends the connection; unless another
-      program has the database open, it then holds no -wal/-shm files.)doc")
-      .def(py::init([](const py::object& path, const std::string& mode) {
+      program has the database open, it then holds no -wal/-shm files.
+path  may also name a PostgreSQL server ("postgresql://station1@db/study" or "service=NAME";
+      password from ~/.pgpass): 'r' reads the server, 'rw' makes this process a station that
+      stores every trial in its local journal first (journal=PATH, or the default of
+      docs/session-store.md) and ships it in the background.)doc")
+      .def(py::init([](const py::object& path, const std::string& mode, const std::optional<std::string>& journal) {
              if (mode != "r" && mode != "rw") throw InvalidArgument("mode is '" + mode + "'; allowed: r, rw");
              const StoreMode sm = mode == "r" ? StoreMode::read_only : StoreMode::read_write;
-             return std::make_shared<StoreHandle>(Store::open(path_of(path), sm), sm);
+             return std::make_shared<StoreHandle>(Store::open(path_of(path), sm, StoreOptions{journal.value_or("")}), sm);
            }),
-           py::arg("path"), py::arg("mode") = "r")
+           py::arg("path"), py::arg("mode") = "r", py::arg("journal") = py::none())
       .def("close", &StoreHandle::close, "Closes the database (again: nothing).")
       .def_property_readonly(
           "closed", [](const StoreHandle& h) { return !h.store; }, "True after close().")

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "json_views.hpp"
+#include "texel/error.hpp"
 #include "texel/experiment/store.hpp"
 
 namespace texel::experiment {
@@ -28,6 +29,39 @@ ordered_json session_view(const SessionInfo& s) {
 }
 
 std::string to_json(const SessionInfo& s) { return session_view(s).dump(); }
+
+std::string to_json(const ShipStatus& s) {
+  return ordered_json{{"station", s.station},
+                      {"server", s.server},
+                      {"journal", s.journal},
+                      {"connected", s.connected},
+                      {"error", s.last_error},
+                      {"trials_local", s.trials_local},
+                      {"trials_shipped", s.trials_shipped},
+                      {"sessions_local", s.sessions_local},
+                      {"completions_pending", s.completions_pending},
+                      {"lag_s", s.lag_s},
+                      {"conflicts", s.conflicts}}
+      .dump();
+}
+
+std::string stations_json(const Store& store) {
+  ordered_json out;
+  const bool multi = store.is_station() || is_postgres(store.path());
+  out["multi_station"] = multi;
+  out["this_station"] = nullptr;
+  if (store.is_station()) out["this_station"] = ordered_json::parse(to_json(store.shipping()));
+  out["server_error"] = "";
+  out["stations"] = ordered_json::array();
+  if (multi) {
+    try {
+      out["stations"] = ordered_json::parse(store.station_rows_json());
+    } catch (const Error& e) {
+      out["server_error"] = e.what();
+    }
+  }
+  return out.dump();
+}
 
 std::string status_json(const Store& store, std::string_view database, const std::optional<std::string>& participant) {
   ordered_json out;

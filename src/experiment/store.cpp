@@ -38,6 +38,7 @@
 #include <sstream>
 #include <utility>
 
+#include "store_pg.hpp"
 #include "texel/error.hpp"
 
 namespace texel::experiment {
@@ -181,6 +182,10 @@ struct StoreConnection {
   std::string path;
   bool writable = false;
   int version = 0;
+  // PostgreSQL (store_pg.hpp): a reader of the server (db is null), or a
+  // station whose db is its local journal.
+  std::shared_ptr<pg::Reader> reader;
+  std::shared_ptr<pg::Station> station;
 
   StoreConnection() = default;
   StoreConnection(const StoreConnection&) = delete;
@@ -355,8 +360,49 @@ Store::~Store() = default;
 Store::Store(Store&&) noexcept = default;
 Store& Store::operator=(Store&&) noexcept = default;
 
+Store Store::open(const std::string& path, StoreMode mode, const StoreOptions& options) {
+  if (!is_postgres(path)) return open(path, mode);
+  if (mode == StoreMode::read_only) {
+    auto s = std::make_shared<StoreConnection>();
+    s->reader = pg::open_reader(path);
+    s->path = s->reader->label();
+    s->version = s->reader->schema_version();
+    return Store(std::move(s));
+  }
+  // A station: the journal first (created if new), then the server link.
+  std::string journal = options.journal;
+  if (journal.empty()) {
+    journal = default_journal(path);
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(journal).parent_path(), ec);
+  }
+  if (is_postgres(journal)) throw InvalidArgument("--journal " + journal + ": a journal is a local SQLite file");
+  Store store = open(journal, StoreMode::read_write);
+  store.impl_->station = pg::start_station(path, journal);
+  return store;
+}
+
+bool Store::is_station() const { return impl_->station != nullptr; }
+
+ShipStatus Store::shipping() const {
+  if (!impl_->station) throw InvalidArgument(impl_->path + " is not a station's journal (no PostgreSQL server behind it)");
+  return impl_->station->status();
+}
+
+bool Store::sync(double timeout_s) {
+  if (!impl_->station) throw InvalidArgument(impl_->path + " is not a station's journal (no PostgreSQL server behind it)");
+  return impl_->station->sync(timeout_s);
+}
+
+std::string Store::station_rows_json() const {
+  if (impl_->reader) return impl_->reader->stations();
+  if (impl_->station) return impl_->station->stations();
+  return "[]";
+}
+
 Store Store::open(const std::string& path, StoreMode mode) {
   namespace fs = std::filesystem;
+  if (is_postgres(path)) return open(path, mode, StoreOptions{});
   auto s = std::make_shared<StoreConnection>();
   s->path = path;
   std::error_code ec;
@@ -366,8 +412,23 @@ Store Store::open(const std::string& path, StoreMode mode) {
 
   // An existing file is never created anew (no SQLITE_OPEN_CREATE), so a
   // path that vanishes between the check and the open is not recreated.
+  //
+  // A reader leaves no files behind. A WAL database read through a
+  // read-only connection gets a -wal and a -shm file that the reader cannot
+  // remove: only the last connection to close removes them, after a final
+  // checkpoint, and only if it can write (sqlite.org/wal.html). So when no
+  // -wal/-shm exists (no writer is connected and the last one closed
+  // cleanly), the reader opens the file read-write with query_only=1 (no
+  // statement can change it) and, if it is the last to close, removes the
+  // files its reading created; the checkpoint then moves at most frames a
+  // writer committed meanwhile, which changes no stored value. When they
+  // exist, a writer is running (or died): the reader opens read-only and
+  // leaves them to that writer, exactly as before.
+  const bool reader_may_clean = mode == StoreMode::read_only && !fs::exists(path + "-wal", ec) && !fs::exists(path + "-shm", ec);
   int flags = SQLITE_OPEN_FULLMUTEX;
-  if (mode == StoreMode::read_only)
+  if (reader_may_clean)
+    flags |= SQLITE_OPEN_READWRITE;
+  else if (mode == StoreMode::read_only)
     flags |= SQLITE_OPEN_READONLY;
   else
     flags |= SQLITE_OPEN_READWRITE | (exists ? 0 : SQLITE_OPEN_CREATE);
@@ -384,6 +445,7 @@ Store Store::open(const std::string& path, StoreMode mode) {
   if (mode == StoreMode::read_write && sqlite3_db_readonly(s->db, "main") == 1)
     throw IoError(path + " is read-only (no write permission); nothing was stored");
   s->writable = mode == StoreMode::read_write;
+  if (reader_may_clean) exec(*s, "PRAGMA query_only = 1", "opening the database for reading");
 
   // Identify the file before changing anything: garbage fails here with
   // SQLITE_NOTADB and is left byte-identical.
@@ -429,6 +491,7 @@ std::int64_t Store::create_session(const std::string& participant, const std::st
   if (protocol.empty()) throw InvalidArgument("create_session: the protocol name is empty");
   if (trials_planned < -1) throw InvalidArgument("trials_planned " + std::to_string(trials_planned) + " is below -1 (adaptive)");
   const std::string op = "creating a session for " + participant;
+  if (impl_->reader) throw IoError(impl_->path + " is open read-only: " + op + " refused");
   Transaction tx(*impl_, op);
   const std::string now = utc_timestamp();
   Stmt(*impl_, "INSERT OR IGNORE INTO participants(code, created_at) VALUES (?, ?)", op).bind(1, participant).bind(2, now).run();
@@ -452,6 +515,12 @@ std::int64_t Store::create_session(const std::string& participant, const std::st
 }
 
 std::optional<SessionInfo> Store::unfinished_session(const std::string& participant, const std::string& protocol) const {
+  if (impl_->reader) {
+    std::optional<SessionInfo> found;
+    for (auto& s : impl_->reader->sessions())
+      if (s.participant == participant && s.protocol == protocol && s.status == "running") found = std::move(s);
+    return found;
+  }
   Stmt st(*impl_,
           (std::string(session_columns) +
            "WHERE s.participant = ? AND s.protocol = ? AND s.status = 'running' ORDER BY s.id DESC LIMIT 1")
@@ -463,6 +532,11 @@ std::optional<SessionInfo> Store::unfinished_session(const std::string& particip
 }
 
 SessionInfo Store::session(std::int64_t id) const {
+  if (impl_->reader) {
+    for (auto& s : impl_->reader->sessions())
+      if (s.id == id) return std::move(s);
+    throw InvalidArgument(impl_->path + " has no session " + std::to_string(id));
+  }
   Stmt st(*impl_, (std::string(session_columns) + "WHERE s.id = ?").c_str(), "reading session " + std::to_string(id));
   st.bind(1, id);
   if (!st.step()) throw InvalidArgument(impl_->path + " has no session " + std::to_string(id));
@@ -470,6 +544,7 @@ SessionInfo Store::session(std::int64_t id) const {
 }
 
 std::vector<SessionInfo> Store::sessions() const {
+  if (impl_->reader) return impl_->reader->sessions();
   Stmt st(*impl_, (std::string(session_columns) + "ORDER BY s.id").c_str(), "listing sessions");
   std::vector<SessionInfo> out;
   while (st.step()) out.push_back(read_session(st));
@@ -477,6 +552,7 @@ std::vector<SessionInfo> Store::sessions() const {
 }
 
 std::vector<std::string> Store::participants() const {
+  if (impl_->reader) return impl_->reader->participants();
   Stmt st(*impl_, "SELECT code FROM participants ORDER BY code", "listing participants");
   std::vector<std::string> out;
   while (st.step()) out.push_back(st.text(0));
@@ -484,7 +560,7 @@ std::vector<std::string> Store::participants() const {
 }
 
 WriterLock Store::acquire_writer(std::int64_t session_id) {
-  if (!impl_->writable)
+  if (!impl_->writable || impl_->reader)
     throw InvalidArgument(impl_->path + " is open read-only; cannot write session " + std::to_string(session_id));
   const SessionInfo info = session(session_id);
   const std::string op = "taking the writer lock of " + session_label(info);
@@ -521,7 +597,10 @@ WriterLock Store::acquire_writer(std::int64_t session_id) {
       .bind(5, utc_timestamp())
       .run();
   tx.commit();
-  return WriterLock(impl_, session_id);
+  WriterLock lock(impl_, session_id);
+  // A station also holds the study-wide lock (a refusal releases ours).
+  if (impl_->station) impl_->station->take_lease(info);
+  return lock;
 }
 
 namespace {
@@ -544,6 +623,7 @@ void check_lock(const StoreImpl& s, const std::shared_ptr<StoreImpl>& mine, cons
 void Store::append_trial(const WriterLock& lock, const StoredTrial& t) {
   const std::int64_t sid = lock.session_id();
   const std::string op = "storing trial " + std::to_string(t.trial) + " of session " + std::to_string(sid);
+  if (!impl_->db) throw InvalidArgument(impl_->path + ": " + op + ": the store is open read-only");
   Transaction tx(*impl_, op);
   check_lock(*impl_, impl_, lock, lock.impl_, op);
   const SessionInfo info = session(sid);
@@ -589,7 +669,8 @@ void Store::append_trial(const WriterLock& lock, const StoredTrial& t) {
     ev.reset();
   }
   Stmt(*impl_, "UPDATE sessions SET updated_at = ? WHERE id = ?", op).bind(1, now).bind(2, sid).run();
-  tx.commit();  // synchronous=FULL: the WAL is fsynced before COMMIT returns
+  tx.commit();                                 // synchronous=FULL: the WAL is fsynced before COMMIT returns
+  if (impl_->station) impl_->station->poke();  // shipped in the background
 }
 
 void Store::finish_session(const WriterLock& lock) {
@@ -602,9 +683,11 @@ void Store::finish_session(const WriterLock& lock) {
       .bind(2, sid)
       .run();
   tx.commit();
+  if (impl_->station) impl_->station->poke();  // the completion record
 }
 
 std::vector<StoredTrial> Store::trials(std::int64_t session_id) const {
+  if (impl_->reader) return impl_->reader->trials(session_id);
   const std::string op = "reading the trials of session " + std::to_string(session_id);
   // One read transaction, so trials and events come from the same snapshot.
   exec(*impl_, "BEGIN", op);
@@ -642,6 +725,7 @@ std::vector<StoredTrial> Store::trials(std::int64_t session_id) const {
 }
 
 std::vector<TrialRow> Store::rows(std::optional<std::int64_t> session_id) const {
+  if (impl_->reader) return impl_->reader->rows(session_id);
   std::string sql =
       "SELECT t.session_id, t.trial, t.row_json, s.participant, s.protocol, s.study FROM trials t JOIN sessions s ON s.id = "
       "t.session_id ";
@@ -689,6 +773,7 @@ WriterLock::~WriterLock() {
     sqlite3_step(st);  // a failure leaves a row that the next run recognises as dead
   }
   sqlite3_finalize(st);
+  if (impl_->station) impl_->station->release_lease(session_id_);
 }
 
 }  // namespace texel::experiment

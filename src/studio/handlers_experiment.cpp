@@ -186,6 +186,15 @@ void on_experiment_list(State& s, Client& c, const Job& job) {
   send(c, r);
 }
 
+// Every station's progress and shipping lag (a PostgreSQL store; an SQLite
+// one answers multi_station false).
+void on_experiment_stations(State& s, Client& c, const Job& job) {
+  ojson r = reply("experiment.stations", job.id);
+  const ojson v = ojson::parse(ex::stations_json(the_store(s)));
+  for (auto it = v.begin(); it != v.end(); ++it) r[it.key()] = it.value();
+  send(c, r);
+}
+
 void on_experiment_start(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
   const json& p = f.raw("protocol");

@@ -14,7 +14,7 @@ namespace texel::studio::detail {
 namespace {
 
 // The order is the one error messages list ("unknown message type …; allowed: …").
-const std::array<MessageSpec, 21> table{{
+const std::array<MessageSpec, 22> table{{
     {"hello", Lane::now, {}, on_hello},
     {"design", Lane::design, {"document", "region", "bins"}, on_design},
     {"match", Lane::fifo, {"document", "region", "into"}, on_match},
@@ -24,6 +24,7 @@ const std::array<MessageSpec, 21> table{{
     {"feel.move", Lane::now, {"seq", "x_mm", "touch"}, on_feel_move},
     {"feel.state", Lane::now, {}, on_feel_state},
     {"experiment.list", Lane::fifo, {}, on_experiment_list},
+    {"experiment.stations", Lane::fifo, {}, on_experiment_stations},
     {"experiment.start", Lane::fifo, {"protocol", "participant", "resume", "simulate"}, on_experiment_start},
     {"experiment.current", Lane::fifo, {"reload", "screen"}, on_experiment_current},
     {"experiment.select", Lane::fifo, {"trial", "stimulus"}, on_experiment_select},

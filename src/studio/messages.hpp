@@ -171,6 +171,7 @@ void on_feel_select(State&, Client&, const Job&);
 void on_feel_move(State&, Client&, const Job&);
 void on_feel_state(State&, Client&, const Job&);
 void on_experiment_list(State&, Client&, const Job&);
+void on_experiment_stations(State&, Client&, const Job&);
 void on_experiment_start(State&, Client&, const Job&);
 void on_experiment_current(State&, Client&, const Job&);
 void on_experiment_select(State&, Client&, const Job&);

@@ -156,6 +156,71 @@ TEST(Store, ReadOnlyModeNeverWrites) {
   EXPECT_EQ(file_bytes(path), before);
 }
 
+// Issue #25: status, export and analyze open read-only and must leave no
+// -wal/-shm beside the database, while reading a running study stays safe.
+TEST(Store, ReaderLeavesNoWalOrShmFiles) {
+  TempDir dir("store");
+  const auto path = dir.at("exp.db");
+  {
+    auto s = ex::Store::open(path, ex::StoreMode::read_write);
+    auto lock = s.acquire_writer(new_session(s));
+    s.append_trial(lock, full_trial(0));
+  }
+  ASSERT_FALSE(std::filesystem::exists(path + "-wal"));
+  const auto before = file_bytes(path);
+  {
+    const auto s = ex::Store::open(path, ex::StoreMode::read_only);
+    EXPECT_EQ(s.rows().size(), 1u);
+    EXPECT_EQ(s.trials(1).size(), 1u);
+  }
+  EXPECT_FALSE(std::filesystem::exists(path + "-wal"));
+  EXPECT_FALSE(std::filesystem::exists(path + "-shm"));
+  EXPECT_EQ(file_bytes(path), before);
+}
+
+TEST(Store, AnSqliteFileIsNoStation) {
+  TempDir dir("store");
+  auto s = ex::Store::open(dir.at("exp.db"), ex::StoreMode::read_write);
+  EXPECT_FALSE(s.is_station());
+  EXPECT_FALSE(ex::is_postgres(dir.at("exp.db")));
+  EXPECT_EQ(ex::stations_json(s), R"({"multi_station":false,"this_station":null,"server_error":"","stations":[]})");
+  EXPECT_THROW((void)s.shipping(), texel::InvalidArgument);
+}
+
+TEST(Store, ReaderBesideARunningWriterSeesItsCommitsAndLeavesItsFiles) {
+  TempDir dir("store");
+  const auto path = dir.at("exp.db");
+  auto w = ex::Store::open(path, ex::StoreMode::read_write);
+  auto lock = w.acquire_writer(new_session(w));
+  w.append_trial(lock, full_trial(0));
+  {
+    // The writer's -wal/-shm exist: the reader opens read-only, as before.
+    const auto r = ex::Store::open(path, ex::StoreMode::read_only);
+    EXPECT_EQ(r.rows().size(), 1u);
+    w.append_trial(lock, full_trial(1));
+    EXPECT_EQ(r.rows().size(), 2u);
+  }
+  EXPECT_TRUE(std::filesystem::exists(path + "-wal"));  // still the writer's
+  w.append_trial(lock, full_trial(2));
+  // A reader that opens first (no files yet) and a writer that comes later:
+  // the reader sees the writer's commits and the last to close cleans up.
+  w = ex::Store::open(dir.at("other.db"), ex::StoreMode::read_write);  // closes the writer of exp.db
+  lock = w.acquire_writer(new_session(w));
+  EXPECT_FALSE(std::filesystem::exists(path + "-wal"));
+  auto r = ex::Store::open(path, ex::StoreMode::read_only);
+  {
+    auto w2 = ex::Store::open(path, ex::StoreMode::read_write);
+    auto lock2 = w2.acquire_writer(1);
+    w2.append_trial(lock2, full_trial(3));
+    EXPECT_EQ(r.rows().size(), 4u);
+  }
+  EXPECT_EQ(r.rows().size(), 4u);
+  r = ex::Store::open(dir.at("other.db"), ex::StoreMode::read_only);
+  EXPECT_FALSE(std::filesystem::exists(path + "-wal"));
+  EXPECT_FALSE(std::filesystem::exists(path + "-shm"));
+  EXPECT_EQ(ex::Store::open(path, ex::StoreMode::read_only).rows().size(), 4u);
+}
+
 TEST(Store, WriteProtectedFileOpenedForWritingIsRefused) {
   TempDir dir("store");
   const auto path = dir.at("exp.db");

@@ -5,14 +5,16 @@
 // MATLAB .mat, the analysis figures) made by the library and handed over as
 // download links; and a protocol editor generated from the protocol schema,
 // checked by the engine's own validation. Everything shown comes from the
-// studio's messages (`experiment.list/current/trials/export/protocol/validate`).
+// studio's messages (`experiment.list/current/trials/export/protocol/validate`);
+// with a PostgreSQL store, every station's progress and shipping lag
+// (`experiment.stations`).
 
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import { studio } from './ws';
 import { h, base64ToBytes, download } from './util';
 import { protocolEditor } from './protocol-editor';
-import type { ExperimentListReply, ExperimentStartRequest, ExportedFile, StoredSession } from './generated/messages';
+import type { ExperimentListReply, ExperimentStartRequest, ExperimentStationsReply, ExportedFile, StoredSession } from './generated/messages';
 
 /** A trial row as column → cell text (the schema's TrialCells; "" = missing). */
 type TrialCells = Record<string, string | undefined>;
@@ -126,6 +128,60 @@ export function mountExperimenter(root: HTMLElement): void {
   const shownRows = new Map<number, { key: string; el: HTMLElement }>();
   const openLink = h('a', { href: '#/participant', target: '_blank', rel: 'noopener', class: 'button', 'data-testid': 'open-participant' }, 'Open the participant screen');
   let list: ExperimentListReply | null = null;
+  // Stations (PostgreSQL store only): hidden while the store is one SQLite file.
+  const stationsBody = h('tbody', {});
+  const stationsNote = h('p', { class: 'hint', 'data-testid': 'stations-note' });
+  const stationsSection = h(
+    'section',
+    { 'aria-label': 'Stations', 'data-testid': 'stations', hidden: true },
+    h('h2', {}, 'Stations'),
+    stationsNote,
+    h(
+      'table',
+      {},
+      h('thead', {}, h('tr', {}, ...['Station', 'Host', 'Trials stored', 'On the server', 'Sessions', 'Shipping lag', 'Last heard'].map((t) => h('th', {}, t)))),
+      stationsBody,
+    ),
+  );
+
+  function seconds(s: number): string {
+    return s < 1 ? `${Math.round(s * 1000)} ms` : s < 120 ? `${s.toFixed(1)} s` : duration(s * 1000);
+  }
+
+  async function refreshStations(): Promise<void> {
+    let r: ExperimentStationsReply;
+    try {
+      r = await client.call('experiment.stations', {}, 15000);
+    } catch {
+      return; // the sessions' refresh reports errors
+    }
+    stationsSection.hidden = !r.multi_station;
+    if (!r.multi_station) return;
+    const me = r.this_station;
+    const notes: string[] = [];
+    if (me) {
+      notes.push(me.connected ? `This studio is station ${me.station}: ${me.trials_shipped} of ${me.trials_local} trials on the server.`
+        : `This studio is station ${me.station}, running on its journal: the server is not reachable (${me.error}).`);
+      notes.push(...me.conflicts.map((c) => `Conflict: ${c}`));
+    }
+    if (r.server_error) notes.push(`Stations unknown: ${r.server_error}`);
+    stationsNote.textContent = notes.join(' ');
+    stationsBody.replaceChildren(
+      ...r.stations.map((st) =>
+        h(
+          'tr',
+          { 'data-testid': `station-${st.station}` },
+          h('td', {}, st.station),
+          h('td', {}, st.host),
+          h('td', {}, String(st.trials_local)),
+          h('td', {}, String(st.trials_shipped)),
+          h('td', {}, String(st.sessions) + (st.completions_pending ? ` (${st.completions_pending} completion${st.completions_pending > 1 ? 's' : ''} waiting)` : '')),
+          h('td', {}, st.trials_local > st.trials_shipped ? seconds(st.lag_s) : 'none'),
+          h('td', {}, `${seconds(st.last_report_s)} ago`),
+        ),
+      ),
+    );
+  }
 
   async function start(protocol: ExperimentStartRequest['protocol'], code: string, resumeIt: boolean, sim: string): Promise<void> {
     const name = typeof protocol === 'string' ? protocol : String(protocol.name ?? 'the edited protocol');
@@ -513,15 +569,20 @@ export function mountExperimenter(root: HTMLElement): void {
         ),
         exportsOut,
       ),
+      stationsSection,
       editorSection,
       status,
     ),
   );
   void refresh();
+  void refreshStations();
   const timer = setInterval(() => {
     if (!document.body.contains(root) || !root.querySelector('.experimenter')) {
       clearInterval(timer);
       while (urls.length) URL.revokeObjectURL(urls.pop()!);
-    } else void refresh();
+    } else {
+      void refresh();
+      void refreshStations();
+    }
   }, 2000);
 }

@@ -1,4 +1,5 @@
-// The durable session store (SQLite; docs/session-store.md).
+// The durable session store (SQLite; PostgreSQL behind a local SQLite
+// journal for several stations; docs/session-store.md).
 //
 // One file holds participants (pseudonymous codes only), sessions (with a
 // copy of the protocol and the seed), and per answered trial: the question
@@ -72,6 +73,49 @@ std::string to_json(const SessionInfo& s);
 
 enum class StoreMode { read_only, read_write };
 
+/// True when `db` names a PostgreSQL server — a `postgresql://` or
+/// `postgres://` URI, or `service=NAME` (libpq's conventions) — rather than
+/// an SQLite file (docs/session-store.md "Many stations").
+bool is_postgres(std::string_view db);
+
+struct StoreOptions {
+  /// A station's local journal (a PostgreSQL `db` opened read_write): every
+  /// trial is committed here first, then shipped. Empty: default_journal(db).
+  std::string journal;
+};
+
+/// `$XDG_STATE_HOME/texel/journal-<user>@<host>-<port>-<database>.db`
+/// (`~/.local/state` without XDG_STATE_HOME): one journal per server,
+/// database and station role.
+std::string default_journal(const std::string& db);
+
+/// A station's shipping state (Store::shipping()).
+struct ShipStatus {
+  std::string server;   ///< the server, as a URI without secrets
+  std::string station;  ///< this station's id: its PostgreSQL role
+  std::string journal;  ///< the local journal's path
+  bool connected = false;
+  std::string last_error;  ///< why the server is not reached (empty when it is)
+  std::int64_t trials_local = 0, trials_shipped = 0;
+  int sessions_local = 0;
+  int completions_pending = 0;         ///< finished sessions whose completion record is not on the server yet
+  double lag_s = 0.0;                  ///< age of the oldest trial not yet on the server; 0 when all are
+  std::vector<std::string> conflicts;  ///< study-wide lock conflicts found when the server came back
+};
+
+/// The shipping state as JSON object text: station, server, journal,
+/// connected, error, trials_local, trials_shipped, sessions_local,
+/// completions_pending, lag_s, conflicts (CLI `sync --json`, the studio).
+std::string to_json(const ShipStatus& s);
+
+/// `texel store init --postgres URI`: as the migration owner (the role the
+/// URI logs in as), create or migrate the `texel` schema, the group roles
+/// texel_station and texel_analyst, and one login role per station and
+/// analyst name (no password: the lab sets it, docs/session-store.md).
+/// Returns the report lines.
+std::vector<std::string> init_postgres(const std::string& db, const std::vector<std::string>& stations,
+                                       const std::vector<std::string>& analysts);
+
 class Store;
 // The connection (store.cpp), shared by a Store and its locks. Declared here,
 // not in a texel::experiment::detail namespace, which would hide texel::detail
@@ -104,12 +148,32 @@ class Store {
   /// read-only, locked) / FormatError (not a Texel database, or a schema
   /// newer than this build) naming the path; nothing stored is touched.
   static Store open(const std::string& path, StoreMode mode);
+  /// `path` may also name a PostgreSQL server (is_postgres()): read_only
+  /// reads the server (with the connecting role's rights); read_write makes
+  /// this process a station that stores every trial in its local journal
+  /// (options.journal) and ships it in the background. A server that cannot
+  /// be reached at start is not an error for a station (shipping().connected
+  /// says so); a wrong URI or password, a server without the Texel schema or
+  /// with a newer one is (InvalidArgument / IoError / FormatError).
+  static Store open(const std::string& path, StoreMode mode, const StoreOptions& options);
   ~Store();
   Store(Store&&) noexcept;
   Store& operator=(Store&&) noexcept;
 
   [[nodiscard]] int schema_version() const;
+  /// The SQLite path; a station's journal; a PostgreSQL reader's server URI
+  /// without secrets.
   [[nodiscard]] const std::string& path() const;
+
+  /// A station (a PostgreSQL db opened read_write)?
+  [[nodiscard]] bool is_station() const;
+  /// Where shipping stands; InvalidArgument unless is_station().
+  [[nodiscard]] ShipStatus shipping() const;
+  /// Ships now and waits up to timeout_s for every stored trial and
+  /// completion to be on the server; true when they are.
+  bool sync(double timeout_s);
+  /// stations_json()'s list, read from the server (PostgreSQL only).
+  [[nodiscard]] std::string station_rows_json() const;
 
   /// Creates the participant if new (code: 1–32 of A–Z a–z 0–9 _ . -).
   std::int64_t create_session(const std::string& participant, const std::string& protocol, const std::string& study,
@@ -138,6 +202,16 @@ class Store {
   explicit Store(std::shared_ptr<StoreConnection> impl);
   std::shared_ptr<StoreConnection> impl_;
 };
+
+/// Every station's progress and shipping lag (the experimenter's view), as
+/// JSON object text: "multi_station" (false for an SQLite file: then
+/// "stations" is empty), "this_station" (shipping(), or null when this
+/// process is no station), "server_error" (why the list could not be read,
+/// or "") and "stations": per station of texel.station_progress its station,
+/// host, trials_local, trials_shipped, sessions, completions_pending,
+/// lag_s (age of its oldest unshipped trial at its last report) and
+/// last_report_s (seconds since that report).
+std::string stations_json(const Store& store);
 
 /// Where every session stands (`texel experiment status --json`), as JSON
 /// object text: database (the `database` label given), schema_version,
