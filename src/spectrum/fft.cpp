@@ -7,6 +7,7 @@
 
 #include <kiss_fftr.h>
 
+#include "texel/detail/lanes.hpp"
 #include "texel/error.hpp"
 
 namespace texel::detail {
@@ -114,8 +115,15 @@ __attribute__((target("avx2"))) void stage_avx2(const double* xr, const double* 
   radix4_stage(xr, xi, yr, yi, m, s, tw);
 }
 
+__attribute__((target("avx512f"))) void stage_avx512(const double* xr, const double* xi, double* yr, double* yi, std::size_t m,
+                                                     std::size_t s, const Twiddles* tw) {
+  radix4_stage(xr, xi, yr, yi, m, s, tw);
+}
+
 StageFn stage_fn() {
-  static const StageFn fn = __builtin_cpu_supports("avx2") ? &stage_avx2 : &stage_baseline;
+  // The widest the CPU has (and TEXEL_SIMD allows): element-wise IEEE
+  // arithmetic without contraction, so every width gives the same bits.
+  static const StageFn fn = detail::simd_lanes() == 8 ? &stage_avx512 : detail::simd_lanes() == 4 ? &stage_avx2 : &stage_baseline;
   return fn;
 }
 
