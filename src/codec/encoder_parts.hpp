@@ -41,6 +41,9 @@ void centre(std::vector<double>& x);
 /// How differently two signals of the same length distribute their power
 /// over half-octave bands (dB; docs/encoder.md §1 step 4).
 double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx);
+/// The log-spectral centroid of a whole signal (its mean removed), dB re
+/// 1 cpm: Percept::log_centroid_db's band and weighting at swipe speed v.
+double log_centroid_db(std::span<const double> x, double dx, double v);
 
 // --- split.cpp -------------------------------------------------------------------
 

@@ -75,6 +75,7 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
       sum.spread_db += q.spread_db / used;
       sum.drawn_pitch_db += q.drawn_pitch_db / used;
       sum.drawn_noisiness_db += q.drawn_noisiness_db / used;
+      sum.log_centroid_db += q.log_centroid_db / used;
     }
   } catch (const InvalidArgument&) {
     return std::nullopt;  // not renderable (e.g. too little of the distribution in the band)
@@ -83,6 +84,13 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
 }
 
 double Fitter::operator()(double p_db, double i_db) {
+  if (cfg.target == EncoderConfig::Target::centroid) {  // |residuals|, as least squares minimises
+    const std::optional<Residuals> r = residuals(p_db, i_db);
+    if (!r) return 1e6;
+    double sum = 0.0;
+    for (const double x : *r) sum += x * x;
+    return std::sqrt(sum);
+  }
   const std::optional<Percept> q = percept(p_db, i_db);
   return q ? fit_distance(target, *q, cfg.model) : 1e6;
 }
@@ -97,6 +105,16 @@ std::optional<Residuals> Fitter::residuals(double p_db, double i_db) {
   if (!q) return std::nullopt;
   const PerceptualModel& m = cfg.model;
   const double tie = std::sqrt(m.tie_weight);
+  // The centroid target fits the fine part's physical log-spectral moments:
+  // its centroid (Percept::log_centroid_db) and spread, in the JND units of
+  // pitch and noisiness (docs/encoder.md §3, "Targets").
+  if (cfg.target == EncoderConfig::Target::centroid)
+    return Residuals{(q->log_centroid_db - target.log_centroid_db) / m.pitch_jnd_db,
+                     (q->spread_db - target.spread_db) / m.noisiness_jnd_db,
+                     0.0,
+                     0.0,
+                     0.0,
+                     0.0};
   // Without a display in the loop the drawn terms are 0 (exactly: the sums
   // below are then the model's distance as before, bit for bit).
   const double w = display_in_loop(m) ? m.drawn_weight : 0.0;

@@ -79,6 +79,17 @@ double threshold_db(Hertz f) {
 
 namespace {
 
+/// Percept::log_centroid_db of a power spectrum `p` whose bins are at
+/// frequencies `f` (cpm) and levels `d` (dB), on a grid of spacing dx.
+double log_centroid(const std::vector<double>& p, const std::vector<double>& f, const std::vector<double>& d, double dx, double v,
+                    double f_lo) {
+  const double lo = std::max(f_lo, centroid_low_hz / v), hi = centroid_top_nyquist * 0.5 / dx;
+  double sp = 0.0, spd = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i)
+    if (f[i] >= lo && f[i] <= hi) sp += p[i], spd += p[i] * d[i];
+  return sp > 0.0 ? spd / sp : 0.0;
+}
+
 /// Version 1 (the model before): every bin weighted by its own
 /// suprathreshold sensitivity and amplitude.
 Percept perceive_v1(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
@@ -181,6 +192,7 @@ Percept perceive_v1(std::span<const double> fine, double spacing_mm, const Perce
   q.mean_db = db_of(spf / sp);
   const double pd = spd / sp;
   q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  if (model.centroid) q.log_centroid_db = log_centroid(p, bins.f, bins.d, spacing_mm, v, f_lo);
   q.drawn_pitch_db = q.pitch_db;
   q.drawn_noisiness_db = q.noisiness_db;
   if (drawn && sw0 > 0.0) {
@@ -359,6 +371,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   q.mean_db = db_of(spf / sp);
   const double pd = spd / sp;
   q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  if (model.centroid) q.log_centroid_db = log_centroid(p, x.f, x.d, spacing_mm, v, f_lo);
   q.drawn_pitch_db = q.pitch_db;
   q.drawn_noisiness_db = q.noisiness_db;
   if (display) pool(drawn, q.drawn_pitch_db, q.drawn_noisiness_db);
