@@ -231,10 +231,16 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   // fit matched the fine part's log-spectral moments; the decoded texture as
   // a whole (coarse profile, fine strength, the stream's own seed) is then
   // moved in Central Pitch until its log-spectral centroid is the input's,
-  // by secant steps on the stream's 0.01 dB grid.
-  if (fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered) {
-    const double v = fit_cfg.model.swipe_speed.value();
-    const double goal = log_centroid_db(a, dx, v);
+  // by secant steps on the stream's 0.01 dB grid. Not where the part below
+  // the fine/coarse boundary carries half the power or more: the centroid
+  // then follows the coarse profile's power, which Central Pitch would be
+  // bent to make up for.
+  double below = 0.0;
+  const double v = fit_cfg.model.swipe_speed.value();
+  const double goal = fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered
+                          ? log_centroid_db(a, dx, v, 1.0 / cfg.boundary.value(), &below)
+                          : 0.0;
+  if (fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered && below < 0.5) {
     std::vector<double> d(n);
     auto centroid_at = [&](std::int16_t cdb) {
       f.central_pitch_cdb = cdb;

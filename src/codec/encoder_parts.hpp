@@ -43,7 +43,8 @@ void centre(std::vector<double>& x);
 double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx);
 /// The log-spectral centroid of a whole signal (its mean removed), dB re
 /// 1 cpm: Percept::log_centroid_db's band and weighting at swipe speed v.
-double log_centroid_db(std::span<const double> x, double dx, double v);
+/// `below`, if given, receives the share of the whole spectrum's power under f_split (cpm).
+double log_centroid_db(std::span<const double> x, double dx, double v, double f_split = 0.0, double* below = nullptr);
 
 // --- split.cpp -------------------------------------------------------------------
 

@@ -134,16 +134,18 @@ double shape_distance_db(const std::vector<double>& x, const std::vector<double>
   return num_ / den;
 }
 
-double log_centroid_db(std::span<const double> x, double dx, double v) {
+double log_centroid_db(std::span<const double> x, double dx, double v, double f_split, double* below) {
   std::size_t m = 0;
   const std::vector<double> p = power_spectrum(centred(x), m);
   const double df = 1.0 / (static_cast<double>(m) * dx);
   const double lo = centroid_low_hz / v, hi = centroid_top_nyquist * 0.5 / dx;
-  double sp = 0.0, spd = 0.0;
+  double sp = 0.0, spd = 0.0, all = 0.0, sb = 0.0;
   for (std::size_t i = 1; i < p.size(); ++i) {
     const double f = static_cast<double>(i) * df;
     if (f >= lo && f <= hi) sp += p[i], spd += p[i] * db_of(f);
+    all += p[i], sb += f < f_split ? p[i] : 0.0;
   }
+  if (below) *below = all > 0.0 ? sb / all : 0.0;
   return sp > 0.0 ? spd / sp : 0.0;
 }
 
