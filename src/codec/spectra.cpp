@@ -46,12 +46,11 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   const std::size_t m = seg < 2 ? next_pow2(seg) : std::max<std::size_t>(4, next_pow2(seg));
   m_out = m;
   p.assign(m / 2 + 1, 0.0);
-  // Per thread: the window of the last segment length, the plan of the last
-  // transform length and the work buffers (an encode analyses a few dozen
-  // signals of the same length).
+  // Per thread: the window of the last segment length and the plan of the
+  // last transform length, with its work buffers (an encode analyses a few
+  // dozen signals of the same length).
   struct Scratch {
-    std::vector<double> win, buf;
-    std::vector<std::complex<double>> X;
+    std::vector<double> win;
     std::unique_ptr<texel::detail::Pow2RealFft> fft;
   };
   thread_local Scratch sc;
@@ -67,19 +66,11 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
     return;
   }
   if (!sc.fft || sc.fft->size() != m) sc.fft = std::make_unique<texel::detail::Pow2RealFft>(m);
-  sc.buf.resize(m);
-  std::fill(sc.buf.begin() + static_cast<std::ptrdiff_t>(seg), sc.buf.end(),
-            0.0);  // the zero padding; [0, seg) is written per segment
-  sc.X.resize(m / 2 + 1);
-  std::vector<double>& buf = sc.buf;
-  std::vector<std::complex<double>>& X = sc.X;
   texel::detail::Pow2RealFft* fft = sc.fft.get();
   std::size_t count = 0;
   const std::size_t hop = seg == n ? n : seg / 2;
   for (std::size_t start = 0; start + seg <= n; start += hop) {
-    for (std::size_t i = 0; i < seg; ++i) buf[i] = x[start + i] * win[i];
-    fft->forward(buf, X);
-    for (std::size_t i = 0; i <= m / 2; ++i) p[i] += std::norm(X[i]);
+    fft->add_power(x.subspan(start, seg), win, p);  // |X|² of the windowed, zero-padded segment
     ++count;
   }
   for (double& v : p) v /= static_cast<double>(std::max<std::size_t>(count, 1));

@@ -148,13 +148,12 @@ Pow2RealFft::Pow2RealFft(std::size_t n) : n_(n) {
   ar_.resize(h), ai_.resize(h), br_.resize(h), bi_.resize(h);
 }
 
-void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<double>> out) {
+std::pair<const double*, const double*> Pow2RealFft::transform() {
   const std::size_t h = n_ / 2;  // complex length
   double* xr = ar_.data();
   double* xi = ai_.data();
   double* yr = br_.data();
   double* yi = bi_.data();
-  for (std::size_t j = 0; j < h; ++j) xr[j] = in[2 * j], xi[j] = in[2 * j + 1];
   // Stockham, decimation in frequency: stage by stage between two buffers,
   // natural order at the end.
   const StageFn stage = stage_fn();
@@ -174,19 +173,41 @@ void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<dou
     }
     std::swap(xr, yr), std::swap(xi, yi);
   }
+  return {xr, xi};
+}
+
+template <class Sink>
+void Pow2RealFft::real_split(const double* xr, const double* xi, Sink&& sink) const {
   // Real split: with Z the transform of z_j = x_2j + i·x_2j+1,
   // X_k = E_k + e^{−2πik/n}·O_k, E_k = (Z_k + conj Z_{h−k})/2, O_k = (Z_k − conj Z_{h−k})/(2i).
-  out[0] = {xr[0] + xi[0], 0.0};
-  out[h] = {xr[0] - xi[0], 0.0};
+  const std::size_t h = n_ / 2;
+  sink(0, xr[0] + xi[0], 0.0);
+  sink(h, xr[0] - xi[0], 0.0);
   for (std::size_t k = 1; k <= h / 2; ++k) {
     const std::size_t c = h - k;
     const double er = 0.5 * (xr[k] + xr[c]), ei = 0.5 * (xi[k] - xi[c]);
     const double orr = 0.5 * (xi[k] + xi[c]), oi = -0.5 * (xr[k] - xr[c]);
     const double tr = sr_[k] * orr - si_[k] * oi, ti = sr_[k] * oi + si_[k] * orr;
-    out[k] = {er + tr, ei + ti};
+    sink(k, er + tr, ei + ti);
     // X_{h−k} = conj E + e^{−2πi(h−k)/n}·conj O = conj E − conj(e^{−2πik/n}·O)
-    if (c != k) out[c] = {er - tr, -ei + ti};
+    if (c != k) sink(c, er - tr, -ei + ti);
   }
+}
+
+void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<double>> out) {
+  const std::size_t h = n_ / 2;
+  for (std::size_t j = 0; j < h; ++j) ar_[j] = in[2 * j], ai_[j] = in[2 * j + 1];
+  const auto [xr, xi] = transform();
+  real_split(xr, xi, [&](std::size_t k, double re, double im) { out[k] = {re, im}; });
+}
+
+void Pow2RealFft::add_power(std::span<const double> x, std::span<const double> window, std::span<double> p) {
+  const std::size_t h = n_ / 2, seg = x.size();
+  // The padded product x·window, packed as forward() packs its input.
+  auto at = [&](std::size_t i) { return i < seg ? x[i] * window[i] : 0.0; };
+  for (std::size_t j = 0; j < h; ++j) ar_[j] = at(2 * j), ai_[j] = at(2 * j + 1);
+  const auto [xr, xi] = transform();
+  real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] += re * re + im * im; });
 }
 
 }  // namespace texel::detail
