@@ -1,5 +1,6 @@
 #include "fft.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -204,8 +205,12 @@ void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<dou
 void Pow2RealFft::add_power(std::span<const double> x, std::span<const double> window, std::span<double> p) {
   const std::size_t h = n_ / 2, seg = x.size();
   // The padded product x·window, packed as forward() packs its input.
-  auto at = [&](std::size_t i) { return i < seg ? x[i] * window[i] : 0.0; };
-  for (std::size_t j = 0; j < h; ++j) ar_[j] = at(2 * j), ai_[j] = at(2 * j + 1);
+  const std::size_t pairs = seg / 2;
+  for (std::size_t j = 0; j < pairs; ++j) ar_[j] = x[2 * j] * window[2 * j], ai_[j] = x[2 * j + 1] * window[2 * j + 1];
+  std::size_t j = pairs;
+  if (seg % 2 == 1) ar_[j] = x[seg - 1] * window[seg - 1], ai_[j] = 0.0, ++j;
+  std::fill(ar_.begin() + static_cast<std::ptrdiff_t>(j), ar_.begin() + static_cast<std::ptrdiff_t>(h), 0.0);
+  std::fill(ai_.begin() + static_cast<std::ptrdiff_t>(j), ai_.begin() + static_cast<std::ptrdiff_t>(h), 0.0);
   const auto [xr, xi] = transform();
   real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] += re * re + im * im; });
 }
