@@ -118,7 +118,13 @@ struct Fitter {
     std::optional<Percept> percept;
   };
   std::vector<Evaluated> memo;  // every point evaluated (a fit evaluates a few dozen)
-  int draws = 2;                // candidate draws per evaluation (1 or 2)
+  struct Drawn {
+    double p_db, i_db;
+    std::uint64_t seed;
+    Percept percept;
+  };
+  std::vector<Drawn> drawn;  // every candidate rendered: the grid's one-draw points are not drawn again with two
+  int draws = 2;             // candidate draws per evaluation (1 or 2)
 
   [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
   std::optional<Percept> evaluate(double p_db, double i_db);

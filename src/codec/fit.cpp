@@ -68,7 +68,13 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
   const auto used = static_cast<double>(std::clamp(draws, 1, 2));
   try {
     for (std::size_t d = 0; d < static_cast<std::size_t>(used); ++d) {
-      const Percept q = render_percept(p_db, i_db, seeds[d]);
+      auto seen = std::find_if(drawn.begin(), drawn.end(),
+                               [&](const Drawn& x) { return x.p_db == p_db && x.i_db == i_db && x.seed == seeds[d]; });
+      if (seen == drawn.end()) {
+        drawn.push_back({p_db, i_db, seeds[d], render_percept(p_db, i_db, seeds[d])});
+        seen = drawn.end() - 1;
+      }
+      const Percept& q = seen->percept;
       sum.pitch_db += q.pitch_db / used;
       sum.noisiness_db += q.noisiness_db / used;
       sum.mean_db += q.mean_db / used;
