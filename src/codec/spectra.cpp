@@ -45,7 +45,7 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   // three samples only).
   const std::size_t m = seg < 2 ? next_pow2(seg) : std::max<std::size_t>(4, next_pow2(seg));
   m_out = m;
-  p.assign(m / 2 + 1, 0.0);
+  p.resize(m / 2 + 1);  // every bin is written below
   // Per thread: the window of the last segment length and the plan of the
   // last transform length, with its work buffers (an encode analyses a few
   // dozen signals of the same length).
@@ -62,7 +62,7 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   const std::vector<double>& win = sc.win;
   if (m < 2) {
     // One sample (or none): only the DC bin, and no real FFT of length 1.
-    if (seg == 1) p[0] = x[0] * win[0] * x[0] * win[0];
+    p[0] = seg == 1 ? x[0] * win[0] * x[0] * win[0] : 0.0;
     return;
   }
   if (!sc.fft || sc.fft->size() != m) sc.fft = std::make_unique<texel::detail::Pow2RealFft>(m);
@@ -70,7 +70,9 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   std::size_t count = 0;
   const std::size_t hop = seg == n ? n : seg / 2;
   for (std::size_t start = 0; start + seg <= n; start += hop) {
-    fft->add_power(x.subspan(start, seg), win, p);  // |X|² of the windowed, zero-padded segment
+    // |X|² of the windowed, zero-padded segment: the first stored (0 + v is
+    // v: no zeroed spectrum needed), the others added.
+    fft->add_power(x.subspan(start, seg), win, p, count > 0);
     ++count;
   }
   for (double& v : p) v /= static_cast<double>(std::max<std::size_t>(count, 1));

@@ -202,7 +202,7 @@ void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<dou
   real_split(xr, xi, [&](std::size_t k, double re, double im) { out[k] = {re, im}; });
 }
 
-void Pow2RealFft::add_power(std::span<const double> x, std::span<const double> window, std::span<double> p) {
+void Pow2RealFft::add_power(std::span<const double> x, std::span<const double> window, std::span<double> p, bool add) {
   const std::size_t h = n_ / 2, seg = x.size();
   // The padded product x·window, packed as forward() packs its input.
   const std::size_t pairs = seg / 2;
@@ -212,7 +212,10 @@ void Pow2RealFft::add_power(std::span<const double> x, std::span<const double> w
   std::fill(ar_.begin() + static_cast<std::ptrdiff_t>(j), ar_.begin() + static_cast<std::ptrdiff_t>(h), 0.0);
   std::fill(ai_.begin() + static_cast<std::ptrdiff_t>(j), ai_.begin() + static_cast<std::ptrdiff_t>(h), 0.0);
   const auto [xr, xi] = transform();
-  real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] += re * re + im * im; });
+  if (add)
+    real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] += re * re + im * im; });
+  else
+    real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] = re * re + im * im; });
 }
 
 }  // namespace texel::detail
