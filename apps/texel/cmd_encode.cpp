@@ -31,6 +31,7 @@ struct EncodeArgs {
   std::optional<double> weight_exponent;    ///< default: the model version's
   std::optional<double> sensitivity_scale;  ///< default: the model version's
   std::string no_texture = std::string(codec::to_string(codec::EncoderConfig{}.no_texture));
+  std::string target = std::string(codec::to_string(codec::EncoderConfig{}.target));
   std::string display_response = std::string(codec::to_string(codec::PerceptualModel{}.display_response));
   double drawn_weight = codec::PerceptualModel{}.drawn_weight;
   unsigned coarse_bits = 6;
@@ -53,6 +54,7 @@ codec::EncoderConfig config_of(const EncodeArgs& a) {
   if (a.weight_exponent) c.model.weight_exponent = *a.weight_exponent;
   if (a.sensitivity_scale) c.model.sensitivity_scale = *a.sensitivity_scale;
   c.no_texture = codec::parse_no_texture(a.no_texture, "--no-texture");
+  c.target = codec::parse_target(a.target, "--target");
   // The display in the model's loop: the --device's frequency response
   // (--display-response device, the default; docs/encoder.md §2).
   c.model.display_response = codec::parse_display_response(a.display_response, "display_response");
@@ -97,7 +99,8 @@ void print_summary(const std::string& input, const codec::EncodeResult& r, const
     std::cout << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength "
               << detail::fixed(s.fine_strength, 3);
   std::cout << "\n  " << r.samples << " samples (" << r.samples * 2 << " bytes as u16) -> " << r.bytes.size() << " bytes"
-            << (out ? " in " + *out : std::string()) << "; model " << r.model_version << " distance "
+            << (out ? " in " + *out : std::string()) << "; model " << r.model_version
+            << (r.target == codec::EncoderConfig::Target::centroid ? " (centroid target)" : "") << " distance "
             << detail::fixed(r.model_distance, 2) << " JND\n";
 }
 
@@ -229,6 +232,11 @@ void register_encode(CLI::App& app) {
                   "An input without texture (variation RMS <= 2^-16): flag (encode a flat surface, say so) or refuse "
                   "(exit 2) [flag]")
       ->group(g);
+  cmd->add_option("--target", a->target,
+                  "What Central Pitch matches: felt (the model's felt pitch), centroid (the recording's log-spectral "
+                  "centroid, the decoded texture swiped at --swipe-speed) or automatic (centroid for .wav and time .csv "
+                  "recordings, felt for maps) [automatic]")
+      ->group(g);
   cmd->add_option("--display-response", a->display_response,
                   "Perceptual model: device (felt as the --device's frequency response passes it at the swipe speed) or "
                   "flat (the texture as drawn) [device]")
@@ -265,8 +273,9 @@ void register_encode(CLI::App& app) {
       if (cmd->count("--coarse-bits")) to.coarse_bits = a->coarse_bits;
       to.max_bytes = a->max_bytes;
       if (auto t = codec::transcode_file(a->inputs[0], signal_options(a->input), to)) {
-        for (const char* flag : {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit", "--weight-exponent",
-                                 "--sensitivity-scale", "--display-response", "--drawn-weight", "--model", "--no-texture"})
+        for (const char* flag :
+             {"--boundary", "--texel-length", "--seed", "--parameterization", "--fit", "--weight-exponent", "--sensitivity-scale",
+              "--display-response", "--drawn-weight", "--model", "--no-texture", "--target"})
           if (cmd->count(flag))
             throw InvalidArgument(std::string(flag) + " applies to estimation; '" + a->inputs[0] +
                                   "' holds Texel parameters and is transcoded with its own (add --estimate to re-estimate it)");

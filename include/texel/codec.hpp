@@ -56,6 +56,9 @@ struct Signal {
   std::vector<double> amplitude;  ///< nominally in [0, 1]
   Millimetres spacing{0.0};       ///< > 0
   std::string description;        ///< where it came from, for reports
+  /// A time recording (a vibration or sound at a finger speed: .wav, time
+  /// .csv), which EncoderConfig::Target::automatic encodes to its centroid.
+  bool recording = false;
 };
 
 /// texel::load_signal (every format, texel/signal.hpp), plus the one format
@@ -124,7 +127,16 @@ struct PerceptualModel {
   /// decides (docs/encoder.md §2). 0: the display alone. Unused without a
   /// display in the loop. >= 0.
   double drawn_weight = 1.0;
+  /// Also measure Percept::log_centroid_db (the encoder's centroid target
+  /// sets it; off, the field stays 0 and perceiving costs nothing more).
+  bool centroid = false;
 };
+
+/// The log-spectral centroid's band (Percept::log_centroid_db): from
+/// 20 Hz at the model's swipe speed (the low end of recordings and of touch)
+/// to 0.9 of the grid's Nyquist frequency (where anti-alias filters still pass).
+inline constexpr double centroid_low_hz = 20.0;
+inline constexpr double centroid_top_nyquist = 0.9;
 
 /// The defaults of model `version` (1 or 2; InvalidArgument otherwise):
 /// version 1 is the model before, bit for bit.
@@ -156,6 +168,11 @@ struct Percept {
   /// equal to pitch_db and noisiness_db when no display is in the loop.
   double drawn_pitch_db = 0.0;
   double drawn_noisiness_db = 0.0;
+  /// Physical: the log-spectral centroid, the power-weighted mean of
+  /// 10·log10 f (dB re 1 cpm) over every bin from centroid_low_hz (and
+  /// f_min) to centroid_top_nyquist, unmasked: what the `centroid` target
+  /// matches (EncoderConfig::target). 0 unless PerceptualModel::centroid.
+  double log_centroid_db = 0.0;
 };
 
 /// A percept as named fields, the names every front door reports it under
@@ -206,6 +223,12 @@ struct EncoderConfig {
   /// [choice] flag: encoded as a flat surface with EncodeResult::no_texture
   /// set; refuse: InvalidArgument (the CLI's exit 2 with one line).
   enum class NoTexture { flag, refuse } no_texture = NoTexture::flag;
+  /// What Central Pitch matches (docs/encoder.md §3, "Targets"): felt, the
+  /// model's felt pitch; centroid, the felt fit with Central Pitch then moved
+  /// until the decoded texture's log-spectral centroid is the input's;
+  /// automatic [default], centroid for recordings (Signal::recording) and
+  /// felt for maps. [choice]; named in every result (EncodeResult::target).
+  enum class Target { automatic, felt, centroid } target = Target::automatic;
 };
 
 /// The floor of "no texture": zero-mean RMS of the amplitude (0 … 1) at or
@@ -214,6 +237,9 @@ inline constexpr double no_texture_floor = 1.0 / 65536.0;
 std::string_view to_string(EncoderConfig::NoTexture n);
 /// "flag" or "refuse"; errors name `field`.
 EncoderConfig::NoTexture parse_no_texture(std::string_view text, std::string_view field = "no_texture");
+std::string_view to_string(EncoderConfig::Target t);
+/// "automatic", "felt" or "centroid"; errors name `field`.
+EncoderConfig::Target parse_target(std::string_view text, std::string_view field = "target");
 
 struct EncodeResult {
   Bitstream bitstream;
@@ -245,6 +271,8 @@ struct EncodeResult {
     bool irregularity = false;
     [[nodiscard]] bool any() const { return central_pitch || irregularity; }
   } at_bound;
+  /// The target the fit matched (felt or centroid; never automatic).
+  EncoderConfig::Target target = EncoderConfig::Target::felt;
   int evaluations = 0;
   double seconds = 0.0;
   std::size_t samples = 0;

@@ -96,6 +96,10 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   f.texel_length_um = static_cast<std::uint16_t>(std::lround(L_used * 1000.0));
   EncoderConfig fit_cfg = cfg;
   fit_cfg.texel_length = Millimetres(f.texel_length_um / 1000.0);
+  if (fit_cfg.target == EncoderConfig::Target::automatic)
+    fit_cfg.target = signal.recording ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  res.target = fit_cfg.target;
+  fit_cfg.model.centroid = fit_cfg.target == EncoderConfig::Target::centroid;
 
   Split sp = split(a, dx, fit_cfg,
                    rec                         ? SplitMode::fine_only
@@ -223,6 +227,49 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   res.bytes = write_bitstream(b);
   res.bitstream = parse_bitstream(res.bytes);  // what a decoder sees
   res.spec = to_spec(res.bitstream);
+  // The centroid target's last step (docs/encoder.md §3, "Targets"): the
+  // fit matched the fine part's log-spectral moments; the decoded texture as
+  // a whole (coarse profile, fine strength, the stream's own seed) is then
+  // moved in Central Pitch until its log-spectral centroid is the input's,
+  // by secant steps on the stream's 0.01 dB grid. Not where the part below
+  // the fine/coarse boundary carries half the power or more: the centroid
+  // then follows the coarse profile's power, which Central Pitch would be
+  // bent to make up for.
+  double below = 0.0;
+  const double v = fit_cfg.model.swipe_speed.value();
+  const double goal = fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered
+                          ? log_centroid_db(a, dx, v, 1.0 / cfg.boundary.value(), &below)
+                          : 0.0;
+  if (fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered && below < 0.5) {
+    std::vector<double> d(n);
+    auto centroid_at = [&](std::int16_t cdb) {
+      f.central_pitch_cdb = cdb;
+      res.bytes = write_bitstream(b);
+      res.bitstream = parse_bitstream(res.bytes);
+      res.spec = to_spec(res.bitstream);
+      TexelTexture(res.spec, Millimetres(len), Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max})
+          .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, d);
+      return log_centroid_db(d, dx, v);
+    };
+    const Box box = fit_box(fit_cfg, band_max);
+    const auto lo = static_cast<std::int16_t>(std::ceil(box.p_lo * 100.0)),
+               hi = static_cast<std::int16_t>(std::floor(box.p_hi * 100.0));
+    std::int16_t p0 = f.central_pitch_cdb;
+    double c0 = centroid_at(p0);
+    double slope = 1.0;  // the centroid rises with Central Pitch about dB for dB
+    for (int step = 0; step < 6 && std::fabs(c0 - goal) > 0.02; ++step) {
+      const auto p1 = static_cast<std::int16_t>(std::clamp<long>(std::lround(p0 + 100.0 * (goal - c0) / slope), lo, hi));
+      if (p1 == p0) break;
+      const double c1 = centroid_at(p1);
+      const double s = (c1 - c0) / ((p1 - p0) / 100.0);
+      if (std::fabs(c1 - goal) < std::fabs(c0 - goal)) p0 = p1, c0 = c1;
+      if (!(s > 0.1)) break;  // flat at the band's edge: keep the better point
+      slope = s;
+    }
+    centroid_at(p0);
+    res.at_bound.central_pitch = p0 <= lo || p0 >= hi;
+    if (res.at_bound.any()) res.irregularity_identifiable = false;
+  }
 
   // The decoded texture on the input's grid, under the model.
   if (has_fine) {
@@ -231,7 +278,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, d);
     EncoderConfig c2 = fit_cfg;
     const Split dsp = res.coarse ? split(d, dx, c2, SplitMode::two_scale, sp.window) : split(d, dx, c2, SplitMode::fine_only);
-    res.decoded = perceive(dsp.fine, dx, cfg.model, res.coarse ? 1.0 / cfg.boundary.value() : 0.0);
+    res.decoded = perceive(dsp.fine, dx, fit_cfg.model, res.coarse ? 1.0 / cfg.boundary.value() : 0.0);
     res.model_distance = distance(res.input, res.decoded, cfg.model);
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -41,6 +41,10 @@ void centre(std::vector<double>& x);
 /// How differently two signals of the same length distribute their power
 /// over half-octave bands (dB; docs/encoder.md §1 step 4).
 double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx);
+/// The log-spectral centroid of a whole signal (its mean removed), dB re
+/// 1 cpm: Percept::log_centroid_db's band and weighting at swipe speed v.
+/// `below`, if given, receives the share of the whole spectrum's power under f_split (cpm).
+double log_centroid_db(std::span<const double> x, double dx, double v, double f_split = 0.0, double* below = nullptr);
 
 // --- split.cpp -------------------------------------------------------------------
 
@@ -114,7 +118,13 @@ struct Fitter {
     std::optional<Percept> percept;
   };
   std::vector<Evaluated> memo;  // every point evaluated (a fit evaluates a few dozen)
-  int draws = 2;                // candidate draws per evaluation (1 or 2)
+  struct Drawn {
+    double p_db, i_db;
+    std::uint64_t seed;
+    Percept percept;
+  };
+  std::vector<Drawn> drawn;  // every candidate rendered: the grid's one-draw points are not drawn again with two
+  int draws = 2;             // candidate draws per evaluation (1 or 2)
 
   [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
   std::optional<Percept> evaluate(double p_db, double i_db);

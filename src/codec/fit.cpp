@@ -68,13 +68,20 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
   const auto used = static_cast<double>(std::clamp(draws, 1, 2));
   try {
     for (std::size_t d = 0; d < static_cast<std::size_t>(used); ++d) {
-      const Percept q = render_percept(p_db, i_db, seeds[d]);
+      auto seen = std::find_if(drawn.begin(), drawn.end(),
+                               [&](const Drawn& x) { return x.p_db == p_db && x.i_db == i_db && x.seed == seeds[d]; });
+      if (seen == drawn.end()) {
+        drawn.push_back({p_db, i_db, seeds[d], render_percept(p_db, i_db, seeds[d])});
+        seen = drawn.end() - 1;
+      }
+      const Percept& q = seen->percept;
       sum.pitch_db += q.pitch_db / used;
       sum.noisiness_db += q.noisiness_db / used;
       sum.mean_db += q.mean_db / used;
       sum.spread_db += q.spread_db / used;
       sum.drawn_pitch_db += q.drawn_pitch_db / used;
       sum.drawn_noisiness_db += q.drawn_noisiness_db / used;
+      sum.log_centroid_db += q.log_centroid_db / used;
     }
   } catch (const InvalidArgument&) {
     return std::nullopt;  // not renderable (e.g. too little of the distribution in the band)
@@ -83,6 +90,13 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
 }
 
 double Fitter::operator()(double p_db, double i_db) {
+  if (cfg.target == EncoderConfig::Target::centroid) {  // |residuals|, as least squares minimises
+    const std::optional<Residuals> r = residuals(p_db, i_db);
+    if (!r) return 1e6;
+    double sum = 0.0;
+    for (const double x : *r) sum += x * x;
+    return std::sqrt(sum);
+  }
   const std::optional<Percept> q = percept(p_db, i_db);
   return q ? fit_distance(target, *q, cfg.model) : 1e6;
 }
@@ -97,6 +111,16 @@ std::optional<Residuals> Fitter::residuals(double p_db, double i_db) {
   if (!q) return std::nullopt;
   const PerceptualModel& m = cfg.model;
   const double tie = std::sqrt(m.tie_weight);
+  // The centroid target fits the fine part's physical log-spectral moments:
+  // its centroid (Percept::log_centroid_db) and spread, in the JND units of
+  // pitch and noisiness (docs/encoder.md §3, "Targets").
+  if (cfg.target == EncoderConfig::Target::centroid)
+    return Residuals{(q->log_centroid_db - target.log_centroid_db) / m.pitch_jnd_db,
+                     (q->spread_db - target.spread_db) / m.noisiness_jnd_db,
+                     0.0,
+                     0.0,
+                     0.0,
+                     0.0};
   // Without a display in the loop the drawn terms are 0 (exactly: the sums
   // below are then the model's distance as before, bit for bit).
   const double w = display_in_loop(m) ? m.drawn_weight : 0.0;

@@ -79,6 +79,17 @@ double threshold_db(Hertz f) {
 
 namespace {
 
+/// Percept::log_centroid_db of a power spectrum `p` whose bins are at
+/// frequencies `f` (cpm) and levels `d` (dB), on a grid of spacing dx.
+double log_centroid(const std::vector<double>& p, const std::vector<double>& f, const std::vector<double>& d, double dx, double v,
+                    double f_lo) {
+  const double lo = std::max(f_lo, centroid_low_hz / v), hi = centroid_top_nyquist * 0.5 / dx;
+  double sp = 0.0, spd = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i)
+    if (f[i] >= lo && f[i] <= hi) sp += p[i], spd += p[i] * d[i];
+  return sp > 0.0 ? spd / sp : 0.0;
+}
+
 /// Version 1 (the model before): every bin weighted by its own
 /// suprathreshold sensitivity and amplitude.
 Percept perceive_v1(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
@@ -181,6 +192,7 @@ Percept perceive_v1(std::span<const double> fine, double spacing_mm, const Perce
   q.mean_db = db_of(spf / sp);
   const double pd = spd / sp;
   q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  if (model.centroid) q.log_centroid_db = log_centroid(p, bins.f, bins.d, spacing_mm, v, f_lo);
   q.drawn_pitch_db = q.pitch_db;
   q.drawn_noisiness_db = q.noisiness_db;
   if (drawn && sw0 > 0.0) {
@@ -220,6 +232,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
     std::vector<double> f, d, h2;
     std::vector<int> band;  // band of each bin (−1: below f_min)
     std::vector<double> centre_hz;
+    std::vector<std::size_t> end;  // band k's bins are [end[k−1] (first for k = 0), end[k])
     std::size_t first = 1;
   };
   thread_local std::array<Bins, 4> cache;
@@ -255,6 +268,10 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
     const int bands = x.first < p.size() ? x.band.back() + 1 : 0;
     x.centre_hz.resize(static_cast<std::size_t>(bands));
     for (int k = 0; k < bands; ++k) x.centre_hz[static_cast<std::size_t>(k)] = 250.0 * std::exp2((k + k0) * b);
+    // The band index never falls with frequency: each band is one run of bins.
+    x.end.assign(static_cast<std::size_t>(bands), x.first);
+    for (std::size_t i = x.first; i < p.size(); ++i) x.end[static_cast<std::size_t>(x.band[i])] = i + 1;
+    for (std::size_t k = 1; k < x.end.size(); ++k) x.end[k] = std::max(x.end[k], x.end[k - 1]);
     hit = cache.begin() + static_cast<std::ptrdiff_t>(&x - cache.data());
   }
   const Bins& x = *hit;
@@ -269,18 +286,32 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   thread_local Sums felt, drawn;
   felt.reset(bands);
   drawn.reset(display ? bands : 0);
-  double peak = 0.0, peak_felt = 0.0;
-  for (std::size_t i = x.first; i < p.size(); ++i) peak = std::max(peak, p[i]), peak_felt = std::max(peak_felt, p[i] * x.h2[i]);
+  // The peaks in four interleaved running maxima (a maximum does not depend
+  // on the order it is taken in; independent chains keep the pipeline full).
+  std::array<double, 4> pk{}, pkf{};
+  std::size_t i0 = x.first;
+  for (; i0 + 4 <= p.size(); i0 += 4)
+    for (std::size_t j = 0; j < 4; ++j) pk[j] = std::max(pk[j], p[i0 + j]), pkf[j] = std::max(pkf[j], p[i0 + j] * x.h2[i0 + j]);
+  for (std::size_t i = i0; i < p.size(); ++i) pk[0] = std::max(pk[0], p[i]), pkf[0] = std::max(pkf[0], p[i] * x.h2[i]);
+  const double peak = std::max(std::max(pk[0], pk[1]), std::max(pk[2], pk[3]));
+  const double peak_felt = std::max(std::max(pkf[0], pkf[1]), std::max(pkf[2], pkf[3]));
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
   double sp = 0, spf = 0, spd = 0, spdd = 0;
-  for (std::size_t i = x.first; i < p.size(); ++i) {
-    if (!(p[i] > floor)) continue;
-    const auto k = static_cast<std::size_t>(x.band[i]);
-    const double f = x.f[i], d = x.d[i];
-    sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
-    if (p[i] * x.h2[i] > floor_felt) felt.add(k, p[i] * x.h2[i], f, d);
-    if (display) drawn.add(k, p[i], f, d);
+  // Band by band (each a run of bins), the band's sums in registers; every
+  // sum adds the same terms in the same order as bin by bin.
+  for (std::size_t k = 0, i = x.first; k < bands; ++k) {
+    double fe = 0, ff = 0, fd = 0, fdd = 0, de = 0, df = 0, dd = 0, ddd = 0;
+    for (; i < x.end[k]; ++i) {
+      if (!(p[i] > floor)) continue;
+      const double f = x.f[i], d = x.d[i];
+      sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
+      const double w = p[i] * x.h2[i];
+      if (w > floor_felt) fe += w, ff += w * f, fd += w * d, fdd += w * d * d;
+      de += p[i], df += p[i] * f, dd += p[i] * d, ddd += p[i] * d * d;
+    }
+    felt.e[k] = fe, felt.f[k] = ff, felt.d[k] = fd, felt.dd[k] = fdd;
+    if (display) drawn.e[k] = de, drawn.f[k] = df, drawn.d[k] = dd, drawn.dd[k] = ddd;
   }
   if (!(sp > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
   const double s = model.sensitivity_scale, g = model.weight_exponent;
@@ -340,6 +371,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   q.mean_db = db_of(spf / sp);
   const double pd = spd / sp;
   q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
+  if (model.centroid) q.log_centroid_db = log_centroid(p, x.f, x.d, spacing_mm, v, f_lo);
   q.drawn_pitch_db = q.pitch_db;
   q.drawn_noisiness_db = q.noisiness_db;
   if (display) pool(drawn, q.drawn_pitch_db, q.drawn_noisiness_db);

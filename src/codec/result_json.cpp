@@ -54,6 +54,7 @@ std::string to_json(const EncodeResult& r) {
   m["distance_jnd"] = r.model_distance;
   m["evaluations"] = r.evaluations;
   m["fit"] = std::string(to_string(r.fit_method));
+  m["target"] = std::string(to_string(r.target));
   m["display_response"] = std::string(to_string(r.model.display_response));
   if (display_in_loop(r.model)) {
     m["display"] = {{"corner_hz", r.model.display.corner.value()}, {"order", r.model.display.order}};
@@ -75,6 +76,21 @@ EncoderConfig::NoTexture parse_no_texture(std::string_view text, std::string_vie
   if (text == "flag") return EncoderConfig::NoTexture::flag;
   if (text == "refuse") return EncoderConfig::NoTexture::refuse;
   throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: flag, refuse");
+}
+
+std::string_view to_string(EncoderConfig::Target t) {
+  switch (t) {
+    case EncoderConfig::Target::felt: return "felt";
+    case EncoderConfig::Target::centroid: return "centroid";
+    default: return "automatic";
+  }
+}
+
+EncoderConfig::Target parse_target(std::string_view text, std::string_view field) {
+  if (text == "automatic") return EncoderConfig::Target::automatic;
+  if (text == "felt") return EncoderConfig::Target::felt;
+  if (text == "centroid") return EncoderConfig::Target::centroid;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: automatic, felt, centroid");
 }
 
 }  // namespace texel::codec

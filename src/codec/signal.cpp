@@ -60,7 +60,7 @@ std::array<std::pair<const char*, double>, 6> fields(const Percept& p) {
            {"drawn_noisiness_db", p.drawn_noisiness_db}}};
 }
 
-Signal encoder_signal(const texel::Signal& s) { return Signal{s.samples, s.spacing, s.description}; }
+Signal encoder_signal(const texel::Signal& s) { return Signal{s.samples, s.spacing, s.description, s.sample_rate.has_value()}; }
 
 std::size_t zstd_size(std::span<const std::byte> bytes) {
   std::vector<char> out(ZSTD_compressBound(bytes.size()));

@@ -45,13 +45,12 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   // three samples only).
   const std::size_t m = seg < 2 ? next_pow2(seg) : std::max<std::size_t>(4, next_pow2(seg));
   m_out = m;
-  p.assign(m / 2 + 1, 0.0);
-  // Per thread: the window of the last segment length, the plan of the last
-  // transform length and the work buffers (an encode analyses a few dozen
-  // signals of the same length).
+  p.resize(m / 2 + 1);  // every bin is written below
+  // Per thread: the window of the last segment length and the plan of the
+  // last transform length, with its work buffers (an encode analyses a few
+  // dozen signals of the same length).
   struct Scratch {
-    std::vector<double> win, buf;
-    std::vector<std::complex<double>> X;
+    std::vector<double> win;
     std::unique_ptr<texel::detail::Pow2RealFft> fft;
   };
   thread_local Scratch sc;
@@ -63,23 +62,17 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
   const std::vector<double>& win = sc.win;
   if (m < 2) {
     // One sample (or none): only the DC bin, and no real FFT of length 1.
-    if (seg == 1) p[0] = x[0] * win[0] * x[0] * win[0];
+    p[0] = seg == 1 ? x[0] * win[0] * x[0] * win[0] : 0.0;
     return;
   }
   if (!sc.fft || sc.fft->size() != m) sc.fft = std::make_unique<texel::detail::Pow2RealFft>(m);
-  sc.buf.resize(m);
-  std::fill(sc.buf.begin() + static_cast<std::ptrdiff_t>(seg), sc.buf.end(),
-            0.0);  // the zero padding; [0, seg) is written per segment
-  sc.X.resize(m / 2 + 1);
-  std::vector<double>& buf = sc.buf;
-  std::vector<std::complex<double>>& X = sc.X;
   texel::detail::Pow2RealFft* fft = sc.fft.get();
   std::size_t count = 0;
   const std::size_t hop = seg == n ? n : seg / 2;
   for (std::size_t start = 0; start + seg <= n; start += hop) {
-    for (std::size_t i = 0; i < seg; ++i) buf[i] = x[start + i] * win[i];
-    fft->forward(buf, X);
-    for (std::size_t i = 0; i <= m / 2; ++i) p[i] += std::norm(X[i]);
+    // |X|² of the windowed, zero-padded segment: the first stored (0 + v is
+    // v: no zeroed spectrum needed), the others added.
+    fft->add_power(x.subspan(start, seg), win, p, count > 0);
     ++count;
   }
   for (double& v : p) v /= static_cast<double>(std::max<std::size_t>(count, 1));
@@ -132,6 +125,21 @@ double shape_distance_db(const std::vector<double>& x, const std::vector<double>
     den += w;
   }
   return num_ / den;
+}
+
+double log_centroid_db(std::span<const double> x, double dx, double v, double f_split, double* below) {
+  std::size_t m = 0;
+  const std::vector<double> p = power_spectrum(centred(x), m);
+  const double df = 1.0 / (static_cast<double>(m) * dx);
+  const double lo = centroid_low_hz / v, hi = centroid_top_nyquist * 0.5 / dx;
+  double sp = 0.0, spd = 0.0, all = 0.0, sb = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    const double f = static_cast<double>(i) * df;
+    if (f >= lo && f <= hi) sp += p[i], spd += p[i] * db_of(f);
+    all += p[i], sb += f < f_split ? p[i] : 0.0;
+  }
+  if (below) *below = all > 0.0 ? sb / all : 0.0;
+  return sp > 0.0 ? spd / sp : 0.0;
 }
 
 }  // namespace texel::codec::parts

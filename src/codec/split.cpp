@@ -24,8 +24,12 @@ constexpr double strength_snap = 0.02;
 /// branch-free passes whatever the window (blocks of the window's span k:
 /// the prefix extreme within each block from the left, the suffix extreme
 /// from the right; a window covers the tail of one block and the head of
-/// the next). `g`, `h`: scratch.
-void running_extreme(const std::vector<double>& x, std::size_t w, bool max, std::vector<double>& out, std::vector<double>& g,
+/// the next). `g`, `h`: scratch. The prefix and suffix chains of two blocks
+/// run interleaved (four independent chains instead of one at a time: each
+/// step waits for the one before); every value is the same comparison of
+/// the same two numbers as one chain at a time.
+template <bool Max>
+void running_extreme(const std::vector<double>& x, std::size_t w, std::vector<double>& out, std::vector<double>& g,
                      std::vector<double>& h) {
   const std::size_t n = x.size();
   const std::size_t half = w / 2;
@@ -33,18 +37,29 @@ void running_extreme(const std::vector<double>& x, std::size_t w, bool max, std:
   out.resize(n);
   if (n == 0) return;
   // x padded with `half` neutral values on each side, to a whole number of blocks.
-  const double neutral = max ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+  const double neutral = Max ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
   const std::size_t padded = ((n + 2 * half + k - 1) / k) * k;
-  g.resize(padded);
-  h.resize(padded);
-  auto at = [&](std::size_t j) { return j >= half && j - half < n ? x[j - half] : neutral; };
-  auto pick = [max](double a, double b) { return max ? std::max(a, b) : std::min(a, b); };
-  for (std::size_t b = 0; b < padded; b += k) {
-    g[b] = at(b);
-    for (std::size_t j = b + 1; j < b + k; ++j) g[j] = pick(g[j - 1], at(j));
-    h[b + k - 1] = at(b + k - 1);
-    for (std::size_t j = b + k - 1; j-- > b;) h[j] = pick(h[j + 1], at(j));
+  g.assign(padded, neutral);
+  std::copy(x.begin(), x.end(), g.begin() + static_cast<std::ptrdiff_t>(half));
+  h = g;
+  auto pick = [](double a, double b) { return Max ? std::max(a, b) : std::min(a, b); };
+  // In place: g[j] = pick(g[j − 1], x_j) reads x_j before writing it, and
+  // h[j] = pick(h[j + 1], x_j) likewise.
+  std::size_t b = 0;
+  for (; b + 2 * k <= padded; b += 2 * k) {
+    const std::size_t c = b + k;
+    for (std::size_t t = 1; t < k; ++t) {
+      g[b + t] = pick(g[b + t - 1], g[b + t]);
+      g[c + t] = pick(g[c + t - 1], g[c + t]);
+      h[b + k - 1 - t] = pick(h[b + k - t], h[b + k - 1 - t]);
+      h[c + k - 1 - t] = pick(h[c + k - t], h[c + k - 1 - t]);
+    }
   }
+  for (; b < padded; b += k)
+    for (std::size_t t = 1; t < k; ++t) {
+      g[b + t] = pick(g[b + t - 1], g[b + t]);
+      h[b + k - 1 - t] = pick(h[b + k - t], h[b + k - 1 - t]);
+    }
   // Window of output i in padded coordinates: [i, i + k − 1].
   for (std::size_t i = 0; i < n; ++i) out[i] = pick(h[i], g[i + k - 1]);
 }
@@ -282,7 +297,7 @@ void split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, Sp
   // the running extremes' steps; it barely attenuates coarse features (a
   // 5 mm period keeps 98 % of its amplitude).
   const auto smooth = std::max(w, static_cast<std::size_t>(std::round(0.5 * B / dx)));
-  running_extreme(a, w, true, sc.up_raw, sc.prefix, sc.suffix);
+  running_extreme<true>(a, w, sc.up_raw, sc.prefix, sc.suffix);
   moving_average(sc.up_raw, smooth, sc.up, sc.cum);
   std::vector<double>& up = sc.up;
   // The decision coarse-or-not looks at the envelope low-passed at the
@@ -296,7 +311,7 @@ void split(const std::vector<double>& a, double dx, const EncoderConfig& cfg, Sp
     moving_average(sc.slow_1, b_samples, sc.up_slow, sc.cum);
   }
   const std::vector<double>& up_slow = sc.up_slow;
-  running_extreme(a, w, false, sc.lo_raw, sc.prefix, sc.suffix);
+  running_extreme<false>(a, w, sc.lo_raw, sc.prefix, sc.suffix);
   moving_average(sc.lo_raw, smooth, sc.lo, sc.cum);
   const std::vector<double>& lo = sc.lo;
   for (double& v : up) v = std::clamp(v, 1e-6, 1.0);

@@ -1,5 +1,6 @@
 #include "fft.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -7,6 +8,7 @@
 
 #include <kiss_fftr.h>
 
+#include "texel/detail/lanes.hpp"
 #include "texel/error.hpp"
 
 namespace texel::detail {
@@ -114,8 +116,15 @@ __attribute__((target("avx2"))) void stage_avx2(const double* xr, const double* 
   radix4_stage(xr, xi, yr, yi, m, s, tw);
 }
 
+__attribute__((target("avx512f"))) void stage_avx512(const double* xr, const double* xi, double* yr, double* yi, std::size_t m,
+                                                     std::size_t s, const Twiddles* tw) {
+  radix4_stage(xr, xi, yr, yi, m, s, tw);
+}
+
 StageFn stage_fn() {
-  static const StageFn fn = __builtin_cpu_supports("avx2") ? &stage_avx2 : &stage_baseline;
+  // The widest the CPU has (and TEXEL_SIMD allows): element-wise IEEE
+  // arithmetic without contraction, so every width gives the same bits.
+  static const StageFn fn = detail::simd_lanes() == 8 ? &stage_avx512 : detail::simd_lanes() == 4 ? &stage_avx2 : &stage_baseline;
   return fn;
 }
 
@@ -140,13 +149,12 @@ Pow2RealFft::Pow2RealFft(std::size_t n) : n_(n) {
   ar_.resize(h), ai_.resize(h), br_.resize(h), bi_.resize(h);
 }
 
-void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<double>> out) {
+std::pair<const double*, const double*> Pow2RealFft::transform() {
   const std::size_t h = n_ / 2;  // complex length
   double* xr = ar_.data();
   double* xi = ai_.data();
   double* yr = br_.data();
   double* yi = bi_.data();
-  for (std::size_t j = 0; j < h; ++j) xr[j] = in[2 * j], xi[j] = in[2 * j + 1];
   // Stockham, decimation in frequency: stage by stage between two buffers,
   // natural order at the end.
   const StageFn stage = stage_fn();
@@ -166,19 +174,48 @@ void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<dou
     }
     std::swap(xr, yr), std::swap(xi, yi);
   }
+  return {xr, xi};
+}
+
+template <class Sink>
+void Pow2RealFft::real_split(const double* xr, const double* xi, Sink&& sink) const {
   // Real split: with Z the transform of z_j = x_2j + i·x_2j+1,
   // X_k = E_k + e^{−2πik/n}·O_k, E_k = (Z_k + conj Z_{h−k})/2, O_k = (Z_k − conj Z_{h−k})/(2i).
-  out[0] = {xr[0] + xi[0], 0.0};
-  out[h] = {xr[0] - xi[0], 0.0};
+  const std::size_t h = n_ / 2;
+  sink(0, xr[0] + xi[0], 0.0);
+  sink(h, xr[0] - xi[0], 0.0);
   for (std::size_t k = 1; k <= h / 2; ++k) {
     const std::size_t c = h - k;
     const double er = 0.5 * (xr[k] + xr[c]), ei = 0.5 * (xi[k] - xi[c]);
     const double orr = 0.5 * (xi[k] + xi[c]), oi = -0.5 * (xr[k] - xr[c]);
     const double tr = sr_[k] * orr - si_[k] * oi, ti = sr_[k] * oi + si_[k] * orr;
-    out[k] = {er + tr, ei + ti};
+    sink(k, er + tr, ei + ti);
     // X_{h−k} = conj E + e^{−2πi(h−k)/n}·conj O = conj E − conj(e^{−2πik/n}·O)
-    if (c != k) out[c] = {er - tr, -ei + ti};
+    if (c != k) sink(c, er - tr, -ei + ti);
   }
+}
+
+void Pow2RealFft::forward(std::span<const double> in, std::span<std::complex<double>> out) {
+  const std::size_t h = n_ / 2;
+  for (std::size_t j = 0; j < h; ++j) ar_[j] = in[2 * j], ai_[j] = in[2 * j + 1];
+  const auto [xr, xi] = transform();
+  real_split(xr, xi, [&](std::size_t k, double re, double im) { out[k] = {re, im}; });
+}
+
+void Pow2RealFft::add_power(std::span<const double> x, std::span<const double> window, std::span<double> p, bool add) {
+  const std::size_t h = n_ / 2, seg = x.size();
+  // The padded product x·window, packed as forward() packs its input.
+  const std::size_t pairs = seg / 2;
+  for (std::size_t j = 0; j < pairs; ++j) ar_[j] = x[2 * j] * window[2 * j], ai_[j] = x[2 * j + 1] * window[2 * j + 1];
+  std::size_t j = pairs;
+  if (seg % 2 == 1) ar_[j] = x[seg - 1] * window[seg - 1], ai_[j] = 0.0, ++j;
+  std::fill(ar_.begin() + static_cast<std::ptrdiff_t>(j), ar_.begin() + static_cast<std::ptrdiff_t>(h), 0.0);
+  std::fill(ai_.begin() + static_cast<std::ptrdiff_t>(j), ai_.begin() + static_cast<std::ptrdiff_t>(h), 0.0);
+  const auto [xr, xi] = transform();
+  if (add)
+    real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] += re * re + im * im; });
+  else
+    real_split(xr, xi, [&](std::size_t k, double re, double im) { p[k] = re * re + im * im; });
 }
 
 }  // namespace texel::detail

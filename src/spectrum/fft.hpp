@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace texel::detail {
@@ -51,8 +52,22 @@ class Pow2RealFft {
   [[nodiscard]] std::size_t size() const { return n_; }
   /// in.size() == size(); out.size() == size()/2 + 1.
   void forward(std::span<const double> in, std::span<std::complex<double>> out);
+  /// Adds |X_k|² to p[k] (p.size() == size()/2 + 1), or with `add` false
+  /// stores it there, X the transform of x·window zero-padded to size()
+  /// (x.size() == window.size() ≤ size()): bit for bit std::norm of
+  /// forward()'s output for the padded product, without the product's and
+  /// the spectrum's buffers (a periodogram).
+  void add_power(std::span<const double> x, std::span<const double> window, std::span<double> p, bool add = true);
 
  private:
+  /// The complex transform of the packed input in ar_/ai_; the buffers
+  /// holding the result.
+  std::pair<const double*, const double*> transform();
+  /// The real-input split of the complex transform (zr, zi): sink(k, re, im)
+  /// for every k = 0 … size()/2.
+  template <class Sink>
+  void real_split(const double* zr, const double* zi, Sink&& sink) const;
+
   std::size_t n_;                          // real length
   std::vector<Radix4Twiddles> tw_;         // per radix-4 stage and p
   std::vector<double> sr_, si_;            // e^{−2πik/n}, k ≤ n/4: the real split's

@@ -91,6 +91,11 @@ check(dev.attrs["MATLAB_class"] == b"char" and dev.dtype == np.uint16 and "".joi
 # MATLAB's own marker for text stored as integers: 2 = UTF-16 (what MATLAB writes for char).
 check(int(dev.attrs.get("MATLAB_int_decode", -1)) == 2, "v7.3 params.device has MATLAB_int_decode = 2")
 check(int(h["document"].attrs.get("MATLAB_int_decode", -1)) == 2, "v7.3 document has MATLAB_int_decode = 2")
+# The class mark as MATLAB writes it: a scalar, fixed-length ASCII string attribute.
+cls = h5py.h5a.open(dev.id, b"MATLAB_class")
+ctype = cls.get_type()
+check(isinstance(ctype, h5py.h5t.TypeStringID) and not ctype.is_variable_str() and ctype.get_cset() == h5py.h5t.CSET_ASCII
+      and cls.get_space().get_simple_extent_type() == h5py.h5s.SCALAR, "v7.3 MATLAB_class: scalar fixed-length ASCII")
 doc73 = h["document"][:, 0].astype(np.uint16).tobytes().decode("utf-16-le")
 check(doc73 == document, "v7.3 document is the texel.json text")
 check(h["texels"]["frequency_cpm"].shape == (1, k), "v7.3 texels columns")
