@@ -57,6 +57,9 @@ function(texel_find_dependencies component missing_var)
     _texel_package(libkissfft-dev kissfft_FOUND kissfft CONFIG COMPONENTS SHARED)
   elseif(component STREQUAL "plot")
     _texel_pkg_module(TEXEL_CAIRO cairo libcairo2-dev)
+  elseif(component STREQUAL "surface2d")
+    # Friction bitmaps and coarse-profile images (PNG).
+    _texel_pkg_module(TEXEL_PNG libpng libpng-dev)
   elseif(component STREQUAL "player")
     _texel_package(libc6-dev Threads_FOUND Threads)
     _texel_pkg_module(TEXEL_SNDFILE sndfile libsndfile1-dev)
@@ -96,11 +99,12 @@ endfunction()
 # order where every component comes after the ones it needs. The options'
 # checks in cmake/TexelComponents.cmake state the same graph; keep them in
 # step (tests/consumer loads one component and checks what comes along).
-set(TEXEL_COMPONENTS core controller spectrum plot player io codec experiment studio capi)
+set(TEXEL_COMPONENTS core controller spectrum plot surface2d player io codec experiment studio capi)
 set(TEXEL_COMPONENT_NEEDS_core "")
 set(TEXEL_COMPONENT_NEEDS_controller core)
 set(TEXEL_COMPONENT_NEEDS_spectrum core)
 set(TEXEL_COMPONENT_NEEDS_plot core spectrum)
+set(TEXEL_COMPONENT_NEEDS_surface2d core spectrum)
 set(TEXEL_COMPONENT_NEEDS_player core controller spectrum)
 set(TEXEL_COMPONENT_NEEDS_io core)
 set(TEXEL_COMPONENT_NEEDS_codec core io spectrum)

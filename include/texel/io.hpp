@@ -62,6 +62,14 @@ std::string npy_bytes(std::span<const double> values);
 std::string npy_header(std::size_t count);
 /// Reads a 1-D or single-column .npy of float64/float32/int16/uint16 (little-endian).
 std::vector<double> parse_npy(std::string_view bytes, std::string_view origin);
+/// A .npy array of the same dtypes with its shape: `dimensions` 1 (as
+/// parse_npy: rows = the length, columns = 1) or 2 (rows × columns,
+/// row-major values whatever the file's order).
+struct NpyArray {
+  std::size_t rows = 0, columns = 1;
+  std::vector<double> values;
+};
+NpyArray parse_npy_array(std::string_view bytes, std::string_view origin, int dimensions);
 
 /// Two-column CSV with a header: "position_mm,amplitude" and one row per sample.
 std::string csv_columns(std::string_view header_a, std::string_view header_b, std::span<const double> a,

@@ -238,9 +238,10 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
     t.frequency = CyclesPerMm(frequency[i % batch]);
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
-    t.envelope = 1.0 - C * (1.0 - coarse[constant ? 0 : i]);
-    run.offset.push_back(t.envelope - t.envelope * F * 0.5);
-    run.gain.push_back(t.envelope * F * 0.5);
+    const TexelMix mix = texel_mix(coarse[constant ? 0 : i], C, F);
+    t.envelope = mix.envelope;
+    run.offset.push_back(mix.offset);
+    run.gain.push_back(mix.gain);
     phase = phase_after(phase, t.frequency.value(), L);
   }
   return phase;

@@ -146,6 +146,10 @@ std::string npy_header(std::size_t count) {
 }
 
 std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
+  return parse_npy_array(b, origin, 1).values;
+}
+
+NpyArray parse_npy_array(std::string_view b, std::string_view origin, int dimensions) {
   const std::string where(origin);
   if (b.size() < 10 || b.substr(0, 6) != std::string_view("\x93NUMPY", 6))
     throw FormatError(where + ": not a .npy file (bad magic)");
@@ -180,9 +184,8 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
   std::string descr = value_of("descr");
   std::erase(descr, '\'');
   std::erase(descr, ' ');
-  if (value_of("fortran_order").find("True") != std::string::npos) {
-    // A 1-D or (n,1) array reads the same either way; checked via shape below.
-  }
+  // A 1-D or (n,1) array reads the same either way; a 2-D one is transposed.
+  const bool fortran = value_of("fortran_order").find("True") != std::string::npos;
   const std::string shape = value_of("shape");
   // The shape is outside input: every dimension is checked against the data
   // the file actually holds before any size arithmetic, so a declared
@@ -210,7 +213,17 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
     ++non_unit;
     n = d;  // the one dimension that is not 1 (at most data_bytes: no overflow below)
   }
-  if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
+  NpyArray array;
+  if (dimensions == 1) {
+    if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
+    array.rows = n;
+  } else {
+    if (dims.size() != 2 || dims[0] == 0 || dims[1] == 0 || dims[0] > data_bytes / dims[1])
+      throw FormatError(where + ": .npy array of shape " + shape + " is not a non-empty two-dimensional array");
+    array.rows = dims[0];
+    array.columns = dims[1];
+    n = dims[0] * dims[1];
+  }
   std::size_t width = 0;
   if (descr == "<f8")
     width = 8;
@@ -225,9 +238,12 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
   if (b.size() - data_at != n * width)
     throw FormatError(where + ": .npy data holds " + std::to_string(b.size() - data_at) + " bytes, shape needs " +
                       std::to_string(n * width));
-  std::vector<double> out(n);
+  std::vector<double>& out = array.values;
+  out.resize(n);
   const char* p = b.data() + data_at;
-  for (std::size_t i = 0; i < n; ++i, p += width) {
+  for (std::size_t k = 0; k < n; ++k, p += width) {
+    // Fortran order stores columns first: element k is (k % rows, k / rows).
+    const std::size_t i = fortran && dimensions == 2 ? (k % array.rows) * array.columns + k / array.rows : k;
     if (descr == "<f8")
       std::memcpy(&out[i], p, 8);
     else if (descr == "<f4") {
@@ -245,7 +261,7 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
     } else
       out[i] = static_cast<unsigned char>(*p) / 255.0;
   }
-  return out;
+  return array;
 }
 
 std::string csv_columns(std::string_view ha, std::string_view hb, std::span<const double> a, std::span<const double> b) {
