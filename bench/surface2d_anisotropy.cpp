@@ -95,16 +95,15 @@ int main(int argc, char** argv) {
           r.spread_p = hi_p - lo_p;
           r.spread_i = hi_i - lo_i;
           TexelSpec band = spec;
-          const IsotropicBound b = isotropic_bound(
-              PitchDistribution([&] {
-                PitchDistributionConfig c;
-                c.central_pitch = band.central_pitch;
-                c.irregularity = band.irregularity;
-                c.band_min = band.band_min;
-                c.band_max = top;
-                return c;
-              }()),
-              top);
+          const IsotropicBound b = isotropic_bound(PitchDistribution([&] {
+                                                     PitchDistributionConfig c;
+                                                     c.central_pitch = band.central_pitch;
+                                                     c.irregularity = band.irregularity;
+                                                     c.band_min = band.band_min;
+                                                     c.band_max = top;
+                                                     return c;
+                                                   }()),
+                                                   top);
           r.bound_p = b.scan_log_centroid_db;
           r.bound_i = b.scan_log_spread_db;
           r.target_p = b.target_log_centroid_db;

@@ -25,7 +25,8 @@ function(texel_component_requires option reason)
   endforeach()
 endfunction()
 texel_component_requires(TEXEL_WITH_PLOT "spectrum figures" TEXEL_WITH_SPECTRUM)
-texel_component_requires(TEXEL_WITH_SURFACE2D "scans of 2-D fields are measured with the spectrum tools" TEXEL_WITH_SPECTRUM)
+texel_component_requires(TEXEL_WITH_SURFACE2D "scans of 2-D fields are measured with the spectrum tools; .mat and glTF maps"
+                         TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
 texel_component_requires(TEXEL_WITH_PLAYER "swipe spectra, the serial display protocol"
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_CONTROLLER)
 texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading" TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)

@@ -99,14 +99,14 @@ endfunction()
 # order where every component comes after the ones it needs. The options'
 # checks in cmake/TexelComponents.cmake state the same graph; keep them in
 # step (tests/consumer loads one component and checks what comes along).
-set(TEXEL_COMPONENTS core controller spectrum plot surface2d player io codec experiment studio capi)
+set(TEXEL_COMPONENTS core controller spectrum plot player io surface2d codec experiment studio capi)
 set(TEXEL_COMPONENT_NEEDS_core "")
 set(TEXEL_COMPONENT_NEEDS_controller core)
 set(TEXEL_COMPONENT_NEEDS_spectrum core)
 set(TEXEL_COMPONENT_NEEDS_plot core spectrum)
-set(TEXEL_COMPONENT_NEEDS_surface2d core spectrum)
 set(TEXEL_COMPONENT_NEEDS_player core controller spectrum)
 set(TEXEL_COMPONENT_NEEDS_io core)
+set(TEXEL_COMPONENT_NEEDS_surface2d core io spectrum)
 set(TEXEL_COMPONENT_NEEDS_codec core io spectrum)
 set(TEXEL_COMPONENT_NEEDS_experiment core codec player plot spectrum)
 set(TEXEL_COMPONENT_NEEDS_studio core codec experiment player plot spectrum)

@@ -63,7 +63,7 @@ class FineField2D {
 
   TexelSpec spec_;
   Field2D design_;
-  double cos_n_ = 1.0, sin_n_ = 0.0;   // oriented: the grating's direction
+  double cos_n_ = 1.0, sin_n_ = 0.0;                // oriented: the grating's direction
   std::shared_ptr<const class TexelTexture> line_;  // oriented: the 1-D texture along n
   double line_origin_ = 0.0;                        // oriented: projection offset (mm)
   std::unique_ptr<PitchDistribution> cells_;        // cells: the corrected distribution

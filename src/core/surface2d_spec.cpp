@@ -9,12 +9,9 @@ namespace texel {
 
 std::string_view to_string(Field2D f) {
   switch (f) {
-    case Field2D::cells:
-      return "cells";
-    case Field2D::spectral:
-      return "spectral";
-    case Field2D::oriented:
-      return "oriented";
+    case Field2D::cells: return "cells";
+    case Field2D::spectral: return "spectral";
+    case Field2D::oriented: return "oriented";
   }
   return "cells";
 }

@@ -15,8 +15,10 @@
 #include "internal.hpp"
 #include "texel/detail/parallel.hpp"
 #include "texel/error.hpp"
+#include "texel/interchange.hpp"
 #include "texel/io.hpp"
 #include "texel/map_file.hpp"
+#include "texel/matfile.hpp"
 
 namespace texel {
 namespace {
@@ -84,12 +86,72 @@ struct PngWriteHandle {
 
 bool is_bitmap_path(const std::string& path) {
   const std::string ext = output_extension(path);
-  return ext == ".png" || ext == ".npy";
+  return ext == ".png" || ext == ".npy" || ext == ".mat" || ext == ".gltf" || ext == ".glb";
 }
+
+namespace {
+
+/// .mat: the whole map in memory (MATLAB double, height × width).
+BitmapFileStats write_mat_bitmap(const std::string& path, const Surface2D& surface, const BitmapFileOptions& options) {
+  const BitmapGeometry& g = surface.geometry();
+  const std::size_t w = static_cast<std::size_t>(g.width), h = static_cast<std::size_t>(g.height);
+  if (w * h > max_in_memory_pixels)
+    throw InvalidArgument("'" + path + "': a .mat map is held in memory whole; " + std::to_string(g.width) + " × " +
+                          std::to_string(g.height) + " pixels is over the limit of " + std::to_string(max_in_memory_pixels) +
+                          " (write .png or .npy, which stream)");
+  mat::Matrix m;
+  m.rows = h;
+  m.cols = w;
+  m.data.resize(w * h);
+  std::vector<double> row(w);
+  double sum = 0.0;
+  for (std::size_t j = 0; j < h; ++j) {
+    surface.render_rows(static_cast<int>(j), 1, row);
+    for (std::size_t i = 0; i < w; ++i) {
+      m.data[i * h + j] = row[i];  // column-major
+      sum += row[i];
+    }
+  }
+  mat::WriteOptions mo;
+  mo.version = options.mat_version;
+  mat::write_mat(path, {{"amplitude", std::move(m)}, {"pixel_pitch_mm", mat::Matrix::scalar(g.pitch.value())}}, mo);
+  return {g.width, g.height, 64, w * h * 8, sum / static_cast<double>(w * h)};
+}
+
+/// .gltf / .glb: the PNG bitmap inside a glTF asset (MPEG_haptic_material).
+BitmapFileStats write_gltf_bitmap(const std::string& path, const Surface2D& surface, const BitmapFileOptions& options) {
+  const BitmapGeometry& g = surface.geometry();
+  if (static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height) > max_in_memory_pixels)
+    throw InvalidArgument("'" + path + "': a glTF asset is built in memory; the bitmap is over " +
+                          std::to_string(max_in_memory_pixels) + " pixels (write .png or .npy, which stream)");
+  const std::string png = path + ".png.part";
+  BitmapFileStats stats;
+  std::vector<std::byte> bytes;
+  try {
+    stats = write_bitmap(png, surface, options);
+    const std::string text = read_file(png);
+    bytes.assign(reinterpret_cast<const std::byte*>(text.data()), reinterpret_cast<const std::byte*>(text.data()) + text.size());
+    std::remove(png.c_str());
+  } catch (...) {
+    std::remove(png.c_str());
+    throw;
+  }
+  gltf::AssetOptions o;
+  const auto container = output_extension(path) == ".glb" ? gltf::Container::glb : gltf::Container::gltf;
+  const std::vector<std::byte> asset =
+      gltf::asset_2d(bytes, g.width_mm().value(), g.height_mm().value(), "surface2d", o, container);
+  write_file_atomic(path, asset);
+  stats.bytes = asset.size();
+  return stats;
+}
+
+}  // namespace
 
 BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, const BitmapFileOptions& options) {
   const std::string ext = output_extension(path);
-  if (!is_bitmap_path(path)) throw InvalidArgument("'" + path + "': a 2-D bitmap is written as .png or .npy");
+  if (!is_bitmap_path(path)) throw InvalidArgument("'" + path + "': a 2-D bitmap is written as .png, .npy, .mat, .gltf or .glb");
+  if (ext == ".mat") return write_mat_bitmap(path, surface, options);
+  if (ext == ".gltf" || ext == ".glb") return write_gltf_bitmap(path, surface, options);
   const BitmapGeometry& g = surface.geometry();
   const bool png = ext == ".png";
   const int depth = png ? (options.depth == 0 ? g.depth : options.depth) : 64;
@@ -234,9 +296,11 @@ Raster2D read_png_grey(const std::string& path) {
   if (!h.info) throw IoError(path + ": cannot start libpng");
   png_uint_32 w = 0, ht = 0;
   int depth = 0, colour = 0;
-  if (!png_read_header(h.png, h.info, h.f, w, ht, depth, colour)) throw FormatError(path + ": not a readable PNG (" + st.message + ")");
+  if (!png_read_header(h.png, h.info, h.f, w, ht, depth, colour))
+    throw FormatError(path + ": not a readable PNG (" + st.message + ")");
   if (colour != PNG_COLOR_TYPE_GRAY)
-    throw FormatError(path + ": a coarse-profile image must be a grey PNG without alpha (8 or 16 bit); this one has colour type " +
+    throw FormatError(path +
+                      ": a coarse-profile image must be a grey PNG without alpha (8 or 16 bit); this one has colour type " +
                       std::to_string(colour));
   if (w > 65535 || ht > 65535) throw FormatError(path + ": the image is larger than 65535 pixels on a side");
   const int bytes = depth == 16 ? 2 : 1;
@@ -248,8 +312,8 @@ Raster2D read_png_grey(const std::string& path) {
   r.height = static_cast<int>(ht);
   r.values.resize(static_cast<std::size_t>(w) * ht);
   for (std::size_t k = 0; k < r.values.size(); ++k)
-    r.values[k] = bytes == 2 ? static_cast<float>(((data[2 * k] << 8) | data[2 * k + 1]) / 65535.0)
-                             : static_cast<float>(data[k] / 255.0);
+    r.values[k] =
+        bytes == 2 ? static_cast<float>(((data[2 * k] << 8) | data[2 * k + 1]) / 65535.0) : static_cast<float>(data[k] / 255.0);
   return r;
 }
 

@@ -157,7 +157,8 @@ DirectionStats measure_line(const TexelSpec& spec, CyclesPerMm band_top, const S
   const TexelTexture line(fine, grid.length(), Sampling{grid, band_top});
   std::vector<std::vector<double>> scans(static_cast<std::size_t>(options.scans), std::vector<double>(options.samples));
   for (int s = 0; s < options.scans; ++s)
-    line.render(grid, static_cast<std::int64_t>(s) * static_cast<std::int64_t>(options.samples), scans[static_cast<std::size_t>(s)]);
+    line.render(grid, static_cast<std::int64_t>(s) * static_cast<std::int64_t>(options.samples),
+                scans[static_cast<std::size_t>(s)]);
   return summarize_scans(scans, h);
 }
 

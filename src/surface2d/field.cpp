@@ -2,13 +2,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "internal.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
 #include "texel/surface2d.hpp"
 #include "texel/texture.hpp"
-#include "internal.hpp"
 
 namespace texel {
 namespace {
@@ -159,7 +159,8 @@ double FineField2D::value(double x, double y) const {
 
 void FineField2D::row(std::int64_t first, double pitch, double origin_x, double y, std::span<double> out) const {
   if (design_ != Field2D::cells) {
-    for (std::size_t k = 0; k < out.size(); ++k) out[k] = value(static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x, y);
+    for (std::size_t k = 0; k < out.size(); ++k)
+      out[k] = value(static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x, y);
     return;
   }
   // value()'s arithmetic, a cell drawn once per run of pixels in it.

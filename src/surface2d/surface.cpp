@@ -69,8 +69,7 @@ CoarseField2D::CoarseField2D(const Coarse2D& spec, Millimetres region_width, Mil
 
 double CoarseField2D::value(double x, double y) const {
   switch (spec_.index()) {
-    case 0:
-      return std::get<ConstantProfile>(spec_).value;
+    case 0: return std::get<ConstantProfile>(spec_).value;
     case 1: {
       const auto& e = std::get<Edge2D>(spec_);
       const double nx = detmath::cos_cycles(e.angle_deg / 360.0), ny = detmath::sin_cycles(e.angle_deg / 360.0);
@@ -117,7 +116,8 @@ double CoarseField2D::value(double x, double y) const {
 }
 
 void CoarseField2D::row(std::int64_t first, double pitch, double origin_x, double y, std::span<double> out) const {
-  for (std::size_t k = 0; k < out.size(); ++k) out[k] = value(static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x, y);
+  for (std::size_t k = 0; k < out.size(); ++k)
+    out[k] = value(static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x, y);
 }
 
 Surface2D::Surface2D(const BitmapGeometry& geometry, std::vector<Region> regions)
@@ -134,8 +134,10 @@ bool inside(double v, double lo, double hi) { return v + 1e-9 >= lo && v + 1e-9 
 void Surface2D::render_rows(int first_row, int rows, std::span<double> out) const {
   const int w = geometry_.width;
   const double p = geometry_.pitch.value();
-  if (first_row < 0 || rows < 0 || first_row + rows > geometry_.height || out.size() != static_cast<std::size_t>(rows) * static_cast<std::size_t>(w))
-    throw InvalidArgument("render_rows: rows " + std::to_string(first_row) + " + " + std::to_string(rows) + " outside the bitmap or output of the wrong size");
+  if (first_row < 0 || rows < 0 || first_row + rows > geometry_.height ||
+      out.size() != static_cast<std::size_t>(rows) * static_cast<std::size_t>(w))
+    throw InvalidArgument("render_rows: rows " + std::to_string(first_row) + " + " + std::to_string(rows) +
+                          " outside the bitmap or output of the wrong size");
   std::fill(out.begin(), out.end(), 0.0);
   std::vector<double> coarse;
   for (int r = 0; r < rows; ++r) {
@@ -206,7 +208,8 @@ Surface2D prepare_surface2d(const Document& doc) {
 }
 
 Raster2D coarse_raster(const Document& doc, std::size_t region, Millimetres pitch) {
-  if (!doc.surface2d || !doc.device.bitmap) throw InvalidArgument("coarse_raster needs a 2-D document (surface2d) on a device with a bitmap grid");
+  if (!doc.surface2d || !doc.device.bitmap)
+    throw InvalidArgument("coarse_raster needs a 2-D document (surface2d) on a device with a bitmap grid");
   if (region >= doc.surface2d->regions.size())
     throw InvalidArgument("region " + std::to_string(region) + " does not exist (the document has " +
                           std::to_string(doc.surface2d->regions.size()) + ")");
