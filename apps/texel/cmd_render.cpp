@@ -8,10 +8,10 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "render_output.hpp"
+#include "texel/bitmap_file.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
-#include "texel/bitmap_file.hpp"
 
 namespace texel::cli {
 namespace {
@@ -35,7 +35,8 @@ void render_2d(const RenderArgs& a) {
     throw InvalidArgument("--output '" + a.output + "': a 2-D surface is written as .png, .npy, .mat, .gltf or .glb");
   BitmapFileOptions options;
   options.mat_version = mat::parse_mat_version(a.mat_version);
-  if (a.depth != 0 && a.depth != 8 && a.depth != 16) throw InvalidArgument("--depth is " + std::to_string(a.depth) + "; allowed: 8, 16");
+  if (a.depth != 0 && a.depth != 8 && a.depth != 16)
+    throw InvalidArgument("--depth is " + std::to_string(a.depth) + "; allowed: 8, 16");
   check_writable(a.output);
   const Document doc = load_document(*a.document);
   const Surface2D surface = prepare_surface2d(doc);

@@ -72,10 +72,10 @@ BitmapPolarity parse_bitmap_polarity(std::string_view text, std::string_view fie
 /// finger in (x, y) (docs/format.md "Device profiles"; JSON "bitmap").
 /// Pixel (i, j) sits at (i·pitch, j·pitch), rows along y.
 struct BitmapGeometry {
-  int width = 0;               ///< pixels along x, 1 … 65535
-  int height = 0;              ///< pixels along y, 1 … 65535
-  Millimetres pitch{0.1};      ///< pixel spacing (the resolution), > 0
-  int depth = 16;              ///< bits per pixel of its bitmaps: 8 or 16
+  int width = 0;           ///< pixels along x, 1 … 65535
+  int height = 0;          ///< pixels along y, 1 … 65535
+  Millimetres pitch{0.1};  ///< pixel spacing (the resolution), > 0
+  int depth = 16;          ///< bits per pixel of its bitmaps: 8 or 16
   BitmapPolarity polarity = BitmapPolarity::darker_more_friction;
 
   [[nodiscard]] Millimetres width_mm() const { return Millimetres(width * pitch.value()); }

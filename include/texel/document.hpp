@@ -58,7 +58,7 @@ struct Document {
   /// `regions` is then empty, and prepare_surface2d (texel/surface2d.hpp)
   /// prepares it.
   std::optional<Surface2DSpec> surface2d;
-  std::string description;          ///< free text
+  std::string description;  ///< free text
 };
 
 /// Parses and validates a document. `origin` names the source in errors.

@@ -622,7 +622,8 @@ int required_version(const Document& doc) {
 }
 
 Surface prepare_surface(const Document& doc) {
-  if (doc.surface2d) throw InvalidArgument("a 2-D document (surface2d) renders with --surface 2d (prepare_surface2d), not as a 1-D map");
+  if (doc.surface2d)
+    throw InvalidArgument("a 2-D document (surface2d) renders with --surface 2d (prepare_surface2d), not as a 1-D map");
   if (doc.regions.empty()) throw InvalidArgument("document has no regions");
   const Grid grid = doc.device.grid();
   std::vector<Region> regions;

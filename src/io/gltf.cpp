@@ -135,7 +135,6 @@ namespace {
 /// material (the Reference texture only when a .hjif is referenced).
 std::vector<std::byte> assemble(const std::vector<std::byte>& png, float L, float W, float u_end, float v_end,
                                 const std::string& node_name, const AssetOptions& o, Container container) {
-
   // Geometry: positions, normals, texture coordinates, indices (one quad).
   std::vector<std::byte> buf;
   const float pos[4][3] = {{0, 0, 0}, {L, 0, 0}, {L, W, 0}, {0, W, 0}};
@@ -192,7 +191,8 @@ std::vector<std::byte> assemble(const std::vector<std::byte>& png, float L, floa
   ojson material{{"name", "Texel texture"}, {"haptic", 0}, {modality_key, std::move(textures)}};
   if (o.hjif_uri.empty()) material.erase("haptic");
   ojson root{
-      {"asset", {{"version", "2.0"}, {"generator", o.hjif_uri.empty() ? "Texel (texel render --surface 2d)" : "Texel (texel export)"}}},
+      {"asset",
+       {{"version", "2.0"}, {"generator", o.hjif_uri.empty() ? "Texel (texel render --surface 2d)" : "Texel (texel export)"}}},
       {"extensionsUsed", {"MPEG_media", "MPEG_haptic", "MPEG_haptic_material"}},
       {"extensions",
        {{"MPEG_media",

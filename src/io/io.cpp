@@ -145,9 +145,7 @@ std::string npy_header(std::size_t count) {
   return out;
 }
 
-std::vector<double> parse_npy(std::string_view b, std::string_view origin) {
-  return parse_npy_array(b, origin, 1).values;
-}
+std::vector<double> parse_npy(std::string_view b, std::string_view origin) { return parse_npy_array(b, origin, 1).values; }
 
 NpyArray parse_npy_array(std::string_view b, std::string_view origin, int dimensions) {
   const std::string where(origin);
