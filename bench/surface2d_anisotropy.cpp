@@ -30,6 +30,7 @@ struct Row {
   double mean_p, mean_i, spread_p, spread_i;
   double bound_p, bound_i;  // the stationary bound's prediction (A·S2), and its target
   double target_p, target_i;
+  double matched_p, matched_i;  // the moment fit's prediction
   std::vector<DirectionStats> per_direction;
 };
 
@@ -51,8 +52,8 @@ int main(int argc, char** argv) {
   const std::vector<double> irregularities = quick ? std::vector<double>{-5.0} : std::vector<double>{-10.0, -5.0, 0.0, 5.0};
   const std::vector<double> lengths = quick ? std::vector<double>{0.25} : std::vector<double>{0.25, 1.0};
   std::vector<Row> rows;
-  std::printf("%6s %6s %5s %-9s | %7s %7s | %7s %7s %6s %6s | %7s %7s\n", "P_dB", "I_dB", "L_mm", "design", "1D_P", "1D_I",
-              "mean_P", "mean_I", "sprP", "sprI", "bnd_P", "bnd_I");
+  std::printf("%6s %6s %5s %-9s | %7s %7s | %7s %7s %6s %6s | %7s %7s | %7s %7s\n", "P_dB", "I_dB", "L_mm", "design", "1D_P",
+              "1D_I", "mean_P", "mean_I", "sprP", "sprI", "mom_P", "mom_I", "nnls_P", "nnls_I");
   for (double p : pitches)
     for (double irr : irregularities)
       for (double l : lengths) {
@@ -108,9 +109,12 @@ int main(int argc, char** argv) {
           r.bound_i = b.scan_log_spread_db;
           r.target_p = b.target_log_centroid_db;
           r.target_i = b.target_log_spread_db;
-          std::printf("%6.2f %6.2f %5.2f %-9s | %7.2f %7.2f | %7.2f %7.2f %6.2f %6.2f | %7.2f %7.2f (target %6.2f %6.2f)\n", p,
-                      irr, l, r.design.c_str(), r.line_p, r.line_i, r.mean_p, r.mean_i, r.spread_p, r.spread_i, r.bound_p,
-                      r.bound_i, r.target_p, r.target_i);
+          r.matched_p = b.matched_log_centroid_db;
+          r.matched_i = b.matched_log_spread_db;
+          std::printf(
+              "%6.2f %6.2f %5.2f %-9s | %7.2f %7.2f | %7.2f %7.2f %6.2f %6.2f | %7.2f %7.2f | %7.2f %7.2f (target %6.2f %6.2f)\n",
+              p, irr, l, r.design.c_str(), r.line_p, r.line_i, r.mean_p, r.mean_i, r.spread_p, r.spread_i, r.matched_p,
+              r.matched_i, r.bound_p, r.bound_i, r.target_p, r.target_i);
           std::fflush(stdout);
           rows.push_back(std::move(r));
         }
@@ -130,11 +134,11 @@ int main(int argc, char** argv) {
   if (!csv.empty()) {
     std::ofstream out(csv);
     out << "central_pitch_db,irregularity_db,texel_length_mm,design,line_p_db,line_i_db,mean_p_db,mean_i_db,spread_p_db,"
-           "spread_i_db,bound_p_db,bound_i_db,target_p_db,target_i_db\n";
+           "spread_i_db,nnls_p_db,nnls_i_db,target_p_db,target_i_db,moment_p_db,moment_i_db\n";
     for (const auto& r : rows)
       out << r.p << "," << r.i << "," << r.l << "," << r.design << "," << r.line_p << "," << r.line_i << "," << r.mean_p << ","
           << r.mean_i << "," << r.spread_p << "," << r.spread_i << "," << r.bound_p << "," << r.bound_i << "," << r.target_p
-          << "," << r.target_i << "\n";
+          << "," << r.target_i << "," << r.matched_p << "," << r.matched_i << "\n";
   }
   if (!figure.empty()) {
     // Per direction: the deviation from the direction mean, every texture

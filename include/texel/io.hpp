@@ -60,6 +60,10 @@ std::string output_extension(const std::string& path);
 std::string npy_bytes(std::span<const double> values);
 /// The header of that file for `count` values (the data follows it).
 std::string npy_header(std::size_t count);
+/// The header of a float64 (rows, columns) C-order array.
+std::string npy_header(std::size_t rows, std::size_t columns);
+/// The header for a shape written out ("12," or "3, 4").
+std::string npy_header_for_shape(const std::string& shape);
 /// Reads a 1-D or single-column .npy of float64/float32/int16/uint16 (little-endian).
 std::vector<double> parse_npy(std::string_view bytes, std::string_view origin);
 /// A .npy array of the same dtypes with its shape: `dimensions` 1 (as

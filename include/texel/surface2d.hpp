@@ -144,15 +144,29 @@ Raster2D render_raster(const Surface2D& surface);
 /// radial spectrum S2 ≥ 0 whose straight scans S1 = A·S2 (the Abel relation,
 /// S1(k) = 2∫_k^∞ S2(q)·q/√(q² − k²) dq, exact for piecewise-constant S2)
 /// are closest to it in relative (log-spectral) terms, on a log-frequency grid.
+///
+/// Two fits are made. `radial`/`scan`: the log-spectral-shape fit above.
+/// `matched_radial`/`matched_scan`: the moment fit — the power-weighted
+/// log-frequency moments (what Central Pitch and Irregularity measure) of a
+/// scan are the radial spectrum's moments convolved with the cosine law's,
+/// mean −3.01 dB and variance 3.94² dB², so S2 lognormal with the 1-D
+/// median + 3.01 dB and σ'² = max(σ² − σ_cos², 0) reaches the 1-D Central
+/// Pitch exactly and the Irregularity max(I_1D, 3.94 dB): the best any
+/// non-negative S2 can do in those two measures.
 struct IsotropicBound {
-  std::vector<double> frequency;  ///< k = q grid (cpm), log-spaced
-  std::vector<double> target;     ///< t(k), density per cpm (unit area)
-  std::vector<double> radial;     ///< S2 on [q_j, q_j+1) (≥ 0)
-  std::vector<double> scan;       ///< A·S2: what straight scans carry
+  std::vector<double> frequency;       ///< k = q grid (cpm), log-spaced
+  std::vector<double> target;          ///< t(k), density per cpm (unit area)
+  std::vector<double> radial;          ///< S2 on [q_j, q_j+1) (≥ 0), log-spectral fit
+  std::vector<double> scan;            ///< A·S2: what straight scans carry
+  std::vector<double> matched_radial;  ///< S2 of the moment fit
+  std::vector<double> matched_scan;    ///< its A·S2
   double target_log_centroid_db = 0.0, target_log_spread_db = 0.0;
   double scan_log_centroid_db = 0.0, scan_log_spread_db = 0.0;
+  double matched_log_centroid_db = 0.0, matched_log_spread_db = 0.0;
 };
 IsotropicBound isotropic_bound(const PitchDistribution& distribution, CyclesPerMm band_top);
+/// The moment fit's radial frequency distribution for a 1-D distribution.
+PitchDistribution cosine_corrected(const PitchDistribution& line);
 
 /// Straight scans of a field analysed with the 1-D spectrum tools
 /// (texel/spectrum.hpp): per direction, `scans` parallel lines of `samples`

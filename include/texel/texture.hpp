@@ -96,6 +96,10 @@ inline constexpr double texel_length_mm_max = 1000.0;
 /// Validates every field; throws InvalidArgument naming field, value and range.
 void validate(const TexelSpec& spec);
 
+/// The pitch distribution's configuration of `spec` on a band topped at
+/// `band_top` when spec.band_max is 0 (TexelTexture's, and the 2-D fields').
+PitchDistributionConfig distribution_config(const TexelSpec& spec, CyclesPerMm band_top);
+
 /// The coarse/fine mixing rule (docs/algorithm.md §7), the one definition
 /// the 1-D texels and the 2-D fields (texel/surface2d.hpp) share: with the
 /// coarse profile reading c, coarse strength C and fine strength F, the

@@ -131,8 +131,14 @@ std::string npy_bytes(std::span<const double> values) {
   return out;
 }
 
-std::string npy_header(std::size_t count) {
-  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(count) + ",), }";
+std::string npy_header(std::size_t count) { return npy_header_for_shape(std::to_string(count) + ","); }
+
+std::string npy_header(std::size_t rows, std::size_t columns) {
+  return npy_header_for_shape(std::to_string(rows) + ", " + std::to_string(columns));
+}
+
+std::string npy_header_for_shape(const std::string& shape) {
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + shape + "), }";
   // Magic (6) + version (2) + header length (2) + header, padded with spaces
   // and a final newline to a multiple of 64 bytes (NEP 1).
   const std::size_t unpadded = 10 + header.size() + 1;

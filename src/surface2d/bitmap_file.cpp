@@ -179,15 +179,7 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
     png_set_write_fn(handle.png, &st, on_png_write, on_png_flush);
     if (!png_begin(handle.png, handle.info, g.width, g.height, depth, options.png_compression)) png_fail(st, path);
   } else {
-    std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(g.height) + ", " +
-                         std::to_string(g.width) + "), }";
-    const std::size_t unpadded = 10 + header.size() + 1;
-    header.append((64 - unpadded % 64) % 64, ' ');
-    header.push_back('\n');
-    std::string out("\x93NUMPY\x01\x00", 8);
-    out.push_back(static_cast<char>(header.size() & 0xFF));
-    out.push_back(static_cast<char>((header.size() >> 8) & 0xFF));
-    file.write(out + header);
+    file.write(npy_header(static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width)));
   }
 
   // Each worker renders and encodes one strip of a batch; the calling thread

@@ -42,7 +42,8 @@ IsotropicBound isotropic_bound(const PitchDistribution& distribution, CyclesPerM
   const double sigma = std::max(distribution.sigma(), 0.02);
   // From two decades below the distribution (the scans' low tail) to its top.
   const double f_lo = std::max(lo_band, detmath::exp(mu - 6.0 * sigma)) / 100.0;
-  const double f_hi = std::min(hi_band, detmath::exp(mu + 6.0 * sigma));
+  // Up to the band's top (the radial spectrum of the moment fit sits 3 dB higher).
+  const double f_hi = std::min(hi_band, detmath::exp(mu + 6.0 * sigma + 0.7));
   IsotropicBound b;
   b.frequency.resize(n);
   std::vector<double> dk(n);
@@ -99,8 +100,23 @@ IsotropicBound isotropic_bound(const PitchDistribution& distribution, CyclesPerM
   b.scan.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < n; ++j) b.scan[i] += a[i * n + j] * b.radial[j];
+  // The moment fit: radial power density p(q) = the corrected lognormal in
+  // the band, S2 = p(q)/q (power in an annulus is S2·2πq·dq).
+  const PitchDistribution radial = cosine_corrected(distribution);
+  const double rmu = radial.mu(), rsigma = std::max(radial.sigma(), 0.02);
+  b.matched_radial.assign(n, 0.0);
+  b.matched_scan.assign(n, 0.0);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double q = b.frequency[j] + 0.5 * dk[j];
+    if (q < lo_band || q > hi_band) continue;
+    const double z = (detmath::log(q) - rmu) / rsigma;
+    b.matched_radial[j] = detmath::exp(-0.5 * z * z) / (q * q);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) b.matched_scan[i] += a[i * n + j] * b.matched_radial[j];
   std::tie(b.target_log_centroid_db, b.target_log_spread_db) = log_moments(b.frequency, b.target, dk);
   std::tie(b.scan_log_centroid_db, b.scan_log_spread_db) = log_moments(b.frequency, b.scan, dk);
+  std::tie(b.matched_log_centroid_db, b.matched_log_spread_db) = log_moments(b.frequency, b.matched_scan, dk);
   return b;
 }
 

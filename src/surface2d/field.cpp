@@ -14,7 +14,6 @@ namespace texel {
 namespace {
 
 constexpr double ln10 = 2.302585092994045684;
-constexpr double pi = 3.14159265358979323846;
 // Cells are indexed by 24 bits per axis (the frequency stream's counter is
 // index·2^17 + attempt, so indices stay below 2^47); the pattern repeats
 // every 2^24 cells.
@@ -32,16 +31,26 @@ std::uint64_t cell_index(std::int64_t m, std::int64_t n) {
 
 }  // namespace
 
+PitchDistribution cosine_corrected(const PitchDistribution& line) {
+  // Scans see a radial frequency q at q·|cos θ|: the 1-D lognormal moved up
+  // by the law's mean (+3.01 dB) and narrowed by its variance where the 1-D
+  // spread allows (§11.1).
+  const double mean_shift = -cosine_law_mean_db * ln10 / 10.0;
+  const double law_sd = cosine_law_sd_db * ln10 / 10.0;
+  const double sigma = std::sqrt(std::max(line.sigma() * line.sigma() - law_sd * law_sd, 0.0));
+  PitchDistributionConfig c = line.config();
+  c.parameterization = Parameterization::log;
+  c.central_pitch = Decibels((line.mu() + mean_shift) * 10.0 / ln10);
+  c.irregularity = Decibels(sigma * 10.0 / ln10);
+  try {
+    return PitchDistribution(c);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("2-D field (the 1-D distribution moved up by 3.01 dB for the cosine law): ") + e.what());
+  }
+}
+
 PitchDistribution surface2d_detail::line_distribution(const TexelSpec& spec, CyclesPerMm band_top) {
-  PitchDistributionConfig c;
-  c.central_pitch = spec.central_pitch;
-  c.irregularity = spec.irregularity;
-  c.parameterization = spec.parameterization;
-  c.out_of_band = spec.out_of_band;
-  c.band_min = spec.band_min;
-  c.band_max = spec.band_max.value() > 0.0 ? spec.band_max : band_top;
-  c.quantization_db = spec.quantization_db;
-  return PitchDistribution(c);
+  return PitchDistribution(distribution_config(spec, band_top));
 }
 
 FineField2D::FineField2D(const TexelSpec& spec, Field2D design, double orientation_deg, CyclesPerMm band_top)
@@ -51,25 +60,7 @@ FineField2D::FineField2D(const TexelSpec& spec, Field2D design, double orientati
     throw InvalidArgument("the 2-D field's band top is " + detail::num(band_top.value()) + " cpm; it must be > 0");
   const PitchDistribution line = surface2d_detail::line_distribution(spec, band_top);
   switch (design) {
-    case Field2D::cells: {
-      // Scans see a cell's frequency q at q·|cos θ|: draw q from the 1-D
-      // lognormal moved up by the law's mean (+3.01 dB) and narrowed by its
-      // variance where the 1-D spread allows (§11.2).
-      const double mean_shift = -cosine_law_mean_db * ln10 / 10.0;
-      const double law_sd = cosine_law_sd_db * ln10 / 10.0;
-      const double sigma = std::sqrt(std::max(line.sigma() * line.sigma() - law_sd * law_sd, 0.0));
-      PitchDistributionConfig c = line.config();
-      c.parameterization = Parameterization::log;
-      c.central_pitch = Decibels((line.mu() + mean_shift) * 10.0 / ln10);
-      c.irregularity = Decibels(sigma * 10.0 / ln10);
-      try {
-        cells_ = std::make_unique<PitchDistribution>(c);
-      } catch (const InvalidArgument& e) {
-        throw InvalidArgument(std::string("2-D cells (the 1-D distribution moved up by 3.01 dB for the cosine law): ") +
-                              e.what());
-      }
-      break;
-    }
+    case Field2D::cells: cells_ = std::make_unique<PitchDistribution>(cosine_corrected(line)); break;
     case Field2D::spectral: {
       const IsotropicBound bound = isotropic_bound(line, CyclesPerMm(line.config().band_max.value()));
       const std::size_t bins = bound.radial.size();
@@ -77,7 +68,7 @@ FineField2D::FineField2D(const TexelSpec& spec, Field2D design, double orientati
       for (std::size_t j = 0; j < bins; ++j) {
         const double q0 = bound.frequency[j];
         const double q1 = j + 1 < bins ? bound.frequency[j + 1] : q0 * (bound.frequency[1] / bound.frequency[0]);
-        cdf[j + 1] = cdf[j] + bound.radial[j] * (q1 * q1 - q0 * q0);  // power in the annulus ∝ S2·(q1² − q0²)
+        cdf[j + 1] = cdf[j] + bound.matched_radial[j] * (q1 * q1 - q0 * q0);  // power in the annulus ∝ S2·(q1² − q0²)
       }
       const CounterRng rng(spec.seed, stream_spectral);
       const double turn0 = rng.uniform(0);
