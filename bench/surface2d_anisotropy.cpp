@@ -6,7 +6,7 @@
 // per direction, their spread across directions (max − min), their mean
 // against the 1-D texture's own, and the stationary isotropic bound.
 //
-//   texel_surface2d_anisotropy [--quick] [--scans 16] [--figure spread.svg] [--csv table.csv]
+//   texel_surface2d_anisotropy [--quick] [--scans 16] [--pitches 0,5.67] [--figure spread.svg] [--csv table.csv]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,16 +39,22 @@ struct Row {
 int main(int argc, char** argv) {
   bool quick = false;
   int scans = 16;
+  std::vector<double> only_pitches;
   std::string figure, csv;
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--quick")) quick = true;
     if (!std::strcmp(argv[a], "--figure") && a + 1 < argc) figure = argv[++a];
     if (!std::strcmp(argv[a], "--csv") && a + 1 < argc) csv = argv[++a];
     if (!std::strcmp(argv[a], "--scans") && a + 1 < argc) scans = std::atoi(argv[++a]);
+    if (!std::strcmp(argv[a], "--pitches") && a + 1 < argc) {
+      // A comma-separated subset of the grid's Central Pitches (dB), to split a sweep.
+      for (char* t = std::strtok(argv[++a], ","); t; t = std::strtok(nullptr, ",")) only_pitches.push_back(std::atof(t));
+    }
   }
   // The protocols' textures (examples/protocols: P 0 … 15.3 dB, I −10 … 5 dB
   // moments, L 0.25 and 1 mm).
-  const std::vector<double> pitches = quick ? std::vector<double>{6.0} : std::vector<double>{0.0, 5.67, 11.0, 15.26};
+  const std::vector<double> pitches =
+      quick ? std::vector<double>{6.0} : (only_pitches.empty() ? std::vector<double>{0.0, 5.67, 11.0, 15.26} : only_pitches);
   const std::vector<double> irregularities = quick ? std::vector<double>{-5.0} : std::vector<double>{-10.0, -5.0, 0.0, 5.0};
   const std::vector<double> lengths = quick ? std::vector<double>{0.25} : std::vector<double>{0.25, 1.0};
   std::vector<Row> rows;

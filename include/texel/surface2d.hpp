@@ -39,6 +39,12 @@ class FineField2D {
   /// out[k] = value((first + k)·pitch − origin_x, y): a run of a raster row
   /// whose pixel i sits at i·pitch, in texture coordinates.
   void row(std::int64_t first, double pitch_mm, double origin_x_mm, double y_mm, std::span<double> out) const;
+  /// A block of rows: out[r·stride + k] = value((first + k)·pitch − origin_x,
+  /// ys[r]), the same values row() gives, computed a tile at a time
+  /// (the spectral design's plane waves split into x and y factors once per
+  /// block).
+  void block(std::int64_t first, std::size_t count, double pitch_mm, double origin_x_mm, std::span<const double> ys,
+             double* out, std::size_t stride) const;
   /// Oriented fields are defined for |x|, |y| up to this (mm); at rest beyond.
   static constexpr double oriented_extent_mm = 2000.0;
 

@@ -135,8 +135,12 @@ double FineField2D::value(double x, double y) const {
       return detmath::sin_cycles(c.phase + c.frequency * (c.cos_dir * dx + c.sin_dir * dy));
     }
     case Field2D::spectral: {
+      // sin(2π(a·x + φ + b·y)) split into its x and y factors, as block() computes it.
       double sum = 0.0;
-      for (const Component& k : components_) sum += detmath::sin_cycles(k.phase + k.frequency * (k.cos_dir * x + k.sin_dir * y));
+      for (const Component& k : components_) {
+        const double u = k.frequency * k.cos_dir * x, v = k.phase + k.frequency * k.sin_dir * y;
+        sum += detmath::sin_cycles(u) * detmath::cos_cycles(v) + detmath::cos_cycles(u) * detmath::sin_cycles(v);
+      }
       return std::clamp(sum * spectral_gain_, -1.0, 1.0);
     }
     case Field2D::oriented: {
@@ -148,7 +152,54 @@ double FineField2D::value(double x, double y) const {
   return 0.0;
 }
 
+void FineField2D::block(std::int64_t first, std::size_t count, double pitch, double origin_x, std::span<const double> ys,
+                        double* out, std::size_t stride) const {
+  if (design_ != Field2D::spectral) {
+    for (std::size_t r = 0; r < ys.size(); ++r) row(first, pitch, origin_x, ys[r], std::span<double>(out + r * stride, count));
+    return;
+  }
+  const std::size_t n = components_.size();
+  // y factors of every row, then x factors a tile of columns at a time.
+  std::vector<double> sy(n * ys.size()), cy(n * ys.size());
+  for (std::size_t r = 0; r < ys.size(); ++r)
+    for (std::size_t c = 0; c < n; ++c) {
+      const Component& k = components_[c];
+      const double v = k.phase + k.frequency * k.sin_dir * ys[r];
+      sy[r * n + c] = detmath::sin_cycles(v);
+      cy[r * n + c] = detmath::cos_cycles(v);
+    }
+  constexpr std::size_t tile = 256;
+  std::vector<double> sx(n * tile), cx(n * tile), acc(tile);
+  for (std::size_t t0 = 0; t0 < count; t0 += tile) {
+    const std::size_t m = std::min(tile, count - t0);
+    for (std::size_t c = 0; c < n; ++c) {
+      const Component& k = components_[c];
+      for (std::size_t t = 0; t < m; ++t) {
+        const double x = static_cast<double>(first + static_cast<std::int64_t>(t0 + t)) * pitch - origin_x;
+        const double u = k.frequency * k.cos_dir * x;
+        sx[c * tile + t] = detmath::sin_cycles(u);
+        cx[c * tile + t] = detmath::cos_cycles(u);
+      }
+    }
+    for (std::size_t r = 0; r < ys.size(); ++r) {
+      std::fill(acc.begin(), acc.end(), 0.0);
+      for (std::size_t c = 0; c < n; ++c) {
+        const double s_y = sy[r * n + c], c_y = cy[r * n + c];
+        const double* s_x = sx.data() + c * tile;
+        const double* c_x = cx.data() + c * tile;
+        for (std::size_t t = 0; t < m; ++t) acc[t] += s_x[t] * c_y + c_x[t] * s_y;
+      }
+      double* line = out + r * stride + t0;
+      for (std::size_t t = 0; t < m; ++t) line[t] = std::clamp(acc[t] * spectral_gain_, -1.0, 1.0);
+    }
+  }
+}
+
 void FineField2D::row(std::int64_t first, double pitch, double origin_x, double y, std::span<double> out) const {
+  if (design_ == Field2D::spectral) {
+    block(first, out.size(), pitch, origin_x, std::span<const double>(&y, 1), out.data(), out.size());
+    return;
+  }
   if (design_ != Field2D::cells) {
     for (std::size_t k = 0; k < out.size(); ++k)
       out[k] = value(static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x, y);

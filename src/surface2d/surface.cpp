@@ -139,28 +139,33 @@ void Surface2D::render_rows(int first_row, int rows, std::span<double> out) cons
     throw InvalidArgument("render_rows: rows " + std::to_string(first_row) + " + " + std::to_string(rows) +
                           " outside the bitmap or output of the wrong size");
   std::fill(out.begin(), out.end(), 0.0);
-  std::vector<double> coarse;
-  for (int r = 0; r < rows; ++r) {
-    const int j = first_row + r;
-    const double y = static_cast<double>(j) * p;
-    double* line = out.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(w);
-    for (const Region& region : regions_) {
-      if (!inside(y, region.y0, region.y1)) continue;
-      int i0 = 0;
-      while (i0 < w && !inside(static_cast<double>(i0) * p, region.x0, region.x1)) ++i0;
-      int i1 = i0;
-      while (i1 < w && inside(static_cast<double>(i1) * p, region.x0, region.x1)) ++i1;
-      if (i1 <= i0) continue;
-      const std::span<double> run(line + i0, static_cast<std::size_t>(i1 - i0));
-      region.fine->row(i0, p, region.x0, y - region.y0, run);
-      const double C = region.texel.coarse_strength, F = region.texel.fine_strength;
+  std::vector<double> coarse, ys;
+  for (const Region& region : regions_) {
+    // The region's columns (the same on every row) and its rows in the strip.
+    int i0 = 0;
+    while (i0 < w && !inside(static_cast<double>(i0) * p, region.x0, region.x1)) ++i0;
+    int i1 = i0;
+    while (i1 < w && inside(static_cast<double>(i1) * p, region.x0, region.x1)) ++i1;
+    int r0 = 0;
+    while (r0 < rows && !inside(static_cast<double>(first_row + r0) * p, region.y0, region.y1)) ++r0;
+    int r1 = r0;
+    while (r1 < rows && inside(static_cast<double>(first_row + r1) * p, region.y0, region.y1)) ++r1;
+    if (i1 <= i0 || r1 <= r0) continue;
+    ys.clear();
+    for (int r = r0; r < r1; ++r) ys.push_back(static_cast<double>(first_row + r) * p - region.y0);
+    double* base = out.data() + static_cast<std::size_t>(r0) * static_cast<std::size_t>(w) + static_cast<std::size_t>(i0);
+    const auto n = static_cast<std::size_t>(i1 - i0);
+    region.fine->block(i0, n, p, region.x0, ys, base, static_cast<std::size_t>(w));
+    const double C = region.texel.coarse_strength, F = region.texel.fine_strength;
+    for (int r = r0; r < r1; ++r) {
+      const std::span<double> run(base + static_cast<std::size_t>(r - r0) * static_cast<std::size_t>(w), n);
       if (region.coarse->constant()) {
         const TexelMix mix = texel_mix(region.coarse->value(0.0, 0.0), C, F);
         for (double& v : run) v = mix.offset + mix.gain * v;
       } else {
-        coarse.resize(run.size());
-        region.coarse->row(i0, p, region.x0, y - region.y0, coarse);
-        for (std::size_t k = 0; k < run.size(); ++k) {
+        coarse.resize(n);
+        region.coarse->row(i0, p, region.x0, ys[static_cast<std::size_t>(r - r0)], coarse);
+        for (std::size_t k = 0; k < n; ++k) {
           const TexelMix mix = texel_mix(coarse[k], C, F);
           run[k] = mix.offset + mix.gain * run[k];
         }
