@@ -3,7 +3,7 @@
 // the same number of bytes to the same directory, in the same run; peak
 // memory (VmHWM) of the render. Goal (issue #26): ratio ≤ 4, peak ≤ 64 MB.
 //
-//   texel_bench_bitmap_2d [directory] [size]
+//   texel_bench_bitmap_2d [directory] [size] [cells|spectral]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   region.texel.central_pitch = Decibels(6.0);
   region.texel.irregularity = Decibels(-5.0);
   region.texel.texel_length = Millimetres(0.25);
+  region.field = argc > 3 ? parse_field2d(argv[3]) : Field2D::spectral;
   Surface2DSpec spec;
   spec.regions.push_back(region);
   doc.surface2d = spec;
@@ -51,7 +52,8 @@ int main(int argc, char** argv) {
   const pid_t child = fork();
   if (child == 0) {
     const BitmapFileStats st = write_bitmap(png, surface);
-    std::printf("bitmap: %d x %d, %d bit, %zu pixel bytes\n", st.width, st.height, st.depth, st.bytes);
+    std::printf("bitmap: %d x %d, %d bit, %zu pixel bytes, field %s\n", st.width, st.height, st.depth, st.bytes,
+                std::string(to_string(region.field)).c_str());
     std::fflush(stdout);
     _exit(0);
   }

@@ -2,10 +2,11 @@
 // plane for 2-D touch surfaces and friction bitmaps.
 //
 // A FineField2D is the fine oscillation s(x, y) in [−1, 1] of one texture on
-// the infinite plane, in one of three designs (Field2D): texel cells (the
-// default), a stationary isotropic field whose radial spectrum is the best
-// non-negative fit to the 1-D texture's spectrum through the inverse Abel
-// relation, or an oriented grating. A CoarseField2D is a 2-D coarse profile
+// the infinite plane, in one of three designs (Field2D): a stationary
+// isotropic field (the default) whose radial spectrum is the best
+// non-negative one for the 1-D texture's Central Pitch and Irregularity
+// through the Abel relation (isotropic_bound), texel cells in random
+// orientations, or an oriented grating. A CoarseField2D is a 2-D coarse profile
 // c(x, y) in [0, 1]. A Surface2D puts them in a document's regions and mixes
 // them exactly as the 1-D texels are mixed (texel_mix, §7): every pixel is a
 // pure function of its (x, y), so tiles, strips and threads never change a
@@ -43,8 +44,8 @@ class FineField2D {
   /// ys[r]), the same values row() gives, computed a tile at a time
   /// (the spectral design's plane waves split into x and y factors once per
   /// block).
-  void block(std::int64_t first, std::size_t count, double pitch_mm, double origin_x_mm, std::span<const double> ys,
-             double* out, std::size_t stride) const;
+  void block(std::int64_t first, std::size_t count, double pitch_mm, double origin_x_mm, std::span<const double> ys, double* out,
+             std::size_t stride) const;
   /// Oriented fields are defined for |x|, |y| up to this (mm); at rest beyond.
   static constexpr double oriented_extent_mm = 2000.0;
 

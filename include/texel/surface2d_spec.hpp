@@ -19,8 +19,8 @@ namespace texel {
 
 /// How the fine texture is laid out in the plane (docs/algorithm.md §11).
 enum class Field2D {
-  cells,     ///< texel cells, one frequency each in a random orientation (default [choice])
-  spectral,  ///< stationary isotropic field, radial spectrum from the inverse Abel relation
+  cells,     ///< texel cells, one frequency each in a random orientation (fast; not isotropic enough)
+  spectral,  ///< stationary isotropic field on the moment-fit radial spectrum (default [choice])
   oriented,  ///< a grating: the 1-D texture along direction n (orientation_deg)
 };
 std::string_view to_string(Field2D f);
@@ -81,7 +81,7 @@ struct Region2DSpec {
   Millimetres x{0.0}, y{0.0};
   std::optional<Millimetres> width, height;  ///< none = to the device's edge
   TexelSpec texel;                           ///< the fine texture and C, F (its 1-D coarse profile must be constant)
-  Field2D field = Field2D::cells;
+  Field2D field = Field2D::spectral;
   double orientation_deg = 0.0;  ///< oriented: direction of the grating's wave vector n
   Coarse2D coarse = ConstantProfile{};
 };

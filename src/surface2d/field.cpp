@@ -181,7 +181,8 @@ void FineField2D::block(std::int64_t first, std::size_t count, double pitch, dou
         if (cell_index(m_hi, n) == k0 + (cells - 1)) {
           cells_->draw(spec_.seed, k0, frequency);
         } else {
-          for (std::size_t j = 0; j < cells; ++j) frequency[j] = cells_->draw(spec_.seed, cell_index(m_lo + static_cast<std::int64_t>(j), n));
+          for (std::size_t j = 0; j < cells; ++j)
+            frequency[j] = cells_->draw(spec_.seed, cell_index(m_lo + static_cast<std::int64_t>(j), n));
         }
         for (std::size_t j = 0; j < cells; ++j) {
           const std::uint64_t k = cell_index(m_lo + static_cast<std::int64_t>(j), n);
