@@ -124,7 +124,7 @@ BitmapFileStats write_gltf_bitmap(const std::string& path, const Surface2D& surf
   if (static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height) > max_in_memory_pixels)
     throw InvalidArgument("'" + path + "': a glTF asset is built in memory; the bitmap is over " +
                           std::to_string(max_in_memory_pixels) + " pixels (write .png or .npy, which stream)");
-  const std::string png = path + ".png.part";
+  const std::string png = path + ".part.png";  // removed below
   BitmapFileStats stats;
   std::vector<std::byte> bytes;
   try {
