@@ -206,6 +206,9 @@ Surface2D prepare_surface2d(const Document& doc) {
       r.coarse = std::make_shared<const CoarseField2D>(spec.coarse, Millimetres(r.x1 - r.x0), Millimetres(r.y1 - r.y0));
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(label + e.what());
+    } catch (const Error& e) {
+      // An image that cannot be read: named by its JSON path too.
+      throw FormatError(label + "coarse2d.path: " + e.what());
     }
     regions.push_back(std::move(r));
   }
