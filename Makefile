@@ -113,6 +113,8 @@ bench: build web web-test
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
 	$(BUILD)/bin/texel_bench_encode --json $(BUILD)/bench_encode.json
 	$(PY) bench/render_to_file.py $(BUILD)/bin/texel
+	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 spectral
+	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 cells
 	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null
 	$(PY) bench/studio_latency.py $(BUILD)/browser-artifacts/latency.json
 	TEXEL_PG_EXTRA_OPTS="-c track_commit_timestamp=on" scripts/pg-test-server.sh start $(BUILD)/bench-pg.env >/dev/null

@@ -5,6 +5,7 @@
 option(TEXEL_WITH_CONTROLLER "texel::controller: the reference display controller and its POSIX host HAL" ON)
 option(TEXEL_WITH_SPECTRUM "texel::spectrum: spectral analysis (KISS FFT)" ON)
 option(TEXEL_WITH_PLOT "texel::plot: PNG/SVG figures (Cairo)" ON)
+option(TEXEL_WITH_SURFACE2D "texel::surface2d: the 2-D model, friction bitmaps (libpng)" ON)
 option(TEXEL_WITH_PLAYER "texel::player: the real-time player and its sinks (libsndfile, PortAudio)" ON)
 option(TEXEL_WITH_IO "texel::io: .mat interchange and the signal loader (libmatio, libsndfile)" ON)
 option(TEXEL_WITH_CODEC "texel::codec: encoder, .texel bitstream, decoder (zstd)" ON)
@@ -24,6 +25,8 @@ function(texel_component_requires option reason)
   endforeach()
 endfunction()
 texel_component_requires(TEXEL_WITH_PLOT "spectrum figures" TEXEL_WITH_SPECTRUM)
+texel_component_requires(TEXEL_WITH_SURFACE2D "scans of 2-D fields are measured with the spectrum tools; .mat and glTF maps"
+                         TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
 texel_component_requires(TEXEL_WITH_PLAYER "swipe spectra, the serial display protocol"
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_CONTROLLER)
 texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading" TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
@@ -33,7 +36,7 @@ texel_component_requires(TEXEL_WITH_STUDIO "the studio runs experiments" TEXEL_W
 texel_component_requires(TEXEL_WITH_CAPI "the C ABI encodes and plays" TEXEL_WITH_CODEC TEXEL_WITH_PLAYER)
 
 # The CLI, the tests and the benchmarks use every component.
-set(TEXEL_COMPONENT_OPTIONS TEXEL_WITH_CONTROLLER TEXEL_WITH_SPECTRUM TEXEL_WITH_PLOT TEXEL_WITH_PLAYER
+set(TEXEL_COMPONENT_OPTIONS TEXEL_WITH_CONTROLLER TEXEL_WITH_SPECTRUM TEXEL_WITH_PLOT TEXEL_WITH_SURFACE2D TEXEL_WITH_PLAYER
     TEXEL_WITH_IO TEXEL_WITH_CODEC TEXEL_WITH_EXPERIMENTS TEXEL_WITH_STUDIO TEXEL_WITH_CAPI)
 set(TEXEL_COMPONENTS_OFF "")
 foreach(option IN LISTS TEXEL_COMPONENT_OPTIONS)

@@ -12,9 +12,11 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   g++ clang libclang-rt-14-dev clang-format
   # libraries, per component: core (nlohmann-json), spectrum (kissfft),
-  # plot (cairo), player (sndfile, portaudio), io (matio, sndfile),
+  # plot (cairo), surface2d (libpng), player (sndfile, portaudio), io (matio, sndfile),
   # codec (sndfile, zstd), experiment (sqlite, Boost.Math), studio (Boost.Beast)
   nlohmann-json3-dev libkissfft-dev libcairo2-dev libsndfile1-dev portaudio19-dev
+  # surface2d (friction bitmaps, coarse-profile images)
+  libpng-dev
   libmatio-dev libzstd-dev libsqlite3-dev libboost-dev
   # experiment: the PostgreSQL store's client library (libpq); the server
   # itself for the tests and `make bench` (initdb + pg_ctl in a temporary

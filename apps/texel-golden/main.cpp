@@ -7,13 +7,20 @@
 //   OUTDIR/references/<stem>.f64      each document's map as little-endian
 //                                     float64: the exact bits of every
 //                                     amplitude, which a u16 file rounds away
+//                                     (a 2-D document: its bitmap's
+//                                     amplitudes, row-major)
 #include <filesystem>
 #include <iostream>
+#include <span>
+#include <vector>
 
 #include "texel/demo.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#if TEXEL_GOLDEN_2D
+#include "texel/surface2d.hpp"
+#endif
 
 int main(int argc, char** argv) {
   if (argc < 2) {
@@ -32,9 +39,20 @@ int main(int argc, char** argv) {
     for (int i = 2; i < argc; ++i) {
       std::string stem = std::filesystem::path(argv[i]).filename().string();
       if (const auto dot = stem.find('.'); dot != std::string::npos) stem.resize(dot);
-      const texel::Surface surface = texel::prepare_surface(texel::load_document(argv[i]));
-      texel::write_file_atomic((out / "references" / (stem + ".f64")).string(),
-                               surface.render_native(texel::SampleFormat::f64le));
+      const texel::Document doc = texel::load_document(argv[i]);
+      const std::string path = (out / "references" / (stem + ".f64")).string();
+#if TEXEL_GOLDEN_2D
+      if (doc.surface2d) {
+        const texel::Surface2D surface = texel::prepare_surface2d(doc);
+        std::vector<double> map(static_cast<std::size_t>(surface.geometry().width) * surface.geometry().height);
+        surface.render_rows(0, surface.geometry().height, map);
+        texel::write_file_atomic(path,
+                                 std::span<const std::byte>(reinterpret_cast<const std::byte*>(map.data()), map.size() * 8));
+        continue;
+      }
+#endif
+      const texel::Surface surface = texel::prepare_surface(doc);
+      texel::write_file_atomic(path, surface.render_native(texel::SampleFormat::f64le));
     }
     return 0;
   } catch (const texel::Error& e) {

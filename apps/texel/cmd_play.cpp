@@ -10,6 +10,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include <unistd.h>
@@ -69,13 +70,13 @@ void run(const PlayArgs& a) {
   if (a.document.empty()) throw InvalidArgument("play: a document is required (or --list-devices)");
   if (a.block < 1 || a.block > 8192) throw InvalidArgument("--block is " + std::to_string(a.block) + "; allowed 1 … 8192 frames");
   const Document doc = build_document(a.document, a.device, a.texture);
-  const bool two_d = a.surface.active();
-  const Surface surface = prepare_surface(doc);
+  const bool two_d = a.surface.active() || doc.surface2d.has_value();
+  const std::optional<Surface> surface = two_d ? std::nullopt : std::optional<Surface>(prepare_surface(doc));
   // A 2-D surface has no 1-D map; the backends other than serial position
   // streaming never read it, so they get a one-sample stand-in.
   const auto map = two_d
                        ? std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f})
-                       : PlayerMap::from_surface(surface);
+                       : PlayerMap::from_surface(*surface);
 
   const BackendChoice choice = parse_backend(a.backend);
   BackendOptions bo;
@@ -112,8 +113,8 @@ void run(const PlayArgs& a) {
     feed_until = feeder(*p, std::move(trace));
     player = std::move(p);
   } else {
-    auto trace = finger_trace(a.finger, surface.grid().length().value(), duration);
-    auto p = std::make_unique<Player>(config, PlayerMap::from_surface(surface));
+    auto trace = finger_trace(a.finger, surface->grid().length().value(), duration);
+    auto p = std::make_unique<Player>(config, PlayerMap::from_surface(*surface));
     feed_until = feeder(*p, std::move(trace));
     player = std::move(p);
   }

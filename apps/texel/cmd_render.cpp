@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "render_output.hpp"
+#include "texel/bitmap_file.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -23,7 +24,37 @@ struct RenderArgs {
   std::optional<std::string> texels_csv;
   std::string mat_version = "5";
   bool json = false;
+  std::string surface = "1d";
+  int depth = 0;
 };
+
+/// --surface 2d: a 2-D document (version 4) to a friction bitmap.
+void render_2d(const RenderArgs& a) {
+  if (!a.document) throw InvalidArgument("--surface 2d needs a 2-D document (version 4, surface2d)");
+  if (!is_bitmap_path(a.output))
+    throw InvalidArgument("--output '" + a.output + "': a 2-D surface is written as .png, .npy, .mat, .gltf or .glb");
+  BitmapFileOptions options;
+  options.mat_version = mat::parse_mat_version(a.mat_version);
+  if (a.depth != 0 && a.depth != 8 && a.depth != 16)
+    throw InvalidArgument("--depth is " + std::to_string(a.depth) + "; allowed: 8, 16");
+  check_writable(a.output);
+  const Document doc = load_document(*a.document);
+  const Surface2D surface = prepare_surface2d(doc);
+  options.depth = a.depth;
+  const BitmapFileStats stats = write_bitmap(a.output, surface, options);
+  if (a.json) {
+    nlohmann::ordered_json j;
+    j["output"] = a.output;
+    j["device"] = doc.device.name;
+    j["width_px"] = stats.width;
+    j["height_px"] = stats.height;
+    j["pixel_pitch_mm"] = surface.geometry().pitch.value();
+    j["depth_bits"] = stats.depth;
+    j["polarity"] = std::string(to_string(surface.geometry().polarity));
+    j["mean_amplitude"] = stats.mean_amplitude;
+    print_json(j);
+  }
+}
 
 std::string texels_csv(const Surface& surface) {
   const bool many = surface.regions().size() > 1;
@@ -99,7 +130,16 @@ void register_render(CLI::App& app) {
       ->default_str("5");
   cmd->add_option("--texels", args->texels_csv, "Also write one row per texel: index,start_mm,frequency_cpm,amplitude");
   cmd->add_flag("--json", args->json, "Print a JSON summary on stdout");
+  cmd->add_option("--surface", args->surface,
+                  "1d (default) or 2d: a 2-D document (version 4) to a friction bitmap (.png, .npy, .mat, .gltf, .glb)")
+      ->check(CLI::IsMember({"1d", "2d"}))
+      ->default_str("1d");
+  cmd->add_option("--depth", args->depth, "--surface 2d PNG bits per pixel: 8 or 16 (default: the device's)");
   cmd->callback([args] {
+    if (args->surface == "2d") {
+      render_2d(*args);
+      return;
+    }
     // Reject a bad extension or MAT version before any work.
     const mat::MatVersion mat_version = mat::parse_mat_version(args->mat_version);
     check_render_output(args->output);

@@ -57,7 +57,8 @@ void run(const SwipeArgs& a) {
     if (frames_d > 2e9) throw InvalidArgument("--duration × --rate is " + detail::num(frames_d) + " samples; at most 2e9");
     return static_cast<std::size_t>(frames_d);
   };
-  if (a.surface.active()) {  // the 2-D player (issue #26)
+  const bool two_d = a.surface.active() || doc.surface2d.has_value();
+  if (two_d) {  // the 2-D player (issue #26)
     const auto map = player_map_2d(a.surface, doc);
     const auto trace = finger_trace_2d(a.finger, a.surface, duration);
     out = render_trace_2d(*map, config, trace, frame_count(), &positions, &y_positions, 64,
@@ -79,8 +80,8 @@ void run(const SwipeArgs& a) {
   // Prepare every output before writing any, so a failure leaves none.
   std::vector<PendingFile> files;
   if (ext == ".csv")
-    files.push_back({a.output, a.surface.active() ? signal_csv(config.rate_hz, positions, y_positions, out)
-                                                  : signal_csv(config.rate_hz, positions, out)});
+    files.push_back(
+        {a.output, two_d ? signal_csv(config.rate_hz, positions, y_positions, out) : signal_csv(config.rate_hz, positions, out)});
   if (a.plot) {
     SwipePlot p;
     p.title = "Swipe: " + std::string(to_string(config.mode)) + " at " + detail::num(config.rate_hz) + " Hz";
@@ -111,7 +112,7 @@ void run(const SwipeArgs& a) {
   j["peak_frequency_hz"] = peak;
   j["spectrum_bin_hz"] = spectrum.frequency_hz.size() > 1 ? spectrum.frequency_hz[1] : 0.0;
   j["swipe"] = {{"mean_speed_mm_s", mean_speed}, {"sd_speed_mm_s", sd_speed}, {"touched_s", touched}};
-  if (a.surface.active())
+  if (two_d)
     j["surface"] = "2d";
   else
     j["swipe"]["directional_proportion"] = directional;
@@ -121,9 +122,9 @@ void run(const SwipeArgs& a) {
     std::cout << a.output << ": " << frames << " samples at " << detail::num(config.rate_hz) << " Hz ("
               << detail::fixed(static_cast<double>(frames) / config.rate_hz, 3) << " s), " << to_string(config.mode)
               << ", spectrum peak " << detail::fixed(peak, 1) << " Hz\n"
-              << "swipe" << (a.surface.active() ? " (2-D)" : "") << ": mean speed " << detail::fixed(mean_speed, 2)
-              << " mm/s, SD " << detail::fixed(sd_speed, 2) << " mm/s";
-    if (!a.surface.active()) std::cout << ", directional proportion " << detail::fixed(directional, 3);
+              << "swipe" << (two_d ? " (2-D)" : "") << ": mean speed " << detail::fixed(mean_speed, 2) << " mm/s, SD "
+              << detail::fixed(sd_speed, 2) << " mm/s";
+    if (!two_d) std::cout << ", directional proportion " << detail::fixed(directional, 3);
     std::cout << "\n";
   }
 }

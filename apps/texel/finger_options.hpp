@@ -64,8 +64,8 @@ struct Surface2DOptions {
 
 void add_surface2d_options(CLI::App& cmd, Surface2DOptions& o);
 /// The 2-D map the options describe for `doc`: a friction bitmap, or the
-/// document's texture laid along the path with the coarse raster. (2-D
-/// documents replace `doc` here once they exist.)
+/// document's texture laid along the path with the coarse raster; a 2-D
+/// document (version 4) brings its own texture and coarse profile.
 std::unique_ptr<const PlayerMap2D> player_map_2d(const Surface2DOptions& o, const Document& doc);
 /// The 2-D trace: the --trace-2d file or a simulated --path (default a line
 /// at --angle) at --speed from (--start, --start-y), sampled at 1 kHz.

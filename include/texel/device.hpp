@@ -60,6 +60,30 @@ struct FrequencyResponse {
 /// Throws InvalidArgument naming `field` (corner_hz, order).
 void validate(const FrequencyResponse& r, std::string_view field = "response");
 
+/// How a 2-D friction bitmap's pixel value relates to the amplitude a (the
+/// fraction of the largest friction reduction, docs/algorithm.md §2).
+/// darker_more_friction: pixel = a·max (white = least friction, black = the
+/// surface at rest); brighter_more_friction: pixel = (1 − a)·max.
+enum class BitmapPolarity { darker_more_friction, brighter_more_friction };
+std::string_view to_string(BitmapPolarity p);
+BitmapPolarity parse_bitmap_polarity(std::string_view text, std::string_view field = "polarity");
+
+/// The 2-D side of a display that takes a friction bitmap or senses the
+/// finger in (x, y) (docs/format.md "Device profiles"; JSON "bitmap").
+/// Pixel (i, j) sits at (i·pitch, j·pitch), rows along y.
+struct BitmapGeometry {
+  int width = 0;           ///< pixels along x, 1 … 65535
+  int height = 0;          ///< pixels along y, 1 … 65535
+  Millimetres pitch{0.1};  ///< pixel spacing (the resolution), > 0
+  int depth = 16;          ///< bits per pixel of its bitmaps: 8 or 16
+  BitmapPolarity polarity = BitmapPolarity::darker_more_friction;
+
+  [[nodiscard]] Millimetres width_mm() const { return Millimetres(width * pitch.value()); }
+  [[nodiscard]] Millimetres height_mm() const { return Millimetres(height * pitch.value()); }
+  /// The highest spatial frequency the pixel grid holds along its axes.
+  [[nodiscard]] CyclesPerMm nyquist() const { return CyclesPerMm(0.5 / pitch.value()); }
+};
+
 struct DeviceProfile {
   std::string name;  ///< e.g. "tpad"
   std::string description;
@@ -74,6 +98,8 @@ struct DeviceProfile {
   /// absent = flat). Rendering never uses it: a document's map is the same
   /// bytes whatever the response. The encoder's model and the player do.
   FrequencyResponse response;
+  /// The 2-D pixel grid ("bitmap" in the JSON; optional: 1-D devices have none).
+  std::optional<BitmapGeometry> bitmap;
 
   [[nodiscard]] Grid grid() const { return Grid{Millimetres(0.0), spacing, samples}; }
   [[nodiscard]] Millimetres length() const { return Millimetres(static_cast<double>(samples) * spacing.value()); }

@@ -17,6 +17,7 @@
 #include "texel/device.hpp"
 #include "texel/reference.hpp"
 #include "texel/surface.hpp"
+#include "texel/surface2d_spec.hpp"
 #include "texel/texture.hpp"
 
 namespace texel {
@@ -44,14 +45,20 @@ struct Document {
   /// O(N log N) instead of O(N²)). Documents are written with the lowest
   /// version that renders their bytes (required_version), so Texel-only
   /// documents stay version 1 and version-2 references stay version 2.
-  static constexpr int current_version = 3;
+  /// Version 4 adds 2-D surfaces ("surface2d", texel/surface2d_spec.hpp);
+  /// a version-4 document holds a 2-D surface and no 1-D texture.
+  static constexpr int current_version = 4;
   /// The version read (parse_document) or current_version; writers use
   /// required_version instead.
   int version = current_version;
   DeviceProfile device;             ///< resolved profile (by name or inline)
   bool device_inline = false;       ///< written inline rather than by name
-  std::vector<RegionSpec> regions;  ///< at least one
-  std::string description;          ///< free text
+  std::vector<RegionSpec> regions;  ///< at least one (none in a 2-D document)
+  /// Set: a 2-D document (version 4) for a device with a bitmap grid;
+  /// `regions` is then empty, and prepare_surface2d (texel/surface2d.hpp)
+  /// prepares it.
+  std::optional<Surface2DSpec> surface2d;
+  std::string description;  ///< free text
 };
 
 /// Parses and validates a document. `origin` names the source in errors.
@@ -66,13 +73,14 @@ Document make_document(const DeviceProfile& device, const TexelSpec& spec);
 Document make_reference_document(const DeviceProfile& device, const ReferenceSpec& spec);
 /// The lowest format version that renders `doc`'s bytes: 1 without
 /// references, 2 when its references use the direct synthesis, 3 when they
-/// use the chirp-z one. Throws InvalidArgument when references of one
+/// use the chirp-z one, 4 for a 2-D document. Throws InvalidArgument when references of one
 /// document use both (no version holds that; documents never parse to it).
 int required_version(const Document& doc);
 /// The reference synthesis a document of format `version` renders with.
 ReferenceSynthesis reference_synthesis(int version);
 
-/// Prepares every region's texture for the document's device grid.
+/// Prepares every region's texture for the document's device grid. Throws
+/// InvalidArgument for a 2-D document (prepare_surface2d renders those).
 Surface prepare_surface(const Document& doc);
 
 }  // namespace texel

@@ -211,6 +211,14 @@ struct AssetOptions {
 /// bytes for .glb.
 std::vector<std::byte> asset(const Document& doc, const AssetOptions& options, Container container);
 
+/// The same asset around a 2-D friction map (`png`: the bitmap, any PNG the
+/// caller made, e.g. texel::write_bitmap's), the quad width × height mm with
+/// +Y down the image's rows. `options.hjif_uri` empty: no haptic stream is
+/// referenced, and the material lists the map as its High_Resolution
+/// texture only; width_mm is not used.
+std::vector<std::byte> asset_2d(const std::vector<std::byte>& png, double width_mm, double height_mm, const std::string& name,
+                                const AssetOptions& options, Container container);
+
 /// A PNG of one row, 16-bit grey (values round(a·65535)), deflate "stored"
 /// blocks: lossless and dependency-free.
 std::vector<std::byte> png_row16(std::span<const double> amplitudes);

@@ -60,11 +60,20 @@ std::string output_extension(const std::string& path);
 std::string npy_bytes(std::span<const double> values);
 /// The header of that file for `count` values (the data follows it).
 std::string npy_header(std::size_t count);
+/// The header of a float64 (rows, columns) C-order array.
+std::string npy_header(std::size_t rows, std::size_t columns);
+/// The header for a shape written out ("12," or "3, 4").
+std::string npy_header_for_shape(const std::string& shape);
 /// Reads a 1-D or single-column .npy of float64/float32/int16/uint16 (little-endian).
 std::vector<double> parse_npy(std::string_view bytes, std::string_view origin);
-/// The same for an array of any shape in C order (row-major), its dimensions
-/// written to `shape` (e.g. {rows, columns} for a 2-D raster).
-std::vector<double> parse_npy(std::string_view bytes, std::string_view origin, std::vector<std::size_t>* shape);
+/// A .npy array of the same dtypes with its shape: `dimensions` 1 (as
+/// parse_npy: rows = the length, columns = 1) or 2 (rows × columns,
+/// row-major values whatever the file's order).
+struct NpyArray {
+  std::size_t rows = 0, columns = 1;
+  std::vector<double> values;
+};
+NpyArray parse_npy_array(std::string_view bytes, std::string_view origin, int dimensions);
 
 /// Two-column CSV with a header: "position_mm,amplitude" and one row per sample.
 std::string csv_columns(std::string_view header_a, std::string_view header_b, std::span<const double> a,

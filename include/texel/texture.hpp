@@ -96,6 +96,25 @@ inline constexpr double texel_length_mm_max = 1000.0;
 /// Validates every field; throws InvalidArgument naming field, value and range.
 void validate(const TexelSpec& spec);
 
+/// The pitch distribution's configuration of `spec` on a band topped at
+/// `band_top` when spec.band_max is 0 (TexelTexture's, and the 2-D fields').
+PitchDistributionConfig distribution_config(const TexelSpec& spec, CyclesPerMm band_top);
+
+/// The coarse/fine mixing rule (docs/algorithm.md §7), the one definition
+/// the 1-D texels and the 2-D fields (texel/surface2d.hpp) share: with the
+/// coarse profile reading c, coarse strength C and fine strength F, the
+/// envelope is e = 1 − C·(1 − c) and the amplitude a = offset + gain·s for a
+/// fine oscillation s in [−1, 1].
+struct TexelMix {
+  double envelope = 1.0;  ///< e
+  double offset = 0.5;    ///< e − e·F/2
+  double gain = 0.5;      ///< e·F/2
+};
+constexpr TexelMix texel_mix(double c, double coarse_strength, double fine_strength) {
+  const double e = 1.0 - coarse_strength * (1.0 - c);
+  return {e, e - e * fine_strength * 0.5, e * fine_strength * 0.5};
+}
+
 /// One texel of a prepared texture.
 struct Texel {
   Millimetres start;      ///< left edge, k·L

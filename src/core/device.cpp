@@ -113,6 +113,27 @@ void validate(const DeviceProfile& p) {
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(at + e.what());
   }
+  if (p.bitmap) {
+    const BitmapGeometry& b = *p.bitmap;
+    if (b.width < 1 || b.width > 65535 || b.height < 1 || b.height > 65535)
+      throw InvalidArgument(at + "bitmap.width_px × height_px is " + std::to_string(b.width) + " × " + std::to_string(b.height) +
+                            "; allowed: 1 … 65535 each");
+    if (!(std::isfinite(b.pitch.value()) && b.pitch.value() > 0.0))
+      throw InvalidArgument(at + "bitmap.pixel_pitch_mm is " + num(b.pitch.value()) + "; it must be a finite number > 0");
+    if (b.depth != 8 && b.depth != 16)
+      throw InvalidArgument(at + "bitmap.depth_bits is " + std::to_string(b.depth) + "; allowed: 8, 16");
+  }
+}
+
+std::string_view to_string(BitmapPolarity p) {
+  return p == BitmapPolarity::darker_more_friction ? "darker_more_friction" : "brighter_more_friction";
+}
+
+BitmapPolarity parse_bitmap_polarity(std::string_view text, std::string_view field) {
+  if (text == "darker_more_friction") return BitmapPolarity::darker_more_friction;
+  if (text == "brighter_more_friction") return BitmapPolarity::brighter_more_friction;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) +
+                        "'; allowed: darker_more_friction, brighter_more_friction");
 }
 
 DeviceProfile parse_device_profile(std::string_view json_text, std::string_view origin) {
@@ -153,6 +174,28 @@ DeviceProfile parse_device_profile(std::string_view json_text, std::string_view 
     } else {
       o.skip("response");
     }
+    if (o.has("bitmap")) {
+      // Optional; 1-D profiles have none and read and write as before.
+      detail::JsonObject b(o.raw("bitmap"), "bitmap");
+      BitmapGeometry g;
+      g.width = static_cast<int>(b.integer("width_px", 1, 65535));
+      g.height = static_cast<int>(b.integer("height_px", 1, 65535));
+      g.pitch = Millimetres(b.number("pixel_pitch_mm", 1e-9, 1e6));
+      g.depth = static_cast<int>(b.integer("depth_bits", 8, 16));
+      if (b.has("polarity")) {
+        try {
+          g.polarity = parse_bitmap_polarity(b.string("polarity"), b.field("polarity"));
+        } catch (const InvalidArgument& e) {
+          throw FormatError(e.what());
+        }
+      } else {
+        b.skip("polarity");
+      }
+      b.finish();
+      p.bitmap = g;
+    } else {
+      o.skip("bitmap");
+    }
     o.finish();
     validate(p);
     return p;
@@ -182,6 +225,15 @@ std::string device_profile_json(const DeviceProfile& p) {
     r["order"] = p.response.order;
     if (!p.response.source.empty()) r["source"] = p.response.source;
     j["response"] = r;
+  }
+  if (p.bitmap) {
+    nlohmann::ordered_json b;
+    b["width_px"] = p.bitmap->width;
+    b["height_px"] = p.bitmap->height;
+    b["pixel_pitch_mm"] = p.bitmap->pitch.value();
+    b["depth_bits"] = p.bitmap->depth;
+    b["polarity"] = std::string(to_string(p.bitmap->polarity));
+    j["bitmap"] = b;
   }
   return j.dump(2) + "\n";
 }

@@ -140,20 +140,24 @@ std::size_t texel_count(Millimetres length, Millimetres texel_length, Fill fill)
   return static_cast<std::size_t>(std::max(n, 0.0));
 }
 
+PitchDistributionConfig distribution_config(const TexelSpec& spec, CyclesPerMm band_top) {
+  PitchDistributionConfig c;
+  c.central_pitch = spec.central_pitch;
+  c.irregularity = spec.irregularity;
+  c.parameterization = spec.parameterization;
+  c.out_of_band = spec.out_of_band;
+  c.band_min = spec.band_min;
+  c.band_max = spec.band_max.value() > 0.0 ? spec.band_max : band_top;
+  c.quantization_db = spec.quantization_db;
+  return c;
+}
+
 TexelTexture::TexelTexture(const TexelSpec& spec, Millimetres length, const Sampling& sampling, std::size_t keep)
     : spec_(spec), length_(length), distribution_([&] {
         validate(spec);
         if (!(std::isfinite(length.value()) && length.value() > 0.0))
           throw InvalidArgument("texture length is " + num(length.value()) + " mm; it must be a finite number > 0");
-        PitchDistributionConfig c;
-        c.central_pitch = spec.central_pitch;
-        c.irregularity = spec.irregularity;
-        c.parameterization = spec.parameterization;
-        c.out_of_band = spec.out_of_band;
-        c.band_min = spec.band_min;
-        c.band_max = spec.band_max.value() > 0.0 ? spec.band_max : sampling.top();
-        c.quantization_db = spec.quantization_db;
-        return PitchDistribution(c);
+        return PitchDistribution(distribution_config(spec, sampling.top()));
       }()) {
   const double L = spec.texel_length.value();
   static std::atomic<std::uint64_t> next_id{1};
@@ -238,9 +242,10 @@ double TexelTexture::draw(std::size_t first, std::size_t count, double phase, Te
     t.frequency = CyclesPerMm(frequency[i % batch]);
     if (spec.phase == PhaseMode::reset) phase = phase_rng.uniform(k + 1);
     t.phase_cycles = phase;
-    t.envelope = 1.0 - C * (1.0 - coarse[constant ? 0 : i]);
-    run.offset.push_back(t.envelope - t.envelope * F * 0.5);
-    run.gain.push_back(t.envelope * F * 0.5);
+    const TexelMix mix = texel_mix(coarse[constant ? 0 : i], C, F);
+    t.envelope = mix.envelope;
+    run.offset.push_back(mix.offset);
+    run.gain.push_back(mix.gain);
     phase = phase_after(phase, t.frequency.value(), L);
   }
   return phase;

@@ -128,22 +128,13 @@ std::vector<std::byte> png_row16(std::span<const double> amplitudes) {
   return png;
 }
 
-std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Container container) {
-  if (!(std::isfinite(o.width_mm) && o.width_mm > 0.0)) throw FieldError("width", "must be a length > 0 mm");
-  if (o.hjif_uri.empty()) throw FieldError("hjif_uri", "is empty; the asset references the exported .hjif by URI");
-  const Surface surface = prepare_surface(doc);
-  std::vector<double> map = surface.render();
-  // The image is a power of two wide (WebGL 1 and mipmaps need it; the
-  // validator notes anything else): the map's samples one per pixel from the
-  // left, zeros after, and the quad's texture coordinates end at the map.
-  std::size_t width = 1;
-  while (width < map.size()) width *= 2;
-  const float u_end = static_cast<float>(static_cast<double>(map.size()) / static_cast<double>(width));
-  map.resize(width, 0.0);
-  const std::vector<std::byte> png = png_row16(map);
-  const float L = static_cast<float>(surface.grid().length().value() / 1000.0);  // metres
-  const float W = static_cast<float>(o.width_mm / 1000.0);
+namespace {
 
+/// The asset around an image: a quad of L × W metres whose texture
+/// coordinates end at (u_end, v_end) of the image, the haptic object and
+/// material (the Reference texture only when a .hjif is referenced).
+std::vector<std::byte> assemble(const std::vector<std::byte>& png, float L, float W, float u_end, float v_end,
+                                const std::string& node_name, const AssetOptions& o, Container container) {
   // Geometry: positions, normals, texture coordinates, indices (one quad).
   std::vector<std::byte> buf;
   const float pos[4][3] = {{0, 0, 0}, {L, 0, 0}, {L, W, 0}, {0, W, 0}};
@@ -153,7 +144,7 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
   for (int v = 0; v < 4; ++v)
     for (float c : {0.0f, 0.0f, 1.0f}) append(buf, c);
   const std::size_t uv_at = buf.size();
-  const float uv[4][2] = {{0, 1}, {u_end, 1}, {u_end, 0}, {0, 0}};
+  const float uv[4][2] = {{0, v_end}, {u_end, v_end}, {u_end, 0}, {0, 0}};
   for (const auto& t : uv)
     for (float c : t) append(buf, c);
   const std::size_t index_at = buf.size();
@@ -195,12 +186,13 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
     buffer["uri"] = "data:application/octet-stream;base64," + base64(std::span<const std::byte>(buf.data(), geometry_bytes));
 
   const std::string modality_key = o.modality == hjif::Modality::friction ? "friction" : "vibrotactileTexture";
-  ojson material{{"name", "Texel texture"},
-                 {"haptic", 0},
-                 {modality_key, ojson::array({ojson{{"texture", {{"index", 0}}}, {"type", "High_Resolution"}},
-                                              ojson{{"texture", {{"index", 0}}}, {"type", "Reference"}}})}};
+  ojson textures = ojson::array({ojson{{"texture", {{"index", 0}}}, {"type", "High_Resolution"}}});
+  if (!o.hjif_uri.empty()) textures.push_back(ojson{{"texture", {{"index", 0}}}, {"type", "Reference"}});
+  ojson material{{"name", "Texel texture"}, {"haptic", 0}, {modality_key, std::move(textures)}};
+  if (o.hjif_uri.empty()) material.erase("haptic");
   ojson root{
-      {"asset", {{"version", "2.0"}, {"generator", "Texel (texel export)"}}},
+      {"asset",
+       {{"version", "2.0"}, {"generator", o.hjif_uri.empty() ? "Texel (texel render --surface 2d)" : "Texel (texel export)"}}},
       {"extensionsUsed", {"MPEG_media", "MPEG_haptic", "MPEG_haptic_material"}},
       {"extensions",
        {{"MPEG_media",
@@ -211,7 +203,7 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
         {"MPEG_haptic_material", {{"materials", ojson::array({std::move(material)})}}}}},
       {"scene", 0},
       {"scenes", ojson::array({ojson{{"name", "display"}, {"nodes", {0}}}})},
-      {"nodes", ojson::array({ojson{{"name", doc.device.name}, {"mesh", 0}}})},
+      {"nodes", ojson::array({ojson{{"name", node_name}, {"mesh", 0}}})},
       {"meshes",
        ojson::array({ojson{{"name", "display surface"},
                            {"primitives", ojson::array({ojson{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}},
@@ -230,6 +222,12 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
       {"bufferViews", std::move(views)},
       {"buffers", ojson::array({std::move(buffer)})}};
 
+  if (o.hjif_uri.empty()) {
+    // A 2-D map without a haptic stream: the material alone.
+    root["extensionsUsed"] = {"MPEG_haptic_material"};
+    root["extensions"].erase("MPEG_media");
+    root["extensions"].erase("MPEG_haptic");
+  }
   std::string text = root.dump();
   if (container == Container::gltf) {
     text += "\n";
@@ -250,6 +248,34 @@ std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Contain
   put32le(out, 0x004E4942u);  // "BIN\0"
   out.insert(out.end(), buf.begin(), buf.end());
   return out;
+}
+
+}  // namespace
+
+std::vector<std::byte> asset(const Document& doc, const AssetOptions& o, Container container) {
+  if (!(std::isfinite(o.width_mm) && o.width_mm > 0.0)) throw FieldError("width", "must be a length > 0 mm");
+  if (o.hjif_uri.empty()) throw FieldError("hjif_uri", "is empty; the asset references the exported .hjif by URI");
+  const Surface surface = prepare_surface(doc);
+  std::vector<double> map = surface.render();
+  // The image is a power of two wide (WebGL 1 and mipmaps need it; the
+  // validator notes anything else): the map's samples one per pixel from the
+  // left, zeros after, and the quad's texture coordinates end at the map.
+  std::size_t width = 1;
+  while (width < map.size()) width *= 2;
+  const float u_end = static_cast<float>(static_cast<double>(map.size()) / static_cast<double>(width));
+  map.resize(width, 0.0);
+  const std::vector<std::byte> png = png_row16(map);
+  const float L = static_cast<float>(surface.grid().length().value() / 1000.0);  // metres
+  const float W = static_cast<float>(o.width_mm / 1000.0);
+  return assemble(png, L, W, u_end, 1.0f, doc.device.name, o, container);
+}
+
+std::vector<std::byte> asset_2d(const std::vector<std::byte>& png, double width_mm, double height_mm, const std::string& name,
+                                const AssetOptions& o, Container container) {
+  if (!(std::isfinite(width_mm) && width_mm > 0.0 && std::isfinite(height_mm) && height_mm > 0.0))
+    throw FieldError("width", "and height must be lengths > 0 mm");
+  return assemble(png, static_cast<float>(width_mm / 1000.0), static_cast<float>(height_mm / 1000.0), 1.0f, 1.0f, name, o,
+                  container);
 }
 
 }  // namespace texel::gltf

@@ -131,8 +131,14 @@ std::string npy_bytes(std::span<const double> values) {
   return out;
 }
 
-std::string npy_header(std::size_t count) {
-  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(count) + ",), }";
+std::string npy_header(std::size_t count) { return npy_header_for_shape(std::to_string(count) + ","); }
+
+std::string npy_header(std::size_t rows, std::size_t columns) {
+  return npy_header_for_shape(std::to_string(rows) + ", " + std::to_string(columns));
+}
+
+std::string npy_header_for_shape(const std::string& shape) {
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + shape + "), }";
   // Magic (6) + version (2) + header length (2) + header, padded with spaces
   // and a final newline to a multiple of 64 bytes (NEP 1).
   const std::size_t unpadded = 10 + header.size() + 1;
@@ -145,9 +151,9 @@ std::string npy_header(std::size_t count) {
   return out;
 }
 
-std::vector<double> parse_npy(std::string_view b, std::string_view origin) { return parse_npy(b, origin, nullptr); }
+std::vector<double> parse_npy(std::string_view b, std::string_view origin) { return parse_npy_array(b, origin, 1).values; }
 
-std::vector<double> parse_npy(std::string_view b, std::string_view origin, std::vector<std::size_t>* shape_out) {
+NpyArray parse_npy_array(std::string_view b, std::string_view origin, int dimensions) {
   const std::string where(origin);
   if (b.size() < 10 || b.substr(0, 6) != std::string_view("\x93NUMPY", 6))
     throw FormatError(where + ": not a .npy file (bad magic)");
@@ -182,9 +188,8 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin, std::
   std::string descr = value_of("descr");
   std::erase(descr, '\'');
   std::erase(descr, ' ');
-  if (value_of("fortran_order").find("True") != std::string::npos) {
-    // A 1-D or (n,1) array reads the same either way; checked via shape below.
-  }
+  // A 1-D or (n,1) array reads the same either way; a 2-D one is transposed.
+  const bool fortran = value_of("fortran_order").find("True") != std::string::npos;
   const std::string shape = value_of("shape");
   // The shape is outside input: every dimension is checked against the data
   // the file actually holds before any size arithmetic, so a declared
@@ -217,11 +222,17 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin, std::
                         " data bytes");
     n = non_unit > 1 ? n * d : d;
   }
-  if (dims.empty() || (non_unit > 1 && !shape_out))
-    throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
-  if (non_unit > 1 && value_of("fortran_order").find("True") != std::string::npos)
-    throw FormatError(where + ": .npy array of shape " + shape + " is in Fortran order; save it in C order");
-  if (shape_out) *shape_out = dims;
+  NpyArray array;
+  if (dimensions == 1) {
+    if (dims.empty() || non_unit > 1) throw FormatError(where + ": .npy array of shape " + shape + " is not one-dimensional");
+    array.rows = n;
+  } else {
+    if (dims.size() != 2 || dims[0] == 0 || dims[1] == 0 || dims[0] > data_bytes / dims[1])
+      throw FormatError(where + ": .npy array of shape " + shape + " is not a non-empty two-dimensional array");
+    array.rows = dims[0];
+    array.columns = dims[1];
+    n = dims[0] * dims[1];
+  }
   std::size_t width = 0;
   if (descr == "<f8")
     width = 8;
@@ -236,9 +247,12 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin, std::
   if (b.size() - data_at != n * width)
     throw FormatError(where + ": .npy data holds " + std::to_string(b.size() - data_at) + " bytes, shape needs " +
                       std::to_string(n * width));
-  std::vector<double> out(n);
+  std::vector<double>& out = array.values;
+  out.resize(n);
   const char* p = b.data() + data_at;
-  for (std::size_t i = 0; i < n; ++i, p += width) {
+  for (std::size_t k = 0; k < n; ++k, p += width) {
+    // Fortran order stores columns first: element k is (k % rows, k / rows).
+    const std::size_t i = fortran && dimensions == 2 ? (k % array.rows) * array.columns + k / array.rows : k;
     if (descr == "<f8")
       std::memcpy(&out[i], p, 8);
     else if (descr == "<f4") {
@@ -256,7 +270,7 @@ std::vector<double> parse_npy(std::string_view b, std::string_view origin, std::
     } else
       out[i] = static_cast<unsigned char>(*p) / 255.0;
   }
-  return out;
+  return array;
 }
 
 std::string csv_columns(std::string_view ha, std::string_view hb, std::span<const double> a, std::span<const double> b) {

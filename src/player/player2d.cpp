@@ -138,14 +138,14 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const Document& doc
 
 Raster2D parse_raster_npy(std::string_view bytes, std::string_view origin, Millimetres pitch, Millimetres origin_x,
                           Millimetres origin_y) {
-  std::vector<std::size_t> shape;
-  const std::vector<double> v = parse_npy(bytes, origin, &shape);
-  if (shape.size() != 2 || shape[0] < 1 || shape[1] < 1 || shape[0] > (1u << 20) || shape[1] > (1u << 20))
+  NpyArray a = parse_npy_array(bytes, origin, 2);
+  if (a.rows > (1u << 20) || a.columns > (1u << 20))
     throw FormatError(std::string(origin) +
                       ": a raster must be a 2-D array (rows along y, columns along x) of 1 … 2^20 per side");
+  const std::vector<double>& v = a.values;
   Raster2D r;
-  r.height = static_cast<int>(shape[0]);
-  r.width = static_cast<int>(shape[1]);
+  r.height = static_cast<int>(a.rows);
+  r.width = static_cast<int>(a.columns);
   r.pitch = pitch;
   r.origin_x = origin_x;
   r.origin_y = origin_y;

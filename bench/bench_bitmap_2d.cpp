@@ -1,0 +1,88 @@
+// texel_bench_bitmap_2d: an 8192 × 8192 16-bit friction bitmap (PNG, the
+// default cells field) written in strips, against `dd conv=fsync` writing
+// the same number of bytes to the same directory, in the same run; peak
+// memory (VmHWM) of the render. Goal (issue #26): ratio ≤ 4, peak ≤ 64 MB.
+//
+//   texel_bench_bitmap_2d [directory] [size] [cells|spectral]
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "texel/bitmap_file.hpp"
+
+using namespace texel;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string dir = argc > 1 ? argv[1] : "/tmp";
+  const int size = argc > 2 ? std::atoi(argv[2]) : 8192;
+  const std::string png = dir + "/texel_bench_bitmap.png";
+  const std::string raw = dir + "/texel_bench_dd.bin";
+  BitmapGeometry g;
+  g.width = size;
+  g.height = size;
+  g.pitch = Millimetres(0.02);  // 164 mm square, Nyquist 25 cpm
+  g.depth = 16;
+  Document doc;
+  doc.device = load_device("tablet-2d");
+  doc.device.bitmap = g;
+  Region2DSpec region;
+  region.texel.central_pitch = Decibels(6.0);
+  region.texel.irregularity = Decibels(-5.0);
+  region.texel.texel_length = Millimetres(0.25);
+  region.field = argc > 3 ? parse_field2d(argv[3]) : Field2D::spectral;
+  Surface2DSpec spec;
+  spec.regions.push_back(region);
+  doc.surface2d = spec;
+  const Surface2D surface = prepare_surface2d(doc);
+  // The render runs in a child so its peak memory is its own.
+  auto t0 = std::chrono::steady_clock::now();
+  const pid_t child = fork();
+  if (child == 0) {
+    const BitmapFileStats st = write_bitmap(png, surface);
+    std::printf("bitmap: %d x %d, %d bit, %zu pixel bytes, field %s\n", st.width, st.height, st.depth, st.bytes,
+                std::string(to_string(region.field)).c_str());
+    std::fflush(stdout);
+    _exit(0);
+  }
+  int status = 0;
+  rusage usage{};
+  wait4(child, &status, 0, &usage);
+  const double render = seconds_since(t0);
+  const long file_bytes = [&] {
+    FILE* f = std::fopen(png.c_str(), "rb");
+    if (!f) return 0L;
+    std::fseek(f, 0, SEEK_END);
+    const long n = std::ftell(f);
+    std::fclose(f);
+    return n;
+  }();
+  const long bytes = static_cast<long>(size) * size * 2;
+  const std::string dd = "dd if=/dev/zero of=" + raw + " bs=1M count=" + std::to_string(bytes >> 20) + " conv=fsync status=none";
+  t0 = std::chrono::steady_clock::now();
+  if (std::system(dd.c_str()) != 0) return 1;
+  const double dd_s = seconds_since(t0);
+  std::remove(raw.c_str());
+  std::remove(png.c_str());
+  std::printf("render+write %.3f s (PNG %ld bytes), dd conv=fsync of %ld bytes %.3f s, ratio %.2f (goal <= 4)\n", render,
+              file_bytes, bytes, dd_s, render / dd_s);
+  std::printf("peak memory of the render: %.1f MB (goal <= 64 MB)\n", static_cast<double>(usage.ru_maxrss) / 1024.0);
+  // On a loaded machine the wall time above includes waiting for a CPU; the
+  // render's own CPU time says what it costs (its threads share it).
+  const double cpu = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                     1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  std::printf("render CPU time %.3f s (user + system, all threads)\n", cpu);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : 1;
+}

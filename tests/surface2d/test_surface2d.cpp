@@ -1,0 +1,189 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "texel/bitmap_file.hpp"
+#include "texel/error.hpp"
+#include "texel/io.hpp"
+#include "texel/surface2d.hpp"
+
+using namespace texel;
+
+namespace {
+
+const std::string data_dir = TEXEL_SURFACE2D_DATA;
+
+Document small_document(Field2D field, Coarse2D coarse = ConstantProfile{}) {
+  Document doc;
+  doc.device = load_device("tablet-2d");
+  BitmapGeometry g = *doc.device.bitmap;
+  g.width = 96;
+  g.height = 64;
+  g.pitch = Millimetres(0.05);
+  doc.device.bitmap = g;
+  Region2DSpec r;
+  r.texel.central_pitch = Decibels(6.0);
+  r.texel.irregularity = Decibels(-5.0);
+  r.texel.coarse_strength = 0.5;
+  r.texel.fine_strength = 0.8;
+  r.field = field;
+  r.orientation_deg = 30.0;
+  r.coarse = coarse;
+  doc.surface2d = Surface2DSpec{{r}};
+  return doc;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_document(text);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Surface2D, DeviceProfileCarriesBitmapGeometry) {
+  const DeviceProfile d = load_device("tablet-2d");
+  ASSERT_TRUE(d.bitmap);
+  EXPECT_EQ(d.bitmap->width, 2360);
+  EXPECT_EQ(d.bitmap->depth, 8);
+  EXPECT_EQ(parse_device_profile(device_profile_json(d), "x").bitmap->height, 1640);
+  // 1-D profiles have none and write no "bitmap".
+  EXPECT_EQ(device_profile_json(load_device("tpad")).find("bitmap"), std::string::npos);
+}
+
+TEST(Surface2D, DocumentVersion4RoundTripsAndValidates) {
+  const Document doc = load_document(data_dir + "/tablet-disc.texel.json");
+  ASSERT_TRUE(doc.surface2d);
+  EXPECT_EQ(required_version(doc), 4);
+  EXPECT_EQ(doc.surface2d->regions.size(), 2u);
+  const Document again = parse_document(document_json(doc));
+  EXPECT_EQ(document_json(again), document_json(doc));
+  EXPECT_THROW((void)prepare_surface(doc), InvalidArgument);
+  const std::string text = read_file(data_dir + "/tablet-disc.texel.json");
+  std::string bad = text;
+  bad.replace(bad.find("\"radius_mm\": 40"), 15, "\"radius_mm\": -4");
+  EXPECT_NE(error_of(bad).find("surface2d.regions[0].coarse2d.radius_mm is -4"), std::string::npos) << error_of(bad);
+  bad = text;
+  bad.replace(bad.find("\"version\": 4"), 12, "\"version\": 3");
+  EXPECT_NE(error_of(bad).find("surface2d needs version 4"), std::string::npos) << error_of(bad);
+  bad = text;
+  bad.replace(bad.find("\"field\": \"cells\""), 16, "\"field\": \"rings\"");
+  EXPECT_NE(error_of(bad).find("surface2d.regions[0].field is 'rings'"), std::string::npos) << error_of(bad);
+  bad = text;
+  bad.replace(bad.find("\"tablet-2d\""), 11, "\"tpad\"");
+  EXPECT_NE(error_of(bad).find("has no bitmap grid"), std::string::npos) << error_of(bad);
+}
+
+TEST(Surface2D, StripsAndPointsGiveTheWholeBitmap) {
+  for (Field2D field : {Field2D::cells, Field2D::spectral, Field2D::oriented}) {
+    const Document doc =
+        small_document(field, Disc2D{Millimetres(2.0), Millimetres(1.5), Millimetres(1.0), Millimetres(0.2), 1.0, 0.1});
+    const Surface2D s = prepare_surface2d(doc);
+    const int w = s.geometry().width, h = s.geometry().height;
+    std::vector<double> whole(static_cast<std::size_t>(w * h)), strip(static_cast<std::size_t>(w * 5));
+    s.render_rows(0, h, whole);
+    s.render_rows(17, 5, strip);
+    for (int k = 0; k < w * 5; ++k) ASSERT_EQ(strip[static_cast<std::size_t>(k)], whole[static_cast<std::size_t>(17 * w + k)]);
+    for (int j : {0, 31, 63})
+      for (int i : {0, 40, 95})
+        ASSERT_EQ(s.amplitude(i * 0.05, j * 0.05), whole[static_cast<std::size_t>(j * w + i)]) << to_string(field);
+    for (double a : whole) ASSERT_TRUE(a >= 0.0 && a <= 1.0);
+  }
+}
+
+TEST(Surface2D, MixesLikeTheOneDimensionalTexels) {
+  // C = 0.5, F = 0.8 and c from the profile: a = e − e·F/2 + e·F/2·s.
+  const Document doc =
+      small_document(Field2D::cells, Edge2D{Millimetres(2.4), Millimetres(0.0), 0.0, Millimetres(0.0), 0.0, 1.0});
+  const Surface2D s = prepare_surface2d(doc);
+  const auto& region = s.regions()[0];
+  for (double x : {0.5, 3.0}) {
+    const double c = x < 2.4 ? 0.0 : 1.0;
+    const TexelMix mix = texel_mix(c, 0.5, 0.8);
+    EXPECT_EQ(s.amplitude(x, 1.0), mix.offset + mix.gain * region.fine->value(x, 1.0));
+  }
+  const Raster2D coarse = coarse_raster(doc);
+  EXPECT_EQ(coarse.width, 96);
+  EXPECT_EQ(coarse.at(10, 3), 0.0f);
+  EXPECT_EQ(coarse.at(60, 3), 1.0f);
+}
+
+TEST(Surface2D, BitmapFilesAreDeterministicAndHonourPolarity) {
+  const auto dir = std::filesystem::temp_directory_path() / ("texel_s2d_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  Document doc = small_document(Field2D::cells);
+  const Surface2D s = prepare_surface2d(doc);
+  BitmapFileOptions one;
+  one.depth = 16;
+  one.threads = 1;
+  one.rows_per_strip = 7;
+  BitmapFileOptions many;
+  many.depth = 16;
+  many.threads = 3;
+  const std::string a = (dir / "a.png").string(), b = (dir / "b.png").string();
+  write_bitmap(a, s, one);
+  write_bitmap(b, s, many);
+  EXPECT_EQ(read_file(a), read_file(b));
+  // The PNG reads back as the amplitudes (16 bit: to_u16). The image is
+  // placed half a pixel left and up, so that pixel centres meet the grid.
+  doc.device.bitmap->polarity = BitmapPolarity::brighter_more_friction;
+  const Surface2D inverted = prepare_surface2d(doc);
+  const std::string c = (dir / "c.png").string();
+  write_bitmap(c, inverted, one);
+  Document with_image = small_document(
+      Field2D::cells, Image2D{a, Millimetres(-0.025), Millimetres(-0.025), Millimetres(0.0), Millimetres(0.0), false});
+  const Raster2D back = coarse_raster(with_image);
+  std::vector<double> row(96);
+  s.render_rows(10, 1, row);
+  for (int i = 0; i < 96; i += 7) EXPECT_NEAR(back.at(i, 10), to_u16(row[static_cast<std::size_t>(i)]) / 65535.0, 2e-6);
+  Document with_inverted = small_document(
+      Field2D::cells, Image2D{c, Millimetres(-0.025), Millimetres(-0.025), Millimetres(0.0), Millimetres(0.0), true});
+  const Raster2D back_inv = coarse_raster(with_inverted);
+  for (int i = 0; i < 96; i += 7) EXPECT_NEAR(back_inv.at(i, 10), back.at(i, 10), 2e-5);
+  // .npy: float64 (height, width).
+  const std::string n = (dir / "m.npy").string();
+  write_bitmap(n, s, one);
+  const NpyArray arr = parse_npy_array(read_file(n), n, 2);
+  EXPECT_EQ(arr.rows, 64u);
+  EXPECT_EQ(arr.columns, 96u);
+  EXPECT_EQ(arr.values[10 * 96 + 5], row[5]);
+  EXPECT_THROW(write_bitmap((dir / "x.bmp").string(), s), InvalidArgument);
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.bmp"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Surface2D, SpectralFieldMeetsItsStationaryBound) {
+  // The stationary bound and its spectral realisation agree within 0.5 dB
+  // (one texture, 8 scans per direction; the sweep is bench/surface2d_anisotropy).
+  TexelSpec spec;
+  spec.central_pitch = Decibels(6.0);
+  spec.irregularity = Decibels(0.0);
+  const CyclesPerMm top(16.0 * std::pow(10.0, 0.6));
+  ScanOptions o;
+  o.directions = 4;
+  o.scans = 3;
+  o.samples = 1024;
+  o.spacing = Millimetres(0.5 / top.value());
+  const FineField2D field(spec, Field2D::spectral, 0.0, top);
+  PitchDistributionConfig c;
+  c.central_pitch = spec.central_pitch;
+  c.irregularity = spec.irregularity;
+  c.band_max = top;
+  const IsotropicBound bound = isotropic_bound(PitchDistribution(c), top);
+  double p = 0.0, i = 0.0;
+  for (const auto& d : measure_scans(field, o)) {
+    p += d.log_centroid_db / o.directions;
+    i += d.log_spread_db / o.directions;
+  }
+  // The moment fit keeps the 1-D Central Pitch; the field reaches it.
+  EXPECT_NEAR(bound.matched_log_centroid_db, bound.target_log_centroid_db, 0.2);
+  EXPECT_NEAR(p, bound.matched_log_centroid_db, 0.5);
+  EXPECT_NEAR(i, bound.matched_log_spread_db, 1.0);
+  // A narrow texture's scans are wider than the 1-D texture: the cosine law.
+  EXPECT_GT(bound.matched_log_spread_db, bound.target_log_spread_db + 1.0);
+}
