@@ -125,7 +125,7 @@ namespace {
 DirectionStats summarize_scans(const std::vector<std::vector<double>>& scans, double spacing) {
   Spectrum sum;
   for (const auto& s : scans) {
-    Spectrum one = magnitude_spectrum(s, spacing);
+    Spectrum one = magnitude_spectrum(s, Millimetres(spacing));
     if (sum.power.empty()) {
       sum = std::move(one);
     } else {
@@ -133,7 +133,7 @@ DirectionStats summarize_scans(const std::vector<std::vector<double>>& scans, do
     }
   }
   const SpectralSummary summary = summarize(sum);
-  return {0.0, summary.log_centroid.value(), summary.log_spread_db};
+  return {0.0, summary.log_centroid.value(), summary.log_spread.value()};
 }
 
 }  // namespace
