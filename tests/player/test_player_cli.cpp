@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "texel/io.hpp"
 #include "texel/player.hpp"
 #include "texel/signal.hpp"
 #include "texel/sinks.hpp"
@@ -157,4 +158,35 @@ TEST_F(Cli, Swipe2dTraceRasterAndBitmap) {
     EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;
   }
   EXPECT_FALSE(fs::exists(csv));
+}
+
+// A version-4 2-D document plays directly: its region's texture laid along
+// the path (felt frequency = Central Pitch × speed at any angle), and a
+// surface of several regions is refused with one line.
+TEST_F(Cli, SwipeOfATwoDimensionalDocumentPeaksAtCentralPitchTimesSpeedAlongAnyAngle) {
+  const std::string doc2d = (dir / "surface.texel.json").string();
+  texel::write_file_atomic(doc2d, R"({"format": "texel-document", "version": 4, "device": "tablet-2d",
+    "surface2d": {"regions": [{"x_mm": 0, "y_mm": 0, "field": "spectral",
+      "texture": {"kind": "texel", "central_pitch_db": 3, "irregularity_db": -5, "texel_length_mm": 1, "seed": 5}}]}})");
+  for (const char* angle : {"0", "37", "90"}) {
+    const std::string wav = (dir / (std::string("a") + angle + ".wav")).string();
+    const CliRun r =
+        run("swipe " + doc2d + " --path line --angle " + angle + " --start 20 --start-y 20 --speed 100 --duration 1 -o " + wav);
+    ASSERT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find("(2-D)"), std::string::npos) << r.out;
+    const texel::Recording rec = texel::read_recording(wav);
+    const std::vector<float> s(rec.samples.begin(), rec.samples.end());
+    // 3 dB = 1.995 cycles/mm; at 100 mm/s: 199.5 Hz.
+    EXPECT_NEAR(texel::signal_spectrum(s, rec.rate.value()).peak_hz(1.0), 199.5, 10.0) << "angle " << angle;
+  }
+  const std::string two = (dir / "two.texel.json").string();
+  texel::write_file_atomic(two, R"({"format": "texel-document", "version": 4, "device": "tablet-2d",
+    "surface2d": {"regions": [
+      {"x_mm": 0, "y_mm": 0, "width_mm": 50, "texture": {"kind": "texel", "central_pitch_db": 3, "irregularity_db": -5, "texel_length_mm": 1, "seed": 5}},
+      {"x_mm": 50, "y_mm": 0, "texture": {"kind": "texel", "central_pitch_db": 6, "irregularity_db": -5, "texel_length_mm": 1, "seed": 6}}]}})");
+  const std::string out = (dir / "two.wav").string();
+  const CliRun bad = run("swipe " + two + " --path circle -o " + out);
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.out.find("one region"), std::string::npos) << bad.out;
+  EXPECT_FALSE(fs::exists(out));
 }
