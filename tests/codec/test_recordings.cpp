@@ -8,6 +8,8 @@
 // test's own measurement (Welch, 4096-sample segments), not the encoder's.
 #include <gtest/gtest.h>
 
+#include "../support/log_centroid.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,20 +31,7 @@ using namespace texel;
 constexpr double fs = 10000.0;  // recording rate, Hz
 constexpr double seconds = 2.0;
 
-/// Power-weighted mean of 10·log10 f (dB re 1 Hz) over 20 Hz … 0.45·rate
-/// (Welch, Hann): the log-spectral centroid.
-double log_centroid_db(const std::vector<double>& x, double rate) {
-  WelchOptions o;
-  o.segment = 4096;
-  const Psd p = welch_psd(x, Millimetres(1.0 / rate), o);
-  double sw = 0, swd = 0;
-  for (std::size_t k = 1; k < p.frequency_cpm.size(); ++k) {
-    const double f = p.frequency_cpm[k];
-    if (f < 20.0 || f > 0.45 * rate) continue;
-    sw += p.density[k], swd += p.density[k] * 10.0 * std::log10(f);
-  }
-  return swd / sw;
-}
+using test_support::log_centroid_db;
 
 /// A recording: the texture's vibration at `speed` (spatial spectrum
 /// `kind`), sensor noise `noise_db` below it and 60 Hz hum `hum_db` below it

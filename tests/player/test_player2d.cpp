@@ -4,6 +4,8 @@
 // and the 2-D paths and trace reader.
 #include <gtest/gtest.h>
 
+#include "../support/log_centroid.hpp"
+
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -30,22 +32,13 @@ constexpr double speed = 100.0;    // mm/s
 constexpr double duration = 0.9;   // s: within one pass of the tpad map
 constexpr double settle_s = 0.05;  // skip the touch-down ramp and filter settling
 
-/// Power-weighted mean of 10·log10 f (dB re 1 Hz) over 20 Hz … 0.45·rate
-/// (Welch, Hann) of the output after `settle_s`: the log-spectral centroid.
+/// The log-spectral centroid (tests/support/log_centroid.hpp) of the output
+/// after `settle_s`.
 double log_centroid_db(const std::vector<float>& y) {
   const auto skip = static_cast<std::size_t>(settle_s * rate);
   const auto end = static_cast<std::size_t>(duration * rate);
   const std::vector<double> x(y.begin() + static_cast<std::ptrdiff_t>(skip), y.begin() + static_cast<std::ptrdiff_t>(end));
-  WelchOptions o;
-  o.segment = 4096;
-  const Psd p = welch_psd(x, Millimetres(1.0 / rate), o);
-  double sw = 0, swd = 0;
-  for (std::size_t k = 1; k < p.frequency_cpm.size(); ++k) {
-    const double f = p.frequency_cpm[k];
-    if (f < 20.0 || f > 0.45 * rate) continue;
-    sw += p.density[k], swd += p.density[k] * 10.0 * std::log10(f);
-  }
-  return swd / sw;
+  return test_support::log_centroid_db(x, rate);
 }
 
 PlayerConfig vibration() {
