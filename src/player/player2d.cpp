@@ -181,10 +181,8 @@ double PlayerMap2D::fine(double s_mm, double speed_mm_s, double limit_hz) const 
 double PlayerMap2D::value(double x_mm, double y_mm, double s_mm, double speed_mm_s, double limit_hz) const noexcept {
   if (kind_ == Kind::bitmap) return std::clamp(static_cast<double>(sample_bilinear(*raster_, x_mm, y_mm)), 0.0, 1.0);
   const double c = raster_ ? static_cast<double>(sample_bilinear(*raster_, x_mm, y_mm)) : 1.0;
-  const double e = 1.0 - coarse_strength_ * (1.0 - c);  // docs/algorithm.md §7
-  const double o = e - e * fine_strength_ / 2;
-  const double g = e * fine_strength_ / 2;
-  return o + g * fine(s_mm, speed_mm_s, limit_hz);
+  const TexelMix mix = texel_mix(c, coarse_strength_, fine_strength_);  // the 1-D rule, docs/algorithm.md §7
+  return mix.offset + mix.gain * fine(s_mm, speed_mm_s, limit_hz);
 }
 
 // ------------------------------------------------------------------- Player2D

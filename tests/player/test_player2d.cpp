@@ -314,16 +314,7 @@ TEST(Player2D, ProcessNeverAllocatesWhileSwapping) {
       }
     });
     std::vector<float> out(frames), x(frames), y(frames);
-    counted_allocations = 0;
-    counted_frees = 0;
-    double sum = 0;
-    for (std::uint64_t b = 0; b < blocks; ++b) {
-      counting = true;
-      const BlockInfo info = player.process(out, x, y);
-      counting = false;
-      sum += info.peak;
-      done.store(b + 1, std::memory_order_relaxed);
-    }
+    const double sum = texel::test_support::alloc::count_blocks(blocks, done, [&] { return player.process(out, x, y).peak; });
     stop = true;
     control.join();
     EXPECT_EQ(counted_allocations.load(), 0u) << to_string(mode);

@@ -22,7 +22,6 @@ using texel::test_support::alloc::all_allocations;
 // Counting is on while the audio thread is inside process().
 using texel::test_support::alloc::counted_allocations;
 using texel::test_support::alloc::counted_frees;
-using texel::test_support::alloc::counting;
 }  // namespace
 
 using namespace texel;
@@ -96,16 +95,7 @@ TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {
       }
     });
     std::vector<float> out(frames);
-    counted_allocations = 0;
-    counted_frees = 0;
-    double sum = 0;
-    for (std::uint64_t b = 0; b < blocks; ++b) {
-      counting = true;
-      const BlockInfo info = player.process(out);
-      counting = false;
-      sum += info.peak;
-      done.store(b + 1, std::memory_order_relaxed);
-    }
+    const double sum = texel::test_support::alloc::count_blocks(blocks, done, [&] { return player.process(out).peak; });
     stop = true;
     control.join();
     EXPECT_EQ(counted_allocations.load(), 0u) << to_string(mode);

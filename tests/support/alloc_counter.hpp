@@ -57,6 +57,27 @@ inline bool counter_works() {
   return counted_allocations.exchange(0) == 1 && counted_frees.exchange(0) == 1;
 }
 
+/// The real-time loop of the player tests: `blocks` calls of `process()`
+/// (which returns the block's peak) with this thread's allocations and
+/// frees counted from zero, publishing the number of blocks done to `done`
+/// after each (a control thread paces its finger samples by it). Returns the
+/// sum of the peaks; counted_allocations / counted_frees then hold what
+/// process() allocated and freed.
+template <class Process>
+double count_blocks(std::uint64_t blocks, std::atomic<std::uint64_t>& done, Process&& process) {
+  counted_allocations = 0;
+  counted_frees = 0;
+  double sum = 0;
+  for (std::uint64_t b = 0; b < blocks; ++b) {
+    counting = true;
+    const double peak = process();
+    counting = false;
+    sum += peak;
+    done.store(b + 1, std::memory_order_relaxed);
+  }
+  return sum;
+}
+
 }  // namespace texel::test_support::alloc
 
 // The replacements pair malloc/aligned_alloc with free on purpose.
