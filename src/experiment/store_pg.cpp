@@ -242,6 +242,13 @@ int server_version(PGconn* c, const std::string& label) {
   return std::atoi(version.c_str());
 }
 
+// A server schema this build cannot use, whoever opens it.
+void refuse_newer(int v, const std::string& label) {
+  if (v > current_server_schema)
+    throw FormatError(label + " has schema version " + std::to_string(v) + ", newer than this build's " +
+                      std::to_string(current_server_schema) + "; use a newer texel");
+}
+
 // Readers and stations need the server at this build's version.
 void check_version(PGconn* c, const std::string& label) {
   const int v = server_version(c, label);
@@ -249,9 +256,7 @@ void check_version(PGconn* c, const std::string& label) {
     throw FormatError(label +
                       " is not a Texel experiment database (no texel schema): the migration owner runs texel store init "
                       "--postgres URI");
-  if (v > current_server_schema)
-    throw FormatError(label + " has schema version " + std::to_string(v) + ", newer than this build's " +
-                      std::to_string(current_server_schema) + "; use a newer texel");
+  refuse_newer(v, label);
   if (v < current_server_schema)
     throw FormatError(label + " has the older schema version " + std::to_string(v) +
                       ": the migration owner runs texel store init --postgres URI to migrate it");
@@ -1142,9 +1147,7 @@ std::vector<std::string> init_postgres(const std::string& db, const std::vector<
              " NOLOGIN; EXCEPTION WHEN duplicate_object OR unique_violation THEN NULL; END $$",
          std::string("creating the role ") + group);
   int v = pg::server_version(c, t.label);
-  if (v > pg::current_server_schema)
-    throw FormatError(t.label + " has schema version " + std::to_string(v) + ", newer than this build's " +
-                      std::to_string(pg::current_server_schema) + "; use a newer texel");
+  pg::refuse_newer(v, t.label);
   const int from = v;
   for (; v < pg::current_server_schema; ++v) {
     must(pg::server_migrations[static_cast<std::size_t>(v)], "migrating the schema to version " + std::to_string(v + 1));
