@@ -2,13 +2,19 @@
 // (include/texel/controller/) on this computer, on a serial port or on a new
 // pseudo-terminal (--pty prints its path for `texel play --backend
 // serial:PATH`). The "actuator" is a status line showing the amplitude.
+// --sensor gives it a finger sensor (a simulated 2-D stroke, or a recorded
+// x, y trace, played in a loop), so it acts as a 2-D display that reports
+// its finger (protocol 1.1) for `texel play --finger serial:PATH`.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <thread>
+#include <vector>
 
 #include <pty.h>
 #include <unistd.h>
@@ -19,6 +25,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/device.hpp"
 #include "texel/error.hpp"
+#include "texel/player2d.hpp"
 
 namespace texel::cli {
 namespace {
@@ -33,13 +40,66 @@ struct ControllerArgs {
   int baud = 921600;
   double duration_s = 0.0;
   bool quiet = false;
+  std::optional<std::string> sensor;  // line | circle | zigzag | a trace CSV
+  double sensor_speed_mm_s = 100.0;
+  double sensor_angle_deg = 0.0;
+  double sensor_radius_mm = 20.0;
+  double sensor_period_s = 2.0;
+  std::vector<double> sensor_start_mm;  // x, y
 };
+
+// The simulated sensor: a 2-D trace played in a loop (each pass ends lifted,
+// as a finger lifts between strokes), linearly interpolated at the
+// controller's clock.
+class LoopedSensor {
+ public:
+  explicit LoopedSensor(std::vector<FingerSample2D> trace) : trace_(std::move(trace)) {
+    if (trace_.size() < 2 || !(trace_.back().t_s > trace_.front().t_s))
+      throw InvalidArgument("--sensor: the trace must span some time (at least two samples)");
+    period_s_ = trace_.back().t_s - trace_.front().t_s;
+  }
+  bool operator()(std::uint32_t t_us, std::int32_t& x_nm, std::int32_t& y_nm, bool& touch) const {
+    const double t = trace_.front().t_s + std::fmod(static_cast<double>(t_us) * 1e-6, period_s_);
+    auto it = std::upper_bound(trace_.begin(), trace_.end(), t, [](double v, const FingerSample2D& s) { return v < s.t_s; });
+    const FingerSample2D& a = *std::prev(it == trace_.begin() ? std::next(it) : it);
+    const FingerSample2D& b = it == trace_.end() ? a : *it;
+    const double f = b.t_s > a.t_s ? (t - a.t_s) / (b.t_s - a.t_s) : 0.0;
+    x_nm = static_cast<std::int32_t>(std::lround((a.x_mm + (b.x_mm - a.x_mm) * f) * 1e6));
+    y_nm = static_cast<std::int32_t>(std::lround((a.y_mm + (b.y_mm - a.y_mm) * f) * 1e6));
+    touch = a.touch;
+    return true;
+  }
+
+ private:
+  std::vector<FingerSample2D> trace_;
+  double period_s_ = 0.0;
+};
+
+std::vector<FingerSample2D> sensor_trace(const ControllerArgs& a) {
+  const std::string& s = *a.sensor;
+  if (s.size() > 4 && s.ends_with(".csv")) return load_trace_2d_csv(s);
+  Path2DConfig c;
+  c.shape = parse_path_shape(s, "--sensor");
+  c.speed_mm_s = a.sensor_speed_mm_s;
+  c.angle_deg = a.sensor_angle_deg;
+  c.radius_mm = a.sensor_radius_mm;
+  c.duration_s = a.sensor_period_s;
+  if (!a.sensor_start_mm.empty()) {
+    if (a.sensor_start_mm.size() != 2) throw InvalidArgument("--sensor-start takes two numbers: x,y (mm)");
+    c.start_x_mm = a.sensor_start_mm[0];
+    c.start_y_mm = a.sensor_start_mm[1];
+  }
+  return simulate_path_2d(c);  // validates speed, radius, period
+}
 
 void run(const ControllerArgs& a) {
   if (a.serial.has_value() == a.pty) throw InvalidArgument("controller: give exactly one of --serial PATH or --pty");
   if (!(a.duration_s >= 0))
     throw InvalidArgument("--duration is " + detail::num(a.duration_s) + "; it must be >= 0 s (0 = until Ctrl-C)");
   const DeviceProfile d = load_device(a.device);
+  // The sensor is read and checked before the port opens.
+  std::optional<LoopedSensor> sensor;
+  if (a.sensor) sensor.emplace(sensor_trace(a));
   int fd = -1;
   int keep_slave = -1;
   std::string where;
@@ -54,6 +114,10 @@ void run(const ControllerArgs& a) {
     where = *a.serial;
   }
   controller::HostHal hal(fd);
+  if (sensor)
+    hal.sensor_2d = [&hal, &sensor](std::int32_t& x, std::int32_t& y, bool& touch) {
+      return (*sensor)(hal.micros(), x, y, touch);
+    };
   controller::Info info;
   info.name = "texel-reference (host)";
   info.refresh_mhz = static_cast<std::uint32_t>(std::llround(d.refresh.value() * 1000.0));
@@ -84,8 +148,8 @@ void run(const ControllerArgs& a) {
   if (tty) std::fprintf(stderr, "\n");
   const controller::Status& s = ctl->status();
   std::cout << "controller stopped: frames ok " << s.frames_ok << ", bad " << s.frames_bad << ", nacks " << s.nacks
-            << ", link errors " << s.link_errors << ", output updates " << s.ticks << ", selected map "
-            << (s.selected == serial::no_map ? std::string("none") : std::to_string(s.selected)) << "\n";
+            << ", link errors " << s.link_errors << ", output updates " << s.ticks << ", finger reports " << s.reports
+            << ", selected map " << (s.selected == serial::no_map ? std::string("none") : std::to_string(s.selected)) << "\n";
   if (keep_slave >= 0) ::close(keep_slave);
 }
 
@@ -100,6 +164,16 @@ void register_controller(CLI::App& app) {
   cmd->add_option("--baud", a->baud, "Baud rate [921600]");
   cmd->add_option("--duration", a->duration_s, "Stop after this many seconds (0 = until Ctrl-C) [0]");
   cmd->add_flag("--quiet", a->quiet, "No status line");
+  cmd->add_option("--sensor", a->sensor,
+                  "A finger sensor, so the controller reports its finger (2-D): line, circle or zigzag (simulated "
+                  "strokes in a loop) or a trace CSV time_s,x_mm,y_mm[,touch] [none: positions come from the host]");
+  cmd->add_option("--sensor-speed", a->sensor_speed_mm_s, "Sensor stroke speed (mm/s) [100]");
+  cmd->add_option("--sensor-angle", a->sensor_angle_deg, "Sensor line / zigzag direction (degrees) [0]");
+  cmd->add_option("--sensor-radius", a->sensor_radius_mm, "Sensor circle radius (mm) [20]");
+  cmd->add_option("--sensor-period", a->sensor_period_s, "Length of one simulated stroke before the finger lifts (s) [2]");
+  cmd->add_option("--sensor-start", a->sensor_start_mm, "Where a sensor stroke starts (circle: its centre), x,y in mm [0,0]")
+      ->delimiter(',')
+      ->expected(2);
   cmd->callback([a] { run(*a); });
 }
 

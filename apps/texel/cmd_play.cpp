@@ -2,6 +2,9 @@
 // recorded finger, on a sound card (PortAudio), a serial friction display, or
 // the `null` backend (no hardware; CI). Shows a live level meter on a
 // terminal and reports blocks processed and the worst block time.
+// --finger serial:PATH takes the finger live from a display's own sensor
+// (its FINGER reports, docs/serial-protocol.md), 1-D or 2-D.
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,7 +12,9 @@
 #include <cstdio>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -22,6 +27,7 @@
 #include "texel/error.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
+#include "texel/serial_link.hpp"
 #include "texel/sinks.hpp"
 
 namespace texel::cli {
@@ -41,6 +47,8 @@ struct PlayArgs {
   std::string audio_device;
   std::string stream = "position";
   int baud = 921600;
+  std::optional<std::string> finger_from;  // serial:PATH — a display's sensor
+  std::uint32_t report_interval_us = 1000;
   bool list_devices = false;
   bool json = false;
 };
@@ -62,6 +70,57 @@ std::function<bool(double)> feeder(P& player, std::vector<Sample> trace) {
   };
 }
 
+// The live finger: a display's FINGER reports, read on their own thread and
+// queued into the player at their place on the player's clock.
+class LiveFinger {
+ public:
+  LiveFinger(SerialLink& link, PlayerBase& player, bool two_d) : link_(link), player_(player), two_d_(two_d) {}
+  ~LiveFinger() { stop(); }
+  void start() {
+    thread_ = std::thread([this] { loop(); });
+  }
+  void stop() {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
+  [[nodiscard]] std::string error() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return error_;
+  }
+  [[nodiscard]] std::uint64_t reports() const { return reports_.load(); }
+  [[nodiscard]] std::uint64_t dropped() const { return dropped_.load(); }
+
+ private:
+  void loop() {
+    std::array<FingerReport, 64> buf;
+    ReportTimeline timeline;
+    try {
+      while (running_) {
+        const std::size_t n = link_.read_reports(buf, 5);
+        for (std::size_t i = 0; i < n; ++i) {
+          const FingerReport& r = buf[i];
+          const double t = timeline.place(r.t_us, player_.time_s());
+          const bool queued = two_d_ ? static_cast<Player2D&>(player_).push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})
+                                     : static_cast<Player&>(player_).push(FingerSample{t, r.x_mm, r.touch});
+          if (!queued) ++dropped_;
+          ++reports_;
+        }
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      error_ = e.what();
+    }
+  }
+  SerialLink& link_;
+  PlayerBase& player_;
+  bool two_d_;
+  std::atomic<bool> running_{true};
+  std::atomic<std::uint64_t> reports_{0}, dropped_{0};
+  mutable std::mutex mutex_;
+  std::string error_;
+  std::thread thread_;
+};
+
 void run(const PlayArgs& a) {
   if (a.list_devices) {
     for (const auto& d : audio_output_devices()) std::cout << d << "\n";
@@ -79,6 +138,17 @@ void run(const PlayArgs& a) {
                        : PlayerMap::from_surface(*surface);
 
   const BackendChoice choice = parse_backend(a.backend);
+  std::optional<std::string> sensor_path;
+  if (a.finger_from) {
+    if (!a.finger_from->starts_with("serial:") || a.finger_from->size() <= 7)
+      throw InvalidArgument("--finger is '" + *a.finger_from + "'; allowed: serial:PATH (a display that reports its finger)");
+    sensor_path = a.finger_from->substr(7);
+    if (a.finger.trace || a.surface.trace_2d || a.surface.path)
+      throw InvalidArgument("--finger serial:PATH takes the finger from the display: give no --trace, --trace-2d or --path");
+    if (a.report_interval_us < serial::min_report_interval_us)
+      throw InvalidArgument("--report-interval is " + std::to_string(a.report_interval_us) +
+                            " µs; allowed >= " + std::to_string(serial::min_report_interval_us));
+  }
   BackendOptions bo;
   bo.block_frames = a.block;
   bo.audio_device = a.audio_device;
@@ -106,7 +176,19 @@ void run(const PlayArgs& a) {
   // Everything from the command line is read and checked before the device opens.
   std::unique_ptr<PlayerBase> player;
   std::function<bool(double)> feed_until;  // queues the trace up to a time; false once it is all queued
-  if (two_d) {
+  if (sensor_path) {
+    // Live: until --duration (0 or absent: until Ctrl-C).
+    duration = a.finger.duration_s.value_or(0.0);
+    if (!(duration >= 0))
+      throw InvalidArgument("--duration is " + detail::num(duration) + "; it must be >= 0 s (0 = until Ctrl-C)");
+    if (duration == 0) duration = std::numeric_limits<double>::infinity();
+    if (two_d)
+      player = std::make_unique<Player2D>(config, player_map_2d(a.surface, doc),
+                                          parse_path_at_lift(a.surface.path_at_lift, "--path-at-lift"));
+    else
+      player = std::make_unique<Player>(config, PlayerMap::from_surface(*surface));
+    feed_until = [](double) { return false; };
+  } else if (two_d) {
     auto trace = finger_trace_2d(a.finger, a.surface, duration);
     auto p = std::make_unique<Player2D>(config, player_map_2d(a.surface, doc),
                                         parse_path_at_lift(a.surface.path_at_lift, "--path-at-lift"));
@@ -119,6 +201,21 @@ void run(const PlayArgs& a) {
     player = std::move(p);
   }
   const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
+  // The display that senses the finger: the one the backend drives, or another.
+  std::unique_ptr<SerialLink> own_link;
+  SerialLink* sensor_link = nullptr;
+  if (sensor_path) {
+    if (choice.kind == BackendChoice::Kind::serial && choice.serial_path == *sensor_path) {
+      sensor_link = backend->serial_link();
+    } else {
+      own_link = std::make_unique<SerialLink>(*sensor_path, a.baud);
+      own_link->hello();
+      sensor_link = own_link.get();
+    }
+    sensor_link->start_reports(a.report_interval_us);
+  }
+  std::optional<LiveFinger> live;
+  if (sensor_link) live.emplace(*sensor_link, *player, two_d);
 
   interrupted = false;
   auto old_handler = std::signal(SIGINT, on_sigint);
@@ -128,6 +225,7 @@ void run(const PlayArgs& a) {
   auto feed = [&] { feed_until(player->time_s() + 0.05); };
   feed();
   backend->start(*player);
+  if (live) live->start();
   const auto t0 = std::chrono::steady_clock::now();
   std::string error;
   while (!interrupted && player->time_s() < duration) {
@@ -135,6 +233,7 @@ void run(const PlayArgs& a) {
     feed();
     player->collect();
     error = backend->error();
+    if (error.empty() && live) error = live->error();
     if (!error.empty()) break;
     if (std::chrono::steady_clock::now() - t0 > std::chrono::duration<double>(duration + 5.0)) {
       error = "the backend stopped producing output (" + backend->describe() + ")";
@@ -146,6 +245,14 @@ void run(const PlayArgs& a) {
                    s.position_mm, s.touching ? "touch" : "lift ", meter(s.peak).c_str(),
                    static_cast<unsigned long long>(s.blocks), s.worst_block_s * 1e3);
       std::fflush(stderr);
+    }
+  }
+  if (live) live->stop();
+  if (sensor_link && error.empty()) {
+    try {
+      sensor_link->start_reports(0);  // the display stops reporting
+    } catch (const Error&) {
+      // Already gone: nothing to stop.
     }
   }
   backend->stop();
@@ -167,6 +274,12 @@ void run(const PlayArgs& a) {
   j["worst_block_fraction"] = s.worst_block_s / block_s;
   j["mean_block_ms"] = s.blocks ? s.total_block_s / static_cast<double>(s.blocks) * 1e3 : 0.0;
   j["underruns"] = s.underruns;
+  if (live) {
+    j["finger"] = "serial " + *sensor_path;
+    j["finger_reports"] = live->reports();
+    j["finger_reports_lost"] = sensor_link->reports_lost();
+    j["finger_reports_dropped"] = live->dropped();
+  }
   j["interrupted"] = interrupted.load();
   if (a.json) {
     print_json(j);
@@ -178,6 +291,9 @@ void run(const PlayArgs& a) {
               << detail::fixed(100.0 * s.worst_block_s / block_s, 2) << " % of the " << detail::fixed(block_s * 1e3, 3)
               << " ms period), mean " << detail::fixed(j["mean_block_ms"].get<double>(), 4) << " ms, underruns " << s.underruns
               << "\n";
+    if (live)
+      std::cout << "finger from " << *sensor_path << ": " << live->reports() << " reports, " << sensor_link->reports_lost()
+                << " lost on the link\n";
   }
 }
 
@@ -195,6 +311,10 @@ void register_play(CLI::App& app) {
   cmd->add_option("--stream", a->stream,
                   "Serial: stream finger positions (the display looks up its map) or drive values [position]");
   cmd->add_option("--baud", a->baud, "Serial baud rate [921600]");
+  cmd->add_option("--finger", a->finger_from,
+                  "Take the finger live from a display's sensor: serial:PATH (its FINGER reports; the same PATH as "
+                  "--backend serial:PATH shares the link); plays until --duration or Ctrl-C");
+  cmd->add_option("--report-interval", a->report_interval_us, "Finger report interval asked of the display (µs) [1000]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
   add_player_options(*cmd, a->finger, a->device, a->texture);
   add_surface2d_options(*cmd, a->surface);

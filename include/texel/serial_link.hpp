@@ -8,10 +8,12 @@
 // becomes an IoError naming the port — never a crash.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "texel/error.hpp"
 #include "texel/serial_protocol.hpp"
@@ -51,6 +53,59 @@ struct DisplayStatus {
   std::uint32_t uptime_ms = 0;
 };
 
+/// One FINGER report of a display's own sensor (protocol 1.1).
+struct FingerReport {
+  std::uint32_t t_us = 0;  ///< the display's clock (µs, wraps at 2³²)
+  double x_mm = 0.0, y_mm = 0.0;
+  bool touch = false;
+  std::uint8_t seq = 0;  ///< counts reports: a gap is a lost report
+};
+
+/// The display's report clock unwrapped into seconds since the first report
+/// it is given, so a session may run for longer than the 71 minutes of the
+/// 32-bit microsecond counter.
+class ReportClock {
+ public:
+  double seconds(std::uint32_t t_us) noexcept {
+    if (!started_) {
+      started_ = true;
+      last_ = t_us;
+    }
+    ticks_ += static_cast<std::uint32_t>(t_us - last_);  // modular difference: the wrap is free
+    last_ = t_us;
+    return static_cast<double>(ticks_) * 1e-6;
+  }
+
+ private:
+  bool started_ = false;
+  std::uint32_t last_ = 0;
+  std::uint64_t ticks_ = 0;
+};
+
+/// Places a display's reports on the player's clock: t = display time +
+/// offset, where the offset is the smallest (arrival − display time) seen —
+/// the least-delayed report — so a report is never placed after it arrived.
+/// The offset may rise by `drift` seconds per second, so a display clock
+/// slower than the player's is followed instead of piling up delay.
+class ReportTimeline {
+ public:
+  static constexpr double drift = 1e-3;
+  /// `arrival_s`: when the report reached the host, on the player's clock.
+  double place(std::uint32_t t_us, double arrival_s) noexcept {
+    const double d = clock_.seconds(t_us);
+    const double c = arrival_s - d;
+    offset_ = have_ ? std::min(c, offset_ + drift * std::max(0.0, arrival_s - last_arrival_s_)) : c;
+    have_ = true;
+    last_arrival_s_ = arrival_s;
+    return d + offset_;
+  }
+
+ private:
+  ReportClock clock_;
+  bool have_ = false;
+  double offset_ = 0.0, last_arrival_s_ = 0.0;
+};
+
 class SerialLink {
  public:
   /// Opens `path` (a tty or pty), raw 8N1 at `baud`. Throws IoError.
@@ -77,6 +132,20 @@ class SerialLink {
   void stream_position(double x_mm, bool touch);
   void stream_drive(double amplitude);
   DisplayStatus status();
+
+  /// Asks the display to report its finger sensor every `interval_us`
+  /// (>= serial::min_report_interval_us; 0 stops). A display without a
+  /// sensor refuses (SerialError no_sensor); one older than protocol 1.1
+  /// does not know the request (SerialError naming that).
+  void start_reports(std::uint32_t interval_us);
+  /// Reads the finger reports that have arrived, waiting
+  /// for the first (`wait_ms`); returns how many were written to `out`. Reports that
+  /// came during a request are kept for this call. May run on one thread
+  /// while another streams (stream_position/stream_drive); never together
+  /// with a request. Throws IoError if the link is gone.
+  std::size_t read_reports(std::span<FingerReport> out, int wait_ms);
+  /// Reports the display sent that never arrived (gaps in their seq).
+  [[nodiscard]] std::uint64_t reports_lost() const { return reports_lost_; }
   /// Sends raw bytes (tests: garbage, truncated frames).
   void send_raw(std::span<const std::byte> bytes);
 
@@ -92,6 +161,12 @@ class SerialLink {
   std::string name_;
   std::uint8_t seq_ = 0;
   serial::Decoder decoder_{};
+  // Finger reports read but not yet taken (bounded: the oldest are dropped).
+  void keep_report(const serial::Frame& f);
+  std::vector<FingerReport> pending_;
+  bool have_report_seq_ = false;
+  std::uint8_t next_report_seq_ = 0;
+  std::uint64_t reports_lost_ = 0;
 };
 
 }  // namespace texel

@@ -31,6 +31,10 @@ inline constexpr std::size_t max_frame = header_size + max_payload + crc_size;
 /// Samples per MAP_DATA frame the host sends (5-byte header + 2 bytes each).
 inline constexpr std::size_t samples_per_chunk = (max_payload - 5) / 2;
 inline constexpr std::uint8_t no_map = 0xFF;
+/// FINGER payload: t_us u32, x_nm i32, y_nm i32, touch u8.
+inline constexpr std::size_t finger_payload = 13;
+/// The shortest interval between finger reports a display accepts (µs).
+inline constexpr std::uint32_t min_report_interval_us = 100;
 
 enum class Type : std::uint8_t {
   hello = 0x01,           ///< host → display: [version u8]
@@ -41,10 +45,12 @@ enum class Type : std::uint8_t {
   position = 0x06,        ///< [x_nm i32][touch u8] — streamed, no reply
   drive = 0x07,           ///< [amplitude u16] — streamed, no reply
   status_request = 0x08,  ///< empty
+  reports = 0x09,         ///< host → display: [interval_us u32] (0 = stop) — the display's finger reports (1.1)
   ack = 0x7E,             ///< display → host: [type u8]
   nack = 0x7F,            ///< display → host: [type u8][error u8][detail u32]
   hello_reply = 0x81,     ///< [version u8][slots u8][max_samples u32][refresh_mhz u32][max_payload u16][name…]
   status = 0x88,          ///< see docs/serial-protocol.md
+  finger = 0x89,          ///< display → host, streamed: [t_us u32][x_nm i32][y_nm i32][touch u8] (1.1)
 };
 
 enum class ErrorCode : std::uint8_t {
@@ -60,6 +66,7 @@ enum class ErrorCode : std::uint8_t {
   no_upload = 9,           ///< MAP_DATA / MAP_END without a MAP_BEGIN for that id
   bad_version = 10,        ///< detail: the display's version
   bad_value = 11,          ///< e.g. spacing 0
+  no_sensor = 12,          ///< REPORTS asked of a display without a finger sensor (1.1)
 };
 
 inline const char* describe(ErrorCode e) {
@@ -76,6 +83,7 @@ inline const char* describe(ErrorCode e) {
     case ErrorCode::no_upload: return "no map upload in progress for that slot";
     case ErrorCode::bad_version: return "protocol version not supported";
     case ErrorCode::bad_value: return "field value out of range";
+    case ErrorCode::no_sensor: return "the display has no finger sensor";
   }
   return "unknown error";
 }

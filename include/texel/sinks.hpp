@@ -27,6 +27,8 @@
 
 namespace texel {
 
+class SerialLink;
+
 enum class WavEncoding { pcm16, pcm24, float32 };
 
 /// Writes a mono WAV atomically (temporary + rename). Samples are clipped to
@@ -75,6 +77,9 @@ class Backend : private PlayerDriver {
   [[nodiscard]] virtual std::string scheduling() const { return "set by the sound system"; }
   /// An error the real-time side met (e.g. the serial link dropped); empty if none.
   [[nodiscard]] virtual std::string error() const { return {}; }
+  /// A serial display's link (null for the other backends): the same
+  /// display's finger reports are read through it (SerialLink::read_reports).
+  [[nodiscard]] virtual SerialLink* serial_link() noexcept { return nullptr; }
 
   /// Snapshot of the statistics; resets the peak.
   BackendStats stats();

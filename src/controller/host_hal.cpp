@@ -104,7 +104,16 @@ bool HostHal::serial_write(const std::uint8_t* buf, int n) {
   return done == n;
 }
 
-bool HostHal::read_position(std::int32_t& x_nm, bool& touch) { return sensor ? sensor(x_nm, touch) : false; }
+bool HostHal::read_position(std::int32_t& x_nm, bool& touch) {
+  std::int32_t y_nm = 0;
+  return sensor_2d ? sensor_2d(x_nm, y_nm, touch) : sensor ? sensor(x_nm, touch) : false;
+}
+
+bool HostHal::read_position_2d(std::int32_t& x_nm, std::int32_t& y_nm, bool& touch) {
+  if (sensor_2d) return sensor_2d(x_nm, y_nm, touch);
+  y_nm = 0;
+  return sensor ? sensor(x_nm, touch) : false;
+}
 
 void HostHal::write_amplitude(std::uint16_t a) {
   amplitude.store(a, std::memory_order_relaxed);

@@ -88,6 +88,7 @@ std::string SerialLink::request(Type type, const std::uint8_t* payload, std::siz
       decoder_.feed(
           buf, static_cast<std::size_t>(got_n),
           [&](const serial::Frame& f) {
+            if (f.type == Type::finger) return keep_report(f);
             if (got || f.seq != seq) return;  // a late reply to an earlier attempt
             if (f.type == expect || f.type == Type::nack) {
               got = true;
@@ -207,6 +208,71 @@ DisplayStatus SerialLink::status() {
   s.map_samples = serial::get_u32(b + 18);
   s.uptime_ms = serial::get_u32(b + 22);
   return s;
+}
+
+void SerialLink::keep_report(const serial::Frame& f) {
+  if (f.length != serial::finger_payload) return;  // malformed: not a report
+  if (have_report_seq_ && f.seq != next_report_seq_) reports_lost_ += static_cast<std::uint8_t>(f.seq - next_report_seq_);
+  have_report_seq_ = true;
+  next_report_seq_ = static_cast<std::uint8_t>(f.seq + 1);
+  constexpr std::size_t max_pending = 4096;  // about 4 s at 1 kHz
+  if (pending_.size() >= max_pending) {
+    pending_.erase(pending_.begin());
+    ++reports_lost_;
+  }
+  FingerReport r;
+  r.t_us = serial::get_u32(f.payload);
+  r.x_mm = serial::get_i32(f.payload + 4) / 1e6;
+  r.y_mm = serial::get_i32(f.payload + 8) / 1e6;
+  r.touch = f.payload[12] != 0;
+  r.seq = f.seq;
+  pending_.push_back(r);
+}
+
+void SerialLink::start_reports(std::uint32_t interval_us) {
+  if (interval_us != 0 && interval_us < serial::min_report_interval_us)
+    throw InvalidArgument("serial link " + name_ + ": report interval is " + std::to_string(interval_us) +
+                          " µs; allowed 0 or >= " + std::to_string(serial::min_report_interval_us));
+  std::uint8_t p[4];
+  serial::put_u32(p, interval_us);
+  try {
+    request(Type::reports, p, sizeof p, Type::ack, "REPORTS");
+  } catch (const SerialError& e) {
+    if (e.code != ErrorCode::unknown_type) throw;
+    throw SerialError("serial link " + name_ +
+                          ": the display does not report its finger (REPORTS is unknown to it: its firmware predates "
+                          "protocol 1.1)",
+                      e.code, e.detail);
+  }
+  have_report_seq_ = false;
+}
+
+std::size_t SerialLink::read_reports(std::span<FingerReport> out, int wait_ms) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(0, wait_ms));
+  while (pending_.size() < out.size()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+    pollfd pf{fd_, POLLIN, 0};
+    // Wait only while nothing is pending; then just drain what has arrived.
+    const int r = ::poll(&pf, 1, pending_.empty() ? static_cast<int>(std::max<long long>(0, left)) : 0);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) break;
+    std::uint8_t buf[512];
+    const ssize_t n = ::read(fd_, buf, sizeof buf);
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+    if (n <= 0)
+      throw IoError("serial link " + name_ + ": the display is disconnected (read: " +
+                    std::string(n < 0 ? std::strerror(errno) : "end of file") + ") while reading finger reports");
+    decoder_.feed(
+        buf, static_cast<std::size_t>(n),
+        [&](const serial::Frame& f) {
+          if (f.type == Type::finger) keep_report(f);
+        },
+        [](ErrorCode) {});
+  }
+  const std::size_t k = std::min(out.size(), pending_.size());
+  std::copy_n(pending_.begin(), k, out.begin());
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(k));
+  return k;
 }
 
 }  // namespace texel

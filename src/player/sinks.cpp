@@ -388,6 +388,7 @@ class SerialBackend final : public PacedBackend {
     }
   }
   ~SerialBackend() override { stop(); }
+  [[nodiscard]] SerialLink* serial_link() noexcept override { return &link_; }
   [[nodiscard]] std::string describe() const override {
     return "serial " + options_.path + " → '" + info_.name + "' (protocol " + std::to_string(info_.version) + ", " +
            detail::num(info_.refresh_hz) + " Hz refresh), streaming " +

@@ -4,11 +4,14 @@
 // never crash, and the controller keeps its last good map.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <random>
+#include <set>
 #include <thread>
 #include <vector>
 
@@ -18,6 +21,7 @@
 #include "texel/controller/controller.hpp"
 #include "texel/controller/host_hal.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
 #include "texel/serial_link.hpp"
 #include "texel/serial_protocol.hpp"
 #include "texel/sinks.hpp"
@@ -114,12 +118,14 @@ struct Rig {
   std::atomic<bool> stop{false};
   std::thread thread;
 
-  Rig() {
+  /// `sensor_2d`: the display's own 2-D finger sensor (none: positions from the host).
+  explicit Rig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
     char name[256];
     if (openpty(&master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
     path = name;
     controller::make_raw(slave);
     hal = std::make_unique<controller::HostHal>(master);
+    hal->sensor_2d = std::move(sensor_2d);
     ctl = std::make_unique<SmallController>(*hal, controller::Info{});
     thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
   }
@@ -301,4 +307,158 @@ TEST(HostController, PlayerDrivesTheDisplayThroughTheSerialBackend) {
   EXPECT_TRUE(backend->error().empty()) << backend->error();
   EXPECT_GT(backend->stats().blocks, 100u);
   EXPECT_GT(a, 0);
+}
+
+// ------------------------------------------ finger reports (protocol 1.1)
+
+namespace {
+
+/// A 2-D sensor: the finger circles (20 mm radius about (50, 40) mm) once a
+/// second, lifted for the last 100 ms of each turn.
+bool circling_finger(controller::HostHal& hal, std::int32_t& x, std::int32_t& y, bool& touch) {
+  const double t = hal.micros() * 1e-6;
+  const double turn = t - std::floor(t);
+  x = static_cast<std::int32_t>(std::lround((50.0 + 20.0 * std::cos(2 * std::numbers::pi * turn)) * 1e6));
+  y = static_cast<std::int32_t>(std::lround((40.0 + 20.0 * std::sin(2 * std::numbers::pi * turn)) * 1e6));
+  touch = turn < 0.9;
+  return true;
+}
+
+}  // namespace
+
+TEST(FingerReports, ADisplayWithASensorReportsItsFingerAtTheIntervalAskedFor) {
+  controller::HostHal* hal_ptr = nullptr;
+  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) { return circling_finger(*hal_ptr, x, y, touch); });
+  hal_ptr = rig.hal.get();
+  SerialLink link(rig.path);
+  link.hello();
+  // Too short an interval is refused; the display says the shortest.
+  try {
+    link.start_reports(50);
+    ADD_FAILURE() << "an interval of 50 µs was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find(">= 100"), std::string::npos) << e.what();
+  }
+  link.start_reports(1000);
+  std::vector<FingerReport> got;
+  std::array<FingerReport, 64> buf;
+  const auto end = std::chrono::steady_clock::now() + 400ms;
+  while (std::chrono::steady_clock::now() < end) {
+    const std::size_t n = link.read_reports(buf, 20);
+    got.insert(got.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  // About one report per millisecond (a loaded host may skip some ticks).
+  EXPECT_GT(got.size(), 100u);
+  EXPECT_LT(got.size(), 450u);
+  ASSERT_GE(got.size(), 2u);
+  EXPECT_EQ(link.reports_lost(), 0u);
+  for (std::size_t i = 1; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].seq, static_cast<std::uint8_t>(got[i - 1].seq + 1));
+    EXPECT_GT(static_cast<std::int32_t>(got[i].t_us - got[i - 1].t_us), 0) << i;
+  }
+  // Never faster than asked: the reports keep to the interval's grid (a late
+  // tick delays one report, the next keeps its slot).
+  const double mean_us = static_cast<double>(got.back().t_us - got.front().t_us) / static_cast<double>(got.size() - 1);
+  EXPECT_GT(mean_us, 990.0);
+  // Every report lies on the circle, and the reported times place it there.
+  for (const FingerReport& r : got) {
+    EXPECT_NEAR(std::hypot(r.x_mm - 50.0, r.y_mm - 40.0), 20.0, 1e-5);
+    // t_us is the tick's time; the sensor is read a few µs later (126 mm/s).
+    const double turn = r.t_us * 1e-6 - std::floor(r.t_us * 1e-6);
+    EXPECT_NEAR(r.x_mm, 50.0 + 20.0 * std::cos(2 * std::numbers::pi * turn), 0.005);
+    if (std::abs(turn - 0.9) > 1e-4) {
+      EXPECT_EQ(r.touch, turn < 0.9);
+    }
+  }
+  // Stopping: no more reports once the ACK is in and the pipe drained.
+  link.start_reports(0);
+  (void)link.read_reports(buf, 20);
+  std::this_thread::sleep_for(20ms);
+  while (link.read_reports(buf, 0) > 0) {
+  }
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(link.read_reports(buf, 10), 0u);
+  EXPECT_EQ(rig.ctl->status().report_interval_us, 0u);
+}
+
+TEST(FingerReports, ADisplayWithoutASensorSaysSo) {
+  Rig rig;  // positions come from the host
+  SerialLink link(rig.path);
+  link.hello();
+  try {
+    link.start_reports(1000);
+    ADD_FAILURE() << "a display without a sensor accepted REPORTS";
+  } catch (const SerialError& e) {
+    EXPECT_EQ(e.code, serial::ErrorCode::no_sensor);
+    EXPECT_NE(std::string(e.what()).find("no finger sensor"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FingerReports, TheTimelineNeverPlacesAReportAfterItArrivedAndFollowsASlowClock) {
+  ReportTimeline tl;
+  // Reports every ms on a display clock near the 32-bit wrap, arriving 2–7 ms
+  // later on a host clock that runs 0.05 % faster.
+  std::uint32_t t_us = 0xFFFFFFFFu - 5000u;
+  double prev = -1.0;
+  for (int k = 0; k < 20000; ++k, t_us += 1000) {
+    const double arrival = k * 1e-3 * 1.0005 + 0.002 + 0.005 * ((k * 7919) % 13) / 13.0;
+    const double placed = tl.place(t_us, arrival);
+    EXPECT_LE(placed, arrival + 1e-12);
+    EXPECT_GT(placed, prev);
+    prev = placed;
+    if (k > 5000) {
+      EXPECT_GT(placed, arrival - 0.0075) << k;  // delay stays bounded: the drift is followed
+    }
+  }
+}
+
+TEST(FingerReports, A2DPlayerDrivesTheDisplayThatReportsTheFinger) {
+  controller::HostHal* hal_ptr = nullptr;
+  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) { return circling_finger(*hal_ptr, x, y, touch); });
+  hal_ptr = rig.hal.get();
+  SerialOptions o;
+  o.path = rig.path;
+  o.rate_hz = 1000;
+  o.stream = SerialStream::drive;
+  const PlayerMap stand_in(Grid{Millimetres(0), Millimetres(1), 1}, std::vector<float>{0.0f});
+  auto backend = make_serial_backend(o, stand_in);
+  ASSERT_NE(backend->serial_link(), nullptr);
+  PlayerConfig c;
+  c.rate_hz = 1000;
+  c.mode = OutputMode::amplitude;
+  // A friction bitmap: 1 where y > 40 mm, 0.2 below.
+  Raster2D bitmap;
+  bitmap.width = 200;
+  bitmap.height = 160;
+  bitmap.pitch = Millimetres(0.5);
+  bitmap.values.resize(200 * 160);
+  for (int r = 0; r < 160; ++r)
+    for (int k = 0; k < 200; ++k)
+      bitmap.values[static_cast<std::size_t>(r) * 200 + static_cast<std::size_t>(k)] = r * 0.5 > 40 ? 1.0f : 0.2f;
+  Player2D player(c, PlayerMap2D::bitmap(std::move(bitmap)));
+  SerialLink& link = *backend->serial_link();
+  link.start_reports(1000);
+  backend->start(player);
+  ReportTimeline tl;
+  std::array<FingerReport, 64> buf;
+  std::size_t reports = 0;
+  std::set<std::uint16_t> seen;
+  const auto end = std::chrono::steady_clock::now() + 1200ms;
+  while (std::chrono::steady_clock::now() < end) {
+    const std::size_t n = link.read_reports(buf, 5);
+    for (std::size_t i = 0; i < n; ++i)
+      player.push({tl.place(buf[i].t_us, player.time_s()), buf[i].x_mm, buf[i].y_mm, buf[i].touch});
+    reports += n;
+    seen.insert(rig.hal->amplitude.load());
+  }
+  backend->stop();
+  EXPECT_TRUE(backend->error().empty()) << backend->error();
+  EXPECT_GT(reports, 300u);
+  // Over a turn the finger crosses both halves of the bitmap: the display was
+  // driven at both frictions.
+  const auto near = [&](float a) {
+    return std::any_of(seen.begin(), seen.end(), [&](std::uint16_t v) { return std::abs(v - u16(a)) <= 66; });
+  };
+  EXPECT_TRUE(near(1.0f)) << seen.size();
+  EXPECT_TRUE(near(0.2f)) << seen.size();
 }

@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "../support/cli_run.hpp"
+#include "../support/controller_process.hpp"
 
 #include <algorithm>
 #include <array>
@@ -322,32 +323,11 @@ TEST(ExperimentCli, SerialFrictionDisplayThroughTheReferenceController) {
   // The reference display controller on a pseudo-terminal stands in for a
   // friction display; the study streams drive values to it.
   TempDir d("texel-exp-serial");
-  int out[2];
-  ASSERT_EQ(::pipe(out), 0);
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    ::dup2(out[1], 1);
-    ::dup2(out[1], 2);
-    ::close(out[0]);
-    ::execl(TEXEL_CLI, TEXEL_CLI, "controller", "--pty", "--duration", "120", "--quiet", static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  ::close(out[1]);
-  FILE* ctl = ::fdopen(out[0], "r");
-  ASSERT_NE(ctl, nullptr);
-  std::array<char, 512> line{};
-  ASSERT_NE(std::fgets(line.data(), static_cast<int>(line.size()), ctl), nullptr);
-  std::string pty = line.data();
-  while (!pty.empty() && (pty.back() == '\n' || pty.back() == '\r')) pty.pop_back();
+  texel::test_support::ControllerProcess ctl(TEXEL_CLI, {"--duration", "120", "--quiet"});
+  ASSERT_FALSE(ctl.pty().empty());
   const CliRun r = run("experiment run " + protocols + "coarse-features.json --participant D1 --db " + d.at("d.db") +
-                       " --simulate default --pace 0.005 --backend serial:" + pty + " --json");
-  ::kill(pid, SIGTERM);  // the controller stops cleanly and reports its counters
-  std::string rest;
-  while (std::fgets(line.data(), static_cast<int>(line.size()), ctl)) rest += line.data();
-  std::fclose(ctl);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+                       " --simulate default --pace 0.005 --backend serial:" + ctl.pty() + " --json");
+  const std::string rest = ctl.stop();
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(r.out.find('{')));
   EXPECT_TRUE(j["finished"].get<bool>());

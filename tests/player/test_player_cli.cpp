@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "../support/cli_run.hpp"
+#include "../support/controller_process.hpp"
 
 #include <algorithm>
 #include <array>
@@ -12,6 +13,8 @@
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "texel/io.hpp"
 #include "texel/player.hpp"
@@ -189,4 +192,36 @@ TEST_F(Cli, SwipeOfATwoDimensionalDocumentPeaksAtCentralPitchTimesSpeedAlongAnyA
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.out.find("one region"), std::string::npos) << bad.out;
   EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, PlayTakesTheFingerLiveFromADisplayThatReportsIt) {
+  // The reference controller with a simulated 2-D sensor (a finger circling
+  // over a disc-shaped coarse feature) reports the finger; `texel play`
+  // computes the 2-D drive and streams it back over the same link.
+  const std::string doc2d = (dir / "disc.texel.json").string();
+  texel::write_file_atomic(doc2d, R"({"format": "texel-document", "version": 4, "device": "tablet-2d",
+    "surface2d": {"regions": [{"x_mm": 0, "y_mm": 0, "field": "spectral",
+      "texture": {"kind": "texel", "central_pitch_db": 6, "irregularity_db": 3, "texel_length_mm": 0.5, "seed": 3,
+                  "coarse_strength": 0.7, "fine_strength": 0.5},
+      "coarse2d": {"kind": "disc", "x_mm": 60, "y_mm": 40, "radius_mm": 10, "edge_mm": 1, "inside": 1, "outside": 0.2}}]}})");
+  texel::test_support::ControllerProcess display(
+      TEXEL_CLI, {"--sensor", "circle", "--sensor-start", "60,40", "--sensor-radius", "15", "--duration", "20", "--quiet"});
+  ASSERT_FALSE(display.pty().empty());
+  const std::string port = "serial:" + display.pty();
+  const CliRun r = run("play " + doc2d + " --backend " + port + " --stream drive --finger " + port + " --duration 1 --json");
+  const std::string counters = display.stop();
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out.substr(r.out.find('{')));
+  EXPECT_EQ(j["surface"], "2d");
+  EXPECT_GT(j["finger_reports"].get<int>(), 100);  // about 1,000 on an idle host
+  EXPECT_EQ(j["finger_reports_lost"].get<int>(), 0);
+  EXPECT_EQ(j["finger_reports_dropped"].get<int>(), 0);
+  EXPECT_NE(counters.find("bad 0, nacks 0, link errors 0"), std::string::npos) << counters;
+
+  // A display without a sensor: one line, exit 2.
+  texel::test_support::ControllerProcess blind(TEXEL_CLI, {"--duration", "20", "--quiet"});
+  const CliRun no = run("play " + doc2d + " --backend null --finger serial:" + blind.pty() + " --duration 1");
+  EXPECT_EQ(no.status, 2);
+  EXPECT_NE(no.out.find("no finger sensor"), std::string::npos) << no.out;
+  EXPECT_EQ(std::count(no.out.begin(), no.out.end(), '\n'), 1) << no.out;
 }

@@ -39,6 +39,12 @@ class Hal {
   /// The display's own finger sensor: true and the position if it has one;
   /// false to use positions streamed by the host.
   virtual bool read_position(std::int32_t& x_nm, bool& touch) = 0;
+  /// The sensor of a 2-D display: true and the position (x, y) if it has one.
+  /// The default is the 1-D sensor with y = 0, so 1-D firmware needs nothing.
+  virtual bool read_position_2d(std::int32_t& x_nm, std::int32_t& y_nm, bool& touch) {
+    y_nm = 0;
+    return read_position(x_nm, touch);
+  }
   /// Sets the friction amplitude (0 = at rest, 65535 = full).
   virtual void write_amplitude(std::uint16_t amplitude) = 0;
   /// Idles until about `t_us` (or returns early when bytes arrive).
@@ -62,12 +68,15 @@ struct Status {
   Mode mode = Mode::idle;
   std::uint16_t amplitude = 0;
   std::int32_t x_nm = 0;
+  std::int32_t y_nm = 0;  ///< a 2-D sensor's y (0 on a 1-D display)
   bool touch = false;
   std::uint32_t frames_ok = 0;
   std::uint32_t frames_bad = 0;  ///< CRC and length errors
   std::uint32_t nacks = 0;
-  std::uint32_t link_errors = 0;  ///< times the link was found down
-  std::uint32_t ticks = 0;        ///< output updates
+  std::uint32_t link_errors = 0;         ///< times the link was found down
+  std::uint32_t ticks = 0;               ///< output updates
+  std::uint32_t reports = 0;             ///< FINGER reports sent
+  std::uint32_t report_interval_us = 0;  ///< 0: not reporting
   serial::ErrorCode last_error = serial::ErrorCode::none;
 };
 
@@ -165,11 +174,12 @@ class Controller {
   }
 
   void tick(std::uint32_t now) {
-    std::int32_t x = 0;
+    std::int32_t x = 0, y = 0;
     bool touch = false;
     bool fresh = true;
-    if (hal_.read_position(x, touch)) {
+    if (hal_.read_position_2d(x, y, touch)) {
       status_.mode = status_.mode == Mode::drive ? Mode::drive : Mode::position;
+      if (status_.report_interval_us != 0 && static_cast<std::int32_t>(now - next_report_us_) >= 0) report(now, x, y, touch);
     } else {
       x = stream_x_nm_;
       touch = stream_touch_;
@@ -189,10 +199,25 @@ class Controller {
       }
     }
     status_.x_nm = x;
+    status_.y_nm = y;
     status_.touch = touch;
     status_.amplitude = a;
     ++status_.ticks;
     hal_.write_amplitude(a);
+  }
+
+  // A FINGER report of the sensor's reading at `now`; its seq counts reports,
+  // so the host sees any it lost. Reports stay on the interval's grid and
+  // skip, rather than burst, when the loop fell behind.
+  void report(std::uint32_t now, std::int32_t x, std::int32_t y, bool touch) {
+    std::uint8_t p[serial::finger_payload];
+    serial::put_u32(p, now);
+    serial::put_i32(p + 4, x);
+    serial::put_i32(p + 8, y);
+    p[12] = touch ? 1 : 0;
+    send(serial::Type::finger, static_cast<std::uint8_t>(status_.reports++), p, sizeof p);
+    next_report_us_ += status_.report_interval_us;
+    if (static_cast<std::int32_t>(now - next_report_us_) >= 0) next_report_us_ = now + status_.report_interval_us;
   }
 
   void send(serial::Type type, std::uint8_t seq, const std::uint8_t* payload, std::size_t n) {
@@ -300,6 +325,18 @@ class Controller {
         status_.mode = Mode::drive;
         return;
       }
+      case Type::reports: {
+        if (f.length != 4) return nack(f, ErrorCode::bad_length);
+        const std::uint32_t interval = serial::get_u32(p);
+        if (interval != 0 && interval < serial::min_report_interval_us)
+          return nack(f, ErrorCode::bad_value, serial::min_report_interval_us);
+        std::int32_t x = 0, y = 0;
+        bool touch = false;
+        if (interval != 0 && !hal_.read_position_2d(x, y, touch)) return nack(f, ErrorCode::no_sensor);
+        status_.report_interval_us = interval;
+        next_report_us_ = hal_.micros();
+        return ack(f);
+      }
       case Type::status_request: {
         if (f.length != 0) return nack(f, ErrorCode::bad_length);
         std::uint8_t r[26];
@@ -341,6 +378,7 @@ class Controller {
   bool stream_touch_ = false;
   std::uint32_t stream_us_ = 0;
   std::uint16_t drive_ = 0;
+  std::uint32_t next_report_us_ = 0;
   bool link_up_ = true;
   std::uint32_t start_us_ = 0;
   std::uint32_t last_byte_us_ = 0;

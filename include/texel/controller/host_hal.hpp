@@ -25,11 +25,15 @@ class HostHal final : public Hal {
   int serial_read(std::uint8_t* buf, int max) override;
   bool serial_write(const std::uint8_t* buf, int n) override;
   bool read_position(std::int32_t& x_nm, bool& touch) override;
+  bool read_position_2d(std::int32_t& x_nm, std::int32_t& y_nm, bool& touch) override;
   void write_amplitude(std::uint16_t amplitude) override;
   void idle_until(std::uint32_t t_us) override;
 
   /// Optional local finger sensor (tests); unset = positions come from the host.
   std::function<bool(std::int32_t&, bool&)> sensor;
+  /// Optional local 2-D finger sensor (a 2-D display; `texel controller
+  /// --sensor`); takes precedence over `sensor`.
+  std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d;
   /// The last amplitude written and how many writes.
   std::atomic<std::uint16_t> amplitude{0};
   std::atomic<std::uint64_t> writes{0};
