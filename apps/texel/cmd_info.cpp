@@ -10,6 +10,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/surface2d.hpp"
 
 namespace texel::cli {
 namespace {
@@ -28,9 +29,57 @@ ordered stats(const std::vector<double>& v) {
   return j;
 }
 
+// A version-4 2-D document: its bitmap grid and its regions (prepared, so
+// every field and coarse profile is checked, images loaded).
+ordered surface2d_info(const Document& doc, ordered j) {
+  const Surface2D surface = prepare_surface2d(doc);
+  const BitmapGeometry& g = surface.geometry();
+  j["bitmap"] = {{"width_px", g.width},
+                 {"height_px", g.height},
+                 {"pixel_pitch_mm", g.pitch.value()},
+                 {"width_mm", g.width_mm().value()},
+                 {"height_mm", g.height_mm().value()},
+                 {"depth_bits", g.depth},
+                 {"polarity", std::string(to_string(g.polarity))},
+                 {"nyquist_cpm", g.nyquist().value()},
+                 {"png_raw_bytes", static_cast<std::int64_t>(g.width) * g.height * (g.depth / 8)}};
+  j["regions"] = ordered::array();
+  const auto& specs = doc.surface2d->regions;
+  for (std::size_t i = 0; i < surface.regions().size(); ++i) {
+    const Surface2D::Region& r = surface.regions()[i];
+    const Region2DSpec& spec = specs[i];
+    const TexelSpec& s = r.texel;
+    ordered rj{{"name", r.name},
+               {"x_mm", r.x0},
+               {"y_mm", r.y0},
+               {"width_mm", r.x1 - r.x0},
+               {"height_mm", r.y1 - r.y0},
+               {"field", std::string(to_string(spec.field))}};
+    if (spec.field == Field2D::oriented) rj["orientation_deg"] = spec.orientation_deg;
+    rj["central_pitch_db"] = s.central_pitch.value();
+    rj["irregularity_db"] = s.irregularity.value();
+    rj["texel_length_mm"] = s.texel_length.value();
+    rj["seed"] = s.seed;
+    rj["coarse2d"] = kind_name(spec.coarse);
+    rj["coarse_strength"] = s.coarse_strength;
+    rj["fine_strength"] = s.fine_strength;
+    j["regions"].push_back(rj);
+  }
+  return j;
+}
+
 ordered document_info(const Document& doc, const std::string& path) {
-  const Surface surface = prepare_surface(doc);
   ordered j;
+  if (doc.surface2d) {
+    j["file"] = path;
+    j["kind"] = "texel-document";
+    j["version"] = doc.version;
+    if (!doc.description.empty()) j["description"] = doc.description;
+    j["device"] = {{"name", doc.device.name}};
+    j["document_bytes"] = document_json(doc).size();
+    return surface2d_info(doc, std::move(j));
+  }
+  const Surface surface = prepare_surface(doc);
   j["file"] = path;
   j["kind"] = "texel-document";
   j["version"] = doc.version;

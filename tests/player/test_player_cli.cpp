@@ -182,6 +182,15 @@ TEST_F(Cli, SwipeOfATwoDimensionalDocumentPeaksAtCentralPitchTimesSpeedAlongAnyA
     // 3 dB = 1.995 cycles/mm; at 100 mm/s: 199.5 Hz.
     EXPECT_NEAR(texel::signal_spectrum(s, rec.rate.value()).peak_hz(1.0), 199.5, 10.0) << "angle " << angle;
   }
+  // `texel info` describes a 2-D document: its bitmap grid and its regions.
+  const CliRun info = run("info " + doc2d + " --json");
+  ASSERT_EQ(info.status, 0) << info.out;
+  const auto j = nlohmann::json::parse(info.out);
+  EXPECT_EQ(j["version"], 4);
+  EXPECT_GT(j["bitmap"]["width_px"].get<int>(), 0);
+  ASSERT_EQ(j["regions"].size(), 1u);
+  EXPECT_EQ(j["regions"][0]["field"], "spectral");
+  EXPECT_EQ(j["regions"][0]["central_pitch_db"], 3.0);
   const std::string two = (dir / "two.texel.json").string();
   texel::write_file_atomic(two, R"({"format": "texel-document", "version": 4, "device": "tablet-2d",
     "surface2d": {"regions": [
