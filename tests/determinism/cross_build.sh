@@ -30,8 +30,9 @@ configs=(
   "clang-O3:clang++:-O3"
 )
 # One configuration also builds the whole texel command, so every module
-# (not only the renderer) keeps compiling with clang.
-full_build="clang-O3"
+# (not only the renderer) keeps compiling with clang: the -O0 one, which
+# compiles in about half the time of -O3 (the suite's budget is CI's).
+full_build="clang-O0"
 fail=0
 for c in "${configs[@]}"; do
   IFS=: read -r name cxx flags <<<"$c"
