@@ -6,7 +6,11 @@
 // 2-D coarse profile; the scan along a chosen direction is plotted.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
 import { withStudio, screenshot } from './studio.mjs';
+
+const axeSource = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
 
 // A small inline display (600 × 400 pixels of 0.25 mm) keeps the engine's
 // work (a bitmap-mode map is the whole bitmap) to a fraction of a second.
@@ -129,7 +133,28 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     await page.press('#s2d-angle-num', 'Enter');
     await page.waitForFunction(() => /at 45°/.test(document.querySelector('[data-testid=s2d-scan-caption]').textContent), null, { timeout: 60_000 });
     await screenshot(page, 'surface2d-shapes-scan');
+
+    // A touch stroke (Pointer Events with pointerType touch) is drawn too, in its own colour.
+    await page.check('#s2d-tool-feel');
+    const cdp = await page.context().newCDPSession(page);
+    const touchAt = (type, f) =>
+      cdp.send('Input.dispatchTouchEvent', { type, touchPoints: f === undefined ? [] : [{ x: Math.round(box.x + box.width * f), y: Math.round(box.y + box.height * 0.2) }] });
+    const movesBefore = (await hooks(page)).movesSent;
+    await touchAt('touchStart', 0.2);
+    for (let k = 1; k <= 10; k++) await touchAt('touchMove', 0.2 + 0.03 * k);
+    await touchAt('touchEnd');
+    assert.ok((await hooks(page)).movesSent >= movesBefore + 10, 'touch samples were sent');
+    const touchInk = await overlayAlpha(page, [[box.width * 0.35, box.height * 0.2]]);
+    assert.ok(touchInk[0] > 0, 'the touch path is drawn');
+
+    // axe-core: no critical or serious finding on the 2-D page.
+    await page.addScriptTag({ content: axeSource });
+    const violations = await page.evaluate(async () =>
+      (await window.axe.run(document, { resultTypes: ['violations'] })).violations.map((v) => `${v.impact} ${v.id}: ${v.nodes.map((n) => n.target.join(' ')).slice(0, 3).join(', ')}`),
+    );
+    console.log(`axe surface2d: ${violations.length ? violations.join('; ') : 'no findings'}`);
+    assert.deepEqual(violations.filter((v) => /^(critical|serious)/.test(v)), []);
     assert.equal(await page.textContent('[data-testid=surface2d-status]'), '');
     assert.deepEqual(errors, []);
-  });
+  }, { contextOptions: { hasTouch: true } });
 });
