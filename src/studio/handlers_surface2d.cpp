@@ -116,11 +116,13 @@ std::shared_ptr<const Prepared> prepared(State& s, const Fields& f, const std::s
   if (!doc.contains("surface2d")) throw Reject{"invalid", type + ": document is not a 2-D document (version 4 with surface2d)"};
   auto p = std::make_shared<Prepared>();
   // Every image path must name one of the images sent; each is rewritten to its temporary copy.
-  json& regions = doc["surface2d"]["regions"];
-  if (regions.is_array()) {
-    for (std::size_t i = 0; i < regions.size(); ++i) {
-      json& c = regions[i]["coarse2d"];
-      if (!c.is_object() || c.value("kind", "") != "image") continue;
+  json* regions = doc["surface2d"].is_object() && doc["surface2d"].contains("regions") ? &doc["surface2d"]["regions"] : nullptr;
+  if (regions && regions->is_array()) {
+    for (std::size_t i = 0; i < regions->size(); ++i) {
+      json& r = (*regions)[i];
+      if (!r.is_object() || !r.contains("coarse2d") || !r["coarse2d"].is_object()) continue;
+      json& c = r["coarse2d"];
+      if (!c.contains("kind") || c["kind"] != "image") continue;
       const std::string where = "document.surface2d.regions[" + std::to_string(i) + "].coarse2d.path";
       const std::string path = c.contains("path") && c["path"].is_string() ? c["path"].get<std::string>() : "";
       const auto it = images.find(path);

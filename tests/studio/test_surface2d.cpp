@@ -156,6 +156,11 @@ TEST(Surface2DStudio, BadInputsGetOneLineErrors) {
       {"texture", {{"kind", "texel"}, {"central_pitch_db", 0}, {"irregularity_db", -5}, {"texel_length_mm", 1}, {"seed", 1}}}};
   expect_error(c.ask({{"type", "surface2d.scan"}, {"document", one_d}, {"angle_deg", 0}}), "invalid", "2-D document");
   expect_error(c.ask({{"type", "feel2d.select"}, {"document", doc}, {"mode", "hover"}}), "invalid", "mode");
+  json odd = doc;
+  odd["surface2d"]["regions"][0] = 7;
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", odd}, {"angle_deg", 0}}), "invalid", "regions[0]");
+  odd["surface2d"] = "flat";
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", odd}, {"angle_deg", 0}}), "invalid", "surface2d");
   expect_error(c.ask({{"type", "feel2d.move"}, {"seq", 1}, {"x_mm", 1}}), "bad_message", "y_mm");
   // Image profiles: only bytes sent along, never a file of the server's.
   expect_error(c.ask({{"type", "surface2d.scan"},

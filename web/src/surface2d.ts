@@ -13,8 +13,9 @@ import './surface2d.css';
 import { studio } from './ws';
 import { h, fmt, base64ToBytes, bytesToBase64, decodeF32, download } from './util';
 import { Hear2D } from './audio2d';
+import { interpLog } from './plots';
 import { greyOf, greyPng, toGreyPng } from './png2d';
-import type { DeviceProfile, Feel2DStateReply, HelloReply, Spectrum, Surface2DDocument, Surface2DViewReply } from './generated/messages';
+import type { DeviceProfile, Feel2DStateReply, HelloReply, Surface2DDocument, Surface2DViewReply } from './generated/messages';
 import type { TexelTexture } from './document';
 
 type Json = null | boolean | number | string | Json[] | { [k: string]: Json };
@@ -491,7 +492,7 @@ export function mountSurface2d(root: HTMLElement): void {
             xs.push(r.scan.frequency_cpm[i]);
             ys.push(r.scan.magnitude_db[i]);
           }
-        spec.setData([xs, xs.map((f) => interpLog(r.target, f)), ys]);
+        spec.setData([xs, xs.map((f) => interpLog(r.target.frequency_cpm, r.target.magnitude_db, f)), ys]);
         view.scanLine = [r.from_mm as [number, number], r.to_mm as [number, number]];
         view.draw();
         scanText.textContent = `Scan of region ${r.region} through its centre at ${fmt(r.angle_deg, 0)}°: ${r.samples} samples ${fmt(r.spacing_mm, 4)} mm apart (the dashed line on the map); the 1-D texture rendered over the same length.`;
@@ -577,21 +578,6 @@ export function mountSurface2d(root: HTMLElement): void {
       setError((e as Error).message);
     }
   })();
-}
-
-function interpLog(s: Spectrum, f: number): number | null {
-  const xs = s.frequency_cpm;
-  if (!xs.length || f < xs[0] || f > xs[xs.length - 1]) return null;
-  let lo = 0;
-  let hi = xs.length - 1;
-  while (hi - lo > 1) {
-    const mid = (lo + hi) >> 1;
-    if (xs[mid] <= f) lo = mid;
-    else hi = mid;
-  }
-  if (hi === lo) return s.magnitude_db[lo];
-  const t = Math.log(f / xs[lo]) / Math.log(xs[hi] / xs[lo]);
-  return s.magnitude_db[lo] + t * (s.magnitude_db[hi] - s.magnitude_db[lo]);
 }
 
 // ------------------------------------------------------------------ MapView
