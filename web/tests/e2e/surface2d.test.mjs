@@ -68,10 +68,15 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     // Zoom in twice: the scale (mm per screen px) shrinks and a finer window is asked for.
     await page.click('[data-testid=s2d-zoom-in]');
     await page.click('[data-testid=s2d-zoom-in]');
-    await page.waitForFunction((s) => window.__texel2d.lastView.mm_per_px < s * 0.5, before.lastView.mm_per_px, { timeout: 30_000 });
-    const zoomed = await hooks(page);
+    // The window asked for narrows with the zoom (the newest reply answers the newest request).
     const spanMm = (v) => v.columns * v.view_pitch_mm;
-    assert.ok(spanMm(zoomed.lastView) < 0.6 * spanMm(before.lastView), `window ${spanMm(before.lastView)} → ${spanMm(zoomed.lastView)} mm wide`);
+    await page.waitForFunction(
+      (span) => window.__texel2d.lastView.columns * window.__texel2d.lastView.view_pitch_mm < 0.6 * span,
+      spanMm(before.lastView),
+      { timeout: 30_000 },
+    );
+    const zoomed = await hooks(page);
+    assert.ok(zoomed.lastView.mm_per_px < 0.5 * before.lastView.mm_per_px, `${before.lastView.mm_per_px} → ${zoomed.lastView.mm_per_px} mm per px`);
     assert.ok(zoomed.lastView.stride <= before.lastView.stride);
     assert.ok(Number(await page.getAttribute('[data-testid=s2d-scale]', 'data-mm-per-px')) < before.lastView.mm_per_px);
     await page.click('[data-testid=s2d-zoom-fit]');
