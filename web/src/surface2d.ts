@@ -427,9 +427,11 @@ export function mountSurface2d(root: HTMLElement): void {
   async function hearSource(): Promise<void> {
     if (!hearIt.enabled) return;
     if (modeSel.value === 'path') {
+      // A 1-D document: an inline profile without its bitmap (versions 1-3 have none).
+      const device = typeof doc.device === 'string' ? doc.device : (({ bitmap: _b, ...d }) => d as DeviceProfile)(doc.device as DeviceProfile);
       const d = await client.request(
         'design',
-        { document: { format: 'texel-document', version: 1, device: doc.device as string, texture: region().texture } },
+        { document: { format: 'texel-document', version: 1, device, texture: region().texture } },
         { lane: 'design2d' },
       );
       if (d) hearIt.setSource({ line: decodeF32(d.map_f32), spacing: d.grid.spacing_mm });

@@ -32,6 +32,12 @@ const SMALL = {
   },
 };
 
+/** The map's box in the viewport, scrolled into view first (controls below it may have scrolled the page). */
+async function mapBox(page) {
+  await page.locator('[data-testid=map2d]').scrollIntoViewIfNeeded();
+  return page.locator('[data-testid=map2d]').boundingBox();
+}
+
 const hooks = (page) => page.evaluate(() => ({ ...window.__texel2d }));
 
 /** Alpha of the overlay canvas (the drawn path) at view points (CSS px). */
@@ -49,9 +55,9 @@ function overlayAlpha(page, pts) {
 
 test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes, scans', { timeout: 180_000 }, async () => {
   await withStudio(async ({ studio, page, errors }) => {
+    // The small display's document, in place before the page's first script runs.
+    await page.addInitScript((d) => localStorage.setItem('texel.surface2d.v1', JSON.stringify({ document: d, images: {} })), SMALL);
     await page.goto(`${studio.url}#/surface`);
-    await page.evaluate((d) => localStorage.setItem('texel.surface2d.v1', JSON.stringify({ document: d, images: {} })), SMALL);
-    await page.reload();
     await page.waitForFunction(() => window.__texel2d?.viewsDrawn > 0, null, { timeout: 60_000 });
 
     // The map view shows an image: many grey levels on the image canvas.
@@ -82,9 +88,10 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     await page.click('[data-testid=s2d-zoom-fit]');
     await page.waitForFunction((s) => Math.abs(window.__texel2d.lastView.mm_per_px - s) < 1e-9, before.lastView.mm_per_px, { timeout: 30_000 });
 
-    // The 2-D feel pad: a mouse stroke (button held) along a diagonal.
+    // The 2-D feel pad: a mouse stroke (button held) along a diagonal, heard through the browser too.
     await page.waitForFunction(() => window.__texel2d.selected === 'path', null, { timeout: 60_000 });
-    const box = await page.locator('[data-testid=map2d]').boundingBox();
+    await page.check('#s2d-hear');
+    let box = await mapBox(page);
     const path = [];
     for (let k = 0; k <= 40; k++) path.push([box.width * (0.25 + 0.45 * (k / 40)), box.height * (0.3 + 0.35 * (k / 40))]);
     const beforeInk = await overlayAlpha(page, path.filter((_, i) => i % 5 === 2));
@@ -113,6 +120,7 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     // A disc placed by dragging becomes the region's coarse2d.
     await page.check('#s2d-tool-shape');
     await page.selectOption('#s2d-shape', 'disc');
+    box = await mapBox(page);
     await page.mouse.move(box.x + box.width * 0.5, box.y + box.height * 0.5);
     await page.mouse.down();
     await page.mouse.move(box.x + box.width * 0.6, box.y + box.height * 0.5, { steps: 5 });
@@ -125,6 +133,7 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
 
     // A painted stroke becomes an image profile whose PNG travels with the messages.
     await page.check('#s2d-tool-paint');
+    box = await mapBox(page);
     const n = (await hooks(page)).viewsDrawn;
     await page.mouse.move(box.x + box.width * 0.3, box.y + box.height * 0.7);
     await page.mouse.down();
@@ -141,6 +150,7 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
 
     // A touch stroke (Pointer Events with pointerType touch) is drawn too, in its own colour.
     await page.check('#s2d-tool-feel');
+    box = await mapBox(page);
     const cdp = await page.context().newCDPSession(page);
     const touchAt = (type, f) =>
       cdp.send('Input.dispatchTouchEvent', { type, touchPoints: f === undefined ? [] : [{ x: Math.round(box.x + box.width * f), y: Math.round(box.y + box.height * 0.2) }] });
@@ -151,6 +161,18 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     assert.ok((await hooks(page)).movesSent >= movesBefore + 10, 'touch samples were sent');
     const touchInk = await overlayAlpha(page, [[box.width * 0.35, box.height * 0.2]]);
     assert.ok(touchInk[0] > 0, 'the touch path is drawn');
+    // A pen stroke (CDP mouse events with pointerType pen).
+    const pen = (type, f) =>
+      cdp.send('Input.dispatchMouseEvent', { type, pointerType: 'pen', button: 'left', buttons: type === 'mouseReleased' ? 0 : 1, clickCount: 1, x: Math.round(box.x + box.width * f), y: Math.round(box.y + box.height * 0.85), force: 0.5 });
+    const beforePen = (await hooks(page)).movesSent;
+    await pen('mousePressed', 0.2);
+    for (let k = 1; k <= 10; k++) await pen('mouseMoved', 0.2 + 0.03 * k);
+    await pen('mouseReleased', 0.5);
+    assert.ok((await hooks(page)).movesSent >= beforePen + 10, 'pen samples were sent');
+    const penInk = await overlayAlpha(page, [[box.width * 0.35, box.height * 0.85]]);
+    assert.ok(penInk[0] > 0, 'the pen path is drawn');
+    assert.ok(await page.isChecked('#s2d-hear'), 'Hear it stayed on (the 2-D worklet started)');
+    await screenshot(page, 'surface2d-touch-pen');
 
     // axe-core: no critical or serious finding on the 2-D page.
     await page.addScriptTag({ content: axeSource });
