@@ -274,7 +274,12 @@ export function mountSurface2d(root: HTMLElement): void {
 
   function showControls(): void {
     const r = region();
-    deviceSel.value = typeof doc.device === 'string' ? doc.device : String((doc.device as { name?: string }).name ?? '');
+    const name = typeof doc.device === 'string' ? doc.device : String((doc.device as { name?: string }).name ?? 'inline');
+    // An opened document's inline profile is offered as itself.
+    deviceSel.querySelector('option[data-inline]')?.remove();
+    if (![...deviceSel.options].some((o) => o.value === name))
+      deviceSel.append(h('option', { value: name, 'data-inline': 'true', disabled: true }, `${name} (the document's own profile)`));
+    deviceSel.value = name;
     fieldSel.value = r.field ?? 'spectral';
     orient.value = String(r.orientation_deg ?? 0);
     (orient as HTMLInputElement).disabled = fieldSel.value !== 'oriented';

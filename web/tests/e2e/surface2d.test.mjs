@@ -171,8 +171,20 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     assert.ok((await hooks(page)).movesSent >= beforePen + 10, 'pen samples were sent');
     const penInk = await overlayAlpha(page, [[box.width * 0.35, box.height * 0.85]]);
     assert.ok(penInk[0] > 0, 'the pen path is drawn');
+    await page.waitForFunction(() => !window.__texel2d.touching, null, { timeout: 10_000 });
     assert.ok(await page.isChecked('#s2d-hear'), 'Hear it stayed on (the 2-D worklet started)');
+    assert.match(await page.textContent('#s2d-device'), /pad-150x100 \(the document's own profile\)/);
     await screenshot(page, 'surface2d-touch-pen');
+
+    // A two-finger pinch zooms in about the fingers.
+    const mmPerPx = async () => Number(await page.getAttribute('[data-testid=map2d]', 'data-mm-per-px'));
+    const pinchFrom = await mmPerPx();
+    const [cx, cy] = [Math.round(box.x + box.width / 2), Math.round(box.y + box.height / 2)];
+    const fingers = (d) => [{ x: cx - d, y: cy, id: 1 }, { x: cx + d, y: cy, id: 2 }];
+    await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: fingers(20) });
+    for (let d = 30; d <= 100; d += 10) await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: fingers(d) });
+    await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+    assert.ok((await mmPerPx()) < 0.4 * pinchFrom, `pinch: ${pinchFrom} → ${await mmPerPx()} mm per px`);
 
     // axe-core: no critical or serious finding on the 2-D page.
     await page.addScriptTag({ content: axeSource });
