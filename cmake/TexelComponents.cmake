@@ -32,7 +32,7 @@ texel_component_requires(TEXEL_WITH_PLAYER "swipe spectra, the serial display pr
 texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading" TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
 texel_component_requires(TEXEL_WITH_EXPERIMENTS "trials encode, play and plot textures"
                          TEXEL_WITH_CODEC TEXEL_WITH_PLAYER TEXEL_WITH_PLOT)
-texel_component_requires(TEXEL_WITH_STUDIO "the studio runs experiments" TEXEL_WITH_EXPERIMENTS)
+texel_component_requires(TEXEL_WITH_STUDIO "the studio runs experiments and shows 2-D surfaces" TEXEL_WITH_EXPERIMENTS TEXEL_WITH_SURFACE2D)
 texel_component_requires(TEXEL_WITH_CAPI "the C ABI encodes and plays" TEXEL_WITH_CODEC TEXEL_WITH_PLAYER)
 
 # The CLI, the tests and the benchmarks use every component.

@@ -64,6 +64,7 @@ void on_feel_state(State& s, Client& c, const Job& job) {
 }
 
 void lift_finger(State& s, std::uint64_t client) {
+  lift_finger_2d(s, client);
   std::lock_guard lock(s.feel_mutex);
   if (s.finger_client == client && s.finger_down) {
     (void)s.presenter->push_finger(s.finger_x, false);

@@ -14,7 +14,7 @@ namespace texel::studio::detail {
 namespace {
 
 // The order is the one error messages list ("unknown message type …; allowed: …").
-const std::array<MessageSpec, 22> table{{
+const std::array<MessageSpec, 27> table{{
     {"hello", Lane::now, {}, on_hello},
     {"design", Lane::design, {"document", "region", "bins"}, on_design},
     {"match", Lane::fifo, {"document", "region", "into"}, on_match},
@@ -37,6 +37,14 @@ const std::array<MessageSpec, 22> table{{
     {"experiment.validate", Lane::fifo, {"protocol"}, on_experiment_validate},
     {"experiment.suspend", Lane::fifo, {}, on_experiment_suspend},
     {"experiment.resume", Lane::fifo, {}, on_experiment_resume},
+    {"surface2d.view",
+     Lane::design,
+     {"document", "images", "x_px", "y_px", "width_px", "height_px", "stride"},
+     on_surface2d_view},
+    {"surface2d.scan", Lane::design, {"document", "images", "region", "angle_deg"}, on_surface2d_scan},
+    {"feel2d.select", Lane::design, {"document", "images", "mode", "region"}, on_feel2d_select},
+    {"feel2d.move", Lane::now, {"seq", "x_mm", "y_mm", "touch"}, on_feel2d_move},
+    {"feel2d.state", Lane::now, {}, on_feel2d_state},
 }};
 
 std::string num(double v) {

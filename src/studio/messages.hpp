@@ -6,7 +6,8 @@
 // and tests/studio checks it against the JSON Schema the front end's message
 // types are generated from. Handlers live in files by concern:
 // handlers_design.cpp (hello, design), handlers_codec.cpp (match, import,
-// export), handlers_feel.cpp (feel.*), handlers_experiment.cpp (experiment.*).
+// export), handlers_feel.cpp (feel.*), handlers_experiment.cpp (experiment.*),
+// handlers_surface2d.cpp (surface2d.*, feel2d.*).
 #pragma once
 
 #include <chrono>
@@ -97,6 +98,9 @@ struct Client {
   bool participant_screen = false;  // asked experiment.current with screen: true (its hand-outs start trial clocks)
 };
 
+struct Surface2DState;  // handlers_surface2d.cpp: the prepared 2-D surface and the 2-D pad's player
+std::shared_ptr<Surface2DState> make_surface2d_state();
+
 /// What the handlers share: the options, the display (one Presenter behind
 /// feel_mutex) and the experiment session (touched by the FIFO worker only).
 struct State {
@@ -109,6 +113,8 @@ struct State {
   double finger_x = 0.0;
   bool finger_down = false;
   std::vector<FingerSample> trace;  // finger samples of the current trial (swipe measures)
+
+  std::shared_ptr<Surface2DState> surface2d = make_surface2d_state();  // its own mutexes
 
   std::optional<experiment::Store> store;
   std::optional<experiment::ActiveSession> active;
@@ -139,6 +145,8 @@ std::string hex(std::span<const std::byte> bytes);
 ojson make_hello(const State& s);
 /// Lifts the finger if `client` was the one touching.
 void lift_finger(State& s, std::uint64_t client);
+/// The same for the 2-D pad's player.
+void lift_finger_2d(State& s, std::uint64_t client);
 
 // -------------------------------------------------------------------- table
 /// When a message is handled: before handle() returns; on the design lane
@@ -184,5 +192,10 @@ void on_experiment_protocol(State&, Client&, const Job&);
 void on_experiment_validate(State&, Client&, const Job&);
 void on_experiment_suspend(State&, Client&, const Job&);
 void on_experiment_resume(State&, Client&, const Job&);
+void on_surface2d_view(State&, Client&, const Job&);
+void on_surface2d_scan(State&, Client&, const Job&);
+void on_feel2d_select(State&, Client&, const Job&);
+void on_feel2d_move(State&, Client&, const Job&);
+void on_feel2d_state(State&, Client&, const Job&);
 
 }  // namespace texel::studio::detail

@@ -6,11 +6,13 @@ import { studio } from './ws';
 import { mountDesigner } from './designer';
 import { mountExperimenter } from './experimenter';
 import { mountParticipant } from './participant';
+import { mountSurface2d } from './surface2d';
 
 const routes: Record<string, (root: HTMLElement) => void> = {
   designer: mountDesigner,
   experimenter: mountExperimenter,
   participant: mountParticipant,
+  surface: mountSurface2d,
 };
 
 function route(): void {

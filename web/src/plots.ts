@@ -230,7 +230,8 @@ export class HistogramPlot {
   }
 }
 
-function interpLog(xs: number[], ys: number[], x: number): number | null {
+/** ys at x, interpolated linearly in log x between the points of ascending xs; null outside them. */
+export function interpLog(xs: number[], ys: number[], x: number): number | null {
   if (!xs.length || x < xs[0] || x > xs[xs.length - 1]) return null;
   let lo = 0;
   let hi = xs.length - 1;

@@ -33,5 +33,7 @@ test('the feel worker and the audio worklet are modules of their own', () => {
   const names = scripts(prod).map(({ f }) => f);
   assert.ok(names.some((f) => f.startsWith('feel-worker-')), names.join(', '));
   assert.ok(names.some((f) => f.startsWith('audio-worklet-')), names.join(', '));
-  for (const { f, text } of scripts(prod)) assert.ok(!text.includes('registerProcessor') || f.startsWith('audio-worklet-'), f);
+  assert.ok(names.some((f) => f.startsWith('audio2d-worklet-')), names.join(', '));
+  for (const { f, text } of scripts(prod))
+    assert.ok(!text.includes('registerProcessor') || f.startsWith('audio-worklet-') || f.startsWith('audio2d-worklet-'), f);
 });

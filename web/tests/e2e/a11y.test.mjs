@@ -63,6 +63,10 @@ test('axe-core: no critical or serious finding on any page', { timeout: 600_000 
     await page.waitForFunction(() => window.__texelStats && window.__texelStats.designsDrawn >= 1, null, { timeout: 30_000 });
     await audited(page, 'designer');
 
+    await page.goto(`${studio.url}#/surface`);
+    await page.waitForFunction(() => window.__texel2d && window.__texel2d.viewsDrawn >= 1, null, { timeout: 60_000 });
+    await audited(page, 'surface2d');
+
     await page.goto(`${studio.url}#/experimenter`);
     await page.waitForSelector('.page-experimenter[data-ready=true]');
     await audited(page, 'experimenter-idle');

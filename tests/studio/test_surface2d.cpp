@@ -1,0 +1,256 @@
+// The 2-D page's messages through the Service (docs/studio.md "The 2-D
+// page"): surface2d.view renders exactly the bitmap's pixels at any stride,
+// surface2d.scan gives a scan spectrum beside the 1-D texture's, the 2-D pad's
+// finger samples reach the Player2D in both modes, coarse images come only as
+// bytes sent along, and every bad input gets a one-line error.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "../support/service_client.hpp"
+#include "../support/temp_dir.hpp"
+#include "base64.hpp"
+#include "texel/bitmap_file.hpp"
+#include "texel/document.hpp"
+#include "texel/studio/service.hpp"
+#include "texel/studio/surface2d_view.hpp"
+#include "texel/surface2d.hpp"
+
+using json = nlohmann::json;
+using namespace std::chrono_literals;
+using texel::studio::Service;
+using texel::studio::ServiceOptions;
+using texel::test_support::Client;
+
+namespace {
+
+json surface_document(
+    const json& coarse =
+        json{{"kind", "disc"}, {"x_mm", 20}, {"y_mm", 15}, {"radius_mm", 8}, {"edge_mm", 1}, {"inside", 1}, {"outside", 0.2}},
+    const std::string& field = "spectral") {
+  const json device = {{"name", "pad-2d"},
+                       {"samples", 400},
+                       {"spacing_mm", 0.1},
+                       {"format", "f32le"},
+                       {"refresh_hz", 6250},
+                       {"band_min_cpm", 0.01},
+                       {"band_max_cpm", 0},
+                       {"layout", json::array()},
+                       {"bitmap",
+                        {{"width_px", 400},
+                         {"height_px", 300},
+                         {"pixel_pitch_mm", 0.1},
+                         {"depth_bits", 8},
+                         {"polarity", "darker_more_friction"}}}};
+  return json{{"format", "texel-document"},
+              {"version", 4},
+              {"device", device},
+              {"surface2d",
+               {{"regions",
+                 {{{"name", "pad"},
+                   {"field", field},
+                   {"texture",
+                    {{"kind", "texel"},
+                     {"central_pitch_db", 0},
+                     {"irregularity_db", -5},
+                     {"texel_length_mm", 1},
+                     {"seed", 3},
+                     {"coarse_strength", 0.8},
+                     {"fine_strength", 0.6}}},
+                   {"coarse2d", coarse}}}}}}};
+}
+
+void expect_error(const json& r, const std::string& code, const std::string& names = "") {
+  EXPECT_EQ(r.value("type", ""), "error") << r.dump();
+  EXPECT_EQ(r.value("code", ""), code) << r.dump();
+  EXPECT_EQ(r.value("message", "").find('\n'), std::string::npos);
+  if (!names.empty()) {
+    EXPECT_NE(r.value("message", "").find(names), std::string::npos) << r.dump();
+  }
+}
+
+std::vector<unsigned char> bytes_of(const json& r) {
+  return texel::studio::detail::base64_decode(r["amplitude_u8"].get<std::string>()).value();
+}
+
+}  // namespace
+
+TEST(Surface2DStudio, ViewIsTheBitmapAtAnyStride) {
+  Service s(ServiceOptions{});
+  Client c(s);
+  const json doc = surface_document();
+  const json full = c.ask({{"type", "surface2d.view"},
+                           {"document", doc},
+                           {"x_px", 0},
+                           {"y_px", 0},
+                           {"width_px", 400},
+                           {"height_px", 300},
+                           {"stride", 1}});
+  ASSERT_EQ(full["type"], "surface2d.view") << full.dump().substr(0, 300);
+  EXPECT_EQ(full["columns"], 400);
+  EXPECT_EQ(full["rows"], 300);
+  EXPECT_DOUBLE_EQ(full["surface"]["pixel_pitch_mm"].get<double>(), 0.1);
+  const auto all = bytes_of(full);
+  ASSERT_EQ(all.size(), 400u * 300u);
+  // The library's own bitmap of the document, pixel for pixel.
+  const texel::Document d = texel::parse_document(doc.dump(), "doc");
+  const texel::Raster2D raster = texel::render_raster(texel::prepare_surface2d(d));
+  int differ = 0;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    differ += std::abs(static_cast<int>(all[i]) - static_cast<int>(std::lround(raster.values[i] * 255.0))) > 1;
+  EXPECT_EQ(differ, 0);
+  // A window at stride 3 holds every third pixel of it; the reply says its clipped size.
+  const json part = c.ask({{"type", "surface2d.view"},
+                           {"document", doc},
+                           {"x_px", 100},
+                           {"y_px", 50},
+                           {"width_px", 1000},
+                           {"height_px", 90},
+                           {"stride", 3}});
+  ASSERT_EQ(part["type"], "surface2d.view");
+  EXPECT_EQ(part["width_px"], 300);
+  EXPECT_EQ(part["columns"], 100);
+  EXPECT_EQ(part["rows"], 30);
+  EXPECT_NEAR(part["view_pitch_mm"].get<double>(), 0.3, 1e-12);
+  const auto some = bytes_of(part);
+  differ = 0;
+  for (int v = 0; v < 30; ++v)
+    for (int u = 0; u < 100; ++u)
+      differ += std::abs(static_cast<int>(some[static_cast<std::size_t>(v * 100 + u)]) -
+                         static_cast<int>(all[static_cast<std::size_t>((50 + 3 * v) * 400 + 100 + 3 * u)])) > 1;
+  EXPECT_EQ(differ, 0);
+}
+
+TEST(Surface2DStudio, BadInputsGetOneLineErrors) {
+  Service s(ServiceOptions{});
+  Client c(s);
+  const json doc = surface_document();
+  auto view = [&](json extra) {
+    json m = {{"type", "surface2d.view"}, {"document", doc}, {"x_px", 0},  {"y_px", 0},
+              {"width_px", 10},           {"height_px", 10}, {"stride", 1}};
+    for (auto& [k, v] : extra.items()) m[k] = v;
+    return c.ask(m);
+  };
+  expect_error(view({{"x_px", 400}}), "invalid", "x_px");
+  expect_error(view({{"stride", 0}}), "invalid", "stride");
+  expect_error(c.ask({{"type", "surface2d.view"},
+                      {"document", doc},
+                      {"x_px", 0},
+                      {"y_px", 0},
+                      {"width_px", 65535},
+                      {"height_px", 65535},
+                      {"stride", 1},
+                      {"zoom", 2}}),
+               "bad_message", "zoom");
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", doc}, {"angle_deg", 400}}), "invalid", "angle_deg");
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", doc}, {"angle_deg", 0}, {"region", 3}}), "invalid", "region");
+  json one_d = {
+      {"format", "texel-document"},
+      {"version", 1},
+      {"device", "tpad"},
+      {"texture", {{"kind", "texel"}, {"central_pitch_db", 0}, {"irregularity_db", -5}, {"texel_length_mm", 1}, {"seed", 1}}}};
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", one_d}, {"angle_deg", 0}}), "invalid", "2-D document");
+  expect_error(c.ask({{"type", "feel2d.select"}, {"document", doc}, {"mode", "hover"}}), "invalid", "mode");
+  json odd = doc;
+  odd["surface2d"]["regions"][0] = 7;
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", odd}, {"angle_deg", 0}}), "invalid", "regions[0]");
+  odd["surface2d"] = "flat";
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", odd}, {"angle_deg", 0}}), "invalid", "surface2d");
+  expect_error(c.ask({{"type", "feel2d.move"}, {"seq", 1}, {"x_mm", 1}}), "bad_message", "y_mm");
+  // Image profiles: only bytes sent along, never a file of the server's.
+  expect_error(c.ask({{"type", "surface2d.scan"},
+                      {"document", surface_document({{"kind", "image"}, {"path", "/etc/passwd.png"}})},
+                      {"angle_deg", 0}}),
+               "invalid", "coarse2d.path");
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", doc}, {"angle_deg", 0}, {"images", {{"../x.png", "AAAA"}}}}),
+               "invalid", "images key");
+  expect_error(c.ask({{"type", "surface2d.scan"}, {"document", doc}, {"angle_deg", 0}, {"images", {{"x.png", "AAAA"}}}}),
+               "invalid", "not a PNG");
+}
+
+TEST(Surface2DStudio, ImagesSentAlongBecomeTheCoarseProfile) {
+  texel::test_support::TempDir dir("studio2d");
+  // A 4 × 2 grey PNG through the library's own writer: a half-white, half-black image.
+  const json black_white =
+      surface_document({{"kind", "edge"}, {"x_mm", 20}, {"y_mm", 0}, {"angle_deg", 0}, {"width_mm", 0}, {"low", 0}, {"high", 1}});
+  json small = black_white;
+  small["device"]["bitmap"]["width_px"] = 4;
+  small["device"]["bitmap"]["height_px"] = 2;
+  small["device"]["bitmap"]["pixel_pitch_mm"] = 10.0;
+  small["surface2d"]["regions"][0]["texture"]["coarse_strength"] = 1;
+  small["surface2d"]["regions"][0]["texture"]["fine_strength"] = 0;
+  small["surface2d"]["regions"][0]["texture"]["central_pitch_db"] = -18;  // inside the 10 mm grid's band
+  small["surface2d"]["regions"][0]["texture"]["irregularity_db"] = -30;
+  const texel::Document d = texel::parse_document(small.dump(), "small");
+  const std::string png = dir.at("edge.png");
+  texel::BitmapFileOptions o;
+  texel::write_bitmap(png, texel::prepare_surface2d(d), o);
+  std::ifstream in(png, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Service s(ServiceOptions{});
+  Client c(s);
+  json doc = surface_document({{"kind", "image"}, {"path", "edge.png"}});
+  doc["surface2d"]["regions"][0]["texture"]["fine_strength"] = 0;
+  doc["surface2d"]["regions"][0]["texture"]["coarse_strength"] = 1;
+  const json r = c.ask({{"type", "surface2d.view"},
+                        {"document", doc},
+                        {"images", {{"edge.png", texel::studio::detail::base64_encode(bytes)}}},
+                        {"x_px", 0},
+                        {"y_px", 150},
+                        {"width_px", 400},
+                        {"height_px", 1},
+                        {"stride", 1}});
+  ASSERT_EQ(r["type"], "surface2d.view") << r.dump().substr(0, 400);
+  const auto row = bytes_of(r);
+  // The image stretches over the region: dark on the left, bright on the right (polarity aside).
+  EXPECT_NE(static_cast<int>(row[10]), static_cast<int>(row[390]));
+}
+
+TEST(Surface2DStudio, ScanAlongADirectionBesideTheTarget) {
+  Service s(ServiceOptions{});
+  Client c(s);
+  const json r = c.ask(
+      {{"type", "surface2d.scan"}, {"document", surface_document(json{{"kind", "constant"}, {"value", 1}})}, {"angle_deg", 30}});
+  ASSERT_EQ(r["type"], "surface2d.scan") << r.dump().substr(0, 300);
+  EXPECT_GT(r["samples"].get<int>(), 200);
+  EXPECT_EQ(r["scan"]["frequency_cpm"].size(), r["scan"]["magnitude_db"].size());
+  EXPECT_GT(r["target"]["frequency_cpm"].size(), 10u);
+  const double dx = r["to_mm"][0].get<double>() - r["from_mm"][0].get<double>();
+  const double dy = r["to_mm"][1].get<double>() - r["from_mm"][1].get<double>();
+  EXPECT_NEAR(std::atan2(dy, dx) * 180.0 / 3.141592653589793, 30.0, 1e-6);
+}
+
+TEST(Surface2DStudio, PadSamplesReachThe2DPlayerInBothModes) {
+  Service s(ServiceOptions{});
+  Client c(s);
+  expect_error(c.ask({{"type", "feel2d.move"}, {"seq", 1}, {"x_mm", 10}, {"y_mm", 10}}), "invalid", "feel2d.select");
+  for (const std::string mode : {"path", "bitmap"}) {
+    const json sel = c.ask({{"type", "feel2d.select"}, {"document", surface_document()}, {"mode", mode}});
+    ASSERT_EQ(sel["type"], "feel2d.selected") << sel.dump();
+    EXPECT_EQ(sel["mode"], mode);
+    c.ask({{"type", "feel2d.state"}});  // resets the peak
+    for (int i = 0; i < 80; ++i) {
+      const json a =
+          c.ask({{"type", "feel2d.move"}, {"seq", i}, {"x_mm", 5.0 + 0.3 * i}, {"y_mm", 5.0 + 0.2 * i}, {"touch", true}});
+      ASSERT_EQ(a["type"], "feel2d.ack") << a.dump();
+      std::this_thread::sleep_for(1ms);
+    }
+    std::this_thread::sleep_for(40ms);
+    const json st = c.ask({{"type", "feel2d.state"}});
+    EXPECT_EQ(st["mode"], mode);
+    EXPECT_GE(st["samples"].get<int>(), 80);
+    EXPECT_GT(st["blocks"].get<int>(), 0);
+    EXPECT_GT(st["peak"].get<double>(), 0.0) << mode;
+    EXPECT_TRUE(st["touching"].get<bool>());
+  }
+  // Leaving lifts the finger.
+  s.disconnect(c.id);
+  Client d(s);
+  std::this_thread::sleep_for(60ms);
+  EXPECT_FALSE(d.ask({{"type", "feel2d.state"}})["touching"].get<bool>());
+}
