@@ -314,16 +314,16 @@ std::unique_ptr<const PlayerMap2D> map_2d() {
 
 /// process() of 16- or 64-frame blocks in a loop on this thread, no JACK:
 /// the finger advancing as in the paced runs (one sample per 48 frames). Per
-/// block: warm (back to back) and cold (a buffer larger than the caches
-/// written between blocks, as other processes do between two periods).
+/// block: warm (back to back) and cold (an 8 MB buffer written between
+/// blocks, as other processes do between two periods).
 /// Returns {p50 warm, p99.9 warm, p50 cold, p99.9 cold} in µs.
 std::array<double, 4> block_costs(PlayerBase& player, const std::function<void(double, double)>& push, std::size_t block) {
-  constexpr std::size_t blocks = 6000;
+  constexpr std::size_t blocks = 2000;
   std::vector<float> out(block), pos(block);
   std::vector<double> warm, cold;
   warm.reserve(blocks);
   cold.reserve(blocks);
-  std::vector<unsigned char> evict(std::size_t{64} << 20);
+  std::vector<unsigned char> evict(std::size_t{8} << 20);  // over a core's L2, part of the shared L3
   std::size_t frames = 0, k = 0;
   for (std::size_t b = 0; b < 2 * blocks; ++b) {
     const bool is_cold = b >= blocks;

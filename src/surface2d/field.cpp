@@ -25,6 +25,10 @@ constexpr std::uint64_t stream_direction = static_cast<std::uint64_t>(Stream::us
 constexpr std::uint64_t stream_cell_phase = static_cast<std::uint64_t>(Stream::user) + 2;
 constexpr std::uint64_t stream_spectral = static_cast<std::uint64_t>(Stream::user) + 3;
 
+/// std::floor, inline: floor_exact where it is exact (|v| < 2^51), the
+/// library's beyond (a call per pixel otherwise: the baseline has no roundsd).
+double cell_floor(double v) { return std::fabs(v) < 0x1p51 ? detmath::floor_exact(v) : std::floor(v); }
+
 std::uint64_t cell_index(std::int64_t m, std::int64_t n) {
   const auto um = static_cast<std::uint64_t>(m + cell_bias) & cell_mask;
   const auto un = static_cast<std::uint64_t>(n + cell_bias) & cell_mask;
@@ -362,9 +366,7 @@ void FineField2D::block(std::int64_t first, std::size_t count, double pitch, dou
     // the pixel rows that cross it (frequencies a run at a time).
     if (count == 0) return;
     const double L = spec_.texel_length.value();
-    const auto cell_of = [&](double v) {
-      return static_cast<std::int64_t>(std::floor((v + TexelTexture::boundary_tolerance_mm) / L));
-    };
+    const auto cell_of = [&](double v) { return static_cast<std::int64_t>(cell_floor((v + TexelTexture::boundary_tolerance_mm) / L)); };
     const std::int64_t m_lo = cell_of(static_cast<double>(first) * pitch - origin_x);
     const std::int64_t m_hi = cell_of(static_cast<double>(first + static_cast<std::int64_t>(count) - 1) * pitch - origin_x);
     const auto cells = static_cast<std::size_t>(m_hi - m_lo + 1);
@@ -451,7 +453,7 @@ void FineField2D::row(std::int64_t first, double pitch, double origin_x, double 
   bool have = false;
   for (std::size_t k = 0; k < out.size(); ++k) {
     const double x = static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x;
-    const auto m = static_cast<std::int64_t>(std::floor((x + TexelTexture::boundary_tolerance_mm) / L));
+    const auto m = static_cast<std::int64_t>(cell_floor((x + TexelTexture::boundary_tolerance_mm) / L));
     if (!have || m != last_m) {
       c = cell(m, n);
       last_m = m;
