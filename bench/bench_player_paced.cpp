@@ -309,7 +309,6 @@ std::unique_ptr<const PlayerMap2D> map_2d() {
   return PlayerMap2D::path_indexed(spec, Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, {}}, disc, std::nullopt);
 }
 
-
 // ------------------------------------------------------- where the tail is
 
 /// process() of 16- or 64-frame blocks in a loop on this thread, no JACK:
@@ -346,12 +345,23 @@ std::array<double, 4> block_costs(PlayerBase& player, const std::function<void(d
 }
 
 void print_block_costs() {
-  std::printf("block cost without JACK (µs; period 333 µs at 16 frames, 1333 µs at 64): warm p50 / p99.9, caches evicted p50 / p99.9\n");
+  std::printf(
+      "block cost without JACK (µs; period 333 µs at 16 frames, 1333 µs at 64): warm p50 / p99.9, caches evicted p50 / p99.9\n");
   for (std::size_t block : {std::size_t{16}, std::size_t{64}}) {
     Player p1(live_config(), map_1d());
-    const auto one = block_costs(p1, [&](double t, double x) { p1.push({t, x, true}); }, block);
+    const auto one = block_costs(
+        p1,
+        [&](double t, double x) {
+          p1.push({t, x, true});
+        },
+        block);
     Player2D p2(live_config(), map_2d());
-    const auto two = block_costs(p2, [&](double t, double x) { p2.push({t, x, 0.3 * x, true}); }, block);
+    const auto two = block_costs(
+        p2,
+        [&](double t, double x) {
+          p2.push({t, x, 0.3 * x, true});
+        },
+        block);
     std::printf("  %2zu frames: 1-D %.2f / %.2f, cold %.2f / %.2f; 2-D %.2f / %.2f, cold %.2f / %.2f\n", block, one[0], one[1],
                 one[2], one[3], two[0], two[1], two[2], two[3]);
   }

@@ -145,8 +145,9 @@ int main(int argc, char** argv) {
       off_p = std::max(off_p, std::fabs(r.mean_p - r.matched_p));
       off_i = std::max(off_i, std::fabs(r.mean_i - r.matched_i));
     }
-  std::printf("spectral field against the stationary bound (goal within 0.5 dB): worst |P - bound| %.2f dB, |I - bound| %.2f dB\n",
-              off_p, off_i);
+  std::printf(
+      "spectral field against the stationary bound (goal within 0.5 dB): worst |P - bound| %.2f dB, |I - bound| %.2f dB\n", off_p,
+      off_i);
   if (!csv.empty()) {
     std::ofstream out(csv);
     out << "central_pitch_db,irregularity_db,texel_length_mm,design,line_p_db,line_i_db,mean_p_db,mean_i_db,spread_p_db,"

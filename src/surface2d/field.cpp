@@ -35,6 +35,19 @@ std::uint64_t cell_index(std::int64_t m, std::int64_t n) {
   return (un << 24) | um;
 }
 
+// The widest of a kernel's builds this CPU runs (detail::simd_lanes); the
+// AVX ones exist on x86 only.
+#if defined(__x86_64__) || defined(__i386__)
+#define TEXEL_LANE_KERNELS(name) &name##_avx512, &name##_avx2, &name##_generic
+#else
+#define TEXEL_LANE_KERNELS(name) nullptr, nullptr, &name##_generic
+#endif
+template <class Kernel>
+Kernel widest(Kernel lanes8, Kernel lanes4, Kernel lanes2) {
+  if (lanes8 && detail::simd_lanes() == 8) return lanes8;
+  if (lanes4 && detail::simd_lanes() == 4) return lanes4;
+  return lanes2;
+}
 
 // The spectral field's pixels, sum over c of sin(2π(u_c + v_c)) =
 // sin 2πu·cos 2πv + cos 2πu·sin 2πv with u_c = fx_c·x, summed in component
@@ -56,8 +69,8 @@ constexpr std::size_t max_components = FineField2D::spectral_components;
 
 template <int W, int R>
 [[gnu::always_inline]] inline void spectral_rows(const SpectralBlock& b, const typename detail::Lanes<W>::type (*sx)[2],
-                                                  const typename detail::Lanes<W>::type (*cx)[2], std::size_t r0, double* out,
-                                                  std::size_t stride, std::size_t live) {
+                                                 const typename detail::Lanes<W>::type (*cx)[2], std::size_t r0, double* out,
+                                                 std::size_t stride, std::size_t live) {
   using V = typename detail::Lanes<W>::type;
   const std::size_t n = b.components;
   const double* sy = b.sy + r0 * n;
@@ -128,18 +141,10 @@ void spectral_generic(const SpectralBlock& b, std::int64_t first, std::size_t co
   spectral_lanes<2>(b, first, count, out, stride);
 }
 
-/// The widest kernel this CPU runs (detail::simd_lanes), chosen once.
 SpectralKernel spectral_kernel() {
-  static const SpectralKernel kernel = [] {
-#if defined(__x86_64__) || defined(__i386__)
-    if (detail::simd_lanes() == 8) return &spectral_avx512;
-    if (detail::simd_lanes() == 4) return &spectral_avx2;
-#endif
-    return &spectral_generic;
-  }();
+  static const SpectralKernel kernel = widest<SpectralKernel>(TEXEL_LANE_KERNELS(spectral));
   return kernel;
 }
-
 
 // value() at W points at once (the spectral design): every lane does value()'s
 // operations in its order, so the results are value()'s bits.
@@ -180,8 +185,8 @@ __attribute__((target("avx512f"))) void spectral_points_avx512(const SpectralPoi
                                                                double* out, std::size_t n) {
   spectral_points_lanes<8>(k, xs, ys, out, n);
 }
-__attribute__((target("avx2"))) void spectral_points_avx2(const SpectralPoints& k, const double* xs, const double* ys, double* out,
-                                                          std::size_t n) {
+__attribute__((target("avx2"))) void spectral_points_avx2(const SpectralPoints& k, const double* xs, const double* ys,
+                                                          double* out, std::size_t n) {
   spectral_points_lanes<4>(k, xs, ys, out, n);
 }
 #endif
@@ -190,16 +195,9 @@ void spectral_points_generic(const SpectralPoints& k, const double* xs, const do
 }
 
 PointsKernel points_kernel() {
-  static const PointsKernel kernel = [] {
-#if defined(__x86_64__) || defined(__i386__)
-    if (detail::simd_lanes() == 8) return &spectral_points_avx512;
-    if (detail::simd_lanes() == 4) return &spectral_points_avx2;
-#endif
-    return &spectral_points_generic;
-  }();
+  static const PointsKernel kernel = widest<PointsKernel>(TEXEL_LANE_KERNELS(spectral_points));
   return kernel;
 }
-
 
 // sin_cycles in place, a vector at a time (sin_cycles_generic's lanes: the
 // scalar bits).
@@ -222,13 +220,7 @@ __attribute__((target("avx2"))) void sines_avx2(double* v, std::size_t n) { sine
 #endif
 void sines_generic(double* v, std::size_t n) { sines_lanes<2>(v, n); }
 void sines(std::span<double> v) {
-  static const SinesKernel kernel = [] {
-#if defined(__x86_64__) || defined(__i386__)
-    if (detail::simd_lanes() == 8) return &sines_avx512;
-    if (detail::simd_lanes() == 4) return &sines_avx2;
-#endif
-    return &sines_generic;
-  }();
+  static const SinesKernel kernel = widest<SinesKernel>(TEXEL_LANE_KERNELS(sines));
   kernel(v.data(), v.size());
 }
 
@@ -366,7 +358,9 @@ void FineField2D::block(std::int64_t first, std::size_t count, double pitch, dou
     // the pixel rows that cross it (frequencies a run at a time).
     if (count == 0) return;
     const double L = spec_.texel_length.value();
-    const auto cell_of = [&](double v) { return static_cast<std::int64_t>(cell_floor((v + TexelTexture::boundary_tolerance_mm) / L)); };
+    const auto cell_of = [&](double v) {
+      return static_cast<std::int64_t>(cell_floor((v + TexelTexture::boundary_tolerance_mm) / L));
+    };
     const std::int64_t m_lo = cell_of(static_cast<double>(first) * pitch - origin_x);
     const std::int64_t m_hi = cell_of(static_cast<double>(first + static_cast<std::int64_t>(count) - 1) * pitch - origin_x);
     const auto cells = static_cast<std::size_t>(m_hi - m_lo + 1);
