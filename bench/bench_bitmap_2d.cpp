@@ -1,5 +1,5 @@
-// texel_bench_bitmap_2d: an 8192 × 8192 16-bit friction bitmap (PNG, the
-// default cells field) written in strips, against `dd conv=fsync` writing
+// texel_bench_bitmap_2d: an 8192 × 8192 16-bit friction bitmap (PNG; the
+// default spectral field, or cells) written in strips, against `dd conv=fsync` writing
 // the same number of bytes to the same directory, in the same run; peak
 // memory (VmHWM) of the render. Goal (issue #26): ratio ≤ 4, peak ≤ 64 MB.
 //

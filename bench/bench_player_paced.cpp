@@ -15,7 +15,9 @@
 // then the null backend (texel play --backend null) under the same loads:
 // underruns in 5 s, worst block, and the scheduling its paced thread got.
 //
-// Usage: texel_bench_player_paced [--seconds S] [--json FILE]
+// Usage: texel_bench_player_paced [--seconds S] [--json FILE] [--costs]
+// (--costs: only the block costs without JACK, warm and with the caches
+// evicted between blocks, which tell whether the tail is the work's own)
 // Needs jackd (Debian jackd2) and stress-ng on PATH; a missing tool is
 // reported and its part skipped (exit 0), never faked.
 #include <fcntl.h>
@@ -30,12 +32,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -305,6 +309,64 @@ std::unique_ptr<const PlayerMap2D> map_2d() {
   return PlayerMap2D::path_indexed(spec, Sampling{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, {}}, disc, std::nullopt);
 }
 
+// ------------------------------------------------------- where the tail is
+
+/// process() of 16- or 64-frame blocks in a loop on this thread, no JACK:
+/// the finger advancing as in the paced runs (one sample per 48 frames). Per
+/// block: warm (back to back) and cold (an 8 MB buffer written between
+/// blocks, as other processes do between two periods).
+/// Returns {p50 warm, p99.9 warm, p50 cold, p99.9 cold} in µs.
+std::array<double, 4> block_costs(PlayerBase& player, const std::function<void(double, double)>& push, std::size_t block) {
+  constexpr std::size_t blocks = 2000;
+  std::vector<float> out(block), pos(block);
+  std::vector<double> warm, cold;
+  warm.reserve(blocks);
+  cold.reserve(blocks);
+  std::vector<unsigned char> evict(std::size_t{8} << 20);  // over a core's L2, part of the shared L3
+  std::size_t frames = 0, k = 0;
+  for (std::size_t b = 0; b < 2 * blocks; ++b) {
+    const bool is_cold = b >= blocks;
+    if (is_cold)
+      for (std::size_t i = 0; i < evict.size(); i += 64) evict[i] = static_cast<unsigned char>(evict[i] + 1);
+    while (frames >= 48 * k) push(static_cast<double>(48 * k) / rate, 1.0 + step_mm * static_cast<double>(k)), ++k;
+    timespec a{}, c{};
+    ::clock_gettime(CLOCK_MONOTONIC, &a);
+    player.process(std::span(out), std::span(pos));
+    ::clock_gettime(CLOCK_MONOTONIC, &c);
+    frames += block;
+    const double us = 1e6 * static_cast<double>(c.tv_sec - a.tv_sec) + 1e-3 * static_cast<double>(c.tv_nsec - a.tv_nsec);
+    (is_cold ? cold : warm).push_back(us);
+  }
+  const auto q = [](std::vector<double>& v, double f) {
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, static_cast<std::size_t>(f * static_cast<double>(v.size())))];
+  };
+  return {q(warm, 0.5), q(warm, 0.999), q(cold, 0.5), q(cold, 0.999)};
+}
+
+void print_block_costs() {
+  std::printf(
+      "block cost without JACK (µs; period 333 µs at 16 frames, 1333 µs at 64): warm p50 / p99.9, caches evicted p50 / p99.9\n");
+  for (std::size_t block : {std::size_t{16}, std::size_t{64}}) {
+    Player p1(live_config(), map_1d());
+    const auto one = block_costs(
+        p1,
+        [&](double t, double x) {
+          p1.push({t, x, true});
+        },
+        block);
+    Player2D p2(live_config(), map_2d());
+    const auto two = block_costs(
+        p2,
+        [&](double t, double x) {
+          p2.push({t, x, 0.3 * x, true});
+        },
+        block);
+    std::printf("  %2zu frames: 1-D %.2f / %.2f, cold %.2f / %.2f; 2-D %.2f / %.2f, cold %.2f / %.2f\n", block, one[0], one[1],
+                one[2], one[3], two[0], two[1], two[2], two[3]);
+  }
+}
+
 std::vector<Result> jack_runs(const std::string& load, std::size_t block, double seconds) {
   std::vector<Result> out;
   const std::string server = "texel-bench-" + std::to_string(::getpid());
@@ -369,13 +431,18 @@ NullResult null_run(const std::string& load) {
 int main(int argc, char** argv) {
   double seconds = 10.0;
   std::string json;
+  bool costs_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--json" && i + 1 < argc)
       json = argv[++i];
+    else if (a == "--costs")
+      costs_only = true;
     else if (a == "--seconds" && i + 1 < argc)
       seconds = std::atof(argv[++i]);
   }
+  print_block_costs();
+  if (costs_only) return 0;
   const bool have_jack = on_path("jackd"), have_stress = on_path("stress-ng");
   if (!have_jack) std::fprintf(stderr, "jackd not found (Debian jackd2): JACK runs skipped\n");
   if (!have_stress) std::fprintf(stderr, "stress-ng not found: busy runs skipped\n");

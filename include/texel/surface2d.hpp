@@ -40,6 +40,9 @@ class FineField2D {
   /// out[k] = value((first + k)·pitch − origin_x, y): a run of a raster row
   /// whose pixel i sits at i·pitch, in texture coordinates.
   void row(std::int64_t first, double pitch_mm, double origin_x_mm, double y_mm, std::span<double> out) const;
+  /// out[i] = value(xs[i], ys[i]), the spectral design several points at a
+  /// time (the same bits as value()). Throws InvalidArgument if the sizes differ.
+  void values(std::span<const double> xs, std::span<const double> ys, std::span<double> out) const;
   /// A block of rows: out[r·stride + k] = value((first + k)·pitch − origin_x,
   /// ys[r]), the same values row() gives, computed a tile at a time
   /// (the spectral design's plane waves split into x and y factors once per

@@ -185,7 +185,11 @@ double OutputStage::step(double a, bool touching) noexcept {
   // π/2 · touch_step_ of the output, no click).
   const bool was_silent = touch_level_ <= 0.0;
   touch_level_ = touching ? std::min(1.0, touch_level_ + touch_step_) : std::max(0.0, touch_level_ - touch_step_);
-  const double env = 0.5 - 0.5 * std::cos(std::numbers::pi * touch_level_);
+  // At full touch and at rest the envelope is exactly 1 and 0 (cos π = −1 and
+  // cos 0 = 1 in IEEE double): no cosine on the steady path.
+  const double env = touch_level_ >= 1.0   ? 1.0
+                     : touch_level_ <= 0.0 ? 0.0
+                                           : 0.5 - 0.5 * std::cos(std::numbers::pi * touch_level_);
 
   // The display's response limit (see player.hpp): what it cannot
   // reproduce is not driven. Starts settled on touch-down from rest.

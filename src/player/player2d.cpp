@@ -73,6 +73,9 @@ void check_response(const std::optional<FrequencyResponse>& r, std::string_view 
 // Raised-cosine fade of a texel felt at `hz` against the limit: 1 up to
 // 0.8·limit, 0 from the limit on.
 double limit_weight(double hz, double limit_hz) noexcept {
+  // Well inside the limit (hz ≤ 0.79·limit puts r under 0.8 whatever the
+  // rounding): 1 without the division.
+  if (limit_hz > 0.0 && hz <= 0.79 * limit_hz) return 1.0;
   const double r = hz / limit_hz;
   if (r <= 0.8) return 1.0;
   if (!(r < 1.0)) return 0.0;
@@ -169,7 +172,10 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::bitmap(Raster2D friction, std::o
 }
 
 double PlayerMap2D::fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  const double s = s_mm - std::floor(s_mm / strip_mm_) * strip_mm_;  // wraps around the strip
+  // Wraps around the strip. In its first half (0 < s < strip/2, the
+  // quotient's floor is 0 whatever the rounding) s_mm − 0·strip is s_mm:
+  // the same value without the division and the floor.
+  const double s = s_mm > 0.0 && s_mm < 0.5 * strip_mm_ ? s_mm : s_mm - std::floor(s_mm / strip_mm_) * strip_mm_;
   auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel_));
   k = std::min(k, frequency_cpm_.size() - 1);
   const double f = frequency_cpm_[k];

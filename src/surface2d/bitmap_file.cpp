@@ -10,10 +10,12 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "internal.hpp"
 #include "texel/detail/parallel.hpp"
+#include "texel/device.hpp"
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
 #include "texel/io.hpp"
@@ -183,16 +185,17 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
   }
 
   // Each worker renders and encodes one strip of a batch; the calling thread
-  // writes the batch in order. Memory: threads × (strip doubles + bytes).
+  // writes a batch in order while the workers render the next one (two sets
+  // of buffers). Memory: 2 × threads × (strip doubles + bytes + levels).
   struct Buffer {
     std::vector<double> amplitude;
     std::vector<unsigned char> bytes;
+    std::vector<std::uint16_t> levels;
     double sum = 0.0;
   };
-  std::vector<Buffer> buffers(static_cast<std::size_t>(std::max(threads, 1)));
-  double total = 0.0;
-  std::size_t written = 0;
-  for (int batch = 0; batch < strips; batch += threads) {
+  const auto per_batch = static_cast<std::size_t>(std::max(threads, 1));
+  std::vector<Buffer> sets[2] = {std::vector<Buffer>(per_batch), std::vector<Buffer>(per_batch)};
+  const auto render_batch = [&](int batch, std::vector<Buffer>& buffers) {
     const int in_batch = std::min(threads, strips - batch);
     detail::parallel_tasks(threads, static_cast<std::size_t>(in_batch), [&](std::size_t, std::size_t t) {
       Buffer& b = buffers[t];
@@ -210,30 +213,65 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
       }
       b.bytes.resize(n * bytes_per_pixel);
       unsigned char* out = b.bytes.data();
-      for (std::size_t k = 0; k < n; ++k) {
-        double a = std::clamp(b.amplitude[k], 0.0, 1.0);
-        if (invert) a = 1.0 - a;
-        if (depth == 8) {
+      if (depth == 8) {
+        for (std::size_t k = 0; k < n; ++k) {
+          double a = std::clamp(b.amplitude[k], 0.0, 1.0);
+          if (invert) a = 1.0 - a;
           out[k] = static_cast<unsigned char>(a * 255.0 + 0.5);
-        } else {
-          const std::uint16_t v = to_u16(a);
-          out[2 * k] = static_cast<unsigned char>(v >> 8);  // PNG samples are big-endian
-          out[2 * k + 1] = static_cast<unsigned char>(v & 0xFF);
         }
+        return;
+      }
+      // to_u16 of the (inverted) amplitude, a vector of pixels at a time
+      // (encode_u16 is to_u16, which clamps the same way).
+      if (invert)
+        for (double& a : b.amplitude) a = 1.0 - std::clamp(a, 0.0, 1.0);
+      b.levels.resize(n);
+      encode_u16(b.amplitude, b.levels);
+      for (std::size_t k = 0; k < n; ++k) {
+        out[2 * k] = static_cast<unsigned char>(b.levels[k] >> 8);  // PNG samples are big-endian
+        out[2 * k + 1] = static_cast<unsigned char>(b.levels[k] & 0xFF);
       }
     });
-    for (int t = 0; t < in_batch; ++t) {
-      Buffer& b = buffers[static_cast<std::size_t>(t)];
-      const int first = (batch + t) * strip;
-      const int rows = std::min(strip, g.height - first);
-      total += b.sum;
-      if (png) {
-        if (!png_rows(handle.png, b.bytes.data(), stride, rows)) png_fail(st, path);
-      } else {
-        file.write(std::span<const std::byte>(reinterpret_cast<const std::byte*>(b.bytes.data()), b.bytes.size()));
-      }
-      written += b.bytes.size();
+  };
+  double total = 0.0;
+  std::size_t written = 0;
+  if (strips > 0) render_batch(0, sets[0]);
+  for (int batch = 0, cur = 0; batch < strips; batch += threads, cur ^= 1) {
+    // The next batch renders on its own thread while this one is written.
+    std::exception_ptr next_error;
+    std::thread next;
+    if (batch + threads < strips) {
+      next = std::thread([&, first = batch + threads, set = cur ^ 1] {
+        try {
+          render_batch(first, sets[set]);
+        } catch (...) {
+          next_error = std::current_exception();
+        }
+      });
     }
+    bool ok = true;
+    std::exception_ptr write_error;
+    try {
+      const int in_batch = std::min(threads, strips - batch);
+      for (int t = 0; t < in_batch && ok; ++t) {
+        Buffer& b = sets[cur][static_cast<std::size_t>(t)];
+        const int first = (batch + t) * strip;
+        const int rows = std::min(strip, g.height - first);
+        total += b.sum;
+        if (png) {
+          ok = png_rows(handle.png, b.bytes.data(), stride, rows);
+        } else {
+          file.write(std::span<const std::byte>(reinterpret_cast<const std::byte*>(b.bytes.data()), b.bytes.size()));
+        }
+        written += b.bytes.size();
+      }
+    } catch (...) {
+      write_error = std::current_exception();
+    }
+    if (next.joinable()) next.join();
+    if (write_error) std::rethrow_exception(write_error);
+    if (!ok) png_fail(st, path);
+    if (next_error) std::rethrow_exception(next_error);
   }
   if (png && !png_end(handle.png, handle.info)) png_fail(st, path);
   file.commit();

@@ -2,8 +2,10 @@
 // fields (docs/algorithm.md §11.1, §11.3).
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "internal.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detmath.hpp"
 #include "texel/spectrum.hpp"
 #include "texel/surface2d.hpp"
@@ -139,26 +141,31 @@ DirectionStats summarize_scans(const std::vector<std::vector<double>>& scans, do
 }  // namespace
 
 std::vector<DirectionStats> measure_scans(const FineField2D& field, const ScanOptions& options) {
-  std::vector<DirectionStats> out;
+  std::vector<DirectionStats> out(static_cast<std::size_t>(std::max(options.directions, 0)));
   const double h = options.spacing.value();
   const double length = h * static_cast<double>(options.samples);
-  for (int d = 0; d < options.directions; ++d) {
+  // Directions on the 1-D renderer's threads (each is independent).
+  detail::parallel_tasks(static_cast<int>(std::thread::hardware_concurrency()), out.size(), [&](std::size_t, std::size_t task) {
+    const int d = static_cast<int>(task);
     const double turn = 0.5 * static_cast<double>(d) / static_cast<double>(options.directions);
     const double ux = detmath::cos_cycles(turn), uy = detmath::sin_cycles(turn);
     std::vector<std::vector<double>> scans(static_cast<std::size_t>(options.scans), std::vector<double>(options.samples));
+    std::vector<double> xs(options.samples), ys(options.samples);
     for (int s = 0; s < options.scans; ++s) {
       // Parallel lines 1.1 scan lengths apart, started off the cell lattice.
       const double offset = (static_cast<double>(s) - 0.5 * options.scans) * 1.1 * length + 0.37;
       const double x0 = -uy * offset - 0.5 * length * ux + 0.123, y0 = ux * offset - 0.5 * length * uy + 0.291;
       for (std::size_t i = 0; i < options.samples; ++i) {
         const double t = static_cast<double>(i) * h;
-        scans[static_cast<std::size_t>(s)][i] = field.value(x0 + t * ux, y0 + t * uy);
+        xs[i] = x0 + t * ux;
+        ys[i] = y0 + t * uy;
       }
+      field.values(xs, ys, scans[static_cast<std::size_t>(s)]);
     }
     DirectionStats st = summarize_scans(scans, h);
     st.direction_deg = 180.0 * static_cast<double>(d) / static_cast<double>(options.directions);
-    out.push_back(st);
-  }
+    out[task] = st;
+  });
   return out;
 }
 

@@ -1,9 +1,11 @@
 // The fine fields of the 2-D model (docs/algorithm.md §11).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "internal.hpp"
 #include "texel/detail/format.hpp"
+#include "texel/detail/lanes.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
@@ -23,10 +25,203 @@ constexpr std::uint64_t stream_direction = static_cast<std::uint64_t>(Stream::us
 constexpr std::uint64_t stream_cell_phase = static_cast<std::uint64_t>(Stream::user) + 2;
 constexpr std::uint64_t stream_spectral = static_cast<std::uint64_t>(Stream::user) + 3;
 
+/// std::floor, inline: floor_exact where it is exact (|v| < 2^51), the
+/// library's beyond (a call per pixel otherwise: the baseline has no roundsd).
+double cell_floor(double v) { return std::fabs(v) < 0x1p51 ? detmath::floor_exact(v) : std::floor(v); }
+
 std::uint64_t cell_index(std::int64_t m, std::int64_t n) {
   const auto um = static_cast<std::uint64_t>(m + cell_bias) & cell_mask;
   const auto un = static_cast<std::uint64_t>(n + cell_bias) & cell_mask;
   return (un << 24) | um;
+}
+
+// The widest of a kernel's builds this CPU runs (detail::simd_lanes); the
+// AVX ones exist on x86 only.
+#if defined(__x86_64__) || defined(__i386__)
+#define TEXEL_LANE_KERNELS(name) &name##_avx512, &name##_avx2, &name##_generic
+#else
+#define TEXEL_LANE_KERNELS(name) nullptr, nullptr, &name##_generic
+#endif
+template <class Kernel>
+Kernel widest(Kernel lanes8, Kernel lanes4, Kernel lanes2) {
+  if (lanes8 && detail::simd_lanes() == 8) return lanes8;
+  if (lanes4 && detail::simd_lanes() == 4) return lanes4;
+  return lanes2;
+}
+
+// The spectral field's pixels, sum over c of sin(2π(u_c + v_c)) =
+// sin 2πu·cos 2πv + cos 2πu·sin 2πv with u_c = fx_c·x, summed in component
+// order for each pixel and scaled and clipped as value() does. Written with
+// explicit lanes (texel/detail/lanes.hpp) like the 1-D render kernel: a panel
+// of 2W columns has its x factors computed once (at most spectral_components
+// of them, on the stack), then rows a group of four at
+// a time keep their 4 × 2W sums in registers while the components stream
+// through (the sums of one pixel are added in the same order and with the same
+// operations as value(), so the lane width changes speed, never bits).
+struct SpectralBlock {
+  const double* fx;  // [c]: frequency·cos(direction)
+  const double* sy;  // [r][c]: sin 2πv
+  const double* cy;  // [r][c]: cos 2πv
+  std::size_t components, rows;
+  double gain, pitch, origin_x;
+};
+constexpr std::size_t max_components = FineField2D::spectral_components;
+
+template <int W, int R>
+[[gnu::always_inline]] inline void spectral_rows(const SpectralBlock& b, const typename detail::Lanes<W>::type (*sx)[2],
+                                                 const typename detail::Lanes<W>::type (*cx)[2], std::size_t r0, double* out,
+                                                 std::size_t stride, std::size_t live) {
+  using V = typename detail::Lanes<W>::type;
+  const std::size_t n = b.components;
+  const double* sy = b.sy + r0 * n;
+  const double* cy = b.cy + r0 * n;
+  V acc[R][2];
+  for (int r = 0; r < R; ++r) acc[r][0] = acc[r][1] = V{};
+  for (std::size_t c = 0; c < n; ++c) {
+    const V s_x0 = sx[c][0], s_x1 = sx[c][1], c_x0 = cx[c][0], c_x1 = cx[c][1];
+    for (int r = 0; r < R; ++r) {
+      const double s_y = sy[static_cast<std::size_t>(r) * n + c];
+      const double c_y = cy[static_cast<std::size_t>(r) * n + c];
+      acc[r][0] += s_x0 * c_y + c_x0 * s_y;
+      acc[r][1] += s_x1 * c_y + c_x1 * s_y;
+    }
+  }
+  const V lo = V{} - 1.0, hi = V{} + 1.0;
+  for (int r = 0; r < R; ++r) {
+    alignas(sizeof(V)) V a[2];
+    for (int v = 0; v < 2; ++v) {
+      a[v] = acc[r][v] * b.gain;
+      a[v] = a[v] < lo ? lo : a[v];  // std::clamp(a, −1, 1)
+      a[v] = hi < a[v] ? hi : a[v];
+    }
+    std::memcpy(out + (r0 + static_cast<std::size_t>(r)) * stride, &a, live * sizeof(double));
+  }
+}
+
+template <int W>
+[[gnu::always_inline]] inline void spectral_lanes(const SpectralBlock& b, std::int64_t first, std::size_t count, double* out,
+                                                  std::size_t stride) {
+  using V = typename detail::Lanes<W>::type;
+  constexpr std::size_t P = 2 * W;
+  const std::size_t n = std::min(b.components, max_components);
+  alignas(sizeof(V)) V sx[max_components][2];
+  alignas(sizeof(V)) V cx[max_components][2];
+  for (std::size_t t0 = 0; t0 < count; t0 += P) {
+    const std::size_t live = std::min(P, count - t0);
+    // x of the panel's columns (past the end: more columns, not stored).
+    V x[2];
+    for (int v = 0; v < 2; ++v)
+      for (int l = 0; l < W; ++l)
+        x[v][l] = static_cast<double>(first + static_cast<std::int64_t>(t0) + v * W + l) * b.pitch - b.origin_x;
+    for (std::size_t c = 0; c < n; ++c)
+      for (int v = 0; v < 2; ++v) {
+        const V u = b.fx[c] * x[v];
+        sx[c][v] = detmath::sin_cycles_generic(u);
+        cx[c][v] = detmath::sin_cycles_generic(u + 0.25);  // cos_cycles
+      }
+    std::size_t r = 0;
+    for (; r + 4 <= b.rows; r += 4) spectral_rows<W, 4>(b, sx, cx, r, out + t0, stride, live);
+    for (; r < b.rows; ++r) spectral_rows<W, 1>(b, sx, cx, r, out + t0, stride, live);
+  }
+}
+
+using SpectralKernel = void (*)(const SpectralBlock&, std::int64_t, std::size_t, double*, std::size_t);
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void spectral_avx512(const SpectralBlock& b, std::int64_t first, std::size_t count,
+                                                        double* out, std::size_t stride) {
+  spectral_lanes<8>(b, first, count, out, stride);
+}
+__attribute__((target("avx2"))) void spectral_avx2(const SpectralBlock& b, std::int64_t first, std::size_t count, double* out,
+                                                   std::size_t stride) {
+  spectral_lanes<4>(b, first, count, out, stride);
+}
+#endif
+void spectral_generic(const SpectralBlock& b, std::int64_t first, std::size_t count, double* out, std::size_t stride) {
+  spectral_lanes<2>(b, first, count, out, stride);
+}
+
+SpectralKernel spectral_kernel() {
+  static const SpectralKernel kernel = widest<SpectralKernel>(TEXEL_LANE_KERNELS(spectral));
+  return kernel;
+}
+
+// value() at W points at once (the spectral design): every lane does value()'s
+// operations in its order, so the results are value()'s bits.
+struct SpectralPoints {
+  const FineField2D::Component* components;
+  std::size_t count;
+  double gain;
+};
+
+template <int W>
+[[gnu::always_inline]] inline void spectral_points_lanes(const SpectralPoints& k, const double* xs, const double* ys, double* out,
+                                                         std::size_t n) {
+  using V = typename detail::Lanes<W>::type;
+  const V lo = V{} - 1.0, hi = V{} + 1.0;
+  for (std::size_t i = 0; i < n; i += W) {
+    const std::size_t live = std::min<std::size_t>(W, n - i);
+    V x = V{}, y = V{};
+    std::memcpy(&x, xs + i, live * sizeof(double));
+    std::memcpy(&y, ys + i, live * sizeof(double));
+    V sum = V{};
+    for (std::size_t c = 0; c < k.count; ++c) {
+      const FineField2D::Component& m = k.components[c];
+      const V u = m.frequency * m.cos_dir * x, v = m.phase + m.frequency * m.sin_dir * y;
+      sum += detmath::sin_cycles_generic(u) * detmath::sin_cycles_generic(v + 0.25) +
+             detmath::sin_cycles_generic(u + 0.25) * detmath::sin_cycles_generic(v);
+    }
+    V a = sum * k.gain;
+    a = a < lo ? lo : a;
+    a = hi < a ? hi : a;
+    std::memcpy(out + i, &a, live * sizeof(double));
+  }
+}
+
+using PointsKernel = void (*)(const SpectralPoints&, const double*, const double*, double*, std::size_t);
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void spectral_points_avx512(const SpectralPoints& k, const double* xs, const double* ys,
+                                                               double* out, std::size_t n) {
+  spectral_points_lanes<8>(k, xs, ys, out, n);
+}
+__attribute__((target("avx2"))) void spectral_points_avx2(const SpectralPoints& k, const double* xs, const double* ys,
+                                                          double* out, std::size_t n) {
+  spectral_points_lanes<4>(k, xs, ys, out, n);
+}
+#endif
+void spectral_points_generic(const SpectralPoints& k, const double* xs, const double* ys, double* out, std::size_t n) {
+  spectral_points_lanes<2>(k, xs, ys, out, n);
+}
+
+PointsKernel points_kernel() {
+  static const PointsKernel kernel = widest<PointsKernel>(TEXEL_LANE_KERNELS(spectral_points));
+  return kernel;
+}
+
+// sin_cycles in place, a vector at a time (sin_cycles_generic's lanes: the
+// scalar bits).
+template <int W>
+[[gnu::always_inline]] inline void sines_lanes(double* v, std::size_t n) {
+  using V = typename detail::Lanes<W>::type;
+  std::size_t i = 0;
+  for (; i + W <= n; i += W) {
+    V u;
+    std::memcpy(&u, v + i, sizeof u);
+    u = detmath::sin_cycles_generic(u);
+    std::memcpy(v + i, &u, sizeof u);
+  }
+  for (; i < n; ++i) v[i] = detmath::sin_cycles(v[i]);
+}
+using SinesKernel = void (*)(double*, std::size_t);
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void sines_avx512(double* v, std::size_t n) { sines_lanes<8>(v, n); }
+__attribute__((target("avx2"))) void sines_avx2(double* v, std::size_t n) { sines_lanes<4>(v, n); }
+#endif
+void sines_generic(double* v, std::size_t n) { sines_lanes<2>(v, n); }
+void sines(std::span<double> v) {
+  static const SinesKernel kernel = widest<SinesKernel>(TEXEL_LANE_KERNELS(sines));
+  kernel(v.data(), v.size());
 }
 
 }  // namespace
@@ -164,7 +359,7 @@ void FineField2D::block(std::int64_t first, std::size_t count, double pitch, dou
     if (count == 0) return;
     const double L = spec_.texel_length.value();
     const auto cell_of = [&](double v) {
-      return static_cast<std::int64_t>(std::floor((v + TexelTexture::boundary_tolerance_mm) / L));
+      return static_cast<std::int64_t>(cell_floor((v + TexelTexture::boundary_tolerance_mm) / L));
     };
     const std::int64_t m_lo = cell_of(static_cast<double>(first) * pitch - origin_x);
     const std::int64_t m_hi = cell_of(static_cast<double>(first + static_cast<std::int64_t>(count) - 1) * pitch - origin_x);
@@ -202,13 +397,14 @@ void FineField2D::block(std::int64_t first, std::size_t count, double pitch, dou
         const double dx = x - static_cast<double>(m) * L;
         line[k] = c.phase + c.frequency * (c.cos_dir * dx + c.sin_dir * dy);
       }
-      for (std::size_t k = 0; k < count; ++k) line[k] = detmath::sin_cycles(line[k]);
+      sines(std::span<double>(line, count));
     }
     return;
   }
   const std::size_t n = components_.size();
-  // y factors of every row, then x factors a tile of columns at a time.
-  std::vector<double> sy(n * ys.size()), cy(n * ys.size());
+  // y factors of every row (row-major: [r][c]), then the pixels a panel of
+  // columns at a time (spectral_lanes).
+  std::vector<double> sy(n * ys.size()), cy(n * ys.size()), fx(n);
   for (std::size_t r = 0; r < ys.size(); ++r)
     for (std::size_t c = 0; c < n; ++c) {
       const Component& k = components_[c];
@@ -216,31 +412,20 @@ void FineField2D::block(std::int64_t first, std::size_t count, double pitch, dou
       sy[r * n + c] = detmath::sin_cycles(v);
       cy[r * n + c] = detmath::cos_cycles(v);
     }
-  constexpr std::size_t tile = 256;
-  std::vector<double> sx(n * tile), cx(n * tile), acc(tile);
-  for (std::size_t t0 = 0; t0 < count; t0 += tile) {
-    const std::size_t m = std::min(tile, count - t0);
-    for (std::size_t c = 0; c < n; ++c) {
-      const Component& k = components_[c];
-      for (std::size_t t = 0; t < m; ++t) {
-        const double x = static_cast<double>(first + static_cast<std::int64_t>(t0 + t)) * pitch - origin_x;
-        const double u = k.frequency * k.cos_dir * x;
-        sx[c * tile + t] = detmath::sin_cycles(u);
-        cx[c * tile + t] = detmath::cos_cycles(u);
-      }
-    }
-    for (std::size_t r = 0; r < ys.size(); ++r) {
-      std::fill(acc.begin(), acc.end(), 0.0);
-      for (std::size_t c = 0; c < n; ++c) {
-        const double s_y = sy[r * n + c], c_y = cy[r * n + c];
-        const double* s_x = sx.data() + c * tile;
-        const double* c_x = cx.data() + c * tile;
-        for (std::size_t t = 0; t < m; ++t) acc[t] += s_x[t] * c_y + c_x[t] * s_y;
-      }
-      double* line = out + r * stride + t0;
-      for (std::size_t t = 0; t < m; ++t) line[t] = std::clamp(acc[t] * spectral_gain_, -1.0, 1.0);
-    }
+  for (std::size_t c = 0; c < n; ++c) fx[c] = components_[c].frequency * components_[c].cos_dir;
+  const SpectralBlock b{fx.data(), sy.data(), cy.data(), n, ys.size(), spectral_gain_, pitch, origin_x};
+  spectral_kernel()(b, first, count, out, stride);
+}
+
+void FineField2D::values(std::span<const double> xs, std::span<const double> ys, std::span<double> out) const {
+  if (xs.size() != out.size() || ys.size() != out.size())
+    throw InvalidArgument("FineField2D::values: " + std::to_string(xs.size()) + " x, " + std::to_string(ys.size()) + " y and " +
+                          std::to_string(out.size()) + " outputs; the three must be equal");
+  if (design_ != Field2D::spectral) {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = value(xs[i], ys[i]);
+    return;
   }
+  points_kernel()({components_.data(), components_.size(), spectral_gain_}, xs.data(), ys.data(), out.data(), out.size());
 }
 
 void FineField2D::row(std::int64_t first, double pitch, double origin_x, double y, std::span<double> out) const {
@@ -262,7 +447,7 @@ void FineField2D::row(std::int64_t first, double pitch, double origin_x, double 
   bool have = false;
   for (std::size_t k = 0; k < out.size(); ++k) {
     const double x = static_cast<double>(first + static_cast<std::int64_t>(k)) * pitch - origin_x;
-    const auto m = static_cast<std::int64_t>(std::floor((x + TexelTexture::boundary_tolerance_mm) / L));
+    const auto m = static_cast<std::int64_t>(cell_floor((x + TexelTexture::boundary_tolerance_mm) / L));
     if (!have || m != last_m) {
       c = cell(m, n);
       last_m = m;
@@ -271,9 +456,9 @@ void FineField2D::row(std::int64_t first, double pitch, double origin_x, double 
     const double dx = x - static_cast<double>(m) * L;
     out[k] = c.phase + c.frequency * (c.cos_dir * dx + c.sin_dir * dy);
   }
-  // The sines in a second pass, which the compiler can run a vector of
-  // pixels at a time (the same operations per pixel as value()).
-  for (double& u : out) u = detmath::sin_cycles(u);
+  // The sines in a second pass, a vector of pixels at a time (the same
+  // operations per pixel as value()).
+  sines(out);
 }
 
 }  // namespace texel

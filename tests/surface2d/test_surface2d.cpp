@@ -187,3 +187,32 @@ TEST(Surface2D, SpectralFieldMeetsItsStationaryBound) {
   // A narrow texture's scans are wider than the 1-D texture: the cosine law.
   EXPECT_GT(bound.matched_log_spread_db, bound.target_log_spread_db + 1.0);
 }
+
+TEST(Surface2D, SpectralKernelsGiveValueBitForBit) {
+  // block() (a panel of columns and four rows at a time) and values() (a
+  // vector of points at a time) are value()'s arithmetic in lanes: equal to
+  // the last bit, at a width and row count that leave partial panels.
+  TexelSpec spec;
+  spec.central_pitch = Decibels(4.0);
+  spec.irregularity = Decibels(2.0);
+  spec.seed = 5;
+  const FineField2D field(spec, Field2D::spectral, 0.0, CyclesPerMm(25.0));
+  const std::size_t cols = 37, rows = 7, stride = 41;
+  const std::vector<double> ys = {-0.3, 0.0, 0.02, 1.7, 2.25, 9.5, 100.125};
+  std::vector<double> out(rows * stride, 7.0);
+  field.block(-5, cols, 0.02, 0.013, ys, out.data(), stride);
+  std::vector<double> px, py;
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t k = 0; k < cols; ++k) {
+      const double x = static_cast<double>(-5 + static_cast<std::int64_t>(k)) * 0.02 - 0.013;
+      ASSERT_EQ(out[r * stride + k], field.value(x, ys[r])) << r << ", " << k;
+      px.push_back(x);
+      py.push_back(ys[r] + 0.5 * x);
+    }
+    ASSERT_EQ(out[r * stride + cols], 7.0);  // nothing written past the run
+  }
+  std::vector<double> pv(px.size());
+  field.values(px, py, pv);
+  for (std::size_t i = 0; i < pv.size(); ++i) ASSERT_EQ(pv[i], field.value(px[i], py[i])) << i;
+  EXPECT_THROW(field.values(px, py, std::span<double>(pv).first(3)), InvalidArgument);
+}
