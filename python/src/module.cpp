@@ -99,6 +99,7 @@ PYBIND11_MODULE(_texel, m) {
   register_spectrum(m);
   register_interchange(m);
   register_player(m);
+  register_surface2d(m);
   register_experiment(m);
   register_session(m);
 }

@@ -159,7 +159,6 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
   if (options.rows_per_strip < 1) throw InvalidArgument("rows_per_strip must be >= 1");
   if (options.png_compression < 0 || options.png_compression > 9)
     throw InvalidArgument("png_compression is " + std::to_string(options.png_compression) + "; allowed: 0 … 9");
-  const bool invert = g.polarity == BitmapPolarity::brighter_more_friction;
   const std::size_t w = static_cast<std::size_t>(g.width);
   const std::size_t bytes_per_pixel = static_cast<std::size_t>(depth / 8);
   const std::size_t stride = w * bytes_per_pixel;
@@ -211,12 +210,10 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
       b.bytes.resize(n * bytes_per_pixel);
       unsigned char* out = b.bytes.data();
       for (std::size_t k = 0; k < n; ++k) {
-        double a = std::clamp(b.amplitude[k], 0.0, 1.0);
-        if (invert) a = 1.0 - a;
+        const std::uint16_t v = bitmap_pixel(b.amplitude[k], g.polarity, depth);
         if (depth == 8) {
-          out[k] = static_cast<unsigned char>(a * 255.0 + 0.5);
+          out[k] = static_cast<unsigned char>(v);
         } else {
-          const std::uint16_t v = to_u16(a);
           out[2 * k] = static_cast<unsigned char>(v >> 8);  // PNG samples are big-endian
           out[2 * k + 1] = static_cast<unsigned char>(v & 0xFF);
         }
