@@ -18,14 +18,14 @@
 
 static int failures = 0;
 
-#define CHECK(cond, ...)                                  \
-  do {                                                    \
-    if (!(cond)) {                                        \
-      fprintf(stderr, "line %d: ", __LINE__);             \
-      fprintf(stderr, __VA_ARGS__);                       \
+#define CHECK(cond, ...)                                          \
+  do {                                                            \
+    if (!(cond)) {                                                \
+      fprintf(stderr, "line %d: ", __LINE__);                     \
+      fprintf(stderr, __VA_ARGS__);                               \
       fprintf(stderr, " (last error: %s)\n", texel_last_error()); \
-      ++failures;                                         \
-    }                                                     \
+      ++failures;                                                 \
+    }                                                             \
   } while (0)
 
 static unsigned char* read_file(const char* path, size_t* size) {
@@ -173,9 +173,10 @@ int main(int argc, char** argv) {
     expected = wav ? wav_data(wav, size, &bytes) : NULL;
     CHECK(expected && bytes == frames * 4 && memcmp(expected, out, bytes) == 0, "swipe differs from %s", argv[4]);
     CHECK(fabsf(x[0] - 3.0f) < 1e-6f && fabsf(y[0] - 1.2f) < 1e-6f, "first position (%g, %g)", x[0], y[0]);
-    CHECK(texel_swipe_2d(doc, trace, needed, TEXEL_MAP2D_BITMAP, TEXEL_PATH_RESET, &config, out, frames, NULL, NULL) == TEXEL_OK &&
-              memcmp(expected, out, bytes) != 0,
-          "bitmap mode plays the bitmap");
+    CHECK(
+        texel_swipe_2d(doc, trace, needed, TEXEL_MAP2D_BITMAP, TEXEL_PATH_RESET, &config, out, frames, NULL, NULL) == TEXEL_OK &&
+            memcmp(expected, out, bytes) != 0,
+        "bitmap mode plays the bitmap");
     CHECK(texel_swipe_2d(doc, trace, needed, (texel_map2d_mode)5, TEXEL_PATH_KEEP, &config, out, frames, NULL, NULL) ==
                   TEXEL_INVALID_ARGUMENT &&
               strstr(texel_last_error(), "mode is 5"),
