@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <new>
@@ -138,6 +139,26 @@ long long enum_value(const E& e) {
   static_assert(sizeof v == sizeof e);
   std::memcpy(&v, &e, sizeof v);
   return static_cast<long long>(static_cast<int>(v));
+}
+
+// The library value of a C enum field: one row per C value (value, library
+// value, C name); any other value is refused, naming the field and listing
+// what is allowed ("mode is 5; allowed: TEXEL_MAP2D_PATH (0), ...").
+template <class To>
+struct Choice {
+  long long c;
+  To value;
+  const char* name;
+};
+template <class To, class E>
+To choose(const E& e, const char* field, std::initializer_list<Choice<To>> choices) {
+  const long long v = enum_value(e);
+  std::string allowed;
+  for (const Choice<To>& c : choices) {
+    if (c.c == v) return c.value;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(c.name) + " (" + std::to_string(c.c) + ")";
+  }
+  throw InvalidArgument(std::string(field) + " is " + std::to_string(v) + "; allowed: " + allowed);
 }
 
 void need_finite(double v, const char* name) {
@@ -311,14 +332,10 @@ texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
   c.no_texture =
       o.refuse_no_texture ? texel::codec::EncoderConfig::NoTexture::refuse : texel::codec::EncoderConfig::NoTexture::flag;
   using Target = texel::codec::EncoderConfig::Target;
-  switch (enum_value(o.target)) {
-    case TEXEL_TARGET_AUTOMATIC: c.target = Target::automatic; break;
-    case TEXEL_TARGET_FELT: c.target = Target::felt; break;
-    case TEXEL_TARGET_CENTROID: c.target = Target::centroid; break;
-    default:
-      throw InvalidArgument("target is " + std::to_string(enum_value(o.target)) +
-                            "; allowed: TEXEL_TARGET_AUTOMATIC (0), TEXEL_TARGET_FELT (1), TEXEL_TARGET_CENTROID (2)");
-  }
+  c.target = choose<Target>(o.target, "target",
+                            {{TEXEL_TARGET_AUTOMATIC, Target::automatic, "TEXEL_TARGET_AUTOMATIC"},
+                             {TEXEL_TARGET_FELT, Target::felt, "TEXEL_TARGET_FELT"},
+                             {TEXEL_TARGET_CENTROID, Target::centroid, "TEXEL_TARGET_CENTROID"}});
   return c;
 }
 
@@ -326,24 +343,17 @@ texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
 texel::PlayerConfig player_config_of(const texel_player_config& c) {
   texel::PlayerConfig pc;
   pc.rate_hz = c.rate_hz;
-  switch (enum_value(c.mode)) {
-    case TEXEL_OUTPUT_AMPLITUDE: pc.mode = texel::OutputMode::amplitude; break;
-    case TEXEL_OUTPUT_VIBRATION: pc.mode = texel::OutputMode::vibration; break;
-    case TEXEL_OUTPUT_CARRIER: pc.mode = texel::OutputMode::carrier; break;
-    default:
-      throw InvalidArgument("mode is " + std::to_string(enum_value(c.mode)) +
-                            "; allowed: TEXEL_OUTPUT_AMPLITUDE (0), TEXEL_OUTPUT_VIBRATION (1), TEXEL_OUTPUT_CARRIER (2)");
-  }
+  pc.mode = choose<texel::OutputMode>(c.mode, "mode",
+                                      {{TEXEL_OUTPUT_AMPLITUDE, texel::OutputMode::amplitude, "TEXEL_OUTPUT_AMPLITUDE"},
+                                       {TEXEL_OUTPUT_VIBRATION, texel::OutputMode::vibration, "TEXEL_OUTPUT_VIBRATION"},
+                                       {TEXEL_OUTPUT_CARRIER, texel::OutputMode::carrier, "TEXEL_OUTPUT_CARRIER"}});
   pc.gain = c.gain;
   pc.carrier_hz = c.carrier_hz;
   pc.prediction_s = c.prediction_s;
-  switch (enum_value(c.response_handling)) {
-    case TEXEL_RESPONSE_LIMIT: pc.response_handling = texel::ResponseHandling::limit; break;
-    case TEXEL_RESPONSE_OFF: pc.response_handling = texel::ResponseHandling::off; break;
-    default:
-      throw InvalidArgument("response_handling is " + std::to_string(enum_value(c.response_handling)) +
-                            "; allowed: TEXEL_RESPONSE_LIMIT (0), TEXEL_RESPONSE_OFF (1)");
-  }
+  pc.response_handling =
+      choose<texel::ResponseHandling>(c.response_handling, "response_handling",
+                                      {{TEXEL_RESPONSE_LIMIT, texel::ResponseHandling::limit, "TEXEL_RESPONSE_LIMIT"},
+                                       {TEXEL_RESPONSE_OFF, texel::ResponseHandling::off, "TEXEL_RESPONSE_OFF"}});
   pc.response_limit_db = c.response_limit_db;
   // The library's extrapolation window must cover the look-ahead.
   pc.extrapolate_s = std::max(pc.extrapolate_s, std::isfinite(c.prediction_s) ? c.prediction_s : 0.0);
@@ -911,14 +921,10 @@ texel_status texel_path2d_simulate(const texel_path2d_config* config, texel_fing
   return guarded([&] {
     const texel_path2d_config& c = need(config, "config");
     texel::Path2DConfig p;
-    switch (enum_value(c.shape)) {
-      case TEXEL_PATH2D_LINE: p.shape = texel::Path2DShape::line; break;
-      case TEXEL_PATH2D_CIRCLE: p.shape = texel::Path2DShape::circle; break;
-      case TEXEL_PATH2D_ZIGZAG: p.shape = texel::Path2DShape::zigzag; break;
-      default:
-        throw InvalidArgument("shape is " + std::to_string(enum_value(c.shape)) +
-                              "; allowed: TEXEL_PATH2D_LINE (0), TEXEL_PATH2D_CIRCLE (1), TEXEL_PATH2D_ZIGZAG (2)");
-    }
+    p.shape = choose<texel::Path2DShape>(c.shape, "shape",
+                                         {{TEXEL_PATH2D_LINE, texel::Path2DShape::line, "TEXEL_PATH2D_LINE"},
+                                          {TEXEL_PATH2D_CIRCLE, texel::Path2DShape::circle, "TEXEL_PATH2D_CIRCLE"},
+                                          {TEXEL_PATH2D_ZIGZAG, texel::Path2DShape::zigzag, "TEXEL_PATH2D_ZIGZAG"}});
     p.speed_mm_s = c.speed_mm_s;
     p.angle_deg = c.angle_deg;
     p.start_x_mm = c.start_x_mm;
@@ -944,14 +950,9 @@ texel_status texel_swipe_2d(const texel_document* doc, const texel_finger2d* tra
     pc.response = d.device.response;  // the display's, as `texel swipe` takes it
     if (samples > 0) need(trace, "trace");
     if (frames > 0) need(out, "out");
-    texel::PathAtLift lift = texel::PathAtLift::keep;
-    switch (enum_value(at_lift)) {
-      case TEXEL_PATH_KEEP: break;
-      case TEXEL_PATH_RESET: lift = texel::PathAtLift::reset; break;
-      default:
-        throw InvalidArgument("at_lift is " + std::to_string(enum_value(at_lift)) +
-                              "; allowed: TEXEL_PATH_KEEP (0), TEXEL_PATH_RESET (1)");
-    }
+    const auto lift = choose<texel::PathAtLift>(at_lift, "at_lift",
+                                                {{TEXEL_PATH_KEEP, texel::PathAtLift::keep, "TEXEL_PATH_KEEP"},
+                                                 {TEXEL_PATH_RESET, texel::PathAtLift::reset, "TEXEL_PATH_RESET"}});
     std::vector<texel::FingerSample2D> t(samples);
     for (std::size_t i = 0; i < samples; ++i) {
       const texel_finger2d& f = trace[i];
@@ -961,18 +962,11 @@ texel_status texel_swipe_2d(const texel_document* doc, const texel_finger2d* tra
         throw InvalidArgument("trace[" + std::to_string(i) + "].t_s is below the sample before; times must be non-decreasing");
       t[i] = texel::FingerSample2D{f.t_s, f.x_mm, f.y_mm, f.touch != 0};
     }
-    std::unique_ptr<const texel::PlayerMap2D> map;
-    switch (enum_value(mode)) {
-      case TEXEL_MAP2D_PATH:
-        map = texel::PlayerMap2D::path_indexed(d, d.surface2d ? std::optional(texel::coarse_raster(d)) : std::nullopt);
-        break;
-      case TEXEL_MAP2D_BITMAP:
-        map = texel::PlayerMap2D::bitmap(texel::render_raster(texel::prepare_surface2d(d)), d.device.response);
-        break;
-      default:
-        throw InvalidArgument("mode is " + std::to_string(enum_value(mode)) +
-                              "; allowed: TEXEL_MAP2D_PATH (0), TEXEL_MAP2D_BITMAP (1)");
-    }
+    const bool bitmap = choose<bool>(
+        mode, "mode", {{TEXEL_MAP2D_PATH, false, "TEXEL_MAP2D_PATH"}, {TEXEL_MAP2D_BITMAP, true, "TEXEL_MAP2D_BITMAP"}});
+    const std::unique_ptr<const texel::PlayerMap2D> map =
+        bitmap ? texel::PlayerMap2D::bitmap(texel::render_raster(texel::prepare_surface2d(d)), d.device.response)
+               : texel::PlayerMap2D::path_indexed(d, d.surface2d ? std::optional(texel::coarse_raster(d)) : std::nullopt);
     std::vector<float> xs, ys;
     const std::vector<float> o =
         texel::render_trace_2d(*map, pc, t, frames, x_mm ? &xs : nullptr, y_mm ? &ys : nullptr, 64, lift);
