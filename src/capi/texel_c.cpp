@@ -361,6 +361,21 @@ texel::PlayerConfig player_config_of(const texel_player_config& c) {
   return pc;
 }
 
+// The numbers of a 2-D path config (texel_path2d_config and Path2DConfig
+// use the same names), either way.
+template <class From, class To>
+void copy_path_numbers(const From& c, To& p) {
+  p.speed_mm_s = c.speed_mm_s;
+  p.angle_deg = c.angle_deg;
+  p.start_x_mm = c.start_x_mm;
+  p.start_y_mm = c.start_y_mm;
+  p.radius_mm = c.radius_mm;
+  p.leg_mm = c.leg_mm;
+  p.zigzag_deg = c.zigzag_deg;
+  p.duration_s = c.duration_s;
+  p.rate_hz = c.rate_hz;
+}
+
 // A row range and buffer of a 2-D surface, named as the C parameters.
 void check_rows(const texel::Surface2D& s, int first_row, int rows, const void* out, std::size_t count) {
   const texel::BitmapGeometry& g = s.geometry();
@@ -904,15 +919,7 @@ texel_path2d_config texel_path2d_config_default(void) {
   const texel::Path2DConfig c;
   texel_path2d_config p{};
   p.shape = TEXEL_PATH2D_LINE;
-  p.speed_mm_s = c.speed_mm_s;
-  p.angle_deg = c.angle_deg;
-  p.start_x_mm = c.start_x_mm;
-  p.start_y_mm = c.start_y_mm;
-  p.radius_mm = c.radius_mm;
-  p.leg_mm = c.leg_mm;
-  p.zigzag_deg = c.zigzag_deg;
-  p.duration_s = c.duration_s;
-  p.rate_hz = c.rate_hz;
+  copy_path_numbers(c, p);
   return p;
 }
 
@@ -925,15 +932,7 @@ texel_status texel_path2d_simulate(const texel_path2d_config* config, texel_fing
                                          {{TEXEL_PATH2D_LINE, texel::Path2DShape::line, "TEXEL_PATH2D_LINE"},
                                           {TEXEL_PATH2D_CIRCLE, texel::Path2DShape::circle, "TEXEL_PATH2D_CIRCLE"},
                                           {TEXEL_PATH2D_ZIGZAG, texel::Path2DShape::zigzag, "TEXEL_PATH2D_ZIGZAG"}});
-    p.speed_mm_s = c.speed_mm_s;
-    p.angle_deg = c.angle_deg;
-    p.start_x_mm = c.start_x_mm;
-    p.start_y_mm = c.start_y_mm;
-    p.radius_mm = c.radius_mm;
-    p.leg_mm = c.leg_mm;
-    p.zigzag_deg = c.zigzag_deg;
-    p.duration_s = c.duration_s;
-    p.rate_hz = c.rate_hz;
+    copy_path_numbers(c, p);
     const std::vector<texel::FingerSample2D> samples = texel::simulate_path_2d(p);
     if (!check_count(samples.size(), trace, capacity, needed, "trace", "samples")) return;
     for (std::size_t i = 0; i < samples.size(); ++i)
