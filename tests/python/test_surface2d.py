@@ -62,6 +62,7 @@ def save(doc, tmp_path, name="d.texel.json"):
 
 
 def test_render_2d_shape_dtype_and_strips(golden):
+    assert repr(golden) == "<texel.Document on 'golden-2d', 2-D, 4 region(s)>"
     info = texel.bitmap_info(golden)
     assert info["width_px"] == 160 and info["height_px"] == 96 and info["pixel_pitch_mm"] == 0.05
     a = texel.render_2d(golden)
