@@ -162,9 +162,13 @@ struct Encode2DResult {
   /// isotropic field's (docs/algorithm.md §11.1: a bitmap cannot carry a
   /// narrower Irregularity; the value is then a convention, see docs).
   bool irregularity_identifiable = true;
+  /// When not identifiable: every Irregularity up to this (dB, the document's
+  /// parameterization) renders the same field; 0 otherwise.
+  double irregularity_bound_db = 0.0;
   bool texel_length_detected = false;  ///< a lattice of cell borders gave the texel length
   bool coarse = false;                 ///< a coarse profile was found
   bool no_texture = false;             ///< no variation above no_texture_floor (a flat surface)
+  double texture_rms = 0.0;            ///< zero-mean RMS of the amplitude (what no_texture is decided on)
   int model_version = 2;
   EncoderConfig::Target target = EncoderConfig::Target::felt;
   int correction_rounds = 0;            ///< rounds run
