@@ -172,6 +172,45 @@ class EncodeResult:
     samples: int
     spacing_mm: float
 
+class Encode2DResult:
+    document: Document
+    coarse_image: Optional[npt.NDArray[np.float32]]
+    spec: dict[str, Any]
+    central_pitch_db: float
+    irregularity_db: float
+    texel_length_mm: float
+    field: Literal["spectral", "cells", "oriented"]
+    per_direction: list[dict[str, Any]]
+    central_pitch_spread_db: float
+    irregularity_spread_db: float
+    anisotropic: bool
+    strongest_direction_deg: float
+    mean_central_pitch_db: float
+    mean_irregularity_db: float
+    irregularity_identifiable: bool
+    irregularity_bound_db: float
+    texel_length_detected: bool
+    coarse: bool
+    no_texture: bool
+    texture_rms: float
+    model_version: int
+    target: Literal["felt", "centroid"]
+    correction_rounds: int
+    correction_residual_db: float
+    method: Literal["bitmap", "scans"]
+    def to_json(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+
+def encode_2d(source: Union[_Path, _Array], *, pitch_mm: Optional[float] = None, device: Optional[_Device] = None,
+              polarity: Optional[Literal["darker_more_friction", "brighter_more_friction"]] = None,
+              directions: int = 18, scan_samples: int = 16384, correction_rounds: int = 2,
+              field: Optional[Literal["spectral", "cells", "oriented"]] = None, detect_lattice: bool = True,
+              coarse_image_path: str = "coarse.npy", swipe_speed_mm_s: Optional[float] = None,
+              boundary_mm: float = 1.0, texel_length_mm: float = 0.25, seed: int = 1,
+              parameterization: str = "moments", model: int = 2,
+              target: Literal["automatic", "felt", "centroid"] = "automatic",
+              no_texture: Literal["flag", "refuse"] = "flag") -> Encode2DResult: ...
+
 # ---------------------------------------------------------------- signals
 class Signal:
     samples: npt.NDArray[np.float64]

@@ -206,3 +206,46 @@ def test_write_bitmap_refuses_other_extensions(golden, tmp_path):
     with pytest.raises(texel.InvalidArgument, match="png, .npy"):
         texel.write_bitmap(golden, tmp_path / "m.bmp")
     assert not (tmp_path / "m.bmp").exists()
+
+
+# ------------------------------------------------------------ 2-D encoding
+CHEAP = dict(directions=4, scan_samples=1024, correction_rounds=0)  # the encoder's own tests measure its accuracy
+
+
+@pytest.fixture(scope="module")
+def square_map(golden):
+    """A 400 × 400 map of 0.05 mm pixels (20 mm square): large enough to scan 1024 samples along every direction."""
+    doc = variant(golden, one_region=True, width_px=400, height_px=400)
+    return texel.render_2d(doc)
+
+
+def test_encode_2d_array_equals_its_npy_file(square_map, tmp_path):
+    r = texel.encode_2d(square_map, pitch_mm=0.05, **CHEAP)
+    np.save(tmp_path / "m.npy", square_map)
+    assert texel.encode_2d(tmp_path / "m.npy", pitch_mm=0.05, **CHEAP).to_json() == r.to_json()
+    j = json.loads(r.to_json())
+    assert j["estimate"]["central_pitch_db"] == r.central_pitch_db and j["method"] == "bitmap" == r.method
+    assert len(r.per_direction) == 4 and [d["direction_deg"] for d in r.per_direction] == [0, 45, 90, 135]
+    assert r.field in ("spectral", "cells", "oriented") and r.document.version == 4
+    assert r.target == "felt" and r.model_version == 2
+    assert "2-D, 1 region(s)" in repr(r.document)
+
+
+def test_encode_2d_saves_a_document_that_renders(square_map, tmp_path):
+    r = texel.encode_2d(square_map, pitch_mm=0.05, coarse_image_path="m.coarse.npy", **CHEAP)
+    r.save(tmp_path / "m.texel.json")
+    doc = texel.load_document(str(tmp_path / "m.texel.json"))
+    assert texel.render_2d(doc).shape == (400, 400)
+    assert (tmp_path / "m.coarse.npy").exists() == (r.coarse_image is not None)
+
+
+@pytest.mark.parametrize("source,kwargs,match", [
+    (np.zeros((2, 20, 20)), dict(pitch_mm=0.05), "3 dimensions"),
+    (np.zeros((20, 20)), {}, "needs pitch_mm"),
+    (np.full((64, 64), 2.0), dict(pitch_mm=0.05), "outside 0 … 1"),
+    (np.zeros((64, 64)), dict(pitch_mm=0.05, field="round"), "field is 'round'"),
+    (np.zeros((64, 64)), dict(pitch_mm=0.05, target="loudest"), "target is 'loudest'"),
+])
+def test_encode_2d_refuses_bad_input(source, kwargs, match):
+    with pytest.raises(texel.InvalidArgument, match=match):
+        texel.encode_2d(source, **{**CHEAP, **kwargs})
