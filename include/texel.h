@@ -501,6 +501,43 @@ TEXEL_API texel_status texel_swipe_2d(const texel_document* doc, const texel_fin
                                       texel_map2d_mode mode, texel_path_at_lift at_lift, const texel_player_config* config,
                                       float* out, size_t frames, float* x_mm, float* y_mm);
 
+/* ------------------------------------------------------------ 2-D encoding */
+
+/* What the 2-D encoder found (docs/encoder.md, "2-D inputs"): a version-4
+ * 2-D document with one region covering the map, its coarse image and the
+ * per-direction diagnostics. */
+typedef struct texel_encode2d_result texel_encode2d_result;
+
+/* The 2-D encoder's own settings; start from texel_encode2d_options_default(). */
+typedef struct texel_encode2d_options {
+  int directions;        /* scan directions over the half turn, >= 2 [18] */
+  size_t scan_samples;   /* samples per direction (parallel scans joined), >= 1024 [16384] */
+  int correction_rounds; /* analysis-by-synthesis rounds through the 2-D design, 0 = none [2] */
+} texel_encode2d_options;
+
+TEXEL_API texel_encode2d_options texel_encode2d_options_default(void);
+
+/* Encodes a map of width_px × height_px amplitudes in [0, 1] (row-major, rows
+ * along y, pixel pitch pitch_mm): the 1-D encoder's settings from `options`
+ * (the perceptual model, target, …; NULL = the defaults), the 2-D encoder's
+ * from `options2d` (NULL = the defaults). With the defaults a 400 × 400 map
+ * takes about ten seconds. */
+TEXEL_API texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_px, double pitch_mm,
+                                       const texel_encode_options* options, const texel_encode2d_options* options2d,
+                                       texel_encode2d_result** out);
+/* The document (a new handle, the caller's). Its region names its coarse
+ * image as "coarse.npy" beside the document: texel_encode2d_result_save
+ * writes both; rendering the document needs the image there. */
+TEXEL_API texel_status texel_encode2d_result_document(const texel_encode2d_result* result, texel_document** out);
+/* The result as JSON text (NUL-terminated; the buffer rule): parameters,
+ * per-direction rows, anisotropy, flags, model, as `texel encode --json`. */
+TEXEL_API texel_status texel_encode2d_result_json(const texel_encode2d_result* result, char* buffer, size_t capacity,
+                                                  size_t* needed);
+/* Writes the document to document_path and its coarse image beside it,
+ * atomically (nothing is left on failure). */
+TEXEL_API texel_status texel_encode2d_result_save(const texel_encode2d_result* result, const char* document_path);
+TEXEL_API void texel_encode2d_result_destroy(texel_encode2d_result* result);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -31,6 +31,7 @@
 #include "texel/codec.hpp"
 #include "texel/device.hpp"
 #include "texel/document.hpp"
+#include "texel/encode2d.hpp"
 #include "texel/error.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
@@ -61,6 +62,10 @@ struct texel_spectrum {
 
 struct texel_surface2d {
   texel::Surface2D surface;
+};
+
+struct texel_encode2d_result {
+  texel::codec::Encode2DResult result;
 };
 
 struct texel_player {
@@ -974,5 +979,60 @@ texel_status texel_swipe_2d(const texel_document* doc, const texel_finger2d* tra
     if (y_mm) std::copy(ys.begin(), ys.end(), y_mm);
   });
 }
+
+// ------------------------------------------------------------ 2-D encoding
+
+texel_encode2d_options texel_encode2d_options_default(void) {
+  const texel::codec::Encode2DConfig c;
+  texel_encode2d_options o{};
+  o.directions = c.directions;
+  o.scan_samples = c.scan_samples;
+  o.correction_rounds = c.correction_rounds;
+  return o;
+}
+
+texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_px, double pitch_mm,
+                             const texel_encode_options* options, const texel_encode2d_options* options2d,
+                             texel_encode2d_result** out) {
+  return create(out, [&] {
+    need_finite(pitch_mm, "pitch_mm");
+    if (width_px < 1 || height_px < 1)
+      throw InvalidArgument("width_px and height_px are " + std::to_string(width_px) + " and " + std::to_string(height_px) +
+                            "; both must be >= 1");
+    need(amplitudes, "amplitudes");
+    texel::codec::Encode2DConfig config;
+    if (options) config.encoder = config_of(*options);
+    if (options2d) {
+      config.directions = options2d->directions;
+      config.scan_samples = options2d->scan_samples;
+      config.correction_rounds = options2d->correction_rounds;
+    }
+    texel::Raster2D map;
+    map.width = width_px;
+    map.height = height_px;
+    map.pitch = texel::Millimetres(pitch_mm);
+    map.values.assign(amplitudes, amplitudes + static_cast<std::size_t>(width_px) * static_cast<std::size_t>(height_px));
+    return std::make_unique<texel_encode2d_result>(texel_encode2d_result{texel::codec::encode_surface2d(map, config)});
+  });
+}
+
+texel_status texel_encode2d_result_document(const texel_encode2d_result* result, texel_document** out) {
+  return create(out, [&] { return std::make_unique<texel_document>(texel_document{need(result, "result").result.document}); });
+}
+
+texel_status texel_encode2d_result_json(const texel_encode2d_result* result, char* buffer, std::size_t capacity,
+                                        std::size_t* needed) {
+  return guarded([&] {
+    const std::string text = texel::codec::to_json(need(result, "result").result);
+    copy_out(text.c_str(), text.size() + 1, buffer, capacity, needed);
+  });
+}
+
+texel_status texel_encode2d_result_save(const texel_encode2d_result* result, const char* document_path) {
+  return guarded(
+      [&] { texel::codec::write_encoding2d(need(result, "result").result, need_text(document_path, "document_path")); });
+}
+
+void texel_encode2d_result_destroy(texel_encode2d_result* result) { delete result; }
 
 }  // extern "C"

@@ -224,6 +224,52 @@ int main(int argc, char** argv) {
     texel_encode_result_destroy(centroid);
   }
 
+  /* ------------------------------------------------------ 2-D encoding */
+  {
+    enum { side = 400 }; /* 20 mm at 0.05 mm: 1024 samples along every direction */
+    static double map[side * side];
+    texel_encode2d_options o2 = texel_encode2d_options_default();
+    texel_encode2d_result *r = NULL, *bad = NULL;
+    texel_document* encoded = NULL;
+    texel_surface2d* es = NULL;
+    texel_bitmap_info ei;
+    char* json;
+    int j, k;
+    FILE* saved;
+    for (j = 0; j < side; ++j)
+      for (k = 0; k < side; ++k) {
+        const double x = k * 0.05, y = j * 0.05;
+        map[j * side + k] = 0.5 + 0.25 * sin(2 * PI * (2 * x + y)) + 0.25 * sin(2 * PI * (-1.5 * x + 2.5 * y));
+      }
+    CHECK(o2.directions == 18 && o2.scan_samples == 16384 && o2.correction_rounds == 2, "2-D encoder defaults");
+    o2.directions = 4; /* cheap: the encoder's own tests measure its accuracy */
+    o2.scan_samples = 1024;
+    o2.correction_rounds = 0;
+    CHECK(texel_encode_2d(map, side, side, 0.05, NULL, &o2, &r) == TEXEL_OK, "encode_2d");
+    CHECK(texel_encode2d_result_json(r, NULL, 0, &needed) == TEXEL_OK && needed > 1, "json size");
+    json = (char*)malloc(needed);
+    CHECK(texel_encode2d_result_json(r, json, needed, NULL) == TEXEL_OK && strstr(json, "\"central_pitch_db\"") &&
+              strlen(json) + 1 == needed,
+          "json");
+    CHECK(texel_encode2d_result_document(r, &encoded) == TEXEL_OK && texel_surface2d_create(encoded, &es) == TEXEL_OK &&
+              texel_surface2d_info(es, &ei) == TEXEL_OK && ei.width_px == side && ei.height_px == side,
+          "the encoded document is a 2-D surface of the map's size");
+    sprintf(path, "%s/encoded.texel.json", argv[5]);
+    CHECK(texel_encode2d_result_save(r, path) == TEXEL_OK && (saved = fopen(path, "rb")) != NULL && fclose(saved) == 0, "save %s",
+          path);
+    CHECK(texel_encode_2d(map, side, 0, 0.05, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && bad == NULL &&
+              strstr(texel_last_error(), "height_px"),
+          "an empty map");
+    map[7] = 1.5;
+    CHECK(texel_encode_2d(map, side, side, 0.05, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && strstr(texel_last_error(), "1.5"),
+          "a value outside [0, 1]");
+    printf("encode_2d: %s\n", json);
+    free(json);
+    texel_surface2d_destroy(es);
+    texel_document_destroy(encoded);
+    texel_encode2d_result_destroy(r);
+  }
+
   texel_surface2d_destroy(s);
   texel_document_destroy(doc);
   texel_document_destroy(doc1d);
