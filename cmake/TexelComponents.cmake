@@ -29,11 +29,13 @@ texel_component_requires(TEXEL_WITH_SURFACE2D "scans of 2-D fields are measured 
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
 texel_component_requires(TEXEL_WITH_PLAYER "swipe spectra, the serial display protocol"
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_CONTROLLER)
-texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading" TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
+texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading; the 2-D encoder"
+                         TEXEL_WITH_SPECTRUM TEXEL_WITH_IO TEXEL_WITH_SURFACE2D)
 texel_component_requires(TEXEL_WITH_EXPERIMENTS "trials encode, play and plot textures"
                          TEXEL_WITH_CODEC TEXEL_WITH_PLAYER TEXEL_WITH_PLOT)
 texel_component_requires(TEXEL_WITH_STUDIO "the studio runs experiments and shows 2-D surfaces" TEXEL_WITH_EXPERIMENTS TEXEL_WITH_SURFACE2D)
-texel_component_requires(TEXEL_WITH_CAPI "the C ABI encodes and plays" TEXEL_WITH_CODEC TEXEL_WITH_PLAYER)
+texel_component_requires(TEXEL_WITH_CAPI "the C ABI encodes, plays and renders 2-D surfaces" TEXEL_WITH_CODEC TEXEL_WITH_PLAYER
+                         TEXEL_WITH_SURFACE2D)
 
 # The CLI, the tests and the benchmarks use every component.
 set(TEXEL_COMPONENT_OPTIONS TEXEL_WITH_CONTROLLER TEXEL_WITH_SPECTRUM TEXEL_WITH_PLOT TEXEL_WITH_SURFACE2D TEXEL_WITH_PLAYER

@@ -192,6 +192,13 @@ TEXEL_API void texel_surface_destroy(texel_surface* surface);
  * encoder's defaults, as `texel encode`): a .texel bitstream of a few bytes.
  * Takes from well under a second to a few seconds. */
 TEXEL_API texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
+/* What Central Pitch matches (docs/encoder.md §3, "Targets"). */
+typedef enum texel_encode_target {
+  TEXEL_TARGET_AUTOMATIC = 0, /* centroid for time recordings (.wav, time .csv), felt for maps: the default */
+  TEXEL_TARGET_FELT = 1,      /* the perceptual model's felt pitch */
+  TEXEL_TARGET_CENTROID = 2   /* the input's log-spectral centroid: the decoded texture swiped at swipe_speed_mm_s */
+} texel_encode_target;
+
 /* What the encoder is given besides the samples; every field has the
  * default of `texel encode` (texel_encode_options_default()). */
 typedef struct texel_encode_options {
@@ -206,6 +213,8 @@ typedef struct texel_encode_options {
   int model_version;                       /* perceptual model: 2, or 1 (the model before) [2] */
   int refuse_no_texture;                   /* 1: an input without texture is TEXEL_INVALID_ARGUMENT; 0: encoded as a
                                               flat surface with texel_encode_flags.no_texture set [0] */
+  /* Appended after 0.1.0. */
+  texel_encode_target target; /* what Central Pitch matches (`texel encode --target`) [AUTOMATIC] */
 } texel_encode_options;
 
 TEXEL_API texel_encode_options texel_encode_options_default(void);
@@ -246,6 +255,8 @@ typedef struct texel_encode_flags {
   int central_pitch_at_bound;    /* 1: Central Pitch ended at an edge of the search box (a limit, not an estimate) */
   int irregularity_at_bound;     /* 1: Irregularity ended at an edge of the search box */
   int irregularity_identifiable; /* 0: a narrower distribution feels the same, or a value is at a bound */
+  /* Appended after 0.1.0. */
+  texel_encode_target target; /* the target the fit matched: FELT or CENTROID (never AUTOMATIC) */
 } texel_encode_flags;
 TEXEL_API texel_status texel_encode_result_flags(const texel_encode_result* result, texel_encode_flags* out);
 TEXEL_API void texel_encode_result_destroy(texel_encode_result* result);
@@ -393,6 +404,139 @@ TEXEL_API texel_status texel_player_process(texel_player* player, float* out, si
 TEXEL_API uint64_t texel_player_samples(const texel_player* player);
 /* Stop the real-time thread first. */
 TEXEL_API void texel_player_destroy(texel_player* player);
+
+/* ----------------------------------------------------------- 2-D surfaces */
+
+/* A version-4 document with a 2-D surface (docs/format.md "2-D surfaces") on
+ * a device with a bitmap grid renders to a friction bitmap, row j at
+ * y = j·pitch, column i at x = i·pitch, and plays under a 2-D finger through
+ * the 2-D player (docs/player.md "The 2-D player"): the same library calls
+ * as `texel render DOC --surface 2d` and `texel swipe DOC --path|--trace-2d`. */
+typedef struct texel_surface2d texel_surface2d;
+
+typedef enum texel_bitmap_polarity {
+  TEXEL_DARKER_MORE_FRICTION = 0,  /* pixel = a·max */
+  TEXEL_BRIGHTER_MORE_FRICTION = 1 /* pixel = (1 − a)·max */
+} texel_bitmap_polarity;
+
+typedef struct texel_bitmap_info {
+  int width_px;          /* pixels along x */
+  int height_px;         /* pixels (rows) along y */
+  double pixel_pitch_mm; /* pixel spacing on both axes */
+  int depth_bits;        /* 8 or 16: the device's bitmap depth */
+  texel_bitmap_polarity polarity;
+} texel_bitmap_info;
+
+/* Prepares a 2-D document's fields for rendering; TEXEL_INVALID_ARGUMENT for
+ * a document without a 2-D surface or a device without a bitmap grid. */
+TEXEL_API texel_status texel_surface2d_create(const texel_document* doc, texel_surface2d** out);
+TEXEL_API texel_status texel_surface2d_info(const texel_surface2d* surface, texel_bitmap_info* out);
+/* Amplitudes in [0, 1] of pixel rows [first_row, first_row + rows), row-major
+ * into out; count must be rows · width_px. Any strip gives the same values as
+ * the whole bitmap (render a large map a strip at a time). */
+TEXEL_API texel_status texel_surface2d_render_rows(const texel_surface2d* surface, int first_row, int rows, double* out,
+                                                   size_t count);
+/* The same rows as the pixels a bitmap of depth_bits (8 or 16; 0 = the
+ * device's) stores, the device's polarity applied: exactly the pixels of
+ * `texel render DOC --surface 2d --depth D -o map.png`. */
+TEXEL_API texel_status texel_surface2d_render_pixels(const texel_surface2d* surface, int first_row, int rows, int depth_bits,
+                                                     uint16_t* out, size_t count);
+/* Writes the bitmap to `path` by extension (.png, .npy, .mat, .gltf, .glb),
+ * strip by strip and atomically (nothing is left on failure), as `texel
+ * render DOC --surface 2d -o PATH`; depth_bits as above (PNG only). */
+TEXEL_API texel_status texel_surface2d_write(const texel_surface2d* surface, const char* path, int depth_bits);
+TEXEL_API void texel_surface2d_destroy(texel_surface2d* surface);
+
+/* One finger sample on a 2-D surface. */
+typedef struct texel_finger2d {
+  double x_mm, y_mm; /* position, surface coordinates */
+  double t_s;        /* time on the player's clock, non-decreasing */
+  int touch;         /* 0 = lifted */
+} texel_finger2d;
+
+typedef enum texel_path2d_shape {
+  TEXEL_PATH2D_LINE = 0,   /* straight at angle_deg */
+  TEXEL_PATH2D_CIRCLE = 1, /* centred on the start, radius_mm */
+  TEXEL_PATH2D_ZIGZAG = 2  /* legs of leg_mm, zigzag_deg between them, about angle_deg */
+} texel_path2d_shape;
+
+/* A simulated stroke at constant speed (`texel swipe --path`); start from
+ * texel_path2d_config_default(). */
+typedef struct texel_path2d_config {
+  texel_path2d_shape shape; /* [LINE] */
+  double speed_mm_s;        /* > 0 [100] */
+  double angle_deg;         /* [0] */
+  double start_x_mm;        /* where the finger lands; circle: its centre [0] */
+  double start_y_mm;        /* [0] */
+  double radius_mm;         /* circle, > 0 [20] */
+  double leg_mm;            /* zigzag leg, > 0 [10] */
+  double zigzag_deg;        /* angle between legs, 0 < · < 180 [90] */
+  double duration_s;        /* > 0 [1] */
+  double rate_hz;           /* samples per second, > 0 [1000] */
+} texel_path2d_config;
+
+TEXEL_API texel_path2d_config texel_path2d_config_default(void);
+/* The stroke's samples (touching throughout, a lifted sample at the end),
+ * under the buffer rule of this header (capacity and *needed in samples). */
+TEXEL_API texel_status texel_path2d_simulate(const texel_path2d_config* config, texel_finger2d* trace, size_t capacity,
+                                             size_t* needed);
+
+/* What the 2-D player plays of a document. */
+typedef enum texel_map2d_mode {
+  TEXEL_MAP2D_PATH = 0,  /* path-indexed: the texture along the finger's travelled path, the coarse profile at (x, y) */
+  TEXEL_MAP2D_BITMAP = 1 /* the document's friction bitmap at (x, y) */
+} texel_map2d_mode;
+
+typedef enum texel_path_at_lift {
+  TEXEL_PATH_KEEP = 0, /* the path continues across lifts: the default */
+  TEXEL_PATH_RESET = 1 /* every stroke starts the texture over */
+} texel_path_at_lift;
+
+/* Plays a document under a 2-D trace through the 2-D real-time player, off
+ * line (`texel swipe DOC --trace-2d`): `frames` output samples into out and,
+ * if not NULL, the finger position used for each into x_mm / y_mm. The
+ * device's frequency response is the document's. TEXEL_MAP2D_PATH plays a
+ * 2-D surface of one region, or a 1-D document's first Texel texture. */
+TEXEL_API texel_status texel_swipe_2d(const texel_document* doc, const texel_finger2d* trace, size_t samples,
+                                      texel_map2d_mode mode, texel_path_at_lift at_lift, const texel_player_config* config,
+                                      float* out, size_t frames, float* x_mm, float* y_mm);
+
+/* ------------------------------------------------------------ 2-D encoding */
+
+/* What the 2-D encoder found (docs/encoder.md, "2-D inputs"): a version-4
+ * 2-D document with one region covering the map, its coarse image and the
+ * per-direction diagnostics. */
+typedef struct texel_encode2d_result texel_encode2d_result;
+
+/* The 2-D encoder's own settings; start from texel_encode2d_options_default(). */
+typedef struct texel_encode2d_options {
+  int directions;        /* scan directions over the half turn, >= 2 [18] */
+  size_t scan_samples;   /* samples per direction (parallel scans joined), >= 1024 [16384] */
+  int correction_rounds; /* analysis-by-synthesis rounds through the 2-D design, 0 = none [2] */
+} texel_encode2d_options;
+
+TEXEL_API texel_encode2d_options texel_encode2d_options_default(void);
+
+/* Encodes a map of width_px × height_px amplitudes in [0, 1] (row-major, rows
+ * along y, pixel pitch pitch_mm): the 1-D encoder's settings from `options`
+ * (the perceptual model, target, …; NULL = the defaults), the 2-D encoder's
+ * from `options2d` (NULL = the defaults). With the defaults a 400 × 400 map
+ * takes about ten seconds. */
+TEXEL_API texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_px, double pitch_mm,
+                                       const texel_encode_options* options, const texel_encode2d_options* options2d,
+                                       texel_encode2d_result** out);
+/* The document (a new handle, the caller's). Its region names its coarse
+ * image as "coarse.npy" beside the document: texel_encode2d_result_save
+ * writes both; rendering the document needs the image there. */
+TEXEL_API texel_status texel_encode2d_result_document(const texel_encode2d_result* result, texel_document** out);
+/* The result as JSON text (NUL-terminated; the buffer rule): parameters,
+ * per-direction rows, anisotropy, flags, model, as `texel encode --json`. */
+TEXEL_API texel_status texel_encode2d_result_json(const texel_encode2d_result* result, char* buffer, size_t capacity,
+                                                  size_t* needed);
+/* Writes the document to document_path and its coarse image beside it,
+ * atomically (nothing is left on failure). */
+TEXEL_API texel_status texel_encode2d_result_save(const texel_encode2d_result* result, const char* document_path);
+TEXEL_API void texel_encode2d_result_destroy(texel_encode2d_result* result);
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -36,7 +36,18 @@ static int take(const char* name, const mxArray* v, void* ctx) {
     o->max_bytes = (size_t)tm_count(name, v);
   else if (tm_is(name, "recover_texel"))
     o->recover_texel = tm_scalar(name, v) != 0.0;
-  else
+  else if (tm_is(name, "target")) {
+    char* s = tm_text(name, v);
+    if (tm_is(s, "automatic"))
+      o->target = TEXEL_TARGET_AUTOMATIC;
+    else if (tm_is(s, "felt"))
+      o->target = TEXEL_TARGET_FELT;
+    else if (tm_is(s, "centroid"))
+      o->target = TEXEL_TARGET_CENTROID;
+    else
+      mexErrMsgIdAndTxt("texel:invalidArgument", "target '%s' is not one of automatic, felt, centroid", s);
+    mxFree(s);
+  } else
     return 0;
   return 1;
 }
@@ -47,6 +58,7 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   texel_params params;
   int has_profile = 0;
   double jnd = 0.0;
+  texel_encode_flags flags;
   size_t nbytes = 0;
   mxArray* bitstream = NULL;
   texel_status st;
@@ -57,7 +69,7 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   a.options = texel_encode_options_default();
   tm_options(nrhs, prhs, 1, take, &a,
              "spacing_mm, device, swipe_speed_mm_s, boundary_mm, texel_length_mm, parameterization, seed, coarse_bits, "
-             "max_bytes, recover_texel");
+             "max_bytes, recover_texel, target");
   if (mxIsChar(prhs[0])) {
     char* path = tm_text("the path", prhs[0]);
     if (a.has_spacing) tm_usage("spacing_mm is for arrays; a file carries its own spacing");
@@ -71,6 +83,7 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   }
   if (st == TEXEL_OK) st = texel_encode_result_params(result, &params, &has_profile);
   if (st == TEXEL_OK) st = texel_encode_result_distance(result, &jnd);
+  if (st == TEXEL_OK) st = texel_encode_result_flags(result, &flags);
   if (st == TEXEL_OK) st = texel_encode_result_bytes(result, NULL, 0, &nbytes);
   if (st == TEXEL_OK) {
     bitstream = mxCreateNumericMatrix(nbytes, 1, mxUINT8_CLASS, mxREAL);
@@ -82,6 +95,7 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   r = tm_params_struct(&params);
   tm_set(r, "has_coarse_profile", mxCreateLogicalScalar(has_profile != 0));
   tm_set_scalar(r, "distance_jnd", jnd);
+  tm_set_text(r, "target", flags.target == TEXEL_TARGET_CENTROID ? "centroid" : "felt");
   tm_set(r, "bitstream", bitstream);
   plhs[0] = r;
 }

@@ -11,8 +11,12 @@
 %   swipe_speed_mm_s  finger speed: time recordings to position, and the model's speed
 %   boundary_mm [1], texel_length_mm [0.25], parameterization ['moments'],
 %   seed [1], coarse_bits [6], max_bytes [0 = none], recover_texel [true]
+%   target            what Central Pitch matches: 'felt' (the model's felt pitch),
+%                     'centroid' (the input's log-spectral centroid) or 'automatic'
+%                     (centroid for time recordings, felt for maps) ['automatic']
 % r holds the decoded parameters (central_pitch_db, irregularity_db, ...,
-% as texel_render takes them), has_coarse_profile, distance_jnd and
+% as texel_render takes them), has_coarse_profile, distance_jnd, target
+% ('felt' or 'centroid': what the fit matched) and
 % bitstream (uint8 column: the .texel file `texel encode -o` writes).
 %
 % This file is the help text; the MEX function built from texel_encode.c

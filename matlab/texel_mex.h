@@ -1,4 +1,4 @@
-/* texel_mex.h — what the five MEX functions share (docs/matlab.md).
+/* texel_mex.h — what the MEX functions share (docs/matlab.md).
  *
  * The MEX functions are thin front doors over the C ABI (texel.h): they read
  * MATLAB name/value pairs into the C structs, call libtexel, and return

@@ -105,14 +105,9 @@ std::unique_ptr<const PlayerMap2D> player_map_2d(const Surface2DOptions& o, cons
   const Millimetres y0(o.raster_origin_mm.size() < 2 ? 0.0 : o.raster_origin_mm[1]);
   const Millimetres pitch(o.raster_pitch_mm);
   if (o.bitmap) return PlayerMap2D::bitmap(load_raster_npy(*o.bitmap, pitch, x0, y0), doc.device.response);
-  if (doc.surface2d) {  // a 2-D document: its first region's texture along the path, its coarse profile at (x, y)
+  if (doc.surface2d) {  // a 2-D document: its region's texture along the path, its coarse profile at (x, y)
     if (o.coarse_raster) throw InvalidArgument("--coarse-raster: a 2-D document carries its own coarse profile");
-    if (doc.surface2d->regions.size() != 1)
-      throw InvalidArgument("the 2-D player plays a surface of one region; the document has " +
-                            std::to_string(doc.surface2d->regions.size()) + " (render it to a bitmap and use --bitmap)");
-    Raster2D coarse = coarse_raster(doc, 0);
-    return PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)},
-                                     std::move(coarse), std::nullopt, 10000.0, doc.device.response);
+    return PlayerMap2D::path_indexed(doc, coarse_raster(doc, 0));
   }
   std::optional<Raster2D> coarse;
   if (o.coarse_raster) coarse = load_raster_npy(*o.coarse_raster, pitch, x0, y0);

@@ -112,11 +112,14 @@ class PlayerMap2D {
                                                          std::optional<Raster2D> coarse, std::optional<Extent2D> extent,
                                                          double strip_mm = 10000.0,
                                                          std::optional<FrequencyResponse> response = std::nullopt);
-  /// Path-indexed from a 1-D texture document, until 2-D documents exist:
-  /// the fine texture of its first Texel region (prepared for the device's
-  /// grid, so the same seed gives the 1-D document's texels), `coarse` and
-  /// `extent` as above (no coarse raster and no extent: a surface without
-  /// edges), the device's frequency response.
+  /// Path-indexed from a texture document. A 1-D document: the fine
+  /// texture of its first Texel region (prepared for the device's grid, so
+  /// the same seed gives the 1-D document's texels), `coarse` and `extent`
+  /// as above (no coarse raster and no extent: a surface without edges). A
+  /// 2-D document (version 4, one surface2d region; more are refused): that
+  /// region's texture, with `coarse` its coarse raster (required:
+  /// coarse_raster(doc), texel/surface2d.hpp), as `texel swipe DOC --path`
+  /// plays it. Either way the device's frequency response.
   static std::unique_ptr<const PlayerMap2D> path_indexed(const Document& doc, std::optional<Raster2D> coarse,
                                                          std::optional<Extent2D> extent = std::nullopt);
   /// Bitmap: a friction raster, values in [0, 1], covering extent_of(friction).

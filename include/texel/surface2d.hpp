@@ -149,6 +149,23 @@ Raster2D coarse_raster(const Document& doc, std::size_t region = 0, Millimetres 
 /// width·height floats: large maps go through write_bitmap instead.
 Raster2D render_raster(const Surface2D& surface);
 
+/// The pixel a friction bitmap stores for amplitude a (docs/format.md
+/// "Friction bitmaps"): a clamped to [0, 1], taken as 1 − a for a device of
+/// polarity brighter_more_friction, then round(a·255) for depth 8 or
+/// to_u16(a) (round(a·65535)) for depth 16. The one rule of write_bitmap's
+/// PNG pixels and of render_pixel_rows.
+inline std::uint16_t bitmap_pixel(double a, BitmapPolarity polarity, int depth) noexcept {
+  a = a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0;  // NaN -> 0
+  if (polarity == BitmapPolarity::brighter_more_friction) a = 1.0 - a;
+  return depth == 8 ? static_cast<std::uint16_t>(a * 255.0 + 0.5) : to_u16(a);
+}
+/// Pixel rows [first_row, first_row + rows) as a bitmap of `depth` bits (8
+/// or 16; 0 = the device's) stores them: bitmap_pixel of render_rows, row-
+/// major into `out` (rows × width). Exactly the pixels write_bitmap puts in
+/// a PNG of that depth. Throws InvalidArgument for a bad depth, row range or
+/// buffer size.
+void render_pixel_rows(const Surface2D& surface, int first_row, int rows, int depth, std::span<std::uint16_t> out);
+
 /// The best a stationary isotropic field can do for a 1-D target: the 1-D
 /// texture's lognormal frequency density t(k) (truncated to its band) and the
 /// radial spectrum S2 ≥ 0 whose straight scans S1 = A·S2 (the Abel relation,

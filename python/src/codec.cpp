@@ -161,6 +161,9 @@ Raises InvalidArgument when the source is sample data or not one Texel texture o
       .def_readonly("distance_jnd", &codec::EncodeResult::model_distance, "Model distance input ↔ decoded (JND units).")
       .def_readonly("model_distance", &codec::EncodeResult::model_distance, "Old name of distance_jnd (kept for a release).")
       .def_readonly("model_version", &codec::EncodeResult::model_version, "The perceptual model that decided (1 or 2).")
+      .def_property_readonly(
+          "target", [](const codec::EncodeResult& r) { return std::string(codec::to_string(r.target)); },
+          "What Central Pitch matched: 'felt' or 'centroid' (never 'automatic').")
       .def_readonly("no_texture", &codec::EncodeResult::no_texture,
                     "The input has no texture (variation at most 2^-16): a flat surface; P and I are defaults.")
       .def_property_readonly(
@@ -192,10 +195,12 @@ Raises InvalidArgument when the source is sample data or not one Texel texture o
       [](const py::object& source, const py::object& device, std::optional<double> spacing_mm,
          std::optional<double> swipe_speed_mm_s, double boundary_mm, double texel_length_mm, std::uint64_t seed,
          const std::string& parameterization, unsigned coarse_bits, std::optional<std::size_t> max_bytes, const std::string& fit,
-         const std::string& display_response, double drawn_weight, int model, const std::string& no_texture) {
+         const std::string& display_response, double drawn_weight, int model, const std::string& no_texture,
+         const std::string& target) {
         codec::EncoderConfig c;
         c.model = codec::model_defaults(model);
         c.no_texture = codec::parse_no_texture(no_texture, "no_texture");
+        c.target = codec::parse_target(target, "target");
         if (swipe_speed_mm_s) c.model.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
         c.boundary = Millimetres(boundary_mm);
         c.texel_length = Millimetres(texel_length_mm);
@@ -221,7 +226,7 @@ Raises InvalidArgument when the source is sample data or not one Texel texture o
       py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("coarse_bits") = 6u,
       py::arg("max_bytes") = py::none(), py::arg("fit") = "least-squares", py::arg("display_response") = "device",
       py::arg("drawn_weight") = codec::PerceptualModel{}.drawn_weight, py::arg("model") = codec::PerceptualModel{}.version,
-      py::arg("no_texture") = "flag",
+      py::arg("no_texture") = "flag", py::arg("target") = std::string(codec::to_string(codec::EncoderConfig{}.target)),
       R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
 
 source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array, read by
@@ -246,6 +251,9 @@ drawn_weight      weight of the texture as drawn beside the displayed one in the
 model             perceptual model version: 2, or 1 (the model before) [2]
 no_texture        an input without texture: 'flag' (a flat surface, result.no_texture) or 'refuse'
                   (InvalidArgument) ['flag']
+target            what Central Pitch matches: 'felt' (the model's felt pitch), 'centroid' (the input's
+                  log-spectral centroid: the decoded texture swiped at swipe_speed_mm_s) or 'automatic'
+                  (centroid for time recordings such as .wav, felt for maps and arrays) ['automatic']
 
 The GIL is released while encoding.)doc");
 }

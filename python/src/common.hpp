@@ -49,6 +49,8 @@ void register_codec(py::module_& m);
 void register_spectrum(py::module_& m);
 void register_interchange(py::module_& m);
 void register_player(py::module_& m);
+void register_surface2d(py::module_& m);
+void register_encode2d(py::module_& m);
 void register_experiment(py::module_& m);
 
 // Declarations shared between areas (defined in render.cpp).

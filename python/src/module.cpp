@@ -96,9 +96,11 @@ PYBIND11_MODULE(_texel, m) {
   register_render(m);
   register_signal(m);
   register_codec(m);
+  register_encode2d(m);
   register_spectrum(m);
   register_interchange(m);
   register_player(m);
+  register_surface2d(m);
   register_experiment(m);
   register_session(m);
 }

@@ -281,6 +281,9 @@ void register_render(py::module_& m) {
            "The whole map: dtype 'native' (the device's sample format, e.g. uint16 for tpad; the .bin bytes),\n"
            "'float64' (amplitudes 0 … 1), 'uint16', 'uint8' or 'float32'.")
       .def("__repr__", [](const Document& d) {
+        if (d.surface2d)
+          return "<texel.Document on '" + d.device.name + "', 2-D, " + std::to_string(d.surface2d->regions.size()) +
+                 " region(s)>";
         return "<texel.Document on '" + d.device.name + "', " + std::to_string(d.regions.size()) + " region(s)>";
       });
   m.def("load_document", &load_document, py::arg("path"), "Loads and validates a *.texel.json document.");

@@ -158,6 +158,7 @@ class EncodeResult:
     distance_jnd: float
     model_distance: float  # old name of distance_jnd
     model_version: int
+    target: Literal["felt", "centroid"]
     no_texture: bool
     at_bound: dict[str, bool]
     def to_json(self) -> str: ...
@@ -170,6 +171,45 @@ class EncodeResult:
     seconds: float
     samples: int
     spacing_mm: float
+
+class Encode2DResult:
+    document: Document
+    coarse_image: Optional[npt.NDArray[np.float32]]
+    spec: dict[str, Any]
+    central_pitch_db: float
+    irregularity_db: float
+    texel_length_mm: float
+    field: Literal["spectral", "cells", "oriented"]
+    per_direction: list[dict[str, Any]]
+    central_pitch_spread_db: float
+    irregularity_spread_db: float
+    anisotropic: bool
+    strongest_direction_deg: float
+    mean_central_pitch_db: float
+    mean_irregularity_db: float
+    irregularity_identifiable: bool
+    irregularity_bound_db: float
+    texel_length_detected: bool
+    coarse: bool
+    no_texture: bool
+    texture_rms: float
+    model_version: int
+    target: Literal["felt", "centroid"]
+    correction_rounds: int
+    correction_residual_db: float
+    method: Literal["bitmap", "scans"]
+    def to_json(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+
+def encode_2d(source: Union[_Path, _Array], *, pitch_mm: Optional[float] = None, device: Optional[_Device] = None,
+              polarity: Optional[Literal["darker_more_friction", "brighter_more_friction"]] = None,
+              directions: int = 18, scan_samples: int = 16384, correction_rounds: int = 2,
+              field: Optional[Literal["spectral", "cells", "oriented"]] = None, detect_lattice: bool = True,
+              coarse_image_path: str = "coarse.npy", swipe_speed_mm_s: Optional[float] = None,
+              boundary_mm: float = 1.0, texel_length_mm: float = 0.25, seed: int = 1,
+              parameterization: str = "moments", model: int = 2,
+              target: Literal["automatic", "felt", "centroid"] = "automatic",
+              no_texture: Literal["flag", "refuse"] = "flag") -> Encode2DResult: ...
 
 # ---------------------------------------------------------------- signals
 class Signal:
@@ -192,7 +232,8 @@ def encode(source: Union[_Path, _Array], *, device: Optional[_Device] = None, sp
            seed: int = 1, parameterization: str = "moments", coarse_bits: int = 6,
            max_bytes: Optional[int] = None, fit: str = "least-squares",
            display_response: Literal["device", "flat"] = "device", drawn_weight: float = 1.0, model: int = 2,
-           no_texture: Literal["flag", "refuse"] = "flag") -> EncodeResult: ...
+           no_texture: Literal["flag", "refuse"] = "flag",
+           target: Literal["automatic", "felt", "centroid"] = "automatic") -> EncodeResult: ...
 
 # ---------------------------------------------------------------- spectrum
 class Spectrum:
@@ -223,6 +264,31 @@ def swipe(document: Document, *, speed_mm_s: float = 100.0, pattern: str = "cons
           gain: float = 1.0, response: str = "limit") -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
 def swipe_measures(t_s: _Array, x_mm: _Array, touch: Optional[_Array] = None, *,
                    still_below_mm_s: float = 0.0) -> dict[str, float]: ...
+
+# ------------------------------------------------------------- 2-D surfaces
+_Path2D = Literal["line", "circle", "zigzag"]
+_Mode2D = Literal["path", "bitmap"]
+_AtLift = Literal["keep", "reset"]
+_F32 = npt.NDArray[np.float32]
+
+def bitmap_info(device: Union[Document, _Device]) -> Optional[dict[str, Any]]: ...
+def render_2d(document: Document, *, dtype: _DType = "float64",
+              rows: Optional[tuple[int, int]] = None) -> npt.NDArray[Any]: ...
+def coarse_raster(document: Document, *, region: int = 0, pitch_mm: Optional[float] = None) -> dict[str, Any]: ...
+def write_bitmap(document: Document, path: _Path, *, depth: int = 0, mat_version: str = "5") -> dict[str, Any]: ...
+def simulate_path_2d(*, path: _Path2D = "line", speed_mm_s: float = 100.0, angle_deg: float = 0.0,
+                     start_x_mm: float = 0.0, start_y_mm: float = 0.0, radius_mm: float = 20.0, leg_mm: float = 10.0,
+                     zigzag_deg: float = 90.0, duration_s: float = 1.0,
+                     rate_hz: float = 1000.0) -> npt.NDArray[np.float64]: ...
+def render_trace_2d(document: Document, trace: _Array, *, duration_s: Optional[float] = None, mode: _Mode2D = "path",
+                    path_at_lift: _AtLift = "keep", rate_hz: float = 48000.0, output: str = "vibration",
+                    carrier_hz: float = 250.0, prediction_s: float = 0.0, gain: float = 1.0,
+                    response: str = "limit") -> tuple[_F32, _F32, _F32]: ...
+def swipe_2d(document: Document, *, path: _Path2D = "line", speed_mm_s: float = 100.0, angle_deg: float = 0.0,
+             start_x_mm: float = 0.0, start_y_mm: float = 0.0, radius_mm: float = 20.0, leg_mm: float = 10.0,
+             zigzag_deg: float = 90.0, duration_s: float = 2.0, mode: _Mode2D = "path", path_at_lift: _AtLift = "keep",
+             rate_hz: float = 48000.0, output: str = "vibration", carrier_hz: float = 250.0, prediction_s: float = 0.0,
+             gain: float = 1.0, response: str = "limit") -> tuple[_F32, _F32, _F32]: ...
 
 # -------------------------------------------------------------- procedures
 class Staircase:

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <new>
@@ -26,14 +27,18 @@
 #include <variant>
 #include <vector>
 
+#include "texel/bitmap_file.hpp"
 #include "texel/codec.hpp"
 #include "texel/device.hpp"
 #include "texel/document.hpp"
+#include "texel/encode2d.hpp"
 #include "texel/error.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
 #include "texel/reference.hpp"
 #include "texel/spectrum.hpp"
 #include "texel/surface.hpp"
+#include "texel/surface2d.hpp"
 #include "texel/texture.hpp"
 
 struct texel_document {
@@ -53,6 +58,14 @@ struct texel_spectrum {
   texel::SpectralReport report;
   std::size_t samples = 0;
   double spacing_mm = 0.0;
+};
+
+struct texel_surface2d {
+  texel::Surface2D surface;
+};
+
+struct texel_encode2d_result {
+  texel::codec::Encode2DResult result;
 };
 
 struct texel_player {
@@ -133,6 +146,26 @@ long long enum_value(const E& e) {
   return static_cast<long long>(static_cast<int>(v));
 }
 
+// The library value of a C enum field: one row per C value (value, library
+// value, C name); any other value is refused, naming the field and listing
+// what is allowed ("mode is 5; allowed: TEXEL_MAP2D_PATH (0), ...").
+template <class To>
+struct Choice {
+  long long c;
+  To value;
+  const char* name;
+};
+template <class To, class E>
+To choose(const E& e, const char* field, std::initializer_list<Choice<To>> choices) {
+  const long long v = enum_value(e);
+  std::string allowed;
+  for (const Choice<To>& c : choices) {
+    if (c.c == v) return c.value;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(c.name) + " (" + std::to_string(c.c) + ")";
+  }
+  throw InvalidArgument(std::string(field) + " is " + std::to_string(v) + "; allowed: " + allowed);
+}
+
 void need_finite(double v, const char* name) {
   if (!std::isfinite(v)) throw InvalidArgument(std::string(name) + " is not a finite number");
 }
@@ -143,15 +176,24 @@ std::string num(double v) {
   return buf;
 }
 
-// The (buffer, capacity, needed) rule of texel.h for a result of `size`
-// bytes: true when the caller gave a buffer with room for it.
-bool check_buffer(std::size_t size, const void* buffer, std::size_t capacity, std::size_t* needed) {
-  if (!buffer && !needed) throw InvalidArgument("buffer and needed are both NULL; give a buffer or ask for the size");
+// The buffer rule of check_buffer for a result of `size` elements (`unit`)
+// in the buffer the caller names `name`.
+bool check_count(std::size_t size, const void* buffer, std::size_t capacity, std::size_t* needed, const char* name,
+                 const char* unit) {
+  if (!buffer && !needed)
+    throw InvalidArgument(std::string(name) + " and needed are both NULL; give a buffer or ask for the size");
   if (needed) *needed = size;
   if (!buffer) return false;
   if (capacity < size)
-    throw BufferTooSmall{"buffer holds " + std::to_string(capacity) + " bytes; " + std::to_string(size) + " needed"};
+    throw BufferTooSmall{std::string(name) + " holds " + std::to_string(capacity) + " " + unit + "; " + std::to_string(size) +
+                         " needed"};
   return true;
+}
+
+// The (buffer, capacity, needed) rule of texel.h for a result of `size`
+// bytes: true when the caller gave a buffer with room for it.
+bool check_buffer(std::size_t size, const void* buffer, std::size_t capacity, std::size_t* needed) {
+  return check_count(size, buffer, capacity, needed, "buffer", "bytes");
 }
 
 void copy_out(const void* data, std::size_t size, void* buffer, std::size_t capacity, std::size_t* needed) {
@@ -294,7 +336,62 @@ texel::codec::EncoderConfig config_of(const texel_encode_options& o) {
   c.model.swipe_speed = texel::MmPerSecond(o.swipe_speed_mm_s);
   c.no_texture =
       o.refuse_no_texture ? texel::codec::EncoderConfig::NoTexture::refuse : texel::codec::EncoderConfig::NoTexture::flag;
+  using Target = texel::codec::EncoderConfig::Target;
+  c.target = choose<Target>(o.target, "target",
+                            {{TEXEL_TARGET_AUTOMATIC, Target::automatic, "TEXEL_TARGET_AUTOMATIC"},
+                             {TEXEL_TARGET_FELT, Target::felt, "TEXEL_TARGET_FELT"},
+                             {TEXEL_TARGET_CENTROID, Target::centroid, "TEXEL_TARGET_CENTROID"}});
   return c;
+}
+
+// texel_player_config -> PlayerConfig (validated), with the C field names.
+texel::PlayerConfig player_config_of(const texel_player_config& c) {
+  texel::PlayerConfig pc;
+  pc.rate_hz = c.rate_hz;
+  pc.mode = choose<texel::OutputMode>(c.mode, "mode",
+                                      {{TEXEL_OUTPUT_AMPLITUDE, texel::OutputMode::amplitude, "TEXEL_OUTPUT_AMPLITUDE"},
+                                       {TEXEL_OUTPUT_VIBRATION, texel::OutputMode::vibration, "TEXEL_OUTPUT_VIBRATION"},
+                                       {TEXEL_OUTPUT_CARRIER, texel::OutputMode::carrier, "TEXEL_OUTPUT_CARRIER"}});
+  pc.gain = c.gain;
+  pc.carrier_hz = c.carrier_hz;
+  pc.prediction_s = c.prediction_s;
+  pc.response_handling =
+      choose<texel::ResponseHandling>(c.response_handling, "response_handling",
+                                      {{TEXEL_RESPONSE_LIMIT, texel::ResponseHandling::limit, "TEXEL_RESPONSE_LIMIT"},
+                                       {TEXEL_RESPONSE_OFF, texel::ResponseHandling::off, "TEXEL_RESPONSE_OFF"}});
+  pc.response_limit_db = c.response_limit_db;
+  // The library's extrapolation window must cover the look-ahead.
+  pc.extrapolate_s = std::max(pc.extrapolate_s, std::isfinite(c.prediction_s) ? c.prediction_s : 0.0);
+  texel::validate(pc);
+  return pc;
+}
+
+// The numbers of a 2-D path config (texel_path2d_config and Path2DConfig
+// use the same names), either way.
+template <class From, class To>
+void copy_path_numbers(const From& c, To& p) {
+  p.speed_mm_s = c.speed_mm_s;
+  p.angle_deg = c.angle_deg;
+  p.start_x_mm = c.start_x_mm;
+  p.start_y_mm = c.start_y_mm;
+  p.radius_mm = c.radius_mm;
+  p.leg_mm = c.leg_mm;
+  p.zigzag_deg = c.zigzag_deg;
+  p.duration_s = c.duration_s;
+  p.rate_hz = c.rate_hz;
+}
+
+// A row range and buffer of a 2-D surface, named as the C parameters.
+void check_rows(const texel::Surface2D& s, int first_row, int rows, const void* out, std::size_t count) {
+  const texel::BitmapGeometry& g = s.geometry();
+  if (first_row < 0 || rows < 0 || first_row > g.height || rows > g.height - first_row)
+    throw InvalidArgument("first_row " + std::to_string(first_row) + " and rows " + std::to_string(rows) +
+                          " are not within the bitmap's " + std::to_string(g.height) + " rows");
+  const std::size_t n = static_cast<std::size_t>(rows) * static_cast<std::size_t>(g.width);
+  if (count != n)
+    throw InvalidArgument("count is " + std::to_string(count) + "; " + std::to_string(rows) + " rows of " +
+                          std::to_string(g.width) + " pixels are " + std::to_string(n));
+  if (n > 0 && !out) throw InvalidArgument("out is NULL");
 }
 
 std::unique_ptr<texel_encode_result> encoded(const texel::codec::Signal& signal, const texel::codec::EncoderConfig& config) {
@@ -493,6 +590,7 @@ texel_encode_options texel_encode_options_default(void) {
   o.swipe_speed_mm_s = c.model.swipe_speed.value();
   o.model_version = c.model.version;
   o.refuse_no_texture = c.no_texture == texel::codec::EncoderConfig::NoTexture::refuse ? 1 : 0;
+  o.target = TEXEL_TARGET_AUTOMATIC;
   return o;
 }
 
@@ -563,6 +661,7 @@ texel_status texel_encode_result_flags(const texel_encode_result* result, texel_
     f.central_pitch_at_bound = r.at_bound.central_pitch ? 1 : 0;
     f.irregularity_at_bound = r.at_bound.irregularity ? 1 : 0;
     f.irregularity_identifiable = r.irregularity_identifiable ? 1 : 0;
+    f.target = r.target == texel::codec::EncoderConfig::Target::centroid ? TEXEL_TARGET_CENTROID : TEXEL_TARGET_FELT;
   });
 }
 
@@ -692,12 +791,7 @@ texel_status texel_spectrum_get_series(const texel_spectrum* spectrum, texel_spe
         throw InvalidArgument("series is " + std::to_string(enum_value(series)) +
                               "; allowed: TEXEL_SERIES_FREQUENCY_CPM (0) … TEXEL_SERIES_BAND_FRACTION (10)");
     }
-    // The buffer rule of check_buffer, counted in values rather than bytes.
-    if (!values && !needed) throw InvalidArgument("values and needed are both NULL; give a buffer or ask for the size");
-    if (needed) *needed = v->size();
-    if (!values) return;
-    if (capacity < v->size())
-      throw BufferTooSmall{"values holds " + std::to_string(capacity) + " values; " + std::to_string(v->size()) + " needed"};
+    if (!check_count(v->size(), values, capacity, needed, "values", "values")) return;
     std::copy(v->begin(), v->end(), values);
   });
 }
@@ -720,34 +814,7 @@ texel_player_config texel_player_config_default(void) {
 }
 
 texel_status texel_player_create(const texel_player_config* config, texel_player** out) {
-  return create(out, [&] {
-    const texel_player_config& c = need(config, "config");
-    texel::PlayerConfig pc;
-    pc.rate_hz = c.rate_hz;
-    switch (enum_value(c.mode)) {
-      case TEXEL_OUTPUT_AMPLITUDE: pc.mode = texel::OutputMode::amplitude; break;
-      case TEXEL_OUTPUT_VIBRATION: pc.mode = texel::OutputMode::vibration; break;
-      case TEXEL_OUTPUT_CARRIER: pc.mode = texel::OutputMode::carrier; break;
-      default:
-        throw InvalidArgument("mode is " + std::to_string(enum_value(c.mode)) +
-                              "; allowed: TEXEL_OUTPUT_AMPLITUDE (0), TEXEL_OUTPUT_VIBRATION (1), TEXEL_OUTPUT_CARRIER (2)");
-    }
-    pc.gain = c.gain;
-    pc.carrier_hz = c.carrier_hz;
-    pc.prediction_s = c.prediction_s;
-    switch (enum_value(c.response_handling)) {
-      case TEXEL_RESPONSE_LIMIT: pc.response_handling = texel::ResponseHandling::limit; break;
-      case TEXEL_RESPONSE_OFF: pc.response_handling = texel::ResponseHandling::off; break;
-      default:
-        throw InvalidArgument("response_handling is " + std::to_string(enum_value(c.response_handling)) +
-                              "; allowed: TEXEL_RESPONSE_LIMIT (0), TEXEL_RESPONSE_OFF (1)");
-    }
-    pc.response_limit_db = c.response_limit_db;
-    // The library's extrapolation window must cover the look-ahead.
-    pc.extrapolate_s = std::max(pc.extrapolate_s, std::isfinite(c.prediction_s) ? c.prediction_s : 0.0);
-    texel::validate(pc);
-    return std::make_unique<texel_player>(pc);
-  });
+  return create(out, [&] { return std::make_unique<texel_player>(player_config_of(need(config, "config"))); });
 }
 
 texel_status texel_player_set_surface(texel_player* player, const texel_surface* surface) {
@@ -799,5 +866,173 @@ texel_status texel_player_process(texel_player* player, float* out, std::size_t 
 std::uint64_t texel_player_samples(const texel_player* player) { return player ? player->player.samples() : 0; }
 
 void texel_player_destroy(texel_player* player) { delete player; }
+
+// ----------------------------------------------------------- 2-D surfaces
+
+texel_status texel_surface2d_create(const texel_document* doc, texel_surface2d** out) {
+  return create(
+      out, [&] { return std::make_unique<texel_surface2d>(texel_surface2d{texel::prepare_surface2d(need(doc, "doc").doc)}); });
+}
+
+texel_status texel_surface2d_info(const texel_surface2d* surface, texel_bitmap_info* out) {
+  return guarded([&] {
+    const texel::BitmapGeometry& g = need(surface, "surface").surface.geometry();
+    texel_bitmap_info& i = need(out, "out");
+    i.width_px = g.width;
+    i.height_px = g.height;
+    i.pixel_pitch_mm = g.pitch.value();
+    i.depth_bits = g.depth;
+    i.polarity =
+        g.polarity == texel::BitmapPolarity::brighter_more_friction ? TEXEL_BRIGHTER_MORE_FRICTION : TEXEL_DARKER_MORE_FRICTION;
+  });
+}
+
+texel_status texel_surface2d_render_rows(const texel_surface2d* surface, int first_row, int rows, double* out,
+                                         std::size_t count) {
+  return guarded([&] {
+    const texel::Surface2D& s = need(surface, "surface").surface;
+    check_rows(s, first_row, rows, out, count);
+    if (count > 0) s.render_rows(first_row, rows, std::span<double>(out, count));
+  });
+}
+
+texel_status texel_surface2d_render_pixels(const texel_surface2d* surface, int first_row, int rows, int depth_bits,
+                                           std::uint16_t* out, std::size_t count) {
+  return guarded([&] {
+    const texel::Surface2D& s = need(surface, "surface").surface;
+    if (depth_bits != 0 && depth_bits != 8 && depth_bits != 16)
+      throw InvalidArgument("depth_bits is " + std::to_string(depth_bits) + "; allowed: 0 (the device's), 8, 16");
+    check_rows(s, first_row, rows, out, count);
+    if (count > 0) texel::render_pixel_rows(s, first_row, rows, depth_bits, std::span<std::uint16_t>(out, count));
+  });
+}
+
+texel_status texel_surface2d_write(const texel_surface2d* surface, const char* path, int depth_bits) {
+  return guarded([&] {
+    const texel::Surface2D& s = need(surface, "surface").surface;
+    if (depth_bits != 0 && depth_bits != 8 && depth_bits != 16)
+      throw InvalidArgument("depth_bits is " + std::to_string(depth_bits) + "; allowed: 0 (the device's), 8, 16");
+    texel::BitmapFileOptions o;
+    o.depth = depth_bits;
+    texel::write_bitmap(need_text(path, "path"), s, o);
+  });
+}
+
+void texel_surface2d_destroy(texel_surface2d* surface) { delete surface; }
+
+texel_path2d_config texel_path2d_config_default(void) {
+  const texel::Path2DConfig c;
+  texel_path2d_config p{};
+  p.shape = TEXEL_PATH2D_LINE;
+  copy_path_numbers(c, p);
+  return p;
+}
+
+texel_status texel_path2d_simulate(const texel_path2d_config* config, texel_finger2d* trace, std::size_t capacity,
+                                   std::size_t* needed) {
+  return guarded([&] {
+    const texel_path2d_config& c = need(config, "config");
+    texel::Path2DConfig p;
+    p.shape = choose<texel::Path2DShape>(c.shape, "shape",
+                                         {{TEXEL_PATH2D_LINE, texel::Path2DShape::line, "TEXEL_PATH2D_LINE"},
+                                          {TEXEL_PATH2D_CIRCLE, texel::Path2DShape::circle, "TEXEL_PATH2D_CIRCLE"},
+                                          {TEXEL_PATH2D_ZIGZAG, texel::Path2DShape::zigzag, "TEXEL_PATH2D_ZIGZAG"}});
+    copy_path_numbers(c, p);
+    const std::vector<texel::FingerSample2D> samples = texel::simulate_path_2d(p);
+    if (!check_count(samples.size(), trace, capacity, needed, "trace", "samples")) return;
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      trace[i] = texel_finger2d{samples[i].x_mm, samples[i].y_mm, samples[i].t_s, samples[i].touch ? 1 : 0};
+  });
+}
+
+texel_status texel_swipe_2d(const texel_document* doc, const texel_finger2d* trace, std::size_t samples, texel_map2d_mode mode,
+                            texel_path_at_lift at_lift, const texel_player_config* config, float* out, std::size_t frames,
+                            float* x_mm, float* y_mm) {
+  return guarded([&] {
+    const texel::Document& d = need(doc, "doc").doc;
+    texel::PlayerConfig pc = player_config_of(need(config, "config"));
+    pc.response = d.device.response;  // the display's, as `texel swipe` takes it
+    if (samples > 0) need(trace, "trace");
+    if (frames > 0) need(out, "out");
+    const auto lift = choose<texel::PathAtLift>(at_lift, "at_lift",
+                                                {{TEXEL_PATH_KEEP, texel::PathAtLift::keep, "TEXEL_PATH_KEEP"},
+                                                 {TEXEL_PATH_RESET, texel::PathAtLift::reset, "TEXEL_PATH_RESET"}});
+    std::vector<texel::FingerSample2D> t(samples);
+    for (std::size_t i = 0; i < samples; ++i) {
+      const texel_finger2d& f = trace[i];
+      if (!std::isfinite(f.x_mm) || !std::isfinite(f.y_mm) || !std::isfinite(f.t_s))
+        throw InvalidArgument("trace[" + std::to_string(i) + "] is not finite");
+      if (i > 0 && !(f.t_s >= t[i - 1].t_s))
+        throw InvalidArgument("trace[" + std::to_string(i) + "].t_s is below the sample before; times must be non-decreasing");
+      t[i] = texel::FingerSample2D{f.t_s, f.x_mm, f.y_mm, f.touch != 0};
+    }
+    const bool bitmap = choose<bool>(
+        mode, "mode", {{TEXEL_MAP2D_PATH, false, "TEXEL_MAP2D_PATH"}, {TEXEL_MAP2D_BITMAP, true, "TEXEL_MAP2D_BITMAP"}});
+    const std::unique_ptr<const texel::PlayerMap2D> map =
+        bitmap ? texel::PlayerMap2D::bitmap(texel::render_raster(texel::prepare_surface2d(d)), d.device.response)
+               : texel::PlayerMap2D::path_indexed(d, d.surface2d ? std::optional(texel::coarse_raster(d)) : std::nullopt);
+    std::vector<float> xs, ys;
+    const std::vector<float> o =
+        texel::render_trace_2d(*map, pc, t, frames, x_mm ? &xs : nullptr, y_mm ? &ys : nullptr, 64, lift);
+    std::copy(o.begin(), o.end(), out);
+    if (x_mm) std::copy(xs.begin(), xs.end(), x_mm);
+    if (y_mm) std::copy(ys.begin(), ys.end(), y_mm);
+  });
+}
+
+// ------------------------------------------------------------ 2-D encoding
+
+texel_encode2d_options texel_encode2d_options_default(void) {
+  const texel::codec::Encode2DConfig c;
+  texel_encode2d_options o{};
+  o.directions = c.directions;
+  o.scan_samples = c.scan_samples;
+  o.correction_rounds = c.correction_rounds;
+  return o;
+}
+
+texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_px, double pitch_mm,
+                             const texel_encode_options* options, const texel_encode2d_options* options2d,
+                             texel_encode2d_result** out) {
+  return create(out, [&] {
+    need_finite(pitch_mm, "pitch_mm");
+    if (width_px < 1 || height_px < 1)
+      throw InvalidArgument("width_px and height_px are " + std::to_string(width_px) + " and " + std::to_string(height_px) +
+                            "; both must be >= 1");
+    need(amplitudes, "amplitudes");
+    texel::codec::Encode2DConfig config;
+    if (options) config.encoder = config_of(*options);
+    if (options2d) {
+      config.directions = options2d->directions;
+      config.scan_samples = options2d->scan_samples;
+      config.correction_rounds = options2d->correction_rounds;
+    }
+    texel::Raster2D map;
+    map.width = width_px;
+    map.height = height_px;
+    map.pitch = texel::Millimetres(pitch_mm);
+    map.values.assign(amplitudes, amplitudes + static_cast<std::size_t>(width_px) * static_cast<std::size_t>(height_px));
+    return std::make_unique<texel_encode2d_result>(texel_encode2d_result{texel::codec::encode_surface2d(map, config)});
+  });
+}
+
+texel_status texel_encode2d_result_document(const texel_encode2d_result* result, texel_document** out) {
+  return create(out, [&] { return std::make_unique<texel_document>(texel_document{need(result, "result").result.document}); });
+}
+
+texel_status texel_encode2d_result_json(const texel_encode2d_result* result, char* buffer, std::size_t capacity,
+                                        std::size_t* needed) {
+  return guarded([&] {
+    const std::string text = texel::codec::to_json(need(result, "result").result);
+    copy_out(text.c_str(), text.size() + 1, buffer, capacity, needed);
+  });
+}
+
+texel_status texel_encode2d_result_save(const texel_encode2d_result* result, const char* document_path) {
+  return guarded(
+      [&] { texel::codec::write_encoding2d(need(result, "result").result, need_text(document_path, "document_path")); });
+}
+
+void texel_encode2d_result_destroy(texel_encode2d_result* result) { delete result; }
 
 }  // extern "C"

@@ -131,6 +131,14 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const TexelSpec& fi
 
 std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const Document& doc, std::optional<Raster2D> coarse,
                                                              std::optional<Extent2D> extent) {
+  if (doc.surface2d) {  // a 2-D document: its one region's texture along the path, its coarse profile at (x, y)
+    if (doc.surface2d->regions.size() != 1)
+      throw InvalidArgument("the 2-D player plays a surface of one region; the document has " +
+                            std::to_string(doc.surface2d->regions.size()) + " (render it to a bitmap and play that)");
+    if (!coarse) throw InvalidArgument("2-D player map: a 2-D document needs its coarse raster (coarse_raster(doc))");
+    return path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)}, std::move(coarse), extent,
+                        10000.0, doc.device.response);
+  }
   const auto region = std::find_if(doc.regions.begin(), doc.regions.end(), [](const RegionSpec& r) { return !r.reference; });
   if (region == doc.regions.end())
     throw InvalidArgument("2-D player map: the document has no Texel region (a reference has no texels to lay along the path)");

@@ -161,12 +161,12 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
   if (options.rows_per_strip < 1) throw InvalidArgument("rows_per_strip must be >= 1");
   if (options.png_compression < 0 || options.png_compression > 9)
     throw InvalidArgument("png_compression is " + std::to_string(options.png_compression) + "; allowed: 0 … 9");
-  const bool invert = g.polarity == BitmapPolarity::brighter_more_friction;
   const std::size_t w = static_cast<std::size_t>(g.width);
   const std::size_t bytes_per_pixel = static_cast<std::size_t>(depth / 8);
   const std::size_t stride = w * bytes_per_pixel;
   const int strip = options.rows_per_strip;
   const int strips = (g.height + strip - 1) / strip;
+  const bool invert = g.polarity == BitmapPolarity::brighter_more_friction;
   const auto threads = static_cast<int>(map_file_threads(options.threads));
 
   AtomicFile file(path);
@@ -215,9 +215,7 @@ BitmapFileStats write_bitmap(const std::string& path, const Surface2D& surface, 
       unsigned char* out = b.bytes.data();
       if (depth == 8) {
         for (std::size_t k = 0; k < n; ++k) {
-          double a = std::clamp(b.amplitude[k], 0.0, 1.0);
-          if (invert) a = 1.0 - a;
-          out[k] = static_cast<unsigned char>(a * 255.0 + 0.5);
+          out[k] = static_cast<unsigned char>(bitmap_pixel(b.amplitude[k], g.polarity, 8));
         }
         return;
       }

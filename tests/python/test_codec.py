@@ -149,3 +149,44 @@ def test_transcode_is_exact_and_equals_the_cli(cli, tmp_path):
         m = tmp_path / "m.bin"
         cli("render", "--seed", "3", "-o", m)
         texel.transcode(str(m), device="tpad")
+
+
+def ridges(n=19200, dx=0.01, seed=7):
+    """Regular ridges at 2 cycles/mm with two harmonics plus fine grit: a texture whose felt pitch (near the
+    fundamental) and log-spectral centroid (pulled up by the grit) differ by several dB."""
+    x = np.arange(n) * dx
+    rng = np.random.default_rng(seed)
+    y = np.sin(2 * np.pi * 2 * x) + 0.5 * np.sin(2 * np.pi * 4 * x + 1) + 0.25 * np.sin(2 * np.pi * 6 * x + 2)
+    for _ in range(100):
+        y += 0.05 * np.sin(2 * np.pi * 2 * 2 ** (1.5 + 0.5 * rng.normal()) * x + rng.uniform(0, 2 * np.pi))
+    return (y - y.min()) / (y.max() - y.min())
+
+
+def test_encode_target_changes_the_result_and_equals_the_cli(cli_json, tmp_path):
+    a = ridges()
+    felt = texel.encode(a, spacing_mm=0.01)  # an array is a map: automatic is felt
+    assert felt.target == "felt" and texel.encode(a, spacing_mm=0.01, target="felt").bytes == felt.bytes
+    centroid = texel.encode(a, spacing_mm=0.01, target="centroid")
+    assert centroid.target == "centroid"
+    assert centroid.central_pitch_db > felt.central_pitch_db + 1.0  # the grit raises the centroid
+    np.save(tmp_path / "r.npy", a)
+    j = cli_json("encode", tmp_path / "r.npy", "--spacing", 0.01, "--target", "centroid", "-o", tmp_path / "r.texel",
+                 "--json")
+    assert (tmp_path / "r.texel").read_bytes() == centroid.bytes
+    assert j["model"]["target"] == "centroid"
+
+
+def test_encode_recording_defaults_to_the_centroid_target(tmp_path):
+    fs, speed = 10000.0, 100.0
+    x = ridges(n=10000, dx=speed / fs)
+    rec = tmp_path / "rec.csv"
+    rec.write_text("time_s,value\n" + "".join(f"{i / fs!r},{v!r}\n" for i, v in enumerate(x)))
+    auto = texel.encode(rec, swipe_speed_mm_s=speed)
+    assert auto.target == "centroid"
+    felt = texel.encode(rec, swipe_speed_mm_s=speed, target="felt")
+    assert felt.target == "felt" and felt.central_pitch_db != auto.central_pitch_db
+
+
+def test_encode_refuses_an_unknown_target():
+    with pytest.raises(texel.InvalidArgument, match="target is 'loudest'; allowed: automatic, felt, centroid"):
+        texel.encode(ridges(n=4096), spacing_mm=0.01, target="loudest")
