@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "encoder_parts.hpp"
@@ -246,8 +247,41 @@ struct BandSums {
   for (int l = 0; l < 4; ++l) in.physical[l] = phys[l];
 }
 
+/// The largest p[i] and p[i]·h2[i] over [first, n), from 0: running maxima
+/// in four lanes (a maximum is the same whatever order it is taken in).
+[[gnu::always_inline]] inline void band_peaks_lanes(const double* p, const double* h2, std::size_t first, std::size_t n,
+                                                    double& peak, double& peak_felt) {
+  using V = double __attribute__((vector_size(32)));
+  V pk = {0.0, 0.0, 0.0, 0.0}, pkf = pk;
+  std::size_t i = first;
+  for (; i + 4 <= n; i += 4) {
+    V v, h;
+    std::memcpy(&v, p + i, sizeof v);
+    std::memcpy(&h, h2 + i, sizeof h);
+    const V f = v * h;
+    pk = pk < v ? v : pk;
+    pkf = pkf < f ? f : pkf;
+  }
+  double a = 0.0, b = 0.0;
+  for (int l = 0; l < 4; ++l) a = std::max(a, pk[l]), b = std::max(b, pkf[l]);
+  for (; i < n; ++i) a = std::max(a, p[i]), b = std::max(b, p[i] * h2[i]);
+  peak = a, peak_felt = b;
+}
+
 void band_sums_baseline(const BandSums& in) { band_sums_lanes(in); }
 __attribute__((target("avx2"))) void band_sums_avx2(const BandSums& in) { band_sums_lanes(in); }
+using PeaksFn = void (*)(const double*, const double*, std::size_t, std::size_t, double&, double&);
+void band_peaks_baseline(const double* p, const double* h2, std::size_t first, std::size_t n, double& peak, double& peak_felt) {
+  band_peaks_lanes(p, h2, first, n, peak, peak_felt);
+}
+__attribute__((target("avx2"))) void band_peaks_avx2(const double* p, const double* h2, std::size_t first, std::size_t n,
+                                                     double& peak, double& peak_felt) {
+  band_peaks_lanes(p, h2, first, n, peak, peak_felt);
+}
+PeaksFn band_peaks() {
+  static const PeaksFn fn = texel::detail::simd_lanes() >= 4 ? &band_peaks_avx2 : &band_peaks_baseline;
+  return fn;
+}
 
 /// The widest the CPU has (and TEXEL_SIMD allows); every width adds the same bits.
 auto band_sums() -> void (*)(const BandSums&) {
@@ -338,15 +372,9 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   thread_local Sums felt, drawn;
   felt.reset(bands);
   drawn.reset(display ? bands : 0);
-  // The peaks in four interleaved running maxima (a maximum does not depend
-  // on the order it is taken in; independent chains keep the pipeline full).
-  std::array<double, 4> pk{}, pkf{};
-  std::size_t i0 = x.first;
-  for (; i0 + 4 <= p.size(); i0 += 4)
-    for (std::size_t j = 0; j < 4; ++j) pk[j] = std::max(pk[j], p[i0 + j]), pkf[j] = std::max(pkf[j], p[i0 + j] * x.h2[i0 + j]);
-  for (std::size_t i = i0; i < p.size(); ++i) pk[0] = std::max(pk[0], p[i]), pkf[0] = std::max(pkf[0], p[i] * x.h2[i]);
-  const double peak = std::max(std::max(pk[0], pk[1]), std::max(pk[2], pk[3]));
-  const double peak_felt = std::max(std::max(pkf[0], pkf[1]), std::max(pkf[2], pkf[3]));
+  // The peaks (a maximum does not depend on the order it is taken in).
+  double peak = 0.0, peak_felt = 0.0;
+  band_peaks()(p.data(), x.h2.data(), x.first, p.size(), peak, peak_felt);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
   double physical[4];  // sp, spf, spd, spdd
