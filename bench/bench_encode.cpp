@@ -13,7 +13,7 @@
 // clock are shared), the ratio encode / baseline much less: it compares
 // runs taken at different loads or on different machines.
 //
-//   texel_bench_encode [--device NAME] [--repeat N] [--json PATH] [--only NAME] [--model 1|2]
+//   texel_bench_encode [--device NAME] [--repeat N (5)] [--json PATH] [--only NAME] [--model 1|2]
 //
 // --model: the perceptual model version (default: the encoder's, 2).
 // --only keeps the maps whose name contains NAME (for profiling one map).
@@ -130,7 +130,7 @@ struct Map {
 int main(int argc, char** argv) {
   std::string device_name = "tpad";
   std::string json_path, only;
-  int repeat = 3;
+  int repeat = 5;
   int model = codec::PerceptualModel{}.version;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
