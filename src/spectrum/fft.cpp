@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -109,12 +110,12 @@ using Twiddles = Radix4Twiddles;
 /// One radix-4 butterfly on values: radix4_block's arithmetic for one q.
 #define TEXEL_BUTTERFLY(a_r, a_i, b_r, b_i, c_r, c_i, d_r, d_i, W, y0r, y0i, y1r, y1i, y2r, y2i, y3r, y3i) \
   do {                                                                                                     \
-    const double apcr = (a_r) + (c_r), apci = (a_i) + (c_i), amcr = (a_r) - (c_r), amci = (a_i) - (c_i);   \
-    const double bpdr = (b_r) + (d_r), bpdi = (b_i) + (d_i);                                               \
-    const double jr = (b_i) - (d_i), ji = (d_r) - (b_r);                                                   \
-    const double u1r = amcr + jr, u1i = amci + ji;                                                         \
-    const double u2r = apcr - bpdr, u2i = apci - bpdi;                                                     \
-    const double u3r = amcr - jr, u3i = amci - ji;                                                         \
+    const auto apcr = (a_r) + (c_r), apci = (a_i) + (c_i), amcr = (a_r) - (c_r), amci = (a_i) - (c_i);     \
+    const auto bpdr = (b_r) + (d_r), bpdi = (b_i) + (d_i);                                                 \
+    const auto jr = (b_i) - (d_i), ji = (d_r) - (b_r);                                                     \
+    const auto u1r = amcr + jr, u1i = amci + ji;                                                           \
+    const auto u2r = apcr - bpdr, u2i = apci - bpdi;                                                       \
+    const auto u3r = amcr - jr, u3i = amci - ji;                                                           \
     y0r = apcr + bpdr, y0i = apci + bpdi;                                                                  \
     y1r = u1r * W##1r - u1i * W##1i, y1i = u1r * W##1i + u1i * W##1r;                                      \
     y2r = u2r * W##2r - u2i * W##2i, y2i = u2r * W##2i + u2i * W##2r;                                      \
@@ -177,7 +178,6 @@ using Twiddles = Radix4Twiddles;
     }
   }
 }
-#undef TEXEL_BUTTERFLY
 
 using PassFn = void (*)(const double*, const double*, double*, double*, std::size_t, std::size_t, const Twiddles*,
                         const Twiddles*);
@@ -199,9 +199,88 @@ __attribute__((target("avx512f"))) void pass_avx512(const double* xr, const doub
 
 /// The pass for stride s: the widest the CPU has, but AVX2's four lanes for
 /// s = 4 (a block of four fills no AVX-512 vector).
+/// radix16_pass at stride 4 in AVX-512: two groups p' and p' + 1 at once,
+/// whose inputs are eight contiguous points of each stream (one vector:
+/// lanes 0–3 are p', lanes 4–7 p' + 1, each with its own twiddles), so every
+/// cache line read is used whole. Lane by lane radix16_pass's operations;
+/// the two halves of each result go to their groups' outputs. m/4 even.
+__attribute__((target("avx512f"))) void pass4_avx512(const double* xr, const double* xi, double* zr, double* zi, std::size_t m,
+                                                     const Twiddles* ta, const Twiddles* tb) {
+  using V = double __attribute__((vector_size(64)));
+  constexpr std::size_t s = 4;
+  const std::size_t mb = m / 4, step = s * m, sm = s * mb;
+  auto load = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  auto halves = [](double* lo, double* hi, V v) {
+    std::memcpy(lo, &v, 4 * sizeof(double));
+    std::memcpy(hi, reinterpret_cast<const double*>(&v) + 4, 4 * sizeof(double));
+  };
+  for (std::size_t pb = 0; pb + 1 < mb; pb += 2) {
+#define TEXEL_W(N, A, B)                                                                    \
+  const V N##1r = {(A).w1r, (A).w1r, (A).w1r, (A).w1r, (B).w1r, (B).w1r, (B).w1r, (B).w1r}, \
+          N##1i = {(A).w1i, (A).w1i, (A).w1i, (A).w1i, (B).w1i, (B).w1i, (B).w1i, (B).w1i}, \
+          N##2r = {(A).w2r, (A).w2r, (A).w2r, (A).w2r, (B).w2r, (B).w2r, (B).w2r, (B).w2r}, \
+          N##2i = {(A).w2i, (A).w2i, (A).w2i, (A).w2i, (B).w2i, (B).w2i, (B).w2i, (B).w2i}, \
+          N##3r = {(A).w3r, (A).w3r, (A).w3r, (A).w3r, (B).w3r, (B).w3r, (B).w3r, (B).w3r}, \
+          N##3i = {(A).w3i, (A).w3i, (A).w3i, (A).w3i, (B).w3i, (B).w3i, (B).w3i, (B).w3i}
+    TEXEL_W(wa0_, ta[pb], ta[pb + 1]);
+    TEXEL_W(wa1_, ta[pb + mb], ta[pb + 1 + mb]);
+    TEXEL_W(wa2_, ta[pb + 2 * mb], ta[pb + 1 + 2 * mb]);
+    TEXEL_W(wa3_, ta[pb + 3 * mb], ta[pb + 1 + 3 * mb]);
+    TEXEL_W(wb_, tb[pb], tb[pb + 1]);
+#undef TEXEL_W
+    const double* ar = xr + s * pb;
+    const double* ai = xi + s * pb;
+    V t0r0, t0i0, t0r1, t0i1, t0r2, t0i2, t0r3, t0i3;
+    V t1r0, t1i0, t1r1, t1i1, t1r2, t1i2, t1r3, t1i3;
+    V t2r0, t2i0, t2r1, t2i1, t2r2, t2i2, t2r3, t2i3;
+    V t3r0, t3i0, t3r1, t3i1, t3r2, t3i2, t3r3, t3i3;
+#define TEXEL_A(K, W)                                                                                                    \
+  TEXEL_BUTTERFLY(load(ar + K * sm), load(ai + K * sm), load(ar + K * sm + step), load(ai + K * sm + step),              \
+                  load(ar + K * sm + 2 * step), load(ai + K * sm + 2 * step), load(ar + K * sm + 3 * step),              \
+                  load(ai + K * sm + 3 * step), W, t##K##r0, t##K##i0, t##K##r1, t##K##i1, t##K##r2, t##K##i2, t##K##r3, \
+                  t##K##i3)
+    TEXEL_A(0, wa0_);
+    TEXEL_A(1, wa1_);
+    TEXEL_A(2, wa2_);
+    TEXEL_A(3, wa3_);
+#undef TEXEL_A
+    double* o = zr + 16 * s * pb;
+    double* oi = zi + 16 * s * pb;
+#define TEXEL_B(R)                                                                                                            \
+  do {                                                                                                                        \
+    V y0r, y0i, y1r, y1i, y2r, y2i, y3r, y3i;                                                                                 \
+    TEXEL_BUTTERFLY(t0r##R, t0i##R, t1r##R, t1i##R, t2r##R, t2i##R, t3r##R, t3i##R, wb_, y0r, y0i, y1r, y1i, y2r, y2i, y3r,   \
+                    y3i);                                                                                                     \
+    halves(o + s * R, o + 16 * s + s * R, y0r), halves(oi + s * R, oi + 16 * s + s * R, y0i);                                 \
+    halves(o + s * R + 4 * s, o + 16 * s + s * R + 4 * s, y1r), halves(oi + s * R + 4 * s, oi + 16 * s + s * R + 4 * s, y1i); \
+    halves(o + s * R + 8 * s, o + 16 * s + s * R + 8 * s, y2r), halves(oi + s * R + 8 * s, oi + 16 * s + s * R + 8 * s, y2i); \
+    halves(o + s * R + 12 * s, o + 16 * s + s * R + 12 * s, y3r),                                                             \
+        halves(oi + s * R + 12 * s, oi + 16 * s + s * R + 12 * s, y3i);                                                       \
+  } while (false)
+    TEXEL_B(0);
+    TEXEL_B(1);
+    TEXEL_B(2);
+    TEXEL_B(3);
+#undef TEXEL_B
+  }
+}
+#undef TEXEL_BUTTERFLY
+
+void pass4_with_avx512(const double* xr, const double* xi, double* yr, double* yi, std::size_t m, std::size_t s,
+                       const Twiddles* ta, const Twiddles* tb) {
+  if (s == 4 && (m / 4) % 2 == 0)
+    pass4_avx512(xr, xi, yr, yi, m, ta, tb);
+  else
+    pass_avx2(xr, xi, yr, yi, m, s, ta, tb);
+}
+
 PassFn pass_fn(std::size_t s) {
   static const int lanes = detail::simd_lanes();
-  return lanes == 8 && s != 4 ? &pass_avx512 : lanes >= 4 ? &pass_avx2 : &pass_baseline;
+  return lanes == 8 && s != 4 ? &pass_avx512 : lanes == 8 ? &pass4_with_avx512 : lanes >= 4 ? &pass_avx2 : &pass_baseline;
 }
 
 using StageFn = void (*)(const double*, const double*, double*, double*, std::size_t, std::size_t, const Twiddles*);
