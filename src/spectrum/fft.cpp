@@ -151,7 +151,11 @@ using Twiddles = Radix4Twiddles;
     double* __restrict oi = zi + 16 * s * pb;
     // Every output is written once from inputs of another buffer: no
     // dependence between iterations (restrict on locals is not enough for GCC).
+#if defined(__clang__)
+#pragma clang loop vectorize(assume_safety)
+#else
 #pragma GCC ivdep
+#endif
     for (std::size_t q = 0; q < s; ++q) {
       double t0r0, t0i0, t0r1, t0i1, t0r2, t0i2, t0r3, t0i3;  // A's butterfly k = 0, outputs 0…3
       double t1r0, t1i0, t1r1, t1i1, t1r2, t1i2, t1r3, t1i3;
@@ -209,12 +213,13 @@ __attribute__((target("avx512f"))) void pass4_avx512(const double* xr, const dou
   using V = double __attribute__((vector_size(64)));
   constexpr std::size_t s = 4;
   const std::size_t mb = m / 4, step = s * m, sm = s * mb;
-  auto load = [](const double* p) {
+  // Inlined (or the build fails): an out-of-line copy would not be compiled for AVX-512.
+  auto load = [](const double* p) __attribute__((always_inline)) {
     V v;
     std::memcpy(&v, p, sizeof v);
     return v;
   };
-  auto halves = [](double* lo, double* hi, V v) {
+  auto halves = [](double* lo, double* hi, const V& v) __attribute__((always_inline)) {
     std::memcpy(lo, &v, 4 * sizeof(double));
     std::memcpy(hi, reinterpret_cast<const double*>(&v) + 4, 4 * sizeof(double));
   };
