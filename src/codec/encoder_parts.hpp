@@ -38,6 +38,8 @@ void power_spectrum(std::span<const double> x, std::vector<double>& p, std::size
 std::vector<double> centred(std::span<const double> x);
 /// x minus its mean, in place.
 void centre(std::vector<double>& x);
+/// centre(x) and centre(y), the two sums in one pass.
+void centre(std::vector<double>& x, std::vector<double>& y);
 /// How differently two signals of the same length distribute their power
 /// over half-octave bands (dB; docs/encoder.md §1 step 4).
 double shape_distance_db(const std::vector<double>& x, const std::vector<double>& y, double dx);
@@ -126,7 +128,13 @@ struct Fitter {
   std::vector<Drawn> drawn;  // every candidate rendered: the grid's one-draw points are not drawn again with two
   int draws = 2;             // candidate draws per evaluation (1 or 2)
 
+  /// Candidate (P, I) drawn with `seed`, rendered on the input's grid into `a`.
+  void render(double p_db, double i_db, std::uint64_t seed, std::vector<double>& a) const;
+  /// The percept of that candidate, analysed like the input.
   [[nodiscard]] Percept render_percept(double p_db, double i_db, std::uint64_t seed) const;
+  /// render_percept of two draws of a fine-only candidate (the same
+  /// percepts, their means taken in one pass).
+  [[nodiscard]] std::array<Percept, 2> render_percepts(double p_db, double i_db, std::array<std::uint64_t, 2> seeds) const;
   std::optional<Percept> evaluate(double p_db, double i_db);
   /// Mean percept over `draws` candidate draws (common random numbers); none if
   /// (P, I) cannot be rendered. Counts one evaluation unless (P, I) was

@@ -28,7 +28,7 @@ TexelTexture fine_texture(double p_db, double i_db, const EncoderConfig& cfg, Cy
   return TexelTexture(fine_spec(p_db, i_db, cfg, band_max, seed), length, Sampling{Grid{}, band_max});
 }
 
-Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) const {
+void Fitter::render(double p_db, double i_db, std::uint64_t seed, std::vector<double>& a) const {
   TexelSpec s = fine_spec(p_db, i_db, cfg, band_max, seed);
   if (two_scale) {
     s.coarse_strength = two_scale->C;
@@ -37,9 +37,13 @@ Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) con
   }
   const TexelTexture t(s, Millimetres(static_cast<double>(samples) * dx),
                        Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max});
-  thread_local std::vector<double> a;  // reused across candidates (no allocation per evaluation)
   a.resize(samples);
   t.render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(samples)}, 0, a);
+}
+
+Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) const {
+  thread_local std::vector<double> a;  // reused across candidates (no allocation per evaluation)
+  render(p_db, i_db, seed, a);
   if (two_scale) {
     thread_local Split sp;  // reused, like `a`
     split(a, dx, cfg, SplitMode::two_scale, two_scale->window, sp);
@@ -47,6 +51,14 @@ Percept Fitter::render_percept(double p_db, double i_db, std::uint64_t seed) con
   }
   centre(a);
   return perceive(a, dx, cfg.model, f_min);
+}
+
+std::array<Percept, 2> Fitter::render_percepts(double p_db, double i_db, std::array<std::uint64_t, 2> seeds) const {
+  thread_local std::array<std::vector<double>, 2> a;  // reused across candidates
+  render(p_db, i_db, seeds[0], a[0]);
+  render(p_db, i_db, seeds[1], a[1]);
+  centre(a[0], a[1]);
+  return {perceive(a[0], dx, cfg.model, f_min), perceive(a[1], dx, cfg.model, f_min)};
 }
 
 /// Mean percept over two candidate draws (common random numbers: the same
@@ -67,9 +79,20 @@ std::optional<Percept> Fitter::evaluate(double p_db, double i_db) {
   constexpr std::array<std::uint64_t, 2> seeds{0x5EED0001, 0x5EED0002};
   const auto used = static_cast<double>(std::clamp(draws, 1, 2));
   try {
+    auto find = [&](std::size_t d) {
+      return std::find_if(drawn.begin(), drawn.end(),
+                          [&](const Drawn& x) { return x.p_db == p_db && x.i_db == i_db && x.seed == seeds[d]; });
+    };
+    if (used == 2 && !two_scale && find(0) == drawn.end() && find(1) == drawn.end()) {
+      // Both draws new: rendered first, then centred in one pass (each
+      // draw's mean is the same sum; two sums at once instead of one after
+      // the other, each addition waiting for the one before).
+      const std::array<Percept, 2> q = render_percepts(p_db, i_db, seeds);
+      drawn.push_back({p_db, i_db, seeds[0], q[0]});
+      drawn.push_back({p_db, i_db, seeds[1], q[1]});
+    }
     for (std::size_t d = 0; d < static_cast<std::size_t>(used); ++d) {
-      auto seen = std::find_if(drawn.begin(), drawn.end(),
-                               [&](const Drawn& x) { return x.p_db == p_db && x.i_db == i_db && x.seed == seeds[d]; });
+      auto seen = find(d);
       if (seen == drawn.end()) {
         drawn.push_back({p_db, i_db, seeds[d], render_percept(p_db, i_db, seeds[d])});
         seen = drawn.end() - 1;

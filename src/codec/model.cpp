@@ -2,10 +2,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "encoder_parts.hpp"
 #include "texel/detail/format.hpp"
+#include "texel/detail/lanes.hpp"
 #include "texel/error.hpp"
 
 namespace texel::codec {
@@ -203,6 +205,90 @@ Percept perceive_v1(std::span<const double> fine, double spacing_mm, const Perce
   return q;
 }
 
+/// Version 2's per-band sums of the spectrum (perceive_v2): in, the power
+/// p, each bin's frequency f, level d and display gain h2, the bands' ends;
+/// out, per band the felt (through the display, masked at floor_felt)
+/// energy and its sums of f, d, d², the same of the texture as drawn (when
+/// `drawn_e` is given), and over all bands the physical sums.
+struct BandSums {
+  const double *p, *f, *d, *h2;
+  const std::size_t* end;
+  std::size_t first, bands;
+  double floor, floor_felt;
+  double *felt_e, *felt_f, *felt_d, *felt_dd;
+  double *drawn_e, *drawn_f, *drawn_d, *drawn_dd;
+  double* physical;
+};
+
+/// Band by band (each a run of bins), bin by bin in order: the four sums of
+/// a kind (energy, f, d, d²) as the four lanes of one vector. Lane by lane
+/// the same terms are added in the same order as four scalar sums: the
+/// term vector is p·(1, f, d, d)·(1, 1, 1, d) = (p, p·f, p·d, (p·d)·d).
+[[gnu::always_inline]] inline void band_sums_lanes(const BandSums& in) {
+  using V = double __attribute__((vector_size(32)));
+  V phys = {0.0, 0.0, 0.0, 0.0};
+  const bool drawn = in.drawn_e != nullptr;
+  for (std::size_t k = 0, i = in.first; k < in.bands; ++k) {
+    V felt = {0.0, 0.0, 0.0, 0.0}, own = {0.0, 0.0, 0.0, 0.0};
+    for (const std::size_t e = in.end[k]; i < e; ++i) {
+      const double pi = in.p[i];
+      if (!(pi > in.floor)) continue;
+      const double f = in.f[i], d = in.d[i];
+      const V a = {1.0, f, d, d}, b = {1.0, 1.0, 1.0, d};
+      const V term = (pi * a) * b;
+      phys += term;
+      const double w = pi * in.h2[i];
+      if (w > in.floor_felt) felt += (w * a) * b;
+      own += term;
+    }
+    in.felt_e[k] = felt[0], in.felt_f[k] = felt[1], in.felt_d[k] = felt[2], in.felt_dd[k] = felt[3];
+    if (drawn) in.drawn_e[k] = own[0], in.drawn_f[k] = own[1], in.drawn_d[k] = own[2], in.drawn_dd[k] = own[3];
+  }
+  for (int l = 0; l < 4; ++l) in.physical[l] = phys[l];
+}
+
+/// The largest p[i] and p[i]·h2[i] over [first, n), from 0: running maxima
+/// in four lanes (a maximum is the same whatever order it is taken in).
+[[gnu::always_inline]] inline void band_peaks_lanes(const double* p, const double* h2, std::size_t first, std::size_t n,
+                                                    double& peak, double& peak_felt) {
+  using V = double __attribute__((vector_size(32)));
+  V pk = {0.0, 0.0, 0.0, 0.0}, pkf = pk;
+  std::size_t i = first;
+  for (; i + 4 <= n; i += 4) {
+    V v, h;
+    std::memcpy(&v, p + i, sizeof v);
+    std::memcpy(&h, h2 + i, sizeof h);
+    const V f = v * h;
+    pk = pk < v ? v : pk;
+    pkf = pkf < f ? f : pkf;
+  }
+  double a = 0.0, b = 0.0;
+  for (int l = 0; l < 4; ++l) a = std::max(a, pk[l]), b = std::max(b, pkf[l]);
+  for (; i < n; ++i) a = std::max(a, p[i]), b = std::max(b, p[i] * h2[i]);
+  peak = a, peak_felt = b;
+}
+
+void band_sums_baseline(const BandSums& in) { band_sums_lanes(in); }
+__attribute__((target("avx2"))) void band_sums_avx2(const BandSums& in) { band_sums_lanes(in); }
+using PeaksFn = void (*)(const double*, const double*, std::size_t, std::size_t, double&, double&);
+void band_peaks_baseline(const double* p, const double* h2, std::size_t first, std::size_t n, double& peak, double& peak_felt) {
+  band_peaks_lanes(p, h2, first, n, peak, peak_felt);
+}
+__attribute__((target("avx2"))) void band_peaks_avx2(const double* p, const double* h2, std::size_t first, std::size_t n,
+                                                     double& peak, double& peak_felt) {
+  band_peaks_lanes(p, h2, first, n, peak, peak_felt);
+}
+PeaksFn band_peaks() {
+  static const PeaksFn fn = texel::detail::simd_lanes() >= 4 ? &band_peaks_avx2 : &band_peaks_baseline;
+  return fn;
+}
+
+/// The widest the CPU has (and TEXEL_SIMD allows); every width adds the same bits.
+auto band_sums() -> void (*)(const BandSums&) {
+  static void (*const fn)(const BandSums&) = texel::detail::simd_lanes() >= 4 ? &band_sums_avx2 : &band_sums_baseline;
+  return fn;
+}
+
 /// Version 2 threshold of the non-Pacinian channel (dB above the Pacinian
 /// best, 250 Hz): flat 30 dB up to 100 Hz, rising 6 dB/octave above.
 double non_pacinian_db(double hz) { return 30.0 + 6.0 * std::max(0.0, std::log2(std::max(hz, 1e-6) / 100.0)); }
@@ -286,33 +372,16 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   thread_local Sums felt, drawn;
   felt.reset(bands);
   drawn.reset(display ? bands : 0);
-  // The peaks in four interleaved running maxima (a maximum does not depend
-  // on the order it is taken in; independent chains keep the pipeline full).
-  std::array<double, 4> pk{}, pkf{};
-  std::size_t i0 = x.first;
-  for (; i0 + 4 <= p.size(); i0 += 4)
-    for (std::size_t j = 0; j < 4; ++j) pk[j] = std::max(pk[j], p[i0 + j]), pkf[j] = std::max(pkf[j], p[i0 + j] * x.h2[i0 + j]);
-  for (std::size_t i = i0; i < p.size(); ++i) pk[0] = std::max(pk[0], p[i]), pkf[0] = std::max(pkf[0], p[i] * x.h2[i]);
-  const double peak = std::max(std::max(pk[0], pk[1]), std::max(pk[2], pk[3]));
-  const double peak_felt = std::max(std::max(pkf[0], pkf[1]), std::max(pkf[2], pkf[3]));
+  // The peaks (a maximum does not depend on the order it is taken in).
+  double peak = 0.0, peak_felt = 0.0;
+  band_peaks()(p.data(), x.h2.data(), x.first, p.size(), peak, peak_felt);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
-  double sp = 0, spf = 0, spd = 0, spdd = 0;
-  // Band by band (each a run of bins), the band's sums in registers; every
-  // sum adds the same terms in the same order as bin by bin.
-  for (std::size_t k = 0, i = x.first; k < bands; ++k) {
-    double fe = 0, ff = 0, fd = 0, fdd = 0, de = 0, df = 0, dd = 0, ddd = 0;
-    for (; i < x.end[k]; ++i) {
-      if (!(p[i] > floor)) continue;
-      const double f = x.f[i], d = x.d[i];
-      sp += p[i], spf += p[i] * f, spd += p[i] * d, spdd += p[i] * d * d;
-      const double w = p[i] * x.h2[i];
-      if (w > floor_felt) fe += w, ff += w * f, fd += w * d, fdd += w * d * d;
-      de += p[i], df += p[i] * f, dd += p[i] * d, ddd += p[i] * d * d;
-    }
-    felt.e[k] = fe, felt.f[k] = ff, felt.d[k] = fd, felt.dd[k] = fdd;
-    if (display) drawn.e[k] = de, drawn.f[k] = df, drawn.d[k] = dd, drawn.dd[k] = ddd;
-  }
+  double physical[4];  // sp, spf, spd, spdd
+  band_sums()(BandSums{p.data(), x.f.data(), x.d.data(), x.h2.data(), x.end.data(), x.first, bands, floor, floor_felt,
+                       felt.e.data(), felt.f.data(), felt.d.data(), felt.dd.data(), display ? drawn.e.data() : nullptr,
+                       drawn.f.data(), drawn.d.data(), drawn.dd.data(), physical});
+  const double sp = physical[0], spf = physical[1], spd = physical[2], spdd = physical[3];
   if (!(sp > 0.0)) throw InvalidArgument("the fine texture is empty: no spectral content above " + num(f_lo) + " cycles/mm");
   const double s = model.sensitivity_scale, g = model.weight_exponent;
   // Felt pitch and noisiness of one set of band sums.

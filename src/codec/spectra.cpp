@@ -90,6 +90,19 @@ void centre(std::vector<double>& x) {
   for (double& v : x) v -= mean;
 }
 
+void centre(std::vector<double>& x, std::vector<double>& y) {
+  if (x.size() != y.size() || x.empty()) {
+    centre(x), centre(y);
+    return;
+  }
+  // std::accumulate's sums ((0 + x0) + x1) + …, the two interleaved.
+  double sx = 0.0, sy = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) sx += x[i], sy += y[i];
+  const double mx = sx / static_cast<double>(x.size()), my = sy / static_cast<double>(y.size());
+  for (double& v : x) v -= mx;
+  for (double& v : y) v -= my;
+}
+
 std::vector<double> centred(std::span<const double> x) {
   const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
   std::vector<double> y(x.begin(), x.end());

@@ -60,9 +60,10 @@ class Pow2RealFft {
   void add_power(std::span<const double> x, std::span<const double> window, std::span<double> p, bool add = true);
 
  private:
-  /// The complex transform of the packed input in ar_/ai_; the buffers
-  /// holding the result.
-  std::pair<const double*, const double*> transform();
+  /// The complex transform of the packed input in ar_/ai_, whose points
+  /// from `live` on are zero (and need not be stored there unless the
+  /// transform is a single radix-2 stage, size() == 4); the buffers holding the result.
+  std::pair<const double*, const double*> transform(std::size_t live);
   /// The real-input split of the complex transform (zr, zi): sink(k, re, im)
   /// for every k = 0 … size()/2.
   template <class Sink>
@@ -70,6 +71,7 @@ class Pow2RealFft {
 
   std::size_t n_;                          // real length
   std::vector<Radix4Twiddles> tw_;         // per radix-4 stage and p
+  std::vector<double> first_tw_;           // the first stage's, as six arrays of p
   std::vector<double> sr_, si_;            // e^{−2πik/n}, k ≤ n/4: the real split's
   std::vector<double> ar_, ai_, br_, bi_;  // ping-pong buffers
 };
