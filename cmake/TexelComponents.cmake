@@ -30,8 +30,8 @@ texel_component_requires(TEXEL_WITH_SURFACE2D "scans of 2-D fields are measured 
 texel_component_requires(TEXEL_WITH_PLAYER "swipe spectra, the serial display protocol"
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_CONTROLLER)
 texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading" TEXEL_WITH_SPECTRUM TEXEL_WITH_IO)
-texel_component_requires(TEXEL_WITH_EXPERIMENTS "trials encode, play and plot textures"
-                         TEXEL_WITH_CODEC TEXEL_WITH_PLAYER TEXEL_WITH_PLOT)
+texel_component_requires(TEXEL_WITH_EXPERIMENTS "trials encode, play and plot textures and scan 2-D surfaces"
+                         TEXEL_WITH_CODEC TEXEL_WITH_PLAYER TEXEL_WITH_PLOT TEXEL_WITH_SURFACE2D)
 texel_component_requires(TEXEL_WITH_STUDIO "the studio runs experiments" TEXEL_WITH_EXPERIMENTS)
 texel_component_requires(TEXEL_WITH_CAPI "the C ABI encodes and plays" TEXEL_WITH_CODEC TEXEL_WITH_PLAYER)
 
