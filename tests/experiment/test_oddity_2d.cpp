@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -50,17 +51,91 @@ std::vector<ex::MatchPoint> perceived(const json& pair, const json& odd) {
   return out;
 }
 
-TEST(Oddity2D, PerceivedPositions) {
-  for (const std::string mode : {"path-indexed", "spectral", "oriented"}) {
-    const auto p = perceived(json{{"mode", mode}, {"directions_deg", {0, 60}}}, json{{"mode", mode}, {"pitch_shift_db", -2}});
-    std::printf("%s: pair %.2f/%.2f  %.2f/%.2f odd %.2f/%.2f\n", mode.c_str(), p[0].pitch_db, p[0].irregularity_db, p[1].pitch_db,
-                p[1].irregularity_db, p[2].pitch_db, p[2].irregularity_db);
-  }
+TEST(Oddity2D, ShippedProtocolsValidate) {
+  const ex::Protocol d = ex::parse_protocol(texel::read_file(dir + "direction-independence.json"));
+  EXPECT_EQ(d.planned_trials(), 62);
+  const ex::Protocol r = ex::parse_protocol(texel::read_file(dir + "rendering-2d.json"));
+  EXPECT_EQ(r.planned_trials(), 48);
+  auto message = [](std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    return texel::test_support::message_of<texel::FormatError>([&] { (void)ex::parse_protocol(text); });
+  };
+  const std::string text = texel::read_file(dir + "direction-independence.json");
+  EXPECT_NE(message(text, "\"device\": \"tablet-2d\"", "\"device\": \"tpad\"").find("no bitmap grid"), std::string::npos);
+  EXPECT_NE(message(text, "\"mode\": \"spectral\"", "\"mode\": \"bitmap\"").find("conditions[2].pair.mode is 'bitmap'"),
+            std::string::npos);
+  EXPECT_NE(message(text, "\"pitch_shift_db\": -2", "\"pitch_shift_db\": -2, \"directions_deg\": [0, 1]")
+                .find("odd.directions_deg applies to the pair only"),
+            std::string::npos);
+  EXPECT_NE(message(text, "\"trials_per_condition\": 10", "\"trials_per_condition\": 10, \"staircase\": {}")
+                .find("staircase does not apply to task 'oddity-2d'"),
+            std::string::npos);
+}
+
+// The pair's two swipes of an oriented grating (wave vector at 0°) along 0°
+// and 60° are felt an octave apart (|cos 60°| = 1/2: −3 dB); the
+// path-indexed texture's are felt alike, and so are the isotropic field's.
+TEST(Oddity2D, ObserversFeelTheOrientedGratingsDirectionAndNotThePathIndexedOnes) {
+  const json oriented{{"mode", "oriented"}, {"orientation_deg", 0}, {"directions_deg", {0, 60}}};
+  const json path{{"mode", "path-indexed"}, {"directions_deg", {0, 60}}};
+  const json spectral{{"mode", "spectral"}, {"directions_deg", {0, 60}}};
+  const auto po = perceived(oriented, json{{"mode", "oriented"}, {"pitch_shift_db", -2}});
+  const auto pp = perceived(path, json{{"mode", "path-indexed"}, {"pitch_shift_db", -2}});
+  const auto ps = perceived(spectral, json{{"mode", "spectral"}, {"pitch_shift_db", -2}});
+  EXPECT_NEAR(po[0].pitch_db - po[1].pitch_db, 3.0, 0.5);  // 0° against 60°
+  EXPECT_LT(std::abs(pp[0].pitch_db - pp[1].pitch_db), 0.3);
+  EXPECT_LT(std::abs(ps[0].pitch_db - ps[1].pitch_db), 1.5);
+  // Every interval's percept is near its texture: 3 dB, the odd one 1 dB.
+  EXPECT_NEAR(pp[0].pitch_db, 3.0, 0.3);
+  EXPECT_NEAR(pp[2].pitch_db, 1.0, 0.3);
+
+  // Noise-free observers pick the odd one of the path-indexed trial and a
+  // pair member of the oriented one.
+  ex::MatcherConfig c;
+  c.noise_db = 0.0;
+  const ex::Matcher m(c);
+  EXPECT_EQ(m.odd_one(pp, 0), 2u);
+  EXPECT_NE(m.odd_one(po, 0), 2u);
+}
+
+// Simulated sessions, stored, exported and analysed: the oriented control's
+// direction pair is discriminated (proportion correct drops from the
+// same-direction pair), the path-indexed one's is not.
+TEST(Oddity2D, SimulatedRunExportAndAnalysisThroughTheCli) {
+  texel::test_support::TempDir tmp("oddity-2d");
+  json p = json::parse(texel::read_file(dir + "direction-independence.json"));
+  p["blocks"].erase(0);  // no practice
+  json& b = p["blocks"][0];
+  b["trials_per_condition"] = 12;
+  json kept = json::array();
+  for (const auto& c : b["conditions"])
+    if (c["name"].get<std::string>().rfind("spectral", 0) != 0) kept.push_back(c);  // spectral: the slow field
+  b["conditions"] = kept;
+  const std::string protocol_path = tmp.at("d.json");
+  texel::write_file_atomic(protocol_path, p.dump(2));
+  const std::string db = tmp.at("s.db");
+  const auto run = texel::test_support::run_cli(
+      TEXEL_CLI, "experiment run " + protocol_path + " --participant S01 --db " + db + " --simulate default");
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto csv_run = texel::test_support::run_cli(TEXEL_CLI, "experiment export --db " + db + " -o " + tmp.at("t.csv"));
+  ASSERT_EQ(csv_run.status, 0) << csv_run.out;
+  const std::string csv = texel::read_file(tmp.at("t.csv"));
+  EXPECT_NE(csv.find(",oddity-2d,path-indexed 0/60,path-indexed,direction_difference_deg,60,"), std::string::npos)
+      << csv.substr(0, 600);
+  const auto an = texel::test_support::run_cli(TEXEL_CLI, "experiment analyze --db " + db + " --json -o " + tmp.at("fig"), false);
+  ASSERT_EQ(an.status, 0) << an.out;
+  const json s = json::parse(an.out);
+  const json& d = s.contains("summary") ? s["summary"]["direction-independence"] : s["direction-independence"];
+  ASSERT_EQ(d["conditions"].size(), 4u);
+  std::map<std::string, double> prop;
+  for (const auto& c : d["conditions"]) prop[c["condition"].get<std::string>()] = c["proportion"].get<double>();
+  EXPECT_GT(prop["path-indexed 0/60"], 0.6);
+  EXPECT_LT(prop["oriented 0/60"], prop["oriented 0/0"] - 0.3);
+  for (const auto& e : d["direction_effects"])
+    EXPECT_EQ(e["directions_discriminated"].get<bool>(), e["mode"] == "oriented") << e.dump();
+  EXPECT_TRUE(std::filesystem::exists(tmp.at("fig") + "/direction-independence-proportion-correct.png"));
 }
 
 }  // namespace
-TEST(Oddity2D, Dump) {
-  json p = json::parse(texel::read_file(dir + "direction-independence.json"));
-  ex::Session s(ex::parse_protocol(protocol(json{{"mode", "path-indexed"}, {"directions_deg", {0, 60}}}, json{{"mode", "path-indexed"}})), ex::SessionContext{});
-  std::FILE* f = std::fopen("/tmp/h26s/stim.json", "w"); std::fputs(s.question().stimuli[0].document_json.c_str(), f); std::fclose(f);
-}
