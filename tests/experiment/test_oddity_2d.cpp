@@ -14,12 +14,14 @@
 
 #include "../support/cli_run.hpp"
 #include "../support/expect.hpp"
+#include "../support/service_client.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/observer.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/session.hpp"
 #include "texel/io.hpp"
+#include "texel/studio/service.hpp"
 
 namespace ex = texel::experiment;
 using json = nlohmann::json;
@@ -136,6 +138,38 @@ TEST(Oddity2D, SimulatedRunExportAndAnalysisThroughTheCli) {
   for (const auto& e : d["direction_effects"])
     EXPECT_EQ(e["directions_discriminated"].get<bool>(), e["mode"] == "oriented") << e.dump();
   EXPECT_TRUE(std::filesystem::exists(tmp.at("fig") + "/direction-independence-proportion-correct.png"));
+}
+
+// The studio's experiment messages run the kind (simulated answers through
+// experiment.answer); the question a participant's screen gets names
+// neither the condition nor the mode nor the directions.
+TEST(Oddity2D, RunsThroughTheStudio) {
+  using namespace std::chrono_literals;
+  texel::test_support::TempDir tmp("oddity-2d-studio");
+  texel::studio::ServiceOptions o;
+  o.db_path = tmp.at("s.db");
+  texel::studio::Service service(o);
+  texel::test_support::Client client(service);
+  auto ask = [&](json msg) { return client.ask(std::move(msg), 60s); };
+  const json p = json::parse(protocol(json{{"mode", "oriented"}, {"orientation_deg", 0}, {"directions_deg", {0, 60}}},
+                                      json{{"mode", "path-indexed"}, {"pitch_shift_db", -2}}, 3));
+  const json started = ask({{"type", "experiment.start"}, {"protocol", p}, {"participant", "P01"}, {"simulate", "default"}});
+  ASSERT_EQ(started["type"], "experiment.started") << started.dump();
+  EXPECT_EQ(started["progress"]["planned"], 3);
+  json q = ask({{"type", "experiment.current"}});
+  int answered = 0;
+  while (q["type"] == "experiment.question") {
+    const json& question = q["question"];
+    EXPECT_EQ(question["task"], "oddity-2d");
+    EXPECT_EQ(question["choices"], json({"1", "2", "3"}));
+    const std::string shown = question.dump();
+    for (const char* hidden : {"oriented", "path-indexed", "_deg", "reference", "\"condition\":\"c\"", "correct"})
+      EXPECT_EQ(shown.find(hidden), std::string::npos) << hidden << " in " << shown.substr(0, 400);
+    q = ask({{"type", "experiment.answer"}, {"trial", question["trial"]}, {"simulated", true}});
+    ++answered;
+  }
+  EXPECT_EQ(q["type"], "experiment.finished") << q.dump();
+  EXPECT_EQ(answered, 3);
 }
 
 }  // namespace
