@@ -19,6 +19,9 @@
 #include "texel/error.hpp"
 #include "texel/experiment/observer.hpp"
 #include "texel/experiment/protocol.hpp"
+#include "texel/experiment/runner.hpp"
+#include "texel/experiment/simulate.hpp"
+#include "texel/experiment/store.hpp"
 #include "texel/experiment/session.hpp"
 #include "texel/io.hpp"
 #include "texel/studio/service.hpp"
@@ -138,6 +141,30 @@ TEST(Oddity2D, SimulatedRunExportAndAnalysisThroughTheCli) {
   for (const auto& e : d["direction_effects"])
     EXPECT_EQ(e["directions_discriminated"].get<bool>(), e["mode"] == "oriented") << e.dump();
   EXPECT_TRUE(std::filesystem::exists(tmp.at("fig") + "/direction-independence-proportion-correct.png"));
+}
+
+// Resume is replay: a session stopped after three trials reopens with the
+// same questions (stored questions are compared with the ones the engine
+// would ask now, scans of the static fields included) and continues.
+TEST(Oddity2D, ResumesWhereItStopped) {
+  texel::test_support::TempDir tmp("oddity-2d-resume");
+  const ex::Protocol p = ex::parse_protocol(protocol(json{{"mode", "spectral"}, {"directions_deg", {0, 60}}},
+                                                     json{{"mode", "spectral"}, {"pitch_shift_db", -2}}, 5));
+  std::string third;
+  {
+    ex::Store store = ex::Store::open(tmp.at("s.db"), ex::StoreMode::read_write);
+    ex::ActiveSession a = ex::open_session(store, p, {"P01", false, "default"});
+    const ex::SimulatedParticipant who(ex::simulation_observer(p.observer, "default"), a.session);
+    for (int i = 0; i < 3; ++i) {
+      if (i == 2) third = a.session.question().to_json();
+      (void)ex::record(store, a, who.respond(a.session));
+    }
+  }
+  ex::Store store = ex::Store::open(tmp.at("s.db"), ex::StoreMode::read_write);
+  ex::ActiveSession a = ex::open_session(store, p, {"P01", true, std::nullopt});
+  EXPECT_EQ(a.session.question().trial, 3);
+  EXPECT_EQ(store.rows().size(), 3u);
+  EXPECT_NE(third.find("\"points\""), std::string::npos);  // the scan is in the stored question
 }
 
 // The studio's experiment messages run the kind (simulated answers through

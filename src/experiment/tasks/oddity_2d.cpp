@@ -123,7 +123,7 @@ class Renderer {
 
   std::string stimulus(const View& v, double direction_deg, std::uint64_t seed, Offset offset = {}) const {
     json tex = texel_texture(texture_of(b_.texture), seed);
-    tex["seed"] = seed;
+    tex["seed"] = seed;  // also over a template's own seed: no two intervals are copies
     tex["central_pitch_db"] = tex.value("central_pitch_db", 0.0) + v.pitch_shift_db;
     tex["irregularity_db"] = tex.value("irregularity_db", 0.0) + v.irregularity_shift_db;
     if (v.mode == "1d") return s_.single(tex, b_.display_mm);
