@@ -20,9 +20,9 @@
 #include "texel/experiment/observer.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/runner.hpp"
+#include "texel/experiment/session.hpp"
 #include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
-#include "texel/experiment/session.hpp"
 #include "texel/io.hpp"
 #include "texel/studio/service.hpp"
 
@@ -148,8 +148,8 @@ TEST(Oddity2D, SimulatedRunExportAndAnalysisThroughTheCli) {
 // would ask now, scans of the static fields included) and continues.
 TEST(Oddity2D, ResumesWhereItStopped) {
   texel::test_support::TempDir tmp("oddity-2d-resume");
-  const ex::Protocol p = ex::parse_protocol(protocol(json{{"mode", "spectral"}, {"directions_deg", {0, 60}}},
-                                                     json{{"mode", "spectral"}, {"pitch_shift_db", -2}}, 5));
+  const ex::Protocol p = ex::parse_protocol(
+      protocol(json{{"mode", "oriented"}, {"directions_deg", {0, 60}}}, json{{"mode", "cells"}, {"pitch_shift_db", -2}}, 5));
   std::string third;
   {
     ex::Store store = ex::Store::open(tmp.at("s.db"), ex::StoreMode::read_write);
