@@ -649,14 +649,16 @@ Figure memory_figure(const json& s) {
 // ------------------------------------------------------- 2-D oddity studies
 
 // Proportion correct per condition with its Wilson CI, chance (1/3) dashed;
-// conditions coloured by mode; for the direction study, the one-sided
+// conditions coloured by the pair's mode (direction study) or by block
+// (the rendering study, whose pairs are all 1-D); for the direction study, the one-sided
 // Fisher p of each direction pair against its same-direction baseline
 // printed over it.
 Figure oddity_figure(const Study& study, const json& s, double level) {
+  const char* group = s.contains("direction_effects") ? "mode" : "block";
   std::vector<std::string> names, modes;
   for (const auto& c : s["conditions"]) {
     names.push_back(c["condition"].get<std::string>());
-    const std::string m = c["mode"].get<std::string>();
+    const std::string m = c[group].get<std::string>();
     if (std::find(modes.begin(), modes.end(), m) == modes.end()) modes.push_back(m);
   }
   Figure f = figure(std::string(study.title) + ": proportion correct (oddity)", category_width(names, 720), 480);
@@ -672,7 +674,7 @@ Figure oddity_figure(const Study& study, const json& s, double level) {
     e.cap_px = 0;
     for (std::size_t i = 0; i < names.size(); ++i) {
       const json& c = s["conditions"][i];
-      if (c["mode"] != modes[k]) continue;
+      if (c[group] != modes[k]) continue;
       e.x.push_back(static_cast<double>(i));
       e.y.push_back(d(c["proportion"]));
       e.error.push_back(std::nan(""));
@@ -691,7 +693,8 @@ Figure oddity_figure(const Study& study, const json& s, double level) {
     for (const auto& e : s["direction_effects"]) {
       const auto it = std::find(names.begin(), names.end(), e["condition"].get<std::string>());
       p.notes.push_back(TextNote{static_cast<double>(it - names.begin()), 1.09,
-                                 "p = " + texel::detail::fixed(d(e["p_fisher"]), 3), Rgb{0.1, 0.1, 0.1}, 0.0});
+                                 d(e["p_fisher"]) < 0.001 ? "p < 0.001" : "p = " + texel::detail::fixed(d(e["p_fisher"]), 3),
+                                 Rgb{0.1, 0.1, 0.1}, 0.0});
     }
   f.panels.push_back(std::move(p));
   return f;
