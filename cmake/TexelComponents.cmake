@@ -31,8 +31,8 @@ texel_component_requires(TEXEL_WITH_PLAYER "swipe spectra, the serial display pr
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_CONTROLLER)
 texel_component_requires(TEXEL_WITH_CODEC "the encoder's analysis and signal loading; the 2-D encoder"
                          TEXEL_WITH_SPECTRUM TEXEL_WITH_IO TEXEL_WITH_SURFACE2D)
-texel_component_requires(TEXEL_WITH_EXPERIMENTS "trials encode, play and plot textures"
-                         TEXEL_WITH_CODEC TEXEL_WITH_PLAYER TEXEL_WITH_PLOT)
+texel_component_requires(TEXEL_WITH_EXPERIMENTS "trials encode, play and plot textures and scan 2-D surfaces"
+                         TEXEL_WITH_CODEC TEXEL_WITH_PLAYER TEXEL_WITH_PLOT TEXEL_WITH_SURFACE2D)
 texel_component_requires(TEXEL_WITH_STUDIO "the studio runs experiments and shows 2-D surfaces" TEXEL_WITH_EXPERIMENTS TEXEL_WITH_SURFACE2D)
 texel_component_requires(TEXEL_WITH_CAPI "the C ABI encodes, plays and renders 2-D surfaces" TEXEL_WITH_CODEC TEXEL_WITH_PLAYER
                          TEXEL_WITH_SURFACE2D)

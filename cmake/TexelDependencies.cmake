@@ -111,7 +111,7 @@ set(TEXEL_COMPONENT_NEEDS_player core controller spectrum)
 set(TEXEL_COMPONENT_NEEDS_io core)
 set(TEXEL_COMPONENT_NEEDS_surface2d core io spectrum)
 set(TEXEL_COMPONENT_NEEDS_codec core io spectrum surface2d)
-set(TEXEL_COMPONENT_NEEDS_experiment core codec player plot spectrum)
+set(TEXEL_COMPONENT_NEEDS_experiment core codec player plot spectrum surface2d)
 set(TEXEL_COMPONENT_NEEDS_studio core codec experiment player plot spectrum)
 # The C library is whole in itself (libtexel.so, libtexel.a: src/capi), built
 # from core, codec and player but needing none of their targets installed.

@@ -21,6 +21,7 @@ constexpr std::uint64_t stream_psychometric = static_cast<std::uint64_t>(Stream:
 constexpr std::uint64_t stream_choose = static_cast<std::uint64_t>(Stream::user) + 11;        // counter: 2·trial (+1)
 constexpr std::uint64_t stream_adjust = static_cast<std::uint64_t>(Stream::user) + 12;        // counter: 2·trial (+1)
 constexpr std::uint64_t stream_rate = static_cast<std::uint64_t>(Stream::user) + 13;          // counter: trial
+constexpr std::uint64_t stream_odd = static_cast<std::uint64_t>(Stream::user) + 14;           // counter: 64·trial + 2·i (+1)
 
 std::string num(double v) {
   std::ostringstream s;
@@ -136,6 +137,66 @@ int Matcher::confidence(std::uint64_t trial) const {
   return 1;
 }
 
+std::size_t Matcher::odd_one(std::span<const MatchPoint> perceived, std::uint64_t trial) const {
+  if (perceived.size() < 3 || perceived.size() > 32)
+    throw InvalidArgument("odd_one: " + std::to_string(perceived.size()) + " positions (allowed: 3 … 32)");
+  const CounterRng rng(config_.seed, stream_odd);
+  std::vector<MatchPoint> p(perceived.begin(), perceived.end());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p[i].pitch_db += config_.noise_db * rng.normal(64 * trial + 2 * i);
+    p[i].irregularity_db += config_.noise_db * rng.normal(64 * trial + 2 * i + 1);
+  }
+  std::size_t best = 0;
+  double best_sum = -1.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+      const double dp = p[i].pitch_db - p[j].pitch_db;
+      const double di = config_.irregularity_weight * (p[i].irregularity_db - p[j].irregularity_db);
+      sum += std::sqrt(dp * dp + di * di);
+    }
+    if (sum > best_sum) best_sum = sum, best = i;
+  }
+  return best;
+}
+
+namespace {
+
+// As `texel encode --device`: the encoder's default perceptual model
+// (codec::PerceptualModel::version, docs/encoder.md §2), the display's
+// response in its loop, so simulated observers feel what the encoder does.
+MatchPoint perceive(codec::Signal signal, const DeviceProfile& profile) {
+  codec::EncoderConfig cfg;
+  cfg.model = codec::model_defaults(codec::PerceptualModel{}.version);
+  cfg.model.display = profile.response;
+  const codec::EncodeResult r = codec::encode(signal, cfg);
+  return {r.spec.central_pitch.value(), r.spec.irregularity.value()};
+}
+
+}  // namespace
+
+std::optional<MatchPoint> perceive_document(const std::string& document_json, double length_mm) {
+  const Document doc = parse_document(document_json, "stimulus");
+  codec::Signal signal;
+  signal.amplitude = prepare_surface(doc).render();
+  signal.spacing = doc.device.spacing;
+  if (length_mm > 0) {
+    const auto n = static_cast<std::size_t>(std::floor(length_mm / doc.device.spacing.value() + 1e-9));
+    if (n < 2 || n > signal.amplitude.size())
+      throw InvalidArgument("length_mm: " + num(length_mm) + " (allowed: 2 samples … the device's length)");
+    signal.amplitude.resize(n);
+  }
+  signal.description = "stimulus on " + doc.device.name;
+  try {
+    return perceive(std::move(signal), doc.device);
+  } catch (const FormatError&) {
+    // Without a fine part the encoder reports its 10 dB default pitch,
+    // which a device whose band ends lower (tablet-2d: 7.15 dB) cannot
+    // render: the stimulus has no fine texture to perceive.
+    return std::nullopt;
+  }
+}
+
 MatchPoint perceptual_target(const std::string& reference_name, const std::string& device) {
   (void)reference_info(reference_name);  // throws InvalidArgument listing the names
   const DeviceProfile profile = load_device(device);
@@ -147,14 +208,7 @@ MatchPoint perceptual_target(const std::string& reference_name, const std::strin
   signal.amplitude = surface.render();
   signal.spacing = profile.spacing;
   signal.description = "reference " + reference_name + " on " + profile.name;
-  // As `texel encode --device`: the encoder's default perceptual model
-  // (codec::PerceptualModel::version, docs/encoder.md §2), the display's
-  // response in its loop, so simulated observers feel what the encoder does.
-  codec::EncoderConfig cfg;
-  cfg.model = codec::model_defaults(codec::PerceptualModel{}.version);
-  cfg.model.display = profile.response;
-  const codec::EncodeResult r = codec::encode(signal, cfg);
-  return {r.spec.central_pitch.value(), r.spec.irregularity.value()};
+  return perceive(std::move(signal), profile);
 }
 
 // --- rater -------------------------------------------------------------------------

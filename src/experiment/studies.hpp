@@ -1,4 +1,4 @@
-// The seven studies (internal; docs/experiments.md, docs/analysis.md): one
+// The studies (internal; docs/experiments.md, docs/analysis.md): one
 // row each — the protocol's "study" name, how analyze() summarises it and
 // what its figures show. Validation (protocol.cpp), the summaries
 // (analysis.cpp) and the figures (analysis_figures.cpp) read this table
@@ -17,6 +17,7 @@ enum class StudyDesign {
   quantization,  ///< rating changes under quantization, one-sample t-tests
   guided,        ///< guided / Bayesian matches: as matching, plus convergence and similarity
   memory,        ///< same/different under a memory load: 2 × 2 RM-ANOVA
+  oddity,        ///< proportion correct per condition against chance (the 2-D oddity studies)
 };
 
 struct Study {
@@ -27,6 +28,7 @@ struct Study {
   bool blocks_by_fine_strength = false;  ///< staircase: blocks compared by their fine strength (else by name)
   bool directional = false;              ///< staircase: threshold against directional proportion
   bool ratings_figure = false;           ///< matching: the ratings' box plot
+  bool direction_effects = false;        ///< oddity: each direction pair against its mode's same-direction baseline
 };
 
 /// Every study, in the order of experiments.md (the summary's key order).

@@ -338,8 +338,10 @@ export function mountParticipant(root: HTMLElement): void {
     }
     if (needs.choice) {
       // Visibly different from the row above: a heading says this row answers.
-      const question = q.task === 'oddity' ? 'Answer: the odd one is …' : q.task === 'two-alternative' ? 'Answer: the test texture is like …' : 'Your answer';
-      const g = radioGroup(question, q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? (q.task === 'oddity' ? stimulusName(c) : c) })), (v) => {
+      // The 2-D oddity (oddity-2d) asks the same question as the oddity: which of three differs.
+      const odd = q.task === 'oddity' || q.task === 'oddity-2d';
+      const question = odd ? 'Answer: the odd one is …' : q.task === 'two-alternative' ? 'Answer: the test texture is like …' : 'Your answer';
+      const g = radioGroup(question, q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? (odd ? stimulusName(c) : c) })), (v) => {
         ev('choice', v);
         setAnswer({ choice: v });
       }, 'choices', 'answer-heading');

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <string>
 
 #include "texel/experiment/guided.hpp"
@@ -85,6 +87,11 @@ class Matcher {
   [[nodiscard]] MatchPoint adjust(std::uint64_t trial) const;
   /// 1 … 5: 5 when the slider noise of this trial is small (|n| < 0.5), 1 when |n| >= 2.
   [[nodiscard]] int confidence(std::uint64_t trial) const;
+  /// Oddity among perceived positions (three or more): each position is
+  /// perceived with σ·n added to both coordinates, and the one farthest in
+  /// summed distance (as distance() weighs it) from the others is the odd
+  /// one. Returns its index.
+  [[nodiscard]] std::size_t odd_one(std::span<const MatchPoint> perceived, std::uint64_t trial) const;
   [[nodiscard]] const MatcherConfig& config() const { return config_; }
 
  private:
@@ -98,6 +105,15 @@ class Matcher {
 /// device's frequency response in the model's loop). Nothing is cached. Throws
 /// InvalidArgument for an unknown reference or device. Takes about a second.
 MatchPoint perceptual_target(const std::string& reference_name, const std::string& device = "tpad");
+
+/// The (Central Pitch, Irregularity) a stimulus document produces under the
+/// same perceptual model: the document (a 1-D texture document as JSON text)
+/// is rendered on its device, the span [0, length_mm) of the map (0 = the
+/// whole device) — what a finger swiping it at constant speed feels as
+/// vibration — is encoded as perceptual_target does. Nothing is cached.
+/// nullopt when the encoder finds no fine texture there (a map at rest, or
+/// only content below its fine/coarse boundary).
+std::optional<MatchPoint> perceive_document(const std::string& document_json, double length_mm = 0.0);
 
 // --- rater -------------------------------------------------------------------
 

@@ -49,7 +49,7 @@ struct TaskSettings {
   virtual ~TaskSettings() = default;
 };
 
-/// The seven studies of docs/procedures.md §6 (a protocol's "study"), in that order.
+/// The studies (a protocol's "study"): the seven of docs/procedures.md §6, then the 2-D ones.
 std::vector<std::string> study_names();
 
 /// Slider mappings of the matching studies.

@@ -16,7 +16,8 @@ namespace texel::experiment {
   X(rating)                 \
   X(guided)                 \
   X(same_different)         \
-  X(familiarisation)
+  X(familiarisation)        \
+  X(oddity_2d)
 
 #define TEXEL_DECLARE_TASK(kind) std::unique_ptr<TaskType> make_##kind##_task();
 TEXEL_TASK_TABLE(TEXEL_DECLARE_TASK)

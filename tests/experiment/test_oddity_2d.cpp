@@ -1,0 +1,202 @@
+// The 2-D oddity studies (task kind "oddity-2d", docs/experiments.md "2-D
+// studies"): the shipped protocols validate; simulated observers perceive
+// every interval through the encoder's perceptual model (perceive_document),
+// so the oriented grating's two directions are told apart and the
+// path-indexed texture's are not; a simulated session runs, exports and
+// analyses through the real CLI.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "../support/cli_run.hpp"
+#include "../support/expect.hpp"
+#include "../support/service_client.hpp"
+#include "../support/temp_dir.hpp"
+#include "texel/error.hpp"
+#include "texel/experiment/observer.hpp"
+#include "texel/experiment/protocol.hpp"
+#include "texel/experiment/runner.hpp"
+#include "texel/experiment/session.hpp"
+#include "texel/experiment/simulate.hpp"
+#include "texel/experiment/store.hpp"
+#include "texel/io.hpp"
+#include "texel/studio/service.hpp"
+
+namespace ex = texel::experiment;
+using json = nlohmann::json;
+
+namespace {
+
+const std::string dir = std::string(TEXEL_TEST_SOURCE_DIR) + "/examples/protocols/";
+
+// A one-block protocol whose only condition is `pair` against `odd`.
+std::string protocol(const json& pair, const json& odd, int trials = 1) {
+  json p = json::parse(texel::read_file(dir + "direction-independence.json"));
+  json& b = p["blocks"][1];
+  b["trials_per_condition"] = trials;
+  b["conditions"] = json::array({json{{"name", "c"}, {"pair", pair}, {"odd", odd}}});
+  p["blocks"].erase(0);
+  return p.dump();
+}
+
+// The perceived (Central Pitch, Irregularity) of the three intervals of the
+// first trial, in the order pair, pair, odd.
+std::vector<ex::MatchPoint> perceived(const json& pair, const json& odd) {
+  ex::Session s(ex::parse_protocol(protocol(pair, odd)), ex::SessionContext{});
+  const auto& q = s.question();
+  const int odd_index = std::stoi(s.truth().correct_answer) - 1;
+  std::vector<ex::MatchPoint> out;
+  for (int i = 0; i < 3; ++i)
+    if (i != odd_index) out.push_back(ex::perceive_document(q.stimuli[static_cast<std::size_t>(i)].document_json, 100).value());
+  out.push_back(ex::perceive_document(q.stimuli[static_cast<std::size_t>(odd_index)].document_json, 100).value());
+  return out;
+}
+
+TEST(Oddity2D, ShippedProtocolsValidate) {
+  const ex::Protocol d = ex::parse_protocol(texel::read_file(dir + "direction-independence.json"));
+  EXPECT_EQ(d.planned_trials(), 62);
+  const ex::Protocol r = ex::parse_protocol(texel::read_file(dir + "rendering-2d.json"));
+  EXPECT_EQ(r.planned_trials(), 48);
+  auto message = [](std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    return texel::test_support::message_of<texel::FormatError>([&] { (void)ex::parse_protocol(text); });
+  };
+  const std::string text = texel::read_file(dir + "direction-independence.json");
+  EXPECT_NE(message(text, "\"device\": \"tablet-2d\"", "\"device\": \"tpad\"").find("no bitmap grid"), std::string::npos);
+  EXPECT_NE(message(text, "\"mode\": \"spectral\"", "\"mode\": \"bitmap\"").find("conditions[2].pair.mode is 'bitmap'"),
+            std::string::npos);
+  EXPECT_NE(message(text, "\"pitch_shift_db\": -2", "\"pitch_shift_db\": -2, \"directions_deg\": [0, 1]")
+                .find("odd.directions_deg applies to the pair only"),
+            std::string::npos);
+  EXPECT_NE(message(text, "\"trials_per_condition\": 10", "\"trials_per_condition\": 10, \"staircase\": {}")
+                .find("staircase does not apply to task 'oddity-2d'"),
+            std::string::npos);
+}
+
+// The pair's two swipes of an oriented grating (wave vector at 0°) along 0°
+// and 60° are felt an octave apart (|cos 60°| = 1/2: −3 dB); the
+// path-indexed texture's are felt alike, and so are the isotropic field's.
+TEST(Oddity2D, ObserversFeelTheOrientedGratingsDirectionAndNotThePathIndexedOnes) {
+  const json oriented{{"mode", "oriented"}, {"orientation_deg", 0}, {"directions_deg", {0, 60}}};
+  const json path{{"mode", "path-indexed"}, {"directions_deg", {0, 60}}};
+  const json spectral{{"mode", "spectral"}, {"directions_deg", {0, 60}}};
+  const auto po = perceived(oriented, json{{"mode", "oriented"}, {"pitch_shift_db", -2}});
+  const auto pp = perceived(path, json{{"mode", "path-indexed"}, {"pitch_shift_db", -2}});
+  const auto ps = perceived(spectral, json{{"mode", "spectral"}, {"pitch_shift_db", -2}});
+  EXPECT_NEAR(po[0].pitch_db - po[1].pitch_db, 3.0, 0.5);  // 0° against 60°
+  EXPECT_LT(std::abs(pp[0].pitch_db - pp[1].pitch_db), 0.3);
+  EXPECT_LT(std::abs(ps[0].pitch_db - ps[1].pitch_db), 1.5);
+  // Every interval's percept is near its texture: 3 dB, the odd one 1 dB.
+  EXPECT_NEAR(pp[0].pitch_db, 3.0, 0.3);
+  EXPECT_NEAR(pp[2].pitch_db, 1.0, 0.3);
+
+  // Noise-free observers pick the odd one of the path-indexed trial and a
+  // pair member of the oriented one.
+  ex::MatcherConfig c;
+  c.noise_db = 0.0;
+  const ex::Matcher m(c);
+  EXPECT_EQ(m.odd_one(pp, 0), 2u);
+  EXPECT_NE(m.odd_one(po, 0), 2u);
+}
+
+// Simulated sessions, stored, exported and analysed: the oriented control's
+// direction pair is discriminated (proportion correct drops from the
+// same-direction pair), the path-indexed one's is not.
+TEST(Oddity2D, SimulatedRunExportAndAnalysisThroughTheCli) {
+  texel::test_support::TempDir tmp("oddity-2d");
+  json p = json::parse(texel::read_file(dir + "direction-independence.json"));
+  p["blocks"].erase(0);  // no practice
+  json& b = p["blocks"][0];
+  b["trials_per_condition"] = 12;
+  json kept = json::array();
+  for (const auto& c : b["conditions"])
+    if (c["name"].get<std::string>().rfind("spectral", 0) != 0) kept.push_back(c);  // spectral: the slow field
+  b["conditions"] = kept;
+  const std::string protocol_path = tmp.at("d.json");
+  texel::write_file_atomic(protocol_path, p.dump(2));
+  const std::string db = tmp.at("s.db");
+  const auto run = texel::test_support::run_cli(
+      TEXEL_CLI, "experiment run " + protocol_path + " --participant S01 --db " + db + " --simulate default");
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto csv_run = texel::test_support::run_cli(TEXEL_CLI, "experiment export --db " + db + " -o " + tmp.at("t.csv"));
+  ASSERT_EQ(csv_run.status, 0) << csv_run.out;
+  const std::string csv = texel::read_file(tmp.at("t.csv"));
+  EXPECT_NE(csv.find(",oddity-2d,path-indexed 0/60,path-indexed,direction_difference_deg,60,"), std::string::npos)
+      << csv.substr(0, 600);
+  const auto an = texel::test_support::run_cli(TEXEL_CLI, "experiment analyze --db " + db + " --json -o " + tmp.at("fig"), false);
+  ASSERT_EQ(an.status, 0) << an.out;
+  const json s = json::parse(an.out);
+  const json& d = s.contains("summary") ? s["summary"]["direction-independence"] : s["direction-independence"];
+  ASSERT_EQ(d["conditions"].size(), 4u);
+  std::map<std::string, double> prop;
+  for (const auto& c : d["conditions"]) prop[c["condition"].get<std::string>()] = c["proportion"].get<double>();
+  EXPECT_GT(prop["path-indexed 0/60"], 0.6);
+  EXPECT_LT(prop["oriented 0/60"], prop["oriented 0/0"] - 0.3);
+  for (const auto& e : d["direction_effects"])
+    EXPECT_EQ(e["directions_discriminated"].get<bool>(), e["mode"] == "oriented") << e.dump();
+  EXPECT_TRUE(std::filesystem::exists(tmp.at("fig") + "/direction-independence-proportion-correct.png"));
+}
+
+// Resume is replay: a session stopped after three trials reopens with the
+// same questions (stored questions are compared with the ones the engine
+// would ask now, scans of the static fields included) and continues.
+TEST(Oddity2D, ResumesWhereItStopped) {
+  texel::test_support::TempDir tmp("oddity-2d-resume");
+  const ex::Protocol p = ex::parse_protocol(
+      protocol(json{{"mode", "oriented"}, {"directions_deg", {0, 60}}}, json{{"mode", "cells"}, {"pitch_shift_db", -2}}, 5));
+  std::string third;
+  {
+    ex::Store store = ex::Store::open(tmp.at("s.db"), ex::StoreMode::read_write);
+    ex::ActiveSession a = ex::open_session(store, p, {"P01", false, "default"});
+    const ex::SimulatedParticipant who(ex::simulation_observer(p.observer, "default"), a.session);
+    for (int i = 0; i < 3; ++i) {
+      if (i == 2) third = a.session.question().to_json();
+      (void)ex::record(store, a, who.respond(a.session));
+    }
+  }
+  ex::Store store = ex::Store::open(tmp.at("s.db"), ex::StoreMode::read_write);
+  ex::ActiveSession a = ex::open_session(store, p, {"P01", true, std::nullopt});
+  EXPECT_EQ(a.session.question().trial, 3);
+  EXPECT_EQ(store.rows().size(), 3u);
+  EXPECT_NE(third.find("\"points\""), std::string::npos);  // the scan is in the stored question
+}
+
+// The studio's experiment messages run the kind (simulated answers through
+// experiment.answer); the question a participant's screen gets names
+// neither the condition nor the mode nor the directions.
+TEST(Oddity2D, RunsThroughTheStudio) {
+  using namespace std::chrono_literals;
+  texel::test_support::TempDir tmp("oddity-2d-studio");
+  texel::studio::ServiceOptions o;
+  o.db_path = tmp.at("s.db");
+  texel::studio::Service service(o);
+  texel::test_support::Client client(service);
+  auto ask = [&](json msg) { return client.ask(std::move(msg), 60s); };
+  const json p = json::parse(protocol(json{{"mode", "oriented"}, {"orientation_deg", 0}, {"directions_deg", {0, 60}}},
+                                      json{{"mode", "path-indexed"}, {"pitch_shift_db", -2}}, 3));
+  const json started = ask({{"type", "experiment.start"}, {"protocol", p}, {"participant", "P01"}, {"simulate", "default"}});
+  ASSERT_EQ(started["type"], "experiment.started") << started.dump();
+  EXPECT_EQ(started["progress"]["planned"], 3);
+  json q = ask({{"type", "experiment.current"}});
+  int answered = 0;
+  while (q["type"] == "experiment.question") {
+    const json& question = q["question"];
+    EXPECT_EQ(question["task"], "oddity-2d");
+    EXPECT_EQ(question["choices"], json({"1", "2", "3"}));
+    const std::string shown = question.dump();
+    for (const char* hidden : {"oriented", "path-indexed", "_deg", "reference", "\"condition\":\"c\"", "correct"})
+      EXPECT_EQ(shown.find(hidden), std::string::npos) << hidden << " in " << shown.substr(0, 400);
+    q = ask({{"type", "experiment.answer"}, {"trial", question["trial"]}, {"simulated", true}});
+    ++answered;
+  }
+  EXPECT_EQ(q["type"], "experiment.finished") << q.dump();
+  EXPECT_EQ(answered, 3);
+}
+
+}  // namespace
