@@ -240,9 +240,9 @@ void print_2d_summary(const std::string& input, const codec::Encode2DResult& r, 
               << to_string(r.field) << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength "
               << detail::fixed(s.fine_strength, 3) << (r.coarse ? ", coarse image" : "") << "\n";
     std::cout << "  anisotropy: " << (r.anisotropic ? "ANISOTROPIC" : "isotropic") << ", Central Pitch spread "
-              << detail::fixed(r.central_pitch_spread_db, 2) << " dB over " << r.per_direction.size() << " directions (strongest "
-              << detail::num(r.strongest_direction_deg) << "°), Irregularity spread "
-              << detail::fixed(r.irregularity_spread_db, 2) << " dB\n  per direction (P / I dB):";
+              << detail::fixed(r.central_pitch_spread_db, 2) << " dB over " << r.per_direction.size() << " directions"
+              << (r.anisotropic ? " (strongest across " + detail::fixed(r.strongest_direction_deg, 0) + "°)" : std::string())
+              << ", Irregularity spread " << detail::fixed(r.irregularity_spread_db, 2) << " dB\n  per direction (P / I dB):";
     for (const auto& d : r.per_direction)
       std::cout << " " << detail::num(d.direction_deg) << "° " << detail::fixed(d.central_pitch_db, 1) << "/"
                 << detail::fixed(d.irregularity_db, 1);

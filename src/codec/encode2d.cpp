@@ -26,6 +26,10 @@ constexpr double kCosineSigma = 0.9068996821171089;
 /// [choice] The log spread (natural units) a not identifiable Irregularity
 /// is reported at: a narrow texture (moments: SD a tenth of the mean).
 constexpr double kNarrowSigma = 0.1;
+/// [measured] How much higher the scans of a narrow texture's isotropic
+/// field feel than the texture, under model 2 (2.2–2.4 dB on the test grid:
+/// docs/encoder.md "2-D inputs"): the design correction's first guess.
+constexpr double kNarrowScanOffsetDb = 2.3;
 /// Largest candidate raster side rendered for the design correction.
 constexpr int kCandidateSide = 1024;
 /// Directions a candidate (an isotropic design) is scanned along.
@@ -450,15 +454,21 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
     return measure(r);
   };
   if (cfg.correction_rounds <= 0) return c;
+  std::optional<std::pair<double, double>> last;  // (candidate P, its scans' P) of the same Irregularity rule
   // Round 0: the narrowest texture at the input's pitch. If the input's
   // scans are no wider than its scans, no Irregularity is identifiable.
   if (field != Field2D::oriented) {
+    // Started where a narrow texture's field is usually found: its scans
+    // feel kNarrowScanOffsetDb higher than the texture (which keeps the
+    // candidate off the band top, where the scans' pitch stops following).
+    c.p = clamp_pitch(p_in - kNarrowScanOffsetDb, pitch, field);
     const double i_narrow = irregularity_for_sigma(c.p, kNarrowSigma, param);
     const Analysis a = round(c.p, i_narrow);
     c.range = a.range;
     ++c.rounds;
     if (spread_in <= a.mean_spread + 0.3) {
       c.identifiable = false;
+      last = {c.p, a.mean_p};
       c.p = clamp_pitch(c.p + (p_in - a.mean_p), pitch, field);
       c.i = irregularity_for_sigma(c.p, kNarrowSigma, param);
       c.residual = std::abs(p_in - a.mean_p);
@@ -469,7 +479,16 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
     c.range = a.range;
     ++c.rounds;
     c.residual = std::abs(p_in - a.mean_p);
-    c.p = clamp_pitch(c.p + (p_in - a.mean_p), pitch, field);
+    // A secant step through the last two candidates of the same
+    // Irregularity rule (the scans' pitch need not follow the document's
+    // one to one near the band top); a unit step otherwise.
+    double slope = 1.0;
+    if (last && std::abs(c.p - last->first) > 0.05) {
+      const double s = (a.mean_p - last->second) / (c.p - last->first);
+      if (s > 0.3 && s < 3.0) slope = s;
+    }
+    last = {c.p, a.mean_p};
+    c.p = clamp_pitch(c.p + (p_in - a.mean_p) / slope, pitch, field);
     if (c.identifiable) {
       c.i += i_in - a.mean_i;
       if (field != Field2D::oriented && log_sigma(c.p, c.i, param) < kCosineSigma) {
