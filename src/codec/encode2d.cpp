@@ -565,6 +565,32 @@ std::pair<DeviceProfile, bool> document_device(const Encode2DConfig& cfg, int w,
   return {d, !builtin};
 }
 
+Encode2DResult new_result(std::string method, const Encode2DConfig& config) {
+  Encode2DResult r;
+  r.method = std::move(method);
+  r.model_version = config.encoder.model.version;
+  r.target =
+      config.encoder.target == EncoderConfig::Target::centroid ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  return r;
+}
+
+double strength(double v);
+
+/// An input without texture: a flat surface at its mean level (F = 0), or
+/// refused (EncoderConfig::NoTexture::refuse).
+void flat_surface(Encode2DResult& r, const Encode2DConfig& config, double mean_level, const std::string& why,
+                  const DeviceProfile& device, bool device_inline, int w, int h, double pitch, const std::string& description) {
+  if (config.encoder.no_texture == EncoderConfig::NoTexture::refuse) throw InvalidArgument("the input has no texture: " + why);
+  r.no_texture = true;
+  r.irregularity_identifiable = false;
+  r.field = Field2D::spectral;
+  r.spec = base_spec(config.encoder, TexelSpec{}.central_pitch.value(), TexelSpec{}.irregularity.value(),
+                     config.encoder.texel_length.value());
+  r.spec.fine_strength = 0.0;
+  r.spec.coarse_strength = strength(1.0 - mean_level);
+  r.document = surface_document(device, device_inline, w, h, pitch, r.spec, r.field, 0.0, ConstantProfile{0.0}, description);
+}
+
 double strength(double v) {
   v = std::clamp(v, 0.0, 1.0);
   if (v > 0.98) return 1.0;  // within 2 % of full scale: full scale (as in 1-D)
@@ -596,25 +622,12 @@ Encode2DResult encode_surface2d(const Raster2D& map, const Encode2DConfig& confi
   const double rms = std::sqrt(var / static_cast<double>(map.values.size()));
   const auto [device, device_inline] = document_device(config, w, h, p);
 
-  Encode2DResult r;
-  r.method = "bitmap";
-  r.model_version = config.encoder.model.version;
-  r.target =
-      config.encoder.target == EncoderConfig::Target::centroid ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  Encode2DResult r = new_result("bitmap", config);
   r.texture_rms = rms;
   const std::string description = "Encoded by texel encode from a " + std::to_string(w) + " × " + std::to_string(h) + " map";
   if (rms <= no_texture_floor) {
-    if (config.encoder.no_texture == EncoderConfig::NoTexture::refuse)
-      throw InvalidArgument("the input has no texture: variation RMS " + detail::num(rms) +
-                            " <= " + detail::num(no_texture_floor));
-    r.no_texture = true;
-    r.irregularity_identifiable = false;
-    r.field = Field2D::spectral;
-    r.spec = base_spec(config.encoder, TexelSpec{}.central_pitch.value(), TexelSpec{}.irregularity.value(),
-                       config.encoder.texel_length.value());
-    r.spec.fine_strength = 0.0;
-    r.spec.coarse_strength = strength(1.0 - mean);
-    r.document = surface_document(device, device_inline, w, h, p, r.spec, r.field, 0.0, ConstantProfile{0.0}, description);
+    flat_surface(r, config, mean, "variation RMS " + detail::num(rms) + " <= " + detail::num(no_texture_floor), device,
+                 device_inline, w, h, p, description);
     return r;
   }
 
@@ -724,13 +737,9 @@ Encode2DResult encode_scans(const ScanBundle& bundle, const Encode2DConfig& conf
   const int h = std::max(16, static_cast<int>(std::lround(height_mm / pitch)));
   const auto [device, device_inline] = document_device(config, w, h, pitch);
 
-  Encode2DResult r;
-  r.method = "scans";
-  r.model_version = config.encoder.model.version;
-  r.target =
-      config.encoder.target == EncoderConfig::Target::centroid ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  Encode2DResult r = new_result("scans", config);
   // Per scan: the 1-D encoder. Directions folded to [0°, 180°).
-  std::vector<double> cs, fs, means;
+  std::vector<double> fs, means;
   double total_rms = 0.0;
   for (const Scan1D& s : bundle.scans) {
     const EncodeResult e = encode(Signal{s.amplitude, s.spacing, s.description, false}, config.encoder);
@@ -753,16 +762,8 @@ Encode2DResult encode_scans(const ScanBundle& bundle, const Encode2DConfig& conf
   const double F = strength(percentile(fs, 0.5));
   const double mean_amp = std::accumulate(means.begin(), means.end(), 0.0) / static_cast<double>(means.size());
   if (r.per_direction.empty()) {
-    if (config.encoder.no_texture == EncoderConfig::NoTexture::refuse)
-      throw InvalidArgument("the input has no texture: every scan's variation RMS is at most " + detail::num(no_texture_floor));
-    r.no_texture = true;
-    r.irregularity_identifiable = false;
-    r.spec = base_spec(config.encoder, TexelSpec{}.central_pitch.value(), TexelSpec{}.irregularity.value(),
-                       config.encoder.texel_length.value());
-    r.spec.fine_strength = 0.0;
-    r.spec.coarse_strength = strength(1.0 - mean_amp);
-    r.document =
-        surface_document(device, device_inline, w, h, pitch, r.spec, Field2D::spectral, 0.0, ConstantProfile{0.0}, description);
+    flat_surface(r, config, mean_amp, "every scan's variation RMS is at most " + detail::num(no_texture_floor), device,
+                 device_inline, w, h, pitch, description);
     return r;
   }
   std::sort(r.per_direction.begin(), r.per_direction.end(),
