@@ -12,6 +12,7 @@
 #include "common.hpp"
 #include "texel/codec.hpp"
 #include "texel/detail/format.hpp"
+#include "texel/encode2d.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -39,6 +40,11 @@ struct EncodeArgs {
   bool json = false;
   bool report = false;
   bool estimate = false;  ///< estimate from samples even when the input holds Texel parameters
+  // 2-D inputs (docs/encoder.md "2-D inputs").
+  std::optional<double> pitch_mm;
+  std::optional<std::string> polarity;
+  std::optional<std::string> field;
+  int directions = 18;  // codec::Encode2DConfig::directions
 };
 
 codec::EncoderConfig config_of(const EncodeArgs& a) {
@@ -206,6 +212,100 @@ void run_report(const EncodeArgs& a) {
   }
 }
 
+/// Whether an encode is a 2-D one: a 2-D input (.png, a 2-D .npy, a
+/// .scans.json bundle), --pitch, or a .texel.json output.
+bool is_2d_encode(const EncodeArgs& a) {
+  const std::string& in = a.inputs.at(0);
+  return a.pitch_mm || codec::is_2d_input(in) || output_extension(in) == ".scans.json" ||
+         (a.output && output_extension(*a.output) == ".texel.json");
+}
+
+void print_2d_summary(const std::string& input, const codec::Encode2DResult& r, const std::optional<std::string>& out,
+                      const std::optional<std::string>& image) {
+  const TexelSpec& s = r.spec;
+  const BitmapGeometry& g = *r.document.device.bitmap;
+  std::cout << input << ": 2-D " << r.method << " on " << g.width << " × " << g.height << " px of "
+            << detail::num(g.pitch.value()) << " mm: ";
+  if (r.no_texture) {
+    std::cout << "no texture (variation RMS " << detail::num(r.texture_rms) << "): a flat surface, coarse strength "
+              << detail::fixed(s.coarse_strength, 3) << "\n";
+  } else {
+    std::cout << "Central Pitch " << detail::fixed(s.central_pitch.value(), 2) << " dB, Irregularity "
+              << detail::fixed(s.irregularity.value(), 2) << " dB"
+              << (r.irregularity_identifiable ? ""
+                                              : " (not identifiable: a bitmap carries every Irregularity up to " +
+                                                    detail::fixed(r.irregularity_bound_db, 2) + " dB the same)")
+              << ", texel " << detail::num(s.texel_length.value()) << " mm"
+              << (r.texel_length_detected ? " (cell lattice)" : " (not in the map: the setting)") << ", field "
+              << to_string(r.field) << ", coarse strength " << detail::fixed(s.coarse_strength, 3) << ", fine strength "
+              << detail::fixed(s.fine_strength, 3) << (r.coarse ? ", coarse image" : "") << "\n";
+    std::cout << "  anisotropy: " << (r.anisotropic ? "ANISOTROPIC" : "isotropic") << ", Central Pitch spread "
+              << detail::fixed(r.central_pitch_spread_db, 2) << " dB over " << r.per_direction.size() << " directions"
+              << (r.anisotropic ? " (strongest across " + detail::fixed(r.strongest_direction_deg, 0) + "°)" : std::string())
+              << ", Irregularity spread " << detail::fixed(r.irregularity_spread_db, 2) << " dB\n  per direction (P / I dB):";
+    for (const auto& d : r.per_direction)
+      std::cout << " " << detail::num(d.direction_deg) << "° " << detail::fixed(d.central_pitch_db, 1) << "/"
+                << detail::fixed(d.irregularity_db, 1);
+    std::cout << "\n";
+  }
+  std::cout << "  model " << r.model_version << ", " << r.correction_rounds << " design correction rounds (residual "
+            << detail::fixed(r.correction_residual_db, 2) << " dB)";
+  if (out) std::cout << "; wrote " << *out << (image ? " and " + *image : std::string());
+  std::cout << "\n";
+}
+
+void run_encode2d(const EncodeArgs& a, const CLI::App& cmd) {
+  for (const char* flag : {"--report", "--estimate", "--coarse-bits", "--max-bytes", "--region", "--channel"})
+    if (cmd.count(flag)) throw InvalidArgument(std::string(flag) + " does not apply to a 2-D encode");
+  const std::string& input = a.inputs.at(0);
+  if (a.output && output_extension(*a.output) != ".texel.json")
+    throw InvalidArgument("output '" + *a.output + "' must end in .texel.json (a 2-D encode writes a version-4 document)");
+  if (a.output) check_writable(*a.output);
+  codec::Encode2DConfig cfg;
+  cfg.encoder = config_of(a);
+  cfg.directions = a.directions;
+  if (a.field) cfg.field = parse_field2d(*a.field, "--field");
+  std::optional<DeviceProfile> device;
+  if (a.input.device) device = load_device(*a.input.device);
+  if (device && device->bitmap) cfg.device = device;
+  std::optional<std::string> image;
+  if (a.output) {
+    const std::string stem = a.output->substr(0, a.output->size() - std::string(".texel.json").size());
+    image = stem + ".coarse.npy";
+    cfg.coarse_image_path = std::filesystem::path(*image).filename().string();
+  }
+  codec::Encode2DResult r;
+  if (output_extension(input) == ".scans.json") {
+    if (a.pitch_mm) cfg.device.reset();
+    r = codec::encode_scans(codec::load_scan_bundle(input, signal_options(a.input)), cfg);
+  } else {
+    if (!codec::is_2d_input(input))
+      throw InvalidArgument("'" + input +
+                            "' is not a 2-D input: a 2-D encode reads a grey .png, a 2-D .npy or a .scans.json bundle");
+    codec::Raster2DLoadOptions lo;
+    if (a.pitch_mm) lo.pitch = Millimetres(*a.pitch_mm);
+    lo.device = device;
+    if (a.polarity) lo.polarity = parse_bitmap_polarity(*a.polarity, "--polarity");
+    const codec::Input2D in = codec::load_input2d(input, lo);
+    cfg.depth = in.depth == 8 ? 8 : 16;
+    cfg.polarity = in.polarity;
+    r = codec::encode_surface2d(in.map, cfg);
+  }
+  if (!r.coarse_image) image.reset();
+  if (a.output) codec::write_encoding2d(r, *a.output);
+  if (a.json) {
+    nlohmann::ordered_json j;
+    j["input"] = input;
+    if (a.output) j["output"] = *a.output;
+    if (image) j["coarse_image"] = *image;
+    const nlohmann::ordered_json library = nlohmann::ordered_json::parse(codec::to_json(r));
+    for (const auto& [key, value] : library.items()) j[key] = value;
+    print_json(j);
+  } else {
+    print_2d_summary(input, r, a.output, image);
+  }
+}
+
 }  // namespace
 
 void register_encode(CLI::App& app) {
@@ -249,6 +349,15 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--coarse-bits", a->coarse_bits, "Bits per coarse level, 1 … 16 [6]")->group(g);
   cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")
       ->group(g);
+  const std::string g2 = "2-D inputs (a grey .png, a 2-D .npy or a .scans.json bundle -> a version-4 .texel.json)";
+  cmd->add_option("--pitch", a->pitch_mm, "Pixel pitch of a 2-D map, mm (or --device with a bitmap); never guessed")->group(g2);
+  cmd->add_option("--polarity", a->polarity,
+                  "PNG polarity: darker_more_friction (a = level/max) or brighter_more_friction [the device's, else darker]")
+      ->group(g2);
+  cmd->add_option("--field", a->field,
+                  "Field design of the document: spectral | cells | oriented [cells if a cell lattice is found, else spectral]")
+      ->group(g2);
+  cmd->add_option("--directions", a->directions, "Scan directions over 180° [18]")->group(g2);
   cmd->add_flag("--json", a->json, "Print estimates, model distance and sizes as JSON");
   cmd->add_flag("--estimate", a->estimate,
                 "Estimate parameters from the rendered samples even when the input (a document or .texel) holds them; "
@@ -262,6 +371,7 @@ void register_encode(CLI::App& app) {
       return;
     }
     if (a->inputs.size() != 1) throw InvalidArgument("encode takes one input (several only with --report)");
+    if (is_2d_encode(*a)) return run_encode2d(*a, *cmd);
     if (a->output) {
       if (output_extension(*a->output) != ".texel") throw InvalidArgument("output '" + *a->output + "' must end in .texel");
       check_writable(*a->output);

@@ -113,7 +113,7 @@ struct Encode2DConfig {
   std::size_t scan_samples = 16384;  ///< samples per direction (parallel scans joined), ≥ 1024
   /// Analysis-by-synthesis rounds through the 2-D design (0: the mean of
   /// the directions' 1-D encodes is the document's parameters as is).
-  int correction_rounds = 2;
+  int correction_rounds = 1;
   /// The field design of the document; automatic: cells when a lattice of
   /// cell borders is detected, else spectral.
   std::optional<Field2D> field;
@@ -155,8 +155,10 @@ struct Encode2DResult {
   double central_pitch_spread_db = 0.0;  ///< max − min over directions
   double irregularity_spread_db = 0.0;   ///< max − min over directions
   bool anisotropic = false;              ///< central_pitch_spread_db > the threshold
-  double strongest_direction_deg = 0.0;  ///< the direction of the highest Central Pitch (a grating's wave vector)
-  double mean_central_pitch_db = 0.0;    ///< the directions' mean (before the design correction)
+  /// Maps: the principal axis of the fine part's gradient (a grating's wave
+  /// vector); bundles: the direction of the highest Central Pitch.
+  double strongest_direction_deg = 0.0;
+  double mean_central_pitch_db = 0.0;  ///< the directions' mean (before the design correction)
   double mean_irregularity_db = 0.0;
   /// False when the input's scans are no wider than any stationary
   /// isotropic field's (docs/algorithm.md §11.1: a bitmap cannot carry a

@@ -26,6 +26,10 @@ constexpr double kCosineSigma = 0.9068996821171089;
 /// [choice] The log spread (natural units) a not identifiable Irregularity
 /// is reported at: a narrow texture (moments: SD a tenth of the mean).
 constexpr double kNarrowSigma = 0.1;
+/// [measured] How much higher the scans of a narrow texture's isotropic
+/// field feel than the texture, under model 2 (2.2–2.4 dB on the test grid:
+/// docs/encoder.md "2-D inputs"): the design correction's first guess.
+constexpr double kNarrowScanOffsetDb = 2.3;
 /// Largest candidate raster side rendered for the design correction.
 constexpr int kCandidateSide = 1024;
 /// Directions a candidate (an isotropic design) is scanned along.
@@ -90,6 +94,34 @@ double bilinear(const std::vector<double>& v, int w, int h, double x, double y) 
   return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) + fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
 }
 
+/// Lanczos-3 interpolation (6 × 6 taps, edges held): scans at any angle
+/// keep the grid's content up to near its Nyquist frequency, where bilinear
+/// interpolation would damp oblique scans and fake anisotropy.
+double lanczos3(const std::vector<double>& v, int w, int h, double x, double y) {
+  const auto kernel = [](double t) {
+    if (std::abs(t) < 1e-12) return 1.0;
+    if (std::abs(t) >= 3.0) return 0.0;
+    const double a = kPi * t;
+    return 3.0 * std::sin(a) * std::sin(a / 3.0) / (a * a);
+  };
+  const int i0 = static_cast<int>(std::floor(x)), j0 = static_cast<int>(std::floor(y));
+  double wx[6], wy[6], sx = 0.0, sy = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    wx[k] = kernel(x - (i0 - 2 + k));
+    wy[k] = kernel(y - (j0 - 2 + k));
+    sx += wx[k];
+    sy += wy[k];
+  }
+  double sum = 0.0;
+  for (int b = 0; b < 6; ++b) {
+    const int j = std::clamp(j0 - 2 + b, 0, h - 1);
+    double row = 0.0;
+    for (int k = 0; k < 6; ++k) row += wx[k] * v[static_cast<std::size_t>(j) * w + std::clamp(i0 - 2 + k, 0, w - 1)];
+    sum += wy[b] * row;
+  }
+  return sum / (sx * sy);
+}
+
 // --- the plane's split -------------------------------------------------------
 
 /// Local mean and RMS of the amplitude over a window one boundary (or two
@@ -104,16 +136,20 @@ Envelope envelope(const Raster2D& map, double boundary_mm) {
   const int w = map.width, h = map.height;
   const double p = map.pitch.value();
   std::vector<double> a(map.values.begin(), map.values.end());
-  // RMS frequency along x and y (Rice): f = √(E[a′²] / E[(a − ā)²]) / 2π.
-  const double mean = std::accumulate(a.begin(), a.end(), 0.0) / static_cast<double>(a.size());
+  // RMS frequency along x (Rice: f = √(E[y′²] / E[y²]) / 2π) of the part
+  // above the boundary, y = a less its mean over a boundary-wide window (as
+  // the 1-D split's fine frequency is taken above 1/B).
+  const int rb = std::clamp(static_cast<int>(std::lround(0.5 * boundary_mm / p)), 1, std::max(1, std::min(w, h) / 8));
+  const std::vector<double> low = box(a, w, h, rb);
   double var = 0.0, d2 = 0.0;
   std::size_t nd = 0;
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
-      const double v = a[static_cast<std::size_t>(j) * w + i];
-      var += (v - mean) * (v - mean);
+      const std::size_t k = static_cast<std::size_t>(j) * w + i;
+      const double v = a[k] - low[k];
+      var += v * v;
       if (i + 1 < w) {
-        const double d = (a[static_cast<std::size_t>(j) * w + i + 1] - v) / p;
+        const double d = (a[k + 1] - low[k + 1] - v) / p;
         d2 += d * d;
         ++nd;
       }
@@ -147,8 +183,8 @@ double relative_range(const Envelope& e, int w, int h) {
 
 // --- scans -------------------------------------------------------------------
 
-/// Parallel straight lines across the map along `theta_deg`, bilinear at one
-/// pixel steps, each tapered at its ends and joined, until `total` samples.
+/// Parallel straight lines across the map along `theta_deg`, Lanczos-3 at
+/// one pixel steps, each tapered at its ends and joined, until `total` samples.
 std::vector<double> scan_lines(const std::vector<double>& v, int w, int h, double theta_deg, std::size_t total, int& lines) {
   const double th = theta_deg * kPi / 180.0;
   const double ux = std::cos(th), uy = std::sin(th), nx = -uy, ny = ux;
@@ -189,7 +225,7 @@ std::vector<double> scan_lines(const std::vector<double>& v, int w, int h, doubl
       double g = 1.0;
       const std::size_t edge = std::min(s, n - 1 - s);
       if (edge < kTaper) g = 0.5 - 0.5 * std::cos(kPi * (static_cast<double>(edge) + 0.5) / kTaper);
-      out.push_back(g * bilinear(v, w, h, px + t * ux, py + t * uy));
+      out.push_back(g * lanczos3(v, w, h, px + t * ux, py + t * uy));
     }
   }
   return out;
@@ -283,7 +319,7 @@ std::optional<double> detect_lattice(const Raster2D& map, const std::vector<doub
   sd = std::sqrt(sd / static_cast<double>(g.size()));
   if (!(sd > 0.0)) return std::nullopt;
   const double tol = TexelTexture::boundary_tolerance_mm;
-  double best_z = 0.0, best_l = 0.0;
+  double best_z = 0.0, best_l = 0.0, best_hi = 0.0;
   const auto lo = static_cast<long>(std::ceil(2.0 * p * 1000.0)),
              hi = static_cast<long>(std::floor(std::min(5.0, 0.25 * std::min(w, h) * p) * 1000.0));
   for (long um = lo; um <= hi; ++um) {
@@ -302,12 +338,20 @@ std::optional<double> detect_lattice(const Raster2D& map, const std::vector<doub
     if (n_on < 4 || n_on * 2 > g.size()) continue;
     const double off = (std::accumulate(g.begin(), g.end(), 0.0) - on) / static_cast<double>(g.size() - n_on);
     const double z = (on / static_cast<double>(n_on) - off) / (sd / std::sqrt(static_cast<double>(n_on)));
-    if (z > best_z) {
+    if (z > best_z * (1.0 + 1e-12)) {
       best_z = z;
       best_l = L;
+      best_hi = L;
+    } else if (z >= best_z * (1.0 - 1e-12)) {
+      best_hi = L;  // the same border positions: the same lattice on this grid
     }
   }
   if (best_z < min_z) return std::nullopt;
+  // Lengths that put the borders between the same pixels tie: the roundest of them.
+  for (double step : {0.25, 0.1, 0.05, 0.01, 0.005, 0.001}) {
+    const double r = std::ceil(best_l / step - 1e-9) * step;
+    if (r <= best_hi + 1e-12) return r;
+  }
   return best_l;
 }
 
@@ -370,9 +414,12 @@ TexelSpec base_spec(const EncoderConfig& c, double p_db, double i_db, double tex
 }
 
 /// The band a pitch must stay in on a grid of `pitch` mm (the 1-D encoder's
-/// search box: P ≥ −19.5 dB, below the grid's Nyquist frequency).
-double clamp_pitch(double p_db, double pitch) {
-  const double top = 10.0 * std::log10(0.5 / pitch) - 0.05;
+/// search box: P ≥ −19.5 dB, below the grid's Nyquist frequency; for the
+/// isotropic designs 3.02 dB lower).
+double clamp_pitch(double p_db, double pitch, Field2D field) {
+  // Isotropic designs draw their frequencies 3.01 dB above the 1-D ones
+  // (docs/algorithm.md §11.1), and those must stay below the grid's Nyquist frequency.
+  const double top = 10.0 * std::log10(0.5 / pitch) - 0.05 - (field == Field2D::oriented ? 0.0 : 3.02);
   return std::clamp(p_db, -19.5, top);
 }
 
@@ -394,7 +441,7 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
                   double texel_length, int w, int h, double pitch, Measure&& measure) {
   const Parameterization param = cfg.encoder.parameterization;
   Corrected c;
-  c.p = clamp_pitch(p_in, pitch);
+  c.p = clamp_pitch(p_in, pitch, field);
   c.i = i_in;
   const int cw = std::min(w, kCandidateSide), ch = std::min(h, kCandidateSide);
   const auto round = [&](double p, double i) {
@@ -407,16 +454,22 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
     return measure(r);
   };
   if (cfg.correction_rounds <= 0) return c;
+  std::optional<std::pair<double, double>> last;  // (candidate P, its scans' P) of the same Irregularity rule
   // Round 0: the narrowest texture at the input's pitch. If the input's
   // scans are no wider than its scans, no Irregularity is identifiable.
   if (field != Field2D::oriented) {
+    // Started where a narrow texture's field is usually found: its scans
+    // feel kNarrowScanOffsetDb higher than the texture (which keeps the
+    // candidate off the band top, where the scans' pitch stops following).
+    c.p = clamp_pitch(p_in - kNarrowScanOffsetDb, pitch, field);
     const double i_narrow = irregularity_for_sigma(c.p, kNarrowSigma, param);
     const Analysis a = round(c.p, i_narrow);
     c.range = a.range;
     ++c.rounds;
     if (spread_in <= a.mean_spread + 0.3) {
       c.identifiable = false;
-      c.p = clamp_pitch(c.p + (p_in - a.mean_p), pitch);
+      last = {c.p, a.mean_p};
+      c.p = clamp_pitch(c.p + (p_in - a.mean_p), pitch, field);
       c.i = irregularity_for_sigma(c.p, kNarrowSigma, param);
       c.residual = std::abs(p_in - a.mean_p);
     }
@@ -426,7 +479,16 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
     c.range = a.range;
     ++c.rounds;
     c.residual = std::abs(p_in - a.mean_p);
-    c.p = clamp_pitch(c.p + (p_in - a.mean_p), pitch);
+    // A secant step through the last two candidates of the same
+    // Irregularity rule (the scans' pitch need not follow the document's
+    // one to one near the band top); a unit step otherwise.
+    double slope = 1.0;
+    if (last && std::abs(c.p - last->first) > 0.05) {
+      const double s = (a.mean_p - last->second) / (c.p - last->first);
+      if (s > 0.3 && s < 3.0) slope = s;
+    }
+    last = {c.p, a.mean_p};
+    c.p = clamp_pitch(c.p + (p_in - a.mean_p) / slope, pitch, field);
     if (c.identifiable) {
       c.i += i_in - a.mean_i;
       if (field != Field2D::oriented && log_sigma(c.p, c.i, param) < kCosineSigma) {
@@ -439,11 +501,27 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
   return c;
 }
 
-void fill_spread(Encode2DResult& r) {
+/// The direction (degrees in [0, 180)) along which the map changes most:
+/// the principal axis of its gradient's structure tensor (a grating's wave vector).
+double principal_direction(const std::vector<double>& v, int w, int h) {
+  double xx = 0.0, yy = 0.0, xy = 0.0;
+  for (int j = 0; j + 1 < h; ++j)
+    for (int i = 0; i + 1 < w; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * w + i;
+      const double gx = v[k + 1] - v[k], gy = v[k + static_cast<std::size_t>(w)] - v[k];
+      xx += gx * gx;
+      yy += gy * gy;
+      xy += gx * gy;
+    }
+  const double deg = 0.5 * std::atan2(2.0 * xy, xx - yy) * 180.0 / kPi;
+  return deg < 0.0 ? deg + 180.0 : deg;
+}
+
+void fill_spread(Encode2DResult& r, bool strongest_from_pitch) {
   if (r.per_direction.empty()) return;
   double lo_p = 1e300, hi_p = -1e300, lo_i = 1e300, hi_i = -1e300;
   for (const auto& d : r.per_direction) {
-    if (d.central_pitch_db > hi_p) r.strongest_direction_deg = d.direction_deg;
+    if (strongest_from_pitch && d.central_pitch_db > hi_p) r.strongest_direction_deg = d.direction_deg;
     lo_p = std::min(lo_p, d.central_pitch_db);
     hi_p = std::max(hi_p, d.central_pitch_db);
     lo_i = std::min(lo_i, d.irregularity_db);
@@ -487,6 +565,32 @@ std::pair<DeviceProfile, bool> document_device(const Encode2DConfig& cfg, int w,
   return {d, !builtin};
 }
 
+Encode2DResult new_result(std::string method, const Encode2DConfig& config) {
+  Encode2DResult r;
+  r.method = std::move(method);
+  r.model_version = config.encoder.model.version;
+  r.target =
+      config.encoder.target == EncoderConfig::Target::centroid ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  return r;
+}
+
+double strength(double v);
+
+/// An input without texture: a flat surface at its mean level (F = 0), or
+/// refused (EncoderConfig::NoTexture::refuse).
+void flat_surface(Encode2DResult& r, const Encode2DConfig& config, double mean_level, const std::string& why,
+                  const DeviceProfile& device, bool device_inline, int w, int h, double pitch, const std::string& description) {
+  if (config.encoder.no_texture == EncoderConfig::NoTexture::refuse) throw InvalidArgument("the input has no texture: " + why);
+  r.no_texture = true;
+  r.irregularity_identifiable = false;
+  r.field = Field2D::spectral;
+  r.spec = base_spec(config.encoder, TexelSpec{}.central_pitch.value(), TexelSpec{}.irregularity.value(),
+                     config.encoder.texel_length.value());
+  r.spec.fine_strength = 0.0;
+  r.spec.coarse_strength = strength(1.0 - mean_level);
+  r.document = surface_document(device, device_inline, w, h, pitch, r.spec, r.field, 0.0, ConstantProfile{0.0}, description);
+}
+
 double strength(double v) {
   v = std::clamp(v, 0.0, 1.0);
   if (v > 0.98) return 1.0;  // within 2 % of full scale: full scale (as in 1-D)
@@ -518,32 +622,19 @@ Encode2DResult encode_surface2d(const Raster2D& map, const Encode2DConfig& confi
   const double rms = std::sqrt(var / static_cast<double>(map.values.size()));
   const auto [device, device_inline] = document_device(config, w, h, p);
 
-  Encode2DResult r;
-  r.method = "bitmap";
-  r.model_version = config.encoder.model.version;
-  r.target =
-      config.encoder.target == EncoderConfig::Target::centroid ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  Encode2DResult r = new_result("bitmap", config);
   r.texture_rms = rms;
   const std::string description = "Encoded by texel encode from a " + std::to_string(w) + " × " + std::to_string(h) + " map";
   if (rms <= no_texture_floor) {
-    if (config.encoder.no_texture == EncoderConfig::NoTexture::refuse)
-      throw InvalidArgument("the input has no texture: variation RMS " + detail::num(rms) +
-                            " <= " + detail::num(no_texture_floor));
-    r.no_texture = true;
-    r.irregularity_identifiable = false;
-    r.field = Field2D::spectral;
-    r.spec = base_spec(config.encoder, TexelSpec{}.central_pitch.value(), TexelSpec{}.irregularity.value(),
-                       config.encoder.texel_length.value());
-    r.spec.fine_strength = 0.0;
-    r.spec.coarse_strength = strength(1.0 - mean);
-    r.document = surface_document(device, device_inline, w, h, p, r.spec, r.field, 0.0, ConstantProfile{0.0}, description);
+    flat_surface(r, config, mean, "variation RMS " + detail::num(rms) + " <= " + detail::num(no_texture_floor), device,
+                 device_inline, w, h, p, description);
     return r;
   }
 
   // 1. Scans of the fine part, per direction.
   Analysis in = analyse(map, config, config.directions);
   r.per_direction = in.directions;
-  fill_spread(r);
+  fill_spread(r, false);
   r.anisotropic = r.central_pitch_spread_db > config.anisotropy_threshold_db;
   r.mean_central_pitch_db = in.mean_p;
   r.mean_irregularity_db = in.mean_i;
@@ -551,10 +642,11 @@ Encode2DResult encode_surface2d(const Raster2D& map, const Encode2DConfig& confi
   // 2. Texel length from a lattice of cell borders; the design.
   double texel_length = config.encoder.texel_length.value();
   Field2D field = config.field.value_or(Field2D::spectral);
+  std::vector<double> fine(map.values.size(), 0.0);
+  for (std::size_t k = 0; k < fine.size(); ++k)
+    if (in.env.rms[k] > 0.0) fine[k] = (map.values[k] - in.env.mean[k]) / in.env.rms[k];
+  r.strongest_direction_deg = principal_direction(fine, w, h);
   if (config.detect_lattice) {
-    std::vector<double> fine(map.values.size(), 0.0);
-    for (std::size_t k = 0; k < fine.size(); ++k)
-      if (in.env.rms[k] > 0.0) fine[k] = (map.values[k] - in.env.mean[k]) / in.env.rms[k];
     if (const auto L = detect_lattice(map, fine)) {
       texel_length = *L;
       r.texel_length_detected = true;
@@ -645,13 +737,9 @@ Encode2DResult encode_scans(const ScanBundle& bundle, const Encode2DConfig& conf
   const int h = std::max(16, static_cast<int>(std::lround(height_mm / pitch)));
   const auto [device, device_inline] = document_device(config, w, h, pitch);
 
-  Encode2DResult r;
-  r.method = "scans";
-  r.model_version = config.encoder.model.version;
-  r.target =
-      config.encoder.target == EncoderConfig::Target::centroid ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
+  Encode2DResult r = new_result("scans", config);
   // Per scan: the 1-D encoder. Directions folded to [0°, 180°).
-  std::vector<double> cs, fs, means;
+  std::vector<double> fs, means;
   double total_rms = 0.0;
   for (const Scan1D& s : bundle.scans) {
     const EncodeResult e = encode(Signal{s.amplitude, s.spacing, s.description, false}, config.encoder);
@@ -674,21 +762,13 @@ Encode2DResult encode_scans(const ScanBundle& bundle, const Encode2DConfig& conf
   const double F = strength(percentile(fs, 0.5));
   const double mean_amp = std::accumulate(means.begin(), means.end(), 0.0) / static_cast<double>(means.size());
   if (r.per_direction.empty()) {
-    if (config.encoder.no_texture == EncoderConfig::NoTexture::refuse)
-      throw InvalidArgument("the input has no texture: every scan's variation RMS is at most " + detail::num(no_texture_floor));
-    r.no_texture = true;
-    r.irregularity_identifiable = false;
-    r.spec = base_spec(config.encoder, TexelSpec{}.central_pitch.value(), TexelSpec{}.irregularity.value(),
-                       config.encoder.texel_length.value());
-    r.spec.fine_strength = 0.0;
-    r.spec.coarse_strength = strength(1.0 - mean_amp);
-    r.document =
-        surface_document(device, device_inline, w, h, pitch, r.spec, Field2D::spectral, 0.0, ConstantProfile{0.0}, description);
+    flat_surface(r, config, mean_amp, "every scan's variation RMS is at most " + detail::num(no_texture_floor), device,
+                 device_inline, w, h, pitch, description);
     return r;
   }
   std::sort(r.per_direction.begin(), r.per_direction.end(),
             [](const DirectionEncode& a, const DirectionEncode& b) { return a.direction_deg < b.direction_deg; });
-  fill_spread(r);
+  fill_spread(r, true);
   r.anisotropic = r.per_direction.size() > 1 && r.central_pitch_spread_db > config.anisotropy_threshold_db;
   double mp = 0.0, mi = 0.0, ms = 0.0;
   for (const auto& d : r.per_direction) {
