@@ -101,6 +101,9 @@ void register_encode2d(py::module_& m) {
                " dB I=" + std::to_string(r.spec.irregularity.value()) + " dB, " + std::string(to_string(r.field)) + ", " +
                std::to_string(r.per_direction.size()) + " directions>";
       });
+  // The defaults shown to Python are the library's (one named object: GCC
+  // warns about members of temporaries read in default arguments).
+  static const codec::Encode2DConfig defaults;
   m.def(
       "encode_2d",
       [](const py::object& source, std::optional<double> pitch_mm, const py::object& device, std::optional<std::string> polarity,
@@ -154,13 +157,13 @@ void register_encode2d(py::module_& m) {
         return codec::encode_surface2d(input.map, c);
       },
       py::arg("source"), py::kw_only(), py::arg("pitch_mm") = py::none(), py::arg("device") = py::none(),
-      py::arg("polarity") = py::none(), py::arg("directions") = codec::Encode2DConfig{}.directions,
-      py::arg("scan_samples") = codec::Encode2DConfig{}.scan_samples,
-      py::arg("correction_rounds") = codec::Encode2DConfig{}.correction_rounds, py::arg("field") = py::none(),
-      py::arg("detect_lattice") = true, py::arg("coarse_image_path") = codec::Encode2DConfig{}.coarse_image_path,
+      py::arg("polarity") = py::none(), py::arg("directions") = defaults.directions,
+      py::arg("scan_samples") = defaults.scan_samples,
+      py::arg("correction_rounds") = defaults.correction_rounds, py::arg("field") = py::none(),
+      py::arg("detect_lattice") = true, py::arg("coarse_image_path") = defaults.coarse_image_path,
       py::arg("swipe_speed_mm_s") = py::none(), py::arg("boundary_mm") = 1.0, py::arg("texel_length_mm") = 0.25,
       py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments",
-      py::arg("model") = codec::PerceptualModel{}.version, py::arg("target") = "automatic", py::arg("no_texture") = "flag",
+      py::arg("model") = defaults.encoder.model.version, py::arg("target") = "automatic", py::arg("no_texture") = "flag",
       R"doc(Encodes a 2-D texture into a version-4 2-D document (one region covering the map) with the 1-D
 encoder's perceptual model, as `texel encode map.png` (docs/encoder.md, "2-D inputs").
 
