@@ -512,7 +512,7 @@ typedef struct texel_encode2d_result texel_encode2d_result;
 typedef struct texel_encode2d_options {
   int directions;        /* scan directions over the half turn, >= 2 [18] */
   size_t scan_samples;   /* samples per direction (parallel scans joined), >= 1024 [16384] */
-  int correction_rounds; /* analysis-by-synthesis rounds through the 2-D design, 0 = none [2] */
+  int correction_rounds; /* analysis-by-synthesis rounds through the 2-D design, 0 = none [1] */
 } texel_encode2d_options;
 
 TEXEL_API texel_encode2d_options texel_encode2d_options_default(void);

@@ -203,7 +203,7 @@ class Encode2DResult:
 
 def encode_2d(source: Union[_Path, _Array], *, pitch_mm: Optional[float] = None, device: Optional[_Device] = None,
               polarity: Optional[Literal["darker_more_friction", "brighter_more_friction"]] = None,
-              directions: int = 18, scan_samples: int = 16384, correction_rounds: int = 2,
+              directions: int = 18, scan_samples: int = 16384, correction_rounds: int = 1,
               field: Optional[Literal["spectral", "cells", "oriented"]] = None, detect_lattice: bool = True,
               coarse_image_path: str = "coarse.npy", swipe_speed_mm_s: Optional[float] = None,
               boundary_mm: float = 1.0, texel_length_mm: float = 0.25, seed: int = 1,

@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
         const double x = k * 0.05, y = j * 0.05;
         map[j * side + k] = 0.5 + 0.25 * sin(2 * PI * (2 * x + y)) + 0.25 * sin(2 * PI * (-1.5 * x + 2.5 * y));
       }
-    CHECK(o2.directions == 18 && o2.scan_samples == 16384 && o2.correction_rounds == 2, "2-D encoder defaults");
+    CHECK(o2.directions == 18 && o2.scan_samples == 16384 && o2.correction_rounds == 1, "2-D encoder defaults");
     o2.directions = 4; /* cheap: the encoder's own tests measure its accuracy */
     o2.scan_samples = 1024;
     o2.correction_rounds = 0;
