@@ -2,7 +2,7 @@
 # folder, compiled there with the C compiler alone (strict C99) against
 # texel.h and the built libtexel.so, and run against what the CLI wrote for
 # the same 2-D document.
-#   cmake -DWORK=<dir> -DCC=<cc> -DINCLUDE=<include dir> -DLIBRARY=<libtexel.so> -DTEXEL=<texel>
+#   cmake -DWORK=<dir> -DCC=<cc> [-DCFLAGS=<flags>] -DINCLUDE=<include dir> -DLIBRARY=<libtexel.so> -DTEXEL=<texel>
 #         -DSOURCE=<tests/capi> -P run_surface2d_program.cmake
 cmake_minimum_required(VERSION 3.25)
 
@@ -19,7 +19,8 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 file(COPY ${SOURCE}/surface2d_program.c ${SOURCE}/surface2d-disc.texel.json DESTINATION ${WORK})
 get_filename_component(libdir ${LIBRARY} DIRECTORY)
-run(${CC} -std=c99 -pedantic -Wall -Wextra -Werror -I${INCLUDE} ${WORK}/surface2d_program.c -o ${WORK}/program
+separate_arguments(cflags UNIX_COMMAND "${CFLAGS}")  # e.g. the sanitizers of a sanitized library
+run(${CC} -std=c99 -pedantic -Wall -Wextra -Werror ${cflags} -I${INCLUDE} ${WORK}/surface2d_program.c -o ${WORK}/program
     -L${libdir} -ltexel -lm -Wl,-rpath,${libdir})
 set(doc ${WORK}/surface2d-disc.texel.json)
 run(${TEXEL} render ${doc} --surface 2d -o ${WORK}/cli.npy)
