@@ -169,15 +169,19 @@ Envelope envelope(const Raster2D& map, double boundary_mm) {
   return e;
 }
 
-/// (p98 − p2)/p98 of the smoothed local mean over the interior (a border of
-/// one window left out): the envelope's relative range, scale-free.
+/// (p99.9 − p0.1)/p99.9 of the smoothed local mean over the interior (a
+/// border of one window left out): the envelope's relative range,
+/// scale-free. The quantiles are that far out so a coarse feature covering
+/// a small part of a large map (a 10 mm disc on a tablet is under 1 % of
+/// it) still counts; the local mean is already smooth, and the candidate's
+/// own range, measured the same way, is the threshold's reference.
 double relative_range(const Envelope& e, int w, int h) {
   std::vector<double> v;
   const int b = std::min(2 * e.radius, std::min(w, h) / 4);
   for (int j = b; j < h - b; ++j)
     for (int i = b; i < w - b; ++i) v.push_back(e.mean[static_cast<std::size_t>(j) * w + i]);
   if (v.empty()) v = e.mean;
-  const double hi = percentile(v, 0.98), lo = percentile(v, 0.02);
+  const double hi = percentile(v, 0.999), lo = percentile(v, 0.001);
   return hi > 0.0 ? (hi - lo) / hi : 0.0;
 }
 

@@ -225,6 +225,32 @@ TEST(Encode2D, CoarseDiscAppearsAtItsPlace) {
 
 // --- inputs ---------------------------------------------------------------------
 
+// A small coarse feature on a large map is still found, in its place: a
+// 1.5 mm disc on 40 × 40 mm covers about 1 % of it, even smoothed by the
+// envelope's window (a 10 mm disc on a tablet is under 1 %).
+TEST(Encode2D, SmallCoarseDiscOnALargeMapIsFound) {
+  constexpr int side = 800;
+  const Disc2D disc{Millimetres(20.0), Millimetres(20.0), Millimetres(1.5), Millimetres(0.2), 1.0, 0.0};
+  Document doc = texture_document(3.0, -5.0, 0.5, Field2D::spectral, disc, 0.8, 0.6);
+  doc.device = grid_device(side, side);
+  const Raster2D map = render(doc);
+  codec::Encode2DConfig cfg = quick_config();
+  cfg.directions = 4;
+  cfg.correction_rounds = 0;
+  cfg.coarse_image_path = "small.coarse.npy";
+  const codec::Encode2DResult r = codec::encode_surface2d(map, cfg);
+  ASSERT_TRUE(r.coarse);
+  ASSERT_TRUE(r.coarse_image);
+  const Raster2D& img = *r.coarse_image;
+  const auto c_at = [&](double x, double y) {
+    const int i = std::clamp(static_cast<int>(x / (side * kPitch) * img.width), 0, img.width - 1);
+    const int j = std::clamp(static_cast<int>(y / (side * kPitch) * img.height), 0, img.height - 1);
+    return img.at(i, j);
+  };
+  EXPECT_GT(c_at(20.0, 20.0), c_at(5.0, 5.0) + 0.3);  // the disc stands out where it is
+  EXPECT_LT(c_at(35.0, 35.0), 0.25);
+}
+
 TEST(Encode2D, PngEightAndSixteenBitAndNpyReadAsTheMap) {
   TempDir dir("encode2d");
   Document doc = texture_document(3.0, -5.0, 0.5, Field2D::spectral, ConstantProfile{}, 0.3, 0.8);
