@@ -213,12 +213,11 @@ __attribute__((target("avx512f"))) void pass4_avx512(const double* xr, const dou
   using V = double __attribute__((vector_size(64)));
   constexpr std::size_t s = 4;
   const std::size_t mb = m / 4, step = s * m, sm = s * mb;
-  // Inlined (or the build fails): an out-of-line copy would not be compiled for AVX-512.
-  auto load = [](const double* p) __attribute__((always_inline)) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
+  // An unaligned, aliasing view of 8 doubles: a load is an expression, not a
+  // call (a function returning V would need AVX-512 in its own signature,
+  // which clang refuses for a lambda at -O0).
+  using VU = double __attribute__((vector_size(64), aligned(8), __may_alias__));
+#define load(p) (*reinterpret_cast<const VU*>(p))
   auto halves = [](double* lo, double* hi, const V& v) __attribute__((always_inline)) {
     std::memcpy(lo, &v, 4 * sizeof(double));
     std::memcpy(hi, reinterpret_cast<const double*>(&v) + 4, 4 * sizeof(double));
@@ -273,6 +272,7 @@ __attribute__((target("avx512f"))) void pass4_avx512(const double* xr, const dou
 #undef TEXEL_B
   }
 }
+#undef load
 #undef TEXEL_BUTTERFLY
 
 void pass4_with_avx512(const double* xr, const double* xi, double* yr, double* yi, std::size_t m, std::size_t s,
