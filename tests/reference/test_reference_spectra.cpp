@@ -181,23 +181,31 @@ TEST(BandpassNoise, CentreAndMinus3dBWidth) {
           f.push_back(freq[k]);
           y.push_back(10 * std::log10(power[k]));
         }
-      double best = INFINITY, best_fc = 0, best_q = 0;
-      const double q0 = 1 / (2 * zeta);
-      for (double rf = 0.8; rf <= 1.25; rf += 0.005)
-        for (double rq = 0.7; rq <= 1.4; rq += 0.005) {
-          const double c = fc * rf, q = q0 * rq;
-          double mean = 0;
-          std::vector<double> model(f.size());
-          for (std::size_t i = 0; i < f.size(); ++i) {
-            const double d = f[i] / c - c / f[i];
-            model[i] = -10 * std::log10(1 + q * q * d * d);
-            mean += y[i] - model[i];
-          }
-          mean /= f.size();
-          double err = 0;
-          for (std::size_t i = 0; i < f.size(); ++i) err += (y[i] - model[i] - mean) * (y[i] - model[i] - mean);
-          if (err < best) best = err, best_fc = c, best_q = q;
+      // Misfit of the shape at centre c and quality q (the level A is the mean residual).
+      std::vector<double> model(f.size());
+      const auto misfit = [&](double c, double q) {
+        double mean = 0;
+        for (std::size_t i = 0; i < f.size(); ++i) {
+          const double d = f[i] / c - c / f[i];
+          model[i] = -10 * std::log10(1 + q * q * d * d);
+          mean += y[i] - model[i];
         }
+        mean /= static_cast<double>(f.size());
+        double err = 0;
+        for (std::size_t i = 0; i < f.size(); ++i) err += (y[i] - model[i] - mean) * (y[i] - model[i] - mean);
+        return err;
+      };
+      // Grid search, coarse (steps of 0.02 in both ratios) then fine (0.005) around the coarse best.
+      const double q0 = 1 / (2 * zeta);
+      double best = INFINITY, best_rf = 1, best_rq = 1;
+      const auto search = [&](double rf0, double rf1, double rq0, double rq1, double step) {
+        for (double rf = rf0; rf <= rf1 + 1e-12; rf += step)
+          for (double rq = rq0; rq <= rq1 + 1e-12; rq += step)
+            if (const double e = misfit(fc * rf, q0 * rq); e < best) best = e, best_rf = rf, best_rq = rq;
+      };
+      search(0.8, 1.26, 0.7, 1.4, 0.02);
+      search(best_rf - 0.02, best_rf + 0.02, best_rq - 0.02, best_rq + 0.02, 0.005);
+      const double best_fc = fc * best_rf, best_q = q0 * best_rq;
       EXPECT_NEAR(best_fc / fc, 1.0, 0.10) << name;
       EXPECT_NEAR((best_fc / best_q) / (2 * zeta * fc), 1.0, 0.10) << name << " fitted f_c " << best_fc << " Q " << best_q;
     }
