@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <span>
 #include <string>
 #include <vector>
@@ -161,9 +162,10 @@ class SerialLink {
   std::string name_;
   std::uint8_t seq_ = 0;
   serial::Decoder decoder_{};
-  // Finger reports read but not yet taken (bounded: the oldest are dropped).
+  // Finger reports read but not yet taken (bounded: the oldest are dropped,
+  // in constant time).
   void keep_report(const serial::Frame& f);
-  std::vector<FingerReport> pending_;
+  std::deque<FingerReport> pending_;
   bool have_report_seq_ = false;
   std::uint8_t next_report_seq_ = 0;
   std::uint64_t reports_lost_ = 0;

@@ -217,7 +217,7 @@ void SerialLink::keep_report(const serial::Frame& f) {
   next_report_seq_ = static_cast<std::uint8_t>(f.seq + 1);
   constexpr std::size_t max_pending = 4096;  // about 4 s at 1 kHz
   if (pending_.size() >= max_pending) {
-    pending_.erase(pending_.begin());
+    pending_.pop_front();
     ++reports_lost_;
   }
   FingerReport r;
