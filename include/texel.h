@@ -525,6 +525,18 @@ TEXEL_API texel_encode2d_options texel_encode2d_options_default(void);
 TEXEL_API texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_px, double pitch_mm,
                                        const texel_encode_options* options, const texel_encode2d_options* options2d,
                                        texel_encode2d_result** out);
+/* Encodes a 2-D input file as `texel encode` does: a grey 8/16-bit .png, a
+ * 2-D .npy (a height map, values outside [0, 1], is scaled) or a .scans.json
+ * bundle of 1-D scans. pitch_mm: the pixel pitch (> 0), or 0 to take the
+ * device's bitmap pitch; device: a built-in profile name or a profile's
+ * path, or NULL (then pitch_mm is required); polarity: how a PNG's levels
+ * read (TEXEL_DARKER_MORE_FRICTION or TEXEL_BRIGHTER_MORE_FRICTION), or -1
+ * for the device's (darker_more_friction without one); swipe_speed_mm_s:
+ * for recorded scans in a bundle, 0 for none. The device's frequency
+ * response is the perceptual model's display, as for texel_encode_file. */
+TEXEL_API texel_status texel_encode_2d_file(const char* path, double pitch_mm, const char* device, int polarity,
+                                            double swipe_speed_mm_s, const texel_encode_options* options,
+                                            const texel_encode2d_options* options2d, texel_encode2d_result** out);
 /* The document (a new handle, the caller's). Its region names its coarse
  * image as "coarse.npy" beside the document: texel_encode2d_result_save
  * writes both; rendering the document needs the image there. */

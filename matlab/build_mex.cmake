@@ -11,7 +11,7 @@ get_filename_component(libdir ${LIBRARY} DIRECTORY)
 # each MEX file uses some of: unused ones are not a warning.
 set(ENV{CFLAGS} "-O2 -std=c99 -Wall -Wextra -pedantic -Wno-unused-function")
 string(TIMESTAMP start "%s%f")
-foreach(fn texel_render texel_encode texel_decode texel_spectrum texel_reference texel_render2d texel_swipe2d)
+foreach(fn texel_render texel_encode texel_decode texel_spectrum texel_reference texel_render2d texel_swipe2d texel_encode2d)
   execute_process(
     COMMAND ${MKOCTFILE} --mex -I${INCLUDE} -I${SOURCE} -o ${OUT}/${fn}.mex ${SOURCE}/${fn}.c -L${libdir} -ltexel
             -Wl,-rpath,${libdir}
@@ -25,4 +25,4 @@ foreach(fn texel_render texel_encode texel_decode texel_spectrum texel_reference
 endforeach()
 string(TIMESTAMP end "%s%f")
 math(EXPR ms "(${end} - ${start}) / 1000")
-message(STATUS "built 7 MEX functions in ${ms} ms into ${OUT}")
+message(STATUS "built 8 MEX functions in ${ms} ms into ${OUT}")

@@ -274,23 +274,11 @@ void run_encode2d(const EncodeArgs& a, const CLI::App& cmd) {
     image = stem + ".coarse.npy";
     cfg.coarse_image_path = std::filesystem::path(*image).filename().string();
   }
-  codec::Encode2DResult r;
-  if (output_extension(input) == ".scans.json") {
-    if (a.pitch_mm) cfg.device.reset();
-    r = codec::encode_scans(codec::load_scan_bundle(input, signal_options(a.input)), cfg);
-  } else {
-    if (!codec::is_2d_input(input))
-      throw InvalidArgument("'" + input +
-                            "' is not a 2-D input: a 2-D encode reads a grey .png, a 2-D .npy or a .scans.json bundle");
-    codec::Raster2DLoadOptions lo;
-    if (a.pitch_mm) lo.pitch = Millimetres(*a.pitch_mm);
-    lo.device = device;
-    if (a.polarity) lo.polarity = parse_bitmap_polarity(*a.polarity, "--polarity");
-    const codec::Input2D in = codec::load_input2d(input, lo);
-    cfg.depth = in.depth == 8 ? 8 : 16;
-    cfg.polarity = in.polarity;
-    r = codec::encode_surface2d(in.map, cfg);
-  }
+  codec::Raster2DLoadOptions lo;
+  if (a.pitch_mm) lo.pitch = Millimetres(*a.pitch_mm);
+  lo.device = device;
+  if (a.polarity) lo.polarity = parse_bitmap_polarity(*a.polarity, "--polarity");
+  const codec::Encode2DResult r = codec::encode_2d_file(input, lo, signal_options(a.input), cfg);
   if (!r.coarse_image) image.reset();
   if (a.output) codec::write_encoding2d(r, *a.output);
   if (a.json) {

@@ -196,6 +196,17 @@ Encode2DResult encode_scans(const ScanBundle& bundle, const Encode2DConfig& conf
 /// temporary renamed into place; on any failure nothing is left.
 void write_encoding2d(const Encode2DResult& result, const std::string& document_path);
 
+/// Encodes a 2-D input file, the one rule every front door follows
+/// (`texel encode map.png`, Python encode_2d, C texel_encode_2d_file, MEX
+/// texel_encode2d): a `.scans.json` bundle goes to encode_scans (its scans
+/// read with `signal`; with `load.pitch` given the document's grid is the
+/// scans' own, config.device is ignored), a grey .png or a 2-D .npy to
+/// load_input2d with `load` and then encode_surface2d, the generated device
+/// taking the PNG's depth and polarity. Throws InvalidArgument naming the
+/// file for anything else.
+Encode2DResult encode_2d_file(const std::string& path, const Raster2DLoadOptions& load, const SignalOptions& signal,
+                              Encode2DConfig config);
+
 /// The result as JSON (parameters, per-direction rows, anisotropy, flags,
 /// model), the one serialisation every front door prints.
 std::string to_json(const Encode2DResult& result);

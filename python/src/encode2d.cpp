@@ -139,22 +139,16 @@ void register_encode2d(py::module_& m) {
           py::gil_scoped_release release;
           return codec::encode_surface2d(map, c);
         }
-        const std::string path = path_of(source);
-        if (path.size() > 11 && path.substr(path.size() - 11) == ".scans.json") {
-          SignalOptions so;
-          if (swipe_speed_mm_s) so.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
-          if (pitch_mm) so.spacing = Millimetres(*pitch_mm);
-          const codec::ScanBundle bundle = codec::load_scan_bundle(path, so);
-          py::gil_scoped_release release;
-          return codec::encode_scans(bundle, c);
-        }
         codec::Raster2DLoadOptions lo;
         if (pitch_mm) lo.pitch = Millimetres(*pitch_mm);
         lo.device = dev;
         if (polarity) lo.polarity = parse_bitmap_polarity(*polarity, "polarity");
-        const codec::Input2D input = codec::load_input2d(path, lo);
+        SignalOptions so;
+        if (swipe_speed_mm_s) so.swipe_speed = MmPerSecond(*swipe_speed_mm_s);
+        if (pitch_mm) so.spacing = Millimetres(*pitch_mm);
+        const std::string path = path_of(source);
         py::gil_scoped_release release;
-        return codec::encode_surface2d(input.map, c);
+        return codec::encode_2d_file(path, lo, so, c);
       },
       py::arg("source"), py::kw_only(), py::arg("pitch_mm") = py::none(), py::arg("device") = py::none(),
       py::arg("polarity") = py::none(), py::arg("directions") = defaults.directions,

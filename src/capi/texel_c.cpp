@@ -1016,6 +1016,43 @@ texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_
   });
 }
 
+texel_status texel_encode_2d_file(const char* path, double pitch_mm, const char* device, int polarity, double swipe_speed_mm_s,
+                                  const texel_encode_options* options, const texel_encode2d_options* options2d,
+                                  texel_encode2d_result** out) {
+  return create(out, [&] {
+    need_text(path, "path");
+    need_finite(pitch_mm, "pitch_mm");
+    need_finite(swipe_speed_mm_s, "swipe_speed_mm_s");
+    if (pitch_mm < 0.0) throw InvalidArgument("pitch_mm is " + num(pitch_mm) + "; allowed: 0 (the device's) or a pitch > 0 mm");
+    if (swipe_speed_mm_s < 0.0)
+      throw InvalidArgument("swipe_speed_mm_s is " + num(swipe_speed_mm_s) + "; allowed: 0 (none) or a speed > 0 mm/s");
+    if (polarity != -1 && polarity != TEXEL_DARKER_MORE_FRICTION && polarity != TEXEL_BRIGHTER_MORE_FRICTION)
+      throw InvalidArgument("polarity is " + std::to_string(polarity) +
+                            "; allowed: -1 (the device's), TEXEL_DARKER_MORE_FRICTION (0), TEXEL_BRIGHTER_MORE_FRICTION (1)");
+    texel::codec::Encode2DConfig config;
+    if (options) config.encoder = config_of(*options);
+    if (options2d) {
+      config.directions = options2d->directions;
+      config.scan_samples = options2d->scan_samples;
+      config.correction_rounds = options2d->correction_rounds;
+    }
+    texel::codec::Raster2DLoadOptions load;
+    texel::SignalOptions signal;
+    if (pitch_mm > 0.0) load.pitch = signal.spacing = texel::Millimetres(pitch_mm);
+    if (device) {
+      load.device = signal.device = texel::load_device(device);
+      config.encoder.model.display = load.device->response;  // as texel encode --device
+      if (load.device->bitmap) config.device = load.device;
+    }
+    if (polarity != -1)
+      load.polarity = polarity == TEXEL_BRIGHTER_MORE_FRICTION ? texel::BitmapPolarity::brighter_more_friction
+                                                               : texel::BitmapPolarity::darker_more_friction;
+    if (swipe_speed_mm_s > 0.0) config.encoder.model.swipe_speed = *(signal.swipe_speed = texel::MmPerSecond(swipe_speed_mm_s));
+    return std::make_unique<texel_encode2d_result>(
+        texel_encode2d_result{texel::codec::encode_2d_file(path, load, signal, config)});
+  });
+}
+
 texel_status texel_encode2d_result_document(const texel_encode2d_result* result, texel_document** out) {
   return create(out, [&] { return std::make_unique<texel_document>(texel_document{need(result, "result").result.document}); });
 }

@@ -160,4 +160,19 @@ ScanBundle load_scan_bundle(const std::string& path, const SignalOptions& signal
   return b;
 }
 
+Encode2DResult encode_2d_file(const std::string& path, const Raster2DLoadOptions& load, const SignalOptions& signal,
+                              Encode2DConfig config) {
+  if (output_extension(path) == ".scans.json") {
+    if (load.pitch) config.device.reset();
+    return encode_scans(load_scan_bundle(path, signal), config);
+  }
+  if (!is_2d_input(path))
+    throw InvalidArgument("'" + path +
+                          "' is not a 2-D input: a 2-D encode reads a grey .png, a 2-D .npy or a .scans.json bundle");
+  const Input2D in = load_input2d(path, load);
+  config.depth = in.depth == 8 ? 8 : 16;
+  config.polarity = in.polarity;
+  return encode_surface2d(in.map, config);
+}
+
 }  // namespace texel::codec

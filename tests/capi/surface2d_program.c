@@ -125,6 +125,50 @@ int main(int argc, char** argv) {
   mine = read_file(path, &bytes);
   CHECK(png && mine && size == bytes && memcmp(png, mine, size) == 0, "%s differs from %s", path, argv[3]);
 
+  /* ------------------------------------------- 2-D encoding of a file */
+  /* The CLI's .npy encodes as the same amplitudes in memory do (one JSON,
+   * byte for byte); its PNG, to the same Central Pitch within its levels. */
+  {
+    texel_encode2d_options o2 = texel_encode2d_options_default();
+    texel_encode2d_result *from_npy = NULL, *from_memory = NULL, *from_png = NULL, *bad = NULL;
+    size_t na = 0, nb = 0;
+    char *ja = NULL, *jb = NULL, *jc = NULL;
+    double pa = 0.0, pc = 1e9;
+    o2.directions = 4; /* cheap: the encoder's own tests measure its accuracy */
+    o2.scan_samples = 1024;
+    o2.correction_rounds = 0;
+    CHECK(texel_encode_2d_file(argv[2], 0.05, NULL, -1, 0.0, NULL, &o2, &from_npy) == TEXEL_OK, "encode_2d_file %s", argv[2]);
+    CHECK(texel_encode_2d(whole, info.width_px, info.height_px, 0.05, NULL, &o2, &from_memory) == TEXEL_OK, "encode_2d of it");
+    CHECK(texel_encode_2d_file(argv[3], 0.05, NULL, -1, 0.0, NULL, &o2, &from_png) == TEXEL_OK, "encode_2d_file %s", argv[3]);
+    if (from_npy && from_memory && from_png) {
+      texel_encode2d_result_json(from_npy, NULL, 0, &na);
+      texel_encode2d_result_json(from_memory, NULL, 0, &nb);
+      ja = (char*)malloc(na), jb = (char*)malloc(nb);
+      texel_encode2d_result_json(from_npy, ja, na, NULL);
+      texel_encode2d_result_json(from_memory, jb, nb, NULL);
+      CHECK(na == nb && strcmp(ja, jb) == 0, "encoding the .npy differs from encoding its amplitudes");
+      texel_encode2d_result_json(from_png, NULL, 0, &nb);
+      jc = (char*)malloc(nb);
+      texel_encode2d_result_json(from_png, jc, nb, NULL);
+      if (strstr(ja, "\"central_pitch_db\": ")) pa = strtod(strstr(ja, "\"central_pitch_db\": ") + 20, NULL);
+      if (strstr(jc, "\"central_pitch_db\": ")) pc = strtod(strstr(jc, "\"central_pitch_db\": ") + 20, NULL);
+      CHECK(fabs(pa - pc) < 0.05, "the PNG's Central Pitch %.3f dB against the .npy's %.3f dB", pc, pa);
+    }
+    CHECK(texel_encode_2d_file(argv[3], 0.05, NULL, 7, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && bad == NULL &&
+              strstr(texel_last_error(), "polarity is 7"),
+          "a polarity outside the enumeration");
+    CHECK(texel_encode_2d_file(argv[2], 0.0, NULL, -1, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT &&
+              strstr(texel_last_error(), "pixel pitch"),
+          "a .npy without a pitch");
+    CHECK(texel_encode_2d_file(argv[4], 0.05, NULL, -1, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT &&
+              strstr(texel_last_error(), "is not a 2-D input"),
+          "a WAV is not a 2-D input");
+    free(ja), free(jb), free(jc);
+    texel_encode2d_result_destroy(from_npy);
+    texel_encode2d_result_destroy(from_memory);
+    texel_encode2d_result_destroy(from_png);
+  }
+
   /* ------------------------------------------------------------- errors */
   CHECK(texel_surface2d_render_rows(s, 40, 9, whole, 9 * 80) == TEXEL_INVALID_ARGUMENT &&
             strstr(texel_last_error(), "first_row 40 and rows 9"),
