@@ -158,6 +158,32 @@ assert(isequal(o, wav_floats(read_bytes([out '/trace.wav']))), 'texel_swipe2d(tr
 printf('texel_swipe2d(trace): %d samples, the same as the CLI\n', numel(o));
 assert(~isequal(texel_swipe2d(doc2d, trace, 'output', 'amplitude', 'mode', 'bitmap'), o));
 
+% 2-D encoding: texel_encode2d of a matrix and of the same map as a .npy file give one result; 'save' writes a
+% document texel_render2d renders at the map's size.
+function write_npy(path, A)  % float64, C order (rows along y)
+  hdr = sprintf('{''descr'': ''<f8'', ''fortran_order'': False, ''shape'': (%d, %d), }', rows(A), columns(A));
+  hdr = [hdr repmat(' ', 1, 63 - mod(10 + numel(hdr), 64)) char(10)];
+  f = fopen(path, 'w');
+  fwrite(f, [147 double('NUMPY') 1 0], 'uint8'); fwrite(f, numel(hdr), 'uint16'); fwrite(f, hdr, 'char');
+  fwrite(f, A', 'double'); fclose(f);
+end
+[X, Y] = meshgrid((0:159) * 0.05, (0:119) * 0.05);
+A = 0.5 + 0.25 * sin(2 * pi * (2 * X + Y)) + 0.25 * sin(2 * pi * (-1.5 * X + 2.5 * Y));
+write_npy([out '/map2d.npy'], A);
+cheap = {'directions', 4, 'scan_samples', 1024, 'correction_rounds', 0};
+e1 = texel_encode2d(A, 'pitch_mm', 0.05, cheap{:});
+e2 = texel_encode2d([out '/map2d.npy'], 'pitch_mm', 0.05, cheap{:}, 'save', [out '/map2d.texel.json']);
+assert(strcmp(e2.document, [out '/map2d.texel.json']));
+assert(isequal(e1, rmfield(e2, 'document')), 'texel_encode2d of the .npy differs from the matrix''s');
+assert(strcmp(e1.method, 'bitmap') && numel(e1.anisotropy.directions) == 4 && isfinite(e1.estimate.central_pitch_db));
+[amp2, info2] = texel_render2d([out '/map2d.texel.json']);
+assert(info2.width_px == 160 && info2.height_px == 120 && info2.pixel_pitch_mm == 0.05);
+printf('texel_encode2d: P %.2f dB, I %.2f dB, the matrix and the .npy alike\n', e1.estimate.central_pitch_db, ...
+       e1.estimate.irregularity_db);
+expect_error(@() texel_encode2d(A), 'texel:invalidArgument', 'a matrix needs ''pitch_mm'' (the distance between its pixels, mm)');
+expect_error(@() texel_encode2d([out '/map2d.npy'], cheap{:}), 'texel:invalidArgument', ...
+             cli_error(texel, sprintf('encode "%s/map2d.npy" --directions 4', out)));
+
 % encode target: a map whose felt pitch and log-spectral centroid differ.
 xs = (0:8191)' * 0.01;
 g = sin(2 * pi * 2 * xs) + 0.5 * sin(2 * pi * 4 * xs + 1) + 0.25 * sin(2 * pi * 6 * xs + 2);

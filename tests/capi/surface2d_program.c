@@ -125,50 +125,6 @@ int main(int argc, char** argv) {
   mine = read_file(path, &bytes);
   CHECK(png && mine && size == bytes && memcmp(png, mine, size) == 0, "%s differs from %s", path, argv[3]);
 
-  /* ------------------------------------------- 2-D encoding of a file */
-  /* The CLI's .npy encodes as the same amplitudes in memory do (one JSON,
-   * byte for byte); its PNG, to the same Central Pitch within its levels. */
-  {
-    texel_encode2d_options o2 = texel_encode2d_options_default();
-    texel_encode2d_result *from_npy = NULL, *from_memory = NULL, *from_png = NULL, *bad = NULL;
-    size_t na = 0, nb = 0;
-    char *ja = NULL, *jb = NULL, *jc = NULL;
-    double pa = 0.0, pc = 1e9;
-    o2.directions = 4; /* cheap: the encoder's own tests measure its accuracy */
-    o2.scan_samples = 1024;
-    o2.correction_rounds = 0;
-    CHECK(texel_encode_2d_file(argv[2], 0.05, NULL, -1, 0.0, NULL, &o2, &from_npy) == TEXEL_OK, "encode_2d_file %s", argv[2]);
-    CHECK(texel_encode_2d(whole, info.width_px, info.height_px, 0.05, NULL, &o2, &from_memory) == TEXEL_OK, "encode_2d of it");
-    CHECK(texel_encode_2d_file(argv[3], 0.05, NULL, -1, 0.0, NULL, &o2, &from_png) == TEXEL_OK, "encode_2d_file %s", argv[3]);
-    if (from_npy && from_memory && from_png) {
-      texel_encode2d_result_json(from_npy, NULL, 0, &na);
-      texel_encode2d_result_json(from_memory, NULL, 0, &nb);
-      ja = (char*)malloc(na), jb = (char*)malloc(nb);
-      texel_encode2d_result_json(from_npy, ja, na, NULL);
-      texel_encode2d_result_json(from_memory, jb, nb, NULL);
-      CHECK(na == nb && strcmp(ja, jb) == 0, "encoding the .npy differs from encoding its amplitudes");
-      texel_encode2d_result_json(from_png, NULL, 0, &nb);
-      jc = (char*)malloc(nb);
-      texel_encode2d_result_json(from_png, jc, nb, NULL);
-      if (strstr(ja, "\"central_pitch_db\": ")) pa = strtod(strstr(ja, "\"central_pitch_db\": ") + 20, NULL);
-      if (strstr(jc, "\"central_pitch_db\": ")) pc = strtod(strstr(jc, "\"central_pitch_db\": ") + 20, NULL);
-      CHECK(fabs(pa - pc) < 0.05, "the PNG's Central Pitch %.3f dB against the .npy's %.3f dB", pc, pa);
-    }
-    CHECK(texel_encode_2d_file(argv[3], 0.05, NULL, 7, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && bad == NULL &&
-              strstr(texel_last_error(), "polarity is 7"),
-          "a polarity outside the enumeration");
-    CHECK(texel_encode_2d_file(argv[2], 0.0, NULL, -1, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT &&
-              strstr(texel_last_error(), "pixel pitch"),
-          "a .npy without a pitch");
-    CHECK(texel_encode_2d_file(argv[4], 0.05, NULL, -1, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT &&
-              strstr(texel_last_error(), "is not a 2-D input"),
-          "a WAV is not a 2-D input");
-    free(ja), free(jb), free(jc);
-    texel_encode2d_result_destroy(from_npy);
-    texel_encode2d_result_destroy(from_memory);
-    texel_encode2d_result_destroy(from_png);
-  }
-
   /* ------------------------------------------------------------- errors */
   CHECK(texel_surface2d_render_rows(s, 40, 9, whole, 9 * 80) == TEXEL_INVALID_ARGUMENT &&
             strstr(texel_last_error(), "first_row 40 and rows 9"),
@@ -307,6 +263,41 @@ int main(int argc, char** argv) {
     map[7] = 1.5;
     CHECK(texel_encode_2d(map, side, side, 0.05, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && strstr(texel_last_error(), "1.5"),
           "a value outside [0, 1]");
+    /* The same map as a .npy file (float64, C order) encodes to the same result. */
+    sprintf(path, "%s/map.npy", argv[5]);
+    {
+      static const char magic[] = "\x93NUMPY\x01\x00";
+      char header[128];
+      int len = sprintf(header, "{'descr': '<f8', 'fortran_order': False, 'shape': (%d, %d), }", side, side);
+      texel_encode2d_result* from_file = NULL;
+      char* file_json;
+      size_t file_needed = 0;
+      FILE* f = fopen(path, "wb");
+      while ((10 + len + 1) % 64 != 0) header[len++] = ' ';
+      header[len++] = '\n';
+      CHECK(f && fwrite(magic, 1, 8, f) == 8 && fputc(len & 0xff, f) != EOF && fputc(len >> 8, f) != EOF &&
+                fwrite(header, 1, (size_t)len, f) == (size_t)len && fwrite(map, sizeof map[0], side * side, f) == side * side &&
+                fclose(f) == 0,
+            "write %s", path);
+      CHECK(texel_encode_2d_file(path, 0.05, NULL, -1, 0.0, NULL, &o2, &from_file) == TEXEL_OK &&
+                texel_encode2d_result_json(from_file, NULL, 0, &file_needed) == TEXEL_OK,
+            "encode_2d_file %s", path);
+      file_json = (char*)malloc(file_needed ? file_needed : 1);
+      CHECK(file_needed == needed && texel_encode2d_result_json(from_file, file_json, file_needed, NULL) == TEXEL_OK &&
+                strcmp(file_json, json) == 0,
+            "encoding %s differs from encoding the same map in memory", path);
+      free(file_json);
+      texel_encode2d_result_destroy(from_file);
+      CHECK(texel_encode_2d_file(path, 0.05, NULL, 7, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && bad == NULL &&
+                strstr(texel_last_error(), "polarity is 7"),
+            "a polarity outside the enumeration");
+      CHECK(texel_encode_2d_file(path, 0.0, NULL, -1, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT &&
+                strstr(texel_last_error(), "pixel pitch"),
+            "a .npy without a pitch");
+      CHECK(texel_encode_2d_file(argv[4], 0.05, NULL, -1, 0.0, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT &&
+                strstr(texel_last_error(), "is not a 2-D input"),
+            "a WAV is not a 2-D input");
+    }
     printf("encode_2d: %s\n", json);
     free(json);
     texel_surface2d_destroy(es);
