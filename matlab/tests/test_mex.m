@@ -167,7 +167,7 @@ function write_npy(path, A)  % float64, C order (rows along y)
   fwrite(f, [147 double('NUMPY') 1 0], 'uint8'); fwrite(f, numel(hdr), 'uint16'); fwrite(f, hdr, 'char');
   fwrite(f, A', 'double'); fclose(f);
 end
-[X, Y] = meshgrid((0:159) * 0.05, (0:119) * 0.05);
+[X, Y] = meshgrid((0:399) * 0.05, (0:399) * 0.05);
 A = 0.5 + 0.25 * sin(2 * pi * (2 * X + Y)) + 0.25 * sin(2 * pi * (-1.5 * X + 2.5 * Y));
 write_npy([out '/map2d.npy'], A);
 cheap = {'directions', 4, 'scan_samples', 1024, 'correction_rounds', 0};
@@ -177,7 +177,7 @@ assert(strcmp(e2.document, [out '/map2d.texel.json']));
 assert(isequal(e1, rmfield(e2, 'document')), 'texel_encode2d of the .npy differs from the matrix''s');
 assert(strcmp(e1.method, 'bitmap') && numel(e1.anisotropy.directions) == 4 && isfinite(e1.estimate.central_pitch_db));
 [amp2, info2] = texel_render2d([out '/map2d.texel.json']);
-assert(info2.width_px == 160 && info2.height_px == 120 && info2.pixel_pitch_mm == 0.05);
+assert(info2.width_px == 400 && info2.height_px == 400 && info2.pixel_pitch_mm == 0.05);
 printf('texel_encode2d: P %.2f dB, I %.2f dB, the matrix and the .npy alike\n', e1.estimate.central_pitch_db, ...
        e1.estimate.irregularity_db);
 expect_error(@() texel_encode2d(A), 'texel:invalidArgument', 'a matrix needs ''pitch_mm'' (the distance between its pixels, mm)');
