@@ -239,6 +239,18 @@ def test_encode_2d_saves_a_document_that_renders(square_map, tmp_path):
     assert (tmp_path / "m.coarse.npy").exists() == (r.coarse_image is not None)
 
 
+def test_encode_2d_of_a_png_keeps_its_depth_and_polarity_as_the_cli_does(golden, cli, tmp_path):
+    """An 8-bit PNG read brighter-more-friction: the document's generated device says so, as `texel encode` writes it."""
+    doc = variant(golden, one_region=True, width_px=400, height_px=400, depth_bits=8)
+    texel.write_bitmap(doc, tmp_path / "m.png")
+    r = texel.encode_2d(tmp_path / "m.png", pitch_mm=0.05, polarity="brighter_more_friction", **CHEAP)
+    bitmap = json.loads(r.document.to_json())["device"]["bitmap"]
+    assert bitmap["depth_bits"] == 8 and bitmap["polarity"] == "brighter_more_friction"
+    cli("encode", tmp_path / "m.png", "--pitch", "0.05", "--polarity", "brighter_more_friction", "--directions", "4",
+        "-o", tmp_path / "cli.texel.json")
+    assert json.loads((tmp_path / "cli.texel.json").read_text())["device"]["bitmap"] == bitmap
+
+
 @pytest.mark.parametrize("source,kwargs,match", [
     (np.zeros((2, 20, 20)), dict(pitch_mm=0.05), "3 dimensions"),
     (np.zeros((20, 20)), {}, "needs pitch_mm"),
