@@ -289,7 +289,7 @@ TEST(Surface2D, TileFieldMeetsTheStationaryBound) {
   // Irregularity (a wrong radial spectrum, scale or interpolation fails it);
   // the sweep is bench/surface2d_anisotropy.
   // (The widest textures' low frequencies need long scans: the sweep's.)
-  for (const auto& [p_db, i_db] : {std::pair{6.0, 0.0}, std::pair{6.0, -10.0}, std::pair{0.0, 0.0}}) {
+  for (const auto& [p_db, i_db] : {std::pair{6.0, -10.0}, std::pair{0.0, 0.0}}) {
     const CyclesPerMm top(16.0 * std::pow(10.0, p_db / 10.0));
     TexelSpec spec;
     spec.central_pitch = Decibels(p_db);
@@ -345,6 +345,7 @@ TEST(Surface2D, DocumentVersion5DefaultsToTheTileField) {
   v4_spectral.replace(v4_spectral.find("\"field\": \"cells\""), 16, "\"field\": \"spectral\"");
   Document a = parse_document(v5_spectral), b = parse_document(v4_spectral);
   for (Document* d : {&a, &b}) {
+    d->surface2d->regions.pop_back();  // the oriented region: the same in both, and slow to prepare
     BitmapGeometry g = *d->device.bitmap;
     g.width = 64;
     g.height = 16;
