@@ -59,7 +59,8 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[a], "--lengths") && a + 1 < argc) numbers(argv[++a], only_lengths);
     if (!std::strcmp(argv[a], "--designs") && a + 1 < argc) {
       designs.clear();
-      for (char* t = std::strtok(argv[++a], ","); t; t = std::strtok(nullptr, ",")) designs.push_back(parse_field2d(t, "--designs"));
+      for (char* t = std::strtok(argv[++a], ","); t; t = std::strtok(nullptr, ","))
+        designs.push_back(parse_field2d(t, "--designs"));
     }
   }
   // The protocols' textures (examples/protocols: P 0 … 15.3 dB, I −10 … 5 dB

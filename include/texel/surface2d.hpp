@@ -72,9 +72,9 @@ class FineField2D {
   /// samples (tile_samples) h apart, period N·h; s is the sum over the
   /// bands of each tile's cubic B-spline, clipped to [−1, 1].
   struct TileBand {
-    double spacing_mm = 0.0;           ///< h
-    double q_lo = 0.0, q_hi = 0.0;     ///< the band's radial frequencies (cpm), q_lo ≤ |q| < q_hi
-    std::size_t modes = 0;             ///< lattice frequencies with power
+    double spacing_mm = 0.0;        ///< h
+    double q_lo = 0.0, q_hi = 0.0;  ///< the band's radial frequencies (cpm), q_lo ≤ |q| < q_hi
+    std::size_t modes = 0;          ///< lattice frequencies with power
     [[nodiscard]] double period_mm() const { return spacing_mm * static_cast<double>(tile_samples); }
   };
   [[nodiscard]] std::vector<TileBand> tile_bands() const;

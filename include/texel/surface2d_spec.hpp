@@ -85,8 +85,8 @@ struct Region2DSpec {
   Millimetres x{0.0}, y{0.0};
   std::optional<Millimetres> width, height;  ///< none = to the device's edge
   TexelSpec texel;                           ///< the fine texture and C, F (its 1-D coarse profile must be constant)
-  Field2D field = Field2D::spectral;  ///< parse_document: default_field2d(version)
-  double orientation_deg = 0.0;  ///< oriented: direction of the grating's wave vector n
+  Field2D field = Field2D::spectral;         ///< parse_document: default_field2d(version)
+  double orientation_deg = 0.0;              ///< oriented: direction of the grating's wave vector n
   Coarse2D coarse = ConstantProfile{};
 };
 

@@ -225,7 +225,6 @@ void sines(std::span<double> v) {
   kernel(v.data(), v.size());
 }
 
-
 // ---- The tile design (§11.2): periodic tiles by an inverse FFT, cubic B-splines between samples.
 
 constexpr std::size_t tile_n = FineField2D::tile_samples;
@@ -422,9 +421,10 @@ void FineField2D::build_tiles(const PitchDistribution& line) {
   const double q_max = std::min(hi_band, detmath::exp(rmu + 4.0 * rsigma));
   const double q_min = std::max(lo_band, detmath::exp(rmu - 4.0 * rsigma));
   if (!(q_min < q_max))
-    throw InvalidArgument("field 'tile': the texture's radial spectrum (" + detail::num(detmath::exp(rmu - 4.0 * rsigma)) + " … " +
-                          detail::num(detmath::exp(rmu + 4.0 * rsigma)) + " cpm) lies outside its band " + detail::num(lo_band) +
-                          " … " + detail::num(hi_band) + " cpm (the bitmap's Nyquist frequency is too low for it)");
+    throw InvalidArgument("field 'tile': the texture's radial spectrum (" + detail::num(detmath::exp(rmu - 4.0 * rsigma)) +
+                          " … " + detail::num(detmath::exp(rmu + 4.0 * rsigma)) + " cpm) lies outside its band " +
+                          detail::num(lo_band) + " … " + detail::num(hi_band) +
+                          " cpm (the bitmap's Nyquist frequency is too low for it)");
   const auto S2 = [&](double q) {
     const double z = (detmath::log(q) - rmu) / rsigma;
     return detmath::exp(-0.5 * z * z) / (q * q);

@@ -246,8 +246,8 @@ TEST(Surface2D, TileRowsGiveValueBitForBit) {
   for (const FineField2D& field : {tile_field(4.0, 2.0, 25.0), tile_field(0.0, 5.0, 16.0, 9)}) {
     ASSERT_FALSE(field.tile_bands().empty());
     const std::size_t cols = 600, stride = 611;
-    for (const std::vector<double>& ys : {std::vector<double>{-0.3, -0.28, -0.26, -0.24, -0.22},
-                                          std::vector<double>{-0.3, 0.0, 0.02, 1.7, 2.25, 9.5, 100.125}}) {
+    for (const std::vector<double>& ys :
+         {std::vector<double>{-0.3, -0.28, -0.26, -0.24, -0.22}, std::vector<double>{-0.3, 0.0, 0.02, 1.7, 2.25, 9.5, 100.125}}) {
       std::vector<double> out(ys.size() * stride, 7.0);
       field.block(-5, cols, 0.02, 0.013, ys, out.data(), stride);
       for (std::size_t r = 0; r < ys.size(); ++r) {
@@ -270,8 +270,7 @@ TEST(Surface2D, TileFieldIsPeriodicSmoothAndScaled) {
   // One band: the field repeats after the tile's period, to the last bit.
   const double T = band.period_mm();
   EXPECT_GT(T, 20.0);
-  for (double x : {0.1, 3.7, 11.0})
-    EXPECT_NEAR(field.value(x + T, x * 0.5 - T), field.value(x, x * 0.5), 1e-12);
+  for (double x : {0.1, 3.7, 11.0}) EXPECT_NEAR(field.value(x + T, x * 0.5 - T), field.value(x, x * 0.5), 1e-12);
   // RMS 1/3 (clipped at ±1), mean near 0.
   double sum = 0.0, sum2 = 0.0;
   const int n = 20000;
