@@ -35,6 +35,37 @@ Document small_document(Field2D field, Coarse2D coarse = ConstantProfile{}) {
   return doc;
 }
 
+/// A field's straight scans along four directions (`scans` of `samples`
+/// points, sampled at 16× the mean frequency, the field's band top) averaged
+/// over the directions: Central Pitch and Irregularity as measured, and the
+/// stationary bound of the texture.
+struct ScansAndBound {
+  double p, i;
+  IsotropicBound bound;
+};
+ScansAndBound scans_and_bound(Field2D design, double p_db, double i_db, int scans, std::size_t samples) {
+  const CyclesPerMm top(16.0 * std::pow(10.0, p_db / 10.0));
+  TexelSpec spec;
+  spec.central_pitch = Decibels(p_db);
+  spec.irregularity = Decibels(i_db);
+  ScanOptions o;
+  o.directions = 4;
+  o.scans = scans;
+  o.samples = samples;
+  o.spacing = Millimetres(0.5 / top.value());
+  const FineField2D field(spec, design, 0.0, top);
+  PitchDistributionConfig c;
+  c.central_pitch = spec.central_pitch;
+  c.irregularity = spec.irregularity;
+  c.band_max = top;
+  ScansAndBound r{0.0, 0.0, isotropic_bound(PitchDistribution(c), top)};
+  for (const auto& d : measure_scans(field, o)) {
+    r.p += d.log_centroid_db / o.directions;
+    r.i += d.log_spread_db / o.directions;
+  }
+  return r;
+}
+
 std::string error_of(const std::string& text) {
   try {
     (void)parse_document(text);
@@ -168,26 +199,7 @@ TEST(Surface2D, BitmapFilesAreDeterministicAndHonourPolarity) {
 TEST(Surface2D, SpectralFieldMeetsItsStationaryBound) {
   // The stationary bound and its spectral realisation agree within 0.5 dB
   // (one texture, 8 scans per direction; the sweep is bench/surface2d_anisotropy).
-  TexelSpec spec;
-  spec.central_pitch = Decibels(6.0);
-  spec.irregularity = Decibels(0.0);
-  const CyclesPerMm top(16.0 * std::pow(10.0, 0.6));
-  ScanOptions o;
-  o.directions = 4;
-  o.scans = 3;
-  o.samples = 1024;
-  o.spacing = Millimetres(0.5 / top.value());
-  const FineField2D field(spec, Field2D::spectral, 0.0, top);
-  PitchDistributionConfig c;
-  c.central_pitch = spec.central_pitch;
-  c.irregularity = spec.irregularity;
-  c.band_max = top;
-  const IsotropicBound bound = isotropic_bound(PitchDistribution(c), top);
-  double p = 0.0, i = 0.0;
-  for (const auto& d : measure_scans(field, o)) {
-    p += d.log_centroid_db / o.directions;
-    i += d.log_spread_db / o.directions;
-  }
+  const auto [p, i, bound] = scans_and_bound(Field2D::spectral, 6.0, 0.0, 3, 1024);
   // The moment fit keeps the 1-D Central Pitch; the field reaches it.
   EXPECT_NEAR(bound.matched_log_centroid_db, bound.target_log_centroid_db, 0.2);
   EXPECT_NEAR(p, bound.matched_log_centroid_db, 0.5);
@@ -289,26 +301,7 @@ TEST(Surface2D, TileFieldMeetsTheStationaryBound) {
   // the sweep is bench/surface2d_anisotropy.
   // (The widest textures' low frequencies need long scans: the sweep's.)
   for (const auto& [p_db, i_db] : {std::pair{6.0, -10.0}, std::pair{0.0, 0.0}}) {
-    const CyclesPerMm top(16.0 * std::pow(10.0, p_db / 10.0));
-    TexelSpec spec;
-    spec.central_pitch = Decibels(p_db);
-    spec.irregularity = Decibels(i_db);
-    ScanOptions o;
-    o.directions = 4;
-    o.scans = 4;
-    o.samples = 2048;
-    o.spacing = Millimetres(0.5 / top.value());
-    const FineField2D field(spec, Field2D::tile, 0.0, top);
-    PitchDistributionConfig c;
-    c.central_pitch = spec.central_pitch;
-    c.irregularity = spec.irregularity;
-    c.band_max = top;
-    const IsotropicBound bound = isotropic_bound(PitchDistribution(c), top);
-    double p = 0.0, i = 0.0;
-    for (const auto& d : measure_scans(field, o)) {
-      p += d.log_centroid_db / o.directions;
-      i += d.log_spread_db / o.directions;
-    }
+    const auto [p, i, bound] = scans_and_bound(Field2D::tile, p_db, i_db, 4, 2048);
     EXPECT_NEAR(p, bound.matched_log_centroid_db, 0.5) << p_db << " " << i_db;
     EXPECT_NEAR(i, bound.matched_log_spread_db, 0.7) << p_db << " " << i_db;
   }
