@@ -10,10 +10,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "texel/bitmap_file.hpp"
 
@@ -87,5 +89,9 @@ int main(int argc, char** argv) {
   const double cpu = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
                      1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   std::printf("render CPU time %.3f s (user + system, all threads)\n", cpu);
+  // What that CPU time implies on an idle machine of this one's cores (the
+  // render's threads and its writer sharing them perfectly): a lower bound.
+  const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
+  std::printf("idle estimate: CPU / %u cores = %.3f s, ratio %.2f to this run's dd\n", cores, cpu / cores, cpu / cores / dd_s);
   return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : 1;
 }
