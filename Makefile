@@ -113,6 +113,7 @@ bench: build web web-test
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
 	$(BUILD)/bin/texel_bench_encode --json $(BUILD)/bench_encode.json
 	$(PY) bench/render_to_file.py $(BUILD)/bin/texel
+	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 tile
 	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 spectral
 	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 cells
 	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null

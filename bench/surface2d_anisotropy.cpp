@@ -6,7 +6,8 @@
 // per direction, their spread across directions (max − min), their mean
 // against the 1-D texture's own, and the stationary isotropic bound.
 //
-//   texel_surface2d_anisotropy [--quick] [--scans 16] [--pitches 0,5.67] [--figure spread.svg] [--csv table.csv]
+//   texel_surface2d_anisotropy [--quick] [--scans 16] [--samples 4096] [--pitches 0,5.67] [--irregularities 5]
+//                              [--lengths 0.25] [--designs cells,spectral,tile] [--figure spread.svg] [--csv table.csv]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,24 +40,38 @@ struct Row {
 int main(int argc, char** argv) {
   bool quick = false;
   int scans = 16;
-  std::vector<double> only_pitches;
+  std::size_t samples = 4096;
+  std::vector<double> only_pitches, only_irregularities, only_lengths;
+  std::vector<Field2D> designs{Field2D::cells, Field2D::spectral, Field2D::tile};
+  const auto numbers = [](char* text, std::vector<double>& out) {
+    for (char* t = std::strtok(text, ","); t; t = std::strtok(nullptr, ",")) out.push_back(std::atof(t));
+  };
   std::string figure, csv;
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--quick")) quick = true;
     if (!std::strcmp(argv[a], "--figure") && a + 1 < argc) figure = argv[++a];
     if (!std::strcmp(argv[a], "--csv") && a + 1 < argc) csv = argv[++a];
     if (!std::strcmp(argv[a], "--scans") && a + 1 < argc) scans = std::atoi(argv[++a]);
-    if (!std::strcmp(argv[a], "--pitches") && a + 1 < argc) {
-      // A comma-separated subset of the grid's Central Pitches (dB), to split a sweep.
-      for (char* t = std::strtok(argv[++a], ","); t; t = std::strtok(nullptr, ",")) only_pitches.push_back(std::atof(t));
+    if (!std::strcmp(argv[a], "--samples") && a + 1 < argc) samples = static_cast<std::size_t>(std::atol(argv[++a]));
+    // Comma-separated subsets of the grid (dB, dB, mm) and of the designs, to split a sweep.
+    if (!std::strcmp(argv[a], "--pitches") && a + 1 < argc) numbers(argv[++a], only_pitches);
+    if (!std::strcmp(argv[a], "--irregularities") && a + 1 < argc) numbers(argv[++a], only_irregularities);
+    if (!std::strcmp(argv[a], "--lengths") && a + 1 < argc) numbers(argv[++a], only_lengths);
+    if (!std::strcmp(argv[a], "--designs") && a + 1 < argc) {
+      designs.clear();
+      for (char* t = std::strtok(argv[++a], ","); t; t = std::strtok(nullptr, ","))
+        designs.push_back(parse_field2d(t, "--designs"));
     }
   }
   // The protocols' textures (examples/protocols: P 0 … 15.3 dB, I −10 … 5 dB
   // moments, L 0.25 and 1 mm).
   const std::vector<double> pitches =
       quick ? std::vector<double>{6.0} : (only_pitches.empty() ? std::vector<double>{0.0, 5.67, 11.0, 15.26} : only_pitches);
-  const std::vector<double> irregularities = quick ? std::vector<double>{-5.0} : std::vector<double>{-10.0, -5.0, 0.0, 5.0};
-  const std::vector<double> lengths = quick ? std::vector<double>{0.25} : std::vector<double>{0.25, 1.0};
+  const std::vector<double> irregularities =
+      quick ? std::vector<double>{-5.0}
+            : (only_irregularities.empty() ? std::vector<double>{-10.0, -5.0, 0.0, 5.0} : only_irregularities);
+  const std::vector<double> lengths =
+      quick ? std::vector<double>{0.25} : (only_lengths.empty() ? std::vector<double>{0.25, 1.0} : only_lengths);
   std::vector<Row> rows;
   std::printf("%6s %6s %5s %-9s | %7s %7s | %7s %7s %6s %6s | %7s %7s | %7s %7s\n", "P_dB", "I_dB", "L_mm", "design", "1D_P",
               "1D_I", "mean_P", "mean_I", "sprP", "sprI", "mom_P", "mom_I", "nnls_P", "nnls_I");
@@ -74,10 +89,10 @@ int main(int argc, char** argv) {
         const CyclesPerMm top(std::min(94.33962264150944, 16.0 * mean));
         ScanOptions options;
         options.spacing = Millimetres(0.5 / top.value());
-        options.samples = 4096;
+        options.samples = samples;
         options.scans = scans;
         const DirectionStats line = measure_line(spec, top, options);
-        for (Field2D design : {Field2D::cells, Field2D::spectral}) {
+        for (Field2D design : designs) {
           const FineField2D field(spec, design, 0.0, top);
           Row r{};
           r.p = p;
@@ -125,29 +140,22 @@ int main(int argc, char** argv) {
           rows.push_back(std::move(r));
         }
       }
-  double worst_cells_p = 0, worst_cells_i = 0, worst_spec_p = 0, worst_spec_i = 0;
-  for (const auto& r : rows) {
-    if (r.design == "cells") {
-      worst_cells_p = std::max(worst_cells_p, r.spread_p);
-      worst_cells_i = std::max(worst_cells_i, r.spread_i);
-    } else {
-      worst_spec_p = std::max(worst_spec_p, r.spread_p);
-      worst_spec_i = std::max(worst_spec_i, r.spread_i);
-    }
+  for (Field2D design : designs) {
+    const std::string name(to_string(design));
+    // Spread across directions (goal: P 0.5 dB, I 1 dB) and, for the
+    // stationary designs, the mean over directions against the moment bound
+    // (the best a stationary isotropic field does; goal within 0.5 dB).
+    double spread_p = 0, spread_i = 0, off_p = 0, off_i = 0;
+    for (const auto& r : rows)
+      if (r.design == name) {
+        spread_p = std::max(spread_p, r.spread_p);
+        spread_i = std::max(spread_i, r.spread_i);
+        off_p = std::max(off_p, std::fabs(r.mean_p - r.matched_p));
+        off_i = std::max(off_i, std::fabs(r.mean_i - r.matched_i));
+      }
+    std::printf("%s: worst spread across %d directions P %.2f dB, I %.2f dB; worst |mean - moment bound| P %.2f dB, I %.2f dB\n",
+                name.c_str(), ScanOptions{}.directions, spread_p, spread_i, off_p, off_i);
   }
-  std::printf("worst spread across 36 directions: cells P %.2f dB, I %.2f dB; spectral P %.2f dB, I %.2f dB\n", worst_cells_p,
-              worst_cells_i, worst_spec_p, worst_spec_i);
-  // The fidelity bound per (P, I): the spectral field's mean over directions
-  // against the moment bound (the best a stationary isotropic field does).
-  double off_p = 0, off_i = 0;
-  for (const auto& r : rows)
-    if (r.design == "spectral") {
-      off_p = std::max(off_p, std::fabs(r.mean_p - r.matched_p));
-      off_i = std::max(off_i, std::fabs(r.mean_i - r.matched_i));
-    }
-  std::printf(
-      "spectral field against the stationary bound (goal within 0.5 dB): worst |P - bound| %.2f dB, |I - bound| %.2f dB\n", off_p,
-      off_i);
   if (!csv.empty()) {
     std::ofstream out(csv);
     out << "central_pitch_db,irregularity_db,texel_length_mm,design,line_p_db,line_i_db,mean_p_db,mean_i_db,spread_p_db,"
@@ -162,13 +170,14 @@ int main(int argc, char** argv) {
     // of the grid one line, one panel per design and quantity.
     Figure f;
     f.width_px = 1200;
-    f.height_px = 800;
+    f.height_px = 400 * static_cast<int>(designs.size());
     f.columns = 2;
     f.title = "2-D fields: straight scans along 36 directions, deviation from the mean over directions";
-    for (const char* design : {"cells", "spectral"})
+    for (Field2D shown : designs)
       for (int q = 0; q < 2; ++q) {
+        const std::string design(to_string(shown));
         Panel panel;
-        panel.title = std::string(design) + (q == 0 ? ": Central Pitch (log centroid)" : ": Irregularity (log spread)");
+        panel.title = design + (q == 0 ? ": Central Pitch (log centroid)" : ": Irregularity (log spread)");
         panel.x.label = "scan direction (deg)";
         panel.y.label = "deviation (dB)";
         panel.y.min = q == 0 ? -0.5 : -1.0;
@@ -187,7 +196,7 @@ int main(int argc, char** argv) {
         }
         f.panels.push_back(std::move(panel));
       }
-    // Panels ordered cells P, cells I, spectral P, spectral I: 2 columns.
+    // Panels ordered design by design, P then I: 2 columns.
     save_figure(f, figure);
   }
   return 0;

@@ -29,7 +29,7 @@ ordered stats(const std::vector<double>& v) {
   return j;
 }
 
-// A version-4 2-D document: its bitmap grid and its regions (prepared, so
+// A 2-D document (version 4 or 5): its bitmap grid and its regions (prepared, so
 // every field and coarse profile is checked, images loaded).
 ordered surface2d_info(const Document& doc, ordered j) {
   const Surface2D surface = prepare_surface2d(doc);
@@ -56,6 +56,13 @@ ordered surface2d_info(const Document& doc, ordered j) {
                {"height_mm", r.y1 - r.y0},
                {"field", std::string(to_string(spec.field))}};
     if (spec.field == Field2D::oriented) rj["orientation_deg"] = spec.orientation_deg;
+    if (spec.field == Field2D::tile) {
+      // The tile design's periodic tiles (docs/algorithm.md §11.2), one per band.
+      ordered bands = ordered::array();
+      for (const auto& b : r.fine->tile_bands())
+        bands.push_back({{"from_cpm", b.q_lo}, {"to_cpm", b.q_hi}, {"period_mm", b.period_mm()}, {"frequencies", b.modes}});
+      rj["tile_bands"] = std::move(bands);
+    }
     rj["central_pitch_db"] = s.central_pitch.value();
     rj["irregularity_db"] = s.irregularity.value();
     rj["texel_length_mm"] = s.texel_length.value();

@@ -46,15 +46,18 @@ struct Document {
   /// version that renders their bytes (required_version), so Texel-only
   /// documents stay version 1 and version-2 references stay version 2.
   /// Version 4 adds 2-D surfaces ("surface2d", texel/surface2d_spec.hpp);
-  /// a version-4 document holds a 2-D surface and no 1-D texture.
-  static constexpr int current_version = 4;
+  /// a version-4 document holds a 2-D surface and no 1-D texture. Version 5
+  /// is a 2-D document whose regions' field defaults to "tile" (the fast
+  /// isotropic field; version 4's default, "spectral", stays selectable and
+  /// renders version 4's bytes); "tile" needs version 5.
+  static constexpr int current_version = 5;
   /// The version read (parse_document) or current_version; writers use
   /// required_version instead.
   int version = current_version;
   DeviceProfile device;             ///< resolved profile (by name or inline)
   bool device_inline = false;       ///< written inline rather than by name
   std::vector<RegionSpec> regions;  ///< at least one (none in a 2-D document)
-  /// Set: a 2-D document (version 4) for a device with a bitmap grid;
+  /// Set: a 2-D document (version 4 or 5) for a device with a bitmap grid;
   /// `regions` is then empty, and prepare_surface2d (texel/surface2d.hpp)
   /// prepares it.
   std::optional<Surface2DSpec> surface2d;

@@ -2,10 +2,12 @@
 // plane for 2-D touch surfaces and friction bitmaps.
 //
 // A FineField2D is the fine oscillation s(x, y) in [−1, 1] of one texture on
-// the infinite plane, in one of three designs (Field2D): a stationary
-// isotropic field (the default) whose radial spectrum is the best
-// non-negative one for the 1-D texture's Central Pitch and Irregularity
-// through the Abel relation (isotropic_bound), texel cells in random
+// the infinite plane, in one of four designs (Field2D): a stationary
+// isotropic field whose radial spectrum is the best non-negative one for the
+// 1-D texture's Central Pitch and Irregularity through the Abel relation
+// (isotropic_bound) — as 256 plane waves (spectral, version 4's default) or
+// as periodic tiles synthesised by an inverse FFT and interpolated by cubic
+// B-splines (tile, version 5's default) — texel cells in random
 // orientations, or an oriented grating. A CoarseField2D is a 2-D coarse profile
 // c(x, y) in [0, 1]. A Surface2D puts them in a document's regions and mixes
 // them exactly as the 1-D texels are mixed (texel_mix, §7): every pixel is a
@@ -65,6 +67,22 @@ class FineField2D {
   /// and clipped to [−1, 1]).
   static constexpr int spectral_components = 256;
 
+  /// Tile design: one periodic tile per band of radial frequencies (an
+  /// octave-like band of ratio tile_band_ratio, the highest first), N × N
+  /// samples (tile_samples) h apart, period N·h; s is the sum over the
+  /// bands of each tile's cubic B-spline, clipped to [−1, 1].
+  struct TileBand {
+    double spacing_mm = 0.0;        ///< h
+    double q_lo = 0.0, q_hi = 0.0;  ///< the band's radial frequencies (cpm), q_lo ≤ |q| < q_hi
+    std::size_t modes = 0;          ///< lattice frequencies with power
+    [[nodiscard]] double period_mm() const { return spacing_mm * static_cast<double>(tile_samples); }
+  };
+  [[nodiscard]] std::vector<TileBand> tile_bands() const;
+  static constexpr int tile_samples = 1024;
+  static constexpr double tile_band_ratio = 16.0;
+  /// Samples per cycle of a band's highest frequency.
+  static constexpr double tile_oversampling = 4.0;
+
  private:
   struct Cell {
     double frequency, cos_dir, sin_dir, phase;
@@ -79,6 +97,15 @@ class FineField2D {
   std::unique_ptr<PitchDistribution> cells_;        // cells: the corrected distribution
   std::vector<Component> components_;               // spectral
   double spectral_gain_ = 0.0;
+  struct Tile {
+    TileBand band;
+    double inv_spacing = 0.0;
+    std::vector<float> samples;  // tile_samples rows of tile_samples + 3 (the first 3 repeated)
+  };
+  std::vector<Tile> tiles_;  // tile
+  void build_tiles(const PitchDistribution& line);
+  void tile_block(std::int64_t first, std::size_t count, double pitch, double origin_x, std::span<const double> ys, double* out,
+                  std::size_t stride) const;
 };
 
 /// The cosine law a cell design corrects for: a plane wave of frequency q

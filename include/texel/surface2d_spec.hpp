@@ -1,4 +1,4 @@
-// What a 2-D texture document holds (format version 4, docs/format.md "2-D
+// What a 2-D texture document holds (format versions 4 and 5, docs/format.md "2-D
 // surfaces"): rectangular regions of a 2-D surface, each with a fine texture
 // (a TexelSpec: P, I, L, seed, strengths), the 2-D field design that lays it
 // out in the plane, and a 2-D coarse profile. Plain data, parsed and written
@@ -20,9 +20,13 @@ namespace texel {
 /// How the fine texture is laid out in the plane (docs/algorithm.md §11).
 enum class Field2D {
   cells,     ///< texel cells, one frequency each in a random orientation (fast; not isotropic enough)
-  spectral,  ///< stationary isotropic field on the moment-fit radial spectrum (default [choice])
+  spectral,  ///< stationary isotropic field on the moment-fit radial spectrum, 256 plane waves (default of version 4)
   oriented,  ///< a grating: the 1-D texture along direction n (orientation_deg)
+  tile,      ///< the same radial spectrum on periodic FFT tiles, cubic B-spline between samples (default of version 5 [choice])
 };
+/// The field a region of a document of `version` has when it names none:
+/// spectral in version 4, tile from version 5 on.
+constexpr Field2D default_field2d(int version) { return version >= 5 ? Field2D::tile : Field2D::spectral; }
 std::string_view to_string(Field2D f);
 Field2D parse_field2d(std::string_view text, std::string_view field = "field");
 
@@ -81,8 +85,8 @@ struct Region2DSpec {
   Millimetres x{0.0}, y{0.0};
   std::optional<Millimetres> width, height;  ///< none = to the device's edge
   TexelSpec texel;                           ///< the fine texture and C, F (its 1-D coarse profile must be constant)
-  Field2D field = Field2D::spectral;
-  double orientation_deg = 0.0;  ///< oriented: direction of the grating's wave vector n
+  Field2D field = Field2D::spectral;         ///< parse_document: default_field2d(version)
+  double orientation_deg = 0.0;              ///< oriented: direction of the grating's wave vector n
   Coarse2D coarse = ConstantProfile{};
 };
 

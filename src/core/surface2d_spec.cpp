@@ -12,6 +12,7 @@ std::string_view to_string(Field2D f) {
     case Field2D::cells: return "cells";
     case Field2D::spectral: return "spectral";
     case Field2D::oriented: return "oriented";
+    case Field2D::tile: return "tile";
   }
   return "cells";
 }
@@ -20,7 +21,8 @@ Field2D parse_field2d(std::string_view text, std::string_view field) {
   if (text == "cells") return Field2D::cells;
   if (text == "spectral") return Field2D::spectral;
   if (text == "oriented") return Field2D::oriented;
-  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: cells, spectral, oriented");
+  if (text == "tile") return Field2D::tile;
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: cells, spectral, oriented, tile");
 }
 
 std::string kind_name(const Coarse2D& c) {

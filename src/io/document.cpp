@@ -1,5 +1,6 @@
 #include "texel/document.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -367,7 +368,7 @@ ordered coarse2d_json(const Coarse2D& c) {
 
 /// {"regions": [{"name", "x_mm", "y_mm", "width_mm", "height_mm", "field",
 /// "orientation_deg", "texture", "coarse2d"}]} on a device with a bitmap grid.
-Surface2DSpec parse_surface2d(const json& j, const DeviceProfile& device) {
+Surface2DSpec parse_surface2d(const json& j, const DeviceProfile& device, int version) {
   JsonObject o(j, "surface2d");
   const auto& arr = o.raw("regions");
   if (!arr.is_array() || arr.empty()) throw FormatError("surface2d.regions must be a non-empty array");
@@ -383,7 +384,9 @@ Surface2DSpec parse_surface2d(const json& j, const DeviceProfile& device) {
     region.y = Millimetres(r.number_or("y_mm", 0.0, 0.0, 1e9));
     region.width = millimetres(r.optional_number("width_mm", 1e-9, 1e9));
     region.height = millimetres(r.optional_number("height_mm", 1e-9, 1e9));
-    region.field = enum_field(r, "field", region.field, parse_field2d);
+    region.field = enum_field(r, "field", default_field2d(version), parse_field2d);
+    if (region.field == Field2D::tile && version < 5)
+      throw FormatError(path + ".field is 'tile', which needs version 5; version is " + std::to_string(version));
     region.orientation_deg = r.number_or("orientation_deg", 0.0, -1e6, 1e6);
     RegionSpec texture;
     parse_texture(r.raw("texture"), path + ".texture", texture);
@@ -489,12 +492,13 @@ Document parse_document(std::string_view text, std::string_view origin) {
         throw FormatError("device: '" + doc.device.name + "' has no bitmap grid (device.bitmap), which a 2-D document needs");
       o.skip("texture");
       o.skip("regions");
-      doc.surface2d = parse_surface2d(o.raw("surface2d"), doc.device);
+      doc.surface2d = parse_surface2d(o.raw("surface2d"), doc.device, doc.version);
       o.finish();
       return doc;
     }
     o.skip("surface2d");
-    if (doc.version >= 4) throw FormatError("version 4 is a 2-D document and needs 'surface2d'");
+    if (doc.version >= 4)
+      throw FormatError("version " + std::to_string(doc.version) + " is a 2-D document and needs 'surface2d'");
     if (has_texture == has_regions) throw FormatError("give exactly one of 'texture' (whole device) or 'regions'");
     if (has_texture) {
       o.skip("regions");
@@ -603,7 +607,12 @@ ReferenceSynthesis reference_synthesis(int version) {
 }
 
 int required_version(const Document& doc) {
-  if (doc.surface2d) return 4;
+  // A 2-D document is version 4 unless a region's field is tile (version 5).
+  if (doc.surface2d)
+    return std::any_of(doc.surface2d->regions.begin(), doc.surface2d->regions.end(),
+                       [](const Region2DSpec& r) { return r.field == Field2D::tile; })
+               ? 5
+               : 4;
   int version = 1;
   std::size_t first = 0;
   for (std::size_t i = 0; i < doc.regions.size(); ++i) {

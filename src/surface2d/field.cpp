@@ -24,6 +24,7 @@ constexpr std::uint64_t cell_mask = (std::uint64_t{1} << 24) - 1;
 constexpr std::uint64_t stream_direction = static_cast<std::uint64_t>(Stream::user) + 1;
 constexpr std::uint64_t stream_cell_phase = static_cast<std::uint64_t>(Stream::user) + 2;
 constexpr std::uint64_t stream_spectral = static_cast<std::uint64_t>(Stream::user) + 3;
+constexpr std::uint64_t stream_tile = static_cast<std::uint64_t>(Stream::user) + 4;
 
 /// std::floor, inline: floor_exact where it is exact (|v| < 2^51), the
 /// library's beyond (a call per pixel otherwise: the baseline has no roundsd).
@@ -224,6 +225,98 @@ void sines(std::span<double> v) {
   kernel(v.data(), v.size());
 }
 
+// ---- The tile design (§11.2): periodic tiles by an inverse FFT, cubic B-splines between samples.
+
+constexpr std::size_t tile_n = FineField2D::tile_samples;
+constexpr std::size_t tile_row = tile_n + 3;  // a row and its first 3 samples again (the taps never wrap)
+constexpr std::int64_t tile_mask = static_cast<std::int64_t>(tile_n) - 1;
+static_assert((tile_n & (tile_n - 1)) == 0, "tile_samples is a power of two");
+
+/// The four cubic B-spline taps at v (mm) on a tile of spacing 1/inv_h: the
+/// samples first … first + 3 (unwrapped index; first = floor(v/h) − 1) with
+/// weights w. value() and block() both take their taps from here, so both
+/// do the same operations for a point.
+struct Taps {
+  std::int64_t first = 0;
+  double w[4] = {0.0, 0.0, 0.0, 0.0};
+};
+inline Taps taps(double v, double inv_h) {
+  double u = v * inv_h;
+  if (!(std::fabs(u) < 0x1p50)) u = 0.0;  // non-finite or beyond any surface: the tile's origin
+  const double f = detmath::floor_exact(u);
+  const double t = u - f, s = 1.0 - t, t2 = t * t, t3 = t2 * t;
+  Taps k;
+  k.first = static_cast<std::int64_t>(f) - 1;
+  k.w[0] = s * s * s * (1.0 / 6.0);
+  k.w[1] = (3.0 * t3 - 6.0 * t2 + 4.0) * (1.0 / 6.0);
+  k.w[2] = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) * (1.0 / 6.0);
+  k.w[3] = t3 * (1.0 / 6.0);
+  return k;
+}
+/// The x taps of one tile row: w0·s[i] + w1·s[i+1] + w2·s[i+2] + w3·s[i+3].
+inline double tap_row(const float* row, std::int64_t first, const double* w) {
+  const float* s = row + (first & tile_mask);
+  return w[0] * s[0] + w[1] * s[1] + w[2] * s[2] + w[3] * s[3];
+}
+/// The y taps over four x-interpolated values.
+inline double tap_column(const double* w, double c0, double c1, double c2, double c3) {
+  return w[0] * c0 + w[1] * c1 + w[2] * c2 + w[3] * c3;
+}
+
+/// A radix-2 inverse complex FFT (x_j = Σ_k X_k e^{+2πijk/n}) of a power-of-two
+/// length, twiddles from detmath: the same bits on every build.
+class InverseFft {
+ public:
+  explicit InverseFft(std::size_t n) : n_(n), wr_(n / 2), wi_(n / 2), rev_(n) {
+    for (std::size_t k = 0; k < n / 2; ++k) {
+      const double turn = static_cast<double>(k) / static_cast<double>(n);
+      wr_[k] = detmath::cos_cycles(turn);
+      wi_[k] = detmath::sin_cycles(turn);
+    }
+    std::size_t bits = 0;
+    while ((std::size_t{1} << bits) < n) ++bits;
+    for (std::size_t i = 0; i < n; ++i) {
+      std::size_t r = 0;
+      for (std::size_t b = 0; b < bits; ++b)
+        if (i & (std::size_t{1} << b)) r |= std::size_t{1} << (bits - 1 - b);
+      rev_[i] = r;
+    }
+  }
+  void operator()(double* re, double* im) const {
+    for (std::size_t i = 0; i < n_; ++i)
+      if (i < rev_[i]) {
+        std::swap(re[i], re[rev_[i]]);
+        std::swap(im[i], im[rev_[i]]);
+      }
+    for (std::size_t len = 2; len <= n_; len <<= 1) {
+      const std::size_t half = len / 2, step = n_ / len;
+      for (std::size_t i = 0; i < n_; i += len)
+        for (std::size_t k = 0; k < half; ++k) {
+          const double c = wr_[k * step], s = wi_[k * step];
+          const double xr = re[i + k + half], xi = im[i + k + half];
+          const double tr = c * xr - s * xi, ti = c * xi + s * xr;
+          const double ur = re[i + k], ui = im[i + k];
+          re[i + k] = ur + tr;
+          im[i + k] = ui + ti;
+          re[i + k + half] = ur - tr;
+          im[i + k + half] = ui - ti;
+        }
+    }
+  }
+
+ private:
+  std::size_t n_;
+  std::vector<double> wr_, wi_;
+  std::vector<std::size_t> rev_;
+};
+
+/// sinc⁴(u) = (sin πu/πu)⁴: the cubic B-spline's response at u cycles per sample.
+double bspline_response(double u) {
+  if (u == 0.0) return 1.0;
+  const double s = detmath::sin_cycles(0.5 * u) / (3.14159265358979323846 * u);
+  return (s * s) * (s * s);
+}
+
 }  // namespace
 
 PitchDistribution cosine_corrected(const PitchDistribution& line) {
@@ -293,6 +386,7 @@ FineField2D::FineField2D(const TexelSpec& spec, Field2D design, double orientati
       spectral_gain_ = (1.0 / 3.0) / std::sqrt(0.5 * spectral_components);
       break;
     }
+    case Field2D::tile: build_tiles(line); break;
     case Field2D::oriented: {
       if (!std::isfinite(orientation_deg))
         throw InvalidArgument("orientation_deg is " + detail::num(orientation_deg) + "; it must be finite");
@@ -309,6 +403,185 @@ FineField2D::FineField2D(const TexelSpec& spec, Field2D design, double orientati
       break;
     }
   }
+}
+
+void FineField2D::build_tiles(const PitchDistribution& line) {
+  // The moment fit's radial spectrum (isotropic_bound's matched_radial):
+  // S2(q) = exp(−z²/2)/q², z = (ln q − μ')/σ', within the 1-D band, cut at
+  // ±4σ' (all but 6·10⁻⁵ of the power).
+  const PitchDistribution radial = [&] {
+    try {
+      return cosine_corrected(line);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(std::string("field 'tile': ") + e.what());
+    }
+  }();
+  const double rmu = radial.mu(), rsigma = std::max(radial.sigma(), 0.02);
+  const double lo_band = line.config().band_min.value(), hi_band = line.config().band_max.value();
+  const double q_max = std::min(hi_band, detmath::exp(rmu + 4.0 * rsigma));
+  const double q_min = std::max(lo_band, detmath::exp(rmu - 4.0 * rsigma));
+  if (!(q_min < q_max))
+    throw InvalidArgument("field 'tile': the texture's radial spectrum (" + detail::num(detmath::exp(rmu - 4.0 * rsigma)) +
+                          " … " + detail::num(detmath::exp(rmu + 4.0 * rsigma)) + " cpm) lies outside its band " +
+                          detail::num(lo_band) + " … " + detail::num(hi_band) +
+                          " cpm (the bitmap's Nyquist frequency is too low for it)");
+  const auto S2 = [&](double q) {
+    const double z = (detmath::log(q) - rmu) / rsigma;
+    return detmath::exp(-0.5 * z * z) / (q * q);
+  };
+  // Bands of equal log width, at most tile_band_ratio each, the highest first.
+  const double span = detmath::log(q_max / q_min);
+  const int bands = std::max(1, static_cast<int>(std::ceil(span / detmath::log(tile_band_ratio) - 1e-9)));
+  const double ratio = detmath::exp(span / static_cast<double>(bands));
+  constexpr auto half = static_cast<std::int64_t>(tile_n / 2);
+  // Lattice frequencies (m, n)/T of the half-plane (n > 0, or n = 0 and m > 0:
+  // a real field of cosines, one per frequency pair ±q) whose |q| is in the band.
+  struct Mode {
+    std::int64_t m, n;
+    double power;  // S2(q)/T²: the field's power at this frequency
+  };
+  const auto band_modes = [&](const TileBand& b, std::vector<Mode>& out) {
+    out.clear();
+    const double T = b.period_mm();
+    const auto reach = static_cast<std::int64_t>(std::ceil(b.q_hi * T));
+    for (std::int64_t n = 0; n <= std::min(reach, half - 1); ++n)
+      for (std::int64_t m = -std::min(reach, half - 1); m <= std::min(reach, half - 1); ++m) {
+        if (n == 0 && m <= 0) continue;
+        const double q = std::sqrt(static_cast<double>(m * m + n * n)) / T;
+        if (q < b.q_lo || q >= b.q_hi) continue;
+        out.push_back({m, n, S2(q) / (T * T)});
+      }
+  };
+  std::vector<TileBand> spec(static_cast<std::size_t>(bands));
+  double total = 0.0;
+  std::vector<Mode> modes;
+  for (int k = 0; k < bands; ++k) {
+    TileBand& b = spec[static_cast<std::size_t>(k)];
+    b.q_hi = k == 0 ? q_max : spec[static_cast<std::size_t>(k - 1)].q_lo;
+    b.q_lo = k + 1 == bands ? q_min : b.q_hi / ratio;
+    b.spacing_mm = 1.0 / (tile_oversampling * b.q_hi);
+    band_modes(b, modes);
+    b.modes = modes.size();
+    for (const Mode& md : modes) total += md.power;
+  }
+  if (!(total > 0.0)) throw InvalidArgument("field 'tile': the texture's radial spectrum has no power on the tiles' lattices");
+  // A cosine of amplitude A has power A²/2: A = √(2·power), scaled so that the
+  // field's RMS is 1/3 (like spectral: clipping touches 0.3 % of it).
+  const double gain = (1.0 / 3.0) / std::sqrt(total);
+  const InverseFft fft(tile_n);
+  const CounterRng rng(spec_.seed, stream_tile);
+  for (int k = 0; k < bands; ++k) {
+    Tile t;
+    t.band = spec[static_cast<std::size_t>(k)];
+    t.inv_spacing = 1.0 / t.band.spacing_mm;
+    band_modes(t.band, modes);
+    // The coefficients' spectrum, column m at a time (only the columns with
+    // modes: |m| ≤ q_hi·T = N/oversampling), divided by the B-spline's response
+    // so that the interpolated field has amplitude A at (m, n)/T.
+    std::vector<std::int64_t> columns;
+    for (const Mode& md : modes) columns.push_back(md.m);
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+    const std::size_t nc = columns.size();
+    std::vector<double> re(nc * tile_n, 0.0), im(nc * tile_n, 0.0);  // [column][n]
+    for (const Mode& md : modes) {
+      const auto c = static_cast<std::size_t>(std::lower_bound(columns.begin(), columns.end(), md.m) - columns.begin());
+      const std::uint64_t counter = (static_cast<std::uint64_t>(k) << 32) | (static_cast<std::uint64_t>(md.n + half) << 16) |
+                                    static_cast<std::uint64_t>(md.m + half);
+      const double phase = rng.uniform(counter);
+      const double amplitude = std::sqrt(2.0 * md.power) * gain /
+                               (bspline_response(static_cast<double>(md.m) / static_cast<double>(tile_n)) *
+                                bspline_response(static_cast<double>(md.n) / static_cast<double>(tile_n)));
+      const std::size_t at = c * tile_n + static_cast<std::size_t>(md.n);
+      re[at] = amplitude * detmath::cos_cycles(phase);
+      im[at] = amplitude * detmath::sin_cycles(phase);
+    }
+    // Along y (n → row j) per column, then along x (m → sample i) per row;
+    // the tile is the real part.
+    for (std::size_t c = 0; c < nc; ++c) fft(re.data() + c * tile_n, im.data() + c * tile_n);
+    t.samples.assign(tile_n * tile_row, 0.0F);
+    std::vector<double> xr(tile_n), xi(tile_n);
+    for (std::size_t j = 0; j < tile_n; ++j) {
+      std::fill(xr.begin(), xr.end(), 0.0);
+      std::fill(xi.begin(), xi.end(), 0.0);
+      for (std::size_t c = 0; c < nc; ++c) {
+        const auto i = static_cast<std::size_t>(columns[c] & tile_mask);
+        xr[i] = re[c * tile_n + j];
+        xi[i] = im[c * tile_n + j];
+      }
+      fft(xr.data(), xi.data());
+      float* row = t.samples.data() + j * tile_row;
+      for (std::size_t i = 0; i < tile_n; ++i) row[i] = static_cast<float>(xr[i]);
+      for (std::size_t i = 0; i < 3; ++i) row[tile_n + i] = row[i];
+    }
+    tiles_.push_back(std::move(t));
+  }
+}
+
+std::vector<FineField2D::TileBand> FineField2D::tile_bands() const {
+  std::vector<TileBand> out;
+  for (const Tile& t : tiles_) out.push_back(t.band);
+  return out;
+}
+
+void FineField2D::tile_block(std::int64_t first, std::size_t count, double pitch, double origin_x, std::span<const double> ys,
+                             double* out, std::size_t stride) const {
+  const std::size_t rows = ys.size();
+  // Columns a chunk at a time: their x taps once, then the tile rows the
+  // block's rows reach interpolated along x once each, then every pixel row
+  // a vector of y taps over them (value()'s operations: x first, then y).
+  constexpr std::size_t chunk = 512;
+  std::vector<std::int64_t> ix(chunk);
+  std::vector<double> wx(4 * chunk), xrows;
+  std::vector<Taps> ty(rows);
+  for (const Tile& t : tiles_) {
+    // value()'s sum starts at 0.0: the first band's 0.0 + b (b, but −0 → +0).
+    const bool first_band = &t == tiles_.data();
+    std::int64_t j_lo = 0, j_hi = -1;
+    for (std::size_t r = 0; r < rows; ++r) {
+      ty[r] = taps(ys[r], t.inv_spacing);
+      j_lo = r == 0 ? ty[r].first : std::min(j_lo, ty[r].first);
+      j_hi = r == 0 ? ty[r].first + 3 : std::max(j_hi, ty[r].first + 3);
+    }
+    // Rows far apart (not a strip): four tile rows per pixel row instead.
+    const bool shared = j_hi - j_lo + 1 <= static_cast<std::int64_t>(4 * rows);
+    for (std::size_t c0 = 0; c0 < count; c0 += chunk) {
+      const std::size_t n = std::min(chunk, count - c0);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double x = static_cast<double>(first + static_cast<std::int64_t>(c0 + k)) * pitch - origin_x;
+        const Taps tx = taps(x, t.inv_spacing);
+        ix[k] = tx.first;
+        std::copy(tx.w, tx.w + 4, wx.begin() + static_cast<std::ptrdiff_t>(4 * k));
+      }
+      const auto along_x = [&](std::int64_t j, double* dst) {
+        const float* row = t.samples.data() + static_cast<std::size_t>(j & tile_mask) * tile_row;
+        for (std::size_t k = 0; k < n; ++k) dst[k] = tap_row(row, ix[k], wx.data() + 4 * k);
+      };
+      const auto along_y = [&](std::size_t r, const double* a) {
+        double* o = out + r * stride + c0;
+        const double* w = ty[r].w;
+        const double *a0 = a, *a1 = a + n, *a2 = a + 2 * n, *a3 = a + 3 * n;
+        if (first_band) {
+          for (std::size_t k = 0; k < n; ++k) o[k] = 0.0 + tap_column(w, a0[k], a1[k], a2[k], a3[k]);
+        } else {
+          for (std::size_t k = 0; k < n; ++k) o[k] += tap_column(w, a0[k], a1[k], a2[k], a3[k]);
+        }
+      };
+      if (shared) {
+        xrows.resize(static_cast<std::size_t>(j_hi - j_lo + 1) * n);
+        for (std::int64_t j = j_lo; j <= j_hi; ++j) along_x(j, xrows.data() + static_cast<std::size_t>(j - j_lo) * n);
+        for (std::size_t r = 0; r < rows; ++r) along_y(r, xrows.data() + static_cast<std::size_t>(ty[r].first - j_lo) * n);
+      } else {
+        xrows.resize(4 * n);
+        for (std::size_t r = 0; r < rows; ++r) {
+          for (std::int64_t d = 0; d < 4; ++d) along_x(ty[r].first + d, xrows.data() + static_cast<std::size_t>(d) * n);
+          along_y(r, xrows.data());
+        }
+      }
+    }
+  }
+  for (std::size_t r = 0; r < rows; ++r)
+    for (double& v : std::span<double>(out + r * stride, count)) v = std::clamp(v, -1.0, 1.0);
 }
 
 FineField2D::Cell FineField2D::cell(std::int64_t m, std::int64_t n) const {
@@ -338,6 +611,17 @@ double FineField2D::value(double x, double y) const {
       }
       return std::clamp(sum * spectral_gain_, -1.0, 1.0);
     }
+    case Field2D::tile: {
+      double sum = 0.0;
+      for (const Tile& t : tiles_) {
+        const Taps tx = taps(x, t.inv_spacing), ty = taps(y, t.inv_spacing);
+        double c[4];
+        for (std::int64_t d = 0; d < 4; ++d)
+          c[d] = tap_row(t.samples.data() + static_cast<std::size_t>((ty.first + d) & tile_mask) * tile_row, tx.first, tx.w);
+        sum += tap_column(ty.w, c[0], c[1], c[2], c[3]);
+      }
+      return std::clamp(sum, -1.0, 1.0);
+    }
     case Field2D::oriented: {
       const double t = x * cos_n_ + y * sin_n_ + line_origin_;
       // C = 0, F = 1: a = (1 + s)/2.
@@ -349,6 +633,10 @@ double FineField2D::value(double x, double y) const {
 
 void FineField2D::block(std::int64_t first, std::size_t count, double pitch, double origin_x, std::span<const double> ys,
                         double* out, std::size_t stride) const {
+  if (design_ == Field2D::tile) {
+    tile_block(first, count, pitch, origin_x, ys, out, stride);
+    return;
+  }
   if (design_ == Field2D::oriented) {
     for (std::size_t r = 0; r < ys.size(); ++r) row(first, pitch, origin_x, ys[r], std::span<double>(out + r * stride, count));
     return;
@@ -429,7 +717,7 @@ void FineField2D::values(std::span<const double> xs, std::span<const double> ys,
 }
 
 void FineField2D::row(std::int64_t first, double pitch, double origin_x, double y, std::span<double> out) const {
-  if (design_ == Field2D::spectral) {
+  if (design_ == Field2D::spectral || design_ == Field2D::tile) {
     block(first, out.size(), pitch, origin_x, std::span<const double>(&y, 1), out.data(), out.size());
     return;
   }

@@ -138,18 +138,28 @@ void Surface2D::render_rows(int first_row, int rows, std::span<double> out) cons
       out.size() != static_cast<std::size_t>(rows) * static_cast<std::size_t>(w))
     throw InvalidArgument("render_rows: rows " + std::to_string(first_row) + " + " + std::to_string(rows) +
                           " outside the bitmap or output of the wrong size");
-  std::fill(out.begin(), out.end(), 0.0);
-  std::vector<double> coarse, ys;
+  // Each region's columns (the same on every row) and its rows in the strip.
+  struct Span {
+    int i0, i1, r0, r1;
+  };
+  std::vector<Span> spans;
+  bool covered = false;  // a region writes every pixel of the strip: no need to clear it
   for (const Region& region : regions_) {
-    // The region's columns (the same on every row) and its rows in the strip.
-    int i0 = 0;
-    while (i0 < w && !inside(static_cast<double>(i0) * p, region.x0, region.x1)) ++i0;
-    int i1 = i0;
-    while (i1 < w && inside(static_cast<double>(i1) * p, region.x0, region.x1)) ++i1;
-    int r0 = 0;
-    while (r0 < rows && !inside(static_cast<double>(first_row + r0) * p, region.y0, region.y1)) ++r0;
-    int r1 = r0;
-    while (r1 < rows && inside(static_cast<double>(first_row + r1) * p, region.y0, region.y1)) ++r1;
+    Span sp{0, 0, 0, 0};
+    while (sp.i0 < w && !inside(static_cast<double>(sp.i0) * p, region.x0, region.x1)) ++sp.i0;
+    sp.i1 = sp.i0;
+    while (sp.i1 < w && inside(static_cast<double>(sp.i1) * p, region.x0, region.x1)) ++sp.i1;
+    while (sp.r0 < rows && !inside(static_cast<double>(first_row + sp.r0) * p, region.y0, region.y1)) ++sp.r0;
+    sp.r1 = sp.r0;
+    while (sp.r1 < rows && inside(static_cast<double>(first_row + sp.r1) * p, region.y0, region.y1)) ++sp.r1;
+    covered = covered || (sp.i0 == 0 && sp.i1 == w && sp.r0 == 0 && sp.r1 == rows);
+    spans.push_back(sp);
+  }
+  if (!covered) std::fill(out.begin(), out.end(), 0.0);
+  std::vector<double> coarse, ys;
+  for (std::size_t ri = 0; ri < regions_.size(); ++ri) {
+    const Region& region = regions_[ri];
+    const auto [i0, i1, r0, r1] = spans[ri];
     if (i1 <= i0 || r1 <= r0) continue;
     ys.clear();
     for (int r = r0; r < r1; ++r) ys.push_back(static_cast<double>(first_row + r) * p - region.y0);

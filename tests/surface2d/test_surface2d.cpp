@@ -35,6 +35,37 @@ Document small_document(Field2D field, Coarse2D coarse = ConstantProfile{}) {
   return doc;
 }
 
+/// A field's straight scans along four directions (`scans` of `samples`
+/// points, sampled at 16× the mean frequency, the field's band top) averaged
+/// over the directions: Central Pitch and Irregularity as measured, and the
+/// stationary bound of the texture.
+struct ScansAndBound {
+  double p, i;
+  IsotropicBound bound;
+};
+ScansAndBound scans_and_bound(Field2D design, double p_db, double i_db, int scans, std::size_t samples) {
+  const CyclesPerMm top(16.0 * std::pow(10.0, p_db / 10.0));
+  TexelSpec spec;
+  spec.central_pitch = Decibels(p_db);
+  spec.irregularity = Decibels(i_db);
+  ScanOptions o;
+  o.directions = 4;
+  o.scans = scans;
+  o.samples = samples;
+  o.spacing = Millimetres(0.5 / top.value());
+  const FineField2D field(spec, design, 0.0, top);
+  PitchDistributionConfig c;
+  c.central_pitch = spec.central_pitch;
+  c.irregularity = spec.irregularity;
+  c.band_max = top;
+  ScansAndBound r{0.0, 0.0, isotropic_bound(PitchDistribution(c), top)};
+  for (const auto& d : measure_scans(field, o)) {
+    r.p += d.log_centroid_db / o.directions;
+    r.i += d.log_spread_db / o.directions;
+  }
+  return r;
+}
+
 std::string error_of(const std::string& text) {
   try {
     (void)parse_document(text);
@@ -80,7 +111,7 @@ TEST(Surface2D, DocumentVersion4RoundTripsAndValidates) {
 }
 
 TEST(Surface2D, StripsAndPointsGiveTheWholeBitmap) {
-  for (Field2D field : {Field2D::cells, Field2D::spectral, Field2D::oriented}) {
+  for (Field2D field : {Field2D::cells, Field2D::spectral, Field2D::oriented, Field2D::tile}) {
     const Document doc =
         small_document(field, Disc2D{Millimetres(2.0), Millimetres(1.5), Millimetres(1.0), Millimetres(0.2), 1.0, 0.1});
     const Surface2D s = prepare_surface2d(doc);
@@ -129,6 +160,14 @@ TEST(Surface2D, BitmapFilesAreDeterministicAndHonourPolarity) {
   write_bitmap(a, s, one);
   write_bitmap(b, s, many);
   EXPECT_EQ(read_file(a), read_file(b));
+  {
+    // The tile field too: strips of 7 rows on one thread, 64 on three.
+    const Surface2D t = prepare_surface2d(small_document(Field2D::tile));
+    const std::string ta = (dir / "ta.png").string(), tb = (dir / "tb.png").string();
+    write_bitmap(ta, t, one);
+    write_bitmap(tb, t, many);
+    EXPECT_EQ(read_file(ta), read_file(tb));
+  }
   // The PNG reads back as the amplitudes (16 bit: to_u16). The image is
   // placed half a pixel left and up, so that pixel centres meet the grid.
   doc.device.bitmap->polarity = BitmapPolarity::brighter_more_friction;
@@ -160,26 +199,7 @@ TEST(Surface2D, BitmapFilesAreDeterministicAndHonourPolarity) {
 TEST(Surface2D, SpectralFieldMeetsItsStationaryBound) {
   // The stationary bound and its spectral realisation agree within 0.5 dB
   // (one texture, 8 scans per direction; the sweep is bench/surface2d_anisotropy).
-  TexelSpec spec;
-  spec.central_pitch = Decibels(6.0);
-  spec.irregularity = Decibels(0.0);
-  const CyclesPerMm top(16.0 * std::pow(10.0, 0.6));
-  ScanOptions o;
-  o.directions = 4;
-  o.scans = 3;
-  o.samples = 1024;
-  o.spacing = Millimetres(0.5 / top.value());
-  const FineField2D field(spec, Field2D::spectral, 0.0, top);
-  PitchDistributionConfig c;
-  c.central_pitch = spec.central_pitch;
-  c.irregularity = spec.irregularity;
-  c.band_max = top;
-  const IsotropicBound bound = isotropic_bound(PitchDistribution(c), top);
-  double p = 0.0, i = 0.0;
-  for (const auto& d : measure_scans(field, o)) {
-    p += d.log_centroid_db / o.directions;
-    i += d.log_spread_db / o.directions;
-  }
+  const auto [p, i, bound] = scans_and_bound(Field2D::spectral, 6.0, 0.0, 3, 1024);
   // The moment fit keeps the 1-D Central Pitch; the field reaches it.
   EXPECT_NEAR(bound.matched_log_centroid_db, bound.target_log_centroid_db, 0.2);
   EXPECT_NEAR(p, bound.matched_log_centroid_db, 0.5);
@@ -215,4 +235,133 @@ TEST(Surface2D, SpectralKernelsGiveValueBitForBit) {
   field.values(px, py, pv);
   for (std::size_t i = 0; i < pv.size(); ++i) ASSERT_EQ(pv[i], field.value(px[i], py[i])) << i;
   EXPECT_THROW(field.values(px, py, std::span<double>(pv).first(3)), InvalidArgument);
+}
+
+namespace {
+
+/// The tile field of a texture on a band topped at `top`.
+FineField2D tile_field(double p_db, double i_db, double top, std::uint64_t seed = 5) {
+  TexelSpec spec;
+  spec.central_pitch = Decibels(p_db);
+  spec.irregularity = Decibels(i_db);
+  spec.seed = seed;
+  return FineField2D(spec, Field2D::tile, 0.0, CyclesPerMm(top));
+}
+
+}  // namespace
+
+TEST(Surface2D, TileRowsGiveValueBitForBit) {
+  // block() (columns a chunk at a time, the tile rows a strip reaches
+  // interpolated along x once) is value()'s arithmetic: equal to the last
+  // bit, for consecutive rows (a strip), rows far apart, a run longer than a
+  // chunk, negative coordinates, and a wide texture of several bands.
+  for (const FineField2D& field : {tile_field(4.0, 2.0, 25.0), tile_field(0.0, 5.0, 16.0, 9)}) {
+    ASSERT_FALSE(field.tile_bands().empty());
+    const std::size_t cols = 600, stride = 611;
+    for (const std::vector<double>& ys :
+         {std::vector<double>{-0.3, -0.28, -0.26, -0.24, -0.22}, std::vector<double>{-0.3, 0.0, 0.02, 1.7, 2.25, 9.5, 100.125}}) {
+      std::vector<double> out(ys.size() * stride, 7.0);
+      field.block(-5, cols, 0.02, 0.013, ys, out.data(), stride);
+      for (std::size_t r = 0; r < ys.size(); ++r) {
+        for (std::size_t k = 0; k < cols; ++k) {
+          const double x = static_cast<double>(-5 + static_cast<std::int64_t>(k)) * 0.02 - 0.013;
+          ASSERT_EQ(out[r * stride + k], field.value(x, ys[r])) << r << ", " << k;
+        }
+        ASSERT_EQ(out[r * stride + cols], 7.0);  // nothing written past the run
+      }
+    }
+  }
+  // Three bands for the wide texture (P 0 / I 5 dB: 0.03 … 16 cpm), one for a narrow one.
+  EXPECT_EQ(tile_field(0.0, 5.0, 16.0).tile_bands().size(), 3u);
+  EXPECT_EQ(tile_field(6.0, -5.0, 25.0).tile_bands().size(), 1u);
+}
+
+TEST(Surface2D, TileFieldIsPeriodicSmoothAndScaled) {
+  const FineField2D field = tile_field(6.0, -5.0, 25.0);
+  const FineField2D::TileBand band = field.tile_bands().at(0);
+  // One band: the field repeats after the tile's period, to the last bit.
+  const double T = band.period_mm();
+  EXPECT_GT(T, 20.0);
+  for (double x : {0.1, 3.7, 11.0}) EXPECT_NEAR(field.value(x + T, x * 0.5 - T), field.value(x, x * 0.5), 1e-12);
+  // RMS 1/3 (clipped at ±1), mean near 0.
+  double sum = 0.0, sum2 = 0.0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double v = field.value(0.0137 * i, 0.7 + 0.0071 * i);
+    sum += v;
+    sum2 += v * v;
+  }
+  EXPECT_NEAR(std::sqrt(sum2 / n), 1.0 / 3.0, 0.03);
+  EXPECT_NEAR(sum / n, 0.0, 0.03);
+}
+
+TEST(Surface2D, TileFieldMeetsTheStationaryBound) {
+  // Scans along four directions carry the moment fit's Central Pitch and
+  // Irregularity (a wrong radial spectrum, scale or interpolation fails it);
+  // the sweep is bench/surface2d_anisotropy.
+  // (The widest textures' low frequencies need long scans: the sweep's.)
+  for (const auto& [p_db, i_db] : {std::pair{6.0, -10.0}, std::pair{0.0, 0.0}}) {
+    const auto [p, i, bound] = scans_and_bound(Field2D::tile, p_db, i_db, 4, 2048);
+    EXPECT_NEAR(p, bound.matched_log_centroid_db, 0.5) << p_db << " " << i_db;
+    EXPECT_NEAR(i, bound.matched_log_spread_db, 0.7) << p_db << " " << i_db;
+  }
+}
+
+TEST(Surface2D, DocumentVersion5DefaultsToTheTileField) {
+  const std::string text = read_file(data_dir + "/tablet-disc.texel.json");
+  std::string v5 = text;
+  v5.replace(v5.find("\"version\": 4"), 12, "\"version\": 5");
+  v5.replace(v5.find("\"field\": \"cells\","), 17, "");
+  const Document doc = parse_document(v5);
+  EXPECT_EQ(doc.surface2d->regions[0].field, Field2D::tile);
+  EXPECT_EQ(doc.surface2d->regions[1].field, Field2D::oriented);
+  EXPECT_EQ(required_version(doc), 5);
+  EXPECT_EQ(document_json(parse_document(document_json(doc))), document_json(doc));
+  // The same text at version 4: the region without a field is spectral, and
+  // "tile" is refused there with one line naming the field.
+  std::string v4 = v5;
+  v4.replace(v4.find("\"version\": 5"), 12, "\"version\": 4");
+  const Document old = parse_document(v4);
+  EXPECT_EQ(old.surface2d->regions[0].field, Field2D::spectral);
+  EXPECT_EQ(required_version(old), 4);
+  std::string bad = text;
+  bad.replace(bad.find("\"field\": \"cells\""), 16, "\"field\": \"tile\"");
+  const std::string e = error_of(bad);
+  EXPECT_NE(e.find("surface2d.regions[0].field is 'tile', which needs version 5; version is 4"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos);
+  // A v5 document with every field named renders like version 4: spectral's bytes are kept.
+  std::string v5_spectral = text;
+  v5_spectral.replace(v5_spectral.find("\"version\": 4"), 12, "\"version\": 5");
+  v5_spectral.replace(v5_spectral.find("\"field\": \"cells\""), 16, "\"field\": \"spectral\"");
+  std::string v4_spectral = text;
+  v4_spectral.replace(v4_spectral.find("\"field\": \"cells\""), 16, "\"field\": \"spectral\"");
+  Document a = parse_document(v5_spectral), b = parse_document(v4_spectral);
+  for (Document* d : {&a, &b}) {
+    d->surface2d->regions.pop_back();  // the oriented region: the same in both, and slow to prepare
+    BitmapGeometry g = *d->device.bitmap;
+    g.width = 64;
+    g.height = 16;
+    d->device.bitmap = g;
+  }
+  std::vector<double> ra(64 * 16), rb(64 * 16);
+  prepare_surface2d(a).render_rows(0, 16, ra);
+  prepare_surface2d(b).render_rows(0, 16, rb);
+  EXPECT_EQ(ra, rb);
+  EXPECT_EQ(required_version(a), 4);
+}
+
+TEST(Surface2D, TileFieldRejectsATextureAboveItsBand) {
+  // A texture inside the band whose radial spectrum (3 dB higher) lies above
+  // the bitmap's Nyquist frequency.
+  TexelSpec spec;
+  spec.central_pitch = Decibels(6.5);
+  spec.irregularity = Decibels(-10.0);
+  try {
+    (void)FineField2D(spec, Field2D::tile, 0.0, CyclesPerMm(5.0));
+    FAIL() << "no error";
+  } catch (const InvalidArgument& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("field 'tile'"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos);
+  }
 }
