@@ -46,6 +46,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -139,6 +140,14 @@ class PlayerMap2D {
   /// The fine oscillation alone at path length s, in [−1, 1], limited likewise.
   [[nodiscard]] double fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept;
 
+  /// The most samples values() takes at once.
+  static constexpr std::size_t block_max = 64;
+  /// value() of n ≤ block_max samples at once, bit for bit (the players'
+  /// block path: positions and texels first, then the block's sines in SIMD
+  /// lanes): out[i] = value(x[i], y[i], s[i], speed[i], limit_hz). Real-time safe.
+  void values(const double* x_mm, const double* y_mm, const double* s_mm, const double* speed_mm_s, double limit_hz, double* out,
+              std::size_t n) const noexcept;
+
  private:
   PlayerMap2D() = default;
   Kind kind_ = Kind::path_indexed;
@@ -147,8 +156,7 @@ class PlayerMap2D {
   std::optional<Raster2D> raster_;  // path-indexed: coarse profile; bitmap: friction
   double coarse_strength_ = 0.0, fine_strength_ = 1.0;
   double texel_mm_ = 0.0, inv_texel_ = 0.0, strip_mm_ = 0.0;
-  std::vector<double> frequency_cpm_;  // f_k
-  std::vector<double> phase_cycles_;   // φ_k
+  std::vector<double> texels_;  // f_k, φ_k, f_k+1, …: a texel's pair in one cache line
 };
 
 /// What the event ring carries: the sample with its path length (computed by push).

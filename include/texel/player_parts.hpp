@@ -153,12 +153,20 @@ class OutputStage {
   }
   /// One output sample for map value `a` with the finger touching or not.
   double step(double a, bool touching) noexcept;
+  /// step() for out.size() samples, the mode chosen once: out[i] =
+  /// step(a[i], touching[i]) as float, bit for bit. Returns the largest |out[i]|.
+  float run(const double* a, const bool* touching, std::span<float> out) noexcept;
   void end_block() noexcept {
     gain_ = gain_end_;
     carrier_inc_ = inc_end_;
   }
 
  private:
+  template <int Mode>
+  double step_as(double a, bool touching) noexcept;
+  template <int Mode>
+  float run_as(const double* a, const bool* touching, std::span<float> out) noexcept;
+
   const PlayerConfig* config_;
   double touch_level_ = 0.0;  // 0 … 1 before shaping
   double touch_step_ = 0.0;
@@ -225,6 +233,26 @@ class MapExchange {
     fade_pos_ = 0.0;
     return next;
   }
+  /// value() for n samples at once: eval(map, values) writes a map's n
+  /// values; `a` receives the crossfaded ones (the same bits as n calls of
+  /// value()), `old` is scratch for the map fading out. Advances the crossfade.
+  template <class EvalBlock>
+  void values(EvalBlock&& eval, double* a, double* old, std::size_t n) noexcept {
+    if (current_)
+      eval(*current_, a);
+    else
+      std::fill_n(a, n, 0.0);
+    if (!crossfading_) return;
+    if (fading_)
+      eval(*fading_, old);
+    else
+      std::fill_n(old, n, 0.0);
+    for (std::size_t i = 0; i < n && crossfading_; ++i) {
+      const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * fade_pos_);
+      a[i] = old[i] + (a[i] - old[i]) * w;
+      advance_fade();
+    }
+  }
   [[nodiscard]] const Map* current() const noexcept { return current_; }
   [[nodiscard]] bool crossfading() const noexcept { return crossfading_; }
   /// eval(map) of the current map, crossfaded (raised cosine) from the old
@@ -236,17 +264,21 @@ class MapExchange {
       const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * fade_pos_);
       const double old = fading_ ? eval(*fading_) : 0.0;
       a = old + (a - old) * w;
-      fade_pos_ += fade_step_;
-      if (fade_pos_ >= 1.0) {
-        crossfading_ = false;
-        if (fading_ && !retired_.try_push(fading_)) retire_waiting_ = fading_;
-        fading_ = nullptr;
-      }
+      advance_fade();
     }
     return a;
   }
 
  private:
+  void advance_fade() noexcept {
+    fade_pos_ += fade_step_;
+    if (fade_pos_ >= 1.0) {
+      crossfading_ = false;
+      if (fading_ && !retired_.try_push(fading_)) retire_waiting_ = fading_;
+      fading_ = nullptr;
+    }
+  }
+
   SpscQueue<const Map*> retired_;
   std::atomic<const Map*> pending_{nullptr};
   const Map* current_ = nullptr;

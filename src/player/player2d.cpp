@@ -3,10 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <string>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/lanes.hpp"
+#include "texel/detmath.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -28,19 +31,49 @@ Extent2D extent_of(const Raster2D& r) {
   return {r.origin_x.value(), r.origin_y.value(), p * r.width, p * r.height};
 }
 
-float sample_bilinear(const Raster2D& r, double x_mm, double y_mm) noexcept {
-  const double inv = 1.0 / r.pitch.value();
-  const double u = std::clamp((x_mm - r.origin_x.value()) * inv, 0.0, static_cast<double>(r.width - 1));
-  const double v = std::clamp((y_mm - r.origin_y.value()) * inv, 0.0, static_cast<double>(r.height - 1));
-  // NaN positions land on the origin sample.
-  const int i = std::isnan(u) ? 0 : std::min(static_cast<int>(u), std::max(0, r.width - 2));
-  const int j = std::isnan(v) ? 0 : std::min(static_cast<int>(v), std::max(0, r.height - 2));
-  const double fu = std::isnan(u) ? 0.0 : u - i, fv = std::isnan(v) ? 0.0 : v - j;
-  const int i1 = std::min(i + 1, r.width - 1), j1 = std::min(j + 1, r.height - 1);
-  const double a = r.at(i, j) + (r.at(i1, j) - r.at(i, j)) * fu;
-  const double b = r.at(i, j1) + (r.at(i1, j1) - r.at(i, j1)) * fu;
-  return static_cast<float>(a + (b - a) * fv);
-}
+namespace {
+
+// Bilinear reads of one raster with its constants computed once (a block's
+// worth of reads share them). Beyond the edges the nearest edge value; NaN
+// positions land on the origin sample. (Scalar: in SIMD lanes, with the four
+// corners gathered lane by lane, a block's reads measured slower.)
+class Bilinear {
+ public:
+  explicit Bilinear(const Raster2D& r) noexcept
+      : values_(r.values.data()),
+        inv_(1.0 / r.pitch.value()),
+        ox_(r.origin_x.value()),
+        oy_(r.origin_y.value()),
+        umax_(static_cast<double>(r.width - 1)),
+        vmax_(static_cast<double>(r.height - 1)),
+        imax_(std::max(0, r.width - 2)),
+        jmax_(std::max(0, r.height - 2)),
+        width_(r.width),
+        height_(r.height) {}
+
+  [[nodiscard]] float operator()(double x_mm, double y_mm) const noexcept {
+    const double u = std::clamp((x_mm - ox_) * inv_, 0.0, umax_);
+    const double v = std::clamp((y_mm - oy_) * inv_, 0.0, vmax_);
+    const int i = std::isnan(u) ? 0 : std::min(static_cast<int>(u), imax_);
+    const int j = std::isnan(v) ? 0 : std::min(static_cast<int>(v), jmax_);
+    const double fu = std::isnan(u) ? 0.0 : u - i, fv = std::isnan(v) ? 0.0 : v - j;
+    const int i1 = std::min(i + 1, width_ - 1), j1 = std::min(j + 1, height_ - 1);
+    const float* row = values_ + static_cast<std::size_t>(j) * static_cast<std::size_t>(width_);
+    const float* row1 = values_ + static_cast<std::size_t>(j1) * static_cast<std::size_t>(width_);
+    const double a = row[i] + (row[i1] - row[i]) * fu;
+    const double b = row1[i] + (row1[i1] - row1[i]) * fu;
+    return static_cast<float>(a + (b - a) * fv);
+  }
+
+ private:
+  const float* values_;
+  double inv_, ox_, oy_, umax_, vmax_;
+  int imax_, jmax_, width_, height_;
+};
+
+}  // namespace
+
+float sample_bilinear(const Raster2D& r, double x_mm, double y_mm) noexcept { return Bilinear(r)(x_mm, y_mm); }
 
 namespace {
 
@@ -118,13 +151,9 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const TexelSpec& fi
   m->inv_texel_ = 1.0 / L;
   const std::size_t count = texture.texel_count();
   m->strip_mm_ = static_cast<double>(count) * L;
-  m->frequency_cpm_.reserve(count);
-  m->phase_cycles_.reserve(count);
+  m->texels_.reserve(2 * count);
   texture.for_each_texels([&](std::size_t, std::span<const Texel> run) {
-    for (const Texel& t : run) {
-      m->frequency_cpm_.push_back(t.frequency.value());
-      m->phase_cycles_.push_back(t.phase_cycles);
-    }
+    for (const Texel& t : run) m->texels_.insert(m->texels_.end(), {t.frequency.value(), t.phase_cycles});
   });
   return m;
 }
@@ -179,24 +208,138 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::bitmap(Raster2D friction, std::o
   return m;
 }
 
+namespace {
+
+// What PlayerMap2D::values reads, gathered once per call.
+struct MapView {
+  bool bitmap = false;
+  const Raster2D* raster = nullptr;  // path-indexed: coarse (or none); bitmap: friction
+  const double* texels = nullptr;    // f_k, φ_k interleaved
+  std::size_t last = 0;              // the last texel's index
+  double strip = 0.0, inv_texel = 0.0, texel_mm = 0.0, coarse = 0.0, fine = 1.0, limit = 0.0;
+
+  // The texel under path length s, wrapped around the strip: returns f_k and
+  // sets the phase argument φ_k + f_k·(s − k·L) of its oscillation, cycles.
+  double texel_at(double s_mm, double& cycles) const noexcept {
+    // In the strip's first half (0 < s < strip/2, the quotient's floor is 0
+    // whatever the rounding) s_mm − 0·strip is s_mm: the same value without
+    // the division and the floor.
+    const double s = s_mm > 0.0 && s_mm < 0.5 * strip ? s_mm : s_mm - std::floor(s_mm / strip) * strip;
+    auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel));
+    k = std::min(k, last);
+    const double f = texels[2 * k];
+    cycles = texels[2 * k + 1] + f * (s - static_cast<double>(k) * texel_mm);
+    return f;
+  }
+};
+
+// PlayerMap2D::values for n ≤ block_max samples, pass by pass over the block
+// (short loops of independent samples): the raster and the texels sample by
+// sample, then the sine and the mix in W lanes, each lane doing the scalar's
+// operations in the same order (IEEE, -ffp-contract=off), so every width,
+// and value() (n = 1), gives the same bits. The sine is detmath's (an exact
+// reduction and one polynomial, the 1-D renderer's).
+template <int W>
+[[gnu::always_inline]] inline void map_lanes(const MapView& m, const Bilinear* raster, const double* x, const double* y,
+                                             const double* s, const double* speed, double* out, std::size_t n) noexcept {
+  using V = typename detail::Lanes<W>::type;
+  constexpr std::size_t most = PlayerMap2D::block_max;
+  static_assert(most % W == 0);
+  const std::size_t padded = (n + W - 1) / W * W;  // padding lanes: c = 1, no oscillation
+  const V zero{}, one = zero + 1.0;
+  alignas(64) double c[most], cycles[most], weight[most];
+  for (std::size_t i = 0; i < padded; ++i) c[i] = raster && i < n ? static_cast<double>((*raster)(x[i], y[i])) : 1.0;
+  if (m.bitmap) {
+    for (std::size_t b = 0; b < n; b += W) {
+      V v;
+      std::memcpy(&v, c + b, sizeof v);
+      v = v < zero ? zero : (one < v ? one : v);  // std::clamp(c, 0, 1)
+      std::memcpy(out + b, &v, std::min<std::size_t>(W, n - b) * sizeof(double));
+    }
+    return;
+  }
+  for (std::size_t i = 0; i < padded; ++i) {
+    cycles[i] = weight[i] = 0.0;
+    if (i < n) weight[i] = limit_weight(m.texel_at(s[i], cycles[i]) * std::fabs(speed[i]), m.limit);
+  }
+  for (std::size_t b = 0; b < n; b += W) {
+    V cv, w, u;
+    std::memcpy(&cv, c + b, sizeof cv);
+    std::memcpy(&u, cycles + b, sizeof u);
+    std::memcpy(&w, weight + b, sizeof w);
+    const V e = 1.0 - m.coarse * (1.0 - cv);  // texel_mix, docs/algorithm.md §7
+    const V offset = e - e * m.fine * 0.5;
+    const V gain = e * m.fine * 0.5;
+    const V a = offset + gain * (w == zero ? zero : w * detmath::sin_cycles_generic(u));
+    std::memcpy(out + b, &a, std::min<std::size_t>(W, n - b) * sizeof(double));
+  }
+}
+
+template <int W>
+[[gnu::always_inline]] inline void map_lanes(const MapView& m, const double* x, const double* y, const double* s,
+                                             const double* speed, double* out, std::size_t n) noexcept {
+  if (m.raster) {
+    const Bilinear raster(*m.raster);
+    map_lanes<W>(m, &raster, x, y, s, speed, out, n);
+  } else {
+    map_lanes<W>(m, nullptr, x, y, s, speed, out, n);
+  }
+}
+
+using MapKernel = void (*)(const MapView&, const double*, const double*, const double*, const double*, double*,
+                           std::size_t) noexcept;
+// At most AVX2's 4 lanes: a block is 16–64 samples, and a real-time thread
+// gains nothing from waking the AVX-512 units (their clock licence) for a
+// few hundred nanoseconds.
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx2"))) void map_avx2(const MapView& m, const double* x, const double* y, const double* s,
+                                              const double* v, double* out, std::size_t n) noexcept {
+  map_lanes<4>(m, x, y, s, v, out, n);
+}
+#endif
+void map_generic(const MapView& m, const double* x, const double* y, const double* s, const double* v, double* out,
+                 std::size_t n) noexcept {
+  map_lanes<2>(m, x, y, s, v, out, n);
+}
+
+// Chosen before any real-time thread runs (simd_lanes reads the environment
+// once): a namespace-scope constant, not a function-local static.
+const MapKernel map_kernel = [] {
+#if defined(__x86_64__) || defined(__i386__)
+  if (detail::simd_lanes() >= 4) return &map_avx2;
+#endif
+  return &map_generic;
+}();
+
+}  // namespace
+
 double PlayerMap2D::fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  // Wraps around the strip. In its first half (0 < s < strip/2, the
-  // quotient's floor is 0 whatever the rounding) s_mm − 0·strip is s_mm:
-  // the same value without the division and the floor.
-  const double s = s_mm > 0.0 && s_mm < 0.5 * strip_mm_ ? s_mm : s_mm - std::floor(s_mm / strip_mm_) * strip_mm_;
-  auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel_));
-  k = std::min(k, frequency_cpm_.size() - 1);
-  const double f = frequency_cpm_[k];
-  const double w = limit_weight(f * std::fabs(speed_mm_s), limit_hz);
+  MapView m;
+  m.texels = texels_.data(), m.last = texels_.size() / 2 - 1;
+  m.strip = strip_mm_, m.inv_texel = inv_texel_, m.texel_mm = texel_mm_;
+  double cycles = 0.0;
+  const double w = limit_weight(m.texel_at(s_mm, cycles) * std::fabs(speed_mm_s), limit_hz);
   if (w == 0.0) return 0.0;
-  return w * std::sin(2.0 * std::numbers::pi * (phase_cycles_[k] + f * (s - static_cast<double>(k) * texel_mm_)));
+  return w * detmath::sin_cycles(cycles);
 }
 
 double PlayerMap2D::value(double x_mm, double y_mm, double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  if (kind_ == Kind::bitmap) return std::clamp(static_cast<double>(sample_bilinear(*raster_, x_mm, y_mm)), 0.0, 1.0);
-  const double c = raster_ ? static_cast<double>(sample_bilinear(*raster_, x_mm, y_mm)) : 1.0;
-  const TexelMix mix = texel_mix(c, coarse_strength_, fine_strength_);  // the 1-D rule, docs/algorithm.md §7
-  return mix.offset + mix.gain * fine(s_mm, speed_mm_s, limit_hz);
+  double a = 0.0;
+  values(&x_mm, &y_mm, &s_mm, &speed_mm_s, limit_hz, &a, 1);
+  return a;
+}
+
+void PlayerMap2D::values(const double* x, const double* y, const double* s, const double* speed, double limit_hz, double* out,
+                         std::size_t n) const noexcept {
+  MapView m;
+  m.bitmap = kind_ == Kind::bitmap;
+  m.raster = raster_ ? &*raster_ : nullptr;
+  if (!m.bitmap) {
+    m.texels = texels_.data(), m.last = texels_.size() / 2 - 1;
+    m.strip = strip_mm_, m.inv_texel = inv_texel_, m.texel_mm = texel_mm_;
+    m.coarse = coarse_strength_, m.fine = fine_strength_, m.limit = limit_hz;
+  }
+  map_kernel(m, x, y, s, speed, out, std::min(n, block_max));
 }
 
 // ------------------------------------------------------------------- Player2D
@@ -241,7 +384,13 @@ bool Player2D::set_carrier(double hz) {
   return events_.try_push(Event{Event::Kind::carrier, {}, std::clamp(hz, 0.0, config_.rate_hz / 2)});
 }
 
-// Real-time safe, like Player::process.
+// Real-time safe, like Player::process. Each sample's operations are those
+// of a sample-by-sample loop (finger, map value, output stage), done in three
+// passes over chunks of up to PlayerMap2D::block_max samples so the map's
+// sines run in SIMD lanes (PlayerMap2D::values) and the output stage's mode
+// is chosen once: the finger for every sample of the chunk, the maps' values,
+// the output stage. Nothing the output stage does reaches the finger or the
+// map, so the order of the passes changes no value.
 BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::span<float> y_mm,
                             std::span<float> path_mm) noexcept {
   BlockInfo info;
@@ -256,28 +405,38 @@ BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::sp
   // Felt frequencies are limited to the display's response limit, else to
   // 0.45·rate (below the drive's Nyquist).
   const double limit = stage_.limit_hz() > 0.0 ? stage_.limit_hz() : 0.45 * rate;
+  const PlayerMap2D* current = maps_.current();  // fixed for the block (begin_block)
+  constexpr std::size_t chunk = PlayerMap2D::block_max;
+  alignas(64) double x[chunk], y[chunk], s[chunk], speed[chunk], a[chunk], old[chunk];
+  bool touch[chunk];
   float peak = 0.0f;
   std::array<double, 3> p{};
-  bool touching = false;
 
-  for (std::size_t i = 0; i < frames; ++i, ++n_) {
-    const double tau = static_cast<double>(n_) / rate + config_.prediction_s;
-    player_parts::take_events(events_, tau, finger_, stage_, smoothing);
-    p = finger_.position(tau, player_parts::next_finger(events_), config_.extrapolate_s);
-    const PlayerMap2D* current = maps_.current();
-    touching = finger_.touching() && (current == nullptr || current->on_surface(p[0], p[1]));
-    // Path speed from consecutive output samples (s is piecewise linear in
-    // time between finger samples, so this is exact within a segment).
-    const double speed = have_s_ ? std::fabs(p[2] - last_s_) * rate : 0.0;
-    last_s_ = p[2];
-    have_s_ = touching;
-    const double a = maps_.value([&](const PlayerMap2D& m) -> double { return m.value(p[0], p[1], p[2], speed, limit); });
-    const auto yf = static_cast<float>(stage_.step(a, touching));
-    out[i] = yf;
-    if (x_mm.size() >= frames) x_mm[i] = static_cast<float>(p[0]);
-    if (y_mm.size() >= frames) y_mm[i] = static_cast<float>(p[1]);
-    if (path_mm.size() >= frames) path_mm[i] = static_cast<float>(p[2]);
-    peak = std::max(peak, std::fabs(yf));
+  for (std::size_t done = 0; done < frames;) {
+    const std::size_t n = std::min(chunk, frames - done);
+    for (std::size_t i = 0; i < n; ++i, ++n_) {
+      const double tau = static_cast<double>(n_) / rate + config_.prediction_s;
+      player_parts::take_events(events_, tau, finger_, stage_, smoothing);
+      p = finger_.position(tau, player_parts::next_finger(events_), config_.extrapolate_s);
+      touch[i] = finger_.touching() && (current == nullptr || current->on_surface(p[0], p[1]));
+      // Path speed from consecutive output samples (s is piecewise linear in
+      // time between finger samples, so this is exact within a segment).
+      speed[i] = have_s_ ? std::fabs(p[2] - last_s_) * rate : 0.0;
+      last_s_ = p[2];
+      have_s_ = touch[i];
+      x[i] = p[0], y[i] = p[1], s[i] = p[2];
+    }
+    maps_.values([&](const PlayerMap2D& m, double* v) { m.values(x, y, s, speed, limit, v, n); }, a, old, n);
+    const std::span<float> block = out.subspan(done, n);
+    peak = std::max(peak, stage_.run(a, touch, block));
+    if (x_mm.size() >= frames)
+      for (std::size_t i = 0; i < n; ++i) x_mm[done + i] = static_cast<float>(x[i]);
+    if (y_mm.size() >= frames)
+      for (std::size_t i = 0; i < n; ++i) y_mm[done + i] = static_cast<float>(y[i]);
+    if (path_mm.size() >= frames)
+      for (std::size_t i = 0; i < n; ++i) path_mm[done + i] = static_cast<float>(s[i]);
+    info.touching = touch[n - 1];
+    done += n;
   }
   stage_.end_block();
   publish_samples(n_);
@@ -285,7 +444,6 @@ BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::sp
   info.peak = peak;
   info.position_mm = p[0];
   info.position_y_mm = p[1];
-  info.touching = touching;
   info.crossfading = maps_.crossfading();
   return info;
 }
