@@ -61,6 +61,10 @@
 namespace texel {
 
 struct Document;
+class PlayerMap2D;
+namespace detail {
+struct MapAtFinger;  // a map's constants for one block (src/player/player2d.cpp)
+}
 
 /// One finger sample on a 2-D surface.
 struct FingerSample2D {
@@ -140,15 +144,8 @@ class PlayerMap2D {
   /// The fine oscillation alone at path length s, in [−1, 1], limited likewise.
   [[nodiscard]] double fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept;
 
-  /// The most samples values() takes at once.
-  static constexpr std::size_t block_max = 64;
-  /// value() of n ≤ block_max samples at once, bit for bit (the players'
-  /// block path: positions and texels first, then the block's sines in SIMD
-  /// lanes): out[i] = value(x[i], y[i], s[i], speed[i], limit_hz). Real-time safe.
-  void values(const double* x_mm, const double* y_mm, const double* s_mm, const double* speed_mm_s, double limit_hz, double* out,
-              std::size_t n) const noexcept;
-
  private:
+  friend struct detail::MapAtFinger;
   PlayerMap2D() = default;
   Kind kind_ = Kind::path_indexed;
   Extent2D extent_{};
@@ -209,6 +206,7 @@ class Player2D final : public PlayerBase {
   player_parts::FingerTrack<PathSample, 3> finger_;
   player_parts::OutputStage stage_;
   double last_s_ = 0.0;
+  double last_x_ = 0.0, last_y_ = 0.0;  // the finger at the last block's end: its map cells are fetched first
   bool have_s_ = false;
   std::uint64_t n_ = 0;
 };

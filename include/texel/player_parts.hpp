@@ -233,27 +233,9 @@ class MapExchange {
     fade_pos_ = 0.0;
     return next;
   }
-  /// value() for n samples at once: eval(map, values) writes a map's n
-  /// values; `a` receives the crossfaded ones (the same bits as n calls of
-  /// value()), `old` is scratch for the map fading out. Advances the crossfade.
-  template <class EvalBlock>
-  void values(EvalBlock&& eval, double* a, double* old, std::size_t n) noexcept {
-    if (current_)
-      eval(*current_, a);
-    else
-      std::fill_n(a, n, 0.0);
-    if (!crossfading_) return;
-    if (fading_)
-      eval(*fading_, old);
-    else
-      std::fill_n(old, n, 0.0);
-    for (std::size_t i = 0; i < n && crossfading_; ++i) {
-      const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * fade_pos_);
-      a[i] = old[i] + (a[i] - old[i]) * w;
-      advance_fade();
-    }
-  }
   [[nodiscard]] const Map* current() const noexcept { return current_; }
+  /// The map fading out during a crossfade (null: none, or from silence).
+  [[nodiscard]] const Map* fading() const noexcept { return fading_; }
   [[nodiscard]] bool crossfading() const noexcept { return crossfading_; }
   /// eval(map) of the current map, crossfaded (raised cosine) from the old
   /// one during a swap; 0 for no map. Advances the crossfade by one sample.

@@ -8,7 +8,6 @@
 #include <string>
 
 #include "texel/detail/format.hpp"
-#include "texel/detail/lanes.hpp"
 #include "texel/detmath.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
@@ -31,15 +30,15 @@ Extent2D extent_of(const Raster2D& r) {
   return {r.origin_x.value(), r.origin_y.value(), p * r.width, p * r.height};
 }
 
-namespace {
+namespace detail {
 
 // Bilinear reads of one raster with its constants computed once (a block's
 // worth of reads share them). Beyond the edges the nearest edge value; NaN
-// positions land on the origin sample. (Scalar: in SIMD lanes, with the four
-// corners gathered lane by lane, a block's reads measured slower.)
-class Bilinear {
+// positions land on the origin sample.
+class BilinearReader {
  public:
-  explicit Bilinear(const Raster2D& r) noexcept
+  BilinearReader() noexcept = default;  // reads nothing; for a map without a raster
+  explicit BilinearReader(const Raster2D& r) noexcept
       : values_(r.values.data()),
         inv_(1.0 / r.pitch.value()),
         ox_(r.origin_x.value()),
@@ -50,6 +49,20 @@ class Bilinear {
         jmax_(std::max(0, r.height - 2)),
         width_(r.width),
         height_(r.height) {}
+
+  /// Asks for the cache lines a read at (x, y) needs (the finger moves a
+  /// few µm per sample, so a block reads the cells the last one ended on):
+  /// on a thread woken every period they are usually cold.
+  void prefetch(double x_mm, double y_mm) const noexcept {
+    if (values_ == nullptr) return;
+    const double u = std::clamp((x_mm - ox_) * inv_, 0.0, umax_);
+    const double v = std::clamp((y_mm - oy_) * inv_, 0.0, vmax_);
+    const int i = std::isnan(u) ? 0 : std::min(static_cast<int>(u), imax_);
+    const int j = std::isnan(v) ? 0 : std::min(static_cast<int>(v), jmax_);
+    const float* row = values_ + static_cast<std::size_t>(j) * static_cast<std::size_t>(width_) + i;
+    __builtin_prefetch(row);
+    __builtin_prefetch(row + (j + 1 < height_ ? width_ : 0));
+  }
 
   [[nodiscard]] float operator()(double x_mm, double y_mm) const noexcept {
     const double u = std::clamp((x_mm - ox_) * inv_, 0.0, umax_);
@@ -66,14 +79,14 @@ class Bilinear {
   }
 
  private:
-  const float* values_;
-  double inv_, ox_, oy_, umax_, vmax_;
-  int imax_, jmax_, width_, height_;
+  const float* values_ = nullptr;
+  double inv_ = 0.0, ox_ = 0.0, oy_ = 0.0, umax_ = 0.0, vmax_ = 0.0;
+  int imax_ = 0, jmax_ = 0, width_ = 0, height_ = 0;
 };
 
-}  // namespace
+}  // namespace detail
 
-float sample_bilinear(const Raster2D& r, double x_mm, double y_mm) noexcept { return Bilinear(r)(x_mm, y_mm); }
+float sample_bilinear(const Raster2D& r, double x_mm, double y_mm) noexcept { return detail::BilinearReader(r)(x_mm, y_mm); }
 
 namespace {
 
@@ -208,138 +221,87 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::bitmap(Raster2D friction, std::o
   return m;
 }
 
-namespace {
+namespace detail {
 
-// What PlayerMap2D::values reads, gathered once per call.
-struct MapView {
-  bool bitmap = false;
-  const Raster2D* raster = nullptr;  // path-indexed: coarse (or none); bitmap: friction
-  const double* texels = nullptr;    // f_k, φ_k interleaved
-  std::size_t last = 0;              // the last texel's index
-  double strip = 0.0, inv_texel = 0.0, texel_mm = 0.0, coarse = 0.0, fine = 1.0, limit = 0.0;
+// A map's constants gathered once per block (the raster's, the texels', the
+// strengths and the frequency limit), then its value at the finger sample by
+// sample: what PlayerMap2D::value computes, in one pass, without tables (the
+// sine is detmath's: an exact reduction and one polynomial, the 1-D
+// renderer's) and without a division. Real-time safe.
+struct MapAtFinger {
+  MapAtFinger(const PlayerMap2D& m, double limit_hz) noexcept
+      : raster(m.raster_ ? &*m.raster_ : nullptr),
+        read(m.raster_ ? BilinearReader(*m.raster_) : BilinearReader()),
+        bitmap(m.kind_ == PlayerMap2D::Kind::bitmap),
+        texels(m.texels_.data()),
+        last(m.texels_.size() / 2 - 1),
+        strip(m.strip_mm_),
+        inv_texel(m.inv_texel_),
+        texel_mm(m.texel_mm_),
+        coarse(m.coarse_strength_),
+        fine_strength(m.fine_strength_),
+        limit(limit_hz) {}
+
+  // The index k of the texel under path length s_mm; `s` receives s_mm
+  // wrapped around the strip.
+  std::size_t texel_index(double s_mm, double& s) const noexcept {
+    // In the strip's first half (0 < s < strip/2, the quotient's floor is 0
+    // whatever the rounding) s_mm − 0·strip is s_mm: the same value without
+    // the division and the floor.
+    s = s_mm > 0.0 && s_mm < 0.5 * strip ? s_mm : s_mm - std::floor(s_mm / strip) * strip;
+    const auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel));
+    return std::min(k, last);
+  }
 
   // The texel under path length s, wrapped around the strip: returns f_k and
   // sets the phase argument φ_k + f_k·(s − k·L) of its oscillation, cycles.
   double texel_at(double s_mm, double& cycles) const noexcept {
-    // In the strip's first half (0 < s < strip/2, the quotient's floor is 0
-    // whatever the rounding) s_mm − 0·strip is s_mm: the same value without
-    // the division and the floor.
-    const double s = s_mm > 0.0 && s_mm < 0.5 * strip ? s_mm : s_mm - std::floor(s_mm / strip) * strip;
-    auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel));
-    k = std::min(k, last);
+    double s = 0.0;
+    const std::size_t k = texel_index(s_mm, s);
     const double f = texels[2 * k];
     cycles = texels[2 * k + 1] + f * (s - static_cast<double>(k) * texel_mm);
     return f;
   }
+
+  // The raster's cells at (x, y) and the texel at s into the cache.
+  void prefetch(double x_mm, double y_mm, double s_mm) const noexcept {
+    read.prefetch(x_mm, y_mm);
+    if (bitmap) return;
+    double s = 0.0;
+    __builtin_prefetch(texels + 2 * texel_index(s_mm, s));
+  }
+
+  // The fine oscillation at path length s, in [−1, 1], limited (docs/player.md §2).
+  double fine(double s_mm, double speed_mm_s) const noexcept {
+    double cycles = 0.0;
+    const double w = limit_weight(texel_at(s_mm, cycles) * std::fabs(speed_mm_s), limit);
+    if (w == 0.0) return 0.0;
+    return w * detmath::sin_cycles(cycles);
+  }
+
+  double value(double x_mm, double y_mm, double s_mm, double speed_mm_s) const noexcept {
+    if (bitmap) return std::clamp(static_cast<double>(read(x_mm, y_mm)), 0.0, 1.0);
+    const double c = raster ? static_cast<double>(read(x_mm, y_mm)) : 1.0;
+    const TexelMix mix = texel_mix(c, coarse, fine_strength);  // the 1-D rule, docs/algorithm.md §7
+    return mix.offset + mix.gain * fine(s_mm, speed_mm_s);
+  }
+
+  const Raster2D* raster;  // path-indexed: coarse profile (or none); bitmap: friction
+  BilinearReader read;
+  bool bitmap;
+  const double* texels;  // f_k, φ_k interleaved
+  std::size_t last;      // the last texel's index
+  double strip, inv_texel, texel_mm, coarse, fine_strength, limit;
 };
 
-// PlayerMap2D::values for n ≤ block_max samples, pass by pass over the block
-// (short loops of independent samples): the raster and the texels sample by
-// sample, then the sine and the mix in W lanes, each lane doing the scalar's
-// operations in the same order (IEEE, -ffp-contract=off), so every width,
-// and value() (n = 1), gives the same bits. The sine is detmath's (an exact
-// reduction and one polynomial, the 1-D renderer's).
-template <int W>
-[[gnu::always_inline]] inline void map_lanes(const MapView& m, const Bilinear* raster, const double* x, const double* y,
-                                             const double* s, const double* speed, double* out, std::size_t n) noexcept {
-  using V = typename detail::Lanes<W>::type;
-  constexpr std::size_t most = PlayerMap2D::block_max;
-  static_assert(most % W == 0);
-  const std::size_t padded = (n + W - 1) / W * W;  // padding lanes: c = 1, no oscillation
-  const V zero{}, one = zero + 1.0;
-  alignas(64) double c[most], cycles[most], weight[most];
-  for (std::size_t i = 0; i < padded; ++i) c[i] = raster && i < n ? static_cast<double>((*raster)(x[i], y[i])) : 1.0;
-  if (m.bitmap) {
-    for (std::size_t b = 0; b < n; b += W) {
-      V v;
-      std::memcpy(&v, c + b, sizeof v);
-      v = v < zero ? zero : (one < v ? one : v);  // std::clamp(c, 0, 1)
-      std::memcpy(out + b, &v, std::min<std::size_t>(W, n - b) * sizeof(double));
-    }
-    return;
-  }
-  for (std::size_t i = 0; i < padded; ++i) {
-    cycles[i] = weight[i] = 0.0;
-    if (i < n) weight[i] = limit_weight(m.texel_at(s[i], cycles[i]) * std::fabs(speed[i]), m.limit);
-  }
-  for (std::size_t b = 0; b < n; b += W) {
-    V cv, w, u;
-    std::memcpy(&cv, c + b, sizeof cv);
-    std::memcpy(&u, cycles + b, sizeof u);
-    std::memcpy(&w, weight + b, sizeof w);
-    const V e = 1.0 - m.coarse * (1.0 - cv);  // texel_mix, docs/algorithm.md §7
-    const V offset = e - e * m.fine * 0.5;
-    const V gain = e * m.fine * 0.5;
-    const V a = offset + gain * (w == zero ? zero : w * detmath::sin_cycles_generic(u));
-    std::memcpy(out + b, &a, std::min<std::size_t>(W, n - b) * sizeof(double));
-  }
-}
-
-template <int W>
-[[gnu::always_inline]] inline void map_lanes(const MapView& m, const double* x, const double* y, const double* s,
-                                             const double* speed, double* out, std::size_t n) noexcept {
-  if (m.raster) {
-    const Bilinear raster(*m.raster);
-    map_lanes<W>(m, &raster, x, y, s, speed, out, n);
-  } else {
-    map_lanes<W>(m, nullptr, x, y, s, speed, out, n);
-  }
-}
-
-using MapKernel = void (*)(const MapView&, const double*, const double*, const double*, const double*, double*,
-                           std::size_t) noexcept;
-// At most AVX2's 4 lanes: a block is 16–64 samples, and a real-time thread
-// gains nothing from waking the AVX-512 units (their clock licence) for a
-// few hundred nanoseconds.
-#if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx2"))) void map_avx2(const MapView& m, const double* x, const double* y, const double* s,
-                                              const double* v, double* out, std::size_t n) noexcept {
-  map_lanes<4>(m, x, y, s, v, out, n);
-}
-#endif
-void map_generic(const MapView& m, const double* x, const double* y, const double* s, const double* v, double* out,
-                 std::size_t n) noexcept {
-  map_lanes<2>(m, x, y, s, v, out, n);
-}
-
-// Chosen before any real-time thread runs (simd_lanes reads the environment
-// once): a namespace-scope constant, not a function-local static.
-const MapKernel map_kernel = [] {
-#if defined(__x86_64__) || defined(__i386__)
-  if (detail::simd_lanes() >= 4) return &map_avx2;
-#endif
-  return &map_generic;
-}();
-
-}  // namespace
+}  // namespace detail
 
 double PlayerMap2D::fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  MapView m;
-  m.texels = texels_.data(), m.last = texels_.size() / 2 - 1;
-  m.strip = strip_mm_, m.inv_texel = inv_texel_, m.texel_mm = texel_mm_;
-  double cycles = 0.0;
-  const double w = limit_weight(m.texel_at(s_mm, cycles) * std::fabs(speed_mm_s), limit_hz);
-  if (w == 0.0) return 0.0;
-  return w * detmath::sin_cycles(cycles);
+  return detail::MapAtFinger(*this, limit_hz).fine(s_mm, speed_mm_s);
 }
 
 double PlayerMap2D::value(double x_mm, double y_mm, double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  double a = 0.0;
-  values(&x_mm, &y_mm, &s_mm, &speed_mm_s, limit_hz, &a, 1);
-  return a;
-}
-
-void PlayerMap2D::values(const double* x, const double* y, const double* s, const double* speed, double limit_hz, double* out,
-                         std::size_t n) const noexcept {
-  MapView m;
-  m.bitmap = kind_ == Kind::bitmap;
-  m.raster = raster_ ? &*raster_ : nullptr;
-  if (!m.bitmap) {
-    m.texels = texels_.data(), m.last = texels_.size() / 2 - 1;
-    m.strip = strip_mm_, m.inv_texel = inv_texel_, m.texel_mm = texel_mm_;
-    m.coarse = coarse_strength_, m.fine = fine_strength_, m.limit = limit_hz;
-  }
-  map_kernel(m, x, y, s, speed, out, std::min(n, block_max));
+  return detail::MapAtFinger(*this, limit_hz).value(x_mm, y_mm, s_mm, speed_mm_s);
 }
 
 // ------------------------------------------------------------------- Player2D
@@ -384,13 +346,11 @@ bool Player2D::set_carrier(double hz) {
   return events_.try_push(Event{Event::Kind::carrier, {}, std::clamp(hz, 0.0, config_.rate_hz / 2)});
 }
 
-// Real-time safe, like Player::process. Each sample's operations are those
-// of a sample-by-sample loop (finger, map value, output stage), done in three
-// passes over chunks of up to PlayerMap2D::block_max samples so the map's
-// sines run in SIMD lanes (PlayerMap2D::values) and the output stage's mode
-// is chosen once: the finger for every sample of the chunk, the maps' values,
-// the output stage. Nothing the output stage does reaches the finger or the
-// map, so the order of the passes changes no value.
+// Real-time safe, like Player::process. The maps' constants are gathered
+// once per block (detail::MapAtFinger); each sample is then one compact pass
+// (finger, value under it, output stage): on a real-time thread woken every
+// period the caches are cold, and a block's cost is the cache lines it
+// touches as much as its arithmetic.
 BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::span<float> y_mm,
                             std::span<float> path_mm) noexcept {
   BlockInfo info;
@@ -405,45 +365,46 @@ BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::sp
   // Felt frequencies are limited to the display's response limit, else to
   // 0.45·rate (below the drive's Nyquist).
   const double limit = stage_.limit_hz() > 0.0 ? stage_.limit_hz() : 0.45 * rate;
-  const PlayerMap2D* current = maps_.current();  // fixed for the block (begin_block)
-  constexpr std::size_t chunk = PlayerMap2D::block_max;
-  alignas(64) double x[chunk], y[chunk], s[chunk], speed[chunk], a[chunk], old[chunk];
-  bool touch[chunk];
+  // The maps are fixed for the block (begin_block); the one fading out may
+  // only end its fade.
+  const PlayerMap2D* current = maps_.current();
+  const PlayerMap2D* fading = maps_.fading();
+  const std::optional<detail::MapAtFinger> now_at =
+      current ? std::optional<detail::MapAtFinger>(std::in_place, *current, limit) : std::nullopt;
+  const std::optional<detail::MapAtFinger> old_at =
+      fading ? std::optional<detail::MapAtFinger>(std::in_place, *fading, limit) : std::nullopt;
+  if (now_at) now_at->prefetch(last_x_, last_y_, last_s_);
   float peak = 0.0f;
   std::array<double, 3> p{};
+  bool touching = false;
 
-  for (std::size_t done = 0; done < frames;) {
-    const std::size_t n = std::min(chunk, frames - done);
-    for (std::size_t i = 0; i < n; ++i, ++n_) {
-      const double tau = static_cast<double>(n_) / rate + config_.prediction_s;
-      player_parts::take_events(events_, tau, finger_, stage_, smoothing);
-      p = finger_.position(tau, player_parts::next_finger(events_), config_.extrapolate_s);
-      touch[i] = finger_.touching() && (current == nullptr || current->on_surface(p[0], p[1]));
-      // Path speed from consecutive output samples (s is piecewise linear in
-      // time between finger samples, so this is exact within a segment).
-      speed[i] = have_s_ ? std::fabs(p[2] - last_s_) * rate : 0.0;
-      last_s_ = p[2];
-      have_s_ = touch[i];
-      x[i] = p[0], y[i] = p[1], s[i] = p[2];
-    }
-    maps_.values([&](const PlayerMap2D& m, double* v) { m.values(x, y, s, speed, limit, v, n); }, a, old, n);
-    const std::span<float> block = out.subspan(done, n);
-    peak = std::max(peak, stage_.run(a, touch, block));
-    if (x_mm.size() >= frames)
-      for (std::size_t i = 0; i < n; ++i) x_mm[done + i] = static_cast<float>(x[i]);
-    if (y_mm.size() >= frames)
-      for (std::size_t i = 0; i < n; ++i) y_mm[done + i] = static_cast<float>(y[i]);
-    if (path_mm.size() >= frames)
-      for (std::size_t i = 0; i < n; ++i) path_mm[done + i] = static_cast<float>(s[i]);
-    info.touching = touch[n - 1];
-    done += n;
+  for (std::size_t i = 0; i < frames; ++i, ++n_) {
+    const double tau = static_cast<double>(n_) / rate + config_.prediction_s;
+    player_parts::take_events(events_, tau, finger_, stage_, smoothing);
+    p = finger_.position(tau, player_parts::next_finger(events_), config_.extrapolate_s);
+    touching = finger_.touching() && (current == nullptr || current->on_surface(p[0], p[1]));
+    // Path speed from consecutive output samples (s is piecewise linear in
+    // time between finger samples, so this is exact within a segment).
+    const double speed = have_s_ ? std::fabs(p[2] - last_s_) * rate : 0.0;
+    last_s_ = p[2];
+    have_s_ = touching;
+    const double a = maps_.value(
+        [&](const PlayerMap2D& m) -> double { return (&m == current ? *now_at : *old_at).value(p[0], p[1], p[2], speed); });
+    const auto yf = static_cast<float>(stage_.step(a, touching));
+    out[i] = yf;
+    if (x_mm.size() >= frames) x_mm[i] = static_cast<float>(p[0]);
+    if (y_mm.size() >= frames) y_mm[i] = static_cast<float>(p[1]);
+    if (path_mm.size() >= frames) path_mm[i] = static_cast<float>(p[2]);
+    peak = std::max(peak, std::fabs(yf));
   }
   stage_.end_block();
   publish_samples(n_);
+  last_x_ = p[0], last_y_ = p[1];
 
   info.peak = peak;
   info.position_mm = p[0];
   info.position_y_mm = p[1];
+  info.touching = touching;
   info.crossfading = maps_.crossfading();
   return info;
 }

@@ -278,52 +278,6 @@ TEST(Player2D, RasterFromNpyRowsAlongY) {
   EXPECT_THROW(parse_npy(npy("(2, 3)", 6), "r.npy"), FormatError);                           // the 1-D reader still wants 1-D
 }
 
-// The block path (PlayerMap2D::values: the sines of a block in SIMD lanes)
-// gives value()'s bits sample by sample, for any block length, over
-// positions inside, beyond and exactly on the raster's edges, NaN, path
-// lengths before, across and beyond the strip and speeds on both sides of
-// the frequency limit; a bitmap block is the clamped bilinear read.
-TEST(Player2D, BlockValuesEqualValueBitForBit) {
-  TexelSpec spec;
-  spec.coarse_strength = 0.5;
-  spec.central_pitch = Decibels(12.0);
-  const Sampling s{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, {}};
-  const auto path = PlayerMap2D::path_indexed(spec, s, disc(20.0), std::nullopt, 50.0);
-  const auto plain = PlayerMap2D::path_indexed(spec, s, std::nullopt, wide, 50.0);
-  const Raster2D friction = disc(30.0);
-  const auto bitmap = PlayerMap2D::bitmap(friction);
-  constexpr std::size_t n = PlayerMap2D::block_max;
-  std::vector<double> x(n), y(n), path_mm(n), speed(n);
-  std::uint64_t state = 12345;
-  const auto uniform = [&](double lo, double hi) {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return lo + (hi - lo) * static_cast<double>(state >> 11) / 9007199254740992.0;
-  };
-  for (int round = 0; round < 200; ++round) {
-    for (std::size_t i = 0; i < n; ++i) {
-      x[i] = uniform(-60.0, 60.0), y[i] = uniform(-60.0, 60.0);
-      path_mm[i] = uniform(-120.0, 260.0);
-      speed[i] = uniform(-400.0, 400.0);  // 12 dB ≈ 4 cycles/mm: the limit (21.6 kHz) falls inside
-    }
-    x[round % n] = -50.0, y[(round + 1) % n] = 49.5;                // on the edges
-    x[(round + 2) % n] = std::numeric_limits<double>::quiet_NaN();  // lands on the origin sample
-    path_mm[(round + 3) % n] = 50.0;                                // the strip's end
-    for (const auto* map : {path.get(), plain.get(), bitmap.get()})
-      for (std::size_t len : {std::size_t{1}, std::size_t{3}, std::size_t{16}, n}) {
-        std::vector<double> block(len);
-        map->values(x.data(), y.data(), path_mm.data(), speed.data(), 21600.0, block.data(), len);
-        for (std::size_t i = 0; i < len; ++i) {
-          const double one = map->value(x[i], y[i], path_mm[i], speed[i], 21600.0);
-          ASSERT_EQ(std::memcmp(&one, &block[i], sizeof one), 0)
-              << "sample " << i << " of " << len << ": " << one << " vs " << block[i];
-          if (map == bitmap.get() && !std::isnan(x[i])) {
-            ASSERT_EQ(block[i], std::clamp(static_cast<double>(sample_bilinear(friction, x[i], y[i])), 0.0, 1.0));
-          }
-        }
-      }
-  }
-}
-
 // The fine texture's sine is detmath's (docs/player.md §2): against the
 // C library's sin(2π·u) at the same texel and phase it differs by < 1e-14.
 TEST(Player2D, FineTextureMatchesTheCLibrarySine) {
