@@ -153,20 +153,12 @@ class OutputStage {
   }
   /// One output sample for map value `a` with the finger touching or not.
   double step(double a, bool touching) noexcept;
-  /// step() for out.size() samples, the mode chosen once: out[i] =
-  /// step(a[i], touching[i]) as float, bit for bit. Returns the largest |out[i]|.
-  float run(const double* a, const bool* touching, std::span<float> out) noexcept;
   void end_block() noexcept {
     gain_ = gain_end_;
     carrier_inc_ = inc_end_;
   }
 
  private:
-  template <int Mode>
-  double step_as(double a, bool touching) noexcept;
-  template <int Mode>
-  float run_as(const double* a, const bool* touching, std::span<float> out) noexcept;
-
   const PlayerConfig* config_;
   double touch_level_ = 0.0;  // 0 … 1 before shaping
   double touch_step_ = 0.0;
@@ -246,21 +238,17 @@ class MapExchange {
       const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * fade_pos_);
       const double old = fading_ ? eval(*fading_) : 0.0;
       a = old + (a - old) * w;
-      advance_fade();
+      fade_pos_ += fade_step_;
+      if (fade_pos_ >= 1.0) {
+        crossfading_ = false;
+        if (fading_ && !retired_.try_push(fading_)) retire_waiting_ = fading_;
+        fading_ = nullptr;
+      }
     }
     return a;
   }
 
  private:
-  void advance_fade() noexcept {
-    fade_pos_ += fade_step_;
-    if (fade_pos_ >= 1.0) {
-      crossfading_ = false;
-      if (fading_ && !retired_.try_push(fading_)) retire_waiting_ = fading_;
-      fading_ = nullptr;
-    }
-  }
-
   SpscQueue<const Map*> retired_;
   std::atomic<const Map*> pending_{nullptr};
   const Map* current_ = nullptr;

@@ -180,9 +180,7 @@ void OutputStage::use_response(const FrequencyResponse* response) noexcept {
   display_limit_ = true;
 }
 
-template <int Mode>
-[[gnu::always_inline]] inline double OutputStage::step_as(double a, bool touching) noexcept {
-  constexpr auto mode = static_cast<OutputMode>(Mode);
+double OutputStage::step(double a, bool touching) noexcept {
   // Touch / lift ramp (raised cosine: the largest step per sample is
   // π/2 · touch_step_ of the output, no click).
   const bool was_silent = touch_level_ <= 0.0;
@@ -195,72 +193,46 @@ template <int Mode>
 
   // The display's response limit (see player.hpp): what it cannot
   // reproduce is not driven. Starts settled on touch-down from rest.
+  const OutputMode mode = config_->mode;
   if (display_limit_) {
     if ((was_silent && touching) || display_settle_) {
       display_lp_.settle(a);
       display_settle_ = false;
     }
     a = display_lp_(a);
-    if constexpr (mode == OutputMode::amplitude) a = std::clamp(a, 0.0, 1.0);  // the filter's overshoot at steps
+    if (mode == OutputMode::amplitude) a = std::clamp(a, 0.0, 1.0);  // the filter's overshoot at steps
   }
 
   gain_ += gain_step_;
   double y = 0.0;
-  if constexpr (mode == OutputMode::amplitude) {
-    y = a;
-  } else if constexpr (mode == OutputMode::carrier) {
-    y = a * std::sin(2.0 * std::numbers::pi * carrier_phase_);
-    carrier_inc_ += inc_step_;
-    carrier_phase_ += carrier_inc_;
-    carrier_phase_ -= std::floor(carrier_phase_);
-  } else {  // vibration
-    if (was_silent && touching) {
-      // Touch-down from rest: start the filters in their steady state for
-      // the value under the finger, so landing does not thump.
-      lowpass_.settle(a);
-      dc_x1_ = a;
-      dc_y1_ = 0.0;
+  switch (mode) {
+    case OutputMode::amplitude: y = a; break;
+    case OutputMode::carrier: {
+      y = a * std::sin(2.0 * std::numbers::pi * carrier_phase_);
+      carrier_inc_ += inc_step_;
+      carrier_phase_ += carrier_inc_;
+      carrier_phase_ -= std::floor(carrier_phase_);
+      break;
     }
-    const double lp = lowpass_(a);
-    const double hp = lp - dc_x1_ + dc_r_ * dc_y1_;
-    dc_x1_ = lp;
-    dc_y1_ = hp;
-    y = hp;
+    case OutputMode::vibration: {
+      if (was_silent && touching) {
+        // Touch-down from rest: start the filters in their steady state for
+        // the value under the finger, so landing does not thump.
+        lowpass_.settle(a);
+        dc_x1_ = a;
+        dc_y1_ = 0.0;
+      }
+      const double lp = lowpass_(a);
+      const double hp = lp - dc_x1_ + dc_r_ * dc_y1_;
+      dc_x1_ = lp;
+      dc_y1_ = hp;
+      y = hp;
+      break;
+    }
   }
   y *= env * gain_;
-  if constexpr (mode != OutputMode::amplitude) y = std::clamp(y, -1.0, 1.0);
+  if (mode != OutputMode::amplitude) y = std::clamp(y, -1.0, 1.0);
   return y;
-}
-
-constexpr int as_int(OutputMode m) { return static_cast<int>(m); }
-
-double OutputStage::step(double a, bool touching) noexcept {
-  switch (config_->mode) {
-    case OutputMode::amplitude: return step_as<as_int(OutputMode::amplitude)>(a, touching);
-    case OutputMode::carrier: return step_as<as_int(OutputMode::carrier)>(a, touching);
-    case OutputMode::vibration: break;
-  }
-  return step_as<as_int(OutputMode::vibration)>(a, touching);
-}
-
-template <int Mode>
-float OutputStage::run_as(const double* a, const bool* touching, std::span<float> out) noexcept {
-  float peak = 0.0f;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const auto y = static_cast<float>(step_as<Mode>(a[i], touching[i]));
-    out[i] = y;
-    peak = std::max(peak, std::fabs(y));
-  }
-  return peak;
-}
-
-float OutputStage::run(const double* a, const bool* touching, std::span<float> out) noexcept {
-  switch (config_->mode) {
-    case OutputMode::amplitude: return run_as<as_int(OutputMode::amplitude)>(a, touching, out);
-    case OutputMode::carrier: return run_as<as_int(OutputMode::carrier)>(a, touching, out);
-    case OutputMode::vibration: break;
-  }
-  return run_as<as_int(OutputMode::vibration)>(a, touching, out);
 }
 
 }  // namespace player_parts
