@@ -46,7 +46,6 @@
 #pragma once
 
 #include <array>
-#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -61,7 +60,6 @@
 namespace texel {
 
 struct Document;
-class PlayerMap2D;
 namespace detail {
 struct MapAtFinger;  // a map's constants for one block (src/player/player2d.cpp)
 }
