@@ -15,9 +15,10 @@
 // then the null backend (texel play --backend null) under the same loads:
 // underruns in 5 s, worst block, and the scheduling its paced thread got.
 //
-// Usage: texel_bench_player_paced [--seconds S] [--json FILE] [--costs]
+// Usage: texel_bench_player_paced [--seconds S] [--json FILE] [--costs] [--sync]
 // (--costs: only the block costs without JACK, warm and with the caches
-// evicted between blocks, which tell whether the tail is the work's own)
+// evicted between blocks, which tell whether the tail is the work's own;
+// --sync: jackd in synchronous mode, -S)
 // Needs jackd (Debian jackd2) and stress-ng on PATH; a missing tool is
 // reported and its part skipped (exit 0), never faked.
 #include <fcntl.h>
@@ -131,11 +132,17 @@ struct Result {
   std::size_t blocks = 0;
   Stats block_time;  // % of the period
   double lat_p50_ms = 0, lat_p99_ms = 0, lat_max_ms = 0;
+  // What the largest latency is made of: push → start of the callback that
+  // computed it, the sample's offset in its block, and the declared playback
+  // latency; and the longest time between two callback starts (a driver
+  // cycle that came late: the dummy driver's thread or the client woke late).
+  double max_wait_ms = 0, max_offset_ms = 0, longest_gap_ms = 0;
   std::size_t latencies = 0;
   std::uint64_t allocations = 0;
   std::uint64_t xruns = 0;
   std::string scheduling;
   double playback_latency_frames = 0;
+  double playback_latency_min_frames = 0;
 };
 
 struct Run {
@@ -147,6 +154,9 @@ struct Run {
   std::vector<float> positions;
   std::vector<double> push_us;     // per marker k: CLOCK_MONOTONIC at push (µs)
   std::vector<double> latency_us;  // per marker k (0 = not yet played)
+  std::vector<double> wait_us;     // per marker k: push → start of the callback that played it first
+  std::vector<double> offset_us;   // per marker k: its offset in that block
+  double last_cycle_us = 0, longest_gap_us = 0;
   std::atomic<std::size_t> pushed{0};
   long last_marker = -1;
   std::atomic<jack_nframes_t> playback_latency{0};
@@ -175,6 +185,8 @@ int on_process(jack_nframes_t n, void* arg) {
   timespec a{}, b{};
   ::clock_gettime(CLOCK_MONOTONIC, &a);
   const double cycle_us = 1e6 * static_cast<double>(a.tv_sec) + 1e-3 * static_cast<double>(a.tv_nsec);
+  if (r.last_cycle_us > 0) r.longest_gap_us = std::max(r.longest_gap_us, cycle_us - r.last_cycle_us);
+  r.last_cycle_us = cycle_us;
   alloc::counting = true;
   r.player->process(std::span(out, frames), std::span(r.positions.data(), frames));
   alloc::counting = false;
@@ -193,8 +205,12 @@ int on_process(jack_nframes_t n, void* arg) {
     const auto m = static_cast<long>(std::floor((static_cast<double>(r.positions[i]) - 1.0) / step_mm + 1e-3));
     if (m <= r.last_marker || m < 0 || static_cast<std::size_t>(m) >= r.latency_us.size()) continue;
     const double played = first_us + 1e6 * static_cast<double>(i) / rate;
-    for (long q = r.last_marker + 1; q <= m; ++q)
-      r.latency_us[static_cast<std::size_t>(q)] = played - r.push_us[static_cast<std::size_t>(q)];
+    for (long q = r.last_marker + 1; q <= m; ++q) {
+      const auto mk = static_cast<std::size_t>(q);
+      r.latency_us[mk] = played - r.push_us[mk];
+      r.wait_us[mk] = cycle_us - r.push_us[mk];
+      r.offset_us[mk] = 1e6 * static_cast<double>(i) / rate;
+    }
     r.last_marker = m;
   }
   return 0;
@@ -212,9 +228,16 @@ Result run_client(const std::string& server, std::size_t block, double seconds, 
   const auto markers = static_cast<std::size_t>(seconds * 1000.0) + 100;
   r.push_us.assign(markers, 0.0);
   r.latency_us.assign(markers, 0.0);
+  r.wait_us.assign(markers, 0.0);
+  r.offset_us.assign(markers, 0.0);
   jack_status_t status{};
-  r.client =
-      jack_client_open("texel-bench", static_cast<jack_options_t>(JackNoStartServer | JackServerName), &status, server.c_str());
+  // A loaded machine may take longer than the wait in jack_runs to bring the
+  // server up: try for up to 5 s before giving up on this run.
+  for (int attempt = 0; attempt < 25 && !r.client; ++attempt) {
+    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    r.client =
+        jack_client_open("texel-bench", static_cast<jack_options_t>(JackNoStartServer | JackServerName), &status, server.c_str());
+  }
   if (!r.client) {
     res.scheduling = "JACK client failed to open";
     return res;
@@ -233,6 +256,7 @@ Result run_client(const std::string& server, std::size_t block, double seconds, 
   jack_port_get_latency_range(r.port, JackPlaybackLatency, &range);
   r.playback_latency = range.max;
   res.playback_latency_frames = range.max;
+  res.playback_latency_min_frames = range.min;
   const std::size_t warm_blocks = r.blocks.load();
   const std::uint64_t xruns0 = r.xruns.load();
   alloc::counted_allocations = 0;
@@ -262,8 +286,15 @@ Result run_client(const std::string& server, std::size_t block, double seconds, 
   res.blocks = bs.size();
   res.block_time = percentiles(bs, static_cast<double>(block) / rate);
   std::vector<double> lat;
+  std::size_t worst = 0;
   for (std::size_t k = 0; k < r.pushed; ++k)
-    if (r.latency_us[k] != 0.0) lat.push_back(r.latency_us[k] / 1000.0);
+    if (r.latency_us[k] != 0.0) {
+      lat.push_back(r.latency_us[k] / 1000.0);
+      if (r.latency_us[k] > r.latency_us[worst]) worst = k;
+    }
+  res.max_wait_ms = r.wait_us[worst] / 1000.0;
+  res.max_offset_ms = r.offset_us[worst] / 1000.0;
+  res.longest_gap_ms = r.longest_gap_us / 1000.0;
   res.latencies = lat.size();
   if (!lat.empty()) {
     std::sort(lat.begin(), lat.end());
@@ -367,20 +398,34 @@ void print_block_costs() {
   }
 }
 
+/// jackd's synchronous mode (-S, `--sync`): the server waits for its clients
+/// within the cycle, so their output goes out with that cycle, one period
+/// sooner than in the default asynchronous mode, at the risk of an xrun when
+/// a client is late. Which one ran is printed with every result.
+bool jack_sync = false;
+
 std::vector<Result> jack_runs(const std::string& load, std::size_t block, double seconds) {
   std::vector<Result> out;
   const std::string server = "texel-bench-" + std::to_string(::getpid());
   const std::string log = "/tmp/" + server + "-jackd.log";
   const std::string period = std::to_string(block);
   // -P 80: JACK's clients run just below the server's priority, above anything else here.
-  Child jackd = spawn({"jackd", "-n", server, "-R", "-P", "80", "-d", "dummy", "-r", "48000", "-p", period}, log, false);
+  const auto args = [&](std::vector<std::string> scheduling) {
+    std::vector<std::string> a{"jackd", "-n", server};
+    if (jack_sync) a.emplace_back("-S");
+    a.insert(a.end(), scheduling.begin(), scheduling.end());
+    a.insert(a.end(), {"-d", "dummy", "-r", "48000", "-p", period});
+    return a;
+  };
+  const std::string sync = jack_sync ? " -S" : "";
+  Child jackd = spawn(args({"-R", "-P", "80"}), log, false);
   std::this_thread::sleep_for(std::chrono::milliseconds(800));
-  std::string mode = "jackd -R -P 80";
+  std::string mode = "jackd" + sync + " -R -P 80";
   if (!running(jackd)) {  // real-time refused: run without it and say so
     stop(jackd);
-    jackd = spawn({"jackd", "-n", server, "-r", "-d", "dummy", "-r", "48000", "-p", period}, log, false);
+    jackd = spawn(args({"-r"}), log, false);
     std::this_thread::sleep_for(std::chrono::milliseconds(800));
-    mode = "jackd -r (no real-time)";
+    mode = "jackd" + sync + " -r (no real-time)";
   }
   if (!running(jackd)) {
     std::fprintf(stderr, "jackd did not start (see %s); JACK runs skipped\n", log.c_str());
@@ -438,6 +483,8 @@ int main(int argc, char** argv) {
       json = argv[++i];
     else if (a == "--costs")
       costs_only = true;
+    else if (a == "--sync")
+      jack_sync = true;
     else if (a == "--seconds" && i + 1 < argc)
       seconds = std::atof(argv[++i]);
   }
@@ -471,11 +518,13 @@ int main(int argc, char** argv) {
               "p99 %", "p99.9 %", "max %", "lat p50", "lat p99", "lat max", "allocs", "xruns", "scheduling");
   for (const auto& r : results)
     std::printf(
-        "%-5s %-4s %5zu %8zu | %8.3f %8.3f %8.3f %8.3f | %6.3fms %6.3fms %6.3fms | %6llu %5llu | %s (playback latency %.0f "
-        "frames)\n",
+        "%-5s %-4s %5zu %8zu | %8.3f %8.3f %8.3f %8.3f | %6.3fms %6.3fms %6.3fms | %6llu %5llu | %s (playback latency "
+        "%.0f…%.0f frames; latency max = %.3f ms push → callback + %.3f ms in the block + the playback latency; longest "
+        "gap between callbacks %.3f ms)\n",
         r.load.c_str(), r.dim.c_str(), r.block, r.blocks, r.block_time.p50, r.block_time.p99, r.block_time.p999, r.block_time.max,
         r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms, static_cast<unsigned long long>(r.allocations),
-        static_cast<unsigned long long>(r.xruns), r.scheduling.c_str(), r.playback_latency_frames);
+        static_cast<unsigned long long>(r.xruns), r.scheduling.c_str(), r.playback_latency_min_frames, r.playback_latency_frames,
+        r.max_wait_ms, r.max_offset_ms, r.longest_gap_ms);
   for (const auto& n : nulls)
     std::printf(
         "null backend (texel play --backend null), 64 frames, 5 s, %s: %llu blocks, %llu underruns, worst block %.2f %% of the "
@@ -491,10 +540,12 @@ int main(int argc, char** argv) {
             f,
             "%s{\"load\": \"%s\", \"dim\": \"%s\", \"block\": %zu, \"blocks\": %zu, \"p50_pct\": %.4f, \"p99_pct\": %.4f, "
             "\"p999_pct\": %.4f, \"max_pct\": %.4f, \"latency_p50_ms\": %.4f, \"latency_p99_ms\": %.4f, "
-            "\"latency_max_ms\": %.4f, \"allocations\": %llu, \"xruns\": %llu, \"scheduling\": \"%s\"}",
+            "\"latency_max_ms\": %.4f, \"latency_max_wait_ms\": %.4f, \"longest_gap_ms\": %.4f, \"playback_latency_frames\": "
+            "%.0f, \"allocations\": %llu, \"xruns\": %llu, \"scheduling\": \"%s\"}",
             i ? ", " : "", r.load.c_str(), r.dim.c_str(), r.block, r.blocks, r.block_time.p50, r.block_time.p99,
-            r.block_time.p999, r.block_time.max, r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms,
-            static_cast<unsigned long long>(r.allocations), static_cast<unsigned long long>(r.xruns), r.scheduling.c_str());
+            r.block_time.p999, r.block_time.max, r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms, r.max_wait_ms, r.longest_gap_ms,
+            r.playback_latency_frames, static_cast<unsigned long long>(r.allocations), static_cast<unsigned long long>(r.xruns),
+            r.scheduling.c_str());
       }
       std::fprintf(f, "], \"null\": [");
       for (std::size_t i = 0; i < nulls.size(); ++i)

@@ -60,6 +60,9 @@
 namespace texel {
 
 struct Document;
+namespace detail {
+struct MapAtFinger;  // a map's constants for one block (src/player/player2d.cpp)
+}
 
 /// One finger sample on a 2-D surface.
 struct FingerSample2D {
@@ -140,6 +143,7 @@ class PlayerMap2D {
   [[nodiscard]] double fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept;
 
  private:
+  friend struct detail::MapAtFinger;
   PlayerMap2D() = default;
   Kind kind_ = Kind::path_indexed;
   Extent2D extent_{};
@@ -147,8 +151,7 @@ class PlayerMap2D {
   std::optional<Raster2D> raster_;  // path-indexed: coarse profile; bitmap: friction
   double coarse_strength_ = 0.0, fine_strength_ = 1.0;
   double texel_mm_ = 0.0, inv_texel_ = 0.0, strip_mm_ = 0.0;
-  std::vector<double> frequency_cpm_;  // f_k
-  std::vector<double> phase_cycles_;   // φ_k
+  std::vector<double> texels_;  // f_k, φ_k, f_k+1, …: a texel's pair in one cache line
 };
 
 /// What the event ring carries: the sample with its path length (computed by push).
@@ -201,6 +204,7 @@ class Player2D final : public PlayerBase {
   player_parts::FingerTrack<PathSample, 3> finger_;
   player_parts::OutputStage stage_;
   double last_s_ = 0.0;
+  double last_x_ = 0.0, last_y_ = 0.0;  // the finger at the last block's end: its map cells are fetched first
   bool have_s_ = false;
   std::uint64_t n_ = 0;
 };

@@ -226,6 +226,8 @@ class MapExchange {
     return next;
   }
   [[nodiscard]] const Map* current() const noexcept { return current_; }
+  /// The map fading out during a crossfade (null: none, or from silence).
+  [[nodiscard]] const Map* fading() const noexcept { return fading_; }
   [[nodiscard]] bool crossfading() const noexcept { return crossfading_; }
   /// eval(map) of the current map, crossfaded (raised cosine) from the old
   /// one during a swap; 0 for no map. Advances the crossfade by one sample.

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "texel/detail/format.hpp"
+#include "texel/detmath.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -28,19 +29,63 @@ Extent2D extent_of(const Raster2D& r) {
   return {r.origin_x.value(), r.origin_y.value(), p * r.width, p * r.height};
 }
 
-float sample_bilinear(const Raster2D& r, double x_mm, double y_mm) noexcept {
-  const double inv = 1.0 / r.pitch.value();
-  const double u = std::clamp((x_mm - r.origin_x.value()) * inv, 0.0, static_cast<double>(r.width - 1));
-  const double v = std::clamp((y_mm - r.origin_y.value()) * inv, 0.0, static_cast<double>(r.height - 1));
-  // NaN positions land on the origin sample.
-  const int i = std::isnan(u) ? 0 : std::min(static_cast<int>(u), std::max(0, r.width - 2));
-  const int j = std::isnan(v) ? 0 : std::min(static_cast<int>(v), std::max(0, r.height - 2));
-  const double fu = std::isnan(u) ? 0.0 : u - i, fv = std::isnan(v) ? 0.0 : v - j;
-  const int i1 = std::min(i + 1, r.width - 1), j1 = std::min(j + 1, r.height - 1);
-  const double a = r.at(i, j) + (r.at(i1, j) - r.at(i, j)) * fu;
-  const double b = r.at(i, j1) + (r.at(i1, j1) - r.at(i, j1)) * fu;
-  return static_cast<float>(a + (b - a) * fv);
-}
+namespace detail {
+
+// Bilinear reads of one raster with its constants computed once (a block's
+// worth of reads share them). Beyond the edges the nearest edge value; NaN
+// positions land on the origin sample.
+class BilinearReader {
+ public:
+  BilinearReader() noexcept = default;  // reads nothing; for a map without a raster
+  explicit BilinearReader(const Raster2D& r) noexcept
+      : values_(r.values.data()),
+        inv_(1.0 / r.pitch.value()),
+        ox_(r.origin_x.value()),
+        oy_(r.origin_y.value()),
+        umax_(static_cast<double>(r.width - 1)),
+        vmax_(static_cast<double>(r.height - 1)),
+        imax_(std::max(0, r.width - 2)),
+        jmax_(std::max(0, r.height - 2)),
+        width_(r.width),
+        height_(r.height) {}
+
+  /// Asks for the cache lines a read at (x, y) needs (the finger moves a
+  /// few µm per sample, so a block reads the cells the last one ended on):
+  /// on a thread woken every period they are usually cold.
+  void prefetch(double x_mm, double y_mm) const noexcept {
+    if (values_ == nullptr) return;
+    const double u = std::clamp((x_mm - ox_) * inv_, 0.0, umax_);
+    const double v = std::clamp((y_mm - oy_) * inv_, 0.0, vmax_);
+    const int i = std::isnan(u) ? 0 : std::min(static_cast<int>(u), imax_);
+    const int j = std::isnan(v) ? 0 : std::min(static_cast<int>(v), jmax_);
+    const float* row = values_ + static_cast<std::size_t>(j) * static_cast<std::size_t>(width_) + i;
+    __builtin_prefetch(row);
+    __builtin_prefetch(row + (j + 1 < height_ ? width_ : 0));
+  }
+
+  [[nodiscard]] float operator()(double x_mm, double y_mm) const noexcept {
+    const double u = std::clamp((x_mm - ox_) * inv_, 0.0, umax_);
+    const double v = std::clamp((y_mm - oy_) * inv_, 0.0, vmax_);
+    const int i = std::isnan(u) ? 0 : std::min(static_cast<int>(u), imax_);
+    const int j = std::isnan(v) ? 0 : std::min(static_cast<int>(v), jmax_);
+    const double fu = std::isnan(u) ? 0.0 : u - i, fv = std::isnan(v) ? 0.0 : v - j;
+    const int i1 = std::min(i + 1, width_ - 1), j1 = std::min(j + 1, height_ - 1);
+    const float* row = values_ + static_cast<std::size_t>(j) * static_cast<std::size_t>(width_);
+    const float* row1 = values_ + static_cast<std::size_t>(j1) * static_cast<std::size_t>(width_);
+    const double a = row[i] + (row[i1] - row[i]) * fu;
+    const double b = row1[i] + (row1[i1] - row1[i]) * fu;
+    return static_cast<float>(a + (b - a) * fv);
+  }
+
+ private:
+  const float* values_ = nullptr;
+  double inv_ = 0.0, ox_ = 0.0, oy_ = 0.0, umax_ = 0.0, vmax_ = 0.0;
+  int imax_ = 0, jmax_ = 0, width_ = 0, height_ = 0;
+};
+
+}  // namespace detail
+
+float sample_bilinear(const Raster2D& r, double x_mm, double y_mm) noexcept { return detail::BilinearReader(r)(x_mm, y_mm); }
 
 namespace {
 
@@ -118,13 +163,9 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const TexelSpec& fi
   m->inv_texel_ = 1.0 / L;
   const std::size_t count = texture.texel_count();
   m->strip_mm_ = static_cast<double>(count) * L;
-  m->frequency_cpm_.reserve(count);
-  m->phase_cycles_.reserve(count);
+  m->texels_.reserve(2 * count);
   texture.for_each_texels([&](std::size_t, std::span<const Texel> run) {
-    for (const Texel& t : run) {
-      m->frequency_cpm_.push_back(t.frequency.value());
-      m->phase_cycles_.push_back(t.phase_cycles);
-    }
+    for (const Texel& t : run) m->texels_.insert(m->texels_.end(), {t.frequency.value(), t.phase_cycles});
   });
   return m;
 }
@@ -179,24 +220,87 @@ std::unique_ptr<const PlayerMap2D> PlayerMap2D::bitmap(Raster2D friction, std::o
   return m;
 }
 
+namespace detail {
+
+// A map's constants gathered once per block (the raster's, the texels', the
+// strengths and the frequency limit), then its value at the finger sample by
+// sample: what PlayerMap2D::value computes, in one pass, without tables (the
+// sine is detmath's: an exact reduction and one polynomial, the 1-D
+// renderer's) and without a division. Real-time safe.
+struct MapAtFinger {
+  MapAtFinger(const PlayerMap2D& m, double limit_hz) noexcept
+      : raster(m.raster_ ? &*m.raster_ : nullptr),
+        read(m.raster_ ? BilinearReader(*m.raster_) : BilinearReader()),
+        bitmap(m.kind_ == PlayerMap2D::Kind::bitmap),
+        texels(m.texels_.data()),
+        last(m.texels_.size() / 2 - 1),
+        strip(m.strip_mm_),
+        inv_texel(m.inv_texel_),
+        texel_mm(m.texel_mm_),
+        coarse(m.coarse_strength_),
+        fine_strength(m.fine_strength_),
+        limit(limit_hz) {}
+
+  // The index k of the texel under path length s_mm; `s` receives s_mm
+  // wrapped around the strip.
+  std::size_t texel_index(double s_mm, double& s) const noexcept {
+    // In the strip's first half (0 < s < strip/2, the quotient's floor is 0
+    // whatever the rounding) s_mm − 0·strip is s_mm: the same value without
+    // the division and the floor.
+    s = s_mm > 0.0 && s_mm < 0.5 * strip ? s_mm : s_mm - std::floor(s_mm / strip) * strip;
+    const auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel));
+    return std::min(k, last);
+  }
+
+  // The texel under path length s, wrapped around the strip: returns f_k and
+  // sets the phase argument φ_k + f_k·(s − k·L) of its oscillation, cycles.
+  double texel_at(double s_mm, double& cycles) const noexcept {
+    double s = 0.0;
+    const std::size_t k = texel_index(s_mm, s);
+    const double f = texels[2 * k];
+    cycles = texels[2 * k + 1] + f * (s - static_cast<double>(k) * texel_mm);
+    return f;
+  }
+
+  // The raster's cells at (x, y) and the texel at s into the cache.
+  void prefetch(double x_mm, double y_mm, double s_mm) const noexcept {
+    read.prefetch(x_mm, y_mm);
+    if (bitmap) return;
+    double s = 0.0;
+    __builtin_prefetch(texels + 2 * texel_index(s_mm, s));
+  }
+
+  // The fine oscillation at path length s, in [−1, 1], limited (docs/player.md §2).
+  double fine(double s_mm, double speed_mm_s) const noexcept {
+    double cycles = 0.0;
+    const double w = limit_weight(texel_at(s_mm, cycles) * std::fabs(speed_mm_s), limit);
+    if (w == 0.0) return 0.0;
+    return w * detmath::sin_cycles(cycles);
+  }
+
+  double value(double x_mm, double y_mm, double s_mm, double speed_mm_s) const noexcept {
+    if (bitmap) return std::clamp(static_cast<double>(read(x_mm, y_mm)), 0.0, 1.0);
+    const double c = raster ? static_cast<double>(read(x_mm, y_mm)) : 1.0;
+    const TexelMix mix = texel_mix(c, coarse, fine_strength);  // the 1-D rule, docs/algorithm.md §7
+    return mix.offset + mix.gain * fine(s_mm, speed_mm_s);
+  }
+
+  const Raster2D* raster;  // path-indexed: coarse profile (or none); bitmap: friction
+  BilinearReader read;
+  bool bitmap;
+  const double* texels;  // f_k, φ_k interleaved
+  std::size_t last;      // the last texel's index
+  double strip, inv_texel, texel_mm, coarse, fine_strength, limit;
+};
+
+}  // namespace detail
+
 double PlayerMap2D::fine(double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  // Wraps around the strip. In its first half (0 < s < strip/2, the
-  // quotient's floor is 0 whatever the rounding) s_mm − 0·strip is s_mm:
-  // the same value without the division and the floor.
-  const double s = s_mm > 0.0 && s_mm < 0.5 * strip_mm_ ? s_mm : s_mm - std::floor(s_mm / strip_mm_) * strip_mm_;
-  auto k = static_cast<std::size_t>(std::max(0.0, (s + TexelTexture::boundary_tolerance_mm) * inv_texel_));
-  k = std::min(k, frequency_cpm_.size() - 1);
-  const double f = frequency_cpm_[k];
-  const double w = limit_weight(f * std::fabs(speed_mm_s), limit_hz);
-  if (w == 0.0) return 0.0;
-  return w * std::sin(2.0 * std::numbers::pi * (phase_cycles_[k] + f * (s - static_cast<double>(k) * texel_mm_)));
+  return detail::MapAtFinger(*this, limit_hz).fine(s_mm, speed_mm_s);
 }
 
 double PlayerMap2D::value(double x_mm, double y_mm, double s_mm, double speed_mm_s, double limit_hz) const noexcept {
-  if (kind_ == Kind::bitmap) return std::clamp(static_cast<double>(sample_bilinear(*raster_, x_mm, y_mm)), 0.0, 1.0);
-  const double c = raster_ ? static_cast<double>(sample_bilinear(*raster_, x_mm, y_mm)) : 1.0;
-  const TexelMix mix = texel_mix(c, coarse_strength_, fine_strength_);  // the 1-D rule, docs/algorithm.md §7
-  return mix.offset + mix.gain * fine(s_mm, speed_mm_s, limit_hz);
+  return detail::MapAtFinger(*this, limit_hz).value(x_mm, y_mm, s_mm, speed_mm_s);
 }
 
 // ------------------------------------------------------------------- Player2D
@@ -241,7 +345,11 @@ bool Player2D::set_carrier(double hz) {
   return events_.try_push(Event{Event::Kind::carrier, {}, std::clamp(hz, 0.0, config_.rate_hz / 2)});
 }
 
-// Real-time safe, like Player::process.
+// Real-time safe, like Player::process. The maps' constants are gathered
+// once per block (detail::MapAtFinger); each sample is then one compact pass
+// (finger, value under it, output stage): on a real-time thread woken every
+// period the caches are cold, and a block's cost is the cache lines it
+// touches as much as its arithmetic.
 BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::span<float> y_mm,
                             std::span<float> path_mm) noexcept {
   BlockInfo info;
@@ -256,6 +364,15 @@ BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::sp
   // Felt frequencies are limited to the display's response limit, else to
   // 0.45·rate (below the drive's Nyquist).
   const double limit = stage_.limit_hz() > 0.0 ? stage_.limit_hz() : 0.45 * rate;
+  // The maps are fixed for the block (begin_block); the one fading out may
+  // only end its fade.
+  const PlayerMap2D* current = maps_.current();
+  const PlayerMap2D* fading = maps_.fading();
+  const std::optional<detail::MapAtFinger> now_at =
+      current ? std::optional<detail::MapAtFinger>(std::in_place, *current, limit) : std::nullopt;
+  const std::optional<detail::MapAtFinger> old_at =
+      fading ? std::optional<detail::MapAtFinger>(std::in_place, *fading, limit) : std::nullopt;
+  if (now_at) now_at->prefetch(last_x_, last_y_, last_s_);
   float peak = 0.0f;
   std::array<double, 3> p{};
   bool touching = false;
@@ -264,14 +381,14 @@ BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::sp
     const double tau = static_cast<double>(n_) / rate + config_.prediction_s;
     player_parts::take_events(events_, tau, finger_, stage_, smoothing);
     p = finger_.position(tau, player_parts::next_finger(events_), config_.extrapolate_s);
-    const PlayerMap2D* current = maps_.current();
     touching = finger_.touching() && (current == nullptr || current->on_surface(p[0], p[1]));
     // Path speed from consecutive output samples (s is piecewise linear in
     // time between finger samples, so this is exact within a segment).
     const double speed = have_s_ ? std::fabs(p[2] - last_s_) * rate : 0.0;
     last_s_ = p[2];
     have_s_ = touching;
-    const double a = maps_.value([&](const PlayerMap2D& m) -> double { return m.value(p[0], p[1], p[2], speed, limit); });
+    const double a = maps_.value(
+        [&](const PlayerMap2D& m) -> double { return (&m == current ? *now_at : *old_at).value(p[0], p[1], p[2], speed); });
     const auto yf = static_cast<float>(stage_.step(a, touching));
     out[i] = yf;
     if (x_mm.size() >= frames) x_mm[i] = static_cast<float>(p[0]);
@@ -281,6 +398,7 @@ BlockInfo Player2D::process(std::span<float> out, std::span<float> x_mm, std::sp
   }
   stage_.end_block();
   publish_samples(n_);
+  last_x_ = p[0], last_y_ = p[1];
 
   info.peak = peak;
   info.position_mm = p[0];

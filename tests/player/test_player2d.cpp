@@ -6,9 +6,12 @@
 
 #include "../support/log_centroid.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -273,6 +276,63 @@ TEST(Player2D, RasterFromNpyRowsAlongY) {
   EXPECT_THROW(parse_raster_npy(npy("(6,)", 6), "r.npy", Millimetres(0.5)), FormatError);
   EXPECT_THROW(parse_raster_npy(npy("(4, 3)", 6), "r.npy", Millimetres(0.5)), FormatError);  // data short
   EXPECT_THROW(parse_npy(npy("(2, 3)", 6), "r.npy"), FormatError);                           // the 1-D reader still wants 1-D
+}
+
+// The fine texture's sine is detmath's (docs/player.md §2): against the
+// C library's sin(2π·u) at the same texel and phase it differs by < 1e-14.
+TEST(Player2D, FineTextureMatchesTheCLibrarySine) {
+  TexelSpec spec;
+  spec.central_pitch = Decibels(15.0);
+  const Sampling s{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, {}};
+  constexpr double strip = 40.0;
+  const auto map = PlayerMap2D::path_indexed(spec, s, std::nullopt, wide, strip);
+  // The same texels as the map's (the 1-D renderer's, same seed).
+  TexelSpec texels = spec;
+  texels.coarse_strength = 0.0;
+  texels.fill = Fill::whole_texels;
+  const TexelTexture texture(texels, Millimetres(strip), s);
+  double worst = 0.0;
+  std::size_t checked = 0;
+  texture.for_each_texels([&](std::size_t, std::span<const Texel> run) {
+    for (const Texel& t : run)
+      for (double f : {0.1, 0.37, 0.5, 0.93}) {
+        const double at = t.start.value() + f * spec.texel_length.value();
+        const double u = t.phase_cycles + t.frequency.value() * (at - t.start.value());
+        worst = std::max(worst, std::fabs(map->fine(at, 0.0, 1e12) - std::sin(2.0 * std::numbers::pi * u)));
+        ++checked;
+      }
+  });
+  EXPECT_GT(checked, 400u);
+  EXPECT_LT(worst, 1e-14);
+}
+
+// process() in blocks of any length gives the same samples (the passes over
+// a block change no value): 1, 16, 64 and 100 frames (a chunk of 64 and one
+// of 36), path-indexed with a coarse raster and bitmap, every output mode.
+TEST(Player2D, OutputIsTheSameForEveryBlockLength) {
+  TexelSpec spec;
+  spec.coarse_strength = 0.5;
+  const Sampling s{Grid{Millimetres(0.0), Millimetres(0.0053), 19200}, {}};
+  const auto path = PlayerMap2D::path_indexed(spec, s, disc(10.0), std::nullopt);
+  const auto bitmap = PlayerMap2D::bitmap(disc(10.0));
+  Path2DConfig p;
+  p.shape = Path2DShape::circle;
+  p.radius_mm = 10.0;  // crosses the disc's edge
+  p.start_x_mm = 3.0;
+  p.duration_s = 0.1;
+  const auto trace = simulate_path_2d(p);
+  for (OutputMode mode : {OutputMode::vibration, OutputMode::carrier, OutputMode::amplitude})
+    for (const auto* map : {path.get(), bitmap.get()}) {
+      PlayerConfig c;
+      c.rate_hz = rate;
+      c.mode = mode;
+      c.carrier_hz = mode == OutputMode::carrier ? 200.0 : 0.0;
+      const auto one = render_trace_2d(*map, c, trace, 6000, nullptr, nullptr, 1);
+      for (std::size_t block : {16, 64, 100}) {
+        const auto out = render_trace_2d(*map, c, trace, 6000, nullptr, nullptr, block);
+        ASSERT_EQ(std::memcmp(one.data(), out.data(), one.size() * sizeof(float)), 0) << to_string(mode) << ", block " << block;
+      }
+    }
 }
 
 // process() allocates and frees nothing while another thread streams finger
