@@ -2,8 +2,24 @@
 // window of the friction map at a zoom's resolution), surface2d.scan (the map
 // scanned along a direction, beside the 1-D texture's spectrum), and the 2-D
 // feel pad's player: feel2d.select / feel2d.move / feel2d.state drive one
-// Player2D (path-indexed or bitmap) on a null backend of its own, the 1-D
-// Presenter's display staying as it is.
+// Player2D (path-indexed or bitmap); feel2d.raster hands the browser's "Hear
+// it" the bitmap at the device's resolution.
+//
+// The device. The studio's configured backend (`--backend audio|serial:PATH`)
+// is one device, and a Player takes one backend, a backend one player
+// (player.hpp "Lifetime"). The Presenter (Feel-it strip, participant screens)
+// owns it from the start; the 2-D pad borrows it when its finger touches
+// (feel2d.move with touch), and the Presenter takes it back when the Feel-it
+// strip is touched or a participant's stimulus is shown. A hand-over, under
+// the Presenter's feel_mutex: the player that lets go lifts its finger and
+// fades to silence (touch ramp, map crossfade) while its backend still runs,
+// then its backend is stopped and closed; only then is the device opened
+// again for the other (a serial display: HELLO and a blank map again; a
+// sound card: a new stream). The Presenter plays on a null backend while the
+// pad holds the device, so every 1-D message keeps working. With `--backend
+// null` nothing is shared: the pad has its own null backend, as before.
+// A serial display's own finger reports (protocol 1.1) are not read here:
+// the pad's pointer is the finger (docs/studio.md).
 //
 // Coarse images: the studio reads no file a client names. A document whose
 // coarse2d is an `image` sends the PNG's bytes with the message (`images`:
@@ -17,6 +33,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <thread>
 
 #include <unistd.h>
 
@@ -36,6 +53,9 @@ constexpr std::size_t max_images = 16;
 constexpr std::size_t max_raster_pixels = std::size_t{1} << 23;  // bitmap / coarse rasters of the 2-D player (32 MiB)
 constexpr double path_strip_mm = 10000.0;                        // the path-indexed player's strip (player2d.hpp)
 constexpr double finger_lead_s = 0.005;                          // as the 1-D presenter's external finger
+constexpr std::size_t max_hear_bytes = std::size_t{4} << 20;     // feel2d.raster: pixel bytes per reply (before base64)
+constexpr double handover_s = 0.035;                             // a Presenter's lift ramp and crossfade to silence, played out
+constexpr auto handover_limit = std::chrono::milliseconds(250);  // a stalled backend does not hold the hand-over longer
 
 /// A prepared 2-D document and the temporary directory its images live in.
 struct Prepared {
@@ -58,9 +78,9 @@ struct Surface2DState {
   std::string cache_key;
   std::shared_ptr<const Prepared> cache;
 
-  std::mutex feel_mutex;
+  // The pad's player, guarded by State::feel_mutex (the hand-over of the device needs both sides).
   std::unique_ptr<Player2D> player;  // created at the first feel2d.select
-  std::unique_ptr<Backend> backend;  // declared after the player: stopped first
+  std::unique_ptr<Backend> backend;  // declared after the player: stopped first; null while the Presenter has the device
   std::string mode;
   std::uint64_t finger_client = 0;
   double finger_x = 0.0, finger_y = 0.0, last_t = 0.0;
@@ -244,6 +264,119 @@ void on_surface2d_scan(State& s, Client& c, const Job& job) {
   send(c, r);
 }
 
+namespace {
+
+// ------------------------------------------------------------- the device
+
+/// The pad's player's configuration for the configured backend: as the
+/// Presenter plays it (serial: 1 kHz drive values; a sound card: 48 kHz
+/// vibration), null: 48 kHz amplitude as before.
+PlayerConfig player_config(const State& s) {
+  PlayerConfig config;
+  config.response_handling = s.presenter_options.response_handling;
+  config.response_limit_db = s.presenter_options.response_limit_db;
+  switch (parse_backend(s.options.backend).kind) {
+    case BackendChoice::Kind::serial:
+      config.rate_hz = 1000.0;  // presenter.cpp: a friction display takes amplitudes streamed as drive values
+      config.mode = OutputMode::amplitude;
+      break;
+    case BackendChoice::Kind::audio:
+      config.rate_hz = s.presenter_options.rate_hz;
+      config.mode = OutputMode::vibration;
+      break;
+    case BackendChoice::Kind::null: break;
+  }
+  return config;
+}
+
+/// Waits (at most handover_limit) until `done()`, looking every millisecond.
+template <typename F>
+void wait_until(F done) {
+  const auto end = Clock::now() + handover_limit;
+  while (!done() && Clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
+/// A copy of a Feel-it map (Presenter::show takes ownership).
+std::unique_ptr<const PlayerMap> copy_of(const PlayerMap& m) {
+  return std::make_unique<const PlayerMap>(m.grid(), std::vector<float>(m.values().begin(), m.values().end()), m.response());
+}
+
+/// The Presenter on the configured device again, showing the last Feel-it map.
+void reopen_presenter(State& s) {
+  s.presenter.reset();  // the null stand-in
+  try {
+    s.presenter = std::make_unique<experiment::Presenter>(s.presenter_options);
+    s.device_error.clear();
+  } catch (const std::exception& e) {
+    s.presenter = std::make_unique<experiment::Presenter>(presenter_options(s.options, true));
+    s.device_error = "cannot re-open the device " + s.options.backend + ": " + e.what();
+  }
+  if (s.feel_map) s.presenter->show(copy_of(*s.feel_map));
+}
+
+/// Caller holds feel_mutex. The pad's player plays on the configured device
+/// (see the banner); throws a Reject if the device cannot be opened.
+void device_to_pad(State& s, Surface2DState& st) {
+  if (!s.device_shared) {
+    if (!st.backend) {
+      st.backend = make_null_backend(st.player->config().rate_hz, s.presenter_options.block_frames);
+      st.backend->start(*st.player);
+    }
+    return;
+  }
+  if (s.feel2d_holds_device) return;
+  // The Presenter lifts its finger and fades to silence while its backend still runs, then lets go.
+  if (s.finger_down) {
+    (void)s.presenter->push_finger(s.finger_x, false);
+    s.finger_down = false;
+  }
+  s.presenter->blank();
+  const auto blocks = static_cast<std::uint64_t>(std::ceil(handover_s / s.presenter->block_period_s())) + 2;
+  const std::uint64_t b0 = s.presenter->stats().blocks;
+  wait_until([&] { return s.presenter->stats().blocks >= b0 + blocks || !s.presenter->error().empty(); });
+  s.presenter.reset();  // closes the device
+  s.presenter = std::make_unique<experiment::Presenter>(presenter_options(s.options, true));
+  try {
+    const BackendChoice choice = parse_backend(s.options.backend);
+    BackendOptions bo;
+    bo.rate_hz = st.player->config().rate_hz;
+    bo.block_frames = s.presenter_options.block_frames;
+    bo.audio_device = s.options.audio_device;
+    bo.stream = SerialStream::drive;
+    const PlayerMap blank(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
+    st.backend = make_backend(choice, bo, blank);
+    st.backend->start(*st.player);
+  } catch (const std::exception& e) {
+    st.backend.reset();
+    reopen_presenter(s);
+    throw Reject{"internal", "feel2d.move: cannot open the device " + s.options.backend + " for the 2-D pad: " + e.what()};
+  }
+  s.feel2d_holds_device = true;
+  s.device_error.clear();
+}
+
+}  // namespace
+
+void device_to_presenter(State& s) {
+  if (!s.feel2d_holds_device) return;
+  Surface2DState& st = *s.surface2d;
+  if (st.player && st.backend) {
+    // The pad's finger lifts (touch ramp) and the queued samples play out, then the backend lets go.
+    if (st.finger_down) {
+      const double t = std::max(st.last_t, st.player->time_s() + finger_lead_s);
+      if (st.player->push(FingerSample2D{t, st.finger_x, st.finger_y, false})) st.last_t = t;
+      st.finger_down = false;
+    }
+    const double until = st.last_t + st.player->config().touch_ramp_s + 0.002;
+    wait_until([&] { return st.player->time_s() >= until || !st.backend->error().empty(); });
+    st.backend->stop();
+    st.backend.reset();  // closes the device
+    st.player->collect();
+  }
+  s.feel2d_holds_device = false;
+  reopen_presenter(s);
+}
+
 void on_feel2d_select(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
   const std::string mode = f.string("mode", 16);
@@ -260,7 +393,8 @@ void on_feel2d_select(State& s, Client& c, const Job& job) {
   std::unique_ptr<const PlayerMap2D> map;
   try {
     if (mode == "bitmap") {
-      map = PlayerMap2D::bitmap(render_raster(*p->surface), p->doc.device.response);
+      // The whole bitmap at the device's resolution, quantised as its file stores it: what is felt never depends on the view.
+      map = PlayerMap2D::bitmap(device_raster(*p->surface), p->doc.device.response);
     } else {
       const TexelSpec& fine = p->doc.surface2d->regions[region].texel;
       const double texels = path_strip_mm / fine.texel_length.value();
@@ -277,13 +411,9 @@ void on_feel2d_select(State& s, Client& c, const Job& job) {
   const Extent2D extent = map->extent();
   auto* st = s.surface2d.get();
   {
-    std::lock_guard lock(st->feel_mutex);
-    if (!st->player) {
-      PlayerConfig config;  // 48 kHz amplitude output: the drive a friction display takes
-      st->player = std::make_unique<Player2D>(config);
-      st->backend = make_null_backend(config.rate_hz, 64);
-      st->backend->start(*st->player);
-    }
+    std::lock_guard lock(s.feel_mutex);
+    if (!st->player) st->player = std::make_unique<Player2D>(player_config(s));
+    if (!s.device_shared) device_to_pad(s, *st);  // null: its own backend at once, as before; a device: at the first touch
     st->player->set_map(std::move(map));
     st->player->collect();
     st->mode = mode;
@@ -304,12 +434,15 @@ void on_feel2d_move(State& s, Client& c, const Job& job) {
   auto* st = s.surface2d.get();
   double t = 0.0;
   {
-    std::lock_guard lock(st->feel_mutex);
+    std::lock_guard lock(s.feel_mutex);
     if (!st->player) throw Reject{"invalid", job.type + ": no 2-D map is playing; select one first (feel2d.select)"};
+    if (touch) device_to_pad(s, *st);  // a touch takes the device (see the banner)
     t = std::max(st->last_t, st->player->time_s() + finger_lead_s);
-    if (!st->player->push(FingerSample2D{t, x, y, touch}))
-      throw Reject{"busy", "the 2-D player's finger queue is full; send fewer positions"};
-    st->last_t = t;
+    if (st->backend) {  // a lift while the Presenter has the device: nothing to play
+      if (!st->player->push(FingerSample2D{t, x, y, touch}))
+        throw Reject{"busy", "the 2-D player's finger queue is full; send fewer positions"};
+      st->last_t = t;
+    }
     st->finger_client = c.id;
     st->finger_x = x;
     st->finger_y = y;
@@ -326,7 +459,7 @@ void on_feel2d_move(State& s, Client& c, const Job& job) {
 void on_feel2d_state(State& s, Client& c, const Job& job) {
   auto* st = s.surface2d.get();
   ojson r = reply("feel2d.state", job.id);
-  std::lock_guard lock(st->feel_mutex);
+  std::lock_guard lock(s.feel_mutex);
   const BackendStats b = st->backend ? st->backend->stats() : BackendStats{};
   r["mode"] = st->mode.empty() ? ojson(nullptr) : ojson(st->mode);
   r["samples"] = st->samples;
@@ -336,17 +469,67 @@ void on_feel2d_state(State& s, Client& c, const Job& job) {
   r["peak"] = b.peak;
   r["underruns"] = b.underruns;
   r["backend"] = st->backend ? st->backend->describe() : std::string();
+  // The configured device and whether the pad plays on it now (null: the pad's own null backend, always).
+  r["device"] = s.device_description;
+  r["holds_device"] = s.device_shared ? s.feel2d_holds_device : st->backend != nullptr;
+  std::string error = st->backend ? st->backend->error() : std::string();
+  if (error.empty()) error = s.device_error;
+  r["error"] = error;
+  send(c, r);
+}
+
+void on_feel2d_raster(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const auto p = prepared(s, f, job.type);
+  const BitmapGeometry& g = p->surface->geometry();
+  const std::size_t bytes_per_pixel = g.depth == 8 ? 1 : 2;
+  const std::size_t max_pixels = max_hear_bytes / bytes_per_pixel;
+  const auto all = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
+  Raster2D raster;
+  int x0 = 0, y0 = 0;
+  if (all <= max_pixels) {
+    raster = device_raster(*p->surface);
+  } else {
+    // Too large to send whole: the window asked for (the visible part), every device pixel, at most
+    // max_view_samples of them about its centre.
+    const int cx = static_cast<int>(f.integer("x_px", 0, g.width - 1) + f.integer("width_px", 1, 65535) / 2);
+    const int cy = static_cast<int>(f.integer("y_px", 0, g.height - 1) + f.integer("height_px", 1, 65535) / 2);
+    const int side = static_cast<int>(std::sqrt(static_cast<double>(std::min(max_pixels, max_view_samples))));
+    Surface2DWindow w;
+    w.width_px = std::min(side, g.width);
+    w.height_px = std::min(side, g.height);
+    w.x_px = std::clamp(cx - w.width_px / 2, 0, g.width - w.width_px);
+    w.y_px = std::clamp(cy - w.height_px / 2, 0, g.height - w.height_px);
+    raster = device_raster(*p->surface, w);
+    x0 = w.x_px;
+    y0 = w.y_px;
+  }
+  std::vector<unsigned char> bytes(raster.values.size() * bytes_per_pixel);
+  for (std::size_t i = 0; i < raster.values.size(); ++i) {
+    const std::uint16_t v = bitmap_pixel(raster.values[i], BitmapPolarity::darker_more_friction, g.depth);
+    bytes[i * bytes_per_pixel] = static_cast<unsigned char>(v & 0xff);
+    if (bytes_per_pixel == 2) bytes[i * 2 + 1] = static_cast<unsigned char>(v >> 8);
+  }
+  ojson r = reply("feel2d.raster", job.id);
+  r["x_px"] = x0;
+  r["y_px"] = y0;
+  r["width_px"] = raster.width;
+  r["height_px"] = raster.height;
+  r["pixel_pitch_mm"] = g.pitch.value();
+  r["depth_bits"] = g.depth;
+  r["whole"] = all <= max_pixels;
+  r["amplitude"] = base64_encode(std::span<const unsigned char>(bytes));
   send(c, r);
 }
 
 void lift_finger_2d(State& s, std::uint64_t client) {
   auto* st = s.surface2d.get();
-  std::lock_guard lock(st->feel_mutex);
-  if (st->player && st->finger_client == client && st->finger_down) {
+  std::lock_guard lock(s.feel_mutex);
+  if (st->player && st->backend && st->finger_client == client && st->finger_down) {
     const double t = std::max(st->last_t, st->player->time_s() + finger_lead_s);
     if (st->player->push(FingerSample2D{t, st->finger_x, st->finger_y, false})) st->last_t = t;
-    st->finger_down = false;
   }
+  if (st->finger_client == client) st->finger_down = false;
 }
 
 }  // namespace texel::studio::detail
