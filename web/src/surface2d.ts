@@ -246,7 +246,6 @@ export function mountSurface2d(root: HTMLElement): void {
           h('label', { class: 'inline', for: hear.id }, hear, ' Hear it (browser audio)'),
           h('div', { class: 'btn-row' }, clearPath),
           h('p', { class: 'hint' }, 'Player: ', playerText),
-          h('p', { class: 'hint' }, 'Device: ', deviceText),
         ),
         status,
       ),
@@ -254,6 +253,7 @@ export function mountSurface2d(root: HTMLElement): void {
         'div',
         { class: 'plots' },
         h('div', { class: 'btn-row map2d-bar' }, toolGroup, h('span', { class: 'zoom' }, zoomOut, zoomIn, zoomFit), scaleText),
+        h('p', { class: 'hint' }, 'The pad plays on: ', deviceText),
         view.el,
         h('h2', {}, 'Scan along a direction'),
         h('div', { class: 'ctl-row' }, h('label', { for: angle.id }, 'Direction (°, 0 = +x, towards +y)'), angle, angleNum),
@@ -503,8 +503,8 @@ export function mountSurface2d(root: HTMLElement): void {
         : 'no map selected yet';
       playerText.dataset.touching = String(st.touching);
       deviceText.textContent = st.holds_device
-        ? `the pad plays on ${st.backend}${st.underruns ? `, ${st.underruns} underruns` : ''}`
-        : `${st.device} (playing the 1-D Feel-it strip or a participant's stimulus; touch the pad to take it)`;
+        ? `${st.backend}${st.underruns ? `, ${st.underruns} underruns` : ''}`
+        : `${st.device}, not now: the 1-D Feel-it strip or a participant's stimulus has it; touch the pad to take it`;
       if (st.error) deviceText.textContent += ` — ${st.error}`;
       deviceText.dataset.holds = String(st.holds_device);
       if (__TEXEL_TEST_HOOKS__) hooks.device = { holds: st.holds_device, backend: st.backend, device: st.device };
