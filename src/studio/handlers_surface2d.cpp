@@ -27,6 +27,8 @@
 // that lives as long as the prepared surface (the library loads images by
 // path), and any other path is refused.
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -41,6 +43,7 @@
 #include "messages.hpp"
 #include "texel/error.hpp"
 #include "texel/player2d.hpp"
+#include "texel/serial_link.hpp"
 #include "texel/sinks.hpp"
 #include "texel/studio/surface2d_view.hpp"
 #include "texel/surface2d.hpp"
@@ -56,6 +59,8 @@ constexpr double finger_lead_s = 0.005;                          // as the 1-D p
 constexpr std::size_t max_hear_bytes = std::size_t{4} << 20;     // feel2d.raster: pixel bytes per reply (before base64)
 constexpr double handover_s = 0.035;                             // a Presenter's lift ramp and crossfade to silence, played out
 constexpr auto handover_limit = std::chrono::milliseconds(250);  // a stalled backend does not hold the hand-over longer
+constexpr std::uint32_t report_interval_us = 1000;               // a sensing display's finger reports: 1 kHz
+constexpr std::size_t max_trail = 512;                           // display finger positions kept between two feel2d.state
 
 /// A prepared 2-D document and the temporary directory its images live in.
 struct Prepared {
@@ -86,6 +91,30 @@ struct Surface2DState {
   double finger_x = 0.0, finger_y = 0.0, last_t = 0.0;
   bool finger_down = false;
   std::uint64_t samples = 0;
+
+  // A serial display's own finger (protocol 1.1): while the pad holds a display
+  // that reports it, a reader thread places each report on the player's clock
+  // and pushes it (under State::feel_mutex), and the pad only shows it.
+  bool display_finger = false;
+  std::thread reader;
+  std::atomic<bool> reader_stop{false};
+  std::uint64_t reports = 0;                // pushed so far
+  double display_x = 0.0, display_y = 0.0;  // the newest report
+  bool display_touch = false;
+  std::vector<std::array<double, 3>> trail;  // reports since the last feel2d.state: x, y, touch (bounded)
+  std::mutex reader_error_mutex;             // not feel_mutex: its holder may be joining the reader
+  std::string reader_error;
+
+  Surface2DState() = default;
+  Surface2DState(const Surface2DState&) = delete;
+  Surface2DState& operator=(const Surface2DState&) = delete;
+  ~Surface2DState() { stop_reader(); }
+  /// Stops the reader thread (the caller may hold feel_mutex: the reader never waits on it).
+  void stop_reader() {
+    reader_stop = true;
+    if (reader.joinable()) reader.join();
+    reader_stop = false;
+  }
 };
 
 std::shared_ptr<Surface2DState> make_surface2d_state() { return std::make_shared<Surface2DState>(); }
@@ -314,6 +343,53 @@ void reopen_presenter(State& s) {
   if (s.feel_map) s.presenter->show(copy_of(*s.feel_map));
 }
 
+/// A serial display with a finger sensor starts reporting it (true); one
+/// without says no_sensor (false: the pad's pointer is the finger).
+bool asks_for_reports(SerialLink* link) {
+  if (!link) return false;
+  try {
+    link->start_reports(report_interval_us);
+    return true;
+  } catch (const SerialError& e) {
+    if (e.code == serial::ErrorCode::no_sensor || e.code == serial::ErrorCode::unknown_type) return false;
+    throw;
+  }
+}
+
+/// The display's finger reports → the pad's player, until stop_reader().
+void start_reader(State& s, Surface2DState& st) {
+  SerialLink* link = st.backend->serial_link();
+  st.reader = std::thread([&s, &st, link] {
+    std::array<FingerReport, 64> buf;
+    ReportTimeline timeline;
+    try {
+      while (!st.reader_stop) {
+        const std::size_t n = link->read_reports(buf, 5);
+        if (n == 0) continue;
+        // Whoever holds feel_mutex may be stopping this thread: never block on it.
+        std::unique_lock lock(s.feel_mutex, std::defer_lock);
+        while (!st.reader_stop && !lock.try_lock()) std::this_thread::sleep_for(std::chrono::microseconds(100));
+        if (st.reader_stop) break;
+        for (std::size_t i = 0; i < n; ++i) {
+          const FingerReport& r = buf[i];
+          const double t = std::max(st.last_t, timeline.place(r.t_us, st.player->time_s()));
+          if (!st.player->push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) continue;  // full: the next report follows
+          st.last_t = t;
+          ++st.reports;
+          st.display_x = r.x_mm;
+          st.display_y = r.y_mm;
+          st.display_touch = r.touch;
+          if (st.trail.size() < max_trail) st.trail.push_back({r.x_mm, r.y_mm, r.touch ? 1.0 : 0.0});
+        }
+        st.player->collect();
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(st.reader_error_mutex);  // the link is gone
+      st.reader_error = e.what();
+    }
+  });
+}
+
 /// Caller holds feel_mutex. The pad's player plays on the configured device
 /// (see the banner); throws a Reject if the device cannot be opened.
 void device_to_pad(State& s, Surface2DState& st) {
@@ -345,8 +421,12 @@ void device_to_pad(State& s, Surface2DState& st) {
     bo.stream = SerialStream::drive;
     const PlayerMap blank(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
     st.backend = make_backend(choice, bo, blank);
+    st.display_finger = asks_for_reports(st.backend->serial_link());
     st.backend->start(*st.player);
+    if (st.display_finger) start_reader(s, st);
   } catch (const std::exception& e) {
+    st.stop_reader();
+    st.display_finger = false;
     st.backend.reset();
     reopen_presenter(s);
     throw Reject{"internal", "feel2d.move: cannot open the device " + s.options.backend + " for the 2-D pad: " + e.what()};
@@ -361,6 +441,18 @@ void device_to_presenter(State& s) {
   if (!s.feel2d_holds_device) return;
   Surface2DState& st = *s.surface2d;
   if (st.player && st.backend) {
+    if (st.display_finger) {
+      st.stop_reader();
+      try {
+        st.backend->serial_link()->start_reports(0);  // the display stops reporting
+      } catch (const std::exception&) {
+        // Already gone: nothing to stop.
+      }
+      st.display_finger = false;
+      st.finger_down = st.display_touch;
+      st.finger_x = st.display_x;
+      st.finger_y = st.display_y;
+    }
     // The pad's finger lifts (touch ramp) and the queued samples play out, then the backend lets go.
     if (st.finger_down) {
       const double t = std::max(st.last_t, st.player->time_s() + finger_lead_s);
@@ -438,6 +530,13 @@ void on_feel2d_move(State& s, Client& c, const Job& job) {
     if (!st->player) throw Reject{"invalid", job.type + ": no 2-D map is playing; select one first (feel2d.select)"};
     if (touch) device_to_pad(s, *st);  // a touch takes the device (see the banner)
     t = std::max(st->last_t, st->player->time_s() + finger_lead_s);
+    if (st->display_finger) {  // the display's own finger drives the player; the pad only shows it
+      ojson r = reply("feel2d.ack", job.id);
+      r["seq"] = seq;
+      r["t_s"] = st->last_t;
+      send(c, r);
+      return;
+    }
     if (st->backend) {  // a lift while the Presenter has the device: nothing to play
       if (!st->player->push(FingerSample2D{t, x, y, touch}))
         throw Reject{"busy", "the 2-D player's finger queue is full; send fewer positions"};
@@ -474,7 +573,21 @@ void on_feel2d_state(State& s, Client& c, const Job& job) {
   r["holds_device"] = s.device_shared ? s.feel2d_holds_device : st->backend != nullptr;
   std::string error = st->backend ? st->backend->error() : std::string();
   if (error.empty()) error = s.device_error;
+  if (error.empty()) {
+    std::lock_guard error_lock(st->reader_error_mutex);
+    error = st->reader_error;
+  }
   r["error"] = error;
+  // Who moves the finger: the pad's pointer, or the display's own sensor (its reports since the last state).
+  r["finger"] = st->display_finger ? "display" : "pad";
+  if (st->display_finger) {
+    r["y_mm"] = st->display_y;
+    r["reports"] = st->reports;
+    ojson trail = ojson::array();
+    for (const auto& p : st->trail) trail.push_back({p[0], p[1], p[2] != 0.0});
+    r["trail"] = std::move(trail);
+    st->trail.clear();
+  }
   send(c, r);
 }
 
@@ -525,7 +638,7 @@ void on_feel2d_raster(State& s, Client& c, const Job& job) {
 void lift_finger_2d(State& s, std::uint64_t client) {
   auto* st = s.surface2d.get();
   std::lock_guard lock(s.feel_mutex);
-  if (st->player && st->backend && st->finger_client == client && st->finger_down) {
+  if (st->player && st->backend && !st->display_finger && st->finger_client == client && st->finger_down) {
     const double t = std::max(st->last_t, st->player->time_s() + finger_lead_s);
     if (st->player->push(FingerSample2D{t, st->finger_x, st->finger_y, false})) st->last_t = t;
   }

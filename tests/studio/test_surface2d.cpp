@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -274,12 +275,14 @@ struct DisplayRig {
   std::unique_ptr<texel::controller::Controller<32768, 2>> ctl;
   std::atomic<bool> stop{false};
   std::thread thread;
-  DisplayRig() {
+  /// `sensor_2d`: the display's own finger sensor (none: positions come from the host).
+  explicit DisplayRig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
     char name[256];
     if (openpty(&master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
     path = name;
     texel::controller::make_raw(slave);
     hal = std::make_unique<texel::controller::HostHal>(master);
+    hal->sensor_2d = std::move(sensor_2d);
     ctl = std::make_unique<texel::controller::Controller<32768, 2>>(*hal, texel::controller::Info{});
     thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
   }
@@ -420,4 +423,49 @@ TEST(Surface2DStudio, HearItGetsTheBitmapAtTheDevicesResolution) {
   EXPECT_EQ(raster.width, 400);
   EXPECT_DOUBLE_EQ(raster.pitch.value(), 0.1);
   EXPECT_NEAR(raster.values[1234] * 255.0, std::round(raster.values[1234] * 255.0), 1e-3);
+}
+
+TEST(Surface2DStudio, ADisplaysOwnFingerDrivesThePadsPlayerAndThePadShowsIt) {
+  // The finger circles (8 mm about the disc's centre, (20, 15) mm) twice a second, lifted for a tenth of each turn.
+  texel::controller::HostHal* hal = nullptr;
+  DisplayRig rig([&hal](std::int32_t& x, std::int32_t& y, bool& touch) {
+    const double t = hal ? hal->micros() * 1e-6 : 0.0;
+    const double turn = 2.0 * t - std::floor(2.0 * t);
+    x = static_cast<std::int32_t>(std::lround((20.0 + 8.0 * std::cos(2 * M_PI * turn)) * 1e6));
+    y = static_cast<std::int32_t>(std::lround((15.0 + 8.0 * std::sin(2 * M_PI * turn)) * 1e6));
+    touch = turn < 0.9;
+    return true;
+  });
+  hal = rig.hal.get();
+  ServiceOptions o;
+  o.backend = "serial:" + rig.path;
+  Service s(o);
+  Client c(s);
+  ASSERT_EQ(c.ask({{"type", "feel2d.select"}, {"document", surface_document()}, {"mode", "bitmap"}})["type"], "feel2d.selected");
+  EXPECT_EQ(c.ask({{"type", "feel2d.state"}})["finger"], "pad");
+  // A touch on the pad gives the 2-D player the display; from then on the display's finger drives it.
+  ASSERT_EQ(c.ask({{"type", "feel2d.move"}, {"seq", 1}, {"x_mm", 2}, {"y_mm", 2}, {"touch", true}})["type"], "feel2d.ack");
+  DriveRecorder drive(*rig.hal);
+  std::this_thread::sleep_for(400ms);
+  for (int i = 2; i < 20; ++i)
+    c.ask({{"type", "feel2d.move"}, {"seq", i}, {"x_mm", 2}, {"y_mm", 2}, {"touch", true}});  // shown, not played
+  const json st = c.ask({{"type", "feel2d.state"}});
+  const auto values = drive.finish();
+  EXPECT_EQ(st["finger"], "display") << st.dump().substr(0, 400);
+  EXPECT_TRUE(st["holds_device"].get<bool>());
+  EXPECT_EQ(st["error"], "");
+  EXPECT_GT(st["reports"].get<int>(), 200) << "about 1 kHz of reports";
+  ASSERT_GT(st["trail"].size(), 100u);
+  int on_circle = 0;
+  for (const json& p : st["trail"])
+    on_circle += std::abs(std::hypot(p[0].get<double>() - 20.0, p[1].get<double>() - 15.0) - 8.0) < 0.01;
+  EXPECT_EQ(on_circle, static_cast<int>(st["trail"].size())) << "the pad is shown the display's finger";
+  EXPECT_GT(largest(values), 65535 / 20) << "the display's finger on the map drives the display";
+  EXPECT_EQ(st["samples"].get<int>(), 0) << "the pad's own samples are not played meanwhile";
+  // The Feel-it strip takes the display back: it stops reporting, and the pad's pointer is the finger again.
+  c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 10}, {"touch", true}});
+  const json back = c.ask({{"type", "feel2d.state"}});
+  EXPECT_EQ(back["finger"], "pad");
+  EXPECT_FALSE(back["holds_device"].get<bool>());
+  EXPECT_EQ(c.ask({{"type", "feel.state"}})["error"], "");
 }
