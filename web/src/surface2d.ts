@@ -502,6 +502,10 @@ export function mountSurface2d(root: HTMLElement): void {
         ? `${st.mode === 'path' ? 'path-indexed' : 'bitmap'}, ${st.samples} finger samples, x ${fmt(st.x_mm, 1)} mm${st.touching ? ' (touching)' : ''}, peak drive ${fmt(st.peak, 3)}`
         : 'no map selected yet';
       playerText.dataset.touching = String(st.touching);
+      if (st.finger === 'display') {
+        playerText.textContent += ` · the finger is the display's own sensor (${st.reports ?? 0} reports; the pad only shows it)`;
+        if (st.trail?.length) view.displayFinger(st.trail as [number, number, boolean][]);
+      }
       deviceText.textContent = st.holds_device
         ? `${st.backend}${st.underruns ? `, ${st.underruns} underruns` : ''}`
         : `${st.device}, not now: the 1-D Feel-it strip or a participant's stimulus has it; touch the pad to take it`;
@@ -844,6 +848,23 @@ class MapView {
     this.draw();
   }
 
+  private displayDown = false;
+  /** A serial display's own finger (its reports, [x, y, touch]): drawn as a path of its own (violet), the newest 20,000 points. */
+  displayFinger(trail: [number, number, boolean][]): void {
+    for (const [x, y, touch] of trail) {
+      if (!touch) {
+        this.displayDown = false;
+        continue;
+      }
+      if (!this.displayDown) this.strokes.push({ pts: [], type: 'display' });
+      this.displayDown = true;
+      this.strokes[this.strokes.length - 1].pts.push([x, y]);
+    }
+    let n = this.strokes.reduce((a, s) => a + s.pts.length, 0);
+    while (n > 20000 && this.strokes.length > 1) n -= this.strokes.shift()!.pts.length;
+    this.drawOverlay();
+  }
+
   draw(): void {
     const dpr = devicePixelRatio || 1;
     const ctx = this.image.getContext('2d')!;
@@ -888,7 +909,7 @@ class MapView {
     ctx.lineCap = 'round';
     ctx.lineJoin = 'round';
     for (const s of this.strokes) {
-      ctx.strokeStyle = s.type === 'pen' ? '#d6336c' : s.type === 'touch' ? '#2f9e44' : '#f76707';
+      ctx.strokeStyle = s.type === 'pen' ? '#d6336c' : s.type === 'touch' ? '#2f9e44' : s.type === 'display' ? '#7048e8' : '#f76707';
       ctx.lineWidth = 3;
       ctx.beginPath();
       s.pts.forEach((p, i) => (i ? ctx.lineTo(...this.toScreen(...p)) : ctx.moveTo(...this.toScreen(...p))));
