@@ -7,7 +7,6 @@
 // configured backend and hands the device over to and from the 1-D Feel-it
 // strip without a click.
 #include <gtest/gtest.h>
-#include <pty.h>
 
 #include <algorithm>
 #include <atomic>
@@ -19,12 +18,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/display_rig.hpp"
 #include "../support/service_client.hpp"
 #include "../support/temp_dir.hpp"
 #include "base64.hpp"
 #include "texel/bitmap_file.hpp"
-#include "texel/controller/controller.hpp"
-#include "texel/controller/host_hal.hpp"
 #include "texel/document.hpp"
 #include "texel/studio/service.hpp"
 #include "texel/studio/surface2d_view.hpp"
@@ -266,32 +264,7 @@ TEST(Surface2DStudio, PadSamplesReachThe2DPlayerInBothModes) {
 
 namespace {
 
-/// The reference controller on the master side of a pty, as
-/// `texel controller --pty` runs it (tests/controller has the same rig).
-struct DisplayRig {
-  int master = -1, slave = -1;
-  std::string path;
-  std::unique_ptr<texel::controller::HostHal> hal;
-  std::unique_ptr<texel::controller::Controller<32768, 2>> ctl;
-  std::atomic<bool> stop{false};
-  std::thread thread;
-  /// `sensor_2d`: the display's own finger sensor (none: positions come from the host).
-  explicit DisplayRig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
-    char name[256];
-    if (openpty(&master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
-    path = name;
-    texel::controller::make_raw(slave);
-    hal = std::make_unique<texel::controller::HostHal>(master);
-    hal->sensor_2d = std::move(sensor_2d);
-    ctl = std::make_unique<texel::controller::Controller<32768, 2>>(*hal, texel::controller::Info{});
-    thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
-  }
-  ~DisplayRig() {
-    stop = true;
-    thread.join();
-    ::close(slave);
-  }
-};
+using texel::test_support::DisplayRig;
 
 /// Records the display's drive value every 0.2 ms while it lives.
 struct DriveRecorder {
