@@ -103,6 +103,7 @@ const ex::Question& current_question(const State& s, const Fields& f, const std:
 
 void show_stimulus(State& s, const std::string& document_json_text) {
   std::lock_guard lock(s.feel_mutex);
+  device_to_presenter(s);  // a participant's stimulus takes the device back from the 2-D pad
   s.presenter->show(document_json_text);
 }
 

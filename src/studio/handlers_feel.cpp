@@ -1,19 +1,34 @@
 // "Feel it" messages: the one Presenter (external finger) shared by all
 // clients. feel.select swaps a document's map in (design lane, latest wins);
-// feel.move and feel.state are answered before handle() returns.
+// feel.move and feel.state are answered before handle() returns. Selecting a
+// map or touching the strip takes the configured device back from the 2-D
+// pad (device_to_presenter, handlers_surface2d.cpp).
 #include "messages.hpp"
 #include "texel/player.hpp"
 
 namespace texel::studio::detail {
+
+experiment::PresenterOptions presenter_options(const ServiceOptions& o, bool null_backend) {
+  experiment::PresenterOptions po;
+  po.backend = null_backend ? "null" : o.backend;
+  po.audio_device = o.audio_device;
+  po.finger = experiment::FingerSource::external;
+  po.response_handling = parse_response_handling(o.response, "response");
+  return po;
+}
 
 void on_feel_select(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
   // Rendered here, outside feel_mutex: finger samples keep flowing meanwhile.
   // The map carries the document's device response (presenter.hpp).
   auto map = PlayerMap::from_document(document_of(s, f.object("document"), "document"));
+  auto kept = std::make_unique<const PlayerMap>(map->grid(), std::vector<float>(map->values().begin(), map->values().end()),
+                                                map->response());
   {
     std::lock_guard lock(s.feel_mutex);
+    device_to_presenter(s);
     s.presenter->show(std::move(map));
+    s.feel_map = std::move(kept);
   }
   send(c, reply("feel.selected", job.id));
 }
@@ -26,6 +41,7 @@ void on_feel_move(State& s, Client& c, const Job& job) {
   std::optional<FingerSample> sample;
   {
     std::lock_guard lock(s.feel_mutex);
+    if (touch) device_to_presenter(s);
     sample = s.presenter->push_finger(x, touch);
     if (sample) {
       s.finger_client = c.id;
@@ -51,6 +67,8 @@ void on_feel_state(State& s, Client& c, const Job& job) {
     st = s.presenter->stats();
     backend = s.presenter->describe();
     error = s.presenter->error();
+    if (error.empty()) error = s.device_error;
+    if (s.feel2d_holds_device) backend = s.device_description + " (playing the 2-D pad; touch the strip to take it back)";
   }
   ojson r = reply("feel.state", job.id);
   r["position_mm"] = st.position_mm;

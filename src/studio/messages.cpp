@@ -14,7 +14,7 @@ namespace texel::studio::detail {
 namespace {
 
 // The order is the one error messages list ("unknown message type …; allowed: …").
-const std::array<MessageSpec, 27> table{{
+const std::array<MessageSpec, 28> table{{
     {"hello", Lane::now, {}, on_hello},
     {"design", Lane::design, {"document", "region", "bins"}, on_design},
     {"match", Lane::fifo, {"document", "region", "into"}, on_match},
@@ -45,6 +45,7 @@ const std::array<MessageSpec, 27> table{{
     {"feel2d.select", Lane::design, {"document", "images", "mode", "region"}, on_feel2d_select},
     {"feel2d.move", Lane::now, {"seq", "x_mm", "y_mm", "touch"}, on_feel2d_move},
     {"feel2d.state", Lane::now, {}, on_feel2d_state},
+    {"feel2d.raster", Lane::design, {"document", "images", "x_px", "y_px", "width_px", "height_px"}, on_feel2d_raster},
 }};
 
 std::string num(double v) {

@@ -30,6 +30,7 @@
 #include "texel/experiment/presenter.hpp"
 #include "texel/experiment/runner.hpp"
 #include "texel/finger.hpp"
+#include "texel/player.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/studio/handler.hpp"
 #include "texel/studio/service.hpp"
@@ -109,7 +110,16 @@ struct State {
 
   std::mutex feel_mutex;
   std::unique_ptr<experiment::Presenter> presenter;
-  std::uint64_t finger_client = 0;  // who touched last (lifted on disconnect)
+  // The configured backend is one device, played by the Presenter (Feel-it
+  // strip, participant screens) or by the 2-D pad's player, never both
+  // (handlers_surface2d.cpp "The device"). Guarded by feel_mutex.
+  experiment::PresenterOptions presenter_options;  // the configured device's
+  bool device_shared = false;                      // not null: the 2-D pad borrows the device
+  bool feel2d_holds_device = false;                // the Presenter runs on a null backend meanwhile
+  std::string device_description;                  // the configured backend, as opened at start
+  std::string device_error;                        // the device could not be re-opened at a hand-over
+  std::unique_ptr<const PlayerMap> feel_map;       // the last Feel-it map, shown again when the device comes back
+  std::uint64_t finger_client = 0;                 // who touched last (lifted on disconnect)
   double finger_x = 0.0;
   bool finger_down = false;
   std::vector<FingerSample> trace;  // finger samples of the current trial (swipe measures)
@@ -147,6 +157,13 @@ ojson make_hello(const State& s);
 void lift_finger(State& s, std::uint64_t client);
 /// The same for the 2-D pad's player.
 void lift_finger_2d(State& s, std::uint64_t client);
+/// Caller holds feel_mutex: if the 2-D pad plays on the configured device,
+/// ramps it out and gives the device back to the Presenter (which shows the
+/// last Feel-it map again). Never throws: a device that cannot be re-opened
+/// leaves the Presenter on a null backend and says why in device_error.
+void device_to_presenter(State& s);
+/// The Presenter's options for the configured device (or a null backend in its place).
+experiment::PresenterOptions presenter_options(const ServiceOptions& o, bool null_backend = false);
 
 // -------------------------------------------------------------------- table
 /// When a message is handled: before handle() returns; on the design lane
@@ -197,5 +214,6 @@ void on_surface2d_scan(State&, Client&, const Job&);
 void on_feel2d_select(State&, Client&, const Job&);
 void on_feel2d_move(State&, Client&, const Job&);
 void on_feel2d_state(State&, Client&, const Job&);
+void on_feel2d_raster(State&, Client&, const Job&);
 
 }  // namespace texel::studio::detail

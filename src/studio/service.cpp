@@ -123,12 +123,10 @@ struct Service::Impl {
       throw InvalidArgument("max_message_bytes is " + std::to_string(options.max_message_bytes) + "; allowed: 1024 … 2^30");
     if (!(options.max_messages_per_s >= 1 && options.max_messages_per_s <= 1e6))
       throw InvalidArgument("max_messages_per_s is " + std::to_string(options.max_messages_per_s) + "; allowed: 1 … 1e6");
-    experiment::PresenterOptions po;
-    po.backend = options.backend;
-    po.audio_device = options.audio_device;
-    po.finger = experiment::FingerSource::external;
-    po.response_handling = parse_response_handling(options.response, "response");
-    state.presenter = std::make_unique<experiment::Presenter>(po);
+    state.presenter_options = presenter_options(options);
+    state.presenter = std::make_unique<experiment::Presenter>(state.presenter_options);
+    state.device_shared = parse_backend(options.backend).kind != BackendChoice::Kind::null;
+    state.device_description = state.presenter->describe();
     state.hello = make_hello(state);
     state.broadcast = [this](const std::function<ojson(bool)>& make, std::uint64_t except) { broadcast(make, except); };
     design_worker = std::thread([this] { run_design_lane(); });
@@ -144,6 +142,7 @@ struct Service::Impl {
     design_worker.join();
     fifo_worker.join();
     state.active.reset();  // releases the writer lock: the session stays resumable
+    std::lock_guard lock(state.feel_mutex);
     state.presenter->stop();
   }
 

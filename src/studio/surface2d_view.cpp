@@ -21,6 +21,30 @@ bool inside(double v, double lo, double hi) { return v + 1e-9 >= lo && v + 1e-9 
 
 }  // namespace
 
+Raster2D device_raster(const Surface2D& surface, const Surface2DWindow& window) {
+  const BitmapGeometry& g = surface.geometry();
+  Raster2D r;
+  if (window.width_px == 0) {
+    r = render_raster(surface);
+  } else {
+    Surface2DWindow w = window;
+    w.stride = 1;
+    Surface2DView v = surface2d_view(surface, w);
+    r.width = v.columns;
+    r.height = v.rows;
+    r.pitch = g.pitch;
+    r.origin_x = Millimetres(v.window.x_px * g.pitch.value());
+    r.origin_y = Millimetres(v.window.y_px * g.pitch.value());
+    r.values = std::move(v.amplitude);
+  }
+  const double full = g.depth == 8 ? 255.0 : 65535.0;
+  for (float& a : r.values) {
+    const double level = bitmap_pixel(a, g.polarity, g.depth) / full;
+    a = static_cast<float>(g.polarity == BitmapPolarity::brighter_more_friction ? 1.0 - level : level);
+  }
+  return r;
+}
+
 Surface2DView surface2d_view(const Surface2D& surface, const Surface2DWindow& window) {
   const BitmapGeometry& g = surface.geometry();
   const Surface2DWindow& w = window;

@@ -18,6 +18,7 @@
 #include <pty.h>
 #include <unistd.h>
 
+#include "../support/display_rig.hpp"
 #include "texel/controller/controller.hpp"
 #include "texel/controller/host_hal.hpp"
 #include "texel/player.hpp"
@@ -105,39 +106,7 @@ TEST(Protocol, DecoderSurvivesRandomBytes) {
 
 namespace {
 
-using SmallController = controller::Controller<32768, 2>;
-
-/// A controller running on its own thread on the master side of a pty; the
-/// host talks to the slave side by path, as `texel play --backend serial:PATH` does.
-struct Rig {
-  int master = -1;
-  int slave = -1;
-  std::string path;
-  std::unique_ptr<controller::HostHal> hal;
-  std::unique_ptr<SmallController> ctl;
-  std::atomic<bool> stop{false};
-  std::thread thread;
-
-  /// `sensor_2d`: the display's own 2-D finger sensor (none: positions from the host).
-  explicit Rig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
-    char name[256];
-    if (openpty(&master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
-    path = name;
-    controller::make_raw(slave);
-    hal = std::make_unique<controller::HostHal>(master);
-    hal->sensor_2d = std::move(sensor_2d);
-    ctl = std::make_unique<SmallController>(*hal, controller::Info{});
-    thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
-  }
-  ~Rig() {
-    halt();
-    if (slave >= 0) ::close(slave);
-  }
-  void halt() {
-    stop = true;
-    if (thread.joinable()) thread.join();
-  }
-};
+using Rig = test_support::DisplayRig;  // the controller on a pty, on its own thread
 
 std::vector<float> ramp_map(std::size_t n) {
   std::vector<float> v(n);

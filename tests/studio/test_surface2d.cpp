@@ -2,16 +2,23 @@
 // page"): surface2d.view renders exactly the bitmap's pixels at any stride,
 // surface2d.scan gives a scan spectrum beside the 1-D texture's, the 2-D pad's
 // finger samples reach the Player2D in both modes, coarse images come only as
-// bytes sent along, and every bad input gets a one-line error.
+// bytes sent along, and every bad input gets a one-line error. With a serial
+// display (the reference controller on a pty), the pad plays on the studio's
+// configured backend and hands the device over to and from the 1-D Feel-it
+// strip without a click.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "../support/display_rig.hpp"
 #include "../support/service_client.hpp"
 #include "../support/temp_dir.hpp"
 #include "base64.hpp"
@@ -253,4 +260,185 @@ TEST(Surface2DStudio, PadSamplesReachThe2DPlayerInBothModes) {
   Client d(s);
   std::this_thread::sleep_for(60ms);
   EXPECT_FALSE(d.ask({{"type", "feel2d.state"}})["touching"].get<bool>());
+}
+
+namespace {
+
+using texel::test_support::DisplayRig;
+
+/// Records the display's drive value every 0.2 ms while it lives.
+struct DriveRecorder {
+  std::atomic<bool> stop{false};
+  std::vector<std::uint16_t> values;
+  std::thread thread;
+  explicit DriveRecorder(texel::controller::HostHal& hal) {
+    values.reserve(1 << 16);
+    thread = std::thread([this, &hal] {
+      while (!stop && values.size() < (1u << 16)) {
+        values.push_back(hal.amplitude.load());
+        std::this_thread::sleep_for(200us);
+      }
+    });
+  }
+  std::vector<std::uint16_t> finish() {
+    stop = true;
+    thread.join();
+    return values;
+  }
+};
+
+std::uint16_t largest(const std::vector<std::uint16_t>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+int largest_drop(const std::vector<std::uint16_t>& v) {
+  int d = 0;
+  for (std::size_t i = 1; i < v.size(); ++i) d = std::max(d, static_cast<int>(v[i - 1]) - static_cast<int>(v[i]));
+  return d;
+}
+
+}  // namespace
+
+TEST(Surface2DStudio, PadPlaysOnTheStudiosSerialDisplayAndHandsItOver) {
+  DisplayRig rig;
+  ServiceOptions o;
+  o.backend = "serial:" + rig.path;
+  Service s(o);
+  Client c(s);
+  const json one_d = {
+      {"format", "texel-document"},
+      {"version", 1},
+      {"device", "tpad"},
+      {"texture",
+       {{"kind", "texel"}, {"central_pitch_db", 10}, {"irregularity_db", -5}, {"texel_length_mm", 0.25}, {"seed", 1}}}};
+  const json sel1 = c.ask({{"type", "feel.select"}, {"document", one_d}});
+  ASSERT_EQ(sel1["type"], "feel.selected") << sel1.dump();
+  ASSERT_EQ(c.ask({{"type", "feel2d.select"}, {"document", surface_document()}, {"mode", "bitmap"}})["type"], "feel2d.selected");
+  json st = c.ask({{"type", "feel2d.state"}});
+  EXPECT_NE(st["device"].get<std::string>().find("serial"), std::string::npos) << st.dump();
+  EXPECT_FALSE(st["holds_device"].get<bool>());  // the Presenter has it until the pad is touched
+
+  // A stroke on the pad: the display receives the 2-D player's drive values.
+  DriveRecorder during(*rig.hal);
+  for (int i = 0; i < 120; ++i) {
+    const json a = c.ask({{"type", "feel2d.move"}, {"seq", i}, {"x_mm", 5.0 + 0.25 * i}, {"y_mm", 15.0}, {"touch", true}});
+    ASSERT_EQ(a["type"], "feel2d.ack") << a.dump();
+    std::this_thread::sleep_for(1ms);
+  }
+  // Held still at the disc's centre (c = 1): a steady drive the hand-over must ramp down.
+  for (int i = 0; i < 40; ++i) {
+    c.ask({{"type", "feel2d.move"}, {"seq", 200 + i}, {"x_mm", 20.0}, {"y_mm", 15.0}, {"touch", true}});
+    std::this_thread::sleep_for(1ms);
+  }
+  std::this_thread::sleep_for(30ms);
+  const auto stroke = during.finish();
+  st = c.ask({{"type", "feel2d.state"}});
+  EXPECT_TRUE(st["holds_device"].get<bool>()) << st.dump();
+  EXPECT_NE(st["backend"].get<std::string>().find("serial"), std::string::npos) << st.dump();
+  EXPECT_EQ(st["error"], "") << st.dump();
+  EXPECT_GT(st["blocks"].get<int>(), 50);
+  const std::uint16_t held = rig.hal->amplitude.load();
+  EXPECT_GT(largest(stroke), 0) << "the display never received a drive value from the pad";
+  EXPECT_GT(held, 65535 / 10) << "the finger held on the disc drives the display";
+
+  // The Feel-it strip is touched: the pad's finger ramps out, the Presenter takes the display back.
+  DriveRecorder handover(*rig.hal);
+  for (int i = 0; i < 150; ++i) {
+    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 20.0 + 0.1 * i}, {"touch", true}});
+    ASSERT_EQ(a["type"], "feel.ack") << a.dump();
+    std::this_thread::sleep_for(1ms);
+  }
+  std::this_thread::sleep_for(30ms);
+  const auto back = handover.finish();
+  // Up to the moment the display rests (between the two players), the drive only ramps down.
+  const auto rest = std::find(back.begin(), back.end(), std::uint16_t{0});
+  ASSERT_NE(rest, back.end()) << "the display never came to rest between the two players";
+  EXPECT_LT(largest_drop(std::vector<std::uint16_t>(back.begin(), rest + 1)), held * 6 / 10)
+      << "a click: the drive fell from " << held << " at once";
+  EXPECT_GT(largest(back), 0) << "the 1-D strip drives the display again";
+  st = c.ask({{"type", "feel2d.state"}});
+  EXPECT_FALSE(st["holds_device"].get<bool>());
+  const json fs = c.ask({{"type", "feel.state"}});
+  EXPECT_NE(fs["backend"].get<std::string>().find("serial"), std::string::npos) << fs.dump();
+  EXPECT_EQ(fs["error"], "") << fs.dump();
+  c.ask({{"type", "feel.move"}, {"seq", 999}, {"x_mm", 35.0}, {"touch", false}});
+
+  // And the pad takes it once more (the display says HELLO again).
+  for (int i = 0; i < 30; ++i) {
+    c.ask({{"type", "feel2d.move"}, {"seq", 300 + i}, {"x_mm", 20.0}, {"y_mm", 15.0}, {"touch", true}});
+    std::this_thread::sleep_for(1ms);
+  }
+  std::this_thread::sleep_for(30ms);
+  st = c.ask({{"type", "feel2d.state"}});
+  EXPECT_TRUE(st["holds_device"].get<bool>()) << st.dump();
+  EXPECT_GT(rig.hal->amplitude.load(), 65535 / 10);
+  EXPECT_EQ(rig.ctl->status().frames_bad, 0u);
+}
+
+TEST(Surface2DStudio, HearItGetsTheBitmapAtTheDevicesResolution) {
+  Service s(ServiceOptions{});
+  Client c(s);
+  const json doc = surface_document();
+  const json r = c.ask({{"type", "feel2d.raster"}, {"document", doc}});
+  ASSERT_EQ(r["type"], "feel2d.raster") << r.dump().substr(0, 300);
+  EXPECT_TRUE(r["whole"].get<bool>());
+  EXPECT_EQ(r["width_px"], 400);
+  EXPECT_EQ(r["height_px"], 300);
+  EXPECT_EQ(r["depth_bits"], 8);
+  const auto px = texel::studio::detail::base64_decode(r["amplitude"].get<std::string>()).value();
+  ASSERT_EQ(px.size(), 400u * 300u);
+  // Exactly the pixels the device's bitmap file holds (darker = more friction: level = pixel).
+  const texel::Surface2D surface = texel::prepare_surface2d(texel::parse_document(doc.dump(), "doc"));
+  std::vector<std::uint16_t> file(400u * 300u);
+  texel::render_pixel_rows(surface, 0, 300, 0, file);
+  int differ = 0;
+  for (std::size_t i = 0; i < px.size(); ++i) differ += px[i] != file[i];
+  EXPECT_LE(differ, 2);  // float rounding at a level's edge
+  // The same raster as a library call: the device's pitch, quantised levels.
+  const texel::Raster2D raster = texel::studio::device_raster(surface);
+  EXPECT_EQ(raster.width, 400);
+  EXPECT_DOUBLE_EQ(raster.pitch.value(), 0.1);
+  EXPECT_NEAR(raster.values[1234] * 255.0, std::round(raster.values[1234] * 255.0), 1e-3);
+}
+
+TEST(Surface2DStudio, ADisplaysOwnFingerDrivesThePadsPlayerAndThePadShowsIt) {
+  // The finger circles (8 mm about the disc's centre, (20, 15) mm) twice a second, lifted for a tenth of each turn.
+  texel::controller::HostHal* hal = nullptr;
+  DisplayRig rig([&hal](std::int32_t& x, std::int32_t& y, bool& touch) {
+    const double t = hal ? hal->micros() * 1e-6 : 0.0;
+    const double turn = 2.0 * t - std::floor(2.0 * t);
+    x = static_cast<std::int32_t>(std::lround((20.0 + 8.0 * std::cos(2 * M_PI * turn)) * 1e6));
+    y = static_cast<std::int32_t>(std::lround((15.0 + 8.0 * std::sin(2 * M_PI * turn)) * 1e6));
+    touch = turn < 0.9;
+    return true;
+  });
+  hal = rig.hal.get();
+  ServiceOptions o;
+  o.backend = "serial:" + rig.path;
+  Service s(o);
+  Client c(s);
+  ASSERT_EQ(c.ask({{"type", "feel2d.select"}, {"document", surface_document()}, {"mode", "bitmap"}})["type"], "feel2d.selected");
+  EXPECT_EQ(c.ask({{"type", "feel2d.state"}})["finger"], "pad");
+  // A touch on the pad gives the 2-D player the display; from then on the display's finger drives it.
+  ASSERT_EQ(c.ask({{"type", "feel2d.move"}, {"seq", 1}, {"x_mm", 2}, {"y_mm", 2}, {"touch", true}})["type"], "feel2d.ack");
+  DriveRecorder drive(*rig.hal);
+  std::this_thread::sleep_for(400ms);
+  for (int i = 2; i < 20; ++i)
+    c.ask({{"type", "feel2d.move"}, {"seq", i}, {"x_mm", 2}, {"y_mm", 2}, {"touch", true}});  // shown, not played
+  const json st = c.ask({{"type", "feel2d.state"}});
+  const auto values = drive.finish();
+  EXPECT_EQ(st["finger"], "display") << st.dump().substr(0, 400);
+  EXPECT_TRUE(st["holds_device"].get<bool>());
+  EXPECT_EQ(st["error"], "");
+  EXPECT_GT(st["reports"].get<int>(), 200) << "about 1 kHz of reports";
+  ASSERT_GT(st["trail"].size(), 100u);
+  int on_circle = 0;
+  for (const json& p : st["trail"])
+    on_circle += std::abs(std::hypot(p[0].get<double>() - 20.0, p[1].get<double>() - 15.0) - 8.0) < 0.01;
+  EXPECT_EQ(on_circle, static_cast<int>(st["trail"].size())) << "the pad is shown the display's finger";
+  EXPECT_GT(largest(values), 65535 / 20) << "the display's finger on the map drives the display";
+  EXPECT_EQ(st["samples"].get<int>(), 0) << "the pad's own samples are not played meanwhile";
+  // The Feel-it strip takes the display back: it stops reporting, and the pad's pointer is the finger again.
+  c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 10}, {"touch", true}});
+  const json back = c.ask({{"type", "feel2d.state"}});
+  EXPECT_EQ(back["finger"], "pad");
+  EXPECT_FALSE(back["holds_device"].get<bool>());
+  EXPECT_EQ(c.ask({{"type", "feel.state"}})["error"], "");
 }

@@ -56,6 +56,8 @@ const hooks = {
   touching: false,
   scansDrawn: 0,
   selected: null as null | string,
+  hearRaster: null as null | { columns: number; rows: number; pitch: number; whole: boolean },
+  device: null as null | { holds: boolean; backend: string; device: string },
 };
 if (__TEXEL_TEST_HOOKS__) (window as unknown as { __texel2d: typeof hooks }).__texel2d = hooks;
 
@@ -170,6 +172,7 @@ export function mountSurface2d(root: HTMLElement): void {
   const hear = h('input', { id: 's2d-hear', type: 'checkbox' }) as HTMLInputElement;
   const clearPath = h('button', { type: 'button', 'data-testid': 's2d-clear-path' }, 'Clear the path');
   const playerText = h('span', { 'data-testid': 's2d-player', 'aria-live': 'off' }, '–');
+  const deviceText = h('span', { 'data-testid': 's2d-drives', 'aria-live': 'polite' }, '–');
 
   const angle = h('input', { id: 's2d-angle', type: 'range', min: 0, max: 179, step: 1, value: 0 }) as HTMLInputElement;
   const angleNum = h('input', { id: 's2d-angle-num', type: 'number', class: 'num', min: 0, max: 179, step: 1, value: 0, 'aria-label': 'Scan direction (degrees), typed' }) as HTMLInputElement;
@@ -250,6 +253,7 @@ export function mountSurface2d(root: HTMLElement): void {
         'div',
         { class: 'plots' },
         h('div', { class: 'btn-row map2d-bar' }, toolGroup, h('span', { class: 'zoom' }, zoomOut, zoomIn, zoomFit), scaleText),
+        h('p', { class: 'hint' }, 'The pad plays on: ', deviceText),
         view.el,
         h('h2', {}, 'Scan along a direction'),
         h('div', { class: 'ctl-row' }, h('label', { for: angle.id }, 'Direction (°, 0 = +x, towards +y)'), angle, angleNum),
@@ -428,7 +432,12 @@ export function mountSurface2d(root: HTMLElement): void {
       setError((e as Error).message);
     }
   }
-  /** What Hear it plays: path mode, the texture's own 1-D map on the display's 1-D grid; bitmap mode, the view's samples. */
+  /**
+   * What Hear it plays: path mode, the texture's own 1-D map on the display's 1-D grid; bitmap mode, the bitmap at the
+   * device's resolution and depth (feel2d.raster: the whole bitmap up to 4 MiB of pixels, else the 1024 x 1024 device
+   * pixels about the view's centre), so what is heard does not depend on the zoom.
+   */
+  let hearWhole = false;
   async function hearSource(): Promise<void> {
     if (!hearIt.enabled) return;
     if (modeSel.value === 'path') {
@@ -442,11 +451,30 @@ export function mountSurface2d(root: HTMLElement): void {
       if (d) hearIt.setSource({ line: decodeF32(d.map_f32), spacing: d.grid.spacing_mm });
     } else {
       const v = view.lastRaster();
-      if (v) hearIt.setSource(v);
+      const p = surface?.pixel_pitch_mm ?? 0;
+      const win =
+        v && p > 0
+          ? { x_px: Math.max(0, Math.round(v.x0 / p)), y_px: Math.max(0, Math.round(v.y0 / p)), width_px: Math.max(1, Math.round((v.columns * v.pitch) / p)), height_px: Math.max(1, Math.round((v.rows * v.pitch) / p)) }
+          : {};
+      const r = await client.request('feel2d.raster', { ...body(), ...win }, { lane: 'feel2d.raster', timeoutMs: 120000 });
+      if (!r) return;
+      const bytes = base64ToBytes(r.amplitude);
+      const n = r.width_px * r.height_px;
+      const raster = new Float32Array(n);
+      if (r.depth_bits === 8) for (let i = 0; i < n; i++) raster[i] = bytes[i] / 255;
+      else for (let i = 0; i < n; i++) raster[i] = (bytes[2 * i] | (bytes[2 * i + 1] << 8)) / 65535;
+      hearWhole = r.whole;
+      const pitch = r.pixel_pitch_mm;
+      hearIt.setSource({ raster, columns: r.width_px, rows: r.height_px, x0: r.x_px * pitch, y0: r.y_px * pitch, pitch });
+      if (__TEXEL_TEST_HOOKS__) hooks.hearRaster = { columns: r.width_px, rows: r.height_px, pitch, whole: r.whole };
     }
   }
-  view.onRaster = (m) => {
-    if (modeSel.value === 'bitmap') hearIt.setSource(m);
+  let hearTimer: ReturnType<typeof setTimeout> | null = null;
+  view.onRaster = () => {
+    // A bitmap too large to send whole: the device pixels about the view follow the view (debounced).
+    if (modeSel.value !== 'bitmap' || hearWhole || !hearIt.enabled) return;
+    if (hearTimer) clearTimeout(hearTimer);
+    hearTimer = setTimeout(() => void hearSource().catch((e) => setError((e as Error).message)), 300);
   };
   modeSel.addEventListener('change', () => void selectFeel());
   hear.addEventListener('change', async () => {
@@ -474,6 +502,16 @@ export function mountSurface2d(root: HTMLElement): void {
         ? `${st.mode === 'path' ? 'path-indexed' : 'bitmap'}, ${st.samples} finger samples, x ${fmt(st.x_mm, 1)} mm${st.touching ? ' (touching)' : ''}, peak drive ${fmt(st.peak, 3)}`
         : 'no map selected yet';
       playerText.dataset.touching = String(st.touching);
+      if (st.finger === 'display') {
+        playerText.textContent += ` · the finger is the display's own sensor (${st.reports ?? 0} reports; the pad only shows it)`;
+        if (st.trail?.length) view.displayFinger(st.trail as [number, number, boolean][]);
+      }
+      deviceText.textContent = st.holds_device
+        ? `${st.backend}${st.underruns ? `, ${st.underruns} underruns` : ''}`
+        : `${st.device}, not now: the 1-D Feel-it strip or a participant's stimulus has it; touch the pad to take it`;
+      if (st.error) deviceText.textContent += ` — ${st.error}`;
+      deviceText.dataset.holds = String(st.holds_device);
+      if (__TEXEL_TEST_HOOKS__) hooks.device = { holds: st.holds_device, backend: st.backend, device: st.device };
       if (__TEXEL_TEST_HOOKS__) {
         hooks.playerSamples = st.samples;
         hooks.peakMax = Math.max(hooks.peakMax, st.peak);
@@ -810,6 +848,23 @@ class MapView {
     this.draw();
   }
 
+  private displayDown = false;
+  /** A serial display's own finger (its reports, [x, y, touch]): drawn as a path of its own (violet), the newest 20,000 points. */
+  displayFinger(trail: [number, number, boolean][]): void {
+    for (const [x, y, touch] of trail) {
+      if (!touch) {
+        this.displayDown = false;
+        continue;
+      }
+      if (!this.displayDown) this.strokes.push({ pts: [], type: 'display' });
+      this.displayDown = true;
+      this.strokes[this.strokes.length - 1].pts.push([x, y]);
+    }
+    let n = this.strokes.reduce((a, s) => a + s.pts.length, 0);
+    while (n > 20000 && this.strokes.length > 1) n -= this.strokes.shift()!.pts.length;
+    this.drawOverlay();
+  }
+
   draw(): void {
     const dpr = devicePixelRatio || 1;
     const ctx = this.image.getContext('2d')!;
@@ -854,7 +909,7 @@ class MapView {
     ctx.lineCap = 'round';
     ctx.lineJoin = 'round';
     for (const s of this.strokes) {
-      ctx.strokeStyle = s.type === 'pen' ? '#d6336c' : s.type === 'touch' ? '#2f9e44' : '#f76707';
+      ctx.strokeStyle = s.type === 'pen' ? '#d6336c' : s.type === 'touch' ? '#2f9e44' : s.type === 'display' ? '#7048e8' : '#f76707';
       ctx.lineWidth = 3;
       ctx.beginPath();
       s.pts.forEach((p, i) => (i ? ctx.lineTo(...this.toScreen(...p)) : ctx.moveTo(...this.toScreen(...p))));

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "texel/raster2d.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/surface2d.hpp"
 
@@ -37,6 +38,17 @@ inline constexpr std::size_t max_view_samples = std::size_t{1} << 20;
 /// for a window outside the bitmap, a stride < 1 or more than
 /// max_view_samples samples.
 Surface2DView surface2d_view(const Surface2D& surface, const Surface2DWindow& window);
+
+/// The friction raster a bitmap display holds: every device pixel of
+/// `window` (its stride is ignored; width_px 0 = the whole bitmap),
+/// quantised as the device's bitmap file stores it (bitmap_pixel at the
+/// device's depth and polarity) and turned back into an amplitude in [0, 1],
+/// at the device's pixel pitch with the window's corner as origin. What the
+/// studio's 2-D pad plays in bitmap mode, so what is felt or heard does not
+/// depend on the view's zoom. A window holds at most max_view_samples
+/// pixels (throws InvalidArgument as surface2d_view); the whole bitmap
+/// allocates width·height floats.
+Raster2D device_raster(const Surface2D& surface, const Surface2DWindow& window = {});
 
 /// A straight scan of region `region` through its centre along `angle_deg`
 /// (0 = +x, counter-clockwise towards +y), sampled at the bitmap's pixel

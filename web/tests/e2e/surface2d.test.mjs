@@ -111,11 +111,19 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     assert.ok(fed.movesSent >= 30 && fed.acks > 0 && fed.acks <= fed.movesSent, `moves ${fed.movesSent}, acks ${fed.acks}`);
     assert.ok(fed.playerSamples >= fed.acks, `the 2-D player counted ${fed.playerSamples} finger samples`);
     assert.ok(fed.peakMax > 0, `the player's drive was not silent (peak ${fed.peakMax})`);
+    assert.ok(fed.device?.holds && /^null /.test(fed.device.backend), `the pad says which backend it drives: ${JSON.stringify(fed.device)}`);
+    assert.match(await page.textContent('[data-testid=s2d-drives]'), /^null /);
     await screenshot(page, 'surface2d-pad-path');
 
     // Bitmap mode: the same pad drives the player from the rendered map.
     await page.selectOption('#s2d-mode', 'bitmap');
     await page.waitForFunction(() => window.__texel2d.selected === 'bitmap', null, { timeout: 60_000 });
+    // Hear it plays the bitmap at the device's resolution, whatever the zoom.
+    await page.waitForFunction(() => window.__texel2d.hearRaster !== null, null, { timeout: 60_000 });
+    const heard = await hooks(page);
+    const pixelPitch = heard.lastView.view_pitch_mm / heard.lastView.stride;
+    assert.ok(heard.hearRaster.whole && Math.abs(heard.hearRaster.pitch - pixelPitch) < 1e-12, `Hear it: ${JSON.stringify(heard.hearRaster)}, view ${JSON.stringify(heard.lastView)}`);
+    assert.ok(heard.hearRaster.columns * pixelPitch > 0.99 * heard.lastView.columns * heard.lastView.view_pitch_mm, 'the whole width, every device pixel');
 
     // A disc placed by dragging becomes the region's coarse2d.
     await page.check('#s2d-tool-shape');

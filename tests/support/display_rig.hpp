@@ -1,0 +1,56 @@
+// The reference display controller running in-process on the master side of
+// a pty, on its own thread; the host talks to the slave side by path, as
+// `texel play --backend serial:PATH` and `texel studio --backend serial:PATH`
+// do (tests/controller, tests/studio).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <pty.h>
+#include <unistd.h>
+
+#include "texel/controller/controller.hpp"
+#include "texel/controller/host_hal.hpp"
+
+namespace texel::test_support {
+
+struct DisplayRig {
+  using SmallController = controller::Controller<32768, 2>;
+  int master = -1;
+  int slave = -1;
+  std::string path;
+  std::unique_ptr<controller::HostHal> hal;
+  std::unique_ptr<SmallController> ctl;
+  std::atomic<bool> stop{false};
+  std::thread thread;
+
+  /// `sensor_2d`: the display's own 2-D finger sensor (none: positions from the host).
+  explicit DisplayRig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
+    char name[256];
+    if (openpty(&master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
+    path = name;
+    controller::make_raw(slave);
+    hal = std::make_unique<controller::HostHal>(master);
+    hal->sensor_2d = std::move(sensor_2d);
+    ctl = std::make_unique<SmallController>(*hal, controller::Info{});
+    thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
+  }
+  ~DisplayRig() {
+    halt();
+    if (slave >= 0) ::close(slave);
+  }
+  DisplayRig(const DisplayRig&) = delete;
+  DisplayRig& operator=(const DisplayRig&) = delete;
+  void halt() {
+    stop = true;
+    if (thread.joinable()) thread.join();
+  }
+};
+
+}  // namespace texel::test_support
