@@ -11,6 +11,7 @@
 #include <poll.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -131,9 +132,12 @@ int terminal_columns() {
 
 // Reads one line from stdin, pumping the presenter and calling `tick`
 // meanwhile. nullopt on end of input, Ctrl-C or timeout (timeout_s <= 0: none).
+// What was read from stdin but not yet taken as a line.
+std::string input_buffer;
+
 std::optional<std::string> read_line(ex::Presenter* presenter, double timeout_s, bool* timed_out = nullptr,
                                      const std::function<void()>& tick = {}) {
-  static std::string buffer;
+  std::string& buffer = input_buffer;
   const auto t0 = Clock::now();
   if (timed_out) *timed_out = false;
   for (;;) {
@@ -390,7 +394,19 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   const ex::Question& q = session.question();
   const std::string trial_number = std::to_string(q.trial + 1);  // the export's trial_number
   stop = StopReason::none;
-  if (presenter) presenter->prepare(q);  // a 2-D display's maps, before the trial's clock starts
+  if (presenter && presenter->two_d()) {
+    // The display's maps, before the trial's clock starts (a friction
+    // bitmap takes a second or two the first time it is shown).
+    if (interactive()) std::cout << "  Please wait: preparing the textures…" << std::flush;
+    presenter->prepare(q);
+    if (interactive()) std::cout << "\r\033[2K" << std::flush;
+    // Keys typed on a terminal while the maps rendered were meant for no
+    // trial on screen (and their echo would upset the countdown's redraw).
+    if (interactive()) {
+      ::tcflush(STDIN_FILENO, TCIFLUSH);
+      input_buffer.clear();
+    }
+  }
   ex::Response r;
   r.shown_at = ex::utc_timestamp();
   const auto t0 = Clock::now();
@@ -421,8 +437,8 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
                                       {"direction_deg", fixed1(last.direction_deg)},
                                       {"deviation_deg", fixed1(last.deviation_deg)},
                                       {"straightness", detail::fixed(last.straightness, 2)}});
-    std::cout << "  (Your strokes on " << stimulus_name(label) << " went another way than its line: "
-              << ex::direction_words(q.surfaces[static_cast<std::size_t>(felt)].direction_deg) << ". You may feel it again.)\n";
+    std::cout << "  (You stroked " << stimulus_name(label) << " along another line than its own: "
+              << ex::direction_words(q.surfaces[static_cast<std::size_t>(felt)].direction_deg) << ".)\n";
   };
   auto feel = [&](int i) {
     const auto& s = q.stimuli[static_cast<std::size_t>(i)];

@@ -117,7 +117,9 @@ struct Presenter::Display2D {
     return std::make_unique<const PlayerMap2D>(*it->second);
   }
 
-  static constexpr std::size_t cache_size = 6;  // a trial's two fields and its path-indexed intervals, and the next trial's
+  // Every static field of a shipped 2-D protocol (direction-independence
+  // has eight, 15.5 MB each on tablet-2d), so each renders once a session.
+  static constexpr std::size_t cache_size = 8;
   Player2D player;
   StrokeRules rules;
   SerialLink* link = nullptr;
