@@ -18,6 +18,10 @@
 //                 bitmap (Surface2D::amplitude) along the line of direction
 //                 θ through the surface's centre;
 //   1d            the 1-D texture document itself.
+// On a 2-D display the participant strokes the interval instead: each
+// stimulus also has its surface (Question::surfaces: the version-4 document
+// and the direction to stroke along; presenter.hpp), which the question's
+// stored JSON does not carry.
 // No interval is a copy of another: path-indexed and 1-D intervals each have
 // their own texture seed; a static field (spectral, cells, oriented) is one
 // field per condition and view in a session, like one bitmap on the display,
