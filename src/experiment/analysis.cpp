@@ -971,7 +971,13 @@ json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions&
   for (const TrialRow* r : rows) {
     if (r->task != "oddity-2d" || !std::isfinite(r->correct)) continue;
     const std::size_t i = names.add(r->condition);
-    if (i == cells.size()) cells.push_back({r->block, r->reference, r->intensity, 0, 0, {}});
+    if (i == cells.size()) {
+      Cell c;
+      c.block = r->block;
+      c.mode = r->reference;
+      c.direction = r->intensity;
+      cells.push_back(std::move(c));
+    }
     cells[i].n += 1;
     cells[i].k += r->correct > 0.5 ? 1 : 0;
     cells[i].participants.insert(r->participant);
@@ -1040,11 +1046,12 @@ json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions&
                {"correct_when_compliant", c.compliant_correct},
                {"proportion_correct_when_compliant",
                 num(c.compliant ? static_cast<double>(c.compliant_correct) / c.compliant : missing)}};
-      text += "    strokes: " + std::to_string(c.compliant) + "/" + std::to_string(c.stroked) +
-              " trials along the asked directions, median largest deviation " + fmt(median, 1) + "°" +
-              (c.compliant ? ", correct when compliant " + std::to_string(c.compliant_correct) + "/" + std::to_string(c.compliant)
-                           : std::string()) +
-              "\n";
+      text +=
+          "    strokes: " + std::to_string(c.compliant) + "/" + std::to_string(c.stroked) + " trials along the asked directions" +
+          (c.deviations.empty() ? std::string(", no interval stroked") : ", median largest deviation " + fmt(median, 1) + "°") +
+          (c.compliant ? ", correct when compliant " + std::to_string(c.compliant_correct) + "/" + std::to_string(c.compliant)
+                       : std::string()) +
+          "\n";
     }
   }
   out["conditions"] = std::move(cj);
