@@ -55,7 +55,8 @@ $(WEB_TEST_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/
 
 # The studies (issue #8): a simulated cohort of 8 participants through every
 # shipped protocol (free exploration before the quantization test that uses
-# its matches), then each study's summaries and figures.
+# its matches), then each study's summaries and figures. The 2-D
+# direction-independence study runs short: two simulated participants (~10 s).
 PROTOCOLS := $(addprefix examples/protocols/,free-exploration.json quantization.json parameter-mapping.json \
   guided-exploration.json coarse-features.json working-memory.json)
 # Texel length is a between-groups study: each group has its own participants.
@@ -68,6 +69,8 @@ demo: build web
 	$(BUILD)/bin/texel experiment cohort $(PROTOCOLS) --participants 8 --db out/demo/experiments/cohort.db
 	for g in $(TEXEL_LENGTH_GROUPS); do $(BUILD)/bin/texel experiment cohort examples/protocols/$${g#*:}.json \
 	  --participants 8 --prefix $${g%%:*} --db out/demo/experiments/cohort.db || exit 1; done
+	$(BUILD)/bin/texel experiment cohort examples/protocols/direction-independence.json --participants 2 --prefix D \
+	  --db out/demo/experiments/cohort.db
 	$(BUILD)/bin/texel experiment export --db out/demo/experiments/cohort.db -o out/demo/experiments/trials.csv
 	$(BUILD)/bin/texel experiment analyze --db out/demo/experiments/cohort.db -o out/demo/experiments > out/demo/experiments/summary.txt
 	@cat out/demo/experiments/summary.txt

@@ -53,6 +53,8 @@ struct RunArgs {
   std::string backend = "null";
   std::string audio_device;
   std::string response = "limit";
+  std::optional<std::string> finger;  // serial:PATH — the participant strokes a 2-D display
+  double direction_tolerance_deg = ex::StrokeRules{}.tolerance_deg;
   bool json = false;
   bool quiet = false;
   std::optional<std::string> monitor;
@@ -118,6 +120,20 @@ void run(const RunArgs& a) {
   po.backend = a.backend;
   po.audio_device = a.audio_device;
   po.response_handling = parse_response_handling(a.response, "--response");
+  if (a.finger) {
+    // The participant strokes a 2-D display: every block must be a 2-D oddity.
+    if (a.simulate)
+      throw InvalidArgument("--finger: a simulated participant does not stroke a display; give --finger or --simulate");
+    for (const auto& b : protocol_file.blocks)
+      if (b.task != "oddity-2d")
+        throw InvalidArgument("--finger: block '" + b.name + "' is task '" + b.task +
+                              "'; a participant strokes a 2-D display in task oddity-2d only");
+    po.finger = ex::FingerSource::display;
+    po.finger_display = *a.finger;
+    po.stroke_rules.tolerance_deg = a.direction_tolerance_deg;
+    if (!(a.direction_tolerance_deg >= 0 && a.direction_tolerance_deg <= 90))
+      throw InvalidArgument("--direction-tolerance is " + detail::num(a.direction_tolerance_deg) + "; allowed: 0 … 90 degrees");
+  }
   ex::Presenter presenter(po);
   // The experimenter's stream: opened before the database, removed again
   // (if this command created it) when the session cannot start.
@@ -172,7 +188,9 @@ void run(const RunArgs& a) {
                           {"db", a.db}});
   monitor.event("audio", {{"backend", presenter.describe()},
                           {"response", std::string(to_string(po.response_handling))},
-                          {"block_ms", detail::fixed(presenter.block_period_s() * 1e3, 3)}});
+                          {"block_ms", detail::fixed(presenter.block_period_s() * 1e3, 3)},
+                          {"finger", a.finger ? *a.finger : std::string()},
+                          {"direction_tolerance_deg", a.finger ? detail::num(a.direction_tolerance_deg) : std::string()}});
   // Reversals so far per block (a resumed session counts its stored trials).
   std::map<std::string, int> reversals;
   for (const auto& row : store.rows(info.id))
@@ -198,8 +216,8 @@ void run(const RunArgs& a) {
       report_question(monitor, session);
       // Present as a participant would: each stimulus in turn (the pace
       // shared among them), then answer.
-      for (const auto& s : q.stimuli) {
-        presenter.show(s.document_json);
+      for (std::size_t k = 0; k < q.stimuli.size(); ++k) {
+        presenter.show(q, k);
         wait_pumping(&presenter, a.pace / static_cast<double>(std::max<std::size_t>(1, q.stimuli.size())));
       }
       if (q.stimuli.empty()) wait_pumping(&presenter, a.pace);
@@ -283,6 +301,13 @@ void run(const RunArgs& a) {
   j["mean_block_ms"] = s.blocks ? s.total_block_s / static_cast<double>(s.blocks) * 1e3 : 0.0;
   j["late_blocks"] = s.underruns;
   j["stimuli_shown"] = presenter.shown();
+  if (a.finger) {
+    const ex::Presenter::FingerCounts f = presenter.finger_counts();
+    j["finger"] = *a.finger;
+    j["finger_reports"] = f.reports;
+    j["finger_reports_lost"] = f.lost;
+    j["finger_reports_dropped"] = f.dropped;
+  }
   if (a.json) {
     print_json(j);
   } else if (!sim && !a.quiet) {
@@ -370,6 +395,11 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_flag("--resume", a->resume, "Continue the participant's unfinished session of this protocol");
   run_cmd->add_option("--backend", a->backend, "Stimulus output: null (no hardware), audio (PortAudio) or serial:PATH [null]");
   run_cmd->add_option("--audio-device", a->audio_device, "PortAudio output: index or name substring [default output]");
+  run_cmd->add_option("--finger", a->finger,
+                      "The participant strokes a 2-D display that reports the finger: serial:PATH (oddity-2d studies; "
+                      "the same PATH as --backend serial:PATH, or another display)");
+  run_cmd->add_option("--direction-tolerance", a->direction_tolerance_deg,
+                      "--finger: largest deviation (degrees) of an interval's mean stroke direction from the one asked for [20]");
   run_cmd->add_option("--response", a->response,
                       "The stimuli's display frequency response (the protocol's device profile): limit (never drive "
                       "what the display attenuates by 20 dB or more) or off [limit]");

@@ -11,6 +11,7 @@
 #include <poll.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -114,6 +115,7 @@ namespace {
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 std::string num(double v) { return std::isfinite(v) ? detail::num(v) : std::string(); }
+std::string fixed1(double v) { return std::isfinite(v) ? detail::fixed(v, 1) : std::string(); }
 
 // Whether the participant types on the terminal that shows the questions, so
 // lines can be redrawn in place (the countdown).
@@ -130,9 +132,12 @@ int terminal_columns() {
 
 // Reads one line from stdin, pumping the presenter and calling `tick`
 // meanwhile. nullopt on end of input, Ctrl-C or timeout (timeout_s <= 0: none).
+// What was read from stdin but not yet taken as a line.
+std::string input_buffer;
+
 std::optional<std::string> read_line(ex::Presenter* presenter, double timeout_s, bool* timed_out = nullptr,
                                      const std::function<void()>& tick = {}) {
-  static std::string buffer;
+  std::string& buffer = input_buffer;
   const auto t0 = Clock::now();
   if (timed_out) *timed_out = false;
   for (;;) {
@@ -278,13 +283,15 @@ void countdown_phase(ex::Presenter* presenter, double seconds) {
   if (interactive()) std::cout << "\r\033[2K";
 }
 
-std::string how_to_answer(const ex::Question& q) {
+std::string how_to_answer(const ex::Question& q, bool two_d) {
   std::string out;
   const std::size_t n = q.stimuli.size();
   if (q.phases.empty() && n > 1) {
     std::vector<std::string> numbers;
     for (std::size_t i = 1; i <= n; ++i) numbers.push_back(std::to_string(i));
     out += "  Feel a texture: type its number (" + spoken_list(numbers) + ") and press Enter.\n";
+    if (two_d)
+      out += "  Then stroke the display with your finger along the line shown for that texture (back and forth is fine).\n";
     bool numbered = true;
     for (std::size_t i = 0; i < n; ++i) numbered = numbered && q.stimuli[i].label == std::to_string(i + 1);
     if (!numbered) {
@@ -387,6 +394,19 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   const ex::Question& q = session.question();
   const std::string trial_number = std::to_string(q.trial + 1);  // the export's trial_number
   stop = StopReason::none;
+  if (presenter && presenter->two_d()) {
+    // The display's maps, before the trial's clock starts (a friction
+    // bitmap takes a second or two the first time it is shown).
+    if (interactive()) std::cout << "  Please wait: preparing the textures…" << std::flush;
+    presenter->prepare(q);
+    if (interactive()) std::cout << "\r\033[2K" << std::flush;
+    // Keys typed on a terminal while the maps rendered were meant for no
+    // trial on screen (and their echo would upset the countdown's redraw).
+    if (interactive()) {
+      ::tcflush(STDIN_FILENO, TCIFLUSH);
+      input_buffer.clear();
+    }
+  }
   ex::Response r;
   r.shown_at = ex::utc_timestamp();
   const auto t0 = Clock::now();
@@ -400,15 +420,39 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
         {{"trial_number", trial_number}, {"reason", std::string(to_string(why))}, {"t_s", detail::fixed(seconds_since(t0), 3)}});
     return std::nullopt;
   };
+  // A 2-D display: the participant strokes each texture along its own
+  // line. Leaving a texture whose strokes went another way brings one plain
+  // reminder (about the stroke, nothing of the trial); the trial goes on.
+  const bool two_d = presenter && presenter->two_d();
+  int felt = -1;
+  auto remind = [&](int next) {
+    if (!two_d || felt < 0 || felt == next) return;
+    const auto strokes = presenter->strokes(q);
+    const ex::IntervalStrokes& last = strokes[static_cast<std::size_t>(felt)];
+    if (last.strokes == 0 || last.compliant) return;
+    const auto& label = q.stimuli[static_cast<std::size_t>(felt)].label;
+    event("stroke_reminder", label);
+    monitor.event("stroke_reminder", {{"trial_number", trial_number},
+                                      {"stimulus", std::to_string(felt + 1)},
+                                      {"direction_deg", fixed1(last.direction_deg)},
+                                      {"deviation_deg", fixed1(last.deviation_deg)},
+                                      {"straightness", detail::fixed(last.straightness, 2)}});
+    std::cout << "  (You stroked " << stimulus_name(label) << " along another line than its own: "
+              << ex::direction_words(q.surfaces[static_cast<std::size_t>(felt)].direction_deg) << ".)\n";
+  };
   auto feel = [&](int i) {
     const auto& s = q.stimuli[static_cast<std::size_t>(i)];
-    if (presenter) presenter->show(s.document_json);
+    remind(i);
+    felt = i;
+    if (presenter) presenter->show(q, static_cast<std::size_t>(i));
     event("select", s.label);
     monitor.event("play", {{"trial_number", trial_number},
                            {"stimulus", std::to_string(i + 1)},
                            {"label", s.label},
                            {"t_s", detail::fixed(seconds_since(t0), 3)}});
     std::cout << "  Now playing: " << stimulus_name(s.label) << "\n";
+    if (two_d)
+      std::cout << "  Stroke along: " << ex::direction_words(q.surfaces[static_cast<std::size_t>(i)].direction_deg) << "\n";
   };
   report_question(monitor, session);
 
@@ -446,7 +490,7 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   }
   if (!q.phases.empty() && presenter) presenter->blank();
 
-  std::cout << how_to_answer(q);
+  std::cout << how_to_answer(q, two_d);
   if (q.phases.empty() && !q.stimuli.empty()) feel(0);
 
   double slider_p = q.sliders.empty() ? 0 : q.sliders[0].start, slider_i = q.sliders.size() < 2 ? 0 : q.sliders[1].start;
@@ -473,7 +517,7 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
     if (cmd.empty()) continue;
     if (cmd == "q" || cmd == "quit") return ended(StopReason::quit);
     if (cmd == "h" || cmd == "help" || cmd == "?") {
-      std::cout << how_to_answer(q);
+      std::cout << how_to_answer(q, two_d);
       continue;
     }
     std::istringstream in(cmd);
@@ -554,6 +598,22 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
     }
     const double rt = seconds_since(t0) * 1000.0;  // from the first stimulus onset (shown with the question)
     if (presenter) presenter->blank();
+    if (two_d) {
+      r.strokes = presenter->strokes(q);  // stored with the trial; the experimenter's monitor gets each interval
+      for (std::size_t k = 0; k < r.strokes.size(); ++k) {
+        const ex::IntervalStrokes& st = r.strokes[k];
+        monitor.event("strokes", {{"trial_number", trial_number},
+                                  {"stimulus", std::to_string(k + 1)},
+                                  {"instructed_deg", fixed1(st.instructed_deg)},
+                                  {"strokes", std::to_string(st.strokes)},
+                                  {"direction_deg", fixed1(st.direction_deg)},
+                                  {"deviation_deg", fixed1(st.deviation_deg)},
+                                  {"straightness", std::isfinite(st.straightness) ? detail::fixed(st.straightness, 2) : ""},
+                                  {"mean_speed_mm_s", fixed1(st.mean_speed_mm_s)},
+                                  {"path_mm", fixed1(st.path_mm)},
+                                  {"compliant", st.compliant ? "1" : "0"}});
+      }
+    }
     if (q.confidence) {
       const auto c = ask_number(presenter, "How confident are you in this match? 1 (not at all) to 5 (very)", 1, 5, stop);
       if (!c) return ended(stop);

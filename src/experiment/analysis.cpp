@@ -962,16 +962,32 @@ json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions&
     double direction = missing;
     unsigned n = 0, k = 0;
     std::set<std::string> participants;
+    // Strokes on a 2-D display (rows with direction_compliant).
+    unsigned stroked = 0, compliant = 0, compliant_correct = 0;
+    std::vector<double> deviations;
   };
   Ordered names;
   std::vector<Cell> cells;
   for (const TrialRow* r : rows) {
     if (r->task != "oddity-2d" || !std::isfinite(r->correct)) continue;
     const std::size_t i = names.add(r->condition);
-    if (i == cells.size()) cells.push_back({r->block, r->reference, r->intensity, 0, 0, {}});
+    if (i == cells.size()) {
+      Cell c;
+      c.block = r->block;
+      c.mode = r->reference;
+      c.direction = r->intensity;
+      cells.push_back(std::move(c));
+    }
     cells[i].n += 1;
     cells[i].k += r->correct > 0.5 ? 1 : 0;
     cells[i].participants.insert(r->participant);
+    if (std::isfinite(r->direction_compliant)) {
+      cells[i].stroked += 1;
+      const bool ok = r->direction_compliant > 0.5;
+      cells[i].compliant += ok ? 1 : 0;
+      cells[i].compliant_correct += ok && r->correct > 0.5 ? 1 : 0;
+      if (std::isfinite(r->stroke_deviation_deg)) cells[i].deviations.push_back(r->stroke_deviation_deg);
+    }
   }
   // In a fixed order: by block (as first met), mode, direction difference, name.
   Ordered blocks;
@@ -1014,6 +1030,29 @@ json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions&
     text += "  " + names.names[i] + ": " + std::to_string(c.k) + "/" + std::to_string(c.n) +
             " correct = " + fmt(static_cast<double>(c.k) / c.n) + " [" + fmt(lo) + ", " + fmt(hi) +
             "], above chance: " + fmt_p(p_chance) + "\n";
+    if (c.stroked > 0) {
+      // Direction compliance on a 2-D display (docs/experiments.md "The 2-D
+      // display presenter"): trials whose every interval was stroked along
+      // its line, the largest deviation per trial, and the proportion
+      // correct among the compliant trials.
+      const double median = c.deviations.empty() ? missing : stats::quantile(c.deviations, 0.5);
+      cj.back()["direction_compliance"] =
+          json{{"trials_stroked", c.stroked},
+               {"compliant", c.compliant},
+               {"proportion", num(static_cast<double>(c.compliant) / c.stroked)},
+               {"deviation_deg_median", num(median)},
+               {"deviation_deg_max",
+                num(c.deviations.empty() ? missing : *std::max_element(c.deviations.begin(), c.deviations.end()))},
+               {"correct_when_compliant", c.compliant_correct},
+               {"proportion_correct_when_compliant",
+                num(c.compliant ? static_cast<double>(c.compliant_correct) / c.compliant : missing)}};
+      text +=
+          "    strokes: " + std::to_string(c.compliant) + "/" + std::to_string(c.stroked) + " trials along the asked directions" +
+          (c.deviations.empty() ? std::string(", no interval stroked") : ", median largest deviation " + fmt(median, 1) + "°") +
+          (c.compliant ? ", correct when compliant " + std::to_string(c.compliant_correct) + "/" + std::to_string(c.compliant)
+                       : std::string()) +
+          "\n";
+    }
   }
   out["conditions"] = std::move(cj);
   if (study.direction_effects) {

@@ -2,11 +2,20 @@
 #include "texel/experiment/presenter.hpp"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <thread>
 
+#include "texel/detail/format.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
+#include "texel/serial_link.hpp"
+#include "texel/surface2d.hpp"
 
 namespace texel::experiment {
 namespace {
@@ -26,12 +35,123 @@ constexpr double finger_lead_s = 0.05;     // samples queued ahead of the player
 
 }  // namespace
 
+// ------------------------------------------------------------- 2-D display
+
+// The participant's finger on a 2-D display: the display's FINGER reports,
+// read on their own thread, queued into the Player2D at their place on the
+// player's clock and summarised per interval.
+struct Presenter::Display2D {
+  explicit Display2D(const PlayerConfig& config, const StrokeRules& r) : player(config), rules(r) {}
+  ~Display2D() { stop(); }
+
+  void start(SerialLink& l) {
+    link = &l;
+    running = true;
+    thread = std::thread([this] { loop(); });
+  }
+  void stop() {
+    running = false;
+    if (thread.joinable()) thread.join();
+  }
+
+  void loop() {
+    std::array<FingerReport, 64> buf;
+    ReportTimeline timeline;
+    ReportClock clock;
+    try {
+      while (running) {
+        const std::size_t n = link->read_reports(buf, 5);
+        std::lock_guard<std::mutex> lock(mutex);
+        for (std::size_t i = 0; i < n; ++i) {
+          const FingerReport& r = buf[i];
+          const double t = timeline.place(r.t_us, player.time_s());
+          if (!player.push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) ++dropped;
+          ++reports;
+          last_t = clock.seconds(r.t_us);
+          if (!current.empty()) recorders.at(current).add(last_t, r.x_mm, r.y_mm, r.touch);
+        }
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex);
+      error = e.what();
+    }
+  }
+
+  // Stops recording into the current interval (its stroke in progress ends).
+  void leave() {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!current.empty()) recorders.at(current).add(last_t, 0.0, 0.0, false);
+    current.clear();
+  }
+  void enter(const std::string& label) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!current.empty()) recorders.at(current).add(last_t, 0.0, 0.0, false);
+    recorders.try_emplace(label, rules);
+    current = label;
+  }
+
+  // A map for the player to own, from the cache of rendered maps (a
+  // friction bitmap of the display takes a fraction of a second to render;
+  // its copy, a few milliseconds).
+  std::unique_ptr<const PlayerMap2D> map(const SurfaceStimulus& s) {
+    auto it = std::find_if(cache.begin(), cache.end(), [&](const auto& e) { return e.first == s.document_json; });
+    if (it == cache.end()) {
+      const Document doc = parse_document(s.document_json, "stimulus surface");
+      if (!doc.surface2d || doc.surface2d->regions.size() != 1 || !doc.device.bitmap)
+        throw InvalidArgument("a stimulus surface must be a version-4 document of one region on a display with a bitmap grid");
+      const BitmapGeometry& g = *doc.device.bitmap;
+      std::unique_ptr<const PlayerMap2D> m;
+      if (s.kind == SurfaceStimulus::Kind::bitmap)
+        m = PlayerMap2D::bitmap(render_raster(prepare_surface2d(doc)), doc.device.response);
+      else
+        m = PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)},
+                                      std::nullopt, Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0,
+                                      doc.device.response);
+      cache.emplace_front(s.document_json, std::move(m));
+      if (cache.size() > cache_size) cache.pop_back();
+      it = cache.begin();
+    } else {
+      cache.splice(cache.begin(), cache, it);
+      it = cache.begin();
+    }
+    return std::make_unique<const PlayerMap2D>(*it->second);
+  }
+
+  // Every static field of a shipped 2-D protocol (direction-independence
+  // has eight, 15.5 MB each on tablet-2d), so each renders once a session.
+  static constexpr std::size_t cache_size = 8;
+  Player2D player;
+  StrokeRules rules;
+  SerialLink* link = nullptr;
+  std::unique_ptr<SerialLink> own_link;
+  std::list<std::pair<std::string, std::unique_ptr<const PlayerMap2D>>> cache;
+  std::thread thread;
+  std::atomic<bool> running{false};
+  mutable std::mutex mutex;  // guards what follows (the reader thread writes it)
+  std::map<std::string, StrokeRecorder> recorders;
+  std::string current;  // the interval being recorded
+  double last_t = 0.0;
+  std::uint64_t reports = 0, dropped = 0;
+  std::string error;
+};
+
 Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   if (!(options_.swipe_speed_mm_s > 0 && options_.swipe_speed_mm_s <= 10000))
     throw InvalidArgument("swipe speed is " + std::to_string(options_.swipe_speed_mm_s) + "; allowed: 0 … 10000 mm/s");
   if (!(options_.finger_lead_s >= 0 && options_.finger_lead_s <= 0.1))
     throw InvalidArgument("finger lead is " + std::to_string(options_.finger_lead_s) + " s; allowed: 0 … 0.1 s");
   const BackendChoice choice = parse_backend(options_.backend);
+  std::string sensor_path;
+  if (options_.finger == FingerSource::display) {
+    validate(options_.stroke_rules);
+    if (!options_.finger_display.starts_with("serial:") || options_.finger_display.size() <= 7)
+      throw InvalidArgument("finger display is '" + options_.finger_display +
+                            "'; allowed: serial:PATH (a 2-D display that reports its finger)");
+    sensor_path = options_.finger_display.substr(7);
+    if (options_.report_interval_us < serial::min_report_interval_us)
+      throw InvalidArgument("report interval is " + std::to_string(options_.report_interval_us) +
+                            " µs; allowed >= " + std::to_string(serial::min_report_interval_us));
+  }
   PlayerConfig config;
   BackendOptions bo;
   if (choice.kind == BackendChoice::Kind::serial) {
@@ -51,23 +171,63 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   config.response_handling = options_.response_handling;
   config.response_limit_db = options_.response_limit_db;
   bo.rate_hz = config.rate_hz;
+  bo.baud = options_.baud;
   player_ = std::make_unique<Player>(config);
   const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
   backend_ = make_backend(choice, bo, blank_map);
-  pump();
-  backend_->start(*player_);
+  if (options_.finger != FingerSource::display) {
+    pump();
+    backend_->start(*player_);
+    running_ = true;
+    return;
+  }
+  // The 2-D display: the player plays Player2D maps under the display's
+  // finger, reported over the backend's own link or another display's.
+  display_ = std::make_unique<Display2D>(config, options_.stroke_rules);
+  SerialLink* link = nullptr;
+  if (choice.kind == BackendChoice::Kind::serial && choice.serial_path == sensor_path) {
+    link = backend_->serial_link();
+  } else {
+    display_->own_link = std::make_unique<SerialLink>(sensor_path, options_.baud);
+    display_->own_link->hello();
+    link = display_->own_link.get();
+  }
+  try {
+    link->start_reports(options_.report_interval_us);
+  } catch (const SerialError& e) {
+    if (e.code == serial::ErrorCode::no_sensor)
+      throw InvalidArgument("--finger " + options_.finger_display +
+                            ": the display has no finger sensor (it refused FINGER reports), so a participant cannot stroke it; "
+                            "give a 2-D display that reports the finger");
+    throw;
+  }
+  blank();
+  backend_->start(display_->player);
+  display_->start(*link);
   running_ = true;
 }
 
 Presenter::~Presenter() { stop(); }
 
 void Presenter::stop() {
+  if (display_ && display_->running) {
+    display_->stop();
+    if (display_->error.empty()) try {
+        display_->link->start_reports(0);  // the display stops reporting
+      } catch (const Error&) {
+        // Already gone: nothing to stop.
+      }
+  }
   if (running_) backend_->stop();
   running_ = false;
   if (player_) player_->collect();
+  if (display_) display_->player.collect();
 }
 
 void Presenter::show(const std::string& document_json) {
+  if (display_)
+    throw InvalidArgument(
+        "this presenter plays a 2-D display the participant strokes; it plays stimuli with a surface (oddity-2d)");
   // Participants switch back and forth among a trial's few stimuli, and a
   // reference recurs over many trials: keep the last few rendered maps (a
   // noise reference takes ~0.1 s to synthesise; copying its map, 0.1 ms).
@@ -94,7 +254,56 @@ void Presenter::show(std::unique_ptr<const PlayerMap> map) {
   ++shown_;
 }
 
+void Presenter::show(const Question& question, std::size_t i) {
+  const Stimulus& stimulus = question.stimuli.at(i);
+  if (!display_) return show(stimulus.document_json);
+  if (question.surfaces.size() != question.stimuli.size())
+    throw InvalidArgument("task '" + question.task +
+                          "' has no 2-D surfaces: a 2-D display plays the intervals of task oddity-2d only");
+  auto map = display_->map(question.surfaces[i]);
+  last_response_ = map->response();
+  display_->player.set_map(std::move(map));
+  display_->enter(stimulus.label);
+  ++shown_;
+}
+
+void Presenter::prepare(const Question& question) {
+  if (!display_) return;
+  for (const auto& s : question.surfaces) (void)display_->map(s);
+  std::lock_guard<std::mutex> lock(display_->mutex);
+  display_->recorders.clear();
+  display_->current.clear();
+}
+
+std::vector<IntervalStrokes> Presenter::strokes(const Question& question) const {
+  std::vector<IntervalStrokes> out;
+  if (!display_) return out;
+  std::lock_guard<std::mutex> lock(display_->mutex);
+  for (std::size_t i = 0; i < question.stimuli.size(); ++i) {
+    const Stimulus& s = question.stimuli[i];
+    const double direction = i < question.surfaces.size() ? question.surfaces[i].direction_deg : 0.0;
+    const auto it = display_->recorders.find(s.label);
+    out.push_back(it == display_->recorders.end() ? StrokeRecorder(options_.stroke_rules).summary(s.label, direction)
+                                                  : it->second.summary(s.label, direction));
+  }
+  return out;
+}
+
+Presenter::FingerCounts Presenter::finger_counts() const {
+  if (!display_) return {};
+  std::lock_guard<std::mutex> lock(display_->mutex);
+  return {display_->reports, display_->link ? display_->link->reports_lost() : 0, display_->dropped};
+}
+
 void Presenter::blank() {
+  if (display_) {
+    // A one-sample bitmap far off the display: the finger is off it, so the
+    // player fades out.
+    Raster2D off{1, 1, Millimetres(1.0), Millimetres(-1e6), Millimetres(-1e6), {0.0f}};
+    display_->player.set_map(PlayerMap2D::bitmap(std::move(off), last_response_));
+    display_->leave();
+    return;
+  }
   // A one-sample map at rest: the finger is off it, so the player fades out.
   // It carries the last stimulus's display response, so what fades out
   // during the crossfade is still limited as that display needs.
@@ -103,6 +312,10 @@ void Presenter::blank() {
 }
 
 void Presenter::pump() {
+  if (display_) {
+    display_->player.collect();
+    return;
+  }
   if (options_.finger == FingerSource::external) {
     player_->collect();
     return;
@@ -117,7 +330,7 @@ void Presenter::pump() {
 }
 
 std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
-  if (options_.finger != FingerSource::external) return std::nullopt;
+  if (options_.finger != FingerSource::external || display_) return std::nullopt;
   // The player consumes samples in time order: a burst arriving within one
   // clock tick still gets strictly increasing stamps.
   const double t = std::max(player_->time_s() + options_.finger_lead_s, next_finger_s_ + 1e-6);
@@ -130,6 +343,13 @@ std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
 BackendStats Presenter::stats() { return backend_->stats(); }
 std::string Presenter::describe() const { return backend_->describe(); }
 double Presenter::block_period_s() const { return period_s_; }
-std::string Presenter::error() const { return backend_->error(); }
+std::string Presenter::error() const {
+  std::string e = backend_->error();
+  if (e.empty() && display_) {
+    std::lock_guard<std::mutex> lock(display_->mutex);
+    e = display_->error;
+  }
+  return e;
+}
 
 }  // namespace texel::experiment

@@ -130,6 +130,9 @@ const std::vector<Field>& fields() {
       TEXEL_NUMBER(swipe_mean_speed_mm_s),
       TEXEL_NUMBER(swipe_sd_speed_mm_s),
       TEXEL_NUMBER(directional_proportion),
+      TEXEL_NUMBER(strokes),
+      TEXEL_NUMBER(stroke_deviation_deg),
+      TEXEL_NUMBER(direction_compliant),
       TEXEL_STRING(shown_at),
       TEXEL_STRING(answered_at),
       // Derived from `trial`; read back only to check it is a whole number.

@@ -184,6 +184,23 @@ ordered_json response_view(const Response& r) {
   if (r.swipe_mean_speed_mm_s) j["swipe_mean_speed_mm_s"] = *r.swipe_mean_speed_mm_s;
   if (r.swipe_sd_speed_mm_s) j["swipe_sd_speed_mm_s"] = *r.swipe_sd_speed_mm_s;
   if (r.directional_proportion) j["directional_proportion"] = *r.directional_proportion;
+  if (!r.strokes.empty()) {
+    ordered_json list = ordered_json::array();
+    const auto number = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); };
+    for (const auto& i : r.strokes)
+      list.push_back({{"stimulus", i.stimulus},
+                      {"instructed_deg", number(i.instructed_deg)},
+                      {"strokes", i.strokes},
+                      {"direction_deg", number(i.direction_deg)},
+                      {"straightness", number(i.straightness)},
+                      {"deviation_deg", number(i.deviation_deg)},
+                      {"mean_speed_mm_s", number(i.mean_speed_mm_s)},
+                      {"path_mm", i.path_mm},
+                      {"touched_s", i.touched_s},
+                      {"tolerance_deg", number(i.tolerance_deg)},
+                      {"compliant", i.compliant}});
+    j["strokes"] = std::move(list);
+  }
   j["shown_at"] = r.shown_at;
   j["answered_at"] = r.answered_at;
   return j;
@@ -235,6 +252,49 @@ static std::vector<TrialEvent> events_from_json(const json& list) {
   return events;
 }
 
+// A 2-D display's strokes per interval (strokes.hpp), as response_view writes them.
+static std::vector<IntervalStrokes> strokes_from_json(const json& list) {
+  if (!list.is_array() || list.size() > 64) throw FormatError("response.strokes must be an array of at most 64 intervals");
+  std::vector<IntervalStrokes> out;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const json& e = list[k];
+    const std::string where = "response.strokes[" + std::to_string(k) + "]";
+    if (!e.is_object()) throw FormatError(where + " must be an object");
+    IntervalStrokes s;
+    auto number = [&](const char* key, double lo, double hi) {
+      if (!e.contains(key) || e[key].is_null()) return missing;
+      if (!e[key].is_number() || !(e[key].get<double>() >= lo && e[key].get<double>() <= hi))
+        throw FormatError(where + "." + key + " must be a number in " + detail::num(lo) + " … " + detail::num(hi) + ", got " +
+                          e[key].dump());
+      return e[key].get<double>();
+    };
+    for (auto it = e.begin(); it != e.end(); ++it) {
+      static const std::set<std::string> keys = {"stimulus",     "instructed_deg", "strokes",         "direction_deg",
+                                                 "straightness", "deviation_deg",  "mean_speed_mm_s", "path_mm",
+                                                 "touched_s",    "tolerance_deg",  "compliant"};
+      if (!keys.count(it.key())) throw FormatError(where + " has unknown key '" + it.key() + "'");
+    }
+    if (!e.contains("stimulus") || !e["stimulus"].is_string() || e["stimulus"].get_ref<const std::string&>().size() > 64)
+      throw FormatError(where + ".stimulus must be a stimulus label");
+    s.stimulus = e["stimulus"].get<std::string>();
+    s.instructed_deg = number("instructed_deg", 0, 180);
+    const double n = number("strokes", 0, 1e9);
+    if (std::isfinite(n) && n != std::floor(n)) throw FormatError(where + ".strokes must be a whole number");
+    s.strokes = std::isfinite(n) ? static_cast<int>(n) : 0;
+    s.direction_deg = number("direction_deg", 0, 180);
+    s.straightness = number("straightness", 0, 1);
+    s.deviation_deg = number("deviation_deg", 0, 90);
+    s.mean_speed_mm_s = number("mean_speed_mm_s", 0, 1e9);
+    s.path_mm = std::isfinite(number("path_mm", 0, 1e12)) ? e["path_mm"].get<double>() : 0.0;
+    s.touched_s = std::isfinite(number("touched_s", 0, 1e9)) ? e["touched_s"].get<double>() : 0.0;
+    s.tolerance_deg = number("tolerance_deg", 0, 90);
+    if (e.contains("compliant") && !e["compliant"].is_boolean()) throw FormatError(where + ".compliant must be true or false");
+    s.compliant = e.value("compliant", false);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 Response response_from(const json& j) {
   if (!j.is_object()) throw FormatError("a response must be a JSON object");
   Response r;
@@ -255,7 +315,8 @@ Response response_from(const json& j) {
                                               "directional_proportion",
                                               "shown_at",
                                               "answered_at",
-                                              "events"};
+                                              "events",
+                                              "strokes"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!known.count(it.key())) throw FormatError("response has unknown key '" + it.key() + "'");
   if (j.contains("choice")) {
@@ -277,6 +338,7 @@ Response response_from(const json& j) {
   if (j.contains("shown_at") && j["shown_at"].is_string()) r.shown_at = j["shown_at"].get<std::string>();
   if (j.contains("answered_at") && j["answered_at"].is_string()) r.answered_at = j["answered_at"].get<std::string>();
   if (j.contains("events") && !j["events"].is_null()) r.events = events_from_json(j["events"]);
+  if (j.contains("strokes") && !j["strokes"].is_null()) r.strokes = strokes_from_json(j["strokes"]);
   return r;
 }
 
@@ -360,6 +422,7 @@ struct Session::Impl : SessionCore {
     if (r.swipe_mean_speed_mm_s) row.swipe_mean_speed_mm_s = *r.swipe_mean_speed_mm_s;
     if (r.swipe_sd_speed_mm_s) row.swipe_sd_speed_mm_s = *r.swipe_sd_speed_mm_s;
     if (r.directional_proportion) row.directional_proportion = *r.directional_proportion;
+    fill_stroke_columns(r.strokes, q.stimuli.size(), row);
     require(!(std::isfinite(r.rt_ms) && r.rt_ms < 0), "rt_ms is " + texel::detail::num(r.rt_ms) + "; allowed: >= 0 ms");
     if (!q.choices.empty()) {
       require(std::find(q.choices.begin(), q.choices.end(), r.choice) != q.choices.end(),

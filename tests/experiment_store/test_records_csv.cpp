@@ -48,9 +48,9 @@ std::string cell(const std::string& csv_text, const std::string& column, std::si
 
 TEST(TrialCsv, HeaderIsTheColumnList) {
   const auto& cols = ex::trial_columns();
-  ASSERT_EQ(cols.size(), 51u);
+  ASSERT_EQ(cols.size(), 54u);  // with the 2-D display's stroke columns
   EXPECT_EQ(cols.front(), "participant");
-  EXPECT_EQ(cols[45], "answered_at");
+  EXPECT_EQ(cols[48], "answered_at");
   EXPECT_EQ(cols.back(), "suspended_ms");  // trial_number and the timing flags come last (issue #22)
   const auto csv = ex::trials_csv({});
   std::string header;

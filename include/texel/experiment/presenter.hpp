@@ -27,23 +27,39 @@
 // flat). With a serial display the player streams at 1 kHz, below any
 // built-in profile's limit (tpad: 3.98 kHz), so nothing is filtered there.
 //
+// The 2-D display (FingerSource::display, `texel experiment run --finger
+// serial:PATH`): the participant strokes a 2-D surface display themselves.
+// Each interval of an oddity-2d trial plays as a Player2D map (path-indexed,
+// or the static field's friction bitmap: Stimulus::surface) under the live
+// finger the display reports (serial protocol 1.1 FINGER reports, read on
+// their own thread and placed on the player's clock by ReportTimeline). The
+// same reports are summarised per interval (strokes.hpp): strokes, mean
+// direction, speed and path, and whether the direction is the one asked for
+// (StrokeRules). A display without a finger sensor is refused at
+// construction (InvalidArgument, one line).
+//
 // Trade-off: one control thread, no callback into the engine; the real-time
 // side is the player's (no allocation, locks or I/O).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <list>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "texel/experiment/session.hpp"
+#include "texel/experiment/strokes.hpp"
 #include "texel/sinks.hpp"
 
 namespace texel::experiment {
 
-/// Where finger positions come from (see the banner).
-enum class FingerSource { simulated, external };
+/// Where finger positions come from (see the banner): simulated, pushed from
+/// outside (the studio's strip), or a 2-D display's own sensor.
+enum class FingerSource { simulated, external, display };
 
 struct PresenterOptions {
   std::string backend = "null";  ///< "null", "audio", "serial:PATH"
@@ -60,6 +76,13 @@ struct PresenterOptions {
   ResponseHandling response_handling = ResponseHandling::limit;
   /// limit: attenuation (dB) at which the display no longer reproduces, 3 … 60 [20].
   double response_limit_db = 20.0;
+  /// FingerSource::display: the display that reports the finger, "serial:PATH"
+  /// (the backend's own path, or another display's).
+  std::string finger_display;
+  std::uint32_t report_interval_us = 1000;  ///< FINGER report interval asked of the display
+  int baud = 921600;
+  /// FingerSource::display: what a stroke must be (strokes.hpp).
+  StrokeRules stroke_rules;
 };
 
 class Presenter {
@@ -70,8 +93,23 @@ class Presenter {
   Presenter(const Presenter&) = delete;
   Presenter& operator=(const Presenter&) = delete;
 
-  /// Plays the texture document (a Texel document as JSON text).
+  /// Plays the texture document (a Texel document as JSON text). Not on a
+  /// 2-D display (InvalidArgument): it plays stimuli, show(const Stimulus&).
   void show(const std::string& document_json);
+  /// Plays the question's stimulus i: on a 2-D display its surface
+  /// (Question::surfaces[i]; the strokes are this interval's until another
+  /// is shown or blank()), else its document. A 2-D display refuses a
+  /// question without surfaces (InvalidArgument).
+  void show(const Question& question, std::size_t i);
+  /// Renders the question's 2-D maps ahead, so switching costs a copy (no-op
+  /// without a 2-D display). Clears the strokes recorded so far.
+  void prepare(const Question& question);
+  /// Whether the participant strokes a 2-D display (FingerSource::display).
+  [[nodiscard]] bool two_d() const { return display_ != nullptr; }
+  /// The strokes of the question's intervals since prepare(), one entry per
+  /// stimulus in the question's order (an interval never stroked has 0
+  /// strokes and does not comply). Empty without a 2-D display.
+  [[nodiscard]] std::vector<IntervalStrokes> strokes(const Question& question) const;
   /// Plays a map prepared by the caller (PlayerMap::from_document, which
   /// carries the device's response), so a front end shared by several
   /// threads can render outside its lock.
@@ -97,8 +135,15 @@ class Presenter {
   [[nodiscard]] std::size_t shown() const { return shown_; }
   /// An error the backend reported (e.g. the serial link dropped); empty if none.
   [[nodiscard]] std::string error() const;
+  /// 2-D display: finger reports taken, lost on the link, and not queued (the player's queue was full).
+  struct FingerCounts {
+    std::uint64_t reports = 0, lost = 0, dropped = 0;
+  };
+  [[nodiscard]] FingerCounts finger_counts() const;
 
  private:
+  struct Display2D;
+  std::unique_ptr<Display2D> display_;  // FingerSource::display only
   static constexpr std::size_t cache_size = 8;
   std::list<std::pair<std::string, std::unique_ptr<const PlayerMap>>> cache_;  // most recent first
   PresenterOptions options_;

@@ -79,6 +79,10 @@ struct TrialRow {
   double swipe_mean_speed_mm_s = missing;
   double swipe_sd_speed_mm_s = missing;
   double directional_proportion = missing;
+  // -- strokes on a 2-D display (the 2-D display presenter; strokes.hpp), missing otherwise
+  double strokes = missing;               ///< strokes over the trial's intervals
+  double stroke_deviation_deg = missing;  ///< largest deviation of an interval's mean direction from its instructed one
+  double direction_compliant = missing;   ///< 1 when every interval was stroked along its direction (within tolerance)
 
   // -- time stamps (UTC, ISO 8601 with milliseconds)
   std::string shown_at;

@@ -36,8 +36,20 @@
 #include "texel/experiment/records.hpp"
 #include "texel/experiment/staircase.hpp"
 #include "texel/experiment/store.hpp"
+#include "texel/experiment/strokes.hpp"
 
 namespace texel::experiment {
+
+/// How an interval plays on a 2-D display the participant strokes (the
+/// 2-D display presenter, presenter.hpp): the surface and the direction the
+/// participant is asked to stroke along. Engine-side only: not part of the
+/// question's JSON views (the stored question keeps its bytes).
+struct SurfaceStimulus {
+  enum class Kind { path_indexed, bitmap };
+  Kind kind = Kind::path_indexed;  ///< path-indexed texture, or the friction bitmap of a static field
+  std::string document_json;       ///< a version-4 document of one region covering the display
+  double direction_deg = 0.0;      ///< the stroke direction asked for (surface coordinates)
+};
 
 /// Something the participant can select and feel.
 struct Stimulus {
@@ -78,6 +90,9 @@ struct Question {
   std::string task;  ///< the block's task kind
   std::string prompt;
   std::vector<Stimulus> stimuli;
+  /// On a 2-D display (oddity-2d): what plays while the participant strokes
+  /// stimulus i is surfaces[i]; empty for every other task.
+  std::vector<SurfaceStimulus> surfaces;
   std::vector<std::string> choices;                   ///< allowed Response::choice values (empty: none asked)
   std::optional<std::array<double, 2>> rating_scale;  ///< [min, max], whole steps
   std::vector<SliderSpec> sliders;
@@ -107,6 +122,9 @@ struct Response {
   double rt_ms = missing;                    ///< first presentation → answer
   std::vector<TrialEvent> events;            ///< presentation / selection events
   std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
+  /// A 2-D display's strokes, one entry per interval felt (strokes.hpp); fills
+  /// the row's stroke columns.
+  std::vector<IntervalStrokes> strokes;
   std::string shown_at, answered_at;  ///< ISO 8601 UTC
 
   [[nodiscard]] std::string to_json() const;  ///< JSON text (stored with every trial)

@@ -18,6 +18,10 @@
 //                 bitmap (Surface2D::amplitude) along the line of direction
 //                 θ through the surface's centre;
 //   1d            the 1-D texture document itself.
+// On a 2-D display the participant strokes the interval instead: each
+// stimulus also has its surface (Question::surfaces: the version-4 document
+// and the direction to stroke along; presenter.hpp), which the question's
+// stored JSON does not carry.
 // No interval is a copy of another: path-indexed and 1-D intervals each have
 // their own texture seed; a static field (spectral, cells, oriented) is one
 // field per condition and view in a session, like one bitmap on the display,
@@ -121,13 +125,26 @@ class Renderer {
  public:
   Renderer(const SessionCore& s, const Block& b, FieldCache& fields) : s_(s), b_(b), fields_(fields) {}
 
-  std::string stimulus(const View& v, double direction_deg, std::uint64_t seed, Offset offset = {}) const {
+  // The interval: its 1-D stimulus document (the scan along the swipe) and,
+  // for a 2-D display, the surface the participant strokes along θ.
+  std::pair<Stimulus, SurfaceStimulus> stimulus(const std::string& label, const View& v, double direction_deg, std::uint64_t seed,
+                                                Offset offset = {}) const {
     json tex = texel_texture(texture_of(b_.texture), seed);
     tex["seed"] = seed;  // also over a template's own seed: no two intervals are copies
     tex["central_pitch_db"] = tex.value("central_pitch_db", 0.0) + v.pitch_shift_db;
     tex["irregularity_db"] = tex.value("irregularity_db", 0.0) + v.irregularity_shift_db;
-    if (v.mode == "1d") return s_.single(tex, b_.display_mm);
-    const std::vector<double> amplitude = scan(v, direction_deg, tex, offset);
+    // On a 2-D display a 1-D original is the texture along the finger's
+    // path, which is what the path-indexed mode plays.
+    const std::string surface = surface_document(v, tex);
+    std::pair<Stimulus, SurfaceStimulus> out{
+        Stimulus{label, {}},
+        SurfaceStimulus{static_field(v) ? SurfaceStimulus::Kind::bitmap : SurfaceStimulus::Kind::path_indexed, surface,
+                        direction_deg}};
+    if (v.mode == "1d") {
+      out.first.document_json = s_.single(tex, b_.display_mm);
+      return out;
+    }
+    const std::vector<double> amplitude = scan(v, direction_deg, surface, offset);
     // A map that is the scan: a = c (coarse strength 1, fine strength 0).
     // The renderer takes c once per texel, at the texel's centre: texels of
     // an eighth of a sample, with the points shifted by half a texel, give
@@ -141,26 +158,35 @@ class Renderer {
     for (std::size_t i = 0; i < amplitude.size(); ++i)
       points.push_back({std::round((static_cast<double>(i) * dx + texel / 2) * 1e6) / 1e6, std::round(amplitude[i] * 1e5) / 1e5});
     carrier["coarse"] = {{"kind", "points"}, {"points", std::move(points)}};
-    return s_.single(carrier, b_.display_mm);
+    out.first.document_json = s_.single(carrier, b_.display_mm);
+    return out;
   }
 
+  static bool static_field(const View& v) { return v.mode == "spectral" || v.mode == "cells" || v.mode == "oriented"; }
+
  private:
-  // The amplitude along the swipe: samples at the device's 1-D spacing over
-  // display_mm, on the line of direction θ through the surface's centre.
-  std::vector<double> scan(const View& v, double direction_deg, const json& tex, Offset offset) const {
-    const BitmapGeometry& g = *s_.device.bitmap;
-    const double dx = s_.device.spacing.value(), length = b_.display_mm;
-    const auto n = static_cast<std::size_t>(std::floor(length / dx + 1e-9)) + 1;
-    const double th = direction_deg * std::numbers::pi / 180.0, ux = std::cos(th), uy = std::sin(th);
-    const double cx = g.width_mm().value() / 2 + offset.x, cy = g.height_mm().value() / 2 + offset.y;
+  // A version-4 document of one region over the whole display: the texture
+  // in the view's field (a path-indexed or 1-D view names "spectral", which
+  // only the static-field modes read).
+  std::string surface_document(const View& v, const json& tex) const {
     json region = {{"name", "surface"}, {"x_mm", 0.0}, {"y_mm", 0.0}, {"texture", tex}};
-    region["field"] = v.mode == "path-indexed" ? "spectral" : v.mode;
+    region["field"] = static_field(v) ? v.mode : "spectral";
     if (v.mode == "oriented") region["orientation_deg"] = v.orientation_deg;
     const json doc_json = {{"format", "texel-document"},
                            {"version", 4},
                            {"device", s_.protocol.device},
                            {"surface2d", {{"regions", json::array({region})}}}};
-    const std::string doc_text = doc_json.dump();
+    return doc_json.dump();
+  }
+
+  // The amplitude along the swipe: samples at the device's 1-D spacing over
+  // display_mm, on the line of direction θ through the surface's centre.
+  std::vector<double> scan(const View& v, double direction_deg, const std::string& doc_text, Offset offset) const {
+    const BitmapGeometry& g = *s_.device.bitmap;
+    const double dx = s_.device.spacing.value(), length = b_.display_mm;
+    const auto n = static_cast<std::size_t>(std::floor(length / dx + 1e-9)) + 1;
+    const double th = direction_deg * std::numbers::pi / 180.0, ux = std::cos(th), uy = std::sin(th);
+    const double cx = g.width_mm().value() / 2 + offset.x, cy = g.height_mm().value() / 2 + offset.y;
     const Document doc = parse_document(doc_text, "stimulus");
     std::vector<double> out(n);
     if (v.mode == "path-indexed") {
@@ -186,8 +212,6 @@ class Renderer {
   const Block& b_;
   FieldCache& fields_;
 };
-
-bool static_field(const View& v) { return v.mode == "spectral" || v.mode == "cells" || v.mode == "oriented"; }
 
 class Oddity2DBlock : public TaskBlock {
  public:
@@ -219,7 +243,7 @@ class Oddity2DBlock : public TaskBlock {
       const auto k = static_cast<std::uint64_t>(i);
       std::uint64_t seed = s.seed_draw(k);
       Offset offset;
-      if (static_field(v)) {  // one field per (block, condition, view); a random line of it
+      if (Renderer::static_field(v)) {  // one field per (block, condition, view); a random line of it
         seed =
             s.order_rng.bits(draw_counter(static_cast<std::uint64_t>(s.block_index), 1000 + 2 * condition + (is_odd ? 1 : 0))) >>
             11;
@@ -228,8 +252,10 @@ class Oddity2DBlock : public TaskBlock {
             2 * std::numbers::pi * s.trial_rng.uniform(draw_counter(static_cast<std::uint64_t>(s.trial), 9 + 2 * k));
         offset = {r * std::cos(phi), r * std::sin(phi)};
       }
-      const std::string doc = render.stimulus(v, is_odd ? odd_direction : c.directions_deg[next_pair++], seed, offset);
-      q.stimuli.push_back({std::to_string(i + 1), doc});
+      auto [stimulus, surface] =
+          render.stimulus(std::to_string(i + 1), v, is_odd ? odd_direction : c.directions_deg[next_pair++], seed, offset);
+      q.stimuli.push_back(std::move(stimulus));
+      q.surfaces.push_back(std::move(surface));
     }
     q.choices = {"1", "2", "3"};
     t.correct_answer = std::to_string(odd + 1);
