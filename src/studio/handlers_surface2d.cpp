@@ -162,7 +162,7 @@ std::shared_ptr<const Prepared> prepared(State& s, const Fields& f, const std::s
     std::lock_guard lock(st->cache_mutex);
     if (st->cache && st->cache_key == key) return st->cache;
   }
-  if (!doc.contains("surface2d")) throw Reject{"invalid", type + ": document is not a 2-D document (version 4 with surface2d)"};
+  if (!doc.contains("surface2d")) throw Reject{"invalid", type + ": document is not a 2-D document (version 4 or 5 with surface2d)"};
   auto p = std::make_shared<Prepared>();
   // Every image path must name one of the images sent; each is rewritten to its temporary copy.
   json* regions = doc["surface2d"].is_object() && doc["surface2d"].contains("regions") ? &doc["surface2d"]["regions"] : nullptr;
@@ -193,7 +193,7 @@ std::shared_ptr<const Prepared> prepared(State& s, const Fields& f, const std::s
     }
   }
   p->doc = document_of(s, doc, "document");
-  if (!p->doc.surface2d) throw Reject{"invalid", type + ": document is not a 2-D document (version 4 with surface2d)"};
+  if (!p->doc.surface2d) throw Reject{"invalid", type + ": document is not a 2-D document (version 4 or 5 with surface2d)"};
   // An oriented field lays the 1-D texture along ±oriented_extent_mm: bound its texel count like 1-D maps.
   for (std::size_t i = 0; i < p->doc.surface2d->regions.size(); ++i) {
     const Region2DSpec& r = p->doc.surface2d->regions[i];

@@ -1,4 +1,4 @@
-// The 2-D page (#/surface, docs/studio.md "The 2-D page"): a version-4 2-D
+// The 2-D page (#/surface, docs/studio.md "The 2-D page"): a version-4 or -5 2-D
 // document — the designer's texture laid out on a 2-D display in a chosen
 // design, or an opened .texel.json — shown as its friction map, with zoom
 // (wheel, pinch, buttons) and pan; a 2-D feel pad whose finger samples reach
@@ -20,7 +20,7 @@ import type { TexelTexture } from './document';
 
 type Json = null | boolean | number | string | Json[] | { [k: string]: Json };
 type Coarse2D = { kind: string; [k: string]: Json };
-type Field2D = 'spectral' | 'cells' | 'oriented';
+type Field2D = 'tile' | 'spectral' | 'cells' | 'oriented';
 type Tool = 'feel' | 'pan' | 'shape' | 'paint';
 type Shape = 'disc' | 'edge' | 'grid' | 'bump' | 'ramp';
 
@@ -91,10 +91,15 @@ function newDocument(device: string, texture: TexelTexture): Surface2DDocument {
   return { format: 'texel-document', version: 4, device, surface2d: { regions: [region as unknown as { [k: string]: unknown }] } };
 }
 
+/** A 2-D document: version 4, or 5 (whose regions default to the tile field). */
+function is2d(d: Surface2DDocument | null | undefined): boolean {
+  return (d?.version === 4 || d?.version === 5) && Array.isArray(d.surface2d?.regions);
+}
+
 function loadSaved(): Saved | null {
   try {
     const s = JSON.parse(localStorage.getItem(SAVED_KEY) ?? 'null') as Saved | null;
-    return s?.document?.version === 4 && Array.isArray(s.document.surface2d?.regions) ? s : null;
+    return is2d(s?.document) ? s : null;
   } catch {
     return null;
   }
@@ -129,6 +134,7 @@ export function mountSurface2d(root: HTMLElement): void {
   const fieldSel = h(
     'select',
     { id: 's2d-field' },
+    h('option', { value: 'tile' }, 'isotropic, tiled (fast; version 5)'),
     h('option', { value: 'spectral' }, 'isotropic (spectral field)'),
     h('option', { value: 'cells' }, 'texel cells'),
     h('option', { value: 'oriented' }, 'oriented grating'),
@@ -224,8 +230,8 @@ export function mountSurface2d(root: HTMLElement): void {
           label('Design of the fine texture', fieldSel),
           label('Grating direction (oriented)', orient, '°'),
           h('div', { class: 'btn-row' }, fromDesigner, saveDoc),
-          label('Open a version-4 .texel.json', openDoc),
-          label('Document (version 4)', docText),
+          label('Open a 2-D .texel.json (version 4 or 5)', openDoc),
+          label('Document', docText),
         ),
         h(
           'fieldset',
@@ -284,7 +290,7 @@ export function mountSurface2d(root: HTMLElement): void {
     if (![...deviceSel.options].some((o) => o.value === name))
       deviceSel.append(h('option', { value: name, 'data-inline': 'true', disabled: true }, `${name} (the document's own profile)`));
     deviceSel.value = name;
-    fieldSel.value = r.field ?? 'spectral';
+    fieldSel.value = r.field ?? (doc.version === 5 ? 'tile' : 'spectral');
     orient.value = String(r.orientation_deg ?? 0);
     (orient as HTMLInputElement).disabled = fieldSel.value !== 'oriented';
     const c = r.coarse2d ?? { kind: 'constant' };
@@ -565,6 +571,7 @@ export function mountSurface2d(root: HTMLElement): void {
   });
   fieldSel.addEventListener('change', () => {
     region().field = fieldSel.value as Field2D;
+    if (fieldSel.value === 'tile') doc.version = 5; // the tile field needs version 5; the others render alike in 4 and 5
     changed();
   });
   orient.addEventListener('change', () => {
@@ -584,7 +591,7 @@ export function mountSurface2d(root: HTMLElement): void {
     if (!f) return;
     try {
       const j = JSON.parse(await f.text()) as Surface2DDocument;
-      if (j?.version !== 4 || !Array.isArray(j.surface2d?.regions)) throw new Error(`${f.name} is not a version-4 2-D document`);
+      if (!is2d(j)) throw new Error(`${f.name} is not a 2-D document (version 4 or 5 with "surface2d")`);
       doc = j;
       view.fitNext = true;
       changed();

@@ -184,6 +184,15 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     assert.match(await page.textContent('#s2d-device'), /pad-150x100 \(the document's own profile\)/);
     await screenshot(page, 'surface2d-touch-pen');
 
+    // The tile field (version 5's default design): choosing it makes the document version 5, and the view renders it.
+    const tileViews = (await hooks(page)).viewsDrawn;
+    await page.selectOption('#s2d-field', 'tile');
+    await page.waitForFunction(() => /"version": 5/.test(document.querySelector('[data-testid=document2d-json]').value), null, { timeout: 10_000 });
+    assert.equal(JSON.parse(await page.inputValue('[data-testid=document2d-json]')).surface2d.regions[0].field, 'tile');
+    await page.waitForFunction((n) => window.__texel2d.viewsDrawn > n, tileViews, { timeout: 60_000 });
+    assert.equal(await page.getAttribute('[data-testid=surface2d-status]', 'class'), 'status', await page.textContent('[data-testid=surface2d-status]'));
+    await screenshot(page, 'surface2d-tile');
+
     // A two-finger pinch zooms in about the fingers.
     const mmPerPx = async () => Number(await page.getAttribute('[data-testid=map2d]', 'data-mm-per-px'));
     const pinchFrom = await mmPerPx();
