@@ -14,6 +14,7 @@ struct encode_args {
 static int take(const char* name, const mxArray* v, void* ctx) {
   struct encode_args* a = (struct encode_args*)ctx;
   texel_encode_options* o = &a->options;
+  if (tm_take_encode_option(name, v, o)) return 1;
   if (tm_is(name, "spacing_mm")) {
     a->spacing_mm = tm_scalar(name, v);
     a->has_spacing = 1;
@@ -21,14 +22,6 @@ static int take(const char* name, const mxArray* v, void* ctx) {
     a->device = tm_text(name, v);
   else if (tm_is(name, "swipe_speed_mm_s"))
     a->swipe_speed_mm_s = tm_scalar(name, v);
-  else if (tm_is(name, "boundary_mm"))
-    o->boundary_mm = tm_scalar(name, v);
-  else if (tm_is(name, "texel_length_mm"))
-    o->texel_length_mm = tm_scalar(name, v);
-  else if (tm_is(name, "parameterization"))
-    o->parameterization = tm_parameterization(v);
-  else if (tm_is(name, "seed"))
-    o->seed = tm_count(name, v);
   else if (tm_is(name, "coarse_bits")) {
     const uint64_t bits = tm_count(name, v);
     o->coarse_bits = bits > 1000 ? 1000u : (unsigned)bits; /* out of range either way: libtexel names it */
@@ -36,18 +29,7 @@ static int take(const char* name, const mxArray* v, void* ctx) {
     o->max_bytes = (size_t)tm_count(name, v);
   else if (tm_is(name, "recover_texel"))
     o->recover_texel = tm_scalar(name, v) != 0.0;
-  else if (tm_is(name, "target")) {
-    char* s = tm_text(name, v);
-    if (tm_is(s, "automatic"))
-      o->target = TEXEL_TARGET_AUTOMATIC;
-    else if (tm_is(s, "felt"))
-      o->target = TEXEL_TARGET_FELT;
-    else if (tm_is(s, "centroid"))
-      o->target = TEXEL_TARGET_CENTROID;
-    else
-      mexErrMsgIdAndTxt("texel:invalidArgument", "target '%s' is not one of automatic, felt, centroid", s);
-    mxFree(s);
-  } else
+  else
     return 0;
   return 1;
 }

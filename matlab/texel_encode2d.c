@@ -15,8 +15,8 @@ struct encode2d_args {
 
 static int take(const char* name, const mxArray* v, void* ctx) {
   struct encode2d_args* a = (struct encode2d_args*)ctx;
-  texel_encode_options* o = &a->options;
   char* s;
+  if (tm_take_encode_option(name, v, &a->options)) return 1;
   if (tm_is(name, "pitch_mm"))
     a->pitch_mm = tm_scalar(name, v);
   else if (tm_is(name, "device"))
@@ -42,25 +42,6 @@ static int take(const char* name, const mxArray* v, void* ctx) {
   else if (tm_is(name, "correction_rounds")) {
     const uint64_t n = tm_count(name, v);
     a->options2d.correction_rounds = n > 1000 ? 1000 : (int)n;
-  } else if (tm_is(name, "boundary_mm"))
-    o->boundary_mm = tm_scalar(name, v);
-  else if (tm_is(name, "texel_length_mm"))
-    o->texel_length_mm = tm_scalar(name, v);
-  else if (tm_is(name, "parameterization"))
-    o->parameterization = tm_parameterization(v);
-  else if (tm_is(name, "seed"))
-    o->seed = tm_count(name, v);
-  else if (tm_is(name, "target")) {
-    s = tm_text(name, v);
-    if (tm_is(s, "automatic"))
-      o->target = TEXEL_TARGET_AUTOMATIC;
-    else if (tm_is(s, "felt"))
-      o->target = TEXEL_TARGET_FELT;
-    else if (tm_is(s, "centroid"))
-      o->target = TEXEL_TARGET_CENTROID;
-    else
-      mexErrMsgIdAndTxt("texel:invalidArgument", "target '%s' is not one of automatic, felt, centroid", s);
-    mxFree(s);
   } else
     return 0;
   return 1;

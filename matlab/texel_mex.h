@@ -154,6 +154,35 @@ static texel_parameterization tm_parameterization(const mxArray* a) {
   return p;
 }
 
+/* The 1-D encoder's options every encoding function takes (texel_encode,
+ * texel_encode2d): boundary_mm, texel_length_mm, parameterization, seed,
+ * target. 1 if `name` is one of them (stored in *o), else 0. */
+static int tm_take_encode_option(const char* name, const mxArray* v, texel_encode_options* o) {
+  char* s;
+  if (tm_is(name, "boundary_mm"))
+    o->boundary_mm = tm_scalar(name, v);
+  else if (tm_is(name, "texel_length_mm"))
+    o->texel_length_mm = tm_scalar(name, v);
+  else if (tm_is(name, "parameterization"))
+    o->parameterization = tm_parameterization(v);
+  else if (tm_is(name, "seed"))
+    o->seed = tm_count(name, v);
+  else if (tm_is(name, "target")) {
+    s = tm_text(name, v);
+    if (tm_is(s, "automatic"))
+      o->target = TEXEL_TARGET_AUTOMATIC;
+    else if (tm_is(s, "felt"))
+      o->target = TEXEL_TARGET_FELT;
+    else if (tm_is(s, "centroid"))
+      o->target = TEXEL_TARGET_CENTROID;
+    else
+      mexErrMsgIdAndTxt("texel:invalidArgument", "target '%s' is not one of automatic, felt, centroid", s);
+    mxFree(s);
+  } else
+    return 0;
+  return 1;
+}
+
 static const char* tm_parameterization_name(texel_parameterization p) {
   return p == TEXEL_PARAMETERIZATION_LOG ? "log" : "moments";
 }

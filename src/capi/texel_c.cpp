@@ -407,6 +407,17 @@ texel_status create(Handle** out, Make&& make) {
   });
 }
 
+/// The 2-D encoder's settings from the C structs (NULL: the defaults).
+texel::codec::Encode2DConfig config2d_of(const texel_encode_options* options, const texel_encode2d_options* options2d) {
+  texel::codec::Encode2DConfig config;
+  if (options) config.encoder = config_of(*options);
+  if (options2d) {
+    config.directions = options2d->directions;
+    config.scan_samples = options2d->scan_samples;
+    config.correction_rounds = options2d->correction_rounds;
+  }
+  return config;
+}
 }  // namespace
 
 extern "C" {
@@ -1000,13 +1011,7 @@ texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_
       throw InvalidArgument("width_px and height_px are " + std::to_string(width_px) + " and " + std::to_string(height_px) +
                             "; both must be >= 1");
     need(amplitudes, "amplitudes");
-    texel::codec::Encode2DConfig config;
-    if (options) config.encoder = config_of(*options);
-    if (options2d) {
-      config.directions = options2d->directions;
-      config.scan_samples = options2d->scan_samples;
-      config.correction_rounds = options2d->correction_rounds;
-    }
+    texel::codec::Encode2DConfig config = config2d_of(options, options2d);
     texel::Raster2D map;
     map.width = width_px;
     map.height = height_px;
@@ -1029,13 +1034,7 @@ texel_status texel_encode_2d_file(const char* path, double pitch_mm, const char*
     if (polarity != -1 && polarity != TEXEL_DARKER_MORE_FRICTION && polarity != TEXEL_BRIGHTER_MORE_FRICTION)
       throw InvalidArgument("polarity is " + std::to_string(polarity) +
                             "; allowed: -1 (the device's), TEXEL_DARKER_MORE_FRICTION (0), TEXEL_BRIGHTER_MORE_FRICTION (1)");
-    texel::codec::Encode2DConfig config;
-    if (options) config.encoder = config_of(*options);
-    if (options2d) {
-      config.directions = options2d->directions;
-      config.scan_samples = options2d->scan_samples;
-      config.correction_rounds = options2d->correction_rounds;
-    }
+    texel::codec::Encode2DConfig config = config2d_of(options, options2d);
     texel::codec::Raster2DLoadOptions load;
     texel::SignalOptions signal;
     if (pitch_mm > 0.0) load.pitch = signal.spacing = texel::Millimetres(pitch_mm);
