@@ -70,55 +70,37 @@ std::function<bool(double)> feeder(P& player, std::vector<Sample> trace) {
   };
 }
 
-// The live finger: a display's FINGER reports, read on their own thread and
-// queued into the player at their place on the player's clock.
+// The live finger: a display's FINGER reports, read on their own thread
+// (ReportReader) and queued into the player at their place on the player's
+// clock.
 class LiveFinger {
  public:
   LiveFinger(SerialLink& link, PlayerBase& player, bool two_d) : link_(link), player_(player), two_d_(two_d) {}
-  ~LiveFinger() { stop(); }
   void start() {
-    thread_ = std::thread([this] { loop(); });
+    reader_.emplace(link_, [this](std::span<const FingerReport> batch) {
+      for (const FingerReport& r : batch) {
+        const double t = timeline_.place(r.t_us, player_.time_s());
+        const bool queued = two_d_ ? static_cast<Player2D&>(player_).push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})
+                                   : static_cast<Player&>(player_).push(FingerSample{t, r.x_mm, r.touch});
+        if (!queued) ++dropped_;
+        ++reports_;
+      }
+    });
   }
   void stop() {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
+    if (reader_) reader_->stop();
   }
-  [[nodiscard]] std::string error() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return error_;
-  }
+  [[nodiscard]] std::string error() const { return reader_ ? reader_->error() : std::string(); }
   [[nodiscard]] std::uint64_t reports() const { return reports_.load(); }
   [[nodiscard]] std::uint64_t dropped() const { return dropped_.load(); }
 
  private:
-  void loop() {
-    std::array<FingerReport, 64> buf;
-    ReportTimeline timeline;
-    try {
-      while (running_) {
-        const std::size_t n = link_.read_reports(buf, 5);
-        for (std::size_t i = 0; i < n; ++i) {
-          const FingerReport& r = buf[i];
-          const double t = timeline.place(r.t_us, player_.time_s());
-          const bool queued = two_d_ ? static_cast<Player2D&>(player_).push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})
-                                     : static_cast<Player&>(player_).push(FingerSample{t, r.x_mm, r.touch});
-          if (!queued) ++dropped_;
-          ++reports_;
-        }
-      }
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      error_ = e.what();
-    }
-  }
   SerialLink& link_;
   PlayerBase& player_;
   bool two_d_;
-  std::atomic<bool> running_{true};
+  ReportTimeline timeline_;  // the reader thread's
   std::atomic<std::uint64_t> reports_{0}, dropped_{0};
-  mutable std::mutex mutex_;
-  std::string error_;
-  std::thread thread_;
+  std::optional<ReportReader> reader_;  // last: stopped first
 };
 
 void run(const PlayArgs& a) {

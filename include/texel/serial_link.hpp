@@ -9,11 +9,15 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <mutex>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "texel/error.hpp"
@@ -169,6 +173,34 @@ class SerialLink {
   bool have_report_seq_ = false;
   std::uint8_t next_report_seq_ = 0;
   std::uint64_t reports_lost_ = 0;
+};
+
+/// A display's finger reports read on a thread of their own (the display
+/// was asked with SerialLink::start_reports): each batch that arrives is
+/// handed to `on_reports` on that thread, until stop() or destruction. A link
+/// error ends the thread and is kept (error()). The handler places reports on
+/// its player's clock (ReportTimeline) and queues them; it may check
+/// stopping() while it waits for a lock its stopper may hold.
+class ReportReader {
+ public:
+  using Handler = std::function<void(std::span<const FingerReport>)>;
+  ReportReader(SerialLink& link, Handler on_reports);
+  ~ReportReader() { stop(); }
+  ReportReader(const ReportReader&) = delete;
+  ReportReader& operator=(const ReportReader&) = delete;
+  /// Ends the thread (waits for the batch in hand). Idempotent.
+  void stop();
+  [[nodiscard]] bool stopping() const noexcept { return stop_.load(); }
+  /// The link's error that ended the thread; empty while it runs.
+  [[nodiscard]] std::string error() const;
+
+ private:
+  SerialLink& link_;
+  Handler on_reports_;
+  std::atomic<bool> stop_{false};
+  mutable std::mutex error_mutex_;
+  std::string error_;
+  std::thread thread_;
 };
 
 }  // namespace texel

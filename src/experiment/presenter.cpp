@@ -7,6 +7,8 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <span>
 #include <thread>
 
 #include "texel/detail/format.hpp"
@@ -46,36 +48,22 @@ struct Presenter::Display2D {
 
   void start(SerialLink& l) {
     link = &l;
-    running = true;
-    thread = std::thread([this] { loop(); });
+    reader.emplace(l, [this](std::span<const FingerReport> batch) {
+      std::lock_guard<std::mutex> lock(mutex);
+      for (const FingerReport& r : batch) {
+        const double t = timeline.place(r.t_us, player.time_s());
+        if (!player.push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) ++dropped;
+        ++reports;
+        last_t = clock.seconds(r.t_us);
+        if (!current.empty()) recorders.at(current).add(last_t, r.x_mm, r.y_mm, r.touch);
+      }
+    });
   }
   void stop() {
-    running = false;
-    if (thread.joinable()) thread.join();
+    if (reader) reader->stop();
   }
-
-  void loop() {
-    std::array<FingerReport, 64> buf;
-    ReportTimeline timeline;
-    ReportClock clock;
-    try {
-      while (running) {
-        const std::size_t n = link->read_reports(buf, 5);
-        std::lock_guard<std::mutex> lock(mutex);
-        for (std::size_t i = 0; i < n; ++i) {
-          const FingerReport& r = buf[i];
-          const double t = timeline.place(r.t_us, player.time_s());
-          if (!player.push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) ++dropped;
-          ++reports;
-          last_t = clock.seconds(r.t_us);
-          if (!current.empty()) recorders.at(current).add(last_t, r.x_mm, r.y_mm, r.touch);
-        }
-      }
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lock(mutex);
-      error = e.what();
-    }
-  }
+  [[nodiscard]] bool running() const { return reader && !reader->stopping(); }
+  [[nodiscard]] std::string error() const { return reader ? reader->error() : std::string(); }
 
   // Stops recording into the current interval (its stroke in progress ends).
   void leave() {
@@ -125,14 +113,14 @@ struct Presenter::Display2D {
   SerialLink* link = nullptr;
   std::unique_ptr<SerialLink> own_link;
   std::list<std::pair<std::string, std::unique_ptr<const PlayerMap2D>>> cache;
-  std::thread thread;
-  std::atomic<bool> running{false};
+  ReportTimeline timeline;   // the reader's
+  ReportClock clock;         // the reader's
   mutable std::mutex mutex;  // guards what follows (the reader thread writes it)
   std::map<std::string, StrokeRecorder> recorders;
   std::string current;  // the interval being recorded
   double last_t = 0.0;
   std::uint64_t reports = 0, dropped = 0;
-  std::string error;
+  std::optional<ReportReader> reader;  // last: stopped first
 };
 
 Presenter::Presenter(const PresenterOptions& options) : options_(options) {
@@ -210,9 +198,9 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
 Presenter::~Presenter() { stop(); }
 
 void Presenter::stop() {
-  if (display_ && display_->running) {
+  if (display_ && display_->running()) {
     display_->stop();
-    if (display_->error.empty()) try {
+    if (display_->error().empty()) try {
         display_->link->start_reports(0);  // the display stops reporting
       } catch (const Error&) {
         // Already gone: nothing to stop.
@@ -345,10 +333,7 @@ std::string Presenter::describe() const { return backend_->describe(); }
 double Presenter::block_period_s() const { return period_s_; }
 std::string Presenter::error() const {
   std::string e = backend_->error();
-  if (e.empty() && display_) {
-    std::lock_guard<std::mutex> lock(display_->mutex);
-    e = display_->error;
-  }
+  if (e.empty() && display_) e = display_->error();
   return e;
 }
 

@@ -2,6 +2,7 @@
 #include "texel/serial_link.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -273,6 +274,31 @@ std::size_t SerialLink::read_reports(std::span<FingerReport> out, int wait_ms) {
   std::copy_n(pending_.begin(), k, out.begin());
   pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(k));
   return k;
+}
+
+ReportReader::ReportReader(SerialLink& link, Handler on_reports) : link_(link), on_reports_(std::move(on_reports)) {
+  thread_ = std::thread([this] {
+    std::array<FingerReport, 64> buf;
+    try {
+      while (!stop_) {
+        const std::size_t n = link_.read_reports(buf, 5);
+        if (n > 0) on_reports_(std::span<const FingerReport>(buf.data(), n));
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(error_mutex_);
+      error_ = e.what();
+    }
+  });
+}
+
+void ReportReader::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+std::string ReportReader::error() const {
+  std::lock_guard lock(error_mutex_);
+  return error_;
 }
 
 }  // namespace texel

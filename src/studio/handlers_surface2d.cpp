@@ -18,8 +18,9 @@
 // sound card: a new stream). The Presenter plays on a null backend while the
 // pad holds the device, so every 1-D message keeps working. With `--backend
 // null` nothing is shared: the pad has its own null backend, as before.
-// A serial display's own finger reports (protocol 1.1) are not read here:
-// the pad's pointer is the finger (docs/studio.md).
+// A serial display that reports its own finger (protocol 1.1) drives the
+// pad's player with it while the pad holds the display; the pad shows it
+// (docs/studio.md).
 //
 // Coarse images: the studio reads no file a client names. A document whose
 // coarse2d is an `image` sends the PNG's bytes with the message (`images`:
@@ -35,6 +36,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <span>
 #include <thread>
 
 #include <unistd.h>
@@ -96,14 +99,13 @@ struct Surface2DState {
   // that reports it, a reader thread places each report on the player's clock
   // and pushes it (under State::feel_mutex), and the pad only shows it.
   bool display_finger = false;
-  std::thread reader;
-  std::atomic<bool> reader_stop{false};
   std::uint64_t reports = 0;                // pushed so far
   double display_x = 0.0, display_y = 0.0;  // the newest report
   bool display_touch = false;
   std::vector<std::array<double, 3>> trail;  // reports since the last feel2d.state: x, y, touch (bounded)
-  std::mutex reader_error_mutex;             // not feel_mutex: its holder may be joining the reader
-  std::string reader_error;
+  ReportTimeline timeline;                   // the reader's
+  std::atomic<bool> reader_stop{false};      // the reader gives up waiting for feel_mutex
+  std::optional<ReportReader> reader;        // its error stays readable until the next reader starts
 
   Surface2DState() = default;
   Surface2DState(const Surface2DState&) = delete;
@@ -112,7 +114,7 @@ struct Surface2DState {
   /// Stops the reader thread (the caller may hold feel_mutex: the reader never waits on it).
   void stop_reader() {
     reader_stop = true;
-    if (reader.joinable()) reader.join();
+    if (reader) reader->stop();
     reader_stop = false;
   }
 };
@@ -162,7 +164,8 @@ std::shared_ptr<const Prepared> prepared(State& s, const Fields& f, const std::s
     std::lock_guard lock(st->cache_mutex);
     if (st->cache && st->cache_key == key) return st->cache;
   }
-  if (!doc.contains("surface2d")) throw Reject{"invalid", type + ": document is not a 2-D document (version 4 or 5 with surface2d)"};
+  if (!doc.contains("surface2d"))
+    throw Reject{"invalid", type + ": document is not a 2-D document (version 4 or 5 with surface2d)"};
   auto p = std::make_shared<Prepared>();
   // Every image path must name one of the images sent; each is rewritten to its temporary copy.
   json* regions = doc["surface2d"].is_object() && doc["surface2d"].contains("regions") ? &doc["surface2d"]["regions"] : nullptr;
@@ -358,35 +361,24 @@ bool asks_for_reports(SerialLink* link) {
 
 /// The display's finger reports → the pad's player, until stop_reader().
 void start_reader(State& s, Surface2DState& st) {
-  SerialLink* link = st.backend->serial_link();
-  st.reader = std::thread([&s, &st, link] {
-    std::array<FingerReport, 64> buf;
-    ReportTimeline timeline;
-    try {
-      while (!st.reader_stop) {
-        const std::size_t n = link->read_reports(buf, 5);
-        if (n == 0) continue;
-        // Whoever holds feel_mutex may be stopping this thread: never block on it.
-        std::unique_lock lock(s.feel_mutex, std::defer_lock);
-        while (!st.reader_stop && !lock.try_lock()) std::this_thread::sleep_for(std::chrono::microseconds(100));
-        if (st.reader_stop) break;
-        for (std::size_t i = 0; i < n; ++i) {
-          const FingerReport& r = buf[i];
-          const double t = std::max(st.last_t, timeline.place(r.t_us, st.player->time_s()));
-          if (!st.player->push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) continue;  // full: the next report follows
-          st.last_t = t;
-          ++st.reports;
-          st.display_x = r.x_mm;
-          st.display_y = r.y_mm;
-          st.display_touch = r.touch;
-          if (st.trail.size() < max_trail) st.trail.push_back({r.x_mm, r.y_mm, r.touch ? 1.0 : 0.0});
-        }
-        st.player->collect();
-      }
-    } catch (const std::exception& e) {
-      std::lock_guard lock(st.reader_error_mutex);  // the link is gone
-      st.reader_error = e.what();
+  st.reader.reset();  // the previous reader, already stopped
+  st.timeline = ReportTimeline{};
+  st.reader.emplace(*st.backend->serial_link(), [&s, &st](std::span<const FingerReport> batch) {
+    // Whoever holds feel_mutex may be stopping this thread: never block on it.
+    std::unique_lock lock(s.feel_mutex, std::defer_lock);
+    while (!st.reader_stop && !lock.try_lock()) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    if (st.reader_stop) return;
+    for (const FingerReport& r : batch) {
+      const double t = std::max(st.last_t, st.timeline.place(r.t_us, st.player->time_s()));
+      if (!st.player->push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) continue;  // full: the next report follows
+      st.last_t = t;
+      ++st.reports;
+      st.display_x = r.x_mm;
+      st.display_y = r.y_mm;
+      st.display_touch = r.touch;
+      if (st.trail.size() < max_trail) st.trail.push_back({r.x_mm, r.y_mm, r.touch ? 1.0 : 0.0});
     }
+    st.player->collect();
   });
 }
 
@@ -573,10 +565,7 @@ void on_feel2d_state(State& s, Client& c, const Job& job) {
   r["holds_device"] = s.device_shared ? s.feel2d_holds_device : st->backend != nullptr;
   std::string error = st->backend ? st->backend->error() : std::string();
   if (error.empty()) error = s.device_error;
-  if (error.empty()) {
-    std::lock_guard error_lock(st->reader_error_mutex);
-    error = st->reader_error;
-  }
+  if (error.empty() && st->reader) error = st->reader->error();
   r["error"] = error;
   // Who moves the finger: the pad's pointer, or the display's own sensor (its reports since the last state).
   r["finger"] = st->display_finger ? "display" : "pad";
