@@ -5,7 +5,7 @@
 // render (the field's preparation included). Goal (issue #26): ratio ≤ 4,
 // peak ≤ 64 MB.
 //
-//   texel_bench_bitmap_2d [directory] [size] [tile|spectral|cells]
+//   texel_bench_bitmap_2d [directory] [size] [tile|spectral|cells] [rows per strip]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -55,10 +55,15 @@ int main(int argc, char** argv) {
   auto t0 = std::chrono::steady_clock::now();
   const pid_t child = fork();
   if (child == 0) {
+    const auto c0 = std::chrono::steady_clock::now();
     const Surface2D surface = prepare_surface2d(doc);
-    const BitmapFileStats st = write_bitmap(png, surface);
-    std::printf("bitmap: %d x %d, %d bit, %zu pixel bytes, field %s\n", st.width, st.height, st.depth, st.bytes,
-                std::string(to_string(region.field)).c_str());
+    const double prepare_s = seconds_since(c0);
+    BitmapFileOptions options;
+    if (argc > 4) options.rows_per_strip = std::atoi(argv[4]);
+    const BitmapFileStats st = write_bitmap(png, surface, options);
+    std::printf("bitmap: %d x %d, %d bit, %zu pixel bytes, field %s; prepare %.3f s, render and write %.3f s\n", st.width,
+                st.height, st.depth, st.bytes, std::string(to_string(region.field)).c_str(), prepare_s,
+                seconds_since(c0) - prepare_s);
     std::fflush(stdout);
     _exit(0);
   }

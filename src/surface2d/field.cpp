@@ -3,9 +3,14 @@
 #include <cmath>
 #include <cstring>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 #include "internal.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/detail/lanes.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/random.hpp"
@@ -263,6 +268,101 @@ inline double tap_column(const double* w, double c0, double c1, double c2, doubl
   return w[0] * c0 + w[1] * c1 + w[2] * c2 + w[3] * c3;
 }
 
+// block()'s tile kernels with explicit lanes, each lane doing tap_row's or
+// tap_column's operations in their order (so every width gives value()'s
+// bits). The x taps of a chunk of columns are structure-of-arrays: first
+// sample ix[k], weights w[d·wstride + k].
+
+/// A tile row's x taps over n columns: dst[k] = tap_row(row, ix[k], w·k).
+/// AVX2 and AVX-512 gather the four samples of W columns at a time.
+void tile_x_from(const float* row, const std::int64_t* ix, const double* w, std::size_t wstride, double* dst, std::size_t n,
+                 std::size_t k) {
+  for (; k < n; ++k) {
+    const float* s = row + (ix[k] & tile_mask);
+    dst[k] = w[k] * s[0] + w[wstride + k] * s[1] + w[2 * wstride + k] * s[2] + w[3 * wstride + k] * s[3];
+  }
+}
+#if defined(__x86_64__) || defined(__i386__)
+// GCC 12 warns of the intrinsics' own undefined pass-through vectors.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+__attribute__((target("avx512f"))) void tile_x_avx512(const float* row, const std::int64_t* ix, const double* w,
+                                                      std::size_t wstride, double* dst, std::size_t n) {
+  const __m512i mask = _mm512_set1_epi64(tile_mask);
+  std::size_t k = 0;
+  for (; k + 8 <= n; k += 8) {
+    const __m512i i = _mm512_and_si512(_mm512_loadu_si512(ix + k), mask);
+    __m512d acc = _mm512_mul_pd(_mm512_loadu_pd(w + k), _mm512_cvtps_pd(_mm512_i64gather_ps(i, row, 4)));
+    for (std::size_t d = 1; d < 4; ++d)
+      acc = _mm512_add_pd(
+          acc, _mm512_mul_pd(_mm512_loadu_pd(w + d * wstride + k), _mm512_cvtps_pd(_mm512_i64gather_ps(i, row + d, 4))));
+    _mm512_storeu_pd(dst + k, acc);
+  }
+  tile_x_from(row, ix, w, wstride, dst, n, k);
+}
+__attribute__((target("avx2"))) void tile_x_avx2(const float* row, const std::int64_t* ix, const double* w, std::size_t wstride,
+                                                 double* dst, std::size_t n) {
+  const __m256i mask = _mm256_set1_epi64x(tile_mask);
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const __m256i i = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ix + k)), mask);
+    __m256d acc = _mm256_mul_pd(_mm256_loadu_pd(w + k), _mm256_cvtps_pd(_mm256_i64gather_ps(row, i, 4)));
+    for (std::size_t d = 1; d < 4; ++d)
+      acc = _mm256_add_pd(
+          acc, _mm256_mul_pd(_mm256_loadu_pd(w + d * wstride + k), _mm256_cvtps_pd(_mm256_i64gather_ps(row + d, i, 4))));
+    _mm256_storeu_pd(dst + k, acc);
+  }
+  tile_x_from(row, ix, w, wstride, dst, n, k);
+}
+#pragma GCC diagnostic pop
+#endif
+void tile_x_generic(const float* row, const std::int64_t* ix, const double* w, std::size_t wstride, double* dst, std::size_t n) {
+  tile_x_from(row, ix, w, wstride, dst, n, 0);
+}
+
+/// A pixel row's y taps over four x-interpolated rows a0 … a3 (a·n apart):
+/// o[k] = 0.0 + tap_column (the first band: value()'s sum starts at 0.0) or
+/// o[k] += tap_column; the last band clamps to [−1, 1] as std::clamp does.
+template <int W>
+[[gnu::always_inline]] inline void tile_y_lanes(const double* w, const double* a, std::size_t n, double* o, bool first_band,
+                                                bool last_band) {
+  using V = typename detail::Lanes<W>::type;
+  const double *a0 = a, *a1 = a + n, *a2 = a + 2 * n, *a3 = a + 3 * n;
+  const V w0 = V{} + w[0], w1 = V{} + w[1], w2 = V{} + w[2], w3 = V{} + w[3], lo = V{} - 1.0, hi = V{} + 1.0;
+  const auto load = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  std::size_t k = 0;
+  for (; k + W <= n; k += W) {
+    const V c = w0 * load(a0 + k) + w1 * load(a1 + k) + w2 * load(a2 + k) + w3 * load(a3 + k);
+    V v = first_band ? 0.0 + c : load(o + k) + c;
+    if (last_band) v = v < lo ? lo : (hi < v ? hi : v);
+    std::memcpy(o + k, &v, sizeof v);
+  }
+  for (; k < n; ++k) {
+    const double c = tap_column(w, a0[k], a1[k], a2[k], a3[k]);
+    const double v = first_band ? 0.0 + c : o[k] + c;
+    o[k] = last_band ? std::clamp(v, -1.0, 1.0) : v;
+  }
+}
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx512f"))) void tile_y_avx512(const double* w, const double* a, std::size_t n, double* o, bool first,
+                                                      bool last) {
+  tile_y_lanes<8>(w, a, n, o, first, last);
+}
+__attribute__((target("avx2"))) void tile_y_avx2(const double* w, const double* a, std::size_t n, double* o, bool first,
+                                                 bool last) {
+  tile_y_lanes<4>(w, a, n, o, first, last);
+}
+#endif
+void tile_y_generic(const double* w, const double* a, std::size_t n, double* o, bool first, bool last) {
+  tile_y_lanes<2>(w, a, n, o, first, last);
+}
+using TileXKernel = void (*)(const float*, const std::int64_t*, const double*, std::size_t, double*, std::size_t);
+using TileYKernel = void (*)(const double*, const double*, std::size_t, double*, bool, bool);
+
 /// A radix-2 inverse complex FFT (x_j = Σ_k X_k e^{+2πijk/n}) of a power-of-two
 /// length, twiddles from detmath: the same bits on every build.
 class InverseFft {
@@ -498,22 +598,28 @@ void FineField2D::build_tiles(const PitchDistribution& line) {
     }
     // Along y (n → row j) per column, then along x (m → sample i) per row;
     // the tile is the real part.
-    for (std::size_t c = 0; c < nc; ++c) fft(re.data() + c * tile_n, im.data() + c * tile_n);
+    // Each transform is independent: they are spread over the library's
+    // threads (the same operations in any order: the same bits).
+    const int workers = detail::worker_threads(8);
+    detail::parallel_tasks(workers, nc, [&](std::size_t, std::size_t c) { fft(re.data() + c * tile_n, im.data() + c * tile_n); });
     t.samples.assign(tile_n * tile_row, 0.0F);
-    std::vector<double> xr(tile_n), xi(tile_n);
-    for (std::size_t j = 0; j < tile_n; ++j) {
-      std::fill(xr.begin(), xr.end(), 0.0);
-      std::fill(xi.begin(), xi.end(), 0.0);
-      for (std::size_t c = 0; c < nc; ++c) {
-        const auto i = static_cast<std::size_t>(columns[c] & tile_mask);
-        xr[i] = re[c * tile_n + j];
-        xi[i] = im[c * tile_n + j];
+    const auto parts = static_cast<std::size_t>(std::max(workers, 1));
+    detail::parallel_tasks(workers, parts, [&](std::size_t, std::size_t part) {
+      std::vector<double> xr(tile_n), xi(tile_n);
+      for (std::size_t j = tile_n * part / parts; j < tile_n * (part + 1) / parts; ++j) {
+        std::fill(xr.begin(), xr.end(), 0.0);
+        std::fill(xi.begin(), xi.end(), 0.0);
+        for (std::size_t c = 0; c < nc; ++c) {
+          const auto i = static_cast<std::size_t>(columns[c] & tile_mask);
+          xr[i] = re[c * tile_n + j];
+          xi[i] = im[c * tile_n + j];
+        }
+        fft(xr.data(), xi.data());
+        float* row = t.samples.data() + j * tile_row;
+        for (std::size_t i = 0; i < tile_n; ++i) row[i] = static_cast<float>(xr[i]);
+        for (std::size_t i = 0; i < 3; ++i) row[tile_n + i] = row[i];
       }
-      fft(xr.data(), xi.data());
-      float* row = t.samples.data() + j * tile_row;
-      for (std::size_t i = 0; i < tile_n; ++i) row[i] = static_cast<float>(xr[i]);
-      for (std::size_t i = 0; i < 3; ++i) row[tile_n + i] = row[i];
-    }
+    });
     tiles_.push_back(std::move(t));
   }
 }
@@ -531,12 +637,13 @@ void FineField2D::tile_block(std::int64_t first, std::size_t count, double pitch
   // block's rows reach interpolated along x once each, then every pixel row
   // a vector of y taps over them (value()'s operations: x first, then y).
   constexpr std::size_t chunk = 512;
+  static const TileXKernel tile_x = widest<TileXKernel>(TEXEL_LANE_KERNELS(tile_x));
+  static const TileYKernel tile_y = widest<TileYKernel>(TEXEL_LANE_KERNELS(tile_y));
   std::vector<std::int64_t> ix(chunk);
-  std::vector<double> wx(4 * chunk), xrows;
+  std::vector<double> wx(4 * chunk), xrows;  // wx[d·chunk + k]
   std::vector<Taps> ty(rows);
   for (const Tile& t : tiles_) {
-    // value()'s sum starts at 0.0: the first band's 0.0 + b (b, but −0 → +0).
-    const bool first_band = &t == tiles_.data();
+    const bool first_band = &t == tiles_.data(), last_band = &t == &tiles_.back();
     std::int64_t j_lo = 0, j_hi = -1;
     for (std::size_t r = 0; r < rows; ++r) {
       ty[r] = taps(ys[r], t.inv_spacing);
@@ -551,21 +658,13 @@ void FineField2D::tile_block(std::int64_t first, std::size_t count, double pitch
         const double x = static_cast<double>(first + static_cast<std::int64_t>(c0 + k)) * pitch - origin_x;
         const Taps tx = taps(x, t.inv_spacing);
         ix[k] = tx.first;
-        std::copy(tx.w, tx.w + 4, wx.begin() + static_cast<std::ptrdiff_t>(4 * k));
+        for (std::size_t d = 0; d < 4; ++d) wx[d * chunk + k] = tx.w[d];
       }
       const auto along_x = [&](std::int64_t j, double* dst) {
-        const float* row = t.samples.data() + static_cast<std::size_t>(j & tile_mask) * tile_row;
-        for (std::size_t k = 0; k < n; ++k) dst[k] = tap_row(row, ix[k], wx.data() + 4 * k);
+        tile_x(t.samples.data() + static_cast<std::size_t>(j & tile_mask) * tile_row, ix.data(), wx.data(), chunk, dst, n);
       };
       const auto along_y = [&](std::size_t r, const double* a) {
-        double* o = out + r * stride + c0;
-        const double* w = ty[r].w;
-        const double *a0 = a, *a1 = a + n, *a2 = a + 2 * n, *a3 = a + 3 * n;
-        if (first_band) {
-          for (std::size_t k = 0; k < n; ++k) o[k] = 0.0 + tap_column(w, a0[k], a1[k], a2[k], a3[k]);
-        } else {
-          for (std::size_t k = 0; k < n; ++k) o[k] += tap_column(w, a0[k], a1[k], a2[k], a3[k]);
-        }
+        tile_y(ty[r].w, a, n, out + r * stride + c0, first_band, last_band);
       };
       if (shared) {
         xrows.resize(static_cast<std::size_t>(j_hi - j_lo + 1) * n);
@@ -580,8 +679,6 @@ void FineField2D::tile_block(std::int64_t first, std::size_t count, double pitch
       }
     }
   }
-  for (std::size_t r = 0; r < rows; ++r)
-    for (double& v : std::span<double>(out + r * stride, count)) v = std::clamp(v, -1.0, 1.0);
 }
 
 FineField2D::Cell FineField2D::cell(std::int64_t m, std::int64_t n) const {
