@@ -284,8 +284,10 @@ void tile_x_from(const float* row, const std::int64_t* ix, const double* w, std:
 }
 #if defined(__x86_64__) || defined(__i386__)
 // GCC 12 warns of the intrinsics' own undefined pass-through vectors.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 __attribute__((target("avx512f"))) void tile_x_avx512(const float* row, const std::int64_t* ix, const double* w,
                                                       std::size_t wstride, double* dst, std::size_t n) {
   const __m512i mask = _mm512_set1_epi64(tile_mask);
@@ -314,7 +316,9 @@ __attribute__((target("avx2"))) void tile_x_avx2(const float* row, const std::in
   }
   tile_x_from(row, ix, w, wstride, dst, n, k);
 }
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 #endif
 void tile_x_generic(const float* row, const std::int64_t* ix, const double* w, std::size_t wstride, double* dst, std::size_t n) {
   tile_x_from(row, ix, w, wstride, dst, n, 0);
