@@ -32,8 +32,8 @@ namespace ex = texel::experiment;
 // does, and stored with the answer. Bound to one hand-out token: a new
 // question (or a restarted trial) starts from no strokes.
 struct Strokes2DState {
-  std::string token;  // the hand-out these strokes belong to
-  int selected = -1;  // the interval playing (index into Question::stimuli)
+  std::string token;                                    // the hand-out these strokes belong to
+  int selected = -1;                                    // the interval playing (index into Question::stimuli)
   std::map<std::string, ex::StrokeRecorder> recorders;  // by stimulus label
   double last_t_s = 0.0;                                // the newest sample, page seconds
   ReportTimeline timeline;                              // the page's clock onto the player's
@@ -78,8 +78,8 @@ std::unique_ptr<const PlayerMap2D> surface_map(Strokes2DState& st, const ex::Sur
     if (s.kind == ex::SurfaceStimulus::Kind::bitmap)
       m = PlayerMap2D::bitmap(render_raster(prepare_surface2d(doc)), doc.device.response);
     else
-      m = PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)},
-                                    std::nullopt, Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0,
+      m = PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)}, std::nullopt,
+                                    Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0,
                                     doc.device.response);
     st.maps.emplace_front(key, std::move(m));
     if (st.maps.size() > surface_cache_size) st.maps.pop_back();
@@ -374,8 +374,8 @@ void on_experiment_select(State& s, Client& c, const Job& job) {
       it->second.add(st.last_t_s, 0.0, 0.0, false);  // its stroke in progress ends here
       const ex::IntervalStrokes last = it->second.summary(was, q.surfaces[k].direction_deg);
       if (last.strokes > 0 && !last.compliant)
-        r["reminder"] = "You stroked " + stimulus_words(was) + " along another line than its own: " +
-                        ex::direction_words(q.surfaces[k].direction_deg) + ".";
+        r["reminder"] = "You stroked " + stimulus_words(was) +
+                        " along another line than its own: " + ex::direction_words(q.surfaces[k].direction_deg) + ".";
     }
   }
   st.selected = static_cast<int>(i);
