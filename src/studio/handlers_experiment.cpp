@@ -65,14 +65,14 @@ Strokes2DState& strokes_of(State& s) {
   return st;
 }
 
-/// The player map of a 2-D interval (path-indexed, or the static field's friction bitmap), cached.
-std::unique_ptr<const PlayerMap2D> surface_map(Strokes2DState& st, const ex::SurfaceStimulus& s) {
+/// The player map of a 2-D interval (path-indexed, or the static field's friction bitmap), rendered once (cached).
+const PlayerMap2D& surface_map(Strokes2DState& st, const ex::SurfaceStimulus& s) {
   const std::string key = std::string(s.kind == ex::SurfaceStimulus::Kind::bitmap ? "b" : "p") + s.document_json;
   auto it = std::find_if(st.maps.begin(), st.maps.end(), [&](const auto& e) { return e.first == key; });
   if (it == st.maps.end()) {
     const Document doc = parse_document(s.document_json, "stimulus surface");
     if (!doc.surface2d || doc.surface2d->regions.size() != 1 || !doc.device.bitmap)
-      throw Reject{"internal", "experiment.select: a stimulus surface is not a 2-D document of one region on a display"};
+      throw Reject{"internal", "a stimulus surface is not a 2-D document of one region on a display"};
     const BitmapGeometry& g = *doc.device.bitmap;
     std::shared_ptr<const PlayerMap2D> m;
     if (s.kind == ex::SurfaceStimulus::Kind::bitmap)
@@ -88,7 +88,14 @@ std::unique_ptr<const PlayerMap2D> surface_map(Strokes2DState& st, const ex::Sur
     st.maps.splice(st.maps.begin(), st.maps, it);
     it = st.maps.begin();
   }
-  return std::make_unique<const PlayerMap2D>(*it->second);
+  return *it->second;
+}
+
+/// Renders a 2-D question's surfaces ahead (as the terminal prepares them
+/// before the trial's clock starts), so its onset, and so its reaction time,
+/// does not include a bitmap's rendering and switching intervals costs a copy.
+void prepare_surfaces(State& s, const ex::Question& q) {
+  for (const auto& surface : q.surfaces) (void)surface_map(*s.strokes2d, surface);
 }
 
 /// The question's intervals as the participant stroked them (one per stimulus, as Presenter::strokes).
@@ -176,7 +183,8 @@ ojson current_state(State& s, const json& id, bool screen, bool reload = false) 
   if (!s.active->session.finished() && !s.active->suspended) {
     const ex::Question& q = s.active->session.question();
     r["question"] = participant_question(q);
-    if (!q.surfaces.empty()) r["surface"] = surface_size_json(q);  // the page is the touch surface
+    if (!q.surfaces.empty()) r["surface"] = surface_size_json(q);      // the page is the touch surface
+    if (screen && s.active->simulate.empty()) prepare_surfaces(s, q);  // before the hand-out starts the trial's clock
     r["handout"] = handout_json(!screen ? ex::peek(*s.active) : reload ? ex::reload(*s.active) : ex::hand_out(*s.active));
   }
   return r;
@@ -366,7 +374,7 @@ void on_experiment_select(State& s, Client& c, const Job& job) {
   // A 2-D interval: the participant's page strokes it (experiment.stroke). Leaving an interval
   // stroked along another line brings one plain reminder (about the stroke, nothing of the trial).
   Strokes2DState& st = strokes_of(s);
-  auto map = surface_map(st, q.surfaces[i]);  // rendered before the device is taken
+  auto map = std::make_unique<const PlayerMap2D>(surface_map(st, q.surfaces[i]));  // before the device is taken
   if (st.selected >= 0 && static_cast<std::size_t>(st.selected) != i) {
     const auto k = static_cast<std::size_t>(st.selected);
     const std::string& was = q.stimuli[k].label;

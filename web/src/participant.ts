@@ -579,6 +579,8 @@ export function mountParticipant(root: HTMLElement): void {
       if (submit.disabled) return;
       trial.update({ saving: true });
       submit.textContent = 'Saving…';
+      // A 2-D study's next textures are prepared before its clock starts (a bitmap takes seconds the first time).
+      if (surface) timers.push(setTimeout(() => current() && trial.get().saving && (submit.textContent = 'Please wait: preparing the next textures…'), 1500));
       const answer = trial.get().answer;
       ev('answer', answer.choice ?? (answer.rating !== undefined ? String(answer.rating) : 'sliders'));
       // Every stroke sample reaches the studio before the answer (one lane, in order).
