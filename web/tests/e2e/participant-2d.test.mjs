@@ -9,20 +9,9 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { mkdtempSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths } from './studio.mjs';
-import { control } from './participant-helpers.mjs';
-
-function exportRows(db) {
-  const out = join(mkdtempSync(join(tmpdir(), 'texel-export-')), 'x.csv');
-  const r = spawnSync(paths.bin, ['experiment', 'export', '--db', db, '-o', out], { encoding: 'utf8' });
-  assert.equal(r.status, 0, r.stderr);
-  const [head, ...lines] = readFileSync(out, 'utf8').trim().split('\n');
-  const cols = head.split(',');
-  return lines.map((l) => Object.fromEntries(l.split(',').map((v, i) => [cols[i], v])));
-}
+import { withStudio, screenshot } from './studio.mjs';
+import { control, exportRows } from './participant-helpers.mjs';
 
 /** The stored responses (response_json) of the store's trials, by trial, and the events stored with them. */
 function storedResponses(db) {
