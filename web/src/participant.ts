@@ -187,8 +187,12 @@ class StrokeSurface {
     }
   }
 
-  /** A lifted finger ends the stroke (switching intervals, answering). */
+  /** Lifts a finger still down (switching intervals, answering): the stroke ends and the player rests. */
   lift(): void {
+    if (this.last && this.interval >= 0) {
+      this.queue.push([performance.now(), this.last[0], this.last[1], false]);
+      this.pump();
+    }
     this.pointer = null;
     this.last = null;
   }

@@ -101,6 +101,7 @@ test('participant page, 2-D study: strokes on the page drive the 2-D player and 
     const notice = p.locator('[data-testid=participant-notice]');
     await notice.waitFor({ state: 'visible' });
     assert.match(await notice.textContent(), /You stroked texture 2 along another line than its own: /);
+    await screenshot(p, 'participant-2d-tablet-reminder');
     await strokeAlong(p, lines[2], pen);
     await p.waitForFunction(() => window.__texelStrokes.samplesRecorded === window.__texelStrokes.samplesSent, null, { timeout: 10_000 });
     const sent = await strokes(p);
