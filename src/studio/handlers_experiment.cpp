@@ -36,7 +36,9 @@ struct Strokes2DState {
   int selected = -1;                                    // the interval playing (index into Question::stimuli)
   std::map<std::string, ex::StrokeRecorder> recorders;  // by stimulus label
   double last_t_s = 0.0;                                // the newest sample, page seconds
-  ReportTimeline timeline;                              // the page's clock onto the player's
+  // The page's clock onto the player's, for one page (a reloaded page's clock starts again).
+  ReportTimeline timeline;
+  std::uint64_t page = 0;  // the connection whose clock the timeline follows
   // Rendered surfaces (a friction bitmap of the display takes a fraction of a
   // second): every static field of a shipped 2-D protocol renders once.
   std::list<std::pair<std::string, std::shared_ptr<const PlayerMap2D>>> maps;
@@ -61,6 +63,7 @@ Strokes2DState& strokes_of(State& s) {
     st.recorders.clear();
     st.last_t_s = 0.0;
     st.timeline = ReportTimeline{};
+    st.page = 0;
   }
   return st;
 }
@@ -536,14 +539,23 @@ void on_experiment_stroke(State& s, Client& c, const Job& job) {
     parsed.push_back({t_ms, x, y, e[3].get<bool>()});
   }
   ex::StrokeRecorder& rec = st.recorders.at(q.stimuli[static_cast<std::size_t>(stimulus)].label);
+  if (st.page != c.id || (!parsed.empty() && parsed.front().t_ms < st.last_t_s * 1000.0 - 1000.0)) {
+    // Another page (or this one reloaded): its own clock. The stroke in progress ends.
+    rec.add(st.last_t_s, 0.0, 0.0, false);
+    st.timeline = ReportTimeline{};
+    st.page = c.id;
+    st.last_t_s = parsed.empty() ? 0.0 : parsed.front().t_ms / 1000.0;
+  }
   std::size_t played = 0;
   {
     std::lock_guard lock(s.feel_mutex);
     for (const Sample& p : parsed) {
-      rec.add(p.t_ms / 1000.0, p.x, p.y, p.touch);
-      st.last_t_s = p.t_ms / 1000.0;
+      // Never backwards: the timeline reads a step back as its clock's wrap.
+      const double t_s = std::max(p.t_ms / 1000.0, st.last_t_s);
+      rec.add(t_s, p.x, p.y, p.touch);
+      st.last_t_s = t_s;
       // The page's clock placed on the player's (as a display's reports): due a little after arrival.
-      const auto t_us = static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(p.t_ms * 1000.0)) & 0xffffffffu);
+      const auto t_us = static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(t_s * 1e6)) & 0xffffffffu);
       const double t = st.timeline.place(t_us, pad_time_s(s) + page_lead_s);
       if (pad_push(s, c.id, t, p.x, p.y, p.touch)) ++played;
     }
