@@ -39,8 +39,8 @@ struct Strokes2DState {
   // The page's clock onto the player's, for one page (a reloaded page's clock starts again).
   ReportTimeline timeline;
   std::uint64_t page = 0;  // the connection whose clock the timeline follows
-  // Rendered surfaces (a friction bitmap of the display takes a fraction of a
-  // second): every static field of a shipped 2-D protocol renders once.
+  // Rendered surfaces (a friction bitmap of tablet-2d takes seconds): every
+  // static field of a shipped 2-D protocol renders once a session.
   std::list<std::pair<std::string, std::shared_ptr<const PlayerMap2D>>> maps;
 };
 
