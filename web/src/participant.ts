@@ -140,7 +140,14 @@ class StrokeSurface {
     c.addEventListener('pointerup', up);
     c.addEventListener('pointercancel', up);
     c.addEventListener('lostpointercapture', up);
-    new ResizeObserver(() => this.draw()).observe(this.el);
+    this.resize.observe(this.el);
+  }
+
+  private readonly resize = new ResizeObserver(() => this.draw());
+
+  /** The question left the screen. */
+  dispose(): void {
+    this.resize.disconnect();
   }
 
   /** The interval playing and its line (degrees from +x towards +y, down the screen); clears its drawn strokes. */
@@ -367,6 +374,7 @@ export function mountParticipant(root: HTMLElement): void {
           if (__TEXEL_TEST_HOOKS__) hooks2d.samplesSent += samples.length;
         })
       : null;
+    if (surface) endQuestion = () => (clearTimers(), surface.dispose());
 
     try {
       const hi = await getHello();
