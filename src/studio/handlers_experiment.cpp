@@ -4,8 +4,11 @@
 #include <stdlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <list>
+#include <map>
 #include <sstream>
 
 #include "base64.hpp"
@@ -13,13 +16,116 @@
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/export_mat.hpp"
+#include "texel/experiment/strokes.hpp"
 #include "texel/matfile.hpp"
+#include "texel/serial_link.hpp"
+#include "texel/surface2d.hpp"
 
 namespace texel::studio::detail {
 
+namespace ex = texel::experiment;
+
+// The participant's strokes of a 2-D trial (task oddity-2d; docs/studio.md
+// "2-D studies"): the page is the touch surface, its samples drive the 2-D
+// pad's player on the studio's device and are summarised per interval by
+// the library's StrokeRecorder, as the terminal's 2-D display presenter
+// does, and stored with the answer. Bound to one hand-out token: a new
+// question (or a restarted trial) starts from no strokes.
+struct Strokes2DState {
+  std::string token;                                    // the hand-out these strokes belong to
+  int selected = -1;                                    // the interval playing (index into Question::stimuli)
+  std::map<std::string, ex::StrokeRecorder> recorders;  // by stimulus label
+  double last_t_s = 0.0;                                // the newest sample, page seconds
+  // The page's clock onto the player's, for one page (a reloaded page's clock starts again).
+  ReportTimeline timeline;
+  std::uint64_t page = 0;  // the connection whose clock the timeline follows
+  // Rendered surfaces (a friction bitmap of tablet-2d takes seconds): every
+  // static field of a shipped 2-D protocol renders once a session.
+  std::list<std::pair<std::string, std::shared_ptr<const PlayerMap2D>>> maps;
+};
+
+std::shared_ptr<Strokes2DState> make_strokes2d_state() { return std::make_shared<Strokes2DState>(); }
+
 namespace {
 
-namespace ex = texel::experiment;
+constexpr std::size_t surface_cache_size = 8;    // direction-independence has eight static fields
+constexpr std::size_t max_stroke_samples = 512;  // per experiment.stroke message
+constexpr double page_lead_s = 0.005;            // as the 2-D pad's finger: a sample is due this long after it arrives
+const ex::StrokeRules stroke_rules{};            // the terminal presenter's defaults (docs/experiments.md)
+
+/// The strokes of the question in force: reset when its token changes.
+Strokes2DState& strokes_of(State& s) {
+  Strokes2DState& st = *s.strokes2d;
+  const std::string token = ex::peek(*s.active).token;
+  if (st.token != token) {
+    st.token = token;
+    st.selected = -1;
+    st.recorders.clear();
+    st.last_t_s = 0.0;
+    st.timeline = ReportTimeline{};
+    st.page = 0;
+  }
+  return st;
+}
+
+/// The player map of a 2-D interval (path-indexed, or the static field's friction bitmap), rendered once (cached).
+const PlayerMap2D& surface_map(Strokes2DState& st, const ex::SurfaceStimulus& s) {
+  const std::string key = std::string(s.kind == ex::SurfaceStimulus::Kind::bitmap ? "b" : "p") + s.document_json;
+  auto it = std::find_if(st.maps.begin(), st.maps.end(), [&](const auto& e) { return e.first == key; });
+  if (it == st.maps.end()) {
+    const Document doc = parse_document(s.document_json, "stimulus surface");
+    if (!doc.surface2d || doc.surface2d->regions.size() != 1 || !doc.device.bitmap)
+      throw Reject{"internal", "a stimulus surface is not a 2-D document of one region on a display"};
+    const BitmapGeometry& g = *doc.device.bitmap;
+    std::shared_ptr<const PlayerMap2D> m;
+    if (s.kind == ex::SurfaceStimulus::Kind::bitmap)
+      m = PlayerMap2D::bitmap(render_raster(prepare_surface2d(doc)), doc.device.response);
+    else
+      m = PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)}, std::nullopt,
+                                    Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0,
+                                    doc.device.response);
+    st.maps.emplace_front(key, std::move(m));
+    if (st.maps.size() > surface_cache_size) st.maps.pop_back();
+    it = st.maps.begin();
+  } else {
+    st.maps.splice(st.maps.begin(), st.maps, it);
+    it = st.maps.begin();
+  }
+  return *it->second;
+}
+
+/// Renders a 2-D question's surfaces ahead (as the terminal prepares them
+/// before the trial's clock starts), so its onset, and so its reaction time,
+/// does not include a bitmap's rendering and switching intervals costs a copy.
+void prepare_surfaces(State& s, const ex::Question& q) {
+  for (const auto& surface : q.surfaces) (void)surface_map(*s.strokes2d, surface);
+}
+
+/// The question's intervals as the participant stroked them (one per stimulus, as Presenter::strokes).
+std::vector<ex::IntervalStrokes> stroke_summaries(const Strokes2DState& st, const ex::Question& q) {
+  std::vector<ex::IntervalStrokes> out;
+  for (std::size_t i = 0; i < q.stimuli.size(); ++i) {
+    const std::string& label = q.stimuli[i].label;
+    const double direction = q.surfaces[i].direction_deg;
+    const auto it = st.recorders.find(label);
+    out.push_back(it == st.recorders.end() ? ex::StrokeRecorder(stroke_rules).summary(label, direction)
+                                           : it->second.summary(label, direction));
+  }
+  return out;
+}
+
+/// "1" → "texture 1"; named stimuli keep their name (as the participant page says them).
+std::string stimulus_words(const std::string& label) {
+  const bool digits = !label.empty() && std::all_of(label.begin(), label.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+  return digits ? "texture " + label : label;
+}
+
+/// The surface a 2-D question is stroked on: its size (the same display for every interval; nothing of the trial).
+ojson surface_size_json(const ex::Question& q) {
+  const Document doc = parse_document(q.surfaces.front().document_json, "stimulus surface");
+  if (!doc.device.bitmap) return ojson(nullptr);
+  return ojson{{"width_mm", doc.device.bitmap->width_mm().value()}, {"height_mm", doc.device.bitmap->height_mm().value()}};
+}
 
 ex::Store& the_store(State& s) {
   if (!s.store) s.store.emplace(ex::Store::open(s.options.db_path, ex::StoreMode::read_write));
@@ -78,7 +184,10 @@ ojson current_state(State& s, const json& id, bool screen, bool reload = false) 
   r["session"] = session_json(s);
   r["progress"] = progress_json(s);
   if (!s.active->session.finished() && !s.active->suspended) {
-    r["question"] = participant_question(s.active->session.question());
+    const ex::Question& q = s.active->session.question();
+    r["question"] = participant_question(q);
+    if (!q.surfaces.empty()) r["surface"] = surface_size_json(q);      // the page is the touch surface
+    if (screen && s.active->simulate.empty()) prepare_surfaces(s, q);  // before the hand-out starts the trial's clock
     r["handout"] = handout_json(!screen ? ex::peek(*s.active) : reload ? ex::reload(*s.active) : ex::hand_out(*s.active));
   }
   return r;
@@ -110,7 +219,9 @@ void show_stimulus(State& s, const std::string& document_json_text) {
 void new_trial(State& s) {
   std::lock_guard lock(s.feel_mutex);
   s.presenter->blank();
+  pad_blank(s);
   s.trace.clear();
+  s.strokes2d->selected = -1;
 }
 
 std::optional<ex::Protocol> chosen_protocol(const State& s, const json& p) {
@@ -254,11 +365,38 @@ void on_experiment_select(State& s, Client& c, const Job& job) {
   const ex::Question& q = current_question(s, f, job.type);
   if (q.stimuli.empty()) throw Reject{"invalid", "experiment.select: this question has no stimuli"};
   const auto i = static_cast<std::size_t>(f.integer("stimulus", 0, static_cast<std::int64_t>(q.stimuli.size()) - 1));
-  show_stimulus(s, q.stimuli[i].document_json);
   ojson r = reply("experiment.selected", job.id);
   r["trial"] = q.trial;
   r["stimulus"] = i;
   r["label"] = q.stimuli[i].label;
+  if (q.surfaces.empty()) {
+    show_stimulus(s, q.stimuli[i].document_json);
+    send(c, r);
+    return;
+  }
+  // A 2-D interval: the participant's page strokes it (experiment.stroke). Leaving an interval
+  // stroked along another line brings one plain reminder (about the stroke, nothing of the trial).
+  Strokes2DState& st = strokes_of(s);
+  auto map = std::make_unique<const PlayerMap2D>(surface_map(st, q.surfaces[i]));  // before the device is taken
+  if (st.selected >= 0 && static_cast<std::size_t>(st.selected) != i) {
+    const auto k = static_cast<std::size_t>(st.selected);
+    const std::string& was = q.stimuli[k].label;
+    if (auto it = st.recorders.find(was); it != st.recorders.end()) {
+      it->second.add(st.last_t_s, 0.0, 0.0, false);  // its stroke in progress ends here
+      const ex::IntervalStrokes last = it->second.summary(was, q.surfaces[k].direction_deg);
+      if (last.strokes > 0 && !last.compliant)
+        r["reminder"] = "You stroked " + stimulus_words(was) +
+                        " along another line than its own: " + ex::direction_words(q.surfaces[k].direction_deg) + ".";
+    }
+  }
+  st.selected = static_cast<int>(i);
+  st.recorders.try_emplace(q.stimuli[i].label, stroke_rules);
+  {
+    std::lock_guard lock(s.feel_mutex);
+    pad_show(s, std::move(map));
+  }
+  r["stroke_deg"] = ex::line_direction(q.surfaces[i].direction_deg);
+  r["stroke_words"] = ex::direction_words(q.surfaces[i].direction_deg);
   send(c, r);
 }
 
@@ -299,6 +437,13 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
     response.answered_at.clear();
   }
   (void)trial;  // the token names the trial; `trial` stays for older clients' messages
+  if (!f.boolean("simulated", false)) {
+    // Strokes are the studio's record of the participant's page (as a 2-D display's presenter records
+    // them), never the page's claim; those of the question in force (a stale token is refused below).
+    response.strokes.clear();
+    if (s.active && !s.active->session.finished() && !s.active->session.question().surfaces.empty())
+      response.strokes = stroke_summaries(strokes_of(s), s.active->session.question());
+  }
   if (!response.swipe_mean_speed_mm_s) {
     std::lock_guard lock(s.feel_mutex);
     const SwipeMeasures m = swipe_measures(s.trace);
@@ -338,6 +483,7 @@ void on_experiment_suspend(State& s, Client& c, const Job& job) {
   {
     std::lock_guard lock(s.feel_mutex);
     s.presenter->blank();  // nothing to feel while paused
+    pad_blank(s);
   }
   send(c, current_state(s, job.id, c.participant_screen));
   tell_everyone(s, c);
@@ -348,6 +494,78 @@ void on_experiment_resume(State& s, Client& c, const Job& job) {
   ex::resume(*s.active);
   send(c, current_state(s, job.id, c.participant_screen));
   tell_everyone(s, c);
+}
+
+// The participant's finger on a 2-D question's surface (the page): samples
+// [t_ms, x_mm, y_mm, touch], t_ms on the page's clock. Only for the token's
+// trial and the interval playing, else refused (nothing recorded).
+void on_experiment_stroke(State& s, Client& c, const Job& job) {
+  const Fields f(job.msg, job.type);
+  const ex::Question& q = current_question(s, f, job.type);
+  if (q.surfaces.empty()) throw Reject{"invalid", "experiment.stroke: this question is not stroked on a 2-D surface"};
+  const std::string token = f.string("token", 128);
+  try {
+    ex::check_token(the_store(s), &*s.active, token);
+  } catch (const ex::AnswerRefused& e) {
+    throw Reject{"conflict", std::string("experiment.stroke: ") + e.what()};
+  }
+  Strokes2DState& st = strokes_of(s);
+  const std::int64_t stimulus = f.integer("stimulus", 0, static_cast<std::int64_t>(q.stimuli.size()) - 1);
+  if (stimulus != st.selected)
+    throw Reject{"conflict", "experiment.stroke: stimulus " + std::to_string(stimulus) +
+                                 " is not the one playing; select it first (experiment.select)"};
+  const json& samples = f.raw("samples");
+  if (!samples.is_array() || samples.size() > max_stroke_samples)
+    throw Reject{"bad_message", "experiment.stroke: samples must be an array of at most " + std::to_string(max_stroke_samples) +
+                                    " [t_ms, x_mm, y_mm, touch] entries"};
+  struct Sample {
+    double t_ms, x, y;
+    bool touch;
+  };
+  std::vector<Sample> parsed;
+  parsed.reserve(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const json& e = samples[k];
+    const std::string where = "experiment.stroke: samples[" + std::to_string(k) + "]";
+    if (!e.is_array() || e.size() != 4)
+      throw Reject{"bad_message", where + " must be [t_ms, x_mm, y_mm, touch], got " + clipped(e.dump())};
+    for (std::size_t n = 0; n < 3; ++n)
+      if (!e[n].is_number() || !std::isfinite(e[n].get<double>()))
+        throw Reject{"bad_message", where + "[" + std::to_string(n) + "] must be a finite number, got " + clipped(e[n].dump())};
+    const double t_ms = e[0].get<double>(), x = e[1].get<double>(), y = e[2].get<double>();
+    if (t_ms < 0 || t_ms > 1e12 || std::abs(x) > max_abs_mm || std::abs(y) > max_abs_mm)
+      throw Reject{"invalid", where + " is out of range; allowed: t_ms 0 … 1e12, |x_mm|, |y_mm| <= " + json(max_abs_mm).dump()};
+    if (!e[3].is_boolean()) throw Reject{"bad_message", where + "[3] (touch) must be true or false, got " + clipped(e[3].dump())};
+    parsed.push_back({t_ms, x, y, e[3].get<bool>()});
+  }
+  ex::StrokeRecorder& rec = st.recorders.at(q.stimuli[static_cast<std::size_t>(stimulus)].label);
+  if (st.page != c.id || (!parsed.empty() && parsed.front().t_ms < st.last_t_s * 1000.0 - 1000.0)) {
+    // Another page (or this one reloaded): its own clock. The stroke in progress ends.
+    rec.add(st.last_t_s, 0.0, 0.0, false);
+    st.timeline = ReportTimeline{};
+    st.page = c.id;
+    st.last_t_s = parsed.empty() ? 0.0 : parsed.front().t_ms / 1000.0;
+  }
+  std::size_t played = 0;
+  {
+    std::lock_guard lock(s.feel_mutex);
+    for (const Sample& p : parsed) {
+      // Never backwards: the timeline reads a step back as its clock's wrap.
+      const double t_s = std::max(p.t_ms / 1000.0, st.last_t_s);
+      rec.add(t_s, p.x, p.y, p.touch);
+      st.last_t_s = t_s;
+      // The page's clock placed on the player's (as a display's reports): due a little after arrival.
+      const auto t_us = static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(t_s * 1e6)) & 0xffffffffu);
+      const double t = st.timeline.place(t_us, pad_time_s(s) + page_lead_s);
+      if (pad_push(s, c.id, t, p.x, p.y, p.touch)) ++played;
+    }
+  }
+  ojson r = reply("experiment.stroked", job.id);
+  r["trial"] = q.trial;
+  r["stimulus"] = stimulus;
+  r["samples"] = parsed.size();
+  r["played"] = played;
+  send(c, r);
 }
 
 }  // namespace texel::studio::detail

@@ -624,6 +624,50 @@ void on_feel2d_raster(State& s, Client& c, const Job& job) {
   send(c, r);
 }
 
+// ------------------------------------------- a participant's 2-D intervals
+
+void pad_show(State& s, std::unique_ptr<const PlayerMap2D> map) {
+  auto* st = s.surface2d.get();
+  if (!st->player) st->player = std::make_unique<Player2D>(player_config(s));
+  device_to_pad(s, *st);
+  st->player->set_map(std::move(map));
+  st->player->collect();
+  st->mode = "participant";
+}
+
+std::optional<double> pad_push(State& s, std::uint64_t client, double t, double x, double y, bool touch) {
+  auto* st = s.surface2d.get();
+  if (!st->player || st->mode != "participant") return std::nullopt;
+  t = std::max(st->last_t, t);
+  if (st->backend && !st->display_finger) {
+    if (!st->player->push(FingerSample2D{t, x, y, touch})) return std::nullopt;
+    st->last_t = t;
+  }
+  st->finger_client = client;
+  st->finger_x = x;
+  st->finger_y = y;
+  st->finger_down = touch;
+  ++st->samples;
+  st->player->collect();
+  return t;
+}
+
+double pad_time_s(const State& s) { return s.surface2d->player ? s.surface2d->player->time_s() : 0.0; }
+
+void pad_blank(State& s) {
+  auto* st = s.surface2d.get();
+  if (!st->player || st->mode != "participant") return;
+  if (st->backend && st->finger_down && !st->display_finger) {
+    const double t = std::max(st->last_t, st->player->time_s() + finger_lead_s);
+    if (st->player->push(FingerSample2D{t, st->finger_x, st->finger_y, false})) st->last_t = t;
+  }
+  st->finger_down = false;
+  // A one-sample bitmap far off the surface: the finger is off it, so the player fades out (as the presenter blanks).
+  st->player->set_map(PlayerMap2D::bitmap(Raster2D{1, 1, Millimetres(1.0), Millimetres(-1e6), Millimetres(-1e6), {0.0f}}));
+  st->player->collect();
+  st->mode.clear();
+}
+
 void lift_finger_2d(State& s, std::uint64_t client) {
   auto* st = s.surface2d.get();
   std::lock_guard lock(s.feel_mutex);

@@ -14,7 +14,7 @@ namespace texel::studio::detail {
 namespace {
 
 // The order is the one error messages list ("unknown message type …; allowed: …").
-const std::array<MessageSpec, 28> table{{
+const std::array<MessageSpec, 29> table{{
     {"hello", Lane::now, {}, on_hello},
     {"design", Lane::design, {"document", "region", "bins"}, on_design},
     {"match", Lane::fifo, {"document", "region", "into"}, on_match},
@@ -37,6 +37,7 @@ const std::array<MessageSpec, 28> table{{
     {"experiment.validate", Lane::fifo, {"protocol"}, on_experiment_validate},
     {"experiment.suspend", Lane::fifo, {}, on_experiment_suspend},
     {"experiment.resume", Lane::fifo, {}, on_experiment_resume},
+    {"experiment.stroke", Lane::fifo, {"trial", "token", "stimulus", "samples"}, on_experiment_stroke},
     {"surface2d.view",
      Lane::design,
      {"document", "images", "x_px", "y_px", "width_px", "height_px", "stride"},

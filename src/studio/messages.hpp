@@ -31,6 +31,7 @@
 #include "texel/experiment/runner.hpp"
 #include "texel/finger.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/studio/handler.hpp"
 #include "texel/studio/service.hpp"
@@ -101,6 +102,8 @@ struct Client {
 
 struct Surface2DState;  // handlers_surface2d.cpp: the prepared 2-D surface and the 2-D pad's player
 std::shared_ptr<Surface2DState> make_surface2d_state();
+struct Strokes2DState;  // handlers_experiment.cpp: the participant's strokes of a 2-D trial
+std::shared_ptr<Strokes2DState> make_strokes2d_state();
 
 /// What the handlers share: the options, the display (one Presenter behind
 /// feel_mutex) and the experiment session (touched by the FIFO worker only).
@@ -125,6 +128,7 @@ struct State {
   std::vector<FingerSample> trace;  // finger samples of the current trial (swipe measures)
 
   std::shared_ptr<Surface2DState> surface2d = make_surface2d_state();  // its own mutexes
+  std::shared_ptr<Strokes2DState> strokes2d = make_strokes2d_state();  // FIFO worker only
 
   std::optional<experiment::Store> store;
   std::optional<experiment::ActiveSession> active;
@@ -162,6 +166,16 @@ void lift_finger_2d(State& s, std::uint64_t client);
 /// last Feel-it map again). Never throws: a device that cannot be re-opened
 /// leaves the Presenter on a null backend and says why in device_error.
 void device_to_presenter(State& s);
+/// A participant's 2-D interval on the 2-D pad's player (the participant
+/// page strokes it; handlers_experiment.cpp). Caller holds feel_mutex.
+/// pad_show takes the device as the pad's touch does and plays `map`;
+/// pad_push queues one finger sample at player time `t` (nothing unless a
+/// participant's interval plays; returns the time queued, nothing when the
+/// queue is full); pad_blank lifts the finger and fades to silence.
+void pad_show(State& s, std::unique_ptr<const PlayerMap2D> map);
+std::optional<double> pad_push(State& s, std::uint64_t client, double t, double x, double y, bool touch);
+[[nodiscard]] double pad_time_s(const State& s);
+void pad_blank(State& s);
 /// The Presenter's options for the configured device (or a null backend in its place).
 experiment::PresenterOptions presenter_options(const ServiceOptions& o, bool null_backend = false);
 
@@ -209,6 +223,7 @@ void on_experiment_protocol(State&, Client&, const Job&);
 void on_experiment_validate(State&, Client&, const Job&);
 void on_experiment_suspend(State&, Client&, const Job&);
 void on_experiment_resume(State&, Client&, const Job&);
+void on_experiment_stroke(State&, Client&, const Job&);
 void on_surface2d_view(State&, Client&, const Job&);
 void on_surface2d_scan(State&, Client&, const Job&);
 void on_feel2d_select(State&, Client&, const Job&);

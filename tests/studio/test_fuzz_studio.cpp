@@ -39,6 +39,7 @@ const std::vector<std::string> seeds = {
     R"({"type":"experiment.preview","trial":0,"slider_p":50,"slider_i":50})",
     R"({"type":"experiment.answer","trial":0,"response":{"choice":"1","rt_ms":800,"confidence":3}})",
     R"({"type":"experiment.answer","trial":0,"simulated":true})",
+    R"({"type":"experiment.stroke","trial":0,"token":"t","stimulus":0,"samples":[[1.5,10,20,true],[2.5,11,20,false]]})",
     R"({"type":"experiment.stop"})",
 };
 

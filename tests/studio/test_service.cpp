@@ -7,10 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <numbers>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -596,4 +598,81 @@ TEST(Service, ExperimenterTrialsExportsAndProtocols) {
   const json again = c.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "X1"}});
   expect_error(again, "conflict");
   EXPECT_EQ(again["message"].get<std::string>().find("resume: true"), std::string::npos) << again.dump();
+}
+
+// A 2-D study (oddity-2d): the participant's page strokes each interval; the
+// studio records the strokes with the library's StrokeRecorder and stores them
+// with the answer (never the page's own claim), only for the token's trial and
+// the interval playing.
+TEST(Service, TwoDStudyStrokesAreRecordedAndStoredWithTheAnswer) {
+  texel::test_support::TempDir dir("studio");
+  const std::string db = dir.at("db");
+  std::int64_t session_id = 0;
+  {
+    Service s(options(db));
+    Client c(s);
+    const json started = c.ask({{"type", "experiment.start"}, {"protocol", "direction-independence"}, {"participant", "D1"}});
+    ASSERT_EQ(started["type"], "experiment.started") << started.dump();
+    session_id = started["session"]["id"];
+    const json q = c.ask({{"type", "experiment.current"}});
+    ASSERT_EQ(q["question"]["task"], "oddity-2d") << q.dump();
+    EXPECT_GT(q["surface"]["width_mm"].get<double>(), 200.0) << q.dump();
+    const std::string token = q["handout"]["token"];
+    auto stroke = [&](int stimulus, json samples, const std::string& tok) {
+      return c.ask({{"type", "experiment.stroke"}, {"trial", 0}, {"token", tok}, {"stimulus", stimulus}, {"samples", samples}});
+    };
+    // Nothing plays yet: refused.
+    expect_error(stroke(0, json::array({json::array({1.0, 10.0, 10.0, true})}), token), "conflict");
+    std::vector<double> lines;
+    double t_ms = 1000.0;
+    for (int i = 0; i < 3; ++i) {
+      const json sel = c.ask({{"type", "experiment.select"}, {"trial", 0}, {"stimulus", i}});
+      ASSERT_EQ(sel["type"], "experiment.selected") << sel.dump();
+      ASSERT_TRUE(sel.contains("stroke_deg") && sel.contains("stroke_words")) << sel.dump();
+      EXPECT_EQ(sel.contains("reminder"), i == 2) << sel.dump();  // interval 2 (index 1) went across its line
+      lines.push_back(sel["stroke_deg"].get<double>());
+      // Two 60 mm strokes, interval 1 across its line, samples 1 ms and 0.5 mm apart.
+      const double a = (lines.back() + (i == 1 ? 90.0 : 0.0)) * std::numbers::pi / 180.0;
+      for (int pass = 0; pass < 2; ++pass) {
+        json samples = json::array();
+        for (int k = 0; k <= 120; ++k)
+          samples.push_back(
+              {t_ms += 1.0, 100.0 + std::cos(a) * (k * 0.5 - 30.0), 70.0 + std::sin(a) * (k * 0.5 - 30.0), k < 120});
+        const json r = stroke(i, samples, token);
+        ASSERT_EQ(r["type"], "experiment.stroked") << r.dump();
+        EXPECT_EQ(r["samples"], 121);
+        EXPECT_EQ(r["played"], 121);  // the 2-D player got them (null backend)
+        t_ms += 200.0;
+      }
+    }
+    // Refused: another interval than the one playing, another token, malformed samples.
+    expect_error(stroke(0, json::array({json::array({1.0, 10.0, 10.0, true})}), token), "conflict");
+    expect_error(stroke(2, json::array({json::array({1.0, 10.0, 10.0, true})}), "x" + token.substr(1)), "conflict");
+    expect_error(stroke(2, json::array({json::array({1.0, 10.0, 10.0})}), token), "bad_message");
+    expect_error(stroke(2, json::array({json::array({1.0, 1e9, 10.0, true})}), token), "invalid");
+    expect_error(stroke(2, json::array({json::array({1.0, 10.0, 10.0, 1})}), token), "bad_message");
+    expect_error(stroke(2, json::array({json::array({"1", 10.0, 10.0, true})}), token), "bad_message");
+    // The page's own claim of strokes is not stored: the studio's record is.
+    const json answer = c.ask({{"type", "experiment.answer"},
+                               {"trial", 0},
+                               {"token", token},
+                               {"response", {{"choice", "1"}, {"strokes", json::array()}}}});
+    ASSERT_EQ(answer["type"], "experiment.question") << answer.dump();
+    expect_error(stroke(2, json::array({json::array({1.0, 10.0, 10.0, true})}), token), "conflict");  // the trial is answered
+    c.ask({{"type", "experiment.stop"}});
+  }
+  const ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
+  const auto trials = st.trials(session_id);
+  ASSERT_EQ(trials.size(), 1u);
+  const json resp = json::parse(trials[0].response_json);
+  ASSERT_EQ(resp["strokes"].size(), 3u) << resp.dump();
+  for (int i = 0; i < 3; ++i) {
+    const json& s = resp["strokes"][i];
+    EXPECT_EQ(s["strokes"], 2) << s.dump();
+    EXPECT_NEAR(s["path_mm"].get<double>(), 119.0, 1.0) << s.dump();
+    EXPECT_EQ(s["compliant"], i != 1) << s.dump();
+  }
+  EXPECT_EQ(trials[0].row.strokes, 6.0);
+  EXPECT_EQ(trials[0].row.direction_compliant, 0.0);
+  EXPECT_NEAR(trials[0].row.stroke_deviation_deg, 90.0, 1e-6);
 }

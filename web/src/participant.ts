@@ -17,6 +17,14 @@
 // elapsed_s), and the stored reaction time runs from onset without paused
 // time. The page's own events (select, choice, …) are sent with the answer,
 // t_s from when this page showed the question.
+//
+// 2-D studies (task oddity-2d; the reply carries `surface`): the page is the
+// touch surface of the studio's 2-D display (pointer, pen or touch; a tablet
+// in the participant's hands). Each interval shows only the line to stroke
+// along (experiment.selected's stroke_words, drawn across the surface); the
+// strokes go to the studio (experiment.stroke, with the question's token and
+// the interval playing), which plays them on its device and records them as
+// a 2-D display's strokes, stored with the answer.
 
 import { studio, StudioError } from './ws';
 import { h, isoNow, decodeF32 } from './util';
@@ -77,6 +85,177 @@ function drawMiniMap(canvas: HTMLCanvasElement, values: Float32Array): void {
 
 // "1" → "texture 1"; named stimuli ("Reference", "A", "Test") keep their name.
 const stimulusName = (label: string) => (/^\d+$/.test(label) ? `texture ${label}` : label);
+
+/** Test hooks of the 2-D touch surface (test builds only). */
+const hooks2d = { samplesSent: 0, samplesRecorded: 0, refused: 0, line: null as number | null };
+if (__TEXEL_TEST_HOOKS__) (window as unknown as { __texelStrokes: typeof hooks2d }).__texelStrokes = hooks2d;
+
+/**
+ * The 2-D touch surface of one question: the display's rectangle (its aspect kept), the line to stroke
+ * along drawn across it, and the participant's strokes of the interval playing. Samples (page time,
+ * surface mm, touch) go out one message at a time, batched while one is in flight.
+ */
+class StrokeSurface {
+  readonly el: HTMLElement;
+  readonly canvas: HTMLCanvasElement;
+  private line: number | null = null;
+  private trail: [number, number, boolean][] = [];
+  private queue: [number, number, number, boolean][] = [];
+  private inFlight: Promise<void> | null = null;
+  private pointer: number | null = null;
+  private last: [number, number] | null = null;
+  interval = -1; // the stimulus playing; -1: none (strokes are not sent)
+
+  constructor(
+    readonly width_mm: number,
+    readonly height_mm: number,
+    private readonly sendBatch: (interval: number, samples: [number, number, number, boolean][]) => Promise<void>,
+  ) {
+    this.canvas = h('canvas', {
+      class: 'stroke-canvas',
+      'data-testid': 'stroke-surface',
+      role: 'img',
+      'aria-label': 'Touch surface: stroke it with a finger or the pen along the line shown',
+    }) as HTMLCanvasElement;
+    this.el = h('div', { class: 'stroke-surface', style: `aspect-ratio: ${width_mm} / ${height_mm}; max-width: calc(62vh * ${width_mm / height_mm})` }, this.canvas);
+    const c = this.canvas;
+    c.addEventListener('pointerdown', (e) => {
+      if (this.pointer !== null || (e.pointerType === 'mouse' && e.button !== 0)) return;
+      e.preventDefault();
+      this.pointer = e.pointerId;
+      c.setPointerCapture(e.pointerId);
+      this.sample(e, true);
+    });
+    c.addEventListener('pointermove', (e) => {
+      if (e.pointerId !== this.pointer) return;
+      e.preventDefault();
+      const all = typeof e.getCoalescedEvents === 'function' ? e.getCoalescedEvents() : [];
+      for (const ce of all.length ? all : [e]) this.sample(ce, true);
+    });
+    const up = (e: PointerEvent) => {
+      if (e.pointerId !== this.pointer) return;
+      this.sample(e, false);
+      this.pointer = null;
+    };
+    c.addEventListener('pointerup', up);
+    c.addEventListener('pointercancel', up);
+    c.addEventListener('lostpointercapture', up);
+    this.resize.observe(this.el);
+  }
+
+  private readonly resize = new ResizeObserver(() => this.draw());
+
+  /** The question left the screen. */
+  dispose(): void {
+    this.resize.disconnect();
+  }
+
+  /** The interval playing and its line (degrees from +x towards +y, down the screen); clears its drawn strokes. */
+  show(interval: number, lineDeg: number | null): void {
+    this.interval = interval;
+    this.line = lineDeg;
+    this.trail = [];
+    hooks2d.line = lineDeg;
+    this.draw();
+  }
+
+  private sample(e: PointerEvent, touch: boolean): void {
+    const r = this.canvas.getBoundingClientRect();
+    if (!r.width || !r.height) return;
+    const x = Math.min(Math.max(((e.clientX - r.left) / r.width) * this.width_mm, 0), this.width_mm);
+    const y = Math.min(Math.max(((e.clientY - r.top) / r.height) * this.height_mm, 0), this.height_mm);
+    if (this.interval < 0) return;
+    if (!touch && !this.last) return;
+    this.last = touch ? [x, y] : null;
+    this.trail.push([x, y, touch]);
+    if (this.trail.length > 4000) this.trail.splice(0, 1000);
+    this.queue.push([e.timeStamp, x, y, touch]);
+    this.draw();
+    this.pump();
+  }
+
+  private pump(): void {
+    if (this.inFlight || !this.queue.length) return;
+    const batch = this.queue.splice(0, 512);
+    const interval = this.interval;
+    this.inFlight = this.sendBatch(interval, batch)
+      .catch(() => undefined)
+      .then(() => {
+        this.inFlight = null;
+        this.pump();
+      });
+  }
+
+  /** Resolves when every sample taken so far has been sent (before an answer). */
+  async flush(): Promise<void> {
+    while (this.inFlight || this.queue.length) {
+      this.pump();
+      await this.inFlight;
+    }
+  }
+
+  /** Lifts a finger still down (switching intervals, answering): the stroke ends and the player rests. */
+  lift(): void {
+    if (this.last && this.interval >= 0) {
+      this.queue.push([performance.now(), this.last[0], this.last[1], false]);
+      this.pump();
+    }
+    this.pointer = null;
+    this.last = null;
+  }
+
+  private draw(): void {
+    const c = this.canvas;
+    const dpr = window.devicePixelRatio || 1;
+    const w = Math.max(1, Math.round(c.clientWidth * dpr));
+    const hh = Math.max(1, Math.round(c.clientHeight * dpr));
+    if (c.width !== w || c.height !== hh) {
+      c.width = w;
+      c.height = hh;
+    }
+    const ctx = c.getContext('2d');
+    if (!ctx) return;
+    ctx.clearRect(0, 0, w, hh);
+    const k = w / this.width_mm; // px per mm (the aspect is the display's)
+    if (this.line !== null) {
+      // The line to stroke along, through the centre, with arrowheads both ways (a line, not a direction).
+      const a = (this.line * Math.PI) / 180;
+      const [dx, dy] = [Math.cos(a), Math.sin(a)];
+      const half = 0.42 * Math.min(this.width_mm, this.height_mm) * k;
+      const [cx, cy] = [w / 2, hh / 2];
+      const [x0, y0, x1, y1] = [cx - dx * half, cy - dy * half, cx + dx * half, cy + dy * half];
+      ctx.strokeStyle = '#2a6fdb';
+      ctx.lineWidth = 6 * dpr;
+      ctx.lineCap = 'round';
+      ctx.setLineDash([18 * dpr, 12 * dpr]);
+      ctx.beginPath();
+      ctx.moveTo(x0, y0);
+      ctx.lineTo(x1, y1);
+      ctx.stroke();
+      ctx.setLineDash([]);
+      const head = 22 * dpr;
+      for (const [px, py, sx] of [[x1, y1, 1], [x0, y0, -1]] as const) {
+        ctx.beginPath();
+        ctx.moveTo(px, py);
+        ctx.lineTo(px - sx * head * (dx * 0.87 - dy * 0.5), py - sx * head * (dy * 0.87 + dx * 0.5));
+        ctx.moveTo(px, py);
+        ctx.lineTo(px - sx * head * (dx * 0.87 + dy * 0.5), py - sx * head * (dy * 0.87 - dx * 0.5));
+        ctx.stroke();
+      }
+    }
+    // The participant's strokes of this interval.
+    ctx.strokeStyle = 'rgba(29,29,29,0.55)';
+    ctx.lineWidth = 3 * dpr;
+    ctx.beginPath();
+    let down = false;
+    for (const [x, y, t] of this.trail) {
+      if (t && down) ctx.lineTo(x * k, y * k);
+      else if (t) ctx.moveTo(x * k, y * k);
+      down = t;
+    }
+    ctx.stroke();
+  }
+}
 
 type StateMessage = ServerMessages['experiment.question'] | ServerMessages['experiment.idle'] | ServerMessages['experiment.suspended'] | ServerMessages['experiment.finished'];
 
@@ -180,6 +359,22 @@ export function mountParticipant(root: HTMLElement): void {
     const clearTimers = () => timers.forEach((t) => clearTimeout(t));
     endQuestion = clearTimers;
     const current = () => alive() && shownToken === handout.token;
+    // A 2-D question: this page is the display's touch surface (no strip).
+    const surf = reply.surface;
+    const lineText = h('p', { class: 'stroke-line', 'data-testid': 'stroke-line', 'aria-live': 'polite' }, 'Choose a texture to feel, then stroke the surface below along the line shown.');
+    const surface = surf
+      ? new StrokeSurface(surf.width_mm, surf.height_mm, async (interval, samples) => {
+          if (!current()) return;
+          try {
+            const r = await client.call('experiment.stroke', { trial: q.trial, token: handout.token, stimulus: interval, samples }, 30000);
+            if (__TEXEL_TEST_HOOKS__) hooks2d.samplesRecorded += r.samples;
+          } catch {
+            if (__TEXEL_TEST_HOOKS__) hooks2d.refused++; // another trial, paused, or another interval: the push shows what is current
+          }
+          if (__TEXEL_TEST_HOOKS__) hooks2d.samplesSent += samples.length;
+        })
+      : null;
+    if (surface) endQuestion = () => (clearTimers(), surface.dispose());
 
     try {
       const hi = await getHello();
@@ -228,8 +423,23 @@ export function mountParticipant(root: HTMLElement): void {
       if (trial.get().timedOut) return;
       stimulusButtons.forEach((b, k) => b.setAttribute('aria-pressed', String(k === i)));
       ev('select', q.stimuli[i]?.label ?? String(i));
+      const left = surface?.interval ?? -1;
+      if (surface) {
+        surface.lift();
+        await surface.flush(); // the interval left keeps its strokes
+        surface.show(-1, null);
+        lineText.textContent = 'Please wait…';
+      }
       try {
-        await client.call('experiment.select', { trial: q.trial, stimulus: i }, 30000);
+        const r = await client.call('experiment.select', { trial: q.trial, stimulus: i }, 30000);
+        if (surface && current() && r.stroke_deg !== undefined) {
+          surface.show(i, r.stroke_deg);
+          lineText.textContent = `Stroke ${stimulusName(q.stimuli[i]?.label ?? String(i + 1))} along the line: ${r.stroke_words ?? ''}`;
+          if (r.reminder) {
+            ev('stroke_reminder', q.stimuli[left]?.label ?? String(left)); // the interval left, as the terminal records it
+            showNotice(r.reminder);
+          }
+        }
       } catch (e) {
         msg.textContent = e instanceof Error ? e.message : String(e);
       }
@@ -299,7 +509,8 @@ export function mountParticipant(root: HTMLElement): void {
     } else {
       parts.push(phaseArea);
     }
-    parts.push(strip.el);
+    if (surface) parts.push(lineText, surface.el);
+    else parts.push(strip.el);
     parts.push(answerArea);
 
     // ---- answer inputs
@@ -380,8 +591,15 @@ export function mountParticipant(root: HTMLElement): void {
       if (submit.disabled) return;
       trial.update({ saving: true });
       submit.textContent = 'Saving…';
+      // A 2-D study's next textures are prepared before its clock starts (a bitmap takes seconds the first time).
+      if (surface) timers.push(setTimeout(() => current() && trial.get().saving && (submit.textContent = 'Please wait: preparing the next textures…'), 1500));
       const answer = trial.get().answer;
       ev('answer', answer.choice ?? (answer.rating !== undefined ? String(answer.rating) : 'sliders'));
+      // Every stroke sample reaches the studio before the answer (one lane, in order).
+      if (surface) {
+        surface.lift();
+        await surface.flush();
+      }
       // rt_ms, shown_at and answered_at are the server's (its onset per token).
       const response: Response = { ...answer, events };
       try {

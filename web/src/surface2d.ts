@@ -81,14 +81,15 @@ function designerTexture(): TexelTexture {
   }
 }
 
+/** A new 2-D document: version 5 with the tile field (fast, isotropic); opened documents keep their version. */
 function newDocument(device: string, texture: TexelTexture): Surface2DDocument {
   const region: Region2D = {
     name: 'surface',
-    field: 'spectral',
+    field: 'tile',
     texture: { ...texture, coarse_strength: texture.coarse_strength ?? 0.8, fine_strength: texture.fine_strength ?? 0.6 },
     coarse2d: { kind: 'constant', value: 1 },
   };
-  return { format: 'texel-document', version: 4, device, surface2d: { regions: [region as unknown as { [k: string]: unknown }] } };
+  return { format: 'texel-document', version: 5, device, surface2d: { regions: [region as unknown as { [k: string]: unknown }] } };
 }
 
 /** A 2-D document: version 4, or 5 (whose regions default to the tile field). */

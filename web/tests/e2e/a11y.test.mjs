@@ -3,7 +3,8 @@
 // running session, with the session table), and every participant screen
 // state the shipped protocols reach: idle ("please wait"), the first question
 // of each task kind (oddity, practice oddity, two-alternative, match, guided,
-// rating, same-different in both of its phases) and finished; the
+// rating, same-different in both of its phases, the 2-D oddity on the touch
+// surface) and finished; the
 // experimenter view also with a session's staircase track, the exported
 // figures and the protocol editor open. Each page is
 // its own subtest: 0 critical and 0 serious findings. Every finding (any
@@ -85,6 +86,7 @@ test('axe-core: no critical or serious finding on any page', { timeout: 600_000 
       ['guided-exploration', 'guided'],
       ['quantization', 'rating'],
       ['working-memory', 'familiarisation'],
+      ['direction-independence', 'oddity-2d'], // the page as the 2-D display's touch surface
     ];
     let n = 0;
     for (const [name, task] of firsts) {

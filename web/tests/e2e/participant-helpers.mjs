@@ -1,5 +1,21 @@
 // Helpers of the participant-screen tests (participant.test.mjs in Chromium,
-// participant-firefox.test.mjs in Firefox).
+// participant-firefox.test.mjs in Firefox, participant-2d.test.mjs).
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { paths } from './studio.mjs';
+
+/** The store's trials as `texel experiment export` writes them (CSV rows as objects). */
+export function exportRows(db) {
+  const out = join(mkdtempSync(join(tmpdir(), 'texel-export-')), 'x.csv');
+  const r = spawnSync(paths.bin, ['experiment', 'export', '--db', db, '-o', out], { encoding: 'utf8' });
+  assert.equal(r.status, 0, r.stderr);
+  const [head, ...lines] = readFileSync(out, 'utf8').trim().split('\n');
+  const cols = head.split(',');
+  return lines.map((l) => Object.fromEntries(l.split(',').map((v, i) => [cols[i], v])));
+}
 
 /**
  * Sends messages one after another from `page` over a WebSocket of its own

@@ -24,12 +24,11 @@
 // Screenshots: $TEXEL_ARTIFACTS/participant-*.png.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { readFileSync, mkdtempSync, rmSync } from 'node:fs';
+import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { withStudio, screenshot, paths, launchBrowser, checkFrames, startStudio, withoutPractice } from './studio.mjs';
-import { control, STALE_HOOK } from './participant-helpers.mjs';
+import { withStudio, screenshot, launchBrowser, checkFrames, startStudio, withoutPractice } from './studio.mjs';
+import { control, STALE_HOOK, exportRows } from './participant-helpers.mjs';
 
 const TL = withoutPractice('texel-length'); // the first question is a timed staircase trial
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -58,15 +57,6 @@ const endsIn = (p) => p.locator('[data-testid=countdown]').getAttribute('data-le
 async function pickAndSubmit(p) {
   await p.locator('[data-testid=choices] button').first().click();
   await p.locator('[data-testid=submit]:not([disabled])').click();
-}
-
-function exportRows(db) {
-  const out = join(mkdtempSync(join(tmpdir(), 'texel-export-')), 'x.csv');
-  const r = spawnSync(paths.bin, ['experiment', 'export', '--db', db, '-o', out], { encoding: 'utf8' });
-  assert.equal(r.status, 0, r.stderr);
-  const [head, ...lines] = readFileSync(out, 'utf8').trim().split('\n');
-  const cols = head.split(',');
-  return lines.map((l) => Object.fromEntries(l.split(',').map((v, i) => [cols[i], v])));
 }
 
 test('participant screen: wrong session, stale screens, paused answer, reload, timing flags, labels, keyboard', { timeout: 600_000 }, async () => {

@@ -214,3 +214,22 @@ test('2-D page: map view, zoom, feel pad reaching the 2-D player, coarse shapes,
     assert.deepEqual(errors, []);
   }, { contextOptions: { hasTouch: true } });
 });
+
+test('2-D page: a new document is version 5 with the tile field; an opened one keeps its version', { timeout: 120_000 }, async () => {
+  await withStudio(async ({ studio, page, errors }) => {
+    await page.goto(`${studio.url}#/surface`); // nothing saved: a new document
+    await page.waitForFunction(() => document.querySelector('[data-testid=document2d-json]')?.value, null, { timeout: 30_000 });
+    const doc = JSON.parse(await page.inputValue('[data-testid=document2d-json]'));
+    assert.equal(doc.version, 5);
+    assert.equal(doc.surface2d.regions[0].field, 'tile');
+    assert.equal(await page.inputValue('#s2d-field'), 'tile');
+    await page.waitForFunction(() => window.__texel2d?.viewsDrawn > 0, null, { timeout: 60_000 });
+    assert.equal(await page.getAttribute('[data-testid=surface2d-status]', 'class'), 'status', await page.textContent('[data-testid=surface2d-status]'));
+    // An opened version-4 document stays version 4 (its spectral field, its bytes).
+    await page.evaluate((d) => localStorage.setItem('texel.surface2d.v1', JSON.stringify({ document: d, images: {} })), SMALL);
+    await page.reload();
+    await page.waitForFunction(() => /"version": 4/.test(document.querySelector('[data-testid=document2d-json]')?.value ?? ''), null, { timeout: 30_000 });
+    assert.equal(await page.inputValue('#s2d-field'), 'spectral');
+    assert.deepEqual(errors, []);
+  });
+});
