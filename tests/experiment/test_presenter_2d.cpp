@@ -180,7 +180,14 @@ TEST(Presenter2D, RecordsTheDisplaysStrokesPerInterval) {
   ASSERT_TRUE(presenter.two_d());
   EXPECT_THROW(presenter.show("{}"), texel::InvalidArgument);  // a 2-D display plays stimuli, not 1-D documents
 
-  ex::Session session(ex::parse_protocol(one_block({"path-indexed 0/60", "oriented 0/60"})), ex::SessionContext{});
+  const ex::Protocol protocol = ex::parse_protocol(one_block({"path-indexed 0/60", "oriented 0/60"}));
+  ex::Session session(protocol, ex::SessionContext{});
+  // The preload renders the session's two friction bitmaps (the oriented
+  // condition's pair and odd fields) in the background; no trial renders one.
+  presenter.preload(protocol, session.context());
+  for (int k = 0; k < 6000 && !presenter.preloaded(); ++k) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(presenter.preloaded());
+  EXPECT_EQ(presenter.bitmap_counts().preloaded, 2);
   for (int trial = 0; trial < 2; ++trial) {
     const ex::Question& q = session.question();
     ASSERT_EQ(q.surfaces.size(), 3u);
@@ -194,6 +201,7 @@ TEST(Presenter2D, RecordsTheDisplaysStrokesPerInterval) {
     }
     presenter.blank();
     ASSERT_EQ(presenter.error(), "");
+    EXPECT_EQ(presenter.bitmap_counts().at_trial, 0);
     ex::Response r;
     r.choice = "1";
     r.strokes = presenter.strokes(q);

@@ -35,6 +35,7 @@
 #include <memory>
 #include <numbers>
 
+#include "../prepared_surfaces.hpp"
 #include "../task.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/document.hpp"
@@ -128,7 +129,8 @@ double direction_difference(double a, double b) {
 
 // Prepared static fields of a block, by their version-4 document's text:
 // preparing a spectral field (its radial spectrum) costs far more than
-// scanning it.
+// scanning it. They come from the process's prepared surfaces, which the
+// 2-D display presenter renders its bitmaps from and preloads.
 using FieldCache = std::map<std::string, std::shared_ptr<const Surface2D>>;
 
 // Where an interval's line is centred, relative to the surface's centre (mm).
@@ -214,7 +216,7 @@ class Renderer {
       }
     } else {
       auto it = fields_.find(doc_text);
-      if (it == fields_.end()) it = fields_.emplace(doc_text, std::make_shared<const Surface2D>(prepare_surface2d(doc))).first;
+      if (it == fields_.end()) it = fields_.emplace(doc_text, prepared_surface(doc_text)).first;
       const Surface2D& surface = *it->second;
       for (std::size_t i = 0; i < n; ++i) {
         const double u = static_cast<double>(i) * dx;
