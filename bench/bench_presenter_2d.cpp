@@ -4,9 +4,12 @@
 // engine preparing the question (its scans) and, per surface the display
 // would play, the steps of rendering its map: parsing and preparing the
 // version-4 document (prepare_surface2d), rendering the friction bitmap
-// (render_raster) and making the player's map (PlayerMap2D). Then it times
-// Presenter::preload over the whole protocol, the presenter's background
-// work that takes these maps off the participant's path.
+// (render_raster, and the former row-at-a-time rendering it replaced, which
+// must give the same floats) and making the player's map (PlayerMap2D).
+// The engine's questions run first, so the surfaces they prepared are
+// shared (prepared_surfaces.hpp) and "prepare_surface2d" here is the cost
+// the presenter paid before it shared them. The sum is what the presenter
+// renders over a session: its preload does it in the background.
 //
 //   texel_bench_presenter_2d PROTOCOL.json [--json PATH]
 #include <algorithm>
