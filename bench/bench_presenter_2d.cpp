@@ -14,8 +14,8 @@
 //   texel_bench_presenter_2d PROTOCOL.json [--json PATH]
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -125,10 +125,9 @@ int main(int argc, char** argv) {
       } else {
         const texel::BitmapGeometry& g = *doc.device.bitmap;
         t0 = Clock::now();
-        auto m = texel::PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel,
-                                                  texel::Sampling{doc.device.grid(), texel::CyclesPerMm(0.0)}, std::nullopt,
-                                                  texel::Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()},
-                                                  10000.0, doc.device.response);
+        auto m = texel::PlayerMap2D::path_indexed(
+            doc.surface2d->regions[0].texel, texel::Sampling{doc.device.grid(), texel::CyclesPerMm(0.0)}, std::nullopt,
+            texel::Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0, doc.device.response);
         const double b = since(t0);
         path_s += b;
         a += b;

@@ -5,12 +5,12 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <future>
+#include <list>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <span>
-#include <future>
-#include <list>
 #include <thread>
 
 #if defined(__linux__)
@@ -19,6 +19,7 @@
 #include <unistd.h>
 #endif
 
+#include "prepared_surfaces.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
@@ -26,7 +27,6 @@
 #include "texel/player2d.hpp"
 #include "texel/serial_link.hpp"
 #include "texel/surface2d.hpp"
-#include "prepared_surfaces.hpp"
 
 namespace texel::experiment {
 namespace {

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "internal.hpp"
-#include "texel/detail/parallel.hpp"
 #include "texel/detail/format.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -278,7 +278,8 @@ Raster2D render_raster(const Surface2D& surface) {
     std::vector<double>& b = buffers[worker];
     surface.render_rows(first, rows, std::span<double>(b.data(), w * static_cast<std::size_t>(rows)));
     std::transform(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(w) * rows,
-                   r.values.begin() + static_cast<std::ptrdiff_t>(first) * g.width, [](double v) { return static_cast<float>(v); });
+                   r.values.begin() + static_cast<std::ptrdiff_t>(first) * g.width,
+                   [](double v) { return static_cast<float>(v); });
   });
   return r;
 }

@@ -148,8 +148,9 @@ TEST(Oddity2D, TheDirectionsTellNothingAboutWhichIntervalIsOdd) {
   p["version"] = 2;
   EXPECT_EQ(direction_counts(ex::Session(ex::parse_protocol(p.dump()), {})).lone_odd, 0);
   p["blocks"][0]["direction_assignment"] = "alternate";
-  EXPECT_NE(texel::test_support::message_of<texel::FormatError>([&] { (void)ex::parse_protocol(p.dump()); })
-                .find("blocks[0].direction_assignment is 'alternate'; allowed: balanced, pair-spans"),
+  EXPECT_NE(texel::test_support::message_of<texel::FormatError>([&] {
+              (void)ex::parse_protocol(p.dump());
+            }).find("blocks[0].direction_assignment is 'alternate'; allowed: balanced, pair-spans"),
             std::string::npos);
 }
 

@@ -125,9 +125,9 @@ TEST(Strokes, DirectionWordsNameOnlyTheLine) {
 // to the stroke's start is a lifted one, so a stroke recorder separates the
 // strokes without its jump rule (here switched off: any speed, any gap).
 TEST(Presenter2D, TheControllersSensorLiftsBetweenItsStrokes) {
-  texel::test_support::ControllerProcess display(TEXEL_CLI, {"--sensor", "line", "--sensor-angle", "0", "--sensor-start", "40,60",
-                                                             "--sensor-period", "0.3", "--sensor-lift", "0.05", "--duration",
-                                                             "30", "--quiet"});
+  texel::test_support::ControllerProcess display(
+      TEXEL_CLI, {"--sensor", "line", "--sensor-angle", "0", "--sensor-start", "40,60", "--sensor-period", "0.3", "--sensor-lift",
+                  "0.05", "--duration", "30", "--quiet"});
   ASSERT_FALSE(display.pty().empty());
   texel::SerialLink link(display.pty());
   link.hello();

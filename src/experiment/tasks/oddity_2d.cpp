@@ -296,7 +296,8 @@ class Oddity2DBlock : public TaskBlock {
     std::array<double, 3> out{};
     if (how == DirectionAssignment::pair_spans) {
       int next_pair = 0;
-      for (int i = 0; i < 3; ++i) out[static_cast<std::size_t>(i)] = i == odd ? c.directions_deg[drawn] : c.directions_deg[next_pair++];
+      for (int i = 0; i < 3; ++i)
+        out[static_cast<std::size_t>(i)] = i == odd ? c.directions_deg[drawn] : c.directions_deg[next_pair++];
       return out;
     }
     const std::uint64_t lone = s.trial_below(5, 3);
