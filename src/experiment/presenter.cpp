@@ -175,7 +175,7 @@ struct Presenter::Display2D {
       lower_this_threads_priority();
       try {
         render_ahead(Session(protocol, context), stop);
-      } catch (const std::exception&) {
+      } catch (...) {
         // The trial that needs the map renders it and reports the error.
       }
       preloaded = true;
@@ -363,7 +363,9 @@ Presenter::BitmapCounts Presenter::bitmap_counts() const {
 
 void Presenter::prepare(const Question& question) {
   if (!display_) return;
-  for (const auto& s : question.surfaces) (void)display_->map(s);
+  // The bitmaps (a path-indexed map is made when shown, in well under a millisecond).
+  for (const auto& s : question.surfaces)
+    if (s.kind == SurfaceStimulus::Kind::bitmap) (void)display_->bitmap(s.document_json, true);
   std::lock_guard<std::mutex> lock(display_->mutex);
   display_->recorders.clear();
   display_->current.clear();
