@@ -27,7 +27,9 @@
 // field per condition and view in a session, like one bitmap on the display,
 // and each interval is a line of it through its own random point within
 // (side − display_mm)/2 of the surface's centre. Only the texture, the mode
-// and the direction tell the intervals apart.
+// and the direction tell the intervals apart. Which interval is swiped along
+// which of the condition's two directions: DirectionAssignment (balanced
+// from protocol version 3, so the directions never point at the odd one).
 #include <algorithm>
 #include <array>
 #include <cmath>
