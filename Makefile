@@ -119,6 +119,7 @@ bench: build web web-test
 	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 tile
 	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 spectral
 	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 cells
+	$(BUILD)/bin/texel_bench_presenter_2d examples/protocols/direction-independence.json --json $(BUILD)/bench_presenter_2d.json
 	cd web && $(BROWSER_ENV) node --test tests/e2e/latency.test.mjs >/dev/null
 	$(PY) bench/studio_latency.py $(BUILD)/browser-artifacts/latency.json
 	TEXEL_PG_EXTRA_OPTS="-c track_commit_timestamp=on" scripts/pg-test-server.sh start $(BUILD)/bench-pg.env >/dev/null

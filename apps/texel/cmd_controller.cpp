@@ -3,8 +3,9 @@
 // pseudo-terminal (--pty prints its path for `texel play --backend
 // serial:PATH`). The "actuator" is a status line showing the amplitude.
 // --sensor gives it a finger sensor (a simulated 2-D stroke, or a recorded
-// x, y trace, played in a loop), so it acts as a 2-D display that reports
-// its finger (protocol 1.1) for `texel play --finger serial:PATH`.
+// x, y trace, played in a loop, the finger lifted between passes), so it
+// acts as a 2-D display that reports its finger (protocol 1.1) for
+// `texel play --finger serial:PATH`.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -45,21 +46,33 @@ struct ControllerArgs {
   double sensor_angle_deg = 0.0;
   double sensor_radius_mm = 20.0;
   double sensor_period_s = 2.0;
+  double sensor_lift_s = 0.1;
   std::vector<double> sensor_start_mm;  // x, y
 };
 
-// The simulated sensor: a 2-D trace played in a loop (each pass ends lifted,
-// as a finger lifts between strokes), linearly interpolated at the
-// controller's clock.
+// The simulated sensor: a 2-D trace played in a loop, linearly interpolated
+// at the controller's clock. Between two passes the finger is lifted for
+// `lift_s` (reported with touch 0 where the pass ended), as a finger lifts
+// to go back to where its stroke starts: the host sees the end of one
+// stroke and the touch of the next (docs/serial-protocol.md), not a jump.
 class LoopedSensor {
  public:
-  explicit LoopedSensor(std::vector<FingerSample2D> trace) : trace_(std::move(trace)) {
+  LoopedSensor(std::vector<FingerSample2D> trace, double lift_s) : trace_(std::move(trace)), lift_s_(lift_s) {
     if (trace_.size() < 2 || !(trace_.back().t_s > trace_.front().t_s))
       throw InvalidArgument("--sensor: the trace must span some time (at least two samples)");
+    if (!(lift_s_ >= 0.001 && lift_s_ <= 10.0))
+      throw InvalidArgument("--sensor-lift is " + detail::num(lift_s_) + "; allowed: 0.001 … 10 s");
     period_s_ = trace_.back().t_s - trace_.front().t_s;
   }
   bool operator()(std::uint32_t t_us, std::int32_t& x_nm, std::int32_t& y_nm, bool& touch) const {
-    const double t = trace_.front().t_s + std::fmod(static_cast<double>(t_us) * 1e-6, period_s_);
+    const double phase = std::fmod(static_cast<double>(t_us) * 1e-6, period_s_ + lift_s_);
+    if (phase >= period_s_) {  // lifted, above where the pass ended
+      x_nm = static_cast<std::int32_t>(std::lround(trace_.back().x_mm * 1e6));
+      y_nm = static_cast<std::int32_t>(std::lround(trace_.back().y_mm * 1e6));
+      touch = false;
+      return true;
+    }
+    const double t = trace_.front().t_s + phase;
     auto it = std::upper_bound(trace_.begin(), trace_.end(), t, [](double v, const FingerSample2D& s) { return v < s.t_s; });
     const FingerSample2D& a = *std::prev(it == trace_.begin() ? std::next(it) : it);
     const FingerSample2D& b = it == trace_.end() ? a : *it;
@@ -72,6 +85,7 @@ class LoopedSensor {
 
  private:
   std::vector<FingerSample2D> trace_;
+  double lift_s_ = 0.1;
   double period_s_ = 0.0;
 };
 
@@ -99,7 +113,7 @@ void run(const ControllerArgs& a) {
   const DeviceProfile d = load_device(a.device);
   // The sensor is read and checked before the port opens.
   std::optional<LoopedSensor> sensor;
-  if (a.sensor) sensor.emplace(sensor_trace(a));
+  if (a.sensor) sensor.emplace(sensor_trace(a), a.sensor_lift_s);
   int fd = -1;
   int keep_slave = -1;
   std::string where;
@@ -171,6 +185,8 @@ void register_controller(CLI::App& app) {
   cmd->add_option("--sensor-angle", a->sensor_angle_deg, "Sensor line / zigzag direction (degrees) [0]");
   cmd->add_option("--sensor-radius", a->sensor_radius_mm, "Sensor circle radius (mm) [20]");
   cmd->add_option("--sensor-period", a->sensor_period_s, "Length of one simulated stroke before the finger lifts (s) [2]");
+  cmd->add_option("--sensor-lift", a->sensor_lift_s,
+                  "How long the sensor's finger stays lifted between two strokes (s), reported with touch 0 [0.1]");
   cmd->add_option("--sensor-start", a->sensor_start_mm, "Where a sensor stroke starts (circle: its centre), x,y in mm [0,0]")
       ->delimiter(',')
       ->expected(2);

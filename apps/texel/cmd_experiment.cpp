@@ -169,6 +169,9 @@ void run(const RunArgs& a) {
   const std::string& simulate = active.simulate;
   std::optional<ex::SimulatedParticipant> sim;
   if (!simulate.empty()) sim.emplace(ex::simulated_participant(active));
+  // A 2-D display: the session's friction bitmaps render in the background
+  // from now on (instructions, practice), not while the participant waits.
+  presenter.preload(protocol, session.context());
 
   experiment_interrupted = false;
   auto old_int = std::signal(SIGINT, on_experiment_signal);

@@ -396,9 +396,13 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   stop = StopReason::none;
   if (presenter && presenter->two_d()) {
     // The display's maps, before the trial's clock starts (a friction
-    // bitmap takes a second or two the first time it is shown).
+    // bitmap takes about a second to render).
+    // Usually ready: the presenter's preload renders the session's friction
+    // bitmaps in the background from the start. The monitor gets the wait.
     if (interactive()) std::cout << "  Please wait: preparing the textures…" << std::flush;
+    const auto prepared_from = Clock::now();
     presenter->prepare(q);
+    monitor.event("maps_ready", {{"trial_number", trial_number}, {"wait_s", detail::fixed(seconds_since(prepared_from), 3)}});
     if (interactive()) std::cout << "\r\033[2K" << std::flush;
     // Keys typed on a terminal while the maps rendered were meant for no
     // trial on screen (and their echo would upset the countdown's redraw).

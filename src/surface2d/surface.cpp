@@ -5,6 +5,7 @@
 
 #include "internal.hpp"
 #include "texel/detail/format.hpp"
+#include "texel/detail/parallel.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -262,13 +263,24 @@ Raster2D render_raster(const Surface2D& surface) {
   r.width = g.width;
   r.height = g.height;
   r.pitch = g.pitch;
-  r.values.resize(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height));
-  std::vector<double> row(static_cast<std::size_t>(g.width));
-  for (int j = 0; j < g.height; ++j) {
-    surface.render_rows(j, 1, row);
-    std::transform(row.begin(), row.end(), r.values.begin() + static_cast<std::ptrdiff_t>(j) * g.width,
+  const auto w = static_cast<std::size_t>(g.width);
+  r.values.resize(w * static_cast<std::size_t>(g.height));
+  // Strips of rows, not single rows: a spectral field splits its plane
+  // waves into x and y factors once per strip (FineField2D::block), and any
+  // strip gives the same values. Spread over worker_threads() (each worker
+  // its own strip buffer of strip_rows doubles): the same bits on any count.
+  constexpr int strip_rows = 64;
+  const int strips = (g.height + strip_rows - 1) / strip_rows;
+  const int workers = std::min(detail::worker_threads(), std::max(strips, 1));
+  std::vector<std::vector<double>> buffers(static_cast<std::size_t>(workers), std::vector<double>(w * strip_rows));
+  detail::parallel_tasks(workers, static_cast<std::size_t>(strips), [&](std::size_t worker, std::size_t strip) {
+    const int first = static_cast<int>(strip) * strip_rows, rows = std::min(strip_rows, g.height - first);
+    std::vector<double>& b = buffers[worker];
+    surface.render_rows(first, rows, std::span<double>(b.data(), w * static_cast<std::size_t>(rows)));
+    std::transform(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(w) * rows,
+                   r.values.begin() + static_cast<std::ptrdiff_t>(first) * g.width,
                    [](double v) { return static_cast<float>(v); });
-  }
+  });
   return r;
 }
 

@@ -33,11 +33,15 @@ namespace {
 
 const std::string dir = std::string(TEXEL_TEST_SOURCE_DIR) + "/examples/protocols/";
 
-// A one-block protocol whose only condition is `pair` against `odd`.
-std::string protocol(const json& pair, const json& odd, int trials = 1) {
+// A one-block protocol whose only condition is `pair` against `odd`; by
+// default with the former direction assignment (the pair along its two
+// directions, the odd interval along one of them), so the intervals in the
+// order pair, pair, odd are along the pair's first and second directions.
+std::string protocol(const json& pair, const json& odd, int trials = 1, const std::string& assignment = "pair-spans") {
   json p = json::parse(texel::read_file(dir + "direction-independence.json"));
   json& b = p["blocks"][1];
   b["trials_per_condition"] = trials;
+  b["direction_assignment"] = assignment;
   b["conditions"] = json::array({json{{"name", "c"}, {"pair", pair}, {"odd", odd}}});
   p["blocks"].erase(0);
   return p.dump();
@@ -77,6 +81,101 @@ TEST(Oddity2D, ShippedProtocolsValidate) {
   EXPECT_NE(message(text, "\"trials_per_condition\": 10", "\"trials_per_condition\": 10, \"staircase\": {}")
                 .find("staircase does not apply to task 'oddity-2d'"),
             std::string::npos);
+}
+
+// How the directions fall over the intervals of many trials of a 0°/60°
+// condition: `lone_odd` counts the trials whose odd interval is the one
+// swiped along a direction of its own; `odd_at[lone][odd]` the odd
+// interval's position against that interval's.
+struct DirectionCounts {
+  int trials = 0, lone_odd = 0, lone_60 = 0, lone_60_odd = 0;
+  int odd_at[3][3] = {};
+};
+
+DirectionCounts direction_counts(ex::Session s) {
+  DirectionCounts c;
+  while (!s.finished()) {
+    const ex::Question& q = s.question();
+    EXPECT_EQ(q.surfaces.size(), 3u);
+    int lone = -1;
+    for (int i = 0; i < 3; ++i) {
+      const double d = q.surfaces[static_cast<std::size_t>(i)].direction_deg;
+      const double a = q.surfaces[static_cast<std::size_t>((i + 1) % 3)].direction_deg;
+      const double b = q.surfaces[static_cast<std::size_t>((i + 2) % 3)].direction_deg;
+      if (d != a && d != b) lone = i;
+    }
+    EXPECT_GE(lone, 0) << "trial " << q.trial << ": both directions must be swiped";
+    const int odd = std::stoi(s.truth().correct_answer) - 1;
+    ++c.trials;
+    c.lone_odd += lone == odd;
+    const bool at_60 = lone >= 0 && q.surfaces[static_cast<std::size_t>(lone)].direction_deg == 60.0;
+    c.lone_60 += at_60;
+    c.lone_60_odd += at_60 && lone == odd;
+    if (lone >= 0) ++c.odd_at[lone][odd];
+    ex::Response r;
+    r.choice = "1";
+    (void)s.answer(r);
+  }
+  return c;
+}
+
+// The cue the former design gave (docs/experiments.md "Directions"): with
+// the balanced assignment (the shipped protocol's, version 3's default) the
+// interval with a direction of its own is the odd one in 1 trial in 3,
+// whichever direction and position it has; so knowing the directions does
+// not help find the odd one. A version-2 protocol keeps its former design,
+// where that interval is never the odd one.
+TEST(Oddity2D, TheDirectionsTellNothingAboutWhichIntervalIsOdd) {
+  const json pair{{"mode", "1d"}, {"directions_deg", {0, 60}}};
+  const json odd{{"mode", "1d"}, {"pitch_shift_db", -2}};
+  constexpr int n = 900;  // 1-D intervals: a few ms a trial
+  const DirectionCounts b = direction_counts(ex::Session(ex::parse_protocol(protocol(pair, odd, n, "balanced")), {}));
+  ASSERT_EQ(b.trials, n);
+  // Binomial(900, 1/3): sd 14; the bounds are 4 sd.
+  EXPECT_NEAR(b.lone_odd, n / 3, 57);
+  EXPECT_NEAR(b.lone_60, n / 2, 60);
+  EXPECT_NEAR(b.lone_60_odd, b.lone_60 / 3, 40);
+  for (int lone = 0; lone < 3; ++lone) {
+    const int at = b.odd_at[lone][0] + b.odd_at[lone][1] + b.odd_at[lone][2];
+    for (int o = 0; o < 3; ++o) EXPECT_NEAR(b.odd_at[lone][o], at / 3, 40) << "lone " << lone << ", odd " << o;
+  }
+  const DirectionCounts old = direction_counts(ex::Session(ex::parse_protocol(protocol(pair, odd, 60, "pair-spans")), {}));
+  EXPECT_EQ(old.lone_odd, 0);
+  // The default follows the version: 3 balanced, 2 the former design.
+  json p = json::parse(protocol(pair, odd, 60));
+  p["blocks"][0].erase("direction_assignment");
+  EXPECT_GT(direction_counts(ex::Session(ex::parse_protocol(p.dump()), {})).lone_odd, 0);
+  p["version"] = 2;
+  EXPECT_EQ(direction_counts(ex::Session(ex::parse_protocol(p.dump()), {})).lone_odd, 0);
+  p["blocks"][0]["direction_assignment"] = "alternate";
+  EXPECT_NE(texel::test_support::message_of<texel::FormatError>([&] {
+              (void)ex::parse_protocol(p.dump());
+            }).find("blocks[0].direction_assignment is 'alternate'; allowed: balanced, pair-spans"),
+            std::string::npos);
+}
+
+// The direction-independence protocol as shipped before version 3
+// (tests/experiment/data): its questions keep their bytes. The digest is of
+// the questions a build of main before the balanced assignment stored for
+// participant S01 (`texel experiment run --simulate`: identical questions,
+// states, answers and rows but for their time stamps).
+TEST(Oddity2D, AVersionTwoProtocolAsksTheSameQuestions) {
+  const ex::Protocol p =
+      ex::load_protocol(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/experiment/data/direction-independence-v2.json");
+  ex::SessionContext context;
+  context.participant = "S01";
+  context.seed = ex::session_seed(p.seed, "S01");
+  ex::Session s(p, context);
+  std::uint64_t h = 1469598103934665603ull;
+  int trials = 0;
+  while (!s.finished()) {
+    ex::Response r;
+    r.choice = "1";
+    for (unsigned char c : s.answer(r).question_json) h = (h ^ c) * 1099511628211ull;
+    ++trials;
+  }
+  EXPECT_EQ(trials, 62);
+  EXPECT_EQ(h, 0xbf3b0aabb0301c05ull) << "got 0x" << std::hex << h;
 }
 
 // The pair's two swipes of an oriented grating (wave vector at 0°) along 0°

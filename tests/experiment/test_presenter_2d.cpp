@@ -9,6 +9,7 @@
 // sensor in one line.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,7 @@
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/strokes.hpp"
 #include "texel/io.hpp"
+#include "texel/serial_link.hpp"
 
 namespace ex = texel::experiment;
 using json = nlohmann::json;
@@ -118,6 +120,52 @@ TEST(Strokes, DirectionWordsNameOnlyTheLine) {
   EXPECT_EQ(ex::direction_words(135), "⤢ rising to the right, 45° from horizontal");
 }
 
+// The reference controller's sensor in a loop lifts between its strokes,
+// as a finger does (docs/serial-protocol.md): the report before every return
+// to the stroke's start is a lifted one, so a stroke recorder separates the
+// strokes without its jump rule (here switched off: any speed, any gap).
+TEST(Presenter2D, TheControllersSensorLiftsBetweenItsStrokes) {
+  texel::test_support::ControllerProcess display(
+      TEXEL_CLI, {"--sensor", "line", "--sensor-angle", "0", "--sensor-start", "40,60", "--sensor-period", "0.3", "--sensor-lift",
+                  "0.05", "--duration", "30", "--quiet"});
+  ASSERT_FALSE(display.pty().empty());
+  texel::SerialLink link(display.pty());
+  link.hello();
+  link.start_reports(1000);
+  std::vector<texel::FingerReport> got;
+  std::array<texel::FingerReport, 64> buf;
+  const auto end = std::chrono::steady_clock::now() + 1600ms;
+  while (std::chrono::steady_clock::now() < end) {
+    const std::size_t n = link.read_reports(buf, 20);
+    got.insert(got.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  link.start_reports(0);
+  ASSERT_GT(got.size(), 500u);
+  ex::StrokeRules rules;
+  rules.max_speed_mm_s = 1e9;
+  rules.max_gap_s = 1e9;
+  ex::StrokeRecorder recorder(rules);
+  int lifts = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    const texel::FingerReport& r = got[i];
+    recorder.add(r.t_us * 1e-6, r.x_mm, r.y_mm, r.touch);
+    if (i == 0) continue;
+    const texel::FingerReport& prev = got[i - 1];
+    lifts += prev.touch && !r.touch;
+    // Touching, the finger moves 100 mm/s: never a jump between two reports.
+    if (prev.touch && r.touch && r.t_us - prev.t_us < 10000) {
+      EXPECT_LT(std::abs(r.x_mm - prev.x_mm), 2.0) << "report " << i << ": a jump while touching";
+    }
+  }
+  // 1.6 s of 0.35 s passes: four or five lifts, one stroke each side of them.
+  EXPECT_GE(lifts, 4);
+  EXPECT_LE(lifts, 5);
+  const ex::IntervalStrokes summary = recorder.summary("1", 0.0);
+  EXPECT_GE(summary.strokes, lifts);
+  EXPECT_LE(summary.strokes, lifts + 1);
+  EXPECT_NEAR(summary.direction_deg, 0.0, 0.5);
+}
+
 // The library presenter with the reference controller as the display: its
 // sensor strokes along 60° from (60, 40) at 100 mm/s, lifting every 0.6 s.
 TEST(Presenter2D, RecordsTheDisplaysStrokesPerInterval) {
@@ -132,7 +180,14 @@ TEST(Presenter2D, RecordsTheDisplaysStrokesPerInterval) {
   ASSERT_TRUE(presenter.two_d());
   EXPECT_THROW(presenter.show("{}"), texel::InvalidArgument);  // a 2-D display plays stimuli, not 1-D documents
 
-  ex::Session session(ex::parse_protocol(one_block({"path-indexed 0/60", "oriented 0/60"})), ex::SessionContext{});
+  const ex::Protocol protocol = ex::parse_protocol(one_block({"path-indexed 0/60", "oriented 0/60"}));
+  ex::Session session(protocol, ex::SessionContext{});
+  // The preload renders the session's two friction bitmaps (the oriented
+  // condition's pair and odd fields) in the background; no trial renders one.
+  presenter.preload(protocol, session.context());
+  for (int k = 0; k < 6000 && !presenter.preloaded(); ++k) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(presenter.preloaded());
+  EXPECT_EQ(presenter.bitmap_counts().preloaded, 2);
   for (int trial = 0; trial < 2; ++trial) {
     const ex::Question& q = session.question();
     ASSERT_EQ(q.surfaces.size(), 3u);
@@ -146,6 +201,7 @@ TEST(Presenter2D, RecordsTheDisplaysStrokesPerInterval) {
     }
     presenter.blank();
     ASSERT_EQ(presenter.error(), "");
+    EXPECT_EQ(presenter.bitmap_counts().at_trial, 0);
     ex::Response r;
     r.choice = "1";
     r.strokes = presenter.strokes(q);

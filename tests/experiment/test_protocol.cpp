@@ -112,7 +112,11 @@ TEST(ProtocolVersions, StaircaseDefaultsFollowTheVersion) {
   EXPECT_NE(error_of(t).find("blocks[0].staircase.end_value: 'final' is not an end value (allowed: next, last-presented)"),
             std::string::npos)
       << error_of(t);
-  EXPECT_NE(error_of(with_version(minimal_oddity, 3)).find("version 3 is newer"), std::string::npos);
+  // Version 3 changes only the 2-D oddity's direction assignment.
+  const auto v3 = ex::parse_protocol(with_version(minimal_oddity, 3));
+  EXPECT_FALSE(v3.blocks[0].staircase->apply_initial_rule);
+  EXPECT_EQ(v3.blocks[0].staircase->end_value, ex::EndValue::last_presented);
+  EXPECT_NE(error_of(with_version(minimal_oddity, 4)).find("version 4 is newer"), std::string::npos);
 }
 
 TEST(ProtocolVersions, ShippedProtocolsAreVersionTwoWithTheSourcesStaircase) {

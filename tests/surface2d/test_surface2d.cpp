@@ -124,6 +124,10 @@ TEST(Surface2D, StripsAndPointsGiveTheWholeBitmap) {
       for (int i : {0, 40, 95})
         ASSERT_EQ(s.amplitude(i * 0.05, j * 0.05), whole[static_cast<std::size_t>(j * w + i)]) << to_string(field);
     for (double a : whole) ASSERT_TRUE(a >= 0.0 && a <= 1.0);
+    // render_raster (strips over worker threads) gives the same values.
+    const Raster2D raster = render_raster(s);
+    ASSERT_EQ(raster.values.size(), whole.size());
+    for (std::size_t k = 0; k < whole.size(); ++k) ASSERT_EQ(raster.values[k], static_cast<float>(whole[k])) << k;
   }
 }
 

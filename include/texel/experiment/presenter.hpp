@@ -102,8 +102,24 @@ class Presenter {
   /// question without surfaces (InvalidArgument).
   void show(const Question& question, std::size_t i);
   /// Renders the question's 2-D maps ahead, so switching costs a copy (no-op
-  /// without a 2-D display). Clears the strokes recorded so far.
+  /// without a 2-D display). Clears the strokes recorded so far. Waits for
+  /// a bitmap the preload is rendering rather than rendering it again.
   void prepare(const Question& question);
+  /// Starts rendering, on a background thread at a lower priority, every
+  /// friction bitmap a session of `protocol` with `context` will show (the
+  /// questions the session asks, in order, up to the presenter's cache of
+  /// eight), so that a trial's prepare() finds its maps ready. Call it once
+  /// the session is open, before the instructions; stop() ends it. No-op
+  /// without a 2-D display or when already started.
+  void preload(const Protocol& protocol, const SessionContext& context);
+  /// Whether the preload has finished (every bitmap it could keep rendered).
+  [[nodiscard]] bool preloaded() const;
+  /// Friction bitmaps rendered by the preload, and by prepare()/show() for
+  /// a trial (each one a participant waited for).
+  struct BitmapCounts {
+    int preloaded = 0, at_trial = 0;
+  };
+  [[nodiscard]] BitmapCounts bitmap_counts() const;
   /// Whether the participant strokes a 2-D display (FingerSource::display).
   [[nodiscard]] bool two_d() const { return display_ != nullptr; }
   /// The strokes of the question's intervals since prepare(), one entry per

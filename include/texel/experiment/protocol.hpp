@@ -148,7 +148,7 @@ struct Protocol {
   /// 1: the first format (its defaults kept exactly, so stored sessions
   /// replay); 2: the source-faithful defaults (staircase end value and start
   /// rule) and checks (docs/experiments.md "Protocol versions").
-  static constexpr int current_version = 2;
+  static constexpr int current_version = 3;
   int version = current_version;
   std::string name;
   std::string study;

@@ -27,13 +27,17 @@
 // field per condition and view in a session, like one bitmap on the display,
 // and each interval is a line of it through its own random point within
 // (side − display_mm)/2 of the surface's centre. Only the texture, the mode
-// and the direction tell the intervals apart.
+// and the direction tell the intervals apart. Which interval is swiped along
+// which of the condition's two directions: DirectionAssignment (balanced
+// from protocol version 3, so the directions never point at the odd one).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <memory>
 #include <numbers>
 
+#include "../prepared_surfaces.hpp"
 #include "../task.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/document.hpp"
@@ -65,9 +69,24 @@ struct Condition2D {
   double directions_deg[2] = {0.0, 0.0};  // the pair's two swipes; the odd one takes one of them
 };
 
+// Which interval is swiped along which of a condition's two directions
+// (docs/experiments.md "2-D studies", "Directions").
+enum class DirectionAssignment {
+  // Versions 1–2: the pair along its two directions, the odd interval along
+  // one of them (drawn). The one interval with a direction of its own is
+  // always a pair member: a participant told the directions can rule it out.
+  pair_spans,
+  // Version 3: one interval, drawn uniformly, is swiped along one of the two
+  // directions (drawn), the other two along the other. Whether that interval
+  // is the odd one is independent of it (1 in 3), so the directions tell
+  // nothing about which interval is odd.
+  balanced,
+};
+
 struct Oddity2DSettings : TaskSettings {
   std::vector<Condition2D> conditions;
   int trials_per_condition = 10;
+  DirectionAssignment directions = DirectionAssignment::balanced;
 };
 
 const Oddity2DSettings& settings_of(const Block& b) { return static_cast<const Oddity2DSettings&>(*b.settings); }
@@ -112,7 +131,8 @@ double direction_difference(double a, double b) {
 
 // Prepared static fields of a block, by their version-4 document's text:
 // preparing a spectral field (its radial spectrum) costs far more than
-// scanning it.
+// scanning it. They come from the process's prepared surfaces, which the
+// 2-D display presenter renders its bitmaps from and preloads.
 using FieldCache = std::map<std::string, std::shared_ptr<const Surface2D>>;
 
 // Where an interval's line is centred, relative to the surface's centre (mm).
@@ -198,7 +218,7 @@ class Renderer {
       }
     } else {
       auto it = fields_.find(doc_text);
-      if (it == fields_.end()) it = fields_.emplace(doc_text, std::make_shared<const Surface2D>(prepare_surface2d(doc))).first;
+      if (it == fields_.end()) it = fields_.emplace(doc_text, prepared_surface(doc_text)).first;
       const Surface2D& surface = *it->second;
       for (std::size_t i = 0; i < n; ++i) {
         const double u = static_cast<double>(i) * dx;
@@ -231,12 +251,11 @@ class Oddity2DBlock : public TaskBlock {
     t.reference = c.pair.mode;  // exported as `reference`: the analysis compares conditions of one mode
     t.intensity = direction_difference(c.directions_deg[0], c.directions_deg[1]);
     const auto odd = static_cast<int>(s.trial_below(3, 3));
-    const double odd_direction = c.directions_deg[s.trial_below(4, 2)];
+    const std::array<double, 3> direction = directions(st.directions, c, odd, s);
     const Renderer render(s, b, fields_);
     const BitmapGeometry& g = *s.device.bitmap;
     const double radius = (std::min(g.width_mm().value(), g.height_mm().value()) - b.display_mm) / 2;
     const auto condition = static_cast<std::uint64_t>(plan_[static_cast<std::size_t>(s.trial_in_block)]);
-    int next_pair = 0;
     for (int i = 0; i < 3; ++i) {
       const bool is_odd = i == odd;
       const View& v = is_odd ? c.odd : c.pair;
@@ -252,8 +271,7 @@ class Oddity2DBlock : public TaskBlock {
             2 * std::numbers::pi * s.trial_rng.uniform(draw_counter(static_cast<std::uint64_t>(s.trial), 9 + 2 * k));
         offset = {r * std::cos(phi), r * std::sin(phi)};
       }
-      auto [stimulus, surface] =
-          render.stimulus(std::to_string(i + 1), v, is_odd ? odd_direction : c.directions_deg[next_pair++], seed, offset);
+      auto [stimulus, surface] = render.stimulus(std::to_string(i + 1), v, direction[static_cast<std::size_t>(i)], seed, offset);
       q.stimuli.push_back(std::move(stimulus));
       q.surfaces.push_back(std::move(surface));
     }
@@ -274,6 +292,21 @@ class Oddity2DBlock : public TaskBlock {
   bool finished(const SessionCore& s) const override { return s.trial_in_block >= static_cast<int>(plan_.size()); }
 
  private:
+  // Each interval's swipe direction, the odd interval being `odd`.
+  static std::array<double, 3> directions(DirectionAssignment how, const Condition2D& c, int odd, const SessionCore& s) {
+    const std::uint64_t drawn = s.trial_below(4, 2);  // pair_spans: the odd one's; balanced: the lone interval's
+    std::array<double, 3> out{};
+    if (how == DirectionAssignment::pair_spans) {
+      int next_pair = 0;
+      for (int i = 0; i < 3; ++i)
+        out[static_cast<std::size_t>(i)] = i == odd ? c.directions_deg[drawn] : c.directions_deg[next_pair++];
+      return out;
+    }
+    const std::uint64_t lone = s.trial_below(5, 3);
+    for (std::uint64_t i = 0; i < 3; ++i) out[i] = c.directions_deg[i == lone ? drawn : 1 - drawn];
+    return out;
+  }
+
   std::vector<int> plan_;  // condition index per trial
   FieldCache fields_;
 };
@@ -282,7 +315,7 @@ class Oddity2DTask : public TaskType {
  public:
   std::string_view name() const override { return kind_name; }
   std::vector<std::string_view> keys() const override {
-    return {"texture", "display_mm", "time_limit_s", "conditions", "trials_per_condition"};
+    return {"texture", "display_mm", "time_limit_s", "conditions", "trials_per_condition", "direction_assignment"};
   }
 
   void parse(BlockInput& in, Block& b) const override {
@@ -301,6 +334,15 @@ class Oddity2DTask : public TaskType {
     b.time_limit_s = o.number_or("time_limit_s", 30.0, 0.0, 3600.0);
     auto st = std::make_shared<Oddity2DSettings>();
     st->trials_per_condition = static_cast<int>(o.integer("trials_per_condition", 1, 1000));
+    // Version 3 made the balanced assignment the default; earlier protocols
+    // keep the design (and the trials) they were run with.
+    const std::string assignment = o.string_or("direction_assignment", in.version >= 3 ? "balanced" : "pair-spans");
+    if (assignment == "balanced")
+      st->directions = DirectionAssignment::balanced;
+    else if (assignment == "pair-spans")
+      st->directions = DirectionAssignment::pair_spans;
+    else
+      throw FormatError(o.field("direction_assignment") + " is '" + assignment + "'; allowed: balanced, pair-spans");
     const auto& list = o.raw("conditions");
     if (!list.is_array() || list.empty() || list.size() > 64)
       throw FormatError(o.field("conditions") + " must be an array of 1 … 64 conditions");
