@@ -5,7 +5,6 @@
 #include <array>
 #include <atomic>
 #include <cmath>
-#include <future>
 #include <list>
 #include <map>
 #include <mutex>
@@ -13,16 +12,10 @@
 #include <span>
 #include <thread>
 
-#if defined(__linux__)
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-#endif
-
-#include "prepared_surfaces.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/surface_maps.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/serial_link.hpp"
@@ -39,14 +32,6 @@ double finger_x(double t, double speed, double a, double b) {
   const double period = 2.0 * span / speed;
   const double phase = std::fmod(t, period);
   return phase < period / 2 ? a + speed * phase : b - speed * (phase - period / 2);
-}
-
-// The preload's thread yields to the participant's (nice +10 on Linux; the
-// threads it starts to render inherit it). Elsewhere it runs as it is.
-void lower_this_threads_priority() {
-#if defined(__linux__)
-  (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
-#endif
 }
 
 constexpr double finger_rate_hz = 1000.0;  // like a position sensor
@@ -78,10 +63,7 @@ struct Presenter::Display2D {
   }
   void stop() {
     if (reader) reader->stop();
-    if (preloader.joinable()) {
-      preloader.request_stop();
-      preloader.join();  // at most the bitmap being rendered (about a second)
-    }
+    maps.stop();
   }
   [[nodiscard]] bool running() const { return reader && !reader->stopping(); }
   [[nodiscard]] std::string error() const { return reader ? reader->error() : std::string(); }
@@ -99,110 +81,7 @@ struct Presenter::Display2D {
     current = label;
   }
 
-  // A map for the player to own. A path-indexed map is made at once (a
-  // fraction of a millisecond); a friction bitmap comes from the cache of
-  // rendered bitmaps (rendering one of the display takes about a second;
-  // its copy, a few milliseconds), rendered here unless the preload has it
-  // or is rendering it (then this waits for that rendering).
-  std::unique_ptr<const PlayerMap2D> map(const SurfaceStimulus& s) {
-    if (s.kind == SurfaceStimulus::Kind::bitmap) return std::make_unique<const PlayerMap2D>(*bitmap(s.document_json, true));
-    const Document doc = parse_document(s.document_json, "stimulus surface");
-    check(doc);
-    const BitmapGeometry& g = *doc.device.bitmap;
-    return PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)}, std::nullopt,
-                                     Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0,
-                                     doc.device.response);
-  }
-
-  static void check(const Document& doc) {
-    if (!doc.surface2d || doc.surface2d->regions.size() != 1 || !doc.device.bitmap)
-      throw InvalidArgument("a stimulus surface must be a version-4 document of one region on a display with a bitmap grid");
-  }
-
-  // The cached bitmap of a surface document, rendered by this thread if no
-  // other has it or is rendering it. `shown`: the participant needs it now
-  // (it becomes the most recent); the preload's (shown false) never pushes
-  // a bitmap out of a full cache, and gives up (nullptr) instead.
-  std::shared_ptr<const PlayerMap2D> bitmap(const std::string& document_json, bool shown) {
-    std::promise<std::shared_ptr<const PlayerMap2D>> made;
-    MapFuture ready;
-    {
-      std::lock_guard<std::mutex> lock(maps_mutex);
-      for (auto it = bitmaps.begin(); it != bitmaps.end(); ++it)
-        if (it->first == document_json) {
-          if (shown) bitmaps.splice(bitmaps.begin(), bitmaps, it);
-          ready = it->second;
-          break;
-        }
-      if (!ready.valid()) {
-        if (!shown && bitmaps.size() >= cache_size) return nullptr;
-        bitmaps.emplace_front(document_json, made.get_future().share());
-        // The least recently shown ready bitmap makes room (one being
-        // rendered stays: its renderer will fill it).
-        for (auto it = bitmaps.end(); bitmaps.size() > cache_size && it != bitmaps.begin();) {
-          --it;
-          if (it->second.wait_for(std::chrono::seconds(0)) == std::future_status::ready) it = bitmaps.erase(it);
-        }
-      }
-    }
-    if (ready.valid()) return ready.get();
-    try {
-      const Document doc = parse_document(document_json, "stimulus surface");
-      check(doc);
-      std::shared_ptr<const PlayerMap2D> m =
-          PlayerMap2D::bitmap(render_raster(*prepared_surface(document_json)), doc.device.response);
-      ++(shown ? rendered_when_shown : rendered_ahead);
-      made.set_value(m);
-      return m;
-    } catch (...) {
-      made.set_exception(std::current_exception());
-      std::lock_guard<std::mutex> lock(maps_mutex);
-      bitmaps.remove_if([&](const auto& e) { return e.first == document_json; });
-      throw;
-    }
-  }
-
-  // Renders every bitmap the session will show, in the order it shows them,
-  // on a background thread at a lower priority than the participant's
-  // (the player, the reports, the terminal): a shadow session of the same
-  // protocol and context asks the same questions (an oddity-2d trial's
-  // surfaces do not depend on the answers given). Stops at a full cache, at
-  // the end, on stop(), or at the first error (the trial itself then
-  // renders, and reports it).
-  void preload(const Protocol& protocol, const SessionContext& context) {
-    if (preloader.joinable()) return;
-    preloader = std::jthread([this, protocol, context](const std::stop_token& stop) {
-      lower_this_threads_priority();
-      try {
-        render_ahead(Session(protocol, context), stop);
-      } catch (...) {
-        // The trial that needs the map renders it and reports the error.
-      }
-      preloaded = true;
-    });
-  }
-  void render_ahead(Session shadow, const std::stop_token& stop) {
-    while (!stop.stop_requested() && !shadow.finished()) {
-      const Question& q = shadow.question();
-      for (const SurfaceStimulus& s : q.surfaces) {
-        if (stop.stop_requested()) return;
-        if (s.kind == SurfaceStimulus::Kind::bitmap && !bitmap(s.document_json, false)) return;  // the cache is full
-      }
-      Response r;
-      r.choice = q.choices.empty() ? std::string() : q.choices.front();
-      (void)shadow.answer(r);
-    }
-  }
-
-  // The bitmaps shown most recently first: every static field of a shipped
-  // 2-D protocol (direction-independence has eight, 15.5 MB each on
-  // tablet-2d), so each renders once a session.
-  static constexpr std::size_t cache_size = 8;
-  using MapFuture = std::shared_future<std::shared_ptr<const PlayerMap2D>>;
-  std::mutex maps_mutex;  // guards bitmaps (the preload thread fills it)
-  std::list<std::pair<std::string, MapFuture>> bitmaps;
-  std::atomic<bool> preloaded{false};
-  std::atomic<int> rendered_ahead{0}, rendered_when_shown{0};
+  SurfaceMaps maps;  // stopped in stop(), before the player goes
   Player2D player;
   StrokeRules rules;
   SerialLink* link = nullptr;
@@ -214,7 +93,6 @@ struct Presenter::Display2D {
   std::string current;  // the interval being recorded
   double last_t = 0.0;
   std::uint64_t reports = 0, dropped = 0;
-  std::jthread preloader;              // stopped and joined before the bitmaps go
   std::optional<ReportReader> reader;  // last: stopped first
 };
 
@@ -343,7 +221,7 @@ void Presenter::show(const Question& question, std::size_t i) {
   if (question.surfaces.size() != question.stimuli.size())
     throw InvalidArgument("task '" + question.task +
                           "' has no 2-D surfaces: a 2-D display plays the intervals of task oddity-2d only");
-  auto map = display_->map(question.surfaces[i]);
+  auto map = display_->maps.map(question.surfaces[i]);
   last_response_ = map->response();
   display_->player.set_map(std::move(map));
   display_->enter(stimulus.label);
@@ -351,21 +229,20 @@ void Presenter::show(const Question& question, std::size_t i) {
 }
 
 void Presenter::preload(const Protocol& protocol, const SessionContext& context) {
-  if (display_) display_->preload(protocol, context);
+  if (display_) display_->maps.preload(protocol, context);
 }
 
-bool Presenter::preloaded() const { return display_ && display_->preloaded.load(); }
+bool Presenter::preloaded() const { return display_ && display_->maps.preloaded(); }
 
 Presenter::BitmapCounts Presenter::bitmap_counts() const {
   if (!display_) return {};
-  return {display_->rendered_ahead.load(), display_->rendered_when_shown.load()};
+  const SurfaceMaps::Counts c = display_->maps.counts();
+  return {c.preloaded, c.at_trial};
 }
 
 void Presenter::prepare(const Question& question) {
   if (!display_) return;
-  // The bitmaps (a path-indexed map is made when shown, in well under a millisecond).
-  for (const auto& s : question.surfaces)
-    if (s.kind == SurfaceStimulus::Kind::bitmap) (void)display_->bitmap(s.document_json, true);
+  display_->maps.prepare(question);
   std::lock_guard<std::mutex> lock(display_->mutex);
   display_->recorders.clear();
   display_->current.clear();

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <list>
 #include <map>
 #include <sstream>
 
@@ -17,6 +16,7 @@
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/export_mat.hpp"
 #include "texel/experiment/strokes.hpp"
+#include "texel/experiment/surface_maps.hpp"
 #include "texel/matfile.hpp"
 #include "texel/serial_link.hpp"
 #include "texel/surface2d.hpp"
@@ -39,9 +39,9 @@ struct Strokes2DState {
   // The page's clock onto the player's, for one page (a reloaded page's clock starts again).
   ReportTimeline timeline;
   std::uint64_t page = 0;  // the connection whose clock the timeline follows
-  // Rendered surfaces (a friction bitmap of tablet-2d takes seconds): every
-  // static field of a shipped 2-D protocol renders once a session.
-  std::list<std::pair<std::string, std::shared_ptr<const PlayerMap2D>>> maps;
+  // The session's interval maps, the library's (surface_maps.hpp): its friction
+  // bitmaps are preloaded from the moment the session opens. Null until then.
+  std::unique_ptr<ex::SurfaceMaps> maps;
 };
 
 std::shared_ptr<Strokes2DState> make_strokes2d_state() { return std::make_shared<Strokes2DState>(); }
@@ -68,37 +68,27 @@ Strokes2DState& strokes_of(State& s) {
   return st;
 }
 
-/// The player map of a 2-D interval (path-indexed, or the static field's friction bitmap), rendered once (cached).
-const PlayerMap2D& surface_map(Strokes2DState& st, const ex::SurfaceStimulus& s) {
-  const std::string key = std::string(s.kind == ex::SurfaceStimulus::Kind::bitmap ? "b" : "p") + s.document_json;
-  auto it = std::find_if(st.maps.begin(), st.maps.end(), [&](const auto& e) { return e.first == key; });
-  if (it == st.maps.end()) {
-    const Document doc = parse_document(s.document_json, "stimulus surface");
-    if (!doc.surface2d || doc.surface2d->regions.size() != 1 || !doc.device.bitmap)
-      throw Reject{"internal", "a stimulus surface is not a 2-D document of one region on a display"};
-    const BitmapGeometry& g = *doc.device.bitmap;
-    std::shared_ptr<const PlayerMap2D> m;
-    if (s.kind == ex::SurfaceStimulus::Kind::bitmap)
-      m = PlayerMap2D::bitmap(render_raster(prepare_surface2d(doc)), doc.device.response);
-    else
-      m = PlayerMap2D::path_indexed(doc.surface2d->regions[0].texel, Sampling{doc.device.grid(), CyclesPerMm(0.0)}, std::nullopt,
-                                    Extent2D{0.0, 0.0, g.width_mm().value(), g.height_mm().value()}, 10000.0,
-                                    doc.device.response);
-    st.maps.emplace_front(key, std::move(m));
-    if (st.maps.size() > surface_cache_size) st.maps.pop_back();
-    it = st.maps.begin();
-  } else {
-    st.maps.splice(st.maps.begin(), st.maps, it);
-    it = st.maps.begin();
-  }
-  return *it->second;
+/// The player map of a 2-D interval (path-indexed, or the static field's friction bitmap, rendered once).
+std::unique_ptr<const PlayerMap2D> surface_map(Strokes2DState& st, const ex::SurfaceStimulus& s) {
+  if (!st.maps) st.maps = std::make_unique<ex::SurfaceMaps>();
+  return st.maps->map(s);
 }
 
-/// Renders a 2-D question's surfaces ahead (as the terminal prepares them
-/// before the trial's clock starts), so its onset, and so its reaction time,
-/// does not include a bitmap's rendering and switching intervals costs a copy.
+/// Renders a 2-D question's bitmaps unless the preload has them (as the
+/// terminal prepares them before the trial's clock starts), so its onset, and
+/// so its reaction time, does not include a rendering and switching intervals
+/// costs a copy.
 void prepare_surfaces(State& s, const ex::Question& q) {
-  for (const auto& surface : q.surfaces) (void)surface_map(*s.strokes2d, surface);
+  Strokes2DState& st = *s.strokes2d;
+  if (!st.maps) st.maps = std::make_unique<ex::SurfaceMaps>();
+  st.maps->prepare(q);
+}
+
+/// The session's bitmaps rendered in the background from now (a simulated session feels nothing).
+void preload_surfaces(State& s) {
+  Strokes2DState& st = *s.strokes2d;
+  st.maps = std::make_unique<ex::SurfaceMaps>();  // the previous session's preload ends
+  if (s.active->simulate.empty()) st.maps->preload(s.active->session.protocol(), s.active->session.context());
 }
 
 /// The question's intervals as the participant stroked them (one per stimulus, as Presenter::strokes).
@@ -188,6 +178,12 @@ ojson current_state(State& s, const json& id, bool screen, bool reload = false) 
     r["question"] = participant_question(q);
     if (!q.surfaces.empty()) r["surface"] = surface_size_json(q);      // the page is the touch surface
     if (screen && s.active->simulate.empty()) prepare_surfaces(s, q);  // before the hand-out starts the trial's clock
+    if (!screen && s.strokes2d->maps) {
+      // The experimenter's view: bitmaps the preload rendered, and those a participant waited for.
+      const ex::SurfaceMaps::Counts n = s.strokes2d->maps->counts();
+      r["bitmaps"] = ojson{
+          {"preloaded", s.strokes2d->maps->preloaded()}, {"rendered_ahead", n.preloaded}, {"rendered_at_handout", n.at_trial}};
+    }
     r["handout"] = handout_json(!screen ? ex::peek(*s.active) : reload ? ex::reload(*s.active) : ex::hand_out(*s.active));
   }
   return r;
@@ -342,6 +338,7 @@ void on_experiment_start(State& s, Client& c, const Job& job) {
       throw Reject{"conflict", std::string("experiment.start: ") + e.what()};
     }
     new_trial(s);
+    preload_surfaces(s);
   }
   ojson r = reply("experiment.started", job.id);
   r["session"] = session_json(s);
@@ -377,7 +374,7 @@ void on_experiment_select(State& s, Client& c, const Job& job) {
   // A 2-D interval: the participant's page strokes it (experiment.stroke). Leaving an interval
   // stroked along another line brings one plain reminder (about the stroke, nothing of the trial).
   Strokes2DState& st = strokes_of(s);
-  auto map = std::make_unique<const PlayerMap2D>(surface_map(st, q.surfaces[i]));  // before the device is taken
+  auto map = surface_map(st, q.surfaces[i]);  // before the device is taken
   if (st.selected >= 0 && static_cast<std::size_t>(st.selected) != i) {
     const auto k = static_cast<std::size_t>(st.selected);
     const std::string& was = q.stimuli[k].label;
@@ -471,6 +468,7 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
 
 void on_experiment_stop(State& s, Client& c, const Job& job) {
   s.active.reset();
+  if (s.strokes2d->maps) s.strokes2d->maps->stop();  // its preload ends (at most the bitmap being rendered)
   new_trial(s);
   send(c, reply("experiment.idle", job.id));
   tell_everyone(s, c);

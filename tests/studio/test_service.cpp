@@ -9,8 +9,10 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <numbers>
 #include <thread>
@@ -675,4 +677,53 @@ TEST(Service, TwoDStudyStrokesAreRecordedAndStoredWithTheAnswer) {
   EXPECT_EQ(trials[0].row.strokes, 6.0);
   EXPECT_EQ(trials[0].row.direction_compliant, 0.0);
   EXPECT_NEAR(trials[0].row.stroke_deviation_deg, 90.0, 1e-6);
+}
+
+// A 2-D session's friction bitmaps are rendered in the background from the
+// moment it opens (as `texel experiment run` preloads them): a later
+// question of a new bitmap condition is handed out without rendering.
+TEST(Service, TwoDStudyPreloadsItsBitmapsFromTheSessionStart) {
+  texel::test_support::TempDir dir("studio");
+  json protocol = json::parse(std::ifstream(protocols_dir + "/direction-independence.json"));
+  // One path-indexed trial, then one of a static field (two bitmaps: the pair's field and the odd one's).
+  json path_block = protocol["blocks"][1];
+  path_block["name"] = "path";
+  path_block["trials_per_condition"] = 1;
+  path_block["conditions"] = json::array({path_block["conditions"][0]});
+  json bitmap_block = path_block;
+  bitmap_block["name"] = "bitmap";
+  bitmap_block["conditions"] = json::array({protocol["blocks"][1]["conditions"][2]});
+  ASSERT_EQ(bitmap_block["conditions"][0]["pair"]["mode"], "spectral");
+  protocol["name"] = "preload-2d";
+  protocol["blocks"] = json::array({path_block, bitmap_block});
+  Service s(options(dir.at("db")));
+  Client experimenter(s), page(s);
+  const json started = experimenter.ask({{"type", "experiment.start"}, {"protocol", protocol}, {"participant", "P1"}});
+  ASSERT_EQ(started["type"], "experiment.started") << started.dump();
+  json q = page.ask({{"type", "experiment.current"}, {"screen", true}});
+  ASSERT_EQ(q["type"], "experiment.question") << q.dump();
+  json bitmaps;
+  for (const auto until = std::chrono::steady_clock::now() + 120s; std::chrono::steady_clock::now() < until;) {
+    bitmaps = experimenter.ask({{"type", "experiment.current"}})["bitmaps"];
+    if (bitmaps["preloaded"] == true) break;
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_EQ(bitmaps["preloaded"], true) << bitmaps.dump();
+  EXPECT_EQ(bitmaps["rendered_ahead"], 2) << bitmaps.dump();
+  const auto t0 = std::chrono::steady_clock::now();
+  const json next = page.ask({{"type", "experiment.answer"},
+                              {"trial", q["question"]["trial"]},
+                              {"token", q["handout"]["token"]},
+                              {"response", {{"choice", "1"}}}},
+                             60s);
+  const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(next["type"], "experiment.question") << next.dump();
+  EXPECT_EQ(next["question"]["trial"], 1) << next.dump();
+  bitmaps = experimenter.ask({{"type", "experiment.current"}})["bitmaps"];
+  EXPECT_EQ(bitmaps["rendered_at_handout"], 0) << bitmaps.dump();  // nothing rendered while the participant waited
+  EXPECT_EQ(bitmaps["rendered_ahead"], 2) << bitmaps.dump();
+  const json sel = page.ask({{"type", "experiment.select"}, {"trial", 1}, {"stimulus", 0}});
+  EXPECT_EQ(sel["type"], "experiment.selected") << sel.dump();
+  RecordProperty("answer_to_bitmap_question_s", std::to_string(waited_s));
+  std::printf("answer to the bitmap question's hand-out: %.3f s\n", waited_s);
 }
