@@ -48,7 +48,6 @@ std::shared_ptr<Strokes2DState> make_strokes2d_state() { return std::make_shared
 
 namespace {
 
-constexpr std::size_t surface_cache_size = 8;    // direction-independence has eight static fields
 constexpr std::size_t max_stroke_samples = 512;  // per experiment.stroke message
 constexpr double page_lead_s = 0.005;            // as the 2-D pad's finger: a sample is due this long after it arrives
 const ex::StrokeRules stroke_rules{};            // the terminal presenter's defaults (docs/experiments.md)
