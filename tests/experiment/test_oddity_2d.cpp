@@ -65,6 +65,12 @@ TEST(Oddity2D, ShippedProtocolsValidate) {
   EXPECT_EQ(d.planned_trials(), 62);
   const ex::Protocol r = ex::parse_protocol(texel::read_file(dir + "rendering-2d.json"));
   EXPECT_EQ(r.planned_trials(), 48);
+  // Both shipped 2-D protocols have no cue in the directions (version 3).
+  for (const char* f : {"direction-independence.json", "rendering-2d.json"}) {
+    const json j = json::parse(texel::read_file(dir + f));
+    EXPECT_EQ(j["version"], 3) << f;
+    for (const auto& b : j["blocks"]) EXPECT_EQ(b.value("direction_assignment", "balanced"), "balanced") << f;
+  }
   auto message = [](std::string text, const std::string& from, const std::string& to) {
     const auto at = text.find(from);
     EXPECT_NE(at, std::string::npos) << from;
@@ -154,28 +160,39 @@ TEST(Oddity2D, TheDirectionsTellNothingAboutWhichIntervalIsOdd) {
             std::string::npos);
 }
 
-// The direction-independence protocol as shipped before version 3
-// (tests/experiment/data): its questions keep their bytes. The digest is of
-// the questions a build of main before the balanced assignment stored for
-// participant S01 (`texel experiment run --simulate`: identical questions,
-// states, answers and rows but for their time stamps).
-TEST(Oddity2D, AVersionTwoProtocolAsksTheSameQuestions) {
-  const ex::Protocol p =
-      ex::load_protocol(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/experiment/data/direction-independence-v2.json");
+// A shipped protocol as it was before version 3 (tests/experiment/data):
+// its questions keep their bytes. FNV-1a over the questions participant S01
+// is asked (answering "1"; an oddity-2d trial's questions do not depend on
+// the answers).
+std::uint64_t questions_digest(const std::string& file, int& trials) {
+  const ex::Protocol p = ex::load_protocol(std::string(TEXEL_TEST_SOURCE_DIR) + "/tests/experiment/data/" + file);
   ex::SessionContext context;
   context.participant = "S01";
   context.seed = ex::session_seed(p.seed, "S01");
   ex::Session s(p, context);
   std::uint64_t h = 1469598103934665603ull;
-  int trials = 0;
+  trials = 0;
   while (!s.finished()) {
     ex::Response r;
     r.choice = "1";
     for (unsigned char c : s.answer(r).question_json) h = (h ^ c) * 1099511628211ull;
     ++trials;
   }
+  return h;
+}
+
+// The digests are of questions checked against those a build before the
+// balanced assignment stored for participant S01 (`texel experiment run
+// --simulate`: identical questions, states, answers and rows but for their
+// time stamps).
+TEST(Oddity2D, AVersionTwoProtocolAsksTheSameQuestions) {
+  int trials = 0;
+  const std::uint64_t d = questions_digest("direction-independence-v2.json", trials);
   EXPECT_EQ(trials, 62);
-  EXPECT_EQ(h, 0xbf3b0aabb0301c05ull) << "got 0x" << std::hex << h;
+  EXPECT_EQ(d, 0xbf3b0aabb0301c05ull) << "got 0x" << std::hex << d;
+  const std::uint64_t r = questions_digest("rendering-2d-v2.json", trials);
+  EXPECT_EQ(trials, 48);
+  EXPECT_EQ(r, 0x80ac05f79f440177ull) << "got 0x" << std::hex << r;
 }
 
 // The pair's two swipes of an oriented grating (wave vector at 0°) along 0°
