@@ -76,9 +76,10 @@ demo: build web
 	@cat out/demo/experiments/summary.txt
 	@echo "Texel Studio is built: $(BUILD)/bin/texel studio --port 8080  (then open http://127.0.0.1:8080/)"
 
-# Every test: unit and CLI tests (release build), the same under
-# AddressSanitizer + UndefinedBehaviorSanitizer, and byte-identity of the demo
-# set across GCC/clang, -O0/-O3 and SIMD widths.
+# Every test: unit and CLI tests (release build, GCC), the same under
+# AddressSanitizer + UndefinedBehaviorSanitizer (clang, without the `slow`
+# label), and byte-identity of the demo set across GCC/clang, -O0/-O3 and SIMD
+# widths. What each phase proves and costs: docs/testing.md.
 test: test-unit test-browser test-asan test-determinism
 
 # The glTF-Validator test (tests/interchange) runs Khronos' validator from

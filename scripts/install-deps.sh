@@ -7,8 +7,8 @@ set -euo pipefail
 # Exactly what is used, grouped by who uses it; the library components'
 # own lists are in cmake/TexelDependencies.cmake.
 packages=(
-  # toolchain: the release/asan presets (GCC), the clang preset, libFuzzer and
-  # the determinism check (clang + its sanitizer runtimes), `make format`
+  # toolchain: the release preset (GCC), the asan and clang presets, libFuzzer
+  # and the determinism check (clang + its sanitizer runtimes), `make format`
   build-essential cmake ninja-build pkg-config git
   g++ clang libclang-rt-14-dev clang-format
   # libraries, per component: core (nlohmann-json), spectrum (kissfft),

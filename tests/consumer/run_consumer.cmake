@@ -9,8 +9,8 @@
 #               component (configure must fail); the C++ and C consumers and
 #               the installed CLI must write the same bytes.
 # subdirectory: add_subdirectory(TEXEL_SOURCE) with every optional component
-#               off: only the core's dependencies are looked up, and the
-#               embedded core renders the bytes TEXEL_CLI renders.
+#               off, built Debug: only the core's dependencies are looked up,
+#               and the embedded core renders the bytes TEXEL_CLI renders.
 cmake_minimum_required(VERSION 3.25)
 
 include(${CMAKE_CURRENT_LIST_DIR}/consumer_common.cmake)
@@ -87,7 +87,10 @@ elseif(MODE STREQUAL "subdirectory")
   foreach(c CONTROLLER SPECTRUM PLOT SURFACE2D PLAYER IO CODEC EXPERIMENTS STUDIO CAPI PYTHON)
     list(APPEND off -DTEXEL_WITH_${c}=OFF)
   endforeach()
-  run(${configure} -B ${WORK}/core -DTEXEL_SOURCE_DIR=${TEXEL_SOURCE} ${off})
+  # The embedded core is built at -O0 (Debug): compiling it is this test's
+  # whole cost, and its bytes must equal the release CLI's all the same
+  # (determinism across -O levels).
+  run(${configure} -B ${WORK}/core -DCMAKE_BUILD_TYPE=Debug -DTEXEL_SOURCE_DIR=${TEXEL_SOURCE} ${off})
   # Only the core's dependency was looked up.
   file(STRINGS ${WORK}/core/CMakeCache.txt cache)
   foreach(other kissfft_DIR Boost_DIR SQLite3_INCLUDE_DIR TEXEL_CAIRO TEXEL_SNDFILE TEXEL_MATIO TEXEL_PORTAUDIO TEXEL_PNG)
