@@ -35,9 +35,12 @@ struct Table {
   }
 };
 
+/// Never destroyed: a thread still running at exit (a studio Service held in
+/// a static, its worker finishing a job while statics are torn down) may
+/// still look a task kind up.
 Table& table() {
-  static Table t;
-  return t;
+  static Table* const t = new Table;
+  return *t;
 }
 
 }  // namespace
