@@ -177,7 +177,7 @@ ojson current_state(State& s, const json& id, bool screen, bool reload = false) 
     r["question"] = participant_question(q);
     if (!q.surfaces.empty()) r["surface"] = surface_size_json(q);      // the page is the touch surface
     if (screen && s.active->simulate.empty()) prepare_surfaces(s, q);  // before the hand-out starts the trial's clock
-    if (!screen && s.strokes2d->maps) {
+    if (!screen && s.strokes2d->maps && !q.surfaces.empty()) {
       // The experimenter's view: bitmaps the preload rendered, and those a participant waited for.
       const ex::SurfaceMaps::Counts n = s.strokes2d->maps->counts();
       r["bitmaps"] = ojson{
