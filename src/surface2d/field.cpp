@@ -333,15 +333,23 @@ template <int W>
   using V = typename detail::Lanes<W>::type;
   const double *a0 = a, *a1 = a + n, *a2 = a + 2 * n, *a3 = a + 3 * n;
   const V w0 = V{} + w[0], w1 = V{} + w[1], w2 = V{} + w[2], w3 = V{} + w[3], lo = V{} - 1.0, hi = V{} + 1.0;
-  const auto load = [](const double* p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
+  // No lambda here: a lambda does not take the caller's target attribute,
+  // and one returning a wide vector uncalled-inline (clang -O0, sanitizer
+  // builds) passes it by another ABI than the caller reads.
   std::size_t k = 0;
   for (; k + W <= n; k += W) {
-    const V c = w0 * load(a0 + k) + w1 * load(a1 + k) + w2 * load(a2 + k) + w3 * load(a3 + k);
-    V v = first_band ? 0.0 + c : load(o + k) + c;
+    V x0, x1, x2, x3, v;
+    std::memcpy(&x0, a0 + k, sizeof x0);
+    std::memcpy(&x1, a1 + k, sizeof x1);
+    std::memcpy(&x2, a2 + k, sizeof x2);
+    std::memcpy(&x3, a3 + k, sizeof x3);
+    const V c = w0 * x0 + w1 * x1 + w2 * x2 + w3 * x3;
+    if (first_band) {
+      v = 0.0 + c;
+    } else {
+      std::memcpy(&v, o + k, sizeof v);
+      v = v + c;
+    }
     if (last_band) v = v < lo ? lo : (hi < v ? hi : v);
     std::memcpy(o + k, &v, sizeof v);
   }

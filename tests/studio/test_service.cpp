@@ -666,7 +666,9 @@ TEST(Service, TwoDStudyStrokesAreRecordedAndStoredWithTheAnswer) {
                                {"response", {{"choice", "1"}, {"strokes", json::array()}}}});
     ASSERT_EQ(answer["type"], "experiment.question") << answer.dump();
     expect_error(stroke(2, json::array({json::array({1.0, 10.0, 10.0, true})}), token), "conflict");  // the trial is answered
-    c.ask({{"type", "experiment.stop"}});
+    // Stopping waits for the bitmap the preload is rendering (under a
+    // sanitizer on a loaded machine, tens of seconds).
+    c.ask({{"type", "experiment.stop"}}, 120s);
   }
   const ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
   const auto trials = st.trials(session_id);
