@@ -3,7 +3,7 @@
 // field (a spectral field's radial spectrum) takes a few tenths of a second
 // on tablet-2d; the oddity-2d engine scans it and the 2-D display presenter
 // renders its friction bitmap from the same preparation, and the
-// presenter's preload (presenter.hpp) prepares it before the engine needs
+// session's preload (SurfaceMaps, texel/experiment/surface_maps.hpp) prepares it before the engine needs
 // it. Thread-safe: a surface asked while another thread prepares it waits
 // for that preparation instead of repeating it. Bounded: the least recently
 // asked are dropped beyond `capacity` (their holders keep them alive).
