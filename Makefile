@@ -4,18 +4,29 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD := build
 PY := /usr/bin/python3
 
-.PHONY: all deps configure build python wheel web web-test demo test test-unit test-browser test-asan test-determinism bench fuzz format clean
+.PHONY: all deps deps-web configure build cli python wheel web web-test demo test test-unit test-browser test-asan test-determinism bench fuzz tidy format clean
 
 all: build
 
+# Debian packages. The library, the CLI and the Python package need no
+# Node.js; `deps-web` also requires Node.js >= 20 with npm, for Texel Studio's
+# front end (web, demo, test, bench), and says so when it is missing.
 deps:
 	@bash scripts/install-deps.sh
+
+deps-web:
+	@bash scripts/install-deps.sh --web
 
 configure: deps
 	@cmake --preset release >/dev/null
 
+# Every target: libraries, CLI, tests, benchmarks, examples, Python package.
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
+
+# The texel command alone (and the libraries it links): what `make demo` runs.
+cli: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target texel_cli
 
 # The Python package texel (python/README.md): build/python/texel, for
 # PYTHONPATH=build/python /usr/bin/python3.
@@ -40,7 +51,7 @@ WEB_SRC := $(shell find web -path web/node_modules -prune -o -path web/tests -pr
 
 web: $(WEB_OUT)/index.html
 
-web/node_modules/.package-lock.json: web/package-lock.json | deps
+web/node_modules/.package-lock.json: web/package-lock.json | deps-web
 	cd web && npm ci --no-audit --no-fund --loglevel=error
 
 $(WEB_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/schema/studio-messages.schema.json docs/schema/texel-protocol.schema.json
@@ -62,7 +73,10 @@ PROTOCOLS := $(addprefix examples/protocols/,free-exploration.json quantization.
 # Texel length is a between-groups study: each group has its own participants.
 TEXEL_LENGTH_GROUPS := N:texel-length W:texel-length-wide V:texel-length-visual-practice
 
-demo: build web
+# The demo builds only what it runs: the texel command and the studio's
+# bundle (not the tests, benchmarks, examples or Python package; `make test`
+# builds those later in the same build/, reusing what the demo compiled).
+demo: deps-web cli web
 	$(BUILD)/bin/texel demo --out out/demo
 	$(BUILD)/bin/texel atlas --out out/demo/references
 	rm -rf out/demo/experiments && mkdir -p out/demo/experiments
@@ -80,7 +94,7 @@ demo: build web
 # AddressSanitizer + UndefinedBehaviorSanitizer (clang, without the `slow`
 # label), and byte-identity of the demo set across GCC/clang, -O0/-O3 and SIMD
 # widths. What each phase proves and costs: docs/testing.md.
-test: test-unit test-browser test-asan test-determinism
+test: deps-web test-unit test-browser test-asan test-determinism
 
 # The glTF-Validator test (tests/interchange) runs Khronos' validator from
 # web/node_modules: the same one `npm ci` as the web build.
@@ -99,7 +113,7 @@ BROWSER_ENV = TEXEL_BIN=$(CURDIR)/$(BUILD)/bin/texel TEXEL_WEB=$(CURDIR)/$(WEB_T
 test-browser: build web web-test
 	cd web && $(BROWSER_ENV) npm test --silent
 
-test-asan: deps web/node_modules/.package-lock.json
+test-asan: deps-web web/node_modules/.package-lock.json
 	@cmake --preset asan >/dev/null
 	@cmake --build build-asan -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp \
@@ -109,7 +123,7 @@ test-asan: deps web/node_modules/.package-lock.json
 test-determinism: build
 	bash tests/determinism/cross_build.sh
 
-bench: build web web-test
+bench: deps-web build web web-test
 	$(BUILD)/bin/texel_bench --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
@@ -127,12 +141,13 @@ bench: build web web-test
 	$(BUILD)/bin/texel_bench_store_pg --env $(BUILD)/bench-pg.env --stations 50 --trials 1000 --json $(BUILD)/bench_store_pg.json; \
 	  rc=$$?; scripts/pg-test-server.sh stop $(BUILD)/bench-pg.env; exit $$rc
 
-# The libFuzzer targets of every parser of outside input (docs/fuzzing.md):
-# a clang build in build-fuzz with the whole library instrumented, then each
-# target for FUZZ_SECONDS of wall time, two at a time. Their seed corpora are
-# replayed by `make test` (ctest fuzz.*.replay) under any compiler.
+# The libFuzzer targets of every parser of outside input (docs/fuzzing.md),
+# as tests/fuzz/targets.txt lists them: a clang build in build-fuzz with the
+# whole library instrumented, then each target for FUZZ_SECONDS of wall time,
+# two at a time. Their seed corpora are replayed by `make test` (ctest
+# fuzz.*.replay) under any compiler. `make fuzz FUZZ_TARGETS=fuzz_npy` runs one.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := fuzz_document fuzz_npy fuzz_csv fuzz_serial fuzz_mat fuzz_wav fuzz_bitstream fuzz_experiment fuzz_hmpg
+FUZZ_TARGETS ?= $(shell awk '/^fuzz_/ {print $$1}' tests/fuzz/targets.txt)
 
 fuzz: deps
 	@cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTEXEL_FUZZ=ON \

@@ -2,7 +2,18 @@
 # Installs the Debian 12 packages Texel builds, tests and benchmarks with.
 # Idempotent: packages already present are skipped, so a warm machine pays
 # only one dpkg query. Runs as root (CI, containers) or through sudo.
+#
+#   scripts/install-deps.sh          packages for the libraries, CLI, Python, tests
+#   scripts/install-deps.sh --web    the same, and Node.js >= 20 must be present
 set -euo pipefail
+
+want_web=0
+for arg in "$@"; do
+  case "$arg" in
+    --web) want_web=1 ;;
+    *) echo "install-deps: unknown option '$arg'; allowed: --web" >&2; exit 2 ;;
+  esac
+done
 
 # Exactly what is used, grouped by who uses it; the library components'
 # own lists are in cmake/TexelDependencies.cmake.
@@ -49,9 +60,20 @@ packages=(
 
 # Texel Studio's front end builds with the machine's Node.js (>= 20) and npm
 # from the npm registry; Debian 12's own nodejs (18) is too old for Vite.
+# Only the front end needs it: the C++ libraries, the C library, the CLI and
+# the Python package build without Node. With --web (the Makefile's web,
+# demo, test and bench targets) a missing or old Node stops here; without it,
+# a note says what is left out.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null || ! node -e 'process.exit(Number(process.versions.node.split(".")[0]) < 20 ? 1 : 0)'; then
-  echo "install-deps: Node.js >= 20 with npm is needed to build Texel Studio's front end (found: $(node --version 2>/dev/null || echo none))" >&2
-  exit 2
+  found="$(node --version 2>/dev/null || echo none)$(command -v npm >/dev/null || echo ', no npm')"
+  if [ "$want_web" = 1 ]; then
+    echo "install-deps: Node.js >= 20 with npm is needed to build Texel Studio's front end, which make web, demo, test" \
+         "and bench use (found: $found). Install it (https://nodejs.org, or NodeSource's Debian packages);" \
+         "make build, make python and make wheel work without it." >&2
+    exit 2
+  fi
+  echo "install-deps: note: no Node.js >= 20 with npm (found: $found): the libraries, the CLI and the Python package" \
+       "build; Texel Studio's front end (make web, demo, test, bench) needs it." >&2
 fi
 
 missing=()
