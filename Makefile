@@ -129,6 +129,7 @@ bench: deps-web build web web-test
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
 	$(BUILD)/bin/texel_bench_player_paced --json $(BUILD)/bench_player_paced.json
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
+	$(BUILD)/bin/texel_bench_design 40 --json $(BUILD)/bench_design.json
 	$(BUILD)/bin/texel_bench_encode --json $(BUILD)/bench_encode.json
 	$(PY) bench/render_to_file.py $(BUILD)/bin/texel
 	$(BUILD)/bin/texel_bench_bitmap_2d $(BUILD) 8192 tile
@@ -154,6 +155,13 @@ fuzz: deps
 	  -DTEXEL_BUILD_BENCH=OFF -DTEXEL_WITH_PYTHON=OFF >/dev/null
 	@cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS)
 	bash scripts/fuzz.sh build-fuzz $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+# clang-tidy with .clang-tidy's checks over the C++ sources changed against
+# main (scripts/tidy.sh; `make tidy TIDY_BASE=HEAD~3` for another base);
+# every finding fails. docs/testing.md says why it is not a `make test` phase.
+TIDY_BASE ?= main
+tidy: configure
+	bash scripts/tidy.sh --build $(BUILD) --base $(TIDY_BASE)
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -4,8 +4,10 @@
 # target: seconds, total executions (libFuzzer's final "#N DONE" line) and
 # findings (crash/leak/timeout/oom artifacts).
 #
-#   scripts/fuzz.sh <build dir> <seconds> <target>...
+#   scripts/fuzz.sh <build dir> <seconds> [<target>...]
 #
+# The targets and their seed directories are the one list,
+# tests/fuzz/targets.txt; with no target named, every listed one runs.
 # Each target starts from a scratch copy of its seed corpus
 # (<build dir>/fuzz-work/<target>/corpus): the committed corpus in
 # tests/fuzz/corpus/ stays small and reviewed, and a finding is added to it by
@@ -20,12 +22,19 @@ shift 2
 work="$build/fuzz-work"
 mkdir -p "$work"
 
+list="$root/tests/fuzz/targets.txt"
+if [ "$#" -eq 0 ]; then
+  set -- $(awk '/^fuzz_/ {print $1}' "$list")
+fi
+for t in "$@"; do
+  grep -q "^$t[[:space:]]" "$list" || { echo "fuzz.sh: $t is not in $list" >&2; exit 2; }
+done
+
+# The seed directory of a target (column 4 of the list; `-` = none).
 seeds_of() {
-  case "$1" in
-    fuzz_bitstream) echo "$root/tests/codec/corpus" ;;
-    fuzz_experiment) echo "$root/examples/protocols" ;;
-    *) echo "$root/tests/fuzz/corpus/$1" ;;
-  esac
+  local s
+  s=$(awk -v t="$1" '$1 == t {print $4}' "$list")
+  [ "$s" != "-" ] && echo "$root/$s"
 }
 
 run_one() {
@@ -38,7 +47,7 @@ run_one() {
   rm -rf "$dir" && mkdir -p "$dir/corpus" "$dir/artifacts"
   local seeds
   seeds=$(seeds_of "$t")
-  [ -d "$seeds" ] && cp "$seeds"/* "$dir/corpus/" 2>/dev/null
+  [ -n "$seeds" ] && [ -d "$seeds" ] && cp "$seeds"/* "$dir/corpus/" 2>/dev/null
   local start end
   start=$(date +%s)
   (cd "$dir" && nice -n 10 "$bin" "$dir/corpus" -max_total_time="$seconds" -max_len=4096 -rss_limit_mb=2048 \
