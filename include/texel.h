@@ -190,7 +190,15 @@ TEXEL_API void texel_surface_destroy(texel_surface* surface);
 
 /* Encodes a map of `count` amplitudes sampled every `spacing_mm` (the
  * encoder's defaults, as `texel encode`): a .texel bitstream of a few bytes.
- * Takes from well under a second to a few seconds. */
+ * Takes from well under a second to a few seconds.
+ *
+ * Amplitudes are read by the library's one rule for every front door (the
+ * CLI's files, Python's arrays; docs/c-api.md "Input amplitudes"): a map
+ * whose values all lie in [0, 1] is encoded as it is; a map with any value
+ * outside [0, 1] (raw counts, signed data) is first scaled to full range,
+ * a = 0.5 + 0.5·y/max|y| with y the map minus its mean. Refused with
+ * TEXEL_INVALID_ARGUMENT: count < 2, a non-finite value, and a constant map
+ * outside [0, 1] (it holds no texture). Nothing is clamped. */
 TEXEL_API texel_status texel_encode(const double* amplitudes, size_t count, double spacing_mm, texel_encode_result** out);
 /* What Central Pitch matches (docs/encoder.md §3, "Targets"). */
 typedef enum texel_encode_target {
@@ -219,7 +227,7 @@ typedef struct texel_encode_options {
 
 TEXEL_API texel_encode_options texel_encode_options_default(void);
 
-/* texel_encode with options (NULL = the defaults). */
+/* texel_encode with options (NULL = the defaults); amplitudes read as by texel_encode. */
 TEXEL_API texel_status texel_encode_with(const double* amplitudes, size_t count, double spacing_mm,
                                          const texel_encode_options* options, texel_encode_result** out);
 

@@ -58,7 +58,7 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
     st = texel_encode_file(path, a.device, a.swipe_speed_mm_s, &a.options, &result);
   } else {
     size_t count = 0;
-    double* amplitude = tm_vector("the map", prhs[0], &count);
+    double* amplitude = tm_map("the map", prhs[0], &count);
     if (!a.has_spacing) tm_usage("an array needs 'spacing_mm' (the distance between its samples, mm)");
     if (a.device || a.swipe_speed_mm_s != 0.0) tm_usage("device and swipe_speed_mm_s are for files; an array is a map");
     st = texel_encode_with(amplitude, count, a.spacing_mm, &a.options, &result);

@@ -5,6 +5,12 @@
 %   r = texel_encode('scan.mat')                          % any file `texel encode` reads
 %   r = texel_encode('map.bin', 'device', 'tpad')
 %
+% An array is read as `texel encode` reads the same array from a .npy file
+% (docs/c-api.md "Input amplitudes"): double or single as they are, uint16
+% /65535, int16 /32768; a map with any value outside [0, 1] is scaled to full
+% range (0.5 + 0.5*y/max|y| of the zero-mean map), never clamped; uint8
+% (texel_render's 'native' bytes) is refused.
+%
 % Options (texel.h's texel_encode_options; defaults as `texel encode`):
 %   spacing_mm        sample spacing of an array input, mm (required for arrays)
 %   device            a file's device (needed for .bin; its response joins the model)

@@ -87,34 +87,41 @@ static uint64_t tm_count(const char* name, const mxArray* a) {
   return (uint64_t)v;
 }
 
-/* A real numeric vector as doubles (a copy; any numeric class, as the CLI's
- * loaders take integers as their values). */
-static double* tm_vector(const char* name, const mxArray* a, size_t* count) {
+/* A map given as an array, read as the library reads the same array from a
+ * .npy file (docs/c-api.md "Input amplitudes"): double and single as they
+ * are, uint16 as round(a·65535) (/65535: texel_render's 'u16'), int16 /32768.
+ * uint8 is refused: texel_render's 'native' output is the device's bytes as
+ * uint8 (two per sample on a 16-bit device), not amplitudes; so are the other
+ * integer classes, which no Texel output produces. */
+static double* tm_map(const char* name, const mxArray* a, size_t* count) {
   size_t n, i;
   double* out;
+  const mxClassID c = mxGetClassID(a);
   if (!mxIsNumeric(a) || mxIsComplex(a) || mxIsSparse(a))
     mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a real numeric vector", name);
+  if (c == mxUINT8_CLASS)
+    mexErrMsgIdAndTxt("texel:invalidArgument",
+                      "%s is uint8, which Texel reads as device bytes (texel_render's 'native' output), not amplitudes; "
+                      "give amplitudes as double in [0, 1] (texel_render's default output) or uint16 (its 'u16' output)",
+                      name);
+  if (c != mxDOUBLE_CLASS && c != mxSINGLE_CLASS && c != mxUINT16_CLASS && c != mxINT16_CLASS)
+    mexErrMsgIdAndTxt("texel:invalidArgument", "%s is %s; allowed: double or single amplitudes, uint16 (/65535) or int16 (/32768)",
+                      name, mxGetClassName(a));
   n = mxGetNumberOfElements(a);
   if (n > 0 && mxGetM(a) != 1 && mxGetN(a) != 1)
     mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a vector (N×1 or 1×N)", name);
   out = (double*)mxMalloc((n ? n : 1) * sizeof *out);
-  if (mxIsDouble(a)) {
+  if (c == mxDOUBLE_CLASS) {
     if (n) memcpy(out, mxGetPr(a), n * sizeof *out);
   } else {
     const void* d = mxGetData(a);
     for (i = 0; i < n; ++i) {
-      switch (mxGetClassID(a)) {
-        case mxSINGLE_CLASS: out[i] = ((const float*)d)[i]; break;
-        case mxINT8_CLASS: out[i] = ((const int8_t*)d)[i]; break;
-        case mxUINT8_CLASS: out[i] = ((const uint8_t*)d)[i]; break;
-        case mxINT16_CLASS: out[i] = ((const int16_t*)d)[i]; break;
-        case mxUINT16_CLASS: out[i] = ((const uint16_t*)d)[i]; break;
-        case mxINT32_CLASS: out[i] = ((const int32_t*)d)[i]; break;
-        case mxUINT32_CLASS: out[i] = ((const uint32_t*)d)[i]; break;
-        case mxINT64_CLASS: out[i] = (double)((const int64_t*)d)[i]; break;
-        case mxUINT64_CLASS: out[i] = (double)((const uint64_t*)d)[i]; break;
-        default: mexErrMsgIdAndTxt("texel:invalidArgument", "%s has an unsupported class", name);
-      }
+      if (c == mxSINGLE_CLASS)
+        out[i] = ((const float*)d)[i];
+      else if (c == mxUINT16_CLASS)
+        out[i] = ((const uint16_t*)d)[i] / 65535.0;
+      else
+        out[i] = ((const int16_t*)d)[i] / 32768.0;
     }
   }
   *count = n;

@@ -69,7 +69,7 @@ void mexFunction(int nlhs, mxArray* plhs[], int nrhs, const mxArray* prhs[]) {
   if (nrhs < 1) tm_usage("give the map (a numeric vector) first");
   memset(&a, 0, sizeof a);
   a.options = texel_spectrum_options_default();
-  amplitude = tm_vector("the map", prhs[0], &count);
+  amplitude = tm_map("the map", prhs[0], &count);
   tm_options(nrhs, prhs, 1, take, &a, "spacing_mm, window, zero_pad, threshold_db, max_peaks, welch_segment, welch_overlap");
   if (!a.has_spacing) tm_usage("the map needs 'spacing_mm' (the distance between its samples, mm)");
   st = texel_spectrum_analyse(amplitude, count, a.spacing_mm, &a.options, &spec);

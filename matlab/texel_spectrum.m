@@ -3,6 +3,9 @@
 %   s = texel_spectrum(amplitude, 'spacing_mm', info.spacing_mm)
 %   semilogx(s.frequency_cpm, s.magnitude)
 %
+% The map: double or single amplitudes as they are, uint16 /65535 (texel_render's
+% 'u16'), int16 /32768; uint8 (texel_render's 'native' device bytes) is refused.
+%
 % Options (texel.h's texel_spectrum_options; defaults as the CLI's):
 %   spacing_mm (required), window ('blackman-harris' | 'hann' | 'flat-top' |
 %   'rectangular'), zero_pad [4], threshold_db [-40], max_peaks [32],

@@ -206,6 +206,41 @@ expect_error(@() texel_swipe2d(doc2d, 'spiral'), 'texel:invalidArgument', ...
 expect_error(@() texel_swipe2d(doc2d, [0 0 1; 0 0 0.5]), 'texel:invalidArgument', ...
              'trace[1].t_s is below the sample before; times must be non-decreasing');
 
+% One input, one answer (docs/c-api.md "Input amplitudes"): a map outside [0, 1]
+% is scaled to full range by the library's rule, as `texel encode` reads the
+% same array from a .npy file — never clamped; a constant one is refused by both.
+function write_npy1(path, v)  % float64, shape (N,)
+  hdr = sprintf('{''descr'': ''<f8'', ''fortran_order'': False, ''shape'': (%d,), }', numel(v));
+  hdr = [hdr repmat(' ', 1, 63 - mod(10 + numel(hdr), 64)) char(10)];
+  f = fopen(path, 'w');
+  fwrite(f, [147 double('NUMPY') 1 0], 'uint8'); fwrite(f, numel(hdr), 'uint16'); fwrite(f, hdr, 'char');
+  fwrite(f, v(:), 'double'); fclose(f);
+end
+write_npy1([out '/times100.npy'], a * 100);
+cli(texel, sprintf('encode "%s/times100.npy" --spacing %.17g -o "%s/times100.texel"', out, info.spacing_mm, out));
+r100 = texel_encode(a * 100, 'spacing_mm', info.spacing_mm);
+same_bytes(r100.bitstream, read_bytes([out '/times100.texel']), 'texel_encode(map x 100)');
+same_bytes(texel_encode(u16, 'spacing_mm', info.spacing_mm).bitstream, r2.bitstream, 'texel_encode(uint16 map)');
+write_npy1([out '/constant.npy'], 2 * ones(1000, 1));
+refusal = cli_error(texel, sprintf('encode "%s/constant.npy" --spacing 0.01', out));
+try
+  texel_encode(2 * ones(1000, 1), 'spacing_mm', 0.01);
+  error('texel_encode accepted a constant map outside [0, 1]');
+catch err
+  assert(strcmp(err.identifier, 'texel:invalidArgument') && ~isempty(strfind(err.message, 'constant: it holds no texture')) ...
+         && ~isempty(strfind(refusal, 'constant: it holds no texture')), err.message);
+  printf('constant map outside [0, 1] refused: %s\n  CLI: %s\n', err.message, refusal);
+end
+% A 'native' map's uint8 bytes are not amplitudes.
+expect_error(@() texel_spectrum(map, 'spacing_mm', info.spacing_mm), 'texel:invalidArgument', ...
+             ['the map is uint8, which Texel reads as device bytes (texel_render''s ''native'' output), not amplitudes; ' ...
+              'give amplitudes as double in [0, 1] (texel_render''s default output) or uint16 (its ''u16'' output)']);
+expect_error(@() texel_encode(map, 'spacing_mm', info.spacing_mm), 'texel:invalidArgument', ...
+             ['the map is uint8, which Texel reads as device bytes (texel_render''s ''native'' output), not amplitudes; ' ...
+              'give amplitudes as double in [0, 1] (texel_render''s default output) or uint16 (its ''u16'' output)']);
+expect_error(@() texel_spectrum(int32(u16), 'spacing_mm', info.spacing_mm), 'texel:invalidArgument', ...
+             'the map is int32; allowed: double or single amplitudes, uint16 (/65535) or int16 (/32768)');
+
 % Each function's help text (matlab/texel_*.m) names its options.
 for fn = {'texel_render', 'texel_encode', 'texel_decode', 'texel_spectrum', 'texel_reference', 'texel_render2d', 'texel_swipe2d'}
   h = get_help_text([srcdir '/' fn{1} '.m']);

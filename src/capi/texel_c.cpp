@@ -33,9 +33,11 @@
 #include "texel/document.hpp"
 #include "texel/encode2d.hpp"
 #include "texel/error.hpp"
+#include "texel/io.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/reference.hpp"
+#include "texel/signal.hpp"
 #include "texel/spectrum.hpp"
 #include "texel/surface.hpp"
 #include "texel/surface2d.hpp"
@@ -398,6 +400,28 @@ std::unique_ptr<texel_encode_result> encoded(const texel::codec::Signal& signal,
   return std::make_unique<texel_encode_result>(texel_encode_result{texel::codec::encode(signal, config)});
 }
 
+// A map in memory, read by the library's one rule (docs/format.md "Input
+// signals", Scaling): as the float64 .npy file that holds it, through the
+// signal loader — values in [0, 1] as they are; a map with any value outside
+// [0, 1] scaled to full range (a = 0.5 + 0.5·y/max|y|, y the zero-mean map);
+// a constant map outside [0, 1], fewer than 2 samples or a non-finite value
+// refused. So `texel encode map.npy` and Python's texel.encode(array) read
+// the same array to the same samples. The loader's FormatErrors are about a
+// file; here the array is an argument, so they become InvalidArgument naming
+// `amplitudes`.
+texel::Signal map_signal(const double* amplitudes, std::size_t count, double spacing_mm) {
+  texel::SignalOptions options;
+  options.spacing = texel::Millimetres(spacing_mm);
+  const std::string npy = texel::npy_bytes(std::span<const double>(amplitudes, count));
+  try {
+    texel::Signal s = texel::decode_signal(texel::byte_view(npy), texel::SignalFormat::npy, options, "amplitudes");
+    if (s.description.starts_with(".npy")) s.description.replace(0, 4, "C API map");
+    return s;
+  } catch (const texel::FormatError& e) {
+    throw InvalidArgument(e.what());
+  }
+}
+
 template <class Handle, class Make>
 texel_status create(Handle** out, Make&& make) {
   if (out) *out = nullptr;
@@ -611,11 +635,7 @@ texel_status texel_encode_with(const double* amplitudes, std::size_t count, doub
     if (count > 0) need(amplitudes, "amplitudes");
     need_finite(spacing_mm, "spacing_mm");
     const texel::codec::EncoderConfig config = options ? config_of(*options) : texel::codec::EncoderConfig{};
-    texel::codec::Signal signal;
-    if (count > 0) signal.amplitude.assign(amplitudes, amplitudes + count);
-    signal.spacing = texel::Millimetres(spacing_mm);
-    signal.description = "C API map";
-    return encoded(signal, config);
+    return encoded(texel::codec::encoder_signal(map_signal(amplitudes, count, spacing_mm)), config);
   });
 }
 
