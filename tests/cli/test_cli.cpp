@@ -24,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/temp_dir.hpp"
 #include "../support/wav.hpp"
 #include "texel/io.hpp"
 
@@ -77,15 +78,8 @@ Result run_texel(const std::vector<std::string>& args, const fs::path& cwd) {
 
 class Cli : public ::testing::Test {
  protected:
-  fs::path dir;
-
-  void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("texel-cli-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  void TearDown() override { fs::remove_all(dir); }
+  texel::test_support::TempDir tmp{"texel-cli"};
+  const fs::path& dir = tmp.path;
 
   Result run(const std::vector<std::string>& args) { return run_texel(args, dir); }
 

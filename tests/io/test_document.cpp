@@ -13,6 +13,7 @@
 
 #include <unistd.h>
 
+#include "../support/temp_dir.hpp"
 #include "../support/expect.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
@@ -293,9 +294,8 @@ TEST(Document, MalformedAndTruncatedJsonAreRejected) {
 }
 
 TEST(Document, SaveIsAtomicAndLoadRoundTrips) {
-  const fs::path dir = fs::temp_directory_path() / ("texel-doc-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const texel::test_support::TempDir tmp("texel-doc");
+  const fs::path& dir = tmp.path;
   const Document d = parse_document(valid, "doc");
   const std::string path = (dir / "t.texel.json").string();
   save_document(d, path);

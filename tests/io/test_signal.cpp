@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../support/expect.hpp"
+#include "../support/temp_dir.hpp"
 #include "../support/wav.hpp"
 #include "texel/bitstream.hpp"
 #include "texel/codec.hpp"
@@ -34,22 +35,18 @@ std::span<const std::byte> as_span(const std::string& s) { return std::as_bytes(
 
 class SignalLoader : public ::testing::Test {
  protected:
-  fs::path dir;
+  texel::test_support::TempDir tmp{"texel-signal"};
+  const fs::path& dir = tmp.path;
   DeviceProfile tpad = load_device("tpad");
   Document doc;
   std::vector<double> map;
 
   void SetUp() override {
-    dir = fs::temp_directory_path() / ("texel-signal-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
-                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
     TexelSpec spec;
     spec.seed = 9;
     doc = make_document(tpad, spec);
     map = prepare_surface(doc).render();
   }
-  void TearDown() override { fs::remove_all(dir); }
 
   std::string put(const std::string& name, const std::string& bytes) const {
     const std::string p = (dir / name).string();

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/matfile.hpp"
@@ -25,15 +26,9 @@ namespace {
 
 class MatFile : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("texel_matfile_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  std::string path(const std::string& name) const { return tmp_.at(name); }
+  texel::test_support::TempDir tmp_{"texel-matfile"};
+  const fs::path& dir_ = tmp_.path;
 };
 
 std::vector<double> ramp(std::size_t n, double scale = 1.0) {

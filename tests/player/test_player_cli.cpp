@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "../support/cli_run.hpp"
+#include "../support/temp_dir.hpp"
 #include "../support/controller_process.hpp"
 
 #include <algorithm>
@@ -31,14 +32,11 @@ CliRun run(const std::string& args) { return texel::test_support::run_cli(TEXEL_
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = fs::temp_directory_path() / ("texel-player-cli-" + std::to_string(::getpid()) + "-" +
-                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir);
     doc = (dir / "demo.texel.json").string();
     ASSERT_EQ(run("render --seed 1 -o " + doc).status, 0);
   }
-  void TearDown() override { fs::remove_all(dir); }
-  fs::path dir;
+  texel::test_support::TempDir tmp{"texel-player-cli"};
+  const fs::path& dir = tmp.path;
   std::string doc;
 };
 

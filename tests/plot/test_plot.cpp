@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "../support/temp_dir.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/plot.hpp"
@@ -23,26 +24,11 @@ using namespace texel;
 
 namespace {
 
-/// A fresh, empty directory under the system temp dir, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    path_ = fs::temp_directory_path() / ("texel-plot-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  [[nodiscard]] std::string file(const std::string& name) const { return (path_ / name).string(); }
-  [[nodiscard]] std::size_t entries() const {
-    return static_cast<std::size_t>(std::distance(fs::directory_iterator(path_), fs::directory_iterator()));
-  }
-
- private:
-  static inline int counter_ = 0;
-  fs::path path_;
+/// The shared per-test directory (tests/support/temp_dir.hpp), with this file's names.
+struct TempDir : texel::test_support::TempDir {
+  TempDir() : texel::test_support::TempDir("texel-plot") {}
+  [[nodiscard]] std::string file(const std::string& name) const { return at(name); }
+  [[nodiscard]] std::size_t entries() const { return listing().size(); }
 };
 
 std::uint32_t be32(const std::string& b, std::size_t at) {

@@ -5,7 +5,7 @@
 // round-trip through the codec and the file formats.
 #include <gtest/gtest.h>
 
-#include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -106,17 +106,8 @@ TEST(DesignView, AnalysesTheChosenRegion) {
   EXPECT_THROW((void)design_view(doc, o), InvalidArgument);
 }
 
-TEST(DesignView, TpadLatency) {
-  const Document doc = tpad_texel(10, -5);
-  std::vector<double> ms;
-  for (int i = 0; i < 30; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    (void)design_view(doc);
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  std::printf("design_view tpad: median %.2f ms, p95 %.2f ms\n", ms[ms.size() / 2], ms[ms.size() * 95 / 100]);
-}
+// design_view's latency on the tpad is measured by bench/bench_design.cpp
+// (texel_bench_design, `make bench`), not timed here.
 
 TEST(Match, EncodesTheReferenceIntoTheOtherRegion) {
   MatchOptions o;

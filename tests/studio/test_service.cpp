@@ -179,19 +179,8 @@ TEST(Service, DesignRepliesWithTheLibrarysNumbers) {
   Client c(s);
   const json doc = tpad_document();
   const texel::studio::DesignView v = texel::studio::design_view(texel::parse_document(doc.dump()));
-  std::vector<double> ms;
-  json r;
-  for (int i = 0; i < 40; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    r = c.ask({{"type", "design"}, {"document", tpad_document(10.0 + 0.01 * (i % 2))}});
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  std::printf(
-      "design message round trip (tpad, parse + render + analyse + serialize + parse reply): median %.2f ms, p95 %.2f ms, "
-      "reply %zu bytes\n",
-      ms[ms.size() / 2], ms[ms.size() * 95 / 100], r.dump().size());
-  r = c.ask({{"type", "design"}, {"document", doc}});
+  // The round trip's latency is measured by bench/bench_design.cpp (texel_bench_design).
+  const json r = c.ask({{"type", "design"}, {"document", doc}});
   ASSERT_EQ(r["type"], "design") << r.dump();
   EXPECT_EQ(r["grid"]["count"], 19200);
   const auto bytes = texel::studio::detail::base64_decode(r["map_f32"].get<std::string>());
