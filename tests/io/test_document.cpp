@@ -13,8 +13,8 @@
 
 #include <unistd.h>
 
-#include "../support/temp_dir.hpp"
 #include "../support/expect.hpp"
+#include "../support/temp_dir.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "../support/cli_run.hpp"
-#include "../support/temp_dir.hpp"
 #include "../support/controller_process.hpp"
+#include "../support/temp_dir.hpp"
 
 #include <algorithm>
 #include <array>
