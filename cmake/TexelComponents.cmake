@@ -11,7 +11,7 @@ option(TEXEL_WITH_IO "texel::io: .mat interchange and the signal loader (libmati
 option(TEXEL_WITH_CODEC "texel::codec: encoder, .texel bitstream, decoder (zstd)" ON)
 option(TEXEL_WITH_EXPERIMENTS "texel::experiment: procedures, session store, statistics (SQLite, Boost.Math, nlohmann-json)" ON)
 option(TEXEL_WITH_STUDIO "texel::studio and texel::studio_server: Texel Studio's service and server (Boost.Beast)" ON)
-option(TEXEL_WITH_CAPI "texel::c: the C ABI, texel.h" ON)
+option(TEXEL_WITH_CAPI "texel::c and texel::c_static: the C ABI (libtexel.so, libtexel.a), texel.h" ON)
 
 # texel_component_requires(<option> <reason> <needed options...>)
 function(texel_component_requires option reason)
@@ -46,3 +46,9 @@ foreach(option IN LISTS TEXEL_COMPONENT_OPTIONS)
     list(APPEND TEXEL_COMPONENTS_OFF ${option})
   endif()
 endforeach()
+
+# Components built and tested in the tree but not installed: Texel Studio's
+# service and server are the `texel studio` command's insides (the installed
+# CLI carries them); their headers are no public API. docs/architecture.md
+# "What is installed"; cmake/TexelInstall.cmake skips them.
+set(TEXEL_UNINSTALLED_COMPONENTS studio)

@@ -1,5 +1,6 @@
 # Install rules (TEXEL_INSTALL): the libraries as exported targets
-# texel::<name> (static, but for the C library's libtexel.so), the public headers of the components built, the texel CLI,
+# texel::<name> (static, but for the C library's libtexel.so), the public headers of the components built
+# (but those of TEXEL_UNINSTALLED_COMPONENTS: the studio's, cmake/TexelComponents.cmake), the texel CLI,
 # and the CMake package, so that
 #   cmake --install build --prefix /opt/texel
 #   find_package(texel [COMPONENTS player codec ...])   # CMAKE_PREFIX_PATH=/opt/texel
@@ -16,7 +17,7 @@ set(TEXEL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/texel CACHE STRING
 set(TEXEL_INSTALLED_COMPONENTS "")
 foreach(component IN LISTS TEXEL_COMPONENTS)
   get_property(targets GLOBAL PROPERTY TEXEL_COMPONENT_TARGETS_${component})
-  if(NOT targets)
+  if(NOT targets OR component IN_LIST TEXEL_UNINSTALLED_COMPONENTS)
     continue()
   endif()
   # One install component per Texel component (cmake --install build --component capi),
