@@ -16,6 +16,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -42,6 +43,7 @@ struct Stats {
 
 Stats time_runs(int runs, const std::function<void(int)>& body) {
   std::vector<double> ms;
+  ms.reserve(static_cast<std::size_t>(runs));
   for (int i = 0; i < runs; ++i) {
     const auto t0 = clock_type::now();
     body(i);
@@ -69,7 +71,7 @@ struct Client {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int runs = 40;
   std::string json_out;
   for (int i = 1; i < argc; ++i) {
@@ -82,6 +84,7 @@ int main(int argc, char** argv) {
   // Run i uses seed i + 1 in every measure, so no cache of a prepared texture
   // or a view serves a run from the one before.
   std::vector<texel::Document> docs;
+  docs.reserve(static_cast<std::size_t>(runs));
   for (int i = 0; i < runs; ++i) docs.push_back(texel::parse_document(tpad_document(10.0, i + 1).dump()));
   double keep = 0.0;  // keeps the results alive
 
@@ -103,7 +106,7 @@ int main(int argc, char** argv) {
     o.db_path = db.string();
     texel::studio::Service service(o);
     Client c;
-    const std::uint64_t id = service.connect([&c](std::string text) {
+    const std::uint64_t id = service.connect([&c](const std::string& text) {
       json j = json::parse(text);
       std::lock_guard lock(c.m);
       c.replies.push_back(std::move(j));
@@ -142,4 +145,13 @@ int main(int argc, char** argv) {
     std::ofstream(json_out) << out.dump(2) << "\n";
   }
   return keep == -1.0 ? 1 : 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "texel_bench_design: %s\n", e.what());
+    return 1;
+  }
 }
