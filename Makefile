@@ -14,8 +14,8 @@ all: build
 deps:
 	@bash scripts/install-deps.sh
 
-deps-web:
-	@bash scripts/install-deps.sh --web
+deps-web: deps
+	@bash scripts/check-node.sh
 
 configure: deps
 	@cmake --preset release >/dev/null
