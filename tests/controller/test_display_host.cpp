@@ -15,7 +15,10 @@
 #include <thread>
 #include <vector>
 
+#include <csignal>
+
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "../support/controller_process.hpp"
 #include "../support/display_rig.hpp"
@@ -419,4 +422,89 @@ TEST(ControllerCli, TheStrokeSensorsScriptAndLogShowTheMapPlayedUnderTheFinger) 
   }
   EXPECT_GT(played, 200);
   (void)lifted;
+}
+
+// ------------------------------------------------- the host going away (CLI)
+
+namespace {
+
+// The display's clock (HostHal::micros: steady_clock µs, 32 bits) read here:
+// the same clock on the same machine, so the log's t_us place the kill.
+std::uint32_t display_clock_us() {
+  using namespace std::chrono;
+  return static_cast<std::uint32_t>(duration_cast<microseconds>(steady_clock::now().time_since_epoch()).count());
+}
+
+struct LogRow {
+  std::uint32_t t_us = 0;
+  int selected = -1, mode = 0;
+  unsigned amplitude = 0;
+};
+
+std::vector<LogRow> read_log(const std::string& path) {
+  std::vector<LogRow> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    double t = 0, x = 0;
+    int touch = 0;
+    LogRow r;
+    if (std::sscanf(line.c_str(), "%lf,%u,%lf,%d,%d,%d,%u", &t, &r.t_us, &x, &touch, &r.selected, &r.mode, &r.amplitude) == 7)
+      rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST(HostSafety, AKilledHostLeavesTheDisplayAtRestWithin200MsAndCtrlCRestsItAtOnce) {
+  test_support::TempDir tmp;
+  const std::string doc = tmp.at("d.texel.json");
+  { std::ofstream(doc) << document_json(tpad_document()); }
+  for (const int sig : {SIGKILL, SIGINT}) {
+    const std::string log = tmp.at("log" + std::to_string(sig) + ".csv");
+    // A display with a sensor that always touches: the case where a sensor
+    // reading used to keep the stale drive going.
+    test_support::ControllerProcess display(TEXEL_CLI, {"--sensor", "strokes", "--sensor-lift-probability", "0", "--sensor-pause",
+                                                        "0", "--log", log, "--log-every", "1", "--quiet"});
+    ASSERT_FALSE(display.pty().empty());
+    const pid_t host = ::fork();
+    if (host == 0) {
+      const std::string backend = "serial:" + display.pty();
+      ::execl(TEXEL_CLI, TEXEL_CLI, "play", doc.c_str(), "--backend", backend.c_str(), "--stream", "drive", "--pattern",
+              "back-and-forth", "--speed", "50", "--duration", "30", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    std::this_thread::sleep_for(1500ms);
+    const std::uint32_t t_stop = display_clock_us();
+    ::kill(host, sig);
+    int status = 0;
+    ::waitpid(host, &status, 0);
+    std::this_thread::sleep_for(400ms);
+    (void)display.stop();
+    const std::vector<LogRow> rows = read_log(log);
+    const auto after_ms = [&](const LogRow& r) { return static_cast<std::int32_t>(r.t_us - t_stop) / 1000.0; };
+    int driven_before = 0, rows_after = 0;
+    double last_driven_ms = -1e9;
+    for (const LogRow& r : rows) {
+      const double ms = after_ms(r);
+      if (ms > -200 && ms <= 0 && r.amplitude != 0) ++driven_before;
+      if (ms > 0) {
+        ++rows_after;
+        if (r.amplitude != 0) last_driven_ms = ms;
+      }
+    }
+    EXPECT_GT(driven_before, 100) << "signal " << sig << ": the host was driving the display";
+    EXPECT_GT(rows_after, 1000) << "signal " << sig;
+    if (sig == SIGKILL) {
+      // Nobody sent rest: the watchdog (200 ms after the last DRIVE).
+      EXPECT_LE(last_driven_ms, 230.0) << "still driven " << last_driven_ms << " ms after kill -9";
+    } else {
+      // texel play stops and sends rest: at once, and SELECT none.
+      EXPECT_LE(last_driven_ms, 100.0) << "still driven " << last_driven_ms << " ms after Ctrl-C";
+      EXPECT_EQ(rows.back().selected, -1);
+      EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0);
+    }
+  }
 }
