@@ -57,15 +57,16 @@ struct ControllerArgs {
   double sensor_angle_deg = 0.0;
   double sensor_radius_mm = 20.0;
   double sensor_period_s = 2.0;
-  double sensor_lift_s = 0.1;
+  std::optional<double> sensor_lift_s;  // 0.1 s; strokes: the script's default
   std::vector<double> sensor_start_mm;  // x, y
   // The 1-D stroke script (--sensor strokes).
   std::uint64_t seed = 1;
-  std::vector<double> sensor_range_mm{10.0, 90.0};
-  double sensor_speed_variation = 0.25;
-  double sensor_pause_s = 0.1;
-  double sensor_lift_probability = 0.2;
-  double sensor_duration_s = 600.0;
+  // The script's defaults are the library's (StrokeScriptConfig).
+  std::vector<double> sensor_range_mm{StrokeScriptConfig{}.from_mm, StrokeScriptConfig{}.to_mm};
+  double sensor_speed_variation = StrokeScriptConfig{}.speed_variation;
+  double sensor_pause_s = StrokeScriptConfig{}.pause_s;
+  double sensor_lift_probability = StrokeScriptConfig{}.lift_probability;
+  double sensor_duration_s = StrokeScriptConfig{}.duration_s;
   std::optional<std::string> sensor_trace_out;
   std::optional<std::string> log;
   int log_every = 0;  // ticks between log rows; 0 = about 1 kHz
@@ -114,7 +115,7 @@ StrokeScriptConfig stroke_config(const ControllerArgs& a) {
   c.speed_variation = a.sensor_speed_variation;
   c.pause_s = a.sensor_pause_s;
   c.lift_probability = a.sensor_lift_probability;
-  c.lift_s = a.sensor_lift_s;
+  c.lift_s = a.sensor_lift_s.value_or(c.lift_s);
   c.duration_s = a.sensor_duration_s;
   return c;
 }
@@ -208,9 +209,9 @@ void run(const ControllerArgs& a) {
       write_file_atomic(*a.sensor_trace_out, trace_csv(t));
     }
   } else if (a.sensor && a.sensor->starts_with("1d:")) {
-    trace_1d.emplace(load_trace_csv(a.sensor->substr(3)), a.sensor_lift_s);
+    trace_1d.emplace(load_trace_csv(a.sensor->substr(3)), a.sensor_lift_s.value_or(0.1));
   } else if (a.sensor) {
-    sensor.emplace(sensor_trace(a), a.sensor_lift_s);
+    sensor.emplace(sensor_trace(a), a.sensor_lift_s.value_or(0.1));
   }
   if (a.sensor_trace_out && !strokes) throw InvalidArgument("--sensor-trace-out needs --sensor strokes");
   int fd = -1;
@@ -341,15 +342,21 @@ void register_controller(CLI::App& app) {
                   "from the host]");
   cmd->add_option("--sensor-speed", a->sensor_speed_mm_s, "Sensor stroke speed (mm/s; strokes: the median) [100]");
   cmd->add_option("--seed", a->seed, "strokes: the script's seed [1]");
-  cmd->add_option("--sensor-range", a->sensor_range_mm, "strokes: the two ends of the strokes, from,to in mm [10,90]")
+  cmd->add_option("--sensor-range", a->sensor_range_mm,
+                  "strokes: the two ends of the strokes, from,to in mm [" + detail::num(StrokeScriptConfig{}.from_mm) + "," +
+                      detail::num(StrokeScriptConfig{}.to_mm) + "]")
       ->delimiter(',')
       ->expected(2);
-  cmd->add_option("--sensor-speed-variation", a->sensor_speed_variation,
-                  "strokes: SD of ln(stroke speed) from stroke to stroke, 0 … 1 [0.25]");
-  cmd->add_option("--sensor-pause", a->sensor_pause_s, "strokes: mean still pause at a turn (s), 0 … 5 [0.1]");
+  cmd->add_option(
+      "--sensor-speed-variation", a->sensor_speed_variation,
+      "strokes: SD of ln(stroke speed) from stroke to stroke, 0 … 1 [" + detail::num(StrokeScriptConfig{}.speed_variation) + "]");
+  cmd->add_option("--sensor-pause", a->sensor_pause_s,
+                  "strokes: mean still pause at a turn (s), 0 … 5 [" + detail::num(StrokeScriptConfig{}.pause_s) + "]");
   cmd->add_option("--sensor-lift-probability", a->sensor_lift_probability,
-                  "strokes: chance the finger lifts after a stroke (it then repeats the direction), 0 … 1 [0.2]");
-  cmd->add_option("--sensor-duration", a->sensor_duration_s, "strokes: the script's length before it repeats (s) [600]");
+                  "strokes: chance the finger lifts after a stroke (it then repeats the direction), 0 … 1 [" +
+                      detail::num(StrokeScriptConfig{}.lift_probability) + "]");
+  cmd->add_option("--sensor-duration", a->sensor_duration_s,
+                  "strokes: the script's length before it repeats (s) [" + detail::num(StrokeScriptConfig{}.duration_s) + "]");
   cmd->add_option("--sensor-trace-out", a->sensor_trace_out,
                   "strokes: write the script (one period at 1 kHz, time_s,position_mm,touch; t = 0 when the controller "
                   "starts) to this CSV");
@@ -368,7 +375,8 @@ void register_controller(CLI::App& app) {
   cmd->add_option("--sensor-radius", a->sensor_radius_mm, "Sensor circle radius (mm) [20]");
   cmd->add_option("--sensor-period", a->sensor_period_s, "Length of one simulated stroke before the finger lifts (s) [2]");
   cmd->add_option("--sensor-lift", a->sensor_lift_s,
-                  "How long the sensor's finger stays lifted between two strokes (s), reported with touch 0 [0.1]");
+                  "How long the sensor's finger stays lifted between two strokes (s), reported with touch 0 [0.1; strokes: " +
+                      detail::num(StrokeScriptConfig{}.lift_s) + "]");
   cmd->add_option("--sensor-start", a->sensor_start_mm, "Where a sensor stroke starts (circle: its centre), x,y in mm [0,0]")
       ->delimiter(',')
       ->expected(2);

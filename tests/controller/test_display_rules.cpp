@@ -178,7 +178,9 @@ TEST(DisplayRules, StreamedPositionsThatStopArrivingRestTheOutput) {
   hal.frame(ser::Type::position, cat({u32le(2000000), {1}}));
   run_for(c, hal, 1000);
   EXPECT_EQ(hal.amplitude, map[20]);
-  run_for(c, hal, 199000);
+  run_for(c, hal, 198000);  // 199 ms after the POSITION
+  EXPECT_EQ(hal.amplitude, map[20]);
+  run_for(c, hal, 2000);
   EXPECT_EQ(hal.amplitude, 0);
 }
 
