@@ -511,3 +511,58 @@ TEST(HostSafety, AKilledHostLeavesTheDisplayAtRestWithin200MsAndCtrlCRestsItAtOn
     }
   }
 }
+
+TEST(ControllerCli, ARecorded1DTraceIsTheSensorAndBadOptionsAreRefusedWithTheirRange) {
+  test_support::TempDir tmp;
+  const std::string trace = tmp.at("trace.csv"), log_csv = tmp.at("log.csv");
+  {
+    std::ofstream out(trace);
+    out << "time_s,position_mm,touch\n0,20,1\n0.5,70,1\n1.0,20,1\n";
+  }
+  {
+    test_support::ControllerProcess display(TEXEL_CLI,
+                                            {"--sensor", "1d:" + trace, "--sensor-lift", "0.2", "--log", log_csv, "--quiet"});
+    ASSERT_FALSE(display.pty().empty());
+    SerialLink link(display.pty());
+    link.hello();
+    link.start_reports(1000);  // a 1-D display with a sensor reports it
+    std::array<FingerReport, 64> buf;
+    std::size_t n = 0;
+    for (int i = 0; i < 20 && n == 0; ++i) n = link.read_reports(buf, 20);
+    ASSERT_GT(n, 0u);
+    EXPECT_EQ(buf[0].y_mm, 0.0);
+    link.start_reports(0);
+    std::this_thread::sleep_for(1300ms);  // more than a pass and its lift
+  }
+  int touching = 0, lifted = 0;
+  std::ifstream in(log_csv);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    double t = 0, x = 0;
+    unsigned t_us = 0, amp = 0;
+    int touch = 0, sel = 0, mode = 0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%u,%lf,%d,%d,%d,%u", &t, &t_us, &x, &touch, &sel, &mode, &amp), 7) << line;
+    const double phase = std::fmod(t, 1.2);  // 1 s pass + 0.2 s lifted
+    if (phase < 0.999) {
+      EXPECT_EQ(touch, 1) << line;
+      EXPECT_NEAR(x, phase < 0.5 ? 20 + 100 * phase : 70 - 100 * (phase - 0.5), 0.05) << line;
+      ++touching;
+    } else if (phase > 1.001 && phase < 1.199) {
+      EXPECT_EQ(touch, 0) << line;
+      ++lifted;
+    }
+  }
+  EXPECT_GT(touching, 500);
+  EXPECT_GT(lifted, 50);
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--max-payload 10", "--max-payload is 10; allowed 14 … 1024 bytes"},
+           {"--slots 3", "--slots is 3; allowed 1 … 2"},
+           {"--fault bogus", "--fault is 'bogus'; allowed: wrong-crc, ignore-watchdog, drop-reports"},
+           {"--sensor-trace-out x.csv", "--sensor-trace-out needs --sensor strokes"},
+           {"--sensor strokes --sensor-speed-variation 2", "speed variation is 2; allowed 0 … 1"}}) {
+    const CliRun r = run(std::string(TEXEL_CLI) + " controller --pty --duration 1 " + args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+  }
+}
