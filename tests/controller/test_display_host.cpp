@@ -110,6 +110,20 @@ TEST(HostLimits, TheSerialBackendUploadsWithinASmallDisplaysLimits) {
   backend.reset();
 }
 
+TEST(HostLimits, TheSerialBackendNeverStreamsFasterThanTheDisplayRefreshes) {
+  controller::Info info;
+  info.refresh_mhz = 500000;  // 500 Hz
+  Rig rig(info, {});
+  SerialOptions o;
+  o.path = rig.path;
+  o.rate_hz = 1000;
+  o.stream = SerialStream::drive;
+  const PlayerMap stand_in(Grid{Millimetres(0), Millimetres(1), 1}, std::vector<float>{0.0f});
+  auto backend = make_serial_backend(o, stand_in);
+  EXPECT_NE(backend->describe().find("500 Hz refresh), streaming drive values at 500 Hz"), std::string::npos)
+      << backend->describe();
+}
+
 TEST(HostLimits, ADocumentUploadsWithTexelRendersExactBytes) {
   Rig rig;
   const Document doc = tpad_document();
