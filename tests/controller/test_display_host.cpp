@@ -185,6 +185,49 @@ TEST(HostRest, TheSerialBackendRestsTheDisplayOnStopAndSelectsAgainOnStart) {
   EXPECT_EQ(rig.ctl->status().selected, ser::no_map);
 }
 
+TEST(HostThreads, RequestsGoThroughWhileAReportReaderReadsTheSameLink) {
+  // A display that plays its own map: the host SELECTs per interval while
+  // its finger reports arrive on another thread.
+  const StrokeScript script(StrokeScriptConfig{});
+  controller::HostHal* hal = nullptr;
+  Rig rig(controller::Info{}, [&](std::int32_t& x, bool& touch) {
+    const FingerSample f = script.at(hal->micros() * 1e-6);
+    x = static_cast<std::int32_t>(std::lround(f.x_mm * 1e6));
+    touch = f.touch;
+    return true;
+  });
+  hal = rig.hal.get();
+  SerialLink link(rig.path);
+  link.hello();
+  link.upload_raw(0, std::vector<std::uint16_t>(1000, 20000), 100000, 0);
+  link.upload_raw(1, std::vector<std::uint16_t>(1000, 40000), 100000, 0);
+  link.start_reports(1000);
+  std::atomic<std::size_t> reports{0};
+  std::uint8_t last_seq = 0;
+  bool have = false;
+  std::atomic<int> gaps{0};
+  ReportReader reader(link, [&](std::span<const FingerReport> batch) {
+    for (const FingerReport& r : batch) {
+      if (have && r.seq != static_cast<std::uint8_t>(last_seq + 1)) ++gaps;
+      have = true;
+      last_seq = r.seq;
+    }
+    reports += batch.size();
+  });
+  for (int k = 0; k < 60; ++k) {
+    link.select(static_cast<std::uint8_t>(k % 2));
+    const DisplayStatus s = link.status();
+    EXPECT_EQ(s.selected, k % 2) << k;
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_TRUE(link.rest());
+  reader.stop();
+  EXPECT_TRUE(reader.error().empty()) << reader.error();
+  EXPECT_GT(reports.load(), 100u);
+  EXPECT_EQ(gaps.load(), 0);
+  EXPECT_EQ(link.reports_lost(), 0u);
+}
+
 // ------------------------------------------------------ the scripted finger
 
 TEST(StrokeScript, IsDeterministicStrokesBackAndForthAndLifts) {
