@@ -11,10 +11,14 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include "texel/controller/host_hal.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/document.hpp"
 #include "texel/player.hpp"
+#include "texel/surface.hpp"
 
 namespace texel {
 
@@ -29,7 +33,42 @@ SerialLink::SerialLink(int fd, std::string name) : fd_(fd), name_(std::move(name
 }
 
 SerialLink::~SerialLink() {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ < 0) return;
+  if (rest_on_close) send_rest_frames();
+  ::close(fd_);
+}
+
+namespace {
+// One write attempt that never raises SIGPIPE (a socket whose peer is gone)
+// and never waits: for the rest frames of a link that may be dead.
+bool write_once(int fd, const std::uint8_t* p, std::size_t n) noexcept {
+  ssize_t w = ::send(fd, p, n, MSG_NOSIGNAL | MSG_DONTWAIT);
+  if (w < 0 && errno == ENOTSOCK) w = ::write(fd, p, n);
+  return w == static_cast<ssize_t>(n);
+}
+}  // namespace
+
+void SerialLink::send_rest_frames() noexcept {
+  std::lock_guard lock(write_mutex_);
+  std::uint8_t frame[serial::header_size + 2 + serial::crc_size];
+  const std::uint8_t drive0[2] = {0, 0};
+  std::size_t len = serial::encode_frame(Type::drive, seq_++, drive0, 2, frame);
+  write_once(fd_, frame, len);
+  const std::uint8_t none[1] = {serial::no_map};
+  len = serial::encode_frame(Type::select, seq_++, none, 1, frame);
+  write_once(fd_, frame, len);
+}
+
+bool SerialLink::rest() noexcept {
+  if (fd_ < 0) return false;
+  try {
+    stream_drive(0.0);
+    const std::uint8_t none[1] = {serial::no_map};
+    request(Type::select, none, 1, Type::ack, "SELECT", 1);
+    return true;
+  } catch (...) {
+    return false;
+  }
 }
 
 void SerialLink::write_all(const std::uint8_t* p, std::size_t n) {
@@ -54,6 +93,7 @@ void SerialLink::write_all(const std::uint8_t* p, std::size_t n) {
 }
 
 std::uint8_t SerialLink::send(Type type, const std::uint8_t* payload, std::size_t n) {
+  std::lock_guard lock(write_mutex_);
   std::uint8_t frame[serial::max_frame];
   const std::uint8_t seq = seq_++;
   const std::size_t len = serial::encode_frame(type, seq, payload, n, frame);
@@ -62,11 +102,16 @@ std::uint8_t SerialLink::send(Type type, const std::uint8_t* payload, std::size_
 }
 
 void SerialLink::send_raw(std::span<const std::byte> bytes) {
+  std::lock_guard lock(write_mutex_);
   write_all(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
 }
 
-std::string SerialLink::request(Type type, const std::uint8_t* payload, std::size_t n, Type expect, const char* what) {
-  for (int attempt = 0; attempt < attempts; ++attempt) {
+std::string SerialLink::request(Type type, const std::uint8_t* payload, std::size_t n, Type expect, const char* what, int tries) {
+  if (tries <= 0) tries = attempts;
+  requests_waiting_.fetch_add(1);
+  std::unique_lock read_lock(read_mutex_);  // the reply is read here, not by a report reader
+  requests_waiting_.fetch_sub(1);
+  for (int attempt = 0; attempt < tries; ++attempt) {
     const std::uint8_t seq = send(type, payload, n);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
     bool got = false;
@@ -110,7 +155,7 @@ std::string SerialLink::request(Type type, const std::uint8_t* payload, std::siz
     }
     return reply;
   }
-  throw IoError("serial link " + name_ + ": no reply to " + what + " after " + std::to_string(attempts) + " attempts of " +
+  throw IoError("serial link " + name_ + ": no reply to " + what + " after " + std::to_string(tries) + " attempt(s) of " +
                 std::to_string(timeout_ms) + " ms (is the display connected and running?)");
 }
 
@@ -127,11 +172,54 @@ DisplayInfo SerialLink::hello() {
   info.refresh_hz = serial::get_u32(b + 6) / 1000.0;
   info.max_payload = serial::get_u16(b + 10);
   info.name = r.substr(12);
+  const auto bad = [&](const char* field, const std::string& value, const char* allowed) {
+    return IoError("serial link " + name_ + ": HELLO_REPLY " + field + " is " + value + "; allowed " + allowed);
+  };
+  if (info.slots < 1) throw bad("slots", std::to_string(info.slots), "1 … 254");
+  if (info.max_samples < 1) throw bad("max_samples", std::to_string(info.max_samples), ">= 1");
+  if (!(info.refresh_hz > 0)) throw bad("refresh_mhz", "0", ">= 1 (millihertz)");
+  if (info.max_payload < serial::min_max_payload) throw bad("max_payload", std::to_string(info.max_payload), "14 … 1024 bytes");
+  info_ = info;
+  // A display may announce more than a frame can carry; the frame's limit holds.
+  payload_limit_ = std::min<std::size_t>(info.max_payload, serial::max_payload);
   return info;
 }
 
+NativeMap native_map(const Surface& surface) {
+  const Grid& g = surface.grid();
+  const double spacing_nm = g.spacing.value() * 1e6, origin_nm = g.origin.value() * 1e6;
+  if (!(spacing_nm >= 0.5 && spacing_nm < 4294967295.5))
+    throw InvalidArgument("serial: map spacing is " + detail::num(g.spacing.value()) + " mm; allowed 1e-6 … 4294 mm");
+  if (!(std::abs(origin_nm) < 2.1e9))
+    throw InvalidArgument("serial: map origin is " + detail::num(g.origin.value()) + " mm; allowed −2100 … 2100 mm");
+  const std::vector<std::byte> bytes = surface.render_native(SampleFormat::u16le);  // `texel render`'s bytes
+  NativeMap m;
+  m.samples.resize(bytes.size() / 2);
+  for (std::size_t i = 0; i < m.samples.size(); ++i)
+    m.samples[i] =
+        static_cast<std::uint16_t>(std::to_integer<unsigned>(bytes[2 * i]) | (std::to_integer<unsigned>(bytes[2 * i + 1]) << 8));
+  m.spacing_nm = static_cast<std::uint32_t>(std::llround(spacing_nm));
+  m.origin_nm = static_cast<std::int32_t>(std::llround(origin_nm));
+  return m;
+}
+
+NativeMap native_map(const Document& doc) { return native_map(prepare_surface(doc)); }
+
+void SerialLink::upload(std::uint8_t id, const NativeMap& map) { upload_raw(id, map.samples, map.spacing_nm, map.origin_nm); }
+
 void SerialLink::upload_raw(std::uint8_t id, std::span<const std::uint16_t> samples, std::uint32_t spacing_nm,
                             std::int32_t origin_nm, bool corrupt_crc) {
+  if (check_limits && info_.version != 0) {
+    // What the display would answer, without the round trip.
+    if (id >= info_.slots)
+      throw SerialError("serial link " + name_ + ": slot " + std::to_string(id) + " does not exist; the display has " +
+                            std::to_string(info_.slots) + " (0 … " + std::to_string(info_.slots - 1) + ")",
+                        ErrorCode::unknown_map, static_cast<std::uint32_t>(info_.slots));
+    if (samples.size() > info_.max_samples)
+      throw SerialError("serial link " + name_ + ": the map has " + std::to_string(samples.size()) +
+                            " samples; the display holds at most " + std::to_string(info_.max_samples) + " (oversize_map)",
+                        ErrorCode::oversize_map, info_.max_samples);
+  }
   std::uint8_t begin[14] = {id, 0};
   serial::put_u32(begin + 2, static_cast<std::uint32_t>(samples.size()));
   serial::put_u32(begin + 6, spacing_nm);
@@ -139,8 +227,9 @@ void SerialLink::upload_raw(std::uint8_t id, std::span<const std::uint16_t> samp
   request(Type::map_begin, begin, sizeof begin, Type::ack, "MAP_BEGIN");
   std::uint8_t chunk[serial::max_payload];
   std::uint32_t crc = 0;
-  for (std::size_t first = 0; first < samples.size(); first += serial::samples_per_chunk) {
-    const std::size_t n = std::min(serial::samples_per_chunk, samples.size() - first);
+  const std::size_t per_chunk = serial::samples_per_chunk_for(payload_limit_);  // >= 4 (payload >= 14)
+  for (std::size_t first = 0; first < samples.size(); first += per_chunk) {
+    const std::size_t n = std::min(per_chunk, samples.size() - first);
     chunk[0] = id;
     serial::put_u32(chunk + 1, static_cast<std::uint32_t>(first));
     for (std::size_t i = 0; i < n; ++i) serial::put_u16(chunk + 5 + 2 * i, samples[first + i]);
@@ -195,7 +284,8 @@ void SerialLink::stream_drive(double amplitude) {
 
 DisplayStatus SerialLink::status() {
   const std::string r = request(Type::status_request, nullptr, 0, Type::status, "STATUS");
-  if (r.size() < 26) throw IoError("serial link " + name_ + ": STATUS has " + std::to_string(r.size()) + " bytes; expected 26");
+  if (r.size() < serial::status_payload_1_0)
+    throw IoError("serial link " + name_ + ": STATUS has " + std::to_string(r.size()) + " bytes; expected >= 26");
   const auto* b = reinterpret_cast<const std::uint8_t*>(r.data());
   DisplayStatus s;
   s.selected = b[0] == serial::no_map ? -1 : b[0];
@@ -208,18 +298,23 @@ DisplayStatus SerialLink::status() {
   s.last_error = static_cast<ErrorCode>(b[17]);
   s.map_samples = serial::get_u32(b + 18);
   s.uptime_ms = serial::get_u32(b + 22);
+  if (r.size() >= serial::status_payload) {  // revision 1.2; longer: fields of a later revision, ignored
+    s.link_errors = serial::get_u32(b + 26);
+    s.flags = b[30];
+  }
   return s;
 }
 
 void SerialLink::keep_report(const serial::Frame& f) {
   if (f.length != serial::finger_payload) return;  // malformed: not a report
-  if (have_report_seq_ && f.seq != next_report_seq_) reports_lost_ += static_cast<std::uint8_t>(f.seq - next_report_seq_);
+  if (have_report_seq_ && f.seq != next_report_seq_)
+    reports_lost_.fetch_add(static_cast<std::uint8_t>(f.seq - next_report_seq_), std::memory_order_relaxed);
   have_report_seq_ = true;
   next_report_seq_ = static_cast<std::uint8_t>(f.seq + 1);
   constexpr std::size_t max_pending = 4096;  // about 4 s at 1 kHz
   if (pending_.size() >= max_pending) {
     pending_.pop_front();
-    ++reports_lost_;
+    reports_lost_.fetch_add(1, std::memory_order_relaxed);
   }
   FingerReport r;
   r.t_us = serial::get_u32(f.payload);
@@ -245,10 +340,16 @@ void SerialLink::start_reports(std::uint32_t interval_us) {
                           "protocol 1.1)",
                       e.code, e.detail);
   }
+  std::lock_guard lock(read_mutex_);
   have_report_seq_ = false;
 }
 
 std::size_t SerialLink::read_reports(std::span<FingerReport> out, int wait_ms) {
+  if (requests_waiting_.load() > 0) {  // let the request have the link (the mutex is not fair)
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    return 0;
+  }
+  std::lock_guard lock(read_mutex_);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(0, wait_ms));
   while (pending_.size() < out.size()) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
