@@ -27,7 +27,7 @@
 // between its grid samples, never stepped from sample to sample.
 //
 // Band limit ([choice] PlayerConfig::band_limit, on by default;
-// docs/player.md "Band limit"). A spatial frequency f felt at speed v is
+// docs/player.md §5). A spatial frequency f felt at speed v is
 // f·|v| Hz; above the output's Nyquist rate it would alias (a 7.5 dB
 // texture at 100 mm/s, 562 Hz, streamed at 439 Hz on a 1 kHz drive), and no
 // filter after the sampling can remove what sampling folded down. So the
@@ -44,12 +44,14 @@
 //     (5 periods of the limit; at most 32 texels) the weight is at most
 //     max(w_j, raised cosine of the distance / δ), so it is continuous.
 //   - Anything else (reference textures, maps from files or raw values) is
-//     read from a pyramid built when the map is made: each level low-passed
-//     (65-tap Blackman-windowed sinc) and decimated by 2; the finger reads,
-//     blended between two neighbouring levels, the ones whose content stops
-//     under the output's Nyquist frequency at its speed. Trade-off: octave
-//     levels are coarse, so such content is whole only up to about 0.35 ×
-//     the limit and fades above it (a Texel region's is whole to 0.8 ×).
+//     read from a pyramid built when the map is made: level j holds the map
+//     with its content cut to 1/2^j of its Nyquist frequency (129-tap
+//     Blackman-windowed sinc), stored twice oversampled; the finger reads,
+//     cubically and blended between two neighbouring levels, the ones whose
+//     content stops under the output's Nyquist frequency at its speed.
+//     Trade-off: octave levels are coarse, so such content is whole only up
+//     to about a fifth of the limit at worst and fades above it (a Texel
+//     region's is whole to 0.8 × the limit).
 // Off: the map's samples interpolated linearly, as before (aliases).
 // Output modes (PlayerConfig::mode):
 //   amplitude  a(x) in [0, 1], for friction displays (0 = at rest);
@@ -206,7 +208,7 @@ class PlayerMap {
   std::vector<float> values_;
   std::optional<FrequencyResponse> response_;
   double inv_spacing_ = 0.0;
-  std::vector<TexelLine> lines_;           // Texel regions, ascending
+  std::vector<TexelLine> lines_;            // Texel regions, ascending
   std::vector<std::vector<float>> levels_;  // pyramid levels 1, 2, …: spacing 2^j × the grid's
 };
 
@@ -242,7 +244,7 @@ struct PlayerConfig {
   /// default) promises nothing, so nothing is limited.
   FrequencyResponse response{};
   ResponseHandling response_handling = ResponseHandling::limit;  ///< [choice] limit (see above)
-  double response_limit_db = 20.0;  ///< limit: attenuation (dB) at which the display no longer reproduces, 3 … 60
+  double response_limit_db = 20.0;       ///< limit: attenuation (dB) at which the display no longer reproduces, 3 … 60
   BandLimit band_limit = BandLimit::on;  ///< [choice] on: no content above the limit at the finger's speed (see above)
 };
 /// The low-pass corner (Hz) the player applies for `config`, or 0 for none.

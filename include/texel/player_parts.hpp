@@ -13,8 +13,8 @@
 //                 thread (atomic exchange), the crossfade between them and the
 //                 retire queue that takes the old one back to the control thread;
 //   take_events   the event ring's consumer (finger samples, gain, carrier);
-//   limit_weight  the band limit's fade of one texel (docs/player.md
-//                 "Band limit"), the one rule both players apply.
+//   limit_weight  the band limit's fade of one texel (docs/player.md §2
+//                 and §5), the one rule both players apply.
 //
 // They are public only because the players hold them by value; use the
 // players, not these.

@@ -2,7 +2,6 @@
 #include "texel/player.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -147,7 +146,8 @@ std::vector<float> filter_decimate(const std::vector<float>& in, const std::vect
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(out.size()); ++i) {
     double acc = 0.0;
     for (std::int64_t m = -half; m <= half; ++m)
-      acc += h[static_cast<std::size_t>(m + half)] * in[static_cast<std::size_t>(std::clamp<std::int64_t>(step * i + m, 0, n - 1))];
+      acc +=
+          h[static_cast<std::size_t>(m + half)] * in[static_cast<std::size_t>(std::clamp<std::int64_t>(step * i + m, 0, n - 1))];
     out[static_cast<std::size_t>(i)] = static_cast<float>(acc);
   }
   return out;
@@ -181,7 +181,9 @@ double PlayerMap::cubic_level(std::size_t level, double x_mm) const noexcept {
   if (u >= static_cast<double>(last)) return v[static_cast<std::size_t>(last)];
   const auto i = static_cast<std::int64_t>(u);
   const double t = u - static_cast<double>(i);
-  const auto at = [&](std::int64_t k) { return static_cast<double>(v[static_cast<std::size_t>(std::clamp<std::int64_t>(k, 0, last))]); };
+  const auto at = [&](std::int64_t k) {
+    return static_cast<double>(v[static_cast<std::size_t>(std::clamp<std::int64_t>(k, 0, last))]);
+  };
   const double p0 = at(i - 1), p1 = at(i), p2 = at(i + 1), p3 = at(i + 2);
   return p1 + 0.5 * t * (p2 - p0 + t * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + t * (3.0 * (p1 - p2) + p3 - p0)));
 }

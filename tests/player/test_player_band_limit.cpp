@@ -101,8 +101,8 @@ struct AliasCheck {
 // The output (rate `rate`, from `from` s on, `seconds` long) against the
 // texture itself along the same path, evaluated at 2^k × the rate (at least
 // 8 × and 384 kHz) without any band limit: bands of rate/80 below the output's Nyquist.
-AliasCheck check_against_texture(std::span<const float> out, double rate, const PlayerMap& map, double x0, double v,
-                                 double from, double seconds) {
+AliasCheck check_against_texture(std::span<const float> out, double rate, const PlayerMap& map, double x0, double v, double from,
+                                 double seconds) {
   const auto first = static_cast<std::size_t>(std::lround(from * rate));
   const auto count = static_cast<std::size_t>(std::lround(seconds * rate));
   const std::span<const float> y = out.subspan(first, count);
@@ -247,7 +247,8 @@ TEST(BandLimit, SwitchOffGivesTheUnlimitedMap) {
   c.band_limit = BandLimit::off;
   std::vector<float> pos;
   const auto off = render_trace(*map, c, trace, 850, &pos);
-  for (std::size_t i = 20; i < off.size(); ++i) ASSERT_NEAR(off[i], map->sample(5.0 + 100.0 * static_cast<double>(i) / 1000.0), 1e-6) << i;
+  for (std::size_t i = 20; i < off.size(); ++i)
+    ASSERT_NEAR(off[i], map->sample(5.0 + 100.0 * static_cast<double>(i) / 1000.0), 1e-6) << i;
   const AliasCheck aliased = check_against_texture(off, 1000, *map, 5.0, 100.0, 0.05, 0.8);
   EXPECT_GT(aliased.worst_excess, 0.05);
   c.band_limit = BandLimit::on;
@@ -261,14 +262,15 @@ TEST(BandLimit, SwitchOffGivesTheUnlimitedMap) {
 // A map without texels (raw values: two gratings, 1.5 and 43 cpm) swiped at
 // 100 mm/s on a 1 kHz drive: 43 cpm (4.3 kHz) is removed through the
 // pyramid rather than folded down to 300 Hz; 1.5 cpm (150 Hz, a third of
-// the limit: within the pyramid's pass band) stays within 3 dB. The cubic
-// read of a coarse level leaves an image of the grating (here at 440 Hz)
-// about 30 dB down: below 5 % of the texture's RMS (docs/player.md §5).
+// the limit: within the pyramid's pass band) stays within 3 dB. Nothing
+// else reaches 1 % of the texture's RMS (the levels are stored twice
+// oversampled, so the cubic read's images stay far down).
 TEST(BandLimit, MapsWithoutTexelsAreLimitedThroughThePyramid) {
   const auto f = [](double x) { return 0.5 + 0.2 * std::sin(2 * pi * 1.5 * x) + 0.2 * std::sin(2 * pi * 43.0 * x + 1.0); };
   Grid g{Millimetres(0.0), Millimetres(0.0053), 19200};
   std::vector<float> values(static_cast<std::size_t>(g.count));
-  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<float>(f(g.position(static_cast<std::int64_t>(i)).value()));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = static_cast<float>(f(g.position(static_cast<std::int64_t>(i)).value()));
   const PlayerMap map(g, std::move(values));
   EXPECT_EQ(map.texel_regions(), 0u);
   PlayerConfig c;

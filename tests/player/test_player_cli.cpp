@@ -81,8 +81,8 @@ TEST_F(Cli, SwipeAt1kHzFadesWhatTheDriveCannotCarry) {
     return std::sqrt(sq / static_cast<double>(rec.samples.size() - from));
   };
   const double off = ac_rms("--band-limit off"), on = ac_rms("");
-  EXPECT_GT(off, 0.2);   // the aliased stream at full strength (0.5·sin: RMS 0.35)
-  EXPECT_LT(on, 0.03);   // faded: every texel lies above 0.45 kHz (5.62 cpm ± 0.32)
+  EXPECT_GT(off, 0.2);  // the aliased stream at full strength (0.5·sin: RMS 0.35)
+  EXPECT_LT(on, 0.03);  // faded: every texel lies above 0.45 kHz (5.62 cpm ± 0.32)
   const CliRun bad = run("swipe " + narrow + " --band-limit maybe -o " + (dir / "b.wav").string());
   EXPECT_EQ(bad.status, 2) << bad.out;
 }
