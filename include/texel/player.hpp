@@ -53,6 +53,7 @@
 //     to about a fifth of the limit at worst and fades above it (a Texel
 //     region's is whole to 0.8 × the limit).
 // Off: the map's samples interpolated linearly, as before (aliases).
+//
 // Output modes (PlayerConfig::mode):
 //   amplitude  a(x) in [0, 1], for friction displays (0 = at rest);
 //   vibration  a(x) band-passed: a 2nd-order Butterworth low-pass
