@@ -256,7 +256,7 @@ TEST(Player, RegionBoundaryMatchesTheSurfaceMap) {
     const double x = 45 + 50 * static_cast<double>(i) / c.rate_hz;
     ASSERT_NEAR(pos[i], x, 1e-4);
     const Region& r = surface.regions()[x < 50.88 ? 0 : 1];
-    ASSERT_NEAR(out[i], r.texture->sample(Millimetres(static_cast<double>(pos[i]) - r.start.value())), 1e-5) << "x=" << x;
+    ASSERT_NEAR(out[i], r.texture->sample(Millimetres(x - r.start.value())), 1e-5) << "x=" << x;
     const double u = x / surface.grid().spacing.value();
     const auto k = static_cast<std::size_t>(u);
     const double expect = ref[k] + (ref[k + 1] - ref[k]) * (u - static_cast<double>(k));
