@@ -15,6 +15,13 @@
 // then the null backend (texel play --backend null) under the same loads:
 // underruns in 5 s, worst block, and the scheduling its paced thread got.
 //
+// The floor: in every JACK run (same server, same period, same load, same
+// 1 kHz sensor thread) a do-nothing client goes first — its process callback
+// writes zeros and shows the newest pushed marker, nothing else — and the
+// players' p99.9 block time, xruns and latency are reported beside it as
+// ratios. What the floor shows is the machine's (scheduler, timer, VM) tail:
+// a player cannot beat it, and a player within it costs nothing that shows.
+//
 // Usage: texel_bench_player_paced [--seconds S] [--json FILE] [--costs] [--sync]
 // (--costs: only the block costs without JACK, warm and with the caches
 // evicted between blocks, which tell whether the tail is the work's own;
@@ -312,6 +319,29 @@ Result run_client(const std::string& server, std::size_t block, double seconds, 
   return res;
 }
 
+/// The floor (see the banner): a client that does nothing but write zeros
+/// and show the newest marker (so the latency is measured the same way: the
+/// marker shows at the start of the first callback after its push, the least
+/// any client can do). Real-time safe: two fills and an atomic load.
+class FloorClient final : public PlayerBase {
+ public:
+  FloorClient() : PlayerBase(rate) {}
+  ~FloorClient() override { stop_driver(); }
+  void push(double x_mm) { newest_.store(static_cast<float>(x_mm), std::memory_order_relaxed); }
+  BlockInfo process(std::span<float> out, std::span<float> position_mm) noexcept override {
+    std::fill(out.begin(), out.end(), 0.0f);
+    if (position_mm.size() >= out.size()) std::fill_n(position_mm.begin(), out.size(), newest_.load(std::memory_order_relaxed));
+    frames_ += out.size();
+    publish_samples(frames_);
+    return {};
+  }
+  std::size_t collect() override { return 0; }
+
+ private:
+  std::atomic<float> newest_{0.0f};
+  std::uint64_t frames_ = 0;
+};
+
 PlayerConfig live_config() {
   PlayerConfig c;
   c.rate_hz = rate;
@@ -432,6 +462,12 @@ std::vector<Result> jack_runs(const std::string& load, std::size_t block, double
     return out;
   }
   {
+    FloorClient f;
+    Result r = run_client(server, block, seconds, f, [&](double, double x) { f.push(x); });
+    r.load = load, r.dim = "floor", r.scheduling += ", " + mode;
+    out.push_back(r);
+  }
+  {
     Player p(live_config(), map_1d());
     Result r = run_client(server, block, seconds, p, [&](double t, double x) { p.push({t, x, true}); });
     r.load = load, r.dim = "1-D", r.scheduling += ", " + mode;
@@ -514,17 +550,36 @@ int main(int argc, char** argv) {
 
   std::printf("texel_bench_player_paced: JACK dummy driver, 48 kHz, %.0f s per run, %u cores%s\n", seconds, cores,
               have_stress ? "; busy = stress-ng --cpu <cores>" : "");
-  std::printf("%-5s %-4s %5s %8s | %8s %8s %8s %8s | %8s %8s %8s | %6s %5s | %s\n", "load", "dim", "block", "blocks", "p50 %",
+  std::printf("%-5s %-5s %5s %8s | %8s %8s %8s %8s | %8s %8s %8s | %6s %5s | %s\n", "load", "dim", "block", "blocks", "p50 %",
               "p99 %", "p99.9 %", "max %", "lat p50", "lat p99", "lat max", "allocs", "xruns", "scheduling");
   for (const auto& r : results)
     std::printf(
-        "%-5s %-4s %5zu %8zu | %8.3f %8.3f %8.3f %8.3f | %6.3fms %6.3fms %6.3fms | %6llu %5llu | %s (playback latency "
+        "%-5s %-5s %5zu %8zu | %8.3f %8.3f %8.3f %8.3f | %6.3fms %6.3fms %6.3fms | %6llu %5llu | %s (playback latency "
         "%.0f…%.0f frames; latency max = %.3f ms push → callback + %.3f ms in the block + the playback latency; longest "
         "gap between callbacks %.3f ms)\n",
         r.load.c_str(), r.dim.c_str(), r.block, r.blocks, r.block_time.p50, r.block_time.p99, r.block_time.p999, r.block_time.max,
         r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms, static_cast<unsigned long long>(r.allocations),
         static_cast<unsigned long long>(r.xruns), r.scheduling.c_str(), r.playback_latency_min_frames, r.playback_latency_frames,
         r.max_wait_ms, r.max_offset_ms, r.longest_gap_ms);
+  // Beside the floor: each player's figures over the do-nothing client's
+  // of the same run (same load, same period); the block time also as the
+  // difference in points of the period (the floor's own block is a fill of
+  // zeros, so the ratio alone is large whatever the player costs).
+  std::printf("\nbeside the floor (player / do-nothing client of the same run; xruns: player vs floor):\n");
+  std::printf("%-5s %-5s %5s | %10s %12s | %10s %10s %10s | %s\n", "load", "dim", "block", "p99.9", "p99.9 − floor", "lat p50",
+              "lat p99", "lat max", "xruns");
+  const auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+  for (const auto& r : results) {
+    if (r.dim == "floor") continue;
+    const auto floor = std::find_if(results.begin(), results.end(),
+                                    [&](const Result& f) { return f.dim == "floor" && f.load == r.load && f.block == r.block; });
+    if (floor == results.end()) continue;
+    std::printf("%-5s %-5s %5zu | %9.2fx %+10.3f %% | %9.3fx %9.3fx %9.3fx | %llu vs %llu\n", r.load.c_str(), r.dim.c_str(),
+                r.block, ratio(r.block_time.p999, floor->block_time.p999), r.block_time.p999 - floor->block_time.p999,
+                ratio(r.lat_p50_ms, floor->lat_p50_ms), ratio(r.lat_p99_ms, floor->lat_p99_ms),
+                ratio(r.lat_max_ms, floor->lat_max_ms), static_cast<unsigned long long>(r.xruns),
+                static_cast<unsigned long long>(floor->xruns));
+  }
   for (const auto& n : nulls)
     std::printf(
         "null backend (texel play --backend null), 64 frames, 5 s, %s: %llu blocks, %llu underruns, worst block %.2f %% of the "

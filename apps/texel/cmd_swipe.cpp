@@ -28,6 +28,7 @@ struct SwipeArgs {
   std::string output;
   std::optional<std::string> plot;
   std::string wav_format = "pcm16";
+  std::string band_limit = "on";
   bool json = false;
 };
 
@@ -48,7 +49,11 @@ void run(const SwipeArgs& a) {
   if (a.plot) check_writable(*a.plot);
 
   const Document doc = build_document(a.document, a.device, a.texture);
-  const PlayerConfig config = player_config(a.finger, 48000.0, doc.device.response);
+  const PlayerConfig config = [&] {
+    PlayerConfig c = player_config(a.finger, 48000.0, doc.device.response);
+    c.band_limit = parse_band_limit(a.band_limit, "--band-limit");
+    return c;
+  }();
   double duration = 2.0;
   std::vector<float> positions, y_positions, out;
   double mean_speed = 0, sd_speed = 0, directional = 0, touched = 0;
@@ -107,6 +112,7 @@ void run(const SwipeArgs& a) {
   if (a.plot) j["plot"] = *a.plot;
   j["mode"] = std::string(to_string(config.mode));
   j["rate_hz"] = config.rate_hz;
+  j["band_limit"] = std::string(to_string(config.band_limit));
   j["samples"] = frames;
   j["duration_s"] = static_cast<double>(frames) / config.rate_hz;
   j["peak_frequency_hz"] = peak;
@@ -138,6 +144,9 @@ void register_swipe(CLI::App& app) {
   cmd->add_option("-o", a->output, "Output signal: .wav or .csv (time_s,position_mm,output)")->required();
   cmd->add_option("--plot", a->plot, "Also draw position, output and its temporal spectrum (.png or .svg)");
   cmd->add_option("--wav-format", a->wav_format, "WAV sample encoding: pcm16, pcm24 or float [pcm16]");
+  cmd->add_option("--band-limit", a->band_limit,
+                  "on: no content above the drive's limit at the finger's speed (texels faded, docs/player.md); off: the "
+                  "map as sampled (aliases) [on]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
   add_player_options(*cmd, a->finger, a->device, a->texture);
   add_surface2d_options(*cmd, a->surface);

@@ -23,11 +23,36 @@
 // samples ahead of time, so the same code interpolates a whole trace.
 //
 // Map sampling. At audio rates a finger at 100 mm/s moves 0.002 mm per
-// sample, less than one map sample (0.0053 mm on `tpad`), so the map is
-// interpolated linearly between grid samples ("chunked" sampling) instead of
-// stepping from sample to sample. Trade-off: a spatial frequency f felt at
-// speed v above the output Nyquist rate (f·v > rate/2) aliases; the
-// vibration low-pass cannot remove what sampling folded down.
+// sample, less than one map sample (0.0053 mm on `tpad`), so a map is read
+// between its grid samples, never stepped from sample to sample.
+//
+// Band limit ([choice] PlayerConfig::band_limit, on by default;
+// docs/player.md §5). A spatial frequency f felt at speed v is
+// f·|v| Hz; above the output's Nyquist rate it would alias (a 7.5 dB
+// texture at 100 mm/s, 562 Hz, streamed at 439 Hz on a 1 kHz drive), and no
+// filter after the sampling can remove what sampling folded down. So the
+// player band-limits the texture at the finger before it samples it, at
+// the limit L = the display's response limit (below), else 0.45·rate, and
+// the finger's speed |v| (from consecutive output samples):
+//   - Texel regions are evaluated texel by texel at the finger (the map
+//     keeps each texel's frequency, phase and envelope: the value equals the
+//     rendered map's at its grid samples), and texel k is faded towards its
+//     mean by limit_weight(f_k·|v|, L): whole up to 0.8·L, a raised cosine
+//     to 0 at L — the 2-D player's rule. So that a faded texel leaves no step
+//     at its edges (a step is broadband and would alias too), the fade
+//     reaches into its neighbours: within δ = 5·|v|/L of a texel weighted w_j
+//     (5 periods of the limit; at most 32 texels) the weight is at most
+//     max(w_j, raised cosine of the distance / δ), so it is continuous.
+//   - Anything else (reference textures, maps from files or raw values) is
+//     read from a pyramid built when the map is made: level j holds the map
+//     with its content cut to 1/2^j of its Nyquist frequency (129-tap
+//     Blackman-windowed sinc), stored twice oversampled; the finger reads,
+//     cubically and blended between two neighbouring levels, the ones whose
+//     content stops under the output's Nyquist frequency at its speed.
+//     Trade-off: octave levels are coarse, so such content is whole only up
+//     to about a fifth of the limit at worst and fades above it (a Texel
+//     region's is whole to 0.8 × the limit).
+// Off: the map's samples interpolated linearly, as before (aliases).
 //
 // Output modes (PlayerConfig::mode):
 //   amplitude  a(x) in [0, 1], for friction displays (0 = at rest);
@@ -106,6 +131,7 @@ namespace texel {
 
 class Surface;
 class Texture;
+class TexelTexture;
 struct Document;
 
 /// An immutable amplitude map on a uniform grid, in device coordinates (mm).
@@ -137,14 +163,54 @@ class PlayerMap {
   /// take the nearest end value (the caller decides what "off the surface"
   /// means). Real-time safe.
   [[nodiscard]] float sample(double x_mm) const noexcept;
+  /// The value at x with content above `limit_cpm` (cycles/mm: the limit in
+  /// Hz over the finger's speed) removed — see "Band limit" above. An
+  /// infinite limit (a finger at rest) removes nothing: a Texel region gives
+  /// the texture's own value at x (the rendered map's at a grid sample), the
+  /// rest sample(x). Real-time safe: arithmetic on the map's own arrays.
+  [[nodiscard]] double band_limited(double x_mm, double limit_cpm) const noexcept;
+  /// How many of the map's regions are evaluated texel by texel.
+  [[nodiscard]] std::size_t texel_regions() const noexcept { return lines_.size(); }
+  /// Pyramid levels besides the map itself (for content without texels).
+  [[nodiscard]] std::size_t pyramid_levels() const noexcept { return levels_.size(); }
+
+  /// At most this many texels (all regions) are kept for evaluation at the
+  /// finger (32 bytes each); a surface with more plays its regions from the
+  /// pyramid instead.
+  static constexpr std::size_t max_texels = std::size_t{1} << 21;
+  /// The neighbour fade's reach, in periods of the limit, and its cap in texels.
+  static constexpr double fade_reach_periods = 5.0;
+  static constexpr int fade_reach_texels = 32;
   /// True if x lies on the surface: [origin, origin + count·spacing).
   [[nodiscard]] bool on_surface(double x_mm) const noexcept;
 
  private:
+  /// One Texel region, texel by texel (what TexelTexture::render computes).
+  struct TexelLine {
+    struct Texel {
+      double frequency;  // f_k, cycles/mm
+      double phase;      // φ_k, cycles at the texel's left edge
+      double offset;     // e_k·(1 − F/2)
+      double gain;       // e_k·F/2
+    };
+    double start_mm = 0.0, end_mm = 0.0;  // the region on the device: [start, end)
+    double texel_mm = 0.0;                // L
+    double textured_end_mm = 0.0;         // region coordinates: beyond it, rest
+    std::vector<Texel> texels;
+    [[nodiscard]] double value(double local_mm, double limit_cpm) const noexcept;
+  };
+  PlayerMap(Grid grid, std::vector<float> values, std::optional<FrequencyResponse> response, bool pyramid);
+  static TexelLine texel_line(const TexelTexture& texture, double start_mm, double end_mm);
+  void build_pyramid();
+  [[nodiscard]] double cubic_level(std::size_t level, double x_mm) const noexcept;
+  [[nodiscard]] double pyramid_value(double x_mm, double limit_cpm) const noexcept;
+
   Grid grid_;
   std::vector<float> values_;
   std::optional<FrequencyResponse> response_;
   double inv_spacing_ = 0.0;
+  std::vector<TexelLine> lines_;            // Texel regions, ascending
+  std::vector<std::vector<float>> levels_;  // pyramid levels 1, 2, …: spacing 2^j × the grid's
 };
 
 enum class OutputMode { amplitude, vibration, carrier };
@@ -152,6 +218,10 @@ enum class OutputMode { amplitude, vibration, carrier };
 enum class ResponseHandling { limit, off };
 std::string_view to_string(ResponseHandling h);
 ResponseHandling parse_response_handling(std::string_view text, std::string_view field = "response_handling");
+/// Whether the player band-limits the texture at the finger's speed (see "Band limit"). [choice] on.
+enum class BandLimit { on, off };
+std::string_view to_string(BandLimit b);
+BandLimit parse_band_limit(std::string_view text, std::string_view field = "band_limit");
 std::string_view to_string(OutputMode m);
 OutputMode parse_output_mode(std::string_view text, std::string_view field = "output");
 
@@ -175,7 +245,8 @@ struct PlayerConfig {
   /// default) promises nothing, so nothing is limited.
   FrequencyResponse response{};
   ResponseHandling response_handling = ResponseHandling::limit;  ///< [choice] limit (see above)
-  double response_limit_db = 20.0;  ///< limit: attenuation (dB) at which the display no longer reproduces, 3 … 60
+  double response_limit_db = 20.0;       ///< limit: attenuation (dB) at which the display no longer reproduces, 3 … 60
+  BandLimit band_limit = BandLimit::on;  ///< [choice] on: no content above the limit at the finger's speed (see above)
 };
 /// The low-pass corner (Hz) the player applies for `config`, or 0 for none.
 double response_limit_hz(const PlayerConfig& config);
@@ -326,6 +397,8 @@ class Player final : public PlayerBase {
   player_parts::FingerTrack<FingerSample, 1> finger_;
   player_parts::OutputStage stage_;
   std::uint64_t n_ = 0;
+  double last_x_ = 0.0;  // the previous output sample's position (speed)
+  bool have_x_ = false;  // … and whether the finger touched there
 };
 
 /// Off-line rendering of a whole trace through a Player: queues the trace

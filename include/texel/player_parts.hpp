@@ -12,7 +12,9 @@
 //   MapExchange   the map now playing, the one handed over by the control
 //                 thread (atomic exchange), the crossfade between them and the
 //                 retire queue that takes the old one back to the control thread;
-//   take_events   the event ring's consumer (finger samples, gain, carrier).
+//   take_events   the event ring's consumer (finger samples, gain, carrier);
+//   limit_weight  the band limit's fade of one texel (docs/player.md §2
+//                 and §5), the one rule both players apply.
 //
 // They are public only because the players hold them by value; use the
 // players, not these.
@@ -49,6 +51,21 @@ const PlayerConfig& validated(const PlayerConfig& config);
 /// when there are no rows (`expected` names the columns).
 void read_trace_rows(std::string_view text, std::string_view origin, std::size_t positions, const char* expected,
                      const std::function<void(double t, std::span<const double> position, bool touch)>& row);
+
+/// The band limit's weight of a texel whose frequency is `f` against the
+/// limit `limit` (any one unit: felt Hz against Hz, or cycles/mm against the
+/// spatial limit limit_hz/|v|): 1 up to 0.8·limit, a raised cosine down to 0
+/// at the limit, 0 beyond. A limit of 0 (or less) fades everything; an
+/// infinite one nothing. Real-time safe (arithmetic only).
+inline double limit_weight(double f, double limit) noexcept {
+  // Well inside the limit (f ≤ 0.79·limit puts r under 0.8 whatever the
+  // rounding): 1 without the division.
+  if (limit > 0.0 && f <= 0.79 * limit) return 1.0;
+  const double r = f / limit;
+  if (r <= 0.8) return 1.0;
+  if (!(r < 1.0)) return 0.0;
+  return 0.5 + 0.5 * std::cos(std::numbers::pi * (r - 0.8) / 0.2);
+}
 
 struct Biquad {
   double b0 = 1, b1 = 0, b2 = 0, a1 = 0, a2 = 0;

@@ -115,18 +115,6 @@ void check_response(const std::optional<FrequencyResponse>& r, std::string_view 
   }
 }
 
-// Raised-cosine fade of a texel felt at `hz` against the limit: 1 up to
-// 0.8·limit, 0 from the limit on.
-double limit_weight(double hz, double limit_hz) noexcept {
-  // Well inside the limit (hz ≤ 0.79·limit puts r under 0.8 whatever the
-  // rounding): 1 without the division.
-  if (limit_hz > 0.0 && hz <= 0.79 * limit_hz) return 1.0;
-  const double r = hz / limit_hz;
-  if (r <= 0.8) return 1.0;
-  if (!(r < 1.0)) return 0.0;
-  return 0.5 + 0.5 * std::cos(std::numbers::pi * (r - 0.8) / 0.2);
-}
-
 }  // namespace
 
 std::unique_ptr<const PlayerMap2D> PlayerMap2D::path_indexed(const TexelSpec& fine, const Sampling& sampling,
@@ -273,7 +261,7 @@ struct MapAtFinger {
   // The fine oscillation at path length s, in [−1, 1], limited (docs/player.md §2).
   double fine(double s_mm, double speed_mm_s) const noexcept {
     double cycles = 0.0;
-    const double w = limit_weight(texel_at(s_mm, cycles) * std::fabs(speed_mm_s), limit);
+    const double w = player_parts::limit_weight(texel_at(s_mm, cycles) * std::fabs(speed_mm_s), limit);
     if (w == 0.0) return 0.0;
     return w * detmath::sin_cycles(cycles);
   }

@@ -228,7 +228,9 @@ TEST(Player, OffTheSurfaceIsAtRest) {
 
 TEST(Player, RegionBoundaryMatchesTheSurfaceMap) {
   // tpad's layout: a different texture on each half; the player's output is
-  // the surface map, linearly interpolated, across the boundary at 50.88 mm.
+  // each region's texture at the finger across the boundary at 50.88 mm
+  // (evaluated texel by texel: nothing is faded at 50 mm/s and 48 kHz), and
+  // with the band limit off the surface map, linearly interpolated.
   Document doc = make_document(load_device("tpad"), TexelSpec{});
   doc.regions.clear();
   RegionSpec left, right;
@@ -248,13 +250,17 @@ TEST(Player, RegionBoundaryMatchesTheSurfaceMap) {
   c.rate_hz = 48000;
   std::vector<float> pos;
   const auto out = render_trace(*map, c, line(0, 0.2, 45, 50, 1000), 9600, &pos);
+  c.band_limit = BandLimit::off;
+  const auto lerp = render_trace(*map, c, line(0, 0.2, 45, 50, 1000), 9600);
   for (std::size_t i = 1000; i < out.size(); ++i) {
     const double x = 45 + 50 * static_cast<double>(i) / c.rate_hz;
     ASSERT_NEAR(pos[i], x, 1e-4);
+    const Region& r = surface.regions()[x < 50.88 ? 0 : 1];
+    ASSERT_NEAR(out[i], r.texture->sample(Millimetres(x - r.start.value())), 1e-5) << "x=" << x;
     const double u = x / surface.grid().spacing.value();
     const auto k = static_cast<std::size_t>(u);
     const double expect = ref[k] + (ref[k + 1] - ref[k]) * (u - static_cast<double>(k));
-    ASSERT_NEAR(out[i], expect, 1e-5) << "x=" << x;
+    ASSERT_NEAR(lerp[i], expect, 1e-5) << "x=" << x;
   }
   // Both textures are felt: 3.16 cpm and 31.6 cpm at 50 mm/s.
   const auto before = signal_spectrum(std::span(out).subspan(1000, 4000), c.rate_hz);
@@ -327,6 +333,7 @@ TEST(Player, ResponseLimitAttenuatesWhatTheDisplayCannotReproduce) {
     c.response.corner = Hertz(400.0);  // tpad: first order, 400 Hz → limit (20 dB down) at 3.98 kHz
     c.response.order = 1;
     c.response_handling = h;
+    c.band_limit = BandLimit::off;  // the response's filter alone (the band limit would remove 12 kHz)
     const auto out = render_trace(*map, c, line(0.0, 0.6, 5.0, 100.0, 1000.0), 24000);
     double s = 0, cc = 0;  // single-bin DFT over whole periods after 0.1 s
     const std::size_t from = 4800, n = 19200;

@@ -15,6 +15,7 @@
 
 #include "../support/alloc_counter.hpp"
 #include "../support/grids.hpp"
+#include "texel/document.hpp"
 #include "texel/player.hpp"
 
 namespace {
@@ -52,6 +53,41 @@ TEST(PlayerAlloc, QueuesAllocateAtPrepareOnly) {
     EXPECT_EQ(all_allocations.load(), prepared) << "allocated after prepare, capacity " << capacity;
     EXPECT_EQ(player.event_capacity(), capacity);
   }
+}
+
+// The band limit's two paths (docs/player.md §5) while they fade: a Texel
+// map (texel by texel, neighbours' weights) and a map of raw values (the
+// pyramid), swiped at 100 mm/s on a 1 kHz drive, swapped back and forth.
+TEST(PlayerAlloc, BandLimitedProcessAllocatesNothing) {
+  TexelSpec spec;
+  spec.central_pitch = Decibels(6.0);  // 4 cpm: 400 Hz at 100 mm/s, around the 450 Hz limit
+  spec.irregularity = Decibels(1.0);
+  const Document doc = make_document(load_device("tpad"), spec);
+  std::vector<float> raw(19200);
+  for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = static_cast<float>(0.5 + 0.5 * std::sin(0.05 * static_cast<double>(i)));
+  PlayerConfig c;
+  c.rate_hz = 1000;
+  c.crossfade_s = 0.002;
+  Player player(c, PlayerMap::from_document(doc));
+  std::vector<float> out(16);
+  const std::uint64_t allocations = counted_allocations.load(), frees = counted_frees.load();
+  double t = 0;
+  for (int block = 0; block < 4000; ++block) {
+    while (t < 0.016 * block + 0.05 && player.push({t, 50 + 45 * std::sin(2.2 * t), true})) t += 0.001;
+    if (block % 100 == 0) {
+      if ((block / 100) % 2 == 0)
+        player.set_map(std::make_unique<const PlayerMap>(texel::test_support::tpad_grid(), raw));
+      else
+        player.set_map(PlayerMap::from_document(doc));
+    }
+    {
+      texel::test_support::alloc::CountingScope scope;
+      player.process(out);
+    }
+    player.collect();
+  }
+  EXPECT_EQ(counted_allocations.load() - allocations, 0u);
+  EXPECT_EQ(counted_frees.load() - frees, 0u);
 }
 
 TEST(PlayerAlloc, ProcessNeverAllocatesOverAMillionBlocksWhileSwapping) {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -55,6 +56,33 @@ TEST_F(Cli, SwipeWavPeaksAtCentralPitchTimesSpeed) {
   // frequencies spread about ±3 % at Irregularity −5 dB).
   const auto spec = texel::signal_spectrum(s, rate);
   EXPECT_NEAR(spec.peak_hz(1.0), 1000.0, 30.0);
+}
+
+// Issue #36: a 7.5 dB texture (5.62 cpm) at 100 mm/s is 562 Hz, above a
+// 1 kHz drive's Nyquist frequency. With the band limit (the default) it is
+// faded to its mean, not folded down to about 440 Hz; --band-limit off
+// gives the old, aliased stream.
+TEST_F(Cli, SwipeAt1kHzFadesWhatTheDriveCannotCarry) {
+  const std::string narrow = (dir / "narrow.texel.json").string();
+  ASSERT_EQ(run("render --seed 1 --central-pitch 7.5 --irregularity -5 -o " + narrow).status, 0);
+  const auto ac_rms = [&](const std::string& extra) {
+    const std::string wav = (dir / "k.wav").string();
+    const CliRun r = run("swipe " + narrow + " --speed 100 --duration 0.5 --rate 1000 --output amplitude " + extra +
+                         " --wav-format float -o " + wav);
+    EXPECT_EQ(r.status, 0) << r.out;
+    const texel::Recording rec = texel::read_recording(wav);
+    double mean = 0, sq = 0;
+    const std::size_t from = 50;
+    for (std::size_t i = from; i < rec.samples.size(); ++i) mean += rec.samples[i];
+    mean /= static_cast<double>(rec.samples.size() - from);
+    for (std::size_t i = from; i < rec.samples.size(); ++i) sq += (rec.samples[i] - mean) * (rec.samples[i] - mean);
+    return std::sqrt(sq / static_cast<double>(rec.samples.size() - from));
+  };
+  const double off = ac_rms("--band-limit off"), on = ac_rms("");
+  EXPECT_GT(off, 0.2);  // the aliased stream at full strength (0.5·sin: RMS 0.35)
+  EXPECT_LT(on, 0.03);  // faded: every texel lies above 0.45 kHz (5.62 cpm ± 0.32)
+  const CliRun bad = run("swipe " + narrow + " --band-limit maybe -o " + (dir / "b.wav").string());
+  EXPECT_EQ(bad.status, 2) << bad.out;
 }
 
 TEST_F(Cli, SwipeCsvAndPlot) {
