@@ -13,7 +13,7 @@ row per recording and model, then per model the bias, the median and the 90th
 percentile of the |error|, and how many estimates ended at a search bound.
 
     scripts/felt_band_recordings.py FOLDER [--texel build/apps/texel/texel]
-        [--models 2 3] [--speed 100] [--device tpad] [--band 20 1000]
+        [--models 2 3] [--speed 100] [--device tpad] [--band 20 1000] [--target automatic]
 
 No data ships with Texel; the recordings stay where they are (the script
 writes only to a temporary directory).
@@ -83,6 +83,7 @@ def main():
     ap.add_argument("--speed", type=float, default=100.0)
     ap.add_argument("--device", default="tpad")
     ap.add_argument("--band", type=float, nargs=2, default=[20.0, 1000.0])
+    ap.add_argument("--target", default="automatic", help="texel encode --target: automatic (centroid for .wav), felt, centroid")
     a = ap.parse_args()
     files = sorted(f for f in os.listdir(a.folder) if f.lower().endswith(".wav"))
     if not files:
@@ -101,7 +102,7 @@ def main():
                 bit = os.path.join(tmp, "x.texel")
                 doc = os.path.join(tmp, "x.texel.json")
                 out = os.path.join(tmp, "swipe.wav")
-                enc = run([a.texel, "encode", path, "--swipe-speed", str(a.speed), "--model", str(m), "--channel", "mix",
+                enc = run([a.texel, "encode", path, "--swipe-speed", str(a.speed), "--model", str(m), "--channel", "mix", "--target", a.target,
                            "-o", bit, "--json"])
                 j = json.loads(enc.stdout)
                 run([a.texel, "decode", bit, "--device", a.device, "-o", doc])
