@@ -5,7 +5,8 @@ docs/encoder.md §2 ("Version 3", "Real recordings") describes the measure:
 each recording (.wav, a vibration or sound of a tool or finger dragged over a
 surface) is encoded at a nominal swipe speed (`texel encode REC.wav
 --swipe-speed 100 --model M`), decoded for the tpad (`texel decode --device
-tpad`), swiped at the same speed (`texel swipe --speed 100 --rate 44100`),
+tpad`), swiped at the same speed over one stroke (`texel swipe --speed 100
+--rate 44100 --duration 1`),
 and the log-spectral centroid of the swiped vibration in 20–1000 Hz (power-
 weighted mean of 10·log10 f, dB re 1 Hz; Welch, Hann, 4096-sample segments,
 half overlap) is compared with the recording's in the same band. Prints one
@@ -13,7 +14,7 @@ row per recording and model, then per model the bias, the median and the 90th
 percentile of the |error|, and how many estimates ended at a search bound.
 
     scripts/felt_band_recordings.py FOLDER [--texel build/apps/texel/texel]
-        [--models 2 3] [--speed 100] [--device tpad] [--band 20 1000] [--target automatic]
+        [--models 2 3] [--speed 100] [--device tpad] [--band 20 1000] [--duration 1] [--target automatic]
 
 No data ships with Texel; the recordings stay where they are (the script
 writes only to a temporary directory).
@@ -83,6 +84,9 @@ def main():
     ap.add_argument("--speed", type=float, default=100.0)
     ap.add_argument("--device", default="tpad")
     ap.add_argument("--band", type=float, nargs=2, default=[20.0, 1000.0])
+    ap.add_argument("--duration", type=float, default=1.0,
+                    help="swipe length, s: one stroke (the tpad's 101.76 mm take 1.02 s at 100 mm/s; a longer swipe jumps "
+                         "back to the start, and that step lowers the centroid by about 1.5 dB)")
     ap.add_argument("--target", default="automatic", help="texel encode --target: automatic (centroid for .wav), felt, centroid")
     a = ap.parse_args()
     files = sorted(f for f in os.listdir(a.folder) if f.lower().endswith(".wav"))
@@ -106,8 +110,8 @@ def main():
                            "-o", bit, "--json"])
                 j = json.loads(enc.stdout)
                 run([a.texel, "decode", bit, "--device", a.device, "-o", doc])
-                run([a.texel, "swipe", doc, "-o", out, "--speed", str(a.speed), "--rate", str(rate), "--wav-format",
-                     "float"])
+                run([a.texel, "swipe", doc, "-o", out, "--speed", str(a.speed), "--rate", str(rate), "--duration",
+                     str(a.duration), "--wav-format", "float"])
                 y, yr = read_wav(out)
                 got = log_centroid_db(y, yr, lo, hi)
                 e = got - ref
