@@ -11,7 +11,10 @@
 // that keep every trend, predict the one left out. Prints the Markdown table
 // of docs/encoder.md.
 //
-//   texel_fit_model [--quick]   (--quick: the chosen candidate's grid only)
+//   texel_fit_model [--quick | --felt-band]
+//     --quick: version 2's grid only; --felt-band: version 2's grid and
+//     version 3's (the felt band, docs/encoder.md §2 "Version 3") at felt
+//     band tops of 1, 1.2 and 1.5 kHz.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -122,7 +125,8 @@ std::string fmt(double v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  const bool felt_band = argc > 1 && std::string(argv[1]) == "--felt-band";
+  const bool quick = felt_band || (argc > 1 && std::string(argv[1]) == "--quick");
   const auto sig = signals();
   std::vector<Family> fam;
   using W = PerceptualModel::Weighting;
@@ -155,6 +159,19 @@ int main(int argc, char** argv) {
     for (double s : {0.0, 0.5, 1.0})
       for (double g : {1.0, 2.0, 3.0, 4.0}) o.grid.push_back(point("s " + fmt(s) + ", γ " + fmt(g), v2(W::power, s, g, 1.0)));
     fam.push_back(o);
+  }
+  if (felt_band) {
+    for (double top : {1000.0, 1200.0, 1500.0}) {
+      Family o{"version 3: version 2 within the felt band, top " + fmt(top / 1000.0) + " kHz (s, γ)", {}};
+      for (double s : {0.0, 0.5, 1.0})
+        for (double g : {1.0, 2.0, 3.0, 4.0}) {
+          PerceptualModel m = v2(W::power, s, g, 1.0);
+          m.version = 3;
+          m.felt_band_top = Hertz(top);
+          o.grid.push_back(point("s " + fmt(s) + ", γ " + fmt(g), m));
+        }
+      fam.push_back(o);
+    }
   }
   if (!quick) {
     Family a{"suprathreshold contours flatter below 250 Hz, ⅓-octave bands (s_low, s, γ)", {}};

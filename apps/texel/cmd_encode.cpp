@@ -308,7 +308,8 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
   cmd->add_option("--model", a->model,
-                  "Perceptual model version: 2 (calibrated against people's matches) or 1 (the model before) [2]")
+                  "Perceptual model version: 2 (calibrated against people's matches), 3 (version 2 within the felt band: "
+                  "nothing above 1 kHz at the swipe speed is felt) or 1 (the model before) [2]")
       ->group(g);
   cmd->add_option("--weight-exponent", a->weight_exponent,
                   "Perceptual model: exponent of a component's felt weight [the model version's]")
@@ -391,6 +392,7 @@ void register_encode(CLI::App& app) {
     const codec::EncoderConfig cfg = config_of(*a);
     const Signal sig = load_input(a->inputs[0], a->input);
     const codec::EncodeResult r = codec::encode(codec::encoder_signal(sig), cfg);
+    for (const auto& w : r.warnings) std::cerr << "texel: warning: " << w << "\n";
     if (a->output) write_file_atomic(*a->output, std::string_view(reinterpret_cast<const char*>(r.bytes.data()), r.bytes.size()));
     if (a->json)
       print_json(result_json(a->inputs[0], sig, r, a->output));

@@ -76,8 +76,10 @@ Signal encoder_signal(const texel::Signal& signal);
 struct PerceptualModel {
   /// Which model (docs/encoder.md §2, "Model versions"): 2 [default] the
   /// band model calibrated against people's matches; 1 the model before
-  /// (per-bin weighting). Each version's defaults: model_defaults(version).
-  /// Named in every EncodeResult and `--json` ("model_version").
+  /// (per-bin weighting); 3 version 2 within the felt band (nothing above
+  /// felt_band_top is felt, at any level). Each version's defaults:
+  /// model_defaults(version). Named in every EncodeResult and `--json`
+  /// ("model_version").
   int version = 2;
   MmPerSecond swipe_speed{100.0};  ///< mm/s; turns cycles/mm into Hz (typical exploration 50 … 200 mm/s)
   double pitch_jnd_db = 1.0;       ///< just-noticeable pitch change, dB (≈ 25 % frequency)
@@ -130,6 +132,12 @@ struct PerceptualModel {
   /// Also measure Percept::log_centroid_db (the encoder's centroid target
   /// sets it; off, the field stays 0 and perceiving costs nothing more).
   bool centroid = false;
+  /// The top of the felt band (docs/encoder.md §2, "Version 3"), Hz at the
+  /// swipe speed: version 3 gives content above it no weight at any level
+  /// (felt, drawn, the physical tie-break and the centroid target alike).
+  /// Every version reports the input's power above it
+  /// (EncodeResult::beyond_felt_band). [choice] 1000 Hz; > 0.
+  Hertz felt_band_top{1000.0};
 };
 
 /// The log-spectral centroid's band (Percept::log_centroid_db): from
@@ -138,7 +146,7 @@ struct PerceptualModel {
 inline constexpr double centroid_low_hz = 20.0;
 inline constexpr double centroid_top_nyquist = 0.9;
 
-/// The defaults of model `version` (1 or 2; InvalidArgument otherwise):
+/// The defaults of model `version` (1, 2 or 3; InvalidArgument otherwise):
 /// version 1 is the model before, bit for bit.
 PerceptualModel model_defaults(int version);
 std::string_view to_string(PerceptualModel::Weighting w);
@@ -157,6 +165,13 @@ bool display_in_loop(const PerceptualModel& model);
 /// (12 dB/octave either side of 250 Hz) capped by a flat non-Pacinian floor
 /// 30 dB up and a 60 dB ceiling. Weight = 10^(−threshold/20).
 double threshold_db(Hertz f);
+/// Version 3's threshold (docs/encoder.md §2, "Version 3"): threshold_db's
+/// U below 250 Hz (its non-Pacinian floor kept), the Pacinian branch rising
+/// 12 dB/octave above 250 Hz without a cap, and +infinity (no sensitivity)
+/// above `top`, the felt band's top.
+double felt_threshold_db(Hertz f, Hertz top);
+/// The felt band's top in cycles/mm at the model's swipe speed.
+CyclesPerMm felt_band_top_cpm(const PerceptualModel& model);
 
 /// What the model extracts from a fine-texture signal.
 struct Percept {
@@ -273,6 +288,16 @@ struct EncodeResult {
   } at_bound;
   /// The target the fit matched (felt or centroid; never automatic).
   EncoderConfig::Target target = EncoderConfig::Target::felt;
+  /// Share (0 … 1) of the input's power (its zero-mean amplitude, every
+  /// frequency) above the felt band's top (PerceptualModel::felt_band_top at
+  /// the model's swipe speed): airborne sound, a sensor's resonance, or
+  /// texture too fine to be felt at that speed. Reported by every model
+  /// version; only version 3 gives that content no weight.
+  double beyond_felt_band = 0.0;
+  /// Things the user should know about the result, one sentence each
+  /// (e.g. an input dominated by content above the felt band: more than
+  /// half its power); the CLI prints each as "texel: warning: …".
+  std::vector<std::string> warnings;
   int evaluations = 0;
   double seconds = 0.0;
   std::size_t samples = 0;

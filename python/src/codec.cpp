@@ -160,7 +160,12 @@ Raises InvalidArgument when the source is sample data or not one Texel texture o
       .def_property_readonly("decoded_percept", [](const codec::EncodeResult& r) { return percept_dict(r.decoded); })
       .def_readonly("distance_jnd", &codec::EncodeResult::model_distance, "Model distance input ↔ decoded (JND units).")
       .def_readonly("model_distance", &codec::EncodeResult::model_distance, "Old name of distance_jnd (kept for a release).")
-      .def_readonly("model_version", &codec::EncodeResult::model_version, "The perceptual model that decided (1 or 2).")
+      .def_readonly("model_version", &codec::EncodeResult::model_version, "The perceptual model that decided (1, 2 or 3).")
+      .def_readonly("beyond_felt_band", &codec::EncodeResult::beyond_felt_band,
+                    "Share (0 … 1) of the input's power above the felt band (1 kHz at the model's swipe speed).")
+      .def_readonly("warnings", &codec::EncodeResult::warnings,
+                    "What the user should know about the result, one sentence each (e.g. an input dominated by "
+                    "content above the felt band).")
       .def_property_readonly(
           "target", [](const codec::EncodeResult& r) { return std::string(codec::to_string(r.target)); },
           "What Central Pitch matched: 'felt' or 'centroid' (never 'automatic').")
@@ -248,7 +253,8 @@ display_response  'device': the model feels the texture through the device's fre
                   has none), or 'flat': as drawn ['device']
 drawn_weight      weight of the texture as drawn beside the displayed one in the fit (0: the display
                   alone) [1]
-model             perceptual model version: 2, or 1 (the model before) [2]
+model             perceptual model version: 2, 3 (version 2 within the felt band) or 1 (the model
+                  before) [2]
 no_texture        an input without texture: 'flag' (a flat surface, result.no_texture) or 'refuse'
                   (InvalidArgument) ['flag']
 target            what Central Pitch matches: 'felt' (the model's felt pitch), 'centroid' (the input's

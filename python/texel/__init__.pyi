@@ -159,6 +159,8 @@ class EncodeResult:
     model_distance: float  # old name of distance_jnd
     model_version: int
     target: Literal["felt", "centroid"]
+    beyond_felt_band: float
+    warnings: list[str]
     no_texture: bool
     at_bound: dict[str, bool]
     def to_json(self) -> str: ...

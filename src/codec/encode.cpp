@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "encoder_parts.hpp"
@@ -50,6 +51,8 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     if (!std::isfinite(v)) throw InvalidArgument("the input holds a non-finite value");
   std::vector<double> a = signal.amplitude;
   for (double& v : a) v = std::clamp(v, 0.0, 1.0);
+  if (!(cfg.model.felt_band_top.value() > 0.0 && std::isfinite(cfg.model.felt_band_top.value())))
+    throw FieldError("felt_band_top", "is " + num(cfg.model.felt_band_top.value()) + " Hz; it must be > 0");
 
   EncodeResult res;
   res.samples = n;
@@ -71,6 +74,24 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     if (res.no_texture && cfg.no_texture == EncoderConfig::NoTexture::refuse)
       throw InvalidArgument("the input has no texture: its variation (RMS " + num(res.texture_rms) + ") is at most " +
                             num(no_texture_floor) + " of full scale (constant or all zero)");
+  }
+  // How much of the input lies above the felt band (docs/encoder.md §2,
+  // "Version 3"): reported whatever the model; more than half is flagged,
+  // since versions 1 and 2 weigh it and version 3 estimates from the rest.
+  if (!res.no_texture) {
+    const CyclesPerMm top = felt_band_top_cpm(cfg.model);
+    res.beyond_felt_band = power_share_above(a, dx, top.value());
+    if (res.beyond_felt_band > 0.5) {
+      std::string w = num(std::round(res.beyond_felt_band * 1000.0) / 10.0) +
+                      " % of the input's power lies above the felt band (" + num(cfg.model.felt_band_top.value()) + " Hz at " +
+                      num(cfg.model.swipe_speed.value()) + " mm/s, " + num(std::round(top.value() * 100.0) / 100.0) +
+                      " cycles/mm): airborne sound, a sensor resonance, or texture too fine to feel at this speed; ";
+      w += cfg.model.version == 3 ? "model 3 gives it no weight and estimates from the felt band"
+                                  : "model " + std::to_string(cfg.model.version) + " weighs it (model 3 does not)";
+      if (cfg.model.version == 3 && res.beyond_felt_band > 1.0 - 1e-6)
+        w += "; next to nothing is in the felt band, so the whole spectrum decided";
+      res.warnings.push_back(std::move(w));
+    }
   }
   // The band the decoded texture draws from: the analysed grid's Nyquist
   // frequency, rounded down to the stream's 0.01 dB steps (device independent).
@@ -100,6 +121,29 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     fit_cfg.target = signal.recording ? EncoderConfig::Target::centroid : EncoderConfig::Target::felt;
   res.target = fit_cfg.target;
   fit_cfg.model.centroid = fit_cfg.target == EncoderConfig::Target::centroid;
+
+  // Version 3 analyses what can be felt (docs/encoder.md §2, "Version 3"):
+  // the split, the strengths and the fit see the input without its content
+  // above the felt band, which would otherwise shape the envelope and the
+  // fine strength (a recording's airborne sound). A recording is scaled
+  // again as the loader scales one (a = 0.5 + 0.5·y/max|y|), so its felt
+  // part fills the range as it would recorded without that content. Texel
+  // renderings (recovered above from the samples themselves) and inputs
+  // with next to nothing in the felt band are analysed as they are.
+  const bool felt_only = cfg.model.version == 3 && !res.no_texture && !rec && !stepped && res.beyond_felt_band > 1e-4 &&
+                         res.beyond_felt_band < 1.0 - 1e-6;
+  if (felt_only) {
+    lowpass_felt(a, dx, felt_band_top_cpm(cfg.model).value());
+    if (signal.recording) {
+      double mean = 0.0, peak = 0.0;
+      for (double v : a) mean += v;
+      mean /= static_cast<double>(n);
+      for (double v : a) peak = std::max(peak, std::fabs(v - mean));
+      if (peak > 0.0)
+        for (double& v : a) v = 0.5 + 0.5 * (v - mean) / peak;
+    }
+    for (double& v : a) v = std::clamp(v, 0.0, 1.0);
+  }
 
   Split sp = split(a, dx, fit_cfg,
                    rec                         ? SplitMode::fine_only
@@ -143,6 +187,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     std::vector<double> r(n);
     fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
         .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, r);
+    if (felt_only) lowpass_felt(r, dx, felt_band_top_cpm(cfg.model).value());  // compared as the input is
     const Split own = split(r, dx, fit_cfg);
     const double shape = shape_distance_db(a, r, dx);
     if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {
@@ -237,8 +282,11 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   // bent to make up for.
   double below = 0.0;
   const double v = fit_cfg.model.swipe_speed.value();
+  // Version 3: the felt band (the whole band when next to nothing is in it, as the model does).
+  const double centroid_top =
+      res.beyond_felt_band > 1.0 - 1e-6 ? std::numeric_limits<double>::infinity() : centroid_top_cpm(fit_cfg.model);
   const double goal = fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered
-                          ? log_centroid_db(a, dx, v, 1.0 / cfg.boundary.value(), &below)
+                          ? log_centroid_db(a, dx, v, 1.0 / cfg.boundary.value(), &below, centroid_top)
                           : 0.0;
   if (fit_cfg.target == EncoderConfig::Target::centroid && has_fine && !recovered && below < 0.5) {
     std::vector<double> d(n);
@@ -249,7 +297,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
       res.spec = to_spec(res.bitstream);
       TexelTexture(res.spec, Millimetres(len), Sampling{Grid{Millimetres(0.0), Millimetres(dx), 0}, band_max})
           .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, d);
-      return log_centroid_db(d, dx, v);
+      return log_centroid_db(d, dx, v, 0.0, nullptr, centroid_top);
     };
     const Box box = fit_box(fit_cfg, band_max);
     const auto lo = static_cast<std::int16_t>(std::ceil(box.p_lo * 100.0)),

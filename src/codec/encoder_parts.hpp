@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -46,7 +47,20 @@ double shape_distance_db(const std::vector<double>& x, const std::vector<double>
 /// The log-spectral centroid of a whole signal (its mean removed), dB re
 /// 1 cpm: Percept::log_centroid_db's band and weighting at swipe speed v.
 /// `below`, if given, receives the share of the whole spectrum's power under f_split (cpm).
-double log_centroid_db(std::span<const double> x, double dx, double v, double f_split = 0.0, double* below = nullptr);
+/// The band ends at `top_cpm` if lower (version 3: the felt band's top).
+double log_centroid_db(std::span<const double> x, double dx, double v, double f_split = 0.0, double* below = nullptr,
+                       double top_cpm = std::numeric_limits<double>::infinity());
+/// Share (0 … 1) of the power of x (its mean removed) above f_cpm.
+double power_share_above(std::span<const double> x, double dx, double f_cpm);
+/// x without its content above the felt band (version 3's analysis signal,
+/// docs/encoder.md §2 "Version 3"): zero-phase, gain 1 up to top_cpm and a
+/// raised cosine to 0 at 1.2 × top_cpm, the mean kept.
+void lowpass_felt(std::vector<double>& x, double dx, double top_cpm);
+/// The top of the log-spectral centroid's band for `model`, cpm: the felt
+/// band's top under version 3, else none (infinite).
+inline double centroid_top_cpm(const PerceptualModel& model) {
+  return model.version == 3 ? felt_band_top_cpm(model).value() : std::numeric_limits<double>::infinity();
+}
 
 // --- split.cpp -------------------------------------------------------------------
 

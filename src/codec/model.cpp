@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "encoder_parts.hpp"
@@ -79,13 +80,27 @@ double threshold_db(Hertz f) {
   return std::min({pacinian, 30.0, 60.0});
 }
 
+double felt_threshold_db(Hertz f, Hertz top) {
+  const double hz = std::max(f.value(), 1e-6);
+  if (hz > top.value()) return std::numeric_limits<double>::infinity();
+  // Below 250 Hz the non-Pacinian floor holds (version 2's curve); above it
+  // the Pacinian branch keeps rising: no floor where nothing else is felt.
+  if (hz < 250.0) return std::min(12.0 * std::log2(250.0 / hz), 30.0);
+  return 12.0 * std::log2(hz / 250.0);
+}
+
+CyclesPerMm felt_band_top_cpm(const PerceptualModel& model) {
+  return CyclesPerMm(model.felt_band_top.value() / model.swipe_speed.value());
+}
+
 namespace {
 
 /// Percept::log_centroid_db of a power spectrum `p` whose bins are at
-/// frequencies `f` (cpm) and levels `d` (dB), on a grid of spacing dx.
+/// frequencies `f` (cpm) and levels `d` (dB), on a grid of spacing dx, at
+/// most up to `top` cpm (version 3: the felt band's top).
 double log_centroid(const std::vector<double>& p, const std::vector<double>& f, const std::vector<double>& d, double dx, double v,
-                    double f_lo) {
-  const double lo = std::max(f_lo, centroid_low_hz / v), hi = centroid_top_nyquist * 0.5 / dx;
+                    double f_lo, double top = std::numeric_limits<double>::infinity()) {
+  const double lo = std::max(f_lo, centroid_low_hz / v), hi = std::min(centroid_top_nyquist * 0.5 / dx, top);
   double sp = 0.0, spd = 0.0;
   for (std::size_t i = 1; i < p.size(); ++i)
     if (f[i] >= lo && f[i] <= hi) sp += p[i], spd += p[i] * d[i];
@@ -301,11 +316,36 @@ double pacinian_db(double hz) { return std::min(12.0 * std::fabs(std::log2(std::
 /// (suprathreshold-scaled) threshold at its centre, the band's felt weight a
 /// function of that level (PerceptualModel::weighting), and felt pitch the
 /// weighted mean of the bands' log-frequency centroids.
-Percept perceive_v2(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
+/// Version 3 (`felt_band`): the same within the felt band only (bins up to
+/// PerceptualModel::felt_band_top at the model's speed; felt_threshold_db):
+/// felt, drawn and physical sums, the masking peak and the centroid. An
+/// input with next to nothing in the felt band (under 10⁻⁶ of its power)
+/// cannot be felt at this speed; its whole spectrum is then weighed by the
+/// Pacinian branch without the band's edge, so the fit stays defined.
+Percept perceive_v2(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm,
+                    bool felt_band = false) {
   std::size_t m = 0;
   thread_local std::vector<double> p;
   power_spectrum(fine, p, m);
   const double v = model.swipe_speed.value();
+  // Version 3: the felt band's top, cpm (infinite: every bin, version 2).
+  double top_cpm = felt_band ? model.felt_band_top.value() / v : std::numeric_limits<double>::infinity();
+  if (felt_band) {
+    // Nothing in the felt band (less than 10⁻⁶ of the power above f_min):
+    // the whole spectrum, weighed by the Pacinian branch without the edge.
+    const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
+    const double lo = std::max(0.01, f_min_cpm);
+    double in = 0.0, all = 0.0;
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      const double f = static_cast<double>(i) * df;
+      if (f < lo) continue;
+      all += p[i];
+      if (f <= top_cpm) in += p[i];
+    }
+    if (!(in > 1e-6 * all)) top_cpm = std::numeric_limits<double>::infinity();
+  }
+  const Hertz top_hz(top_cpm * v);
+  auto threshold = [&](double hz) { return felt_band ? felt_threshold_db(Hertz(hz), top_hz) : threshold_db(Hertz(hz)); };
   const double f_lo = std::max(0.01, f_min_cpm);
   const bool display = display_in_loop(model);
   const double corner = display ? model.display.corner.value() : 0.0;
@@ -313,8 +353,9 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   const double b = model.band_octaves;
   struct Bins {
     std::size_t m = 0;
-    double dx = 0, v = 0, f_min = 0, b = 0, corner = 0;
+    double dx = 0, v = 0, f_min = 0, b = 0, corner = 0, top = 0;
     int order = 0;
+    std::size_t n = 0;  // bins [first, n) are analysed: up to the felt band's top (version 3), else all
     std::vector<double> f, d, h2;
     std::vector<int> band;  // band of each bin (−1: below f_min)
     std::vector<double> centre_hz;
@@ -324,20 +365,22 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   thread_local std::array<Bins, 4> cache;
   thread_local std::size_t replace = 0;
   auto same = [&](const Bins& x) {
-    return x.m == m && x.dx == spacing_mm && x.v == v && x.f_min == f_lo && x.b == b && x.corner == corner && x.order == order;
+    return x.m == m && x.dx == spacing_mm && x.v == v && x.f_min == f_lo && x.b == b && x.corner == corner && x.order == order &&
+           x.top == top_cpm;
   };
   auto hit = std::find_if(cache.begin(), cache.end(), same);
   if (hit == cache.end()) {
     if (display) validate(model.display, "display");
     Bins& x = cache[replace];
     replace = (replace + 1) % cache.size();
-    x.m = m, x.dx = spacing_mm, x.v = v, x.f_min = f_lo, x.b = b, x.corner = corner, x.order = order;
+    x.m = m, x.dx = spacing_mm, x.v = v, x.f_min = f_lo, x.b = b, x.corner = corner, x.order = order, x.top = top_cpm;
     const double df = 1.0 / (static_cast<double>(m) * spacing_mm);
     x.f.assign(p.size(), 0.0);
     x.d.assign(p.size(), 0.0);
     x.h2.assign(p.size(), 1.0);
     x.band.assign(p.size(), -1);
     x.first = p.size();
+    x.n = p.size();
     // Band k is centred at 250 Hz · 2^((k + k0)·b) at the model's speed.
     const auto index = [&](double f) { return static_cast<int>(std::floor(std::log2(f * v / 250.0) / b + 0.5)); };
     const int k0 = index(f_lo);
@@ -347,16 +390,17 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
       x.d[i] = db_of(f);
       const double h = display ? model.display.gain(Hertz(f * v)) : 1.0;
       x.h2[i] = h * h;
-      if (f < f_lo) continue;
+      if (f > top_cpm && x.n == p.size()) x.n = i;
+      if (f < f_lo || i >= x.n) continue;
       x.band[i] = index(f) - k0;
       x.first = std::min(x.first, i);
     }
-    const int bands = x.first < p.size() ? x.band.back() + 1 : 0;
+    const int bands = x.first < x.n ? x.band[x.n - 1] + 1 : 0;
     x.centre_hz.resize(static_cast<std::size_t>(bands));
     for (int k = 0; k < bands; ++k) x.centre_hz[static_cast<std::size_t>(k)] = 250.0 * std::exp2((k + k0) * b);
     // The band index never falls with frequency: each band is one run of bins.
     x.end.assign(static_cast<std::size_t>(bands), x.first);
-    for (std::size_t i = x.first; i < p.size(); ++i) x.end[static_cast<std::size_t>(x.band[i])] = i + 1;
+    for (std::size_t i = x.first; i < x.n; ++i) x.end[static_cast<std::size_t>(x.band[i])] = i + 1;
     for (std::size_t k = 1; k < x.end.size(); ++k) x.end[k] = std::max(x.end[k], x.end[k - 1]);
     hit = cache.begin() + static_cast<std::ptrdiff_t>(&x - cache.data());
   }
@@ -374,7 +418,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   drawn.reset(display ? bands : 0);
   // The peaks (a maximum does not depend on the order it is taken in).
   double peak = 0.0, peak_felt = 0.0;
-  band_peaks()(p.data(), x.h2.data(), x.first, p.size(), peak, peak_felt);
+  band_peaks()(p.data(), x.h2.data(), x.first, x.n, peak, peak_felt);
   const double floor = peak * std::pow(10.0, -masked_db / 10.0);
   const double floor_felt = peak_felt * std::pow(10.0, -masked_db / 10.0);
   double physical[4];  // sp, spf, spd, spdd
@@ -390,8 +434,10 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
     w.assign(bands, 0.0);
     // Sensation levels (dB, relative): band level above the scaled threshold.
     const double s_low = model.sensitivity_scale_low < 0.0 ? s : model.sensitivity_scale_low;
-    auto level = [&](std::size_t k, double threshold) {
-      return 10.0 * std::log10(u.e[k]) - (x.centre_hz[k] < 250.0 ? s_low : s) * threshold;
+    auto level = [&](std::size_t k, double t_db) {
+      // A band centred beyond the felt band (version 3) is not felt, whatever s (0 · ∞ is no level).
+      if (std::isinf(t_db)) return -std::numeric_limits<double>::infinity();
+      return 10.0 * std::log10(u.e[k]) - (x.centre_hz[k] < 250.0 ? s_low : s) * t_db;
     };
     double top = -1e300;
     for (std::size_t k = 0; k < bands; ++k) {
@@ -400,7 +446,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
       if (model.weighting == PerceptualModel::Weighting::channels)
         top = std::max({top, level(k, pacinian_db(hz)), level(k, non_pacinian_db(hz))});
       else
-        top = std::max(top, level(k, threshold_db(Hertz(hz))));
+        top = std::max(top, level(k, threshold(hz)));
     }
     if (model.weighting == PerceptualModel::Weighting::channels) {
       double jp = 0, jn = 0;
@@ -419,7 +465,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
     } else {
       for (std::size_t k = 0; k < bands; ++k) {
         if (!(u.e[k] > 0.0)) continue;
-        const double l = level(k, threshold_db(Hertz(x.centre_hz[k]))) - top;
+        const double l = level(k, threshold(x.centre_hz[k])) - top;
         w[k] = model.weighting == PerceptualModel::Weighting::equal ? 1.0 / (1.0 + std::exp(-(l + model.window_db) / 1.5))
                                                                     : std::pow(10.0, g * l / 20.0);
       }
@@ -440,7 +486,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   q.mean_db = db_of(spf / sp);
   const double pd = spd / sp;
   q.spread_db = std::sqrt(std::max(0.0, spdd / sp - pd * pd));
-  if (model.centroid) q.log_centroid_db = log_centroid(p, x.f, x.d, spacing_mm, v, f_lo);
+  if (model.centroid) q.log_centroid_db = log_centroid(p, x.f, x.d, spacing_mm, v, f_lo, top_cpm);
   q.drawn_pitch_db = q.pitch_db;
   q.drawn_noisiness_db = q.noisiness_db;
   if (display) pool(drawn, q.drawn_pitch_db, q.drawn_noisiness_db);
@@ -457,7 +503,11 @@ PerceptualModel model_defaults(int version) {
     m.sensitivity_scale = 0.5;
     return m;
   }
-  if (version != 2) throw FieldError("model", "is " + std::to_string(version) + "; allowed: 1, 2");
+  if (version == 3) {
+    m.version = 3;
+    return m;
+  }
+  if (version != 2) throw FieldError("model", "is " + std::to_string(version) + "; allowed: 1, 2, 3");
   return m;
 }
 
@@ -471,10 +521,13 @@ std::string_view to_string(PerceptualModel::Weighting w) {
 
 Percept perceive(std::span<const double> fine, double spacing_mm, const PerceptualModel& model, double f_min_cpm) {
   if (model.version == 1) return perceive_v1(fine, spacing_mm, model, f_min_cpm);
-  if (model.version != 2) throw FieldError("model", "is " + std::to_string(model.version) + "; allowed: 1, 2");
+  if (model.version != 2 && model.version != 3)
+    throw FieldError("model", "is " + std::to_string(model.version) + "; allowed: 1, 2, 3");
   if (!(model.band_octaves >= 0.05 && model.band_octaves <= 2.0))
     throw FieldError("band_octaves", "is " + num(model.band_octaves) + "; allowed: 0.05 … 2");
-  return perceive_v2(fine, spacing_mm, model, f_min_cpm);
+  if (model.version == 3 && !(model.felt_band_top.value() > 0.0 && std::isfinite(model.felt_band_top.value())))
+    throw FieldError("felt_band_top", "is " + num(model.felt_band_top.value()) + " Hz; it must be > 0");
+  return perceive_v2(fine, spacing_mm, model, f_min_cpm, model.version == 3);
 }
 
 double distance(const Percept& a, const Percept& b, const PerceptualModel& model) {

@@ -61,6 +61,12 @@ std::string to_json(const EncodeResult& r) {
     m["drawn_weight"] = r.model.drawn_weight;
   }
   j["model"] = m;
+  // The felt band (docs/encoder.md §2, "Version 3"): its top and the share
+  // of the input's power above it, whatever the model.
+  j["felt_band"] = {{"top_hz", r.model.felt_band_top.value()},
+                    {"top_cpm", felt_band_top_cpm(r.model).value()},
+                    {"power_beyond", r.beyond_felt_band}};
+  j["warnings"] = r.warnings;
   nlohmann::ordered_json z;
   z["bitstream_bytes"] = r.bytes.size();
   z["raw_u16_bytes"] = r.samples * 2;

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <complex>
 #include <memory>
+#include <numbers>
 #include <numeric>
 #include <vector>
 
 #include "../spectrum/fft.hpp"
 #include "encoder_parts.hpp"
+#include "texel/detail/detfft.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 
@@ -140,11 +142,11 @@ double shape_distance_db(const std::vector<double>& x, const std::vector<double>
   return num_ / den;
 }
 
-double log_centroid_db(std::span<const double> x, double dx, double v, double f_split, double* below) {
+double log_centroid_db(std::span<const double> x, double dx, double v, double f_split, double* below, double top_cpm) {
   std::size_t m = 0;
   const std::vector<double> p = power_spectrum(centred(x), m);
   const double df = 1.0 / (static_cast<double>(m) * dx);
-  const double lo = centroid_low_hz / v, hi = centroid_top_nyquist * 0.5 / dx;
+  const double lo = centroid_low_hz / v, hi = std::min(centroid_top_nyquist * 0.5 / dx, top_cpm);
   double sp = 0.0, spd = 0.0, all = 0.0, sb = 0.0;
   for (std::size_t i = 1; i < p.size(); ++i) {
     const double f = static_cast<double>(i) * df;
@@ -153,6 +155,43 @@ double log_centroid_db(std::span<const double> x, double dx, double v, double f_
   }
   if (below) *below = all > 0.0 ? sb / all : 0.0;
   return sp > 0.0 ? spd / sp : 0.0;
+}
+
+double power_share_above(std::span<const double> x, double dx, double f_cpm) {
+  std::size_t m = 0;
+  const std::vector<double> p = power_spectrum(centred(x), m);
+  const double df = 1.0 / (static_cast<double>(m) * dx);
+  double all = 0.0, above = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    all += p[i];
+    if (static_cast<double>(i) * df > f_cpm) above += p[i];
+  }
+  return all > 0.0 ? above / all : 0.0;
+}
+
+void lowpass_felt(std::vector<double>& x, double dx, double top_cpm) {
+  const std::size_t n = x.size();
+  std::size_t size = 2;
+  while (size < n) size <<= 1;
+  const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(n);
+  std::vector<double> re(size, 0.0), im(size, 0.0);
+  for (std::size_t i = 0; i < n; ++i) re[i] = x[i] - mean;
+  const texel::detail::DetFft fft(size);
+  fft.forward(re.data(), im.data());
+  // Gain 1 up to the top, a raised cosine to 0 at 1.2 × top (a brick wall
+  // would ring over the whole signal), 0 above; the same on the mirrored
+  // half, so the result is real. The percept already stops at the top.
+  const double df = 1.0 / (static_cast<double>(size) * dx);
+  for (std::size_t k = 0; k <= size / 2; ++k) {
+    const double f = static_cast<double>(k) * df;
+    const double u = (f - top_cpm) / (0.2 * top_cpm);
+    const double g = u <= 0.0 ? 1.0 : u >= 1.0 ? 0.0 : 0.5 + 0.5 * std::cos(std::numbers::pi * u);
+    re[k] *= g, im[k] *= g;
+    if (k != 0 && k != size / 2) re[size - k] *= g, im[size - k] *= g;
+  }
+  fft.inverse(re.data(), im.data());
+  const double scale = 1.0 / static_cast<double>(size);
+  for (std::size_t i = 0; i < n; ++i) x[i] = mean + re[i] * scale;
 }
 
 }  // namespace texel::codec::parts

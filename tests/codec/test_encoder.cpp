@@ -542,7 +542,13 @@ TEST(ModelVersions, VersionOneStaysSelectableAndIsNamedInTheResult) {
   const EncodeResult b = encode_reference("2sin", v2);
   EXPECT_EQ(b.model_version, 2);
   EXPECT_EQ(PerceptualModel{}.version, 2);
-  EXPECT_THROW((void)model_defaults(3), InvalidArgument);
+  // Version 3 (the felt band, tests/codec/test_felt_band.cpp) is selectable
+  // and named; a version that does not exist is refused.
+  EncoderConfig v3;
+  v3.model = model_defaults(3);
+  v3.model.display = load_device("tpad").response;
+  EXPECT_EQ(encode_reference("2sin", v3).model_version, 3);
+  EXPECT_THROW((void)model_defaults(4), InvalidArgument);
   EncoderConfig bad;
   bad.model.version = 7;
   EXPECT_THROW((void)encode_reference("2sin", bad), InvalidArgument);
