@@ -341,13 +341,13 @@ void list_sessions(const std::string& db, bool as_json, const std::optional<std:
     print_json(arr);
     return;
   }
-  std::printf("%-4s %-12s %-20s %-10s %-12s %s\n", "id", "participant", "protocol", "status", "trials", "updated");
+  std::printf("%-4s %-12s %-20s %-10s %-12s %s\n", "id", "participant", "protocol", "state", "trials", "updated");
   for (const auto& s : arr) {
     const int planned = s["trials_planned"].get<int>();
     const std::string trials = std::to_string(s["trials_done"].get<int>()) + (planned > 0 ? "/" + std::to_string(planned) : "");
     std::printf("%-4lld %-12s %-20s %-10s %-12s %s\n", static_cast<long long>(s["id"].get<std::int64_t>()),
                 s["participant"].get<std::string>().c_str(), s["protocol"].get<std::string>().c_str(),
-                s["status"].get<std::string>().c_str(), trials.c_str(), s["updated_at"].get<std::string>().c_str());
+                s["state"].get<std::string>().c_str(), trials.c_str(), s["updated_at"].get<std::string>().c_str());
   }
 }
 
@@ -363,7 +363,7 @@ void status(const std::string& db, bool as_json, const std::optional<std::string
             << sessions.size() << " sessions\n";
   for (const auto& s : sessions) {
     std::cout << "  session " << s["id"] << " " << s["participant"].get<std::string>() << " " << s["protocol"].get<std::string>()
-              << " [" << s["status"].get<std::string>() << "] " << s["trials_done"] << " trials\n";
+              << " [" << s["state"].get<std::string>() << "] " << s["trials_done"] << " trials\n";
     for (auto it = s["blocks"].begin(); it != s["blocks"].end(); ++it) {
       std::cout << "    " << it.key() << ": " << it.value()["trials"] << " trials";
       if (it.value().contains("current_value"))

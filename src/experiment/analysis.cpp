@@ -22,23 +22,15 @@
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
+#include "analysis_figures.hpp"
 #include "json_views.hpp"
 #include "studies.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/stats.hpp"
+#include "texel/io.hpp"
 
 namespace texel::experiment {
-
-// Figures of one study from its summary (as analyze() builds it) and its
-// non-practice rows; writes into options.out_dir and returns the paths.
-// Defined in analysis_figures.cpp; declared in both files rather than in the
-// public header, which keeps a second `detail` namespace out of
-// texel::experiment (it would hide texel::detail from unqualified lookups).
-namespace analysis_figures {
-std::vector<std::string> study_figures(const Study& study, const nlohmann::ordered_json& summary,
-                                       const std::vector<const TrialRow*>& rows, const AnalysisOptions& options);
-}  // namespace analysis_figures
 
 namespace {
 
@@ -209,7 +201,10 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
   out["variable"] = rows.empty() ? std::string() : rows.front()->variable;
   out["reversals_k"] = o.reversals_k;
   out["convergent_rule"] = o.convergent;
-  json runs = json::array();
+  json runs = json::array(), unfinished = json::array();
+  // Every run that stopped before its stopping rule is named first, so the
+  // reader meets the warning before the numbers.
+  std::string run_text;
   Ordered blocks;
   // group (block, or for texel length the block's condition) → participant → values
   std::map<std::string, std::map<std::string, std::vector<double>>> conv, thr;
@@ -232,7 +227,12 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     // The source's end value is the last one presented; "next" takes the one
     // computed after the last answer (falling back to the last presented
     // when it was not stored).
-    const double convergent = o.convergent == "next" && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
+    const double end_value = o.convergent == "next" && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
+    // A run that stopped before its stopping rule has an end value but no
+    // convergent value: it is reported "not finished" and kept out of the
+    // group statistics unless asked (AnalysisOptions::include_unfinished).
+    const bool finished = std::any_of(run.rows.begin(), run.rows.end(), [](const TrialRow* r) { return r->procedure_finished; });
+    const bool counted = finished || o.include_unfinished;
     const std::size_t used = std::min(o.reversals_k, rev.size());
     std::vector<double> tail(rev.end() - static_cast<std::ptrdiff_t>(used), rev.end());
     const double threshold = mean_of(tail);
@@ -244,29 +244,45 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
       j["group"] = group;
     }
     j["trials"] = run.rows.size();
-    j["finished"] = last.procedure_finished;
+    j["finished"] = finished;
+    j["status"] = finished ? "finished" : "not finished";
+    j["in_group_statistics"] = counted;
     j["reversals"] = rev.size();
     j["reversal_intensities"] = rev;
-    j["convergent"] = num(convergent);
-    j["threshold_last_k"] = num(threshold);
+    j["end_value"] = num(end_value);
+    j["convergent"] = finished ? num(end_value) : json(nullptr);
+    j["threshold_last_k"] = finished ? num(threshold) : json(nullptr);
     j["threshold_reversals_used"] = used;
     if (!coarse) {
       j["directional_proportion"] = num(dir);
       j["swipe_mean_speed_mm_s"] = num(speed);
       j["swipe_sd_speed_mm_s"] = num(speed_sd);
+    }
+    if (!finished) {
+      run_text += "  " + run.participant + " " + run.block + " (session " + std::to_string(run.session_id) +
+                  "): not finished, stopped after " + std::to_string(run.rows.size()) + " trials with " +
+                  std::to_string(rev.size()) + " reversals; its end value " + fmt(end_value) + " is no convergent value" +
+                  (counted ? " (in the group statistics: include_unfinished)\n" : "; left out of the group statistics\n");
+      unfinished.push_back(json{{"participant", run.participant}, {"session_id", run.session_id}, {"block", run.block}});
+    }
+    runs.push_back(std::move(j));
+    if (!counted) continue;
+    if (!coarse) {
       swipe[0][group][run.participant].push_back(speed);
       swipe[1][group][run.participant].push_back(speed_sd);
       swipe[2][group][run.participant].push_back(dir);
     }
-    runs.push_back(std::move(j));
-    conv[group][run.participant].push_back(convergent);
+    conv[group][run.participant].push_back(end_value);
     thr[group][run.participant].push_back(threshold);
   }
+  out["unfinished_runs"] = unfinished;
+  out["include_unfinished"] = o.include_unfinished;
   out["runs"] = runs;
   json bj = json::array();
   std::vector<stats::Observation> obs;
   std::map<std::string, std::map<std::string, double>> per_participant;  // group → participant → convergent
-  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + o.convergent + ")\n";
+  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + o.convergent + ")" +
+          (unfinished.empty() ? std::string() : ", " + std::to_string(unfinished.size()) + " not finished") + "\n" + run_text;
   for (const std::string& b : blocks.names) {
     std::vector<double> cv, tv;
     for (const auto& [p, v] : conv[b]) {
@@ -275,14 +291,19 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
       obs.push_back({p, {b}, cv.back()});
     }
     for (const auto& [p, v] : thr[b]) tv.push_back(mean_of(v));
+    std::size_t left_out = 0;
+    for (const auto& r : runs)
+      if (!r["in_group_statistics"].get<bool>() && (r.contains("group") ? r["group"] : r["block"]) == b) ++left_out;
     json e{{"block", b}};
     if (coarse) e["fine_strength"] = num(block_fine[b]);
     e["participants"] = cv.size();
+    e["unfinished_runs_left_out"] = left_out;
     e["convergent"] = describe_json(cv);
     e["threshold_last_k"] = describe_json(tv);
     const auto d = stats::describe(cv);
     text += "  " + b + ": convergent " + fmt(d.mean) + " ± " + fmt(d.sd) + " (mean ± SD, n = " + std::to_string(d.n) + ", " +
-            fmt(0.95 * 100, 0) + " % CI [" + fmt(d.ci95_low) + ", " + fmt(d.ci95_high) + "])\n";
+            fmt(0.95 * 100, 0) + " % CI [" + fmt(d.ci95_low) + ", " + fmt(d.ci95_high) + "])" +
+            (left_out ? ", " + std::to_string(left_out) + " unfinished run(s) left out" : std::string()) + "\n";
     bj.push_back(std::move(e));
   }
   out["blocks"] = bj;
@@ -523,6 +544,33 @@ json ratings_by_reference(const Rows& ratings) {
   return out;
 }
 
+/// The comparisons of two different references (the source's figure of
+/// parameter mapping): every rated pair of a reference felt against the
+/// match of another, both directions pooled, as "A vs B" (A first in the
+/// matches' order); per participant the mean of their ratings of the pair,
+/// described over participants.
+json reference_comparisons(const Rows& ratings, Ordered names, std::string& text) {
+  std::map<std::pair<std::size_t, std::size_t>, std::map<std::string, std::vector<double>>> v;  // pair → participant → ratings
+  for (const TrialRow* r : ratings) {
+    const std::string other = rendering_of(*r);
+    if (other == r->reference) continue;
+    std::size_t a = names.add(r->reference), b = names.add(other);
+    if (a > b) std::swap(a, b);
+    v[{a, b}][r->participant].push_back(r->rating);
+  }
+  json out = json::array();
+  for (const auto& [ab, per] : v) {
+    std::vector<double> m;
+    for (const auto& [p, x] : per) m.push_back(mean_of(x));
+    out.push_back(json{{"comparison", names.names[ab.first] + " vs " + names.names[ab.second]},
+                       {"a", names.names[ab.first]},
+                       {"b", names.names[ab.second]},
+                       {"rating", describe_json(m)}});
+  }
+  if (!out.empty()) text += "  " + std::to_string(out.size()) + " comparisons of two different references rated\n";
+  return out;
+}
+
 json match_study(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
   Rows matches, ratings;
   for (const TrialRow* r : rows) {
@@ -537,6 +585,7 @@ json match_study(const std::string& study, const Rows& rows, const AnalysisOptio
     Ordered names;
     for (const TrialRow* r : matches) names.add(r->reference);
     out["similarity"] = similarity_matrix(ratings, names, o, text);
+    if (study == "parameter-mapping") out["comparisons"] = reference_comparisons(ratings, names, text);
   }
   return out;
 }
@@ -667,12 +716,25 @@ json guided_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   Rows matches;
   json unfinished = json::array();
   for (const auto& k : order) {
-    matches.push_back(last[k]);
-    if (!last[k]->procedure_finished) unfinished.push_back(json{{"participant", std::get<0>(k)}, {"reference", std::get<2>(k)}});
+    // An unfinished run's estimate is no match: reported, and left out of
+    // the matches' statistics unless asked (include_unfinished).
+    const bool finished = last[k]->procedure_finished;
+    if (finished || o.include_unfinished) matches.push_back(last[k]);
+    if (!finished)
+      unfinished.push_back(json{{"participant", std::get<0>(k)},
+                                {"session_id", std::get<1>(k)},
+                                {"reference", std::get<2>(k)},
+                                {"status", "not finished"},
+                                {"in_group_statistics", o.include_unfinished}});
   }
   json out = json::object();
   matching_summary(matches, o, out, text, "guided-exploration");
-  if (!unfinished.empty()) out["unfinished"] = unfinished;
+  if (!unfinished.empty()) {
+    out["unfinished"] = unfinished;
+    text += "  " + std::to_string(unfinished.size()) + " guided run(s) not finished" +
+            (o.include_unfinished ? " (their last estimates are in the statistics: include_unfinished)\n"
+                                  : ", left out of the statistics\n");
+  }
   if (ratings.empty()) return out;
 
   out["similarity"] = similarity_matrix(ratings, names, o, text);
@@ -688,31 +750,37 @@ struct MemoryPerson {
 };
 using Excluded = std::map<std::string, std::string>;  // participant → reason
 
-/// The source's rule: main-task (same/different) errors more than k SDs
-/// above the group's mean, without any increase in distraction-task (digit
-/// recall) errors — read as: their distraction errors are not above the
-/// group's mean. Mean and SD over every participant, computed once.
-Excluded source_rule(const std::map<std::string, MemoryPerson>& people, double k, json& stats_out) {
+/// The source's rule: main-task (same/different) errors "near two standard
+/// deviations" or more above the group's mean, without any increase in
+/// distraction-task (digit recall) errors — read as: their distraction
+/// errors are not above the group's mean. Mean and SD over every
+/// participant, computed once. "Near" [choice]: z >= k − tolerance
+/// (memory_errors_limit), which reproduces the source's two exclusions from
+/// its own mean and SD (docs/analysis.md).
+Excluded source_rule(const std::map<std::string, MemoryPerson>& people, const AnalysisOptions& o, json& stats_out) {
+  const double k = o.memory_errors_sd;
   std::vector<double> main, distraction;
   for (const auto& [id, p] : people) {
     main.push_back(p.main_errors);
     if (!p.recall.empty()) distraction.push_back(p.distraction_errors);
   }
   const auto dm = stats::describe(main), dd = stats::describe(distraction);
-  const double limit = dm.mean + k * dm.sd;
+  const double limit = memory_errors_limit(dm.mean, dm.sd, o);
   stats_out = json{{"main_errors_mean", num(dm.mean)},
                    {"main_errors_sd", num(dm.sd)},
+                   {"main_errors_z_min", k - o.memory_errors_sd_tolerance},
                    {"main_errors_limit", num(limit)},
                    {"distraction_errors_mean", num(dd.mean)}};
   Excluded out;
   if (!(dm.sd > 0)) return out;
   for (const auto& [id, p] : people) {
-    if (!(p.main_errors > limit)) continue;
+    if (!(p.main_errors >= limit)) continue;
     // No recall data: no increase can be shown, so the main-task errors stand alone.
     const bool increase = !p.recall.empty() && std::isfinite(dd.mean) && p.distraction_errors > dd.mean;
     if (increase) continue;
-    out[id] = fmt(p.main_errors, 0) + " main-task errors > mean + " + fmt(k, 1) + " SD = " + fmt(limit) +
-              " without more distraction errors (" + fmt(p.distraction_errors, 0) + ") than the mean (" + fmt(dd.mean) + ")";
+    out[id] = fmt(p.main_errors, 0) + " main-task errors (z " + fmt((p.main_errors - dm.mean) / dm.sd) + ") >= mean + " +
+              fmt(k - o.memory_errors_sd_tolerance) + " SD = " + fmt(limit) + " without more distraction errors (" +
+              fmt(p.distraction_errors, 0) + ") than the mean (" + fmt(dd.mean) + ")";
   }
   return out;
 }
@@ -763,10 +831,31 @@ json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::
   }
   json out;
   out["rm_anova"] = guarded([&] { return anova_json(stats::rm_anova(obs, {"spacing", "distractor"})); });
-  // R² [choice]: share of the variance of the participant × condition scores
-  // explained by the 2 × 2 effects (SS_effects / SS_total, as a univariate
-  // model of the four cell means reports it); with_subjects adds the
-  // participants' own levels to the model.
+  // The source's R² (its trend figure): across the kept participants, the
+  // least-squares line of main-task errors on distraction-task errors and
+  // its R² (= r², Pearson's r with its t-test and CI beside it).
+  {
+    std::vector<double> x, y;
+    for (const auto& [id, p] : people)
+      if (!excluded.count(id) && !p.recall.empty()) x.push_back(p.distraction_errors), y.push_back(p.main_errors);
+    json r = guarded([&] {
+      const stats::Correlation c = stats::pearson(x, y, o.level);
+      const auto dx = stats::describe(x), dy = stats::describe(y);
+      const double slope = c.r * dy.sd / dx.sd;
+      json j{{"x", "distraction_errors"},
+             {"y", "main_errors"},
+             {"r2", c.r2},
+             {"slope", slope},
+             {"intercept", dy.mean - slope * dx.mean}};
+      j.update(stats::view(c));
+      return j;
+    });
+    out["r2"] = r;
+  }
+  // Effect share (formerly reported as R²): the share of the variance of
+  // the participant × condition scores explained by the 2 × 2 effects
+  // (SS_effects / SS_total, as a univariate model of the four cell means
+  // reports it); with_subjects adds the participants' own levels.
   if (out["rm_anova"].contains("effects")) {
     std::vector<double> all;
     std::map<std::string, std::vector<double>> per;
@@ -776,10 +865,10 @@ json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::
     for (double x : all) ss_total += (x - grand) * (x - grand);
     for (const auto& e : out["rm_anova"]["effects"]) ss_effects += val(e, "ss");
     for (const auto& [id, v] : per) ss_subjects += static_cast<double>(v.size()) * (mean_of(v) - grand) * (mean_of(v) - grand);
-    out["r2"] = json{{"r2", num(ss_total > 0 ? ss_effects / ss_total : missing)},
-                     {"r2_with_subjects", num(ss_total > 0 ? (ss_effects + ss_subjects) / ss_total : missing)}};
+    out["effect_share"] = json{{"share", num(ss_total > 0 ? ss_effects / ss_total : missing)},
+                               {"share_with_subjects", num(ss_total > 0 ? (ss_effects + ss_subjects) / ss_total : missing)}};
   } else {
-    out["r2"] = skipped("the ANOVA did not run");
+    out["effect_share"] = skipped("the ANOVA did not run");
   }
   json tests = json::array();
   for (auto& [spacing, kinds] : by) {
@@ -818,11 +907,12 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   }
   json out = json::object();
   json source_stats;
-  const Excluded by_source = source_rule(people, o.memory_errors_sd, source_stats);
+  const Excluded by_source = source_rule(people, o, source_stats);
   const Excluded by_recall = recall_accuracy_rule(people, o);
   const Excluded& excluded = o.memory_rule == "source" ? by_source : o.memory_rule == "none" ? Excluded{} : by_recall;
   out["outlier_rule"] = json{{"rule", o.memory_rule},
                              {"errors_sd", o.memory_errors_sd},
+                             {"errors_sd_tolerance", o.memory_errors_sd_tolerance},
                              {"recall_chance", o.memory_recall_chance},
                              {"accuracy_sd", o.memory_accuracy_sd}};
   json pj = json::array();
@@ -870,7 +960,13 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
             fmt(val(c["accuracy"], "sem")) + ")\n";
   text += anova_lines(out["rm_anova"], "  ");
   if (out["r2"].contains("r2"))
-    text += "  R² = " + fmt(val(out["r2"], "r2")) + " (with participants: " + fmt(val(out["r2"], "r2_with_subjects")) + ")\n";
+    text += "  main-task errors against distraction-task errors (across participants): R² = " + fmt(val(out["r2"], "r2"), 4) +
+            ", slope " + fmt(val(out["r2"], "slope"), 3) + ", " + r_text(out["r2"]) + "\n";
+  else
+    text += "  R² (main-task against distraction-task errors) skipped: " + out["r2"]["skipped"].get<std::string>() + "\n";
+  if (out["effect_share"].contains("share"))
+    text += "  share of variance explained by the 2 × 2 effects: " + fmt(val(out["effect_share"], "share")) +
+            " (with participants: " + fmt(val(out["effect_share"], "share_with_subjects")) + ")\n";
   for (const auto& t : out["spacing_t_tests"])
     text += "  " + t["spacing"].get<std::string>() + " spacing, distractor − control (paired): " + t_text(t["t_test"]) + "\n";
   for (const auto& r : rules) {
@@ -897,6 +993,9 @@ void check_options(const AnalysisOptions& o) {
     throw InvalidArgument("analysis memory_rule is '" + o.memory_rule + "'; allowed: source, recall-accuracy, none");
   if (!(o.memory_errors_sd > 0) || !std::isfinite(o.memory_errors_sd))
     throw InvalidArgument("analysis memory_errors_sd is " + texel::detail::num(o.memory_errors_sd) + "; allowed > 0");
+  if (!(o.memory_errors_sd_tolerance >= 0) || !(o.memory_errors_sd_tolerance < o.memory_errors_sd))
+    throw InvalidArgument("analysis memory_errors_sd_tolerance is " + texel::detail::num(o.memory_errors_sd_tolerance) +
+                          "; allowed 0 … memory_errors_sd (" + texel::detail::num(o.memory_errors_sd) + "), excluded");
   if (!std::isfinite(o.memory_recall_chance) || o.memory_recall_chance >= 1)
     throw InvalidArgument("analysis memory_recall_chance is " + texel::detail::num(o.memory_recall_chance) +
                           "; allowed < 1 (negative = rule off)");
@@ -1086,7 +1185,41 @@ json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions&
   return out;
 }
 
+/// A CSV field: quoted when it holds a separator, a quote or a line break.
+std::string csv_field(const std::string& v) {
+  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string q = "\"";
+  for (const char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string csv_number(const json& j) { return j.is_number() ? texel::detail::num(j.get<double>()) : std::string(); }
+
+/// The staircase runs as CSV (one row per participant × session × block):
+/// what the summary's `runs` hold, with `status` "finished" / "not
+/// finished" and `convergent` empty for a run that is not finished.
+std::string runs_csv(const json& summary) {
+  std::string out =
+      "participant,session_id,block,group,fine_strength,trials,reversals,status,in_group_statistics,end_value,convergent,"
+      "threshold_last_k,threshold_reversals_used\n";
+  for (const auto& r : summary["runs"]) {
+    out += csv_field(r["participant"].get<std::string>()) + "," + std::to_string(r["session_id"].get<std::int64_t>()) + "," +
+           csv_field(r["block"].get<std::string>()) + "," +
+           (r.contains("group") ? csv_field(r["group"].get<std::string>()) : std::string()) + "," +
+           (r.contains("fine_strength") ? csv_number(r["fine_strength"]) : std::string()) + "," +
+           std::to_string(r["trials"].get<std::size_t>()) + "," + std::to_string(r["reversals"].get<std::size_t>()) + "," +
+           r["status"].get<std::string>() + "," + (r["in_group_statistics"].get<bool>() ? "1" : "0") + "," +
+           csv_number(r["end_value"]) + "," + csv_number(r["convergent"]) + "," + csv_number(r["threshold_last_k"]) + "," +
+           std::to_string(r["threshold_reversals_used"].get<std::size_t>()) + "\n";
+  }
+  return out;
+}
+
 }  // namespace
+
+double memory_errors_limit(double mean, double sd, const AnalysisOptions& o) {
+  return mean + (o.memory_errors_sd - o.memory_errors_sd_tolerance) * sd;
+}
 
 AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions& options) {
   check_options(options);
@@ -1135,6 +1268,11 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       std::filesystem::create_directories(options.out_dir, ec);
       if (ec) throw IoError("cannot create figure directory '" + options.out_dir + "': " + ec.message());
       for (auto& f : analysis_figures::study_figures(st, summary[study], rs, options)) report.figures.push_back(std::move(f));
+      if (st.design == StudyDesign::staircase) {
+        const std::string path = (std::filesystem::path(options.out_dir) / (study + "-runs.csv")).string();
+        write_file_atomic(path, runs_csv(summary[study]));
+        report.tables.push_back(path);
+      }
     }
   }
   report.summary = summary.dump();
