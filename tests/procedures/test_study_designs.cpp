@@ -117,8 +117,9 @@ TEST(StudyDesigns, BaseTexturesKeyIsValidated) {
   EXPECT_NE(error_of(head + patches + R"(, "base_textures": "sometimes"}]})")
                 .find("base_textures is 'sometimes'; allowed: per-trial, per-texture"),
             std::string::npos);
-  const std::string texels = R"("stimuli": {"x": {"texture": {"kind": "texel", "central_pitch_db": 6, "irregularity_db": 0},
-                                                 "different": {"kind": "texel", "central_pitch_db": 7, "irregularity_db": 0}}})";
+  const std::string texels =
+      R"("stimuli": {"x": {"texture": {"kind": "texel", "central_pitch_db": 6, "irregularity_db": 0, "texel_length_mm": 1},
+                                                 "different": {"kind": "texel", "central_pitch_db": 7, "irregularity_db": 0, "texel_length_mm": 1}}})";
   EXPECT_NE(error_of(head + texels + R"(, "base_textures": "per-texture"}]})").find("not a patch-* reference"),
             std::string::npos);
 }
