@@ -5,6 +5,8 @@
 // comparisons the source's figure stresses; the session-state vocabulary.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -160,4 +162,30 @@ TEST(SessionStates, OneVocabularyWithParseAndDerivation) {
   info.status = "finished";
   EXPECT_EQ(ex::session_state(info, true, true), ex::SessionState::finished);
   EXPECT_EQ(json::parse(ex::to_json(info))["state"], "finished");
+}
+
+TEST(StudyDesigns, QuantizationFallbacksAreTodaysEncoderEstimates) {
+  // The trained rater's match stands in as the encoder's estimate of each
+  // reference (what the free-exploration rows carry as the reference's
+  // position), limited to the device ranges: a fallback never goes stale.
+  auto s = make(protocols / "free-exploration.json");
+  const ex::SimulatedParticipant sim(ex::simulation_observer(s.protocol().observer, "default"), s);
+  std::map<std::string, std::pair<double, double>> estimate;
+  while (!s.finished()) {
+    const ex::StoredTrial t = s.answer(sim.respond(s));
+    if (t.row.task == "match") estimate[t.row.reference] = {t.row.reference_pitch_db, t.row.reference_irregularity_db};
+  }
+  ASSERT_EQ(estimate.size(), 9u);
+  const json doc = json::parse(texel::read_file((protocols / "quantization.json").string()));
+  for (const auto& pair : doc["blocks"][0]["pairs"]) {
+    const std::string ref = pair["reference"];
+    const json& t = pair["rendering"]["texture"];
+    ASSERT_TRUE(estimate.count(ref)) << ref;
+    const auto [p, i] = estimate[ref];
+    EXPECT_NEAR(t["central_pitch_db"].get<double>(), std::clamp(p, -20.0, 19.7), 0.006) << ref;
+    EXPECT_NEAR(t["irregularity_db"].get<double>(), std::clamp(i, -30.0, 5.0), 0.006) << ref;
+  }
+  // The source's rater put the waveforms near 0 dB and 4sin near 7.8 dB.
+  for (const char* w : {"square", "tri", "saw"}) EXPECT_LT(std::abs(estimate[w].first), 1.5) << w;
+  EXPECT_NEAR(estimate["4sin"].first, 7.8, 1.0);
 }
