@@ -593,6 +593,7 @@ void register_experiment(CLI::App& app) {
     else
       std::cout << report.text;
     for (const auto& f : report.figures) std::cerr << "wrote " << f << "\n";
+    for (const auto& f : report.tables) std::cerr << "wrote " << f << "\n";
   });
 }
 

@@ -261,7 +261,8 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     if (!finished) {
       run_text += "  " + run.participant + " " + run.block + " (session " + std::to_string(run.session_id) +
                   "): not finished, stopped after " + std::to_string(run.rows.size()) + " trials with " +
-                  std::to_string(rev.size()) + " reversals; its end value " + fmt(end_value) + " is no convergent value" +
+                  std::to_string(rev.size()) + (rev.size() == 1 ? " reversal" : " reversals") + "; its end value " +
+                  fmt(end_value) + " is no convergent value" +
                   (counted ? " (in the group statistics: include_unfinished)\n" : "; left out of the group statistics\n");
       unfinished.push_back(json{{"participant", run.participant}, {"session_id", run.session_id}, {"block", run.block}});
     }

@@ -553,18 +553,31 @@ std::optional<Figure> irregularity_normalised_figure(const json& s, const Rows& 
 /// participants per rated pair, the own-match ratings' mean dashed.
 std::optional<Figure> comparisons_figure(const json& s) {
   if (!s.contains("comparisons") || s["comparisons"].empty()) return std::nullopt;
+  // The references' common prefix ("bandpass-") left out of the labels, so
+  // sixteen "A vs B" fit side by side.
+  std::string prefix;
+  {
+    std::vector<std::string> all;
+    for (const auto& c : s["comparisons"]) all.push_back(c["a"].get<std::string>()), all.push_back(c["b"].get<std::string>());
+    prefix = all.front();
+    for (const auto& n : all)
+      prefix.resize(
+          static_cast<std::size_t>(std::mismatch(prefix.begin(), prefix.end(), n.begin(), n.end()).first - prefix.begin()));
+    prefix.resize(prefix.rfind('-') == std::string::npos ? 0 : prefix.rfind('-') + 1);
+  }
   std::vector<std::string> names;
   ErrorBarSeries e;
   e.label = "reference felt against another's match (mean ± 95 % CI)";
   for (const auto& c : s["comparisons"]) {
-    names.push_back(c["comparison"].get<std::string>());
+    names.push_back(c["a"].get<std::string>().substr(prefix.size()) + " vs " + c["b"].get<std::string>().substr(prefix.size()));
     const json& r = c["rating"];
     e.x.push_back(static_cast<double>(names.size() - 1));
     e.y.push_back(d(r["mean"]));
     e.error.push_back((d(r["ci95_high"]) - d(r["ci95_low"])) / 2);
   }
-  Figure f =
-      figure("Parameter mapping: similarity of two different references (through a match)", category_width(names, 900), 520);
+  Figure f = figure("Parameter mapping: similarity of two different references" +
+                        (prefix.empty() ? std::string() : " (" + prefix + "…)") + ", one felt against the other's match",
+                    category_width(names, 900), 520);
   Panel p;
   p.x = Axis{"comparison", AxisScale::linear, std::nullopt, std::nullopt, false, names};
   p.y = Axis{"similarity rating (0 … 10)", AxisScale::linear, -0.2, 10.2, false};
