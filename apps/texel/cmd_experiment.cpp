@@ -520,6 +520,8 @@ void register_experiment(CLI::App& app) {
     std::string convergent = "last-presented";
     std::string memory_rule = "source";
     double errors_sd = 2.0;
+    double errors_sd_tolerance = 0.15;
+    bool include_unfinished = false;
     double recall_chance = 1.0 / 9.0;
     double accuracy_sd = 2.5;
     std::string confidence_distance = "rater";
@@ -539,6 +541,11 @@ void register_experiment(CLI::App& app) {
                           "Working-memory outliers: source (errors > mean + k SD without more distraction errors), "
                           "recall-accuracy (the earlier rule) or none [source]");
   analyze_cmd->add_option("--memory-errors-sd", an->errors_sd, "Working memory, source rule: k [2]");
+  analyze_cmd->add_option("--memory-errors-sd-tolerance", an->errors_sd_tolerance,
+                          "Working memory, source rule: outlier from z >= k - this (\"near\" k SD; 0 = literal) [0.15]");
+  analyze_cmd->add_flag("--include-unfinished", an->include_unfinished,
+                        "Put procedures that stopped before their stopping rule into the group statistics (still reported "
+                        "\"not finished\")");
   analyze_cmd->add_option("--memory-recall-chance", an->recall_chance,
                           "Working memory, recall-accuracy rule: digit recall at or below this; negative = off [1/9]");
   analyze_cmd->add_option("--memory-accuracy-sd", an->accuracy_sd,
@@ -584,6 +591,8 @@ void register_experiment(CLI::App& app) {
     o.convergent = an->convergent;
     o.memory_rule = an->memory_rule;
     o.memory_errors_sd = an->errors_sd;
+    o.memory_errors_sd_tolerance = an->errors_sd_tolerance;
+    o.include_unfinished = an->include_unfinished;
     o.memory_recall_chance = an->recall_chance;
     o.memory_accuracy_sd = an->accuracy_sd;
     o.confidence_distance = an->confidence_distance;

@@ -292,19 +292,22 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
       obs.push_back({p, {b}, cv.back()});
     }
     for (const auto& [p, v] : thr[b]) tv.push_back(mean_of(v));
-    std::size_t left_out = 0;
+    std::size_t left_out = 0, let_in = 0;
     for (const auto& r : runs)
-      if (!r["in_group_statistics"].get<bool>() && (r.contains("group") ? r["group"] : r["block"]) == b) ++left_out;
+      if ((r.contains("group") ? r["group"] : r["block"]) == b && !r["finished"].get<bool>())
+        ++(r["in_group_statistics"].get<bool>() ? let_in : left_out);
     json e{{"block", b}};
     if (coarse) e["fine_strength"] = num(block_fine[b]);
     e["participants"] = cv.size();
     e["unfinished_runs_left_out"] = left_out;
+    e["unfinished_runs_included"] = let_in;
     e["convergent"] = describe_json(cv);
     e["threshold_last_k"] = describe_json(tv);
     const auto d = stats::describe(cv);
     text += "  " + b + ": convergent " + fmt(d.mean) + " ± " + fmt(d.sd) + " (mean ± SD, n = " + std::to_string(d.n) + ", " +
             fmt(0.95 * 100, 0) + " % CI [" + fmt(d.ci95_low) + ", " + fmt(d.ci95_high) + "])" +
-            (left_out ? ", " + std::to_string(left_out) + " unfinished run(s) left out" : std::string()) + "\n";
+            (left_out ? ", " + std::to_string(left_out) + " unfinished run(s) left out" : std::string()) +
+            (let_in ? ", " + std::to_string(let_in) + " unfinished run(s) included (their end values)" : std::string()) + "\n";
     bj.push_back(std::move(e));
   }
   out["blocks"] = bj;

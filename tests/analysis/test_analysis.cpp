@@ -1017,6 +1017,7 @@ TEST(Analysis, AnUnfinishedStaircaseReadsNotFinishedEverywhere) {
   const json w = summary_of(analyze(with_unfinished_run(), with))["texel-length"];
   EXPECT_EQ(run_of(w, "S09", "narrow")["status"], "not finished");
   EXPECT_EQ(w["blocks"][0]["participants"], 3);
+  EXPECT_EQ(w["blocks"][0]["unfinished_runs_included"], 1);
   EXPECT_DOUBLE_EQ(w["blocks"][0]["convergent"]["mean"].get<double>(), (23.5 + 23.5 + 36.0) / 3);
 }
 
