@@ -200,10 +200,12 @@ Figure convergent_boxes(const Study& study, const json& s) {
   if (s.contains("between_groups") && s["between_groups"]["anova"].contains("p"))
     p.title = "between groups, one-way ANOVA: " + p_text(s["between_groups"]["anova"]);
   if (s.contains("rm_anova") && s["rm_anova"].contains("effects")) p.title = "RM-ANOVA p: " + anova_text(s["rm_anova"]);
+  // In the figure's title (the panel's holds the group test), wide enough to read.
+  if (!s["unfinished_runs"].empty()) f.width_px = 860;
   if (left_out)
-    p.title += (p.title.empty() ? "" : "; ") + std::to_string(left_out) + " run(s) not finished, left out";
+    f.title += " (" + std::to_string(left_out) + " run(s) not finished, left out)";
   else if (!s["unfinished_runs"].empty())
-    p.title += (p.title.empty() ? "" : "; ") + std::to_string(s["unfinished_runs"].size()) + " run(s) not finished, included";
+    f.title += " (" + std::to_string(s["unfinished_runs"].size()) + " run(s) not finished, included)";
   p.x = Axis{coarse ? "fine-texture strength" : "group (frequency distribution, practice)",
              AxisScale::linear,
              std::nullopt,
