@@ -341,13 +341,13 @@ void list_sessions(const std::string& db, bool as_json, const std::optional<std:
     print_json(arr);
     return;
   }
-  std::printf("%-4s %-12s %-20s %-10s %-12s %s\n", "id", "participant", "protocol", "status", "trials", "updated");
+  std::printf("%-4s %-12s %-20s %-10s %-12s %s\n", "id", "participant", "protocol", "state", "trials", "updated");
   for (const auto& s : arr) {
     const int planned = s["trials_planned"].get<int>();
     const std::string trials = std::to_string(s["trials_done"].get<int>()) + (planned > 0 ? "/" + std::to_string(planned) : "");
     std::printf("%-4lld %-12s %-20s %-10s %-12s %s\n", static_cast<long long>(s["id"].get<std::int64_t>()),
                 s["participant"].get<std::string>().c_str(), s["protocol"].get<std::string>().c_str(),
-                s["status"].get<std::string>().c_str(), trials.c_str(), s["updated_at"].get<std::string>().c_str());
+                s["state"].get<std::string>().c_str(), trials.c_str(), s["updated_at"].get<std::string>().c_str());
   }
 }
 
@@ -363,7 +363,7 @@ void status(const std::string& db, bool as_json, const std::optional<std::string
             << sessions.size() << " sessions\n";
   for (const auto& s : sessions) {
     std::cout << "  session " << s["id"] << " " << s["participant"].get<std::string>() << " " << s["protocol"].get<std::string>()
-              << " [" << s["status"].get<std::string>() << "] " << s["trials_done"] << " trials\n";
+              << " [" << s["state"].get<std::string>() << "] " << s["trials_done"] << " trials\n";
     for (auto it = s["blocks"].begin(); it != s["blocks"].end(); ++it) {
       std::cout << "    " << it.key() << ": " << it.value()["trials"] << " trials";
       if (it.value().contains("current_value"))
@@ -520,6 +520,8 @@ void register_experiment(CLI::App& app) {
     std::string convergent = "last-presented";
     std::string memory_rule = "source";
     double errors_sd = 2.0;
+    double errors_sd_tolerance = 0.15;
+    bool include_unfinished = false;
     double recall_chance = 1.0 / 9.0;
     double accuracy_sd = 2.5;
     std::string confidence_distance = "rater";
@@ -539,6 +541,11 @@ void register_experiment(CLI::App& app) {
                           "Working-memory outliers: source (errors > mean + k SD without more distraction errors), "
                           "recall-accuracy (the earlier rule) or none [source]");
   analyze_cmd->add_option("--memory-errors-sd", an->errors_sd, "Working memory, source rule: k [2]");
+  analyze_cmd->add_option("--memory-errors-sd-tolerance", an->errors_sd_tolerance,
+                          "Working memory, source rule: outlier from z >= k - this (\"near\" k SD; 0 = literal) [0.15]");
+  analyze_cmd->add_flag("--include-unfinished", an->include_unfinished,
+                        "Put procedures that stopped before their stopping rule into the group statistics (still reported "
+                        "\"not finished\")");
   analyze_cmd->add_option("--memory-recall-chance", an->recall_chance,
                           "Working memory, recall-accuracy rule: digit recall at or below this; negative = off [1/9]");
   analyze_cmd->add_option("--memory-accuracy-sd", an->accuracy_sd,
@@ -584,6 +591,8 @@ void register_experiment(CLI::App& app) {
     o.convergent = an->convergent;
     o.memory_rule = an->memory_rule;
     o.memory_errors_sd = an->errors_sd;
+    o.memory_errors_sd_tolerance = an->errors_sd_tolerance;
+    o.include_unfinished = an->include_unfinished;
     o.memory_recall_chance = an->recall_chance;
     o.memory_accuracy_sd = an->accuracy_sd;
     o.confidence_distance = an->confidence_distance;
@@ -593,6 +602,7 @@ void register_experiment(CLI::App& app) {
     else
       std::cout << report.text;
     for (const auto& f : report.figures) std::cerr << "wrote " << f << "\n";
+    for (const auto& f : report.tables) std::cerr << "wrote " << f << "\n";
   });
 }
 

@@ -16,6 +16,7 @@
 #include <optional>
 #include <set>
 
+#include "analysis_figures.hpp"
 #include "json_views.hpp"
 #include "studies.hpp"
 #include "texel/detail/format.hpp"
@@ -99,8 +100,11 @@ std::string percent(double v) { return texel::detail::fixed(v * 100, 0) + " %"; 
 
 std::string variable_label(const Study& study) { return std::string(study.variable_label); }
 
+}  // namespace
+
 /// Intensity against trial, one line per block, reversals marked; one panel
-/// per participant (and session).
+/// per participant (and session). Only presented trials: the value computed
+/// after the last answer was never felt, so it is no point of the track.
 Figure staircase_tracks(const Study& study, const Rows& rows) {
   std::map<std::pair<std::string, std::int64_t>, std::map<std::string, Rows>> runs;
   std::vector<std::string> blocks;
@@ -131,13 +135,13 @@ Figure staircase_tracks(const Study& study, const Rows& rows) {
         line.y.push_back(r->intensity);
         if (r->reversal) rev.x.push_back(r->trial_in_block + 1), rev.y.push_back(r->intensity);
       }
-      // The convergent value (computed after the last answer) as the line's end.
-      if (!rs.empty() && std::isfinite(rs.back()->next_intensity)) {
-        line.x.push_back(rs.back()->trial_in_block + 2);
-        line.y.push_back(rs.back()->next_intensity);
-      }
+      const bool finished = std::any_of(rs.begin(), rs.end(), [](const TrialRow* r) { return r->procedure_finished; });
       line.width_px = 1.6;
-      line.label = block;
+      line.label = finished ? block : block + " (not finished)";
+      if (!finished) {
+        line.dashed = true;
+        p.title += " — not finished: " + block;
+      }
       p.lines.push_back(std::move(line));
       p.stems.push_back(std::move(rev));
     }
@@ -151,15 +155,24 @@ Figure staircase_tracks(const Study& study, const Rows& rows) {
   return f;
 }
 
+namespace {
+
 /// Box plots of the per-participant convergent values per block, with the
 /// group mean ± 95 % CI beside each box.
 Figure convergent_boxes(const Study& study, const json& s) {
   const bool coarse = study.blocks_by_fine_strength;
   std::vector<std::string> cats;
   std::map<std::string, std::map<std::string, std::vector<double>>> per;  // block → participant → values
-  for (const auto& r : s["runs"])
+  std::size_t left_out = 0;
+  for (const auto& r : s["runs"]) {
+    // The runs of the group statistics (unfinished ones only when asked).
+    if (!r["in_group_statistics"].get<bool>()) {
+      ++left_out;
+      continue;
+    }
     per[r.contains("group") ? r["group"].get<std::string>() : r["block"].get<std::string>()][r["participant"].get<std::string>()]
-        .push_back(d(r["convergent"]));
+        .push_back(d(r["end_value"]));
+  }
   BoxSeries box;
   box.colour = palette_colour(0);
   box.label = "participants";
@@ -187,6 +200,12 @@ Figure convergent_boxes(const Study& study, const json& s) {
   if (s.contains("between_groups") && s["between_groups"]["anova"].contains("p"))
     p.title = "between groups, one-way ANOVA: " + p_text(s["between_groups"]["anova"]);
   if (s.contains("rm_anova") && s["rm_anova"].contains("effects")) p.title = "RM-ANOVA p: " + anova_text(s["rm_anova"]);
+  // In the figure's title (the panel's holds the group test), wide enough to read.
+  if (!s["unfinished_runs"].empty()) f.width_px = 860;
+  if (left_out)
+    f.title += " (" + std::to_string(left_out) + " run(s) not finished, left out)";
+  else if (!s["unfinished_runs"].empty())
+    f.title += " (" + std::to_string(s["unfinished_runs"].size()) + " run(s) not finished, included)";
   p.x = Axis{coarse ? "fine-texture strength" : "group (frequency distribution, practice)",
              AxisScale::linear,
              std::nullopt,
@@ -200,13 +219,55 @@ Figure convergent_boxes(const Study& study, const json& s) {
   return f;
 }
 
+/// Each participant's convergent value per block as one line across the
+/// blocks (the coarse-feature segments, in fine-strength order): the
+/// source's per-participant figure beside the box plots.
+Figure participant_lines(const Study& study, const json& s) {
+  std::vector<std::string> cats, names;
+  for (const auto& b : s["blocks"]) {
+    names.push_back(b["block"].get<std::string>());
+    cats.push_back(study.blocks_by_fine_strength ? "fine " + percent(d(b["fine_strength"])) : names.back());
+  }
+  std::map<std::string, std::map<std::string, std::vector<double>>> per;  // participant → block → values
+  for (const auto& r : s["runs"])
+    if (r["in_group_statistics"].get<bool>())
+      per[r["participant"].get<std::string>()][r["block"].get<std::string>()].push_back(d(r["end_value"]));
+  Figure f = figure(std::string(study.title) + ": each participant across the segments", 720, 480);
+  Panel p;
+  p.x = Axis{study.blocks_by_fine_strength ? "fine-texture strength" : "block",
+             AxisScale::linear,
+             std::nullopt,
+             std::nullopt,
+             false,
+             cats};
+  p.y.label = "convergent " + variable_label(study);
+  std::size_t k = 0;
+  for (const auto& [who, blocks] : per) {
+    ErrorBarSeries line;
+    line.connect = true;
+    line.colour = palette_colour(k++);
+    line.label = per.size() <= 12 ? who : std::string();
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (blocks.count(names[i])) {
+        line.x.push_back(static_cast<double>(i));
+        line.y.push_back(mean_of(blocks.at(names[i])));
+        line.error.push_back(std::nan(""));
+      }
+    p.error_bars.push_back(std::move(line));
+  }
+  p.legend = per.size() <= 12;
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
 /// Swiping behaviour against the result: directional proportion of each run
 /// against its convergent texel length, one colour per distribution.
 std::optional<Figure> directional_scatter(const json& s) {
   std::map<std::string, StemSeries> series;
   std::vector<std::string> order;
   for (const auto& r : s["runs"]) {
-    const double x = d(r["convergent"]), y = d(r["directional_proportion"]);
+    if (!r["in_group_statistics"].get<bool>()) continue;
+    const double x = d(r["end_value"]), y = d(r["directional_proportion"]);
     if (!std::isfinite(x) || !std::isfinite(y)) continue;
     const std::string b = r.contains("group") ? r["group"].get<std::string>() : r["block"].get<std::string>();
     if (!series.count(b)) order.push_back(b);
@@ -393,6 +454,36 @@ std::optional<Figure> confidence_vs_distance(const std::string& title, const jso
   return f;
 }
 
+/// Distance of the match from the one in use (rater's or mean) per
+/// confidence bin — 1–2, 3, 4, 5 [choice: the two lowest ratings, the
+/// rarest, share a bin] — as box plots: the source's binned figure.
+std::optional<Figure> confidence_bins(const std::string& title, const json& s) {
+  if (!s.contains("confidence_vs_distance")) return std::nullopt;
+  const bool rater = s["confidence_vs_distance"]["distance_to"] == "rater";
+  const std::vector<std::string> cats{"1–2", "3", "4", "5"};
+  BoxSeries box;
+  box.show_points = true;
+  box.groups.resize(cats.size());
+  bool any = false;
+  for (const auto& m : s["matches"]) {
+    const double x = d(m[rater ? "distance_to_rater_db" : "distance_db"]);
+    const double c = m.contains("confidence") ? d(m["confidence"]) : missing;
+    if (!std::isfinite(x) || !std::isfinite(c)) continue;
+    const auto bin = static_cast<std::size_t>(std::clamp(std::lround(c) - 2, 0L, 3L));
+    box.groups[bin].push_back(x);
+    any = true;
+  }
+  if (!any) return std::nullopt;
+  Figure f = figure(title + ": distance of the match per confidence", 700, 480);
+  Panel p;
+  p.x = Axis{"confidence (1 … 5, in four bins)", AxisScale::linear, std::nullopt, std::nullopt, false, cats};
+  p.y.label = "distance from " +
+              std::string(rater ? "the trained rater's match (encoder estimate)" : "the reference's mean match") + " (dB)";
+  p.boxes.push_back(std::move(box));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
 /// A panel of box plots per reference (categories in `names`' order) of each
 /// participant's mean value; `v`: reference → participant → values.
 Panel reference_boxes(const std::vector<std::string>& names,
@@ -459,7 +550,76 @@ std::optional<Figure> irregularity_normalised_figure(const json& s, const Rows& 
   return f;
 }
 
+/// Parameter mapping, the comparisons of two different references (the
+/// source's figure built from them): mean rating ± 95 % CI over
+/// participants per rated pair, the own-match ratings' mean dashed.
+std::optional<Figure> comparisons_figure(const json& s) {
+  if (!s.contains("comparisons") || s["comparisons"].empty()) return std::nullopt;
+  // The references' common prefix ("bandpass-") left out of the labels, so
+  // sixteen "A vs B" fit side by side.
+  std::string prefix;
+  {
+    std::vector<std::string> all;
+    for (const auto& c : s["comparisons"]) all.push_back(c["a"].get<std::string>()), all.push_back(c["b"].get<std::string>());
+    prefix = all.front();
+    for (const auto& n : all)
+      prefix.resize(
+          static_cast<std::size_t>(std::mismatch(prefix.begin(), prefix.end(), n.begin(), n.end()).first - prefix.begin()));
+    prefix.resize(prefix.rfind('-') == std::string::npos ? 0 : prefix.rfind('-') + 1);
+  }
+  std::vector<std::string> names;
+  ErrorBarSeries e;
+  e.label = "reference felt against another's match (mean ± 95 % CI)";
+  for (const auto& c : s["comparisons"]) {
+    names.push_back(c["a"].get<std::string>().substr(prefix.size()) + " vs " + c["b"].get<std::string>().substr(prefix.size()));
+    const json& r = c["rating"];
+    e.x.push_back(static_cast<double>(names.size() - 1));
+    e.y.push_back(d(r["mean"]));
+    e.error.push_back((d(r["ci95_high"]) - d(r["ci95_low"])) / 2);
+  }
+  Figure f = figure("Parameter mapping: similarity of two different references" +
+                        (prefix.empty() ? std::string() : " (" + prefix + "…)") + ", one felt against the other's match",
+                    category_width(names, 900), 520);
+  Panel p;
+  p.x = Axis{"comparison", AxisScale::linear, std::nullopt, std::nullopt, false, names};
+  p.y = Axis{"similarity rating (0 … 10)", AxisScale::linear, -0.2, 10.2, false};
+  std::vector<double> own;
+  if (s.contains("ratings"))
+    for (const auto& r : s["ratings"]) own.push_back(d(r["rating"]["mean"]));
+  const double own_mean = mean_of(own);
+  if (std::isfinite(own_mean))
+    p.lines.push_back(LineSeries{{-0.5, static_cast<double>(names.size()) - 0.5},
+                                 {own_mean, own_mean},
+                                 Rgb{0.45, 0.45, 0.45},
+                                 1.0,
+                                 "own match (mean over references)",
+                                 true});
+  p.error_bars.push_back(std::move(e));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
 // ------------------------------------------------------------ quantization
+
+/// How similar the free-exploration matches feel: the unquantized ratings
+/// of the quantization study (each reference against the participant's own
+/// match, or the rater's), box plots per reference of each participant's
+/// rating (the source's figure of match similarity).
+std::optional<Figure> match_similarity(const Rows& rows) {
+  std::vector<std::string> names;
+  std::map<std::string, std::map<std::string, std::vector<double>>> v;
+  for (const TrialRow* r : rows) {
+    if (r->task != "rating" || r->condition != "unquantized") continue;
+    if (std::find(names.begin(), names.end(), r->reference) == names.end()) names.push_back(r->reference);
+    v[r->reference][r->participant].push_back(r->rating);
+  }
+  if (names.empty()) return std::nullopt;
+  Figure f = figure("Free-exploration matches: similarity to the reference (unquantized)", category_width(names, 700), 480);
+  Panel p = reference_boxes(names, v);
+  p.y = Axis{"similarity rating (1 … 5)", AxisScale::linear, 0.8, 5.2, false};
+  f.panels.push_back(std::move(p));
+  return f;
+}
 
 Figure quantization_figure(const json& s, const Rows& rows) {
   // Per texture: mean change ± 95 % CI per quantization step, its p value above.
@@ -646,6 +806,44 @@ Figure memory_figure(const json& s) {
   return f;
 }
 
+/// The source's trend figure: each participant's main-task errors against
+/// their distraction-task errors, the kept participants' least-squares line
+/// and its R², the excluded participants marked apart.
+std::optional<Figure> memory_errors_trend(const json& s) {
+  StemSeries kept, out;
+  kept.stems = out.stems = false;
+  kept.marker_radius_px = out.marker_radius_px = 4.5;
+  kept.label = "participants";
+  out.label = "excluded (outlier rule)";
+  out.colour = Rgb{0.8, 0.15, 0.1};
+  for (const auto& p : s["participants"]) {
+    const double x = d(p["distraction_errors"]), y = d(p["main_errors"]);
+    if (!std::isfinite(x) || !std::isfinite(y)) continue;
+    StemSeries& to = p["excluded"].is_string() ? out : kept;
+    to.x.push_back(x);
+    to.y.push_back(y);
+  }
+  if (kept.x.empty() && out.x.empty()) return std::nullopt;
+  const json& r = s["r2"];
+  Figure f = figure("Working memory: main-task against distraction-task errors", 700, 520);
+  Panel p;
+  p.title = r.contains("r2") ? "R² = " + texel::detail::fixed(d(r["r2"]), 4) +
+                                   " (kept participants, n = " + std::to_string(r["n"].get<std::size_t>()) + "), " + p_text(r)
+                             : "R² skipped: " + r["skipped"].get<std::string>();
+  p.x.label = "distraction-task (digit recall) errors";
+  p.y.label = "main-task (same/different) errors";
+  if (r.contains("slope") && !kept.x.empty()) {
+    double lo = *std::min_element(kept.x.begin(), kept.x.end()), hi = *std::max_element(kept.x.begin(), kept.x.end());
+    for (double x : out.x) lo = std::min(lo, x), hi = std::max(hi, x);
+    const double a = d(r["intercept"]), b = d(r["slope"]);
+    p.lines.push_back(LineSeries{{lo, hi}, {a + b * lo, a + b * hi}, Rgb{0.3, 0.3, 0.3}, 1.4, "least-squares line (kept)", true});
+  }
+  p.stems.push_back(std::move(kept));
+  if (!out.x.empty()) p.stems.push_back(std::move(out));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
 // ------------------------------------------------------- 2-D oddity studies
 
 // Proportion correct per condition with its Wilson CI, chance (1/3) dashed;
@@ -710,6 +908,7 @@ std::vector<std::string> study_figures(const Study& study, const nlohmann::order
     case StudyDesign::staircase:
       w.save(staircase_tracks(study, rows), "tracks");
       w.save(convergent_boxes(study, summary), "convergent");
+      if (study.blocks_by_fine_strength) w.save(participant_lines(study, summary), "participants");
       if (study.directional)
         if (auto f = directional_scatter(summary)) w.save(*f, "directional");
       break;
@@ -721,8 +920,10 @@ std::vector<std::string> study_figures(const Study& study, const nlohmann::order
         w.save(match_ellipses(title, summary, options.level), "ellipses");
       }
       if (auto f = confidence_vs_distance(title, summary)) w.save(*f, "confidence");
+      if (auto f = confidence_bins(title, summary)) w.save(*f, "confidence-bins");
       if (study.ratings_figure && summary.contains("ratings")) w.save(rating_boxes(title, rows, "0 … 10"), "ratings");
       if (auto f = irregularity_normalised_figure(summary, rows)) w.save(*f, "irregularity-normalised");
+      if (auto f = comparisons_figure(summary)) w.save(*f, "comparisons");
       // Beyond the own-match pairs (the source rated 25 of the 81): the matrix.
       if (study.design == StudyDesign::matching && summary.contains("similarity") &&
           summary["similarity"]["pairs_rated"].get<std::size_t>() > summary["similarity"]["references"].size())
@@ -737,8 +938,14 @@ std::vector<std::string> study_figures(const Study& study, const nlohmann::order
               "similarity");
       }
       break;
-    case StudyDesign::quantization: w.save(quantization_figure(summary, rows), "rating-change"); break;
-    case StudyDesign::memory: w.save(memory_figure(summary), "performance"); break;
+    case StudyDesign::quantization:
+      w.save(quantization_figure(summary, rows), "rating-change");
+      if (auto f = match_similarity(rows)) w.save(*f, "match-similarity");
+      break;
+    case StudyDesign::memory:
+      w.save(memory_figure(summary), "performance");
+      if (auto f = memory_errors_trend(summary)) w.save(*f, "errors-trend");
+      break;
     case StudyDesign::oddity: w.save(oddity_figure(study, summary, options.level), "proportion-correct"); break;
   }
   return w.paths;

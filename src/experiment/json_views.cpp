@@ -4,6 +4,7 @@
 
 #include "json_views.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/session_state.hpp"
 #include "texel/experiment/store.hpp"
 
 namespace texel::experiment {
@@ -18,6 +19,9 @@ ordered_json session_view(const SessionInfo& s) {
   j["study"] = s.study;
   j["status"] = s.status;
   j["finished"] = s.status == "finished";
+  // The store alone: finished or stopped; a front door that holds the
+  // session overwrites it with running / paused (session_state.hpp).
+  j["state"] = to_string(session_state(s));
   j["trials_done"] = s.trials_done;
   j["trials_planned"] = s.trials_planned;
   j["seed"] = s.seed;

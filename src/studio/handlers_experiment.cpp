@@ -15,6 +15,7 @@
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/export_mat.hpp"
+#include "texel/experiment/session_state.hpp"
 #include "texel/experiment/strokes.hpp"
 #include "texel/experiment/surface_maps.hpp"
 #include "texel/matfile.hpp"
@@ -147,7 +148,9 @@ std::vector<Shipped> shipped_protocols(const State& s) {
 // The running session as the library serialises it (as stored now), with
 // "simulated" for the spec in force.
 ojson session_json(State& s) {
-  ojson j = ojson::parse(ex::to_json(the_store(s).session(s.active->info.id)));
+  const ex::SessionInfo info = the_store(s).session(s.active->info.id);
+  ojson j = ojson::parse(ex::to_json(info));
+  j["state"] = ex::to_string(ex::session_state(info, true, s.active->suspended));
   j["simulated"] = !s.active->simulate.empty();
   return j;
 }
@@ -288,7 +291,11 @@ void on_experiment_list(State& s, Client& c, const Job& job) {
                               {"description", sh.protocol.description},
                               {"trials_planned", sh.protocol.planned_trials()}});
   r["sessions"] = ojson::array();
-  for (const auto& i : the_store(s).sessions()) r["sessions"].push_back(ojson::parse(ex::to_json(i)));
+  for (const auto& i : the_store(s).sessions()) {
+    ojson j = ojson::parse(ex::to_json(i));
+    if (s.active && s.active->info.id == i.id) j["state"] = ex::to_string(ex::session_state(i, true, s.active->suspended));
+    r["sessions"].push_back(std::move(j));
+  }
   r["active"] = s.active ? session_json(s) : ojson(nullptr);
   send(c, r);
 }
@@ -575,7 +582,7 @@ void on_experiment_trials(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
   const std::int64_t id = *session_field(s, f, job.type, true);
   ojson r = reply("experiment.trials", job.id);
-  r["session"] = ojson::parse(ex::to_json(the_store(s).session(id)));
+  r["session"] = s.active && s.active->info.id == id ? session_json(s) : ojson::parse(ex::to_json(the_store(s).session(id)));
   r["rows"] = ojson::array();
   for (const auto& row : the_store(s).rows(id)) r["rows"].push_back(ojson::parse(ex::row_json(row)));
   send(c, r);

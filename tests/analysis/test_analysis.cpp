@@ -6,6 +6,7 @@
 // expected figure written as a PNG, and the empty / bad-option cases.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -17,10 +18,13 @@
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/io.hpp"
+// The figure builders a test inspects (internal).
+#include "analysis_figures.hpp"
 
 using namespace texel;
 using namespace texel::experiment;
 using json = nlohmann::ordered_json;
+namespace analysis_figures = texel::experiment::analysis_figures;
 
 // The report's summary (JSON text) as JSON.
 static json summary_of(const AnalysisReport& r) { return json::parse(r.summary); }
@@ -508,7 +512,9 @@ TEST(Analysis, EveryStudyWritesItsFiguresAsPng) {
       "free-exploration-matched-boxes",
       "free-exploration-ellipses",
       "free-exploration-confidence",
+      "free-exploration-confidence-bins",
       "quantization-rating-change",
+      "quantization-match-similarity",
       "guided-exploration-matched-vs-reference",
       "guided-exploration-matched-boxes",
       "guided-exploration-ellipses",
@@ -516,7 +522,9 @@ TEST(Analysis, EveryStudyWritesItsFiguresAsPng) {
       "guided-exploration-similarity",
       "coarse-features-tracks",
       "coarse-features-convergent",
+      "coarse-features-participants",
       "working-memory-performance",
+      "working-memory-errors-trend",
   };
   ASSERT_EQ(r.figures.size(), expected.size());
   for (std::size_t i = 0; i < expected.size(); ++i) {
@@ -524,10 +532,14 @@ TEST(Analysis, EveryStudyWritesItsFiguresAsPng) {
     const std::string bytes = read_file(r.figures[i]);
     EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << expected[i];
   }
-  // Nothing but the figures (no temporaries left behind).
+  // The staircase studies' runs tables beside them.
+  ASSERT_EQ(r.tables.size(), 2u);
+  EXPECT_EQ(std::filesystem::path(r.tables[0]).filename().string(), "texel-length-runs.csv");
+  EXPECT_EQ(std::filesystem::path(r.tables[1]).filename().string(), "coarse-features-runs.csv");
+  // Nothing but the figures and tables (no temporaries left behind).
   std::size_t files = 0;
   for (const auto& e : std::filesystem::directory_iterator(o.out_dir)) files += e.is_regular_file();
-  EXPECT_EQ(files, expected.size());
+  EXPECT_EQ(files, expected.size() + r.tables.size());
   if (const char* keep = std::getenv("TEXEL_ANALYSIS_KEEP"))
     for (const auto& f : r.figures)
       std::filesystem::copy_file(f, std::filesystem::path(keep) / std::filesystem::path(f).filename(),
@@ -549,7 +561,7 @@ TEST(Analysis, SingleParticipantReportsSkippedTestsAndStillDraws) {
   EXPECT_TRUE(summary_of(r)["working-memory"]["rm_anova"].contains("skipped"));
   EXPECT_TRUE(summary_of(r)["guided-exploration"]["references"][0]["ellipse"].contains("skipped"));
   EXPECT_TRUE(summary_of(r)["guided-exploration"]["similarity"]["own_vs_other_t_test"].contains("skipped"));
-  EXPECT_EQ(r.figures.size(), 21u);
+  EXPECT_EQ(r.figures.size(), 25u);
 }
 
 TEST(Analysis, ReactionTimesAreParticipantMedians) {
@@ -600,8 +612,8 @@ TEST(Analysis, SvgFiguresOnRequest) {
   o.out_dir = dir.at("svg");
   o.format = "svg";
   const AnalysisReport r = analyze(memory_rows(), o);
-  ASSERT_EQ(r.figures.size(), 1u);
-  EXPECT_NE(read_file(r.figures[0]).find("</svg>"), std::string::npos);
+  ASSERT_EQ(r.figures.size(), 2u);  // performance, errors trend
+  for (const auto& f : r.figures) EXPECT_NE(read_file(f).find("</svg>"), std::string::npos) << f;
 }
 
 // ------------------------------------------- the source's situations, replayed
@@ -651,8 +663,8 @@ const json& effect(const json& anova, const std::string& name) {
 TEST(Analysis, WorkingMemorySourceRuleExcludesTheSourcesTwoOutliers) {
   const AnalysisReport report = analyze(source_memory_cohort(), {});
   const json s = summary_of(report)["working-memory"];
-  // Main-task errors: mean 10.4375, SD 3.2242570204, limit 16.8860140407;
-  // 17 and 18 exceed it, their 2 and 3 distraction errors are not above 3.25.
+  // Main-task errors: mean 10.4375, SD 3.2242570204, limit (z 1.85)
+  // 16.4024; 17 and 18 reach it, their 2 and 3 distraction errors are not above 3.25.
   EXPECT_EQ(s["outlier_rule"]["rule"], "source");
   EXPECT_EQ(s["included"], 14);
   EXPECT_TRUE(s["participants"][14]["excluded"].is_string());
@@ -663,7 +675,7 @@ TEST(Analysis, WorkingMemorySourceRuleExcludesTheSourcesTwoOutliers) {
   const json& th = s["rules_compared"][0]["thresholds"];
   EXPECT_NEAR(th["main_errors_mean"].get<double>(), 10.4375, 1e-12);
   EXPECT_NEAR(th["main_errors_sd"].get<double>(), 3.2242570204, 1e-9);
-  EXPECT_NEAR(th["main_errors_limit"].get<double>(), 16.8860140407, 1e-9);
+  EXPECT_NEAR(th["main_errors_limit"].get<double>(), 10.4375 + 1.85 * 3.2242570203588508, 1e-9);
   EXPECT_NEAR(th["distraction_errors_mean"].get<double>(), 3.25, 1e-12);
 
   // On the 14 kept: 2 × 2 RM-ANOVA (each F(1, 13) = t² of the effect's
@@ -677,8 +689,15 @@ TEST(Analysis, WorkingMemorySourceRuleExcludesTheSourcesTwoOutliers) {
   EXPECT_NEAR(effect(a, "spacing:distractor")["f"].get<double>(), 47.17741935, 1e-7);
   EXPECT_NEAR(effect(a, "spacing:distractor")["p"].get<double>(), 1.137901131e-05, 1e-13);
   EXPECT_EQ(effect(a, "spacing:distractor")["df_error"].get<double>(), 13.0);
-  EXPECT_NEAR(s["r2"]["r2"].get<double>(), 0.7327586207, 1e-9);
-  EXPECT_NEAR(s["r2"]["r2_with_subjects"].get<double>(), 0.8577586207, 1e-9);
+  EXPECT_NEAR(s["effect_share"]["share"].get<double>(), 0.7327586207, 1e-9);
+  EXPECT_NEAR(s["effect_share"]["share_with_subjects"].get<double>(), 0.8577586207, 1e-9);
+  // The source's R²: main-task errors against distraction-task errors over
+  // the 14 kept (scipy.stats.linregress(distraction, main)).
+  EXPECT_EQ(s["r2"]["n"], 14);
+  EXPECT_NEAR(s["r2"]["r2"].get<double>(), 0.018042870456663553, 1e-12);
+  EXPECT_NEAR(s["r2"]["slope"].get<double>(), -0.2378378378378378, 1e-12);
+  EXPECT_NEAR(s["r2"]["intercept"].get<double>(), 10.227027027027027, 1e-12);
+  EXPECT_NEAR(s["r2"]["p"].get<double>(), 0.6470822245991925, 1e-10);
   const json& narrow = s["spacing_t_tests"][0]["spacing"] == "narrow" ? s["spacing_t_tests"][0] : s["spacing_t_tests"][1];
   const json& wide = s["spacing_t_tests"][0]["spacing"] == "wide" ? s["spacing_t_tests"][0] : s["spacing_t_tests"][1];
   EXPECT_NEAR(narrow["t_test"]["t"].get<double>(), -14.38117456, 1e-7);
@@ -700,7 +719,8 @@ TEST(Analysis, WorkingMemorySourceRuleExcludesTheSourcesTwoOutliers) {
   o.memory_rule = "recall-accuracy";
   const json k = summary_of(analyze(source_memory_cohort(), o))["working-memory"];
   EXPECT_EQ(k["included"], 16);
-  EXPECT_NEAR(k["r2"]["r2"].get<double>(), 0.3941694915, 1e-9);
+  EXPECT_NEAR(k["effect_share"]["share"].get<double>(), 0.3941694915, 1e-9);
+  EXPECT_NEAR(k["r2"]["r2"].get<double>(), 0.09301269205076819, 1e-12);  // all 16
   EXPECT_NEAR(effect(k["rm_anova"], "distractor")["f"].get<double>(), 19.65240642, 1e-7);
 
   // The text prints the source's forms and names who each rule excludes.
@@ -886,6 +906,12 @@ TEST(Analysis, ParameterMappingRatedPairsAndNormalisedIrregularity) {
   }
   EXPECT_TRUE(heatmap);
   EXPECT_TRUE(normalised);
+  // The comparisons of two different references (the source's figure): a vs b, a vs c.
+  ASSERT_EQ(s["comparisons"].size(), 2u);
+  EXPECT_EQ(s["comparisons"][0]["comparison"], "a vs b");
+  EXPECT_DOUBLE_EQ(s["comparisons"][1]["rating"]["mean"].get<double>(), 2.5);
+  EXPECT_TRUE(std::any_of(report.figures.begin(), report.figures.end(),
+                          [](const std::string& f) { return f.ends_with("parameter-mapping-comparisons.png"); }));
 }
 
 TEST(Analysis, GuidedAgainstFreeExplorationSpread) {
@@ -912,4 +938,124 @@ TEST(Analysis, GuidedAgainstFreeExplorationSpread) {
   EXPECT_EQ(t["test"], "welch");
   EXPECT_NEAR(t["t"].get<double>(), -4.813576553, 1e-8);
   EXPECT_NEAR(t["p"].get<double>(), 0.004717043796, 1e-11);
+}
+
+// ------------------------------------------------ issue #37: what the data hold
+
+TEST(Analysis, TracksDrawOnlyThePresentedTrials) {
+  // Six answered trials; the row of the last one carries the value computed
+  // after it (38.5 mm), which was never presented: six points, not seven.
+  std::vector<TrialRow> rows;
+  staircase(rows, "texel-length", "S01", "narrow", {26, 28.5, 31, 33.5, 36, 36}, {}, 38.5);
+  std::vector<const TrialRow*> ptrs;
+  for (const auto& r : rows) ptrs.push_back(&r);
+  const Figure f = analysis_figures::staircase_tracks(*find_study("texel-length"), ptrs);
+  ASSERT_EQ(f.panels.size(), 1u);
+  ASSERT_EQ(f.panels[0].lines.size(), 1u);
+  EXPECT_EQ(f.panels[0].lines[0].x.size(), 6u);
+  EXPECT_EQ(f.panels[0].lines[0].y.back(), 36.0);
+  EXPECT_EQ(f.panels[0].lines[0].label, "narrow");
+}
+
+namespace {
+/// S09's staircase stopped after 6 trials with 0 of its 10 reversals
+/// (procedure_finished never set), beside two finished runs.
+std::vector<TrialRow> with_unfinished_run() {
+  std::vector<TrialRow> rows;
+  staircase(rows, "texel-length", "S01", "narrow", {26, 23.5, 21, 23.5}, {2}, 22.0);
+  staircase(rows, "texel-length", "S02", "narrow", {26, 23.5, 26, 23.5}, {1, 2}, 25.0);
+  staircase(rows, "texel-length", "S09", "narrow", {26, 28.5, 31, 33.5, 36, 36}, {}, 38.5);
+  for (auto& r : rows)
+    if (r.participant == "S09") r.procedure_finished = false;
+  return rows;
+}
+}  // namespace
+
+TEST(Analysis, AnUnfinishedStaircaseReadsNotFinishedEverywhere) {
+  test_support::TempDir dir("texel-analysis");
+  AnalysisOptions o;
+  o.out_dir = dir.at("unfinished");
+  const AnalysisReport report = analyze(with_unfinished_run(), o);
+  const json s = summary_of(report)["texel-length"];
+  const json& run = run_of(s, "S09", "narrow");
+  EXPECT_EQ(run["status"], "not finished");
+  EXPECT_FALSE(run["finished"].get<bool>());
+  EXPECT_TRUE(run["convergent"].is_null());         // no convergent value …
+  EXPECT_EQ(run["end_value"].get<double>(), 36.0);  // … only where it stopped
+  EXPECT_FALSE(run["in_group_statistics"].get<bool>());
+  EXPECT_EQ(run_of(s, "S01", "narrow")["status"], "finished");
+  ASSERT_EQ(s["unfinished_runs"].size(), 1u);
+  // Group statistics over the two finished runs only.
+  EXPECT_EQ(s["blocks"][0]["participants"], 2);
+  EXPECT_EQ(s["blocks"][0]["unfinished_runs_left_out"], 1);
+  EXPECT_DOUBLE_EQ(s["blocks"][0]["convergent"]["mean"].get<double>(), (23.5 + 23.5) / 2);
+  // The text says so, and never calls 36 convergent.
+  EXPECT_NE(report.text.find("S09 narrow (session 1): not finished, stopped after 6 trials with 0 reversals"), std::string::npos)
+      << report.text;
+  EXPECT_EQ(report.text.find("convergent 36"), std::string::npos) << report.text;
+  // The runs table: a status column.
+  ASSERT_EQ(report.tables.size(), 1u);
+  const std::string csv = read_file(report.tables[0]);
+  EXPECT_NE(csv.find(",status,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("S09,1,narrow,narrow,,6,0,not finished,0,36,,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("S01,1,narrow,narrow,,4,1,finished,1,23.5,23.5,21,1"), std::string::npos) << csv;
+  // The figure: the run's line is labelled, and its panel titled, "not finished".
+  std::vector<const TrialRow*> ptrs;
+  const auto rows = with_unfinished_run();
+  for (const auto& r : rows) ptrs.push_back(&r);
+  const Figure f = analysis_figures::staircase_tracks(*find_study("texel-length"), ptrs);
+  bool labelled = false;
+  for (const auto& p : f.panels)
+    for (const auto& l : p.lines)
+      if (l.label == "narrow (not finished)") labelled = p.title.find("not finished") != std::string::npos;
+  EXPECT_TRUE(labelled);
+
+  // Asked for: its end value joins the group statistics, still labelled.
+  AnalysisOptions with = o;
+  with.include_unfinished = true;
+  with.out_dir.clear();
+  const json w = summary_of(analyze(with_unfinished_run(), with))["texel-length"];
+  EXPECT_EQ(run_of(w, "S09", "narrow")["status"], "not finished");
+  EXPECT_EQ(w["blocks"][0]["participants"], 3);
+  EXPECT_EQ(w["blocks"][0]["unfinished_runs_included"], 1);
+  EXPECT_DOUBLE_EQ(w["blocks"][0]["convergent"]["mean"].get<double>(), (23.5 + 23.5 + 36.0) / 3);
+}
+
+TEST(Analysis, AnUnfinishedGuidedRunIsLeftOutOfTheMatches) {
+  std::vector<TrialRow> rows;
+  for (int p = 0; p < 3; ++p) {
+    TrialRow r = base("guided-exploration", "G0" + std::to_string(p + 1), 0);
+    r.task = "guided";
+    r.reference = "4sin";
+    r.pitch_db = p;
+    r.irregularity_db = -p;
+    r.procedure_finished = p != 2;
+    rows.push_back(r);
+  }
+  const json s = summary_of(analyze(rows, {}))["guided-exploration"];
+  EXPECT_EQ(s["references"][0]["n"], 2);
+  ASSERT_EQ(s["unfinished"].size(), 1u);
+  EXPECT_EQ(s["unfinished"][0]["status"], "not finished");
+  AnalysisOptions with;
+  with.include_unfinished = true;
+  EXPECT_EQ(summary_of(analyze(rows, with))["guided-exploration"]["references"][0]["n"], 3);
+}
+
+TEST(Analysis, TheSourceRuleReproducesTheSourcesExclusionsFromItsOwnFigures) {
+  // The source: main-task errors mean 10.63, SD 3.36; it excluded the
+  // participants with 17 (z 1.90) and 18 (z 2.19) errors, "near two
+  // standard deviations". The literal mean + 2 SD (17.35) would keep 17.
+  const AnalysisOptions o;
+  const double limit = memory_errors_limit(10.63, 3.36, o);
+  EXPECT_GE(17.0, limit);
+  EXPECT_GE(18.0, limit);
+  EXPECT_LT(16.0, limit);  // z 1.60: kept
+  AnalysisOptions literal;
+  literal.memory_errors_sd_tolerance = 0;
+  EXPECT_NEAR(memory_errors_limit(10.63, 3.36, literal), 17.35, 1e-12);
+  EXPECT_LT(17.0, memory_errors_limit(10.63, 3.36, literal));
+  // A tolerance at or beyond the SD count is refused.
+  AnalysisOptions bad;
+  bad.memory_errors_sd_tolerance = 2.0;
+  EXPECT_THROW(analyze(memory_rows(), bad), InvalidArgument);
 }

@@ -281,6 +281,10 @@ TEST(ExperimentCli, TerminalRunnerTakesKeyAnswersAndSavesOnEndOfInput) {
   EXPECT_EQ(rows[0].intensity, 26.0);
   const auto status = nlohmann::json::parse(run("experiment status --db " + db + " --json").out);
   EXPECT_EQ(status["sessions"][0]["status"], "running");
+  // The one vocabulary (session_state.hpp): unfinished and held by nobody = stopped, in JSON and text alike.
+  EXPECT_EQ(status["sessions"][0]["state"], "stopped");
+  EXPECT_NE(run("experiment status --db " + db).out.find("[stopped]"), std::string::npos);
+  EXPECT_NE(run("experiment list --db " + db).out.find(" stopped "), std::string::npos);
 }
 
 TEST(ExperimentCli, BadInputIsOneLineExitTwoAndTouchesNothing) {

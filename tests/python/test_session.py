@@ -109,6 +109,7 @@ def test_simulate_cohort_and_protocol_as_dict(protocol, tmp_path):
         ids = simulate_cohort(store, json.loads(protocol.read_text()), ["A1", "A2"])
         assert len(ids) == 2
         assert {x["status"] for x in store.sessions()} == {"finished"}
+        assert {x["state"] for x in store.sessions()} == {"finished"}
 
 
 def test_store_mode_is_checked(tmp_path):

@@ -42,12 +42,10 @@ function duration(ms: number): string {
   return `${Math.floor(m / 60)} h ${m % 60} min`;
 }
 
-type State = 'running' | 'suspended' | 'finished' | string;
-/** A stored session's state as the experimenter needs it: the studio's active one runs; an unfinished other one is suspended. */
-function stateOf(s: StoredSession, activeId: number | null): State {
-  if (s.finished) return 'finished';
-  if (s.id === activeId) return 'running';
-  return s.status === 'running' ? 'suspended' : s.status;
+type State = StoredSession['state'];
+/** A stored session's state: the library's word (session_state.hpp), which the service sets for the session it holds. */
+function stateOf(s: StoredSession, _activeId: number | null): State {
+  return s.state;
 }
 
 const num = (c: string | undefined) => (c === undefined || c === '' ? NaN : Number(c));
@@ -341,7 +339,7 @@ export function mountExperimenter(root: HTMLElement): void {
   function row(s: StoredSession, state: State): HTMLElement {
     const who = `session ${s.id} (${s.participant}, ${s.protocol})`;
     const actions = h('div', { class: 'btn-row' });
-    if (state === 'suspended')
+    if (state === 'stopped')
       actions.append(h('button', { type: 'button', 'aria-label': `Resume ${who}`, onclick: () => void start(s.protocol, s.participant, true, '') }, 'Resume'));
     if (state === 'running') actions.append(h('button', { type: 'button', 'aria-label': `Stop ${who}`, onclick: () => void stop() }, 'Stop'));
     actions.append(

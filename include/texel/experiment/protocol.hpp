@@ -135,6 +135,11 @@ struct Block {
   int matrix_cells = 5;
   bool recall_question = true;
   bool balance_order = false;  ///< draw per trial which stimulus texture comes first (and is repeated on "same")
+  /// `base_textures` "per-texture": each stimulus texture (a `patch-*`
+  /// reference) has one gap set per session and every presentation is a
+  /// rearrangement of it (the source's 64 textures); false ("per-trial",
+  /// the default): a new gap set every trial.
+  bool base_per_texture = false;
 
   // Familiarisation.
   std::vector<NamedTexture> textures;

@@ -37,8 +37,16 @@ class SameDifferentBlock : public TaskBlock {
     // balance_order: which of the pair comes first (and is repeated on a
     // "same" trial) is drawn per trial; otherwise always `texture`.
     const bool swapped = b.balance_order && s.trial_below(64, 2) == 1;
-    const json first = texel_texture(texture_of(swapped ? ms.different : ms.texture), seed);
-    const json second = same ? first : texel_texture(texture_of(swapped ? ms.texture : ms.different), seed);
+    json first = texel_texture(texture_of(swapped ? ms.different : ms.texture), seed);
+    json second = texel_texture(texture_of(swapped ? ms.texture : ms.different), seed);
+    if (b.base_per_texture) {
+      // The source's design: one base gap set per texture for the whole
+      // session, each presentation a rearrangement of it (its own shuffle
+      // number, drawn per trial; the two of a "different" pair differ).
+      first = rearranged(s, texture_of(swapped ? ms.different : ms.texture), 0);
+      second = rearranged(s, texture_of(swapped ? ms.texture : ms.different), 1);
+    }
+    if (same) second = first;
     q.stimuli.push_back({"Texture 1", s.single(first)});
     q.stimuli.push_back({"Texture 2", s.single(second)});
     std::array<int, 16> m{};
@@ -81,6 +89,31 @@ class SameDifferentBlock : public TaskBlock {
 
   bool finished(const SessionCore& s) const override { return s.trial_in_block >= static_cast<int>(plan_.size()); }
 
+  /// The session's base seed of a texture: one per reference name, from the
+  /// session's order stream at a counter no block uses, so every trial of
+  /// every block (training and test) rearranges the same gap set, and the
+  /// familiarisation (its own trial seed) feels other maps.
+  static std::uint64_t base_seed(const SessionCore& s, const std::string& name) {
+    std::uint64_t h = 1469598103934665603ull;  // FNV-1a of the name, folded to 16 bits
+    for (const unsigned char c : name) h = (h ^ c) * 1099511628211ull;
+    return s.order_rng.bits(draw_counter(std::uint64_t{1} << 30, (h ^ (h >> 16) ^ (h >> 32) ^ (h >> 48)) & 0xffff)) >> 11;
+  }
+
+  /// A texture of the block as a rearrangement of its session base: the base
+  /// seed, and shuffle number k of this trial (1 … 2^31 − 1; the two textures
+  /// of a trial, `which` 0 and 1, draw different numbers).
+  static json rearranged(const SessionCore& s, json t, std::uint64_t which) {
+    if (!t.contains("seed")) t["seed"] = base_seed(s, t.value("name", std::string()));
+    const std::uint64_t first = 1 + s.trial_below(80, 2147483646);
+    std::uint64_t k = first;
+    if (which == 1) {
+      k = 1 + s.trial_below(81, 2147483645);
+      if (k >= first) ++k;  // never the first texture's arrangement
+    }
+    t["params"]["shuffle"] = k;
+    return t;
+  }
+
   // The digit the recall question asks for (control: every cell holds 1).
   static int recalled_digit(const Question& q) {
     return q.recall->cell ? (*q.matrix)[static_cast<std::size_t>(*q.recall->cell)] : 1;
@@ -94,8 +127,8 @@ class SameDifferentTask : public TaskType {
  public:
   std::string_view name() const override { return "same-different"; }
   std::vector<std::string_view> keys() const override {
-    return {"stimuli",  "conditions",   "trials_per_condition", "texture_s",
-            "matrix_s", "matrix_cells", "recall_question",      "balance_order"};
+    return {"stimuli",      "conditions",      "trials_per_condition", "texture_s",    "matrix_s",
+            "matrix_cells", "recall_question", "balance_order",        "base_textures"};
   }
 
   void parse(BlockInput& in, Block& b) const override {
@@ -133,6 +166,18 @@ class SameDifferentTask : public TaskType {
     b.matrix_cells = static_cast<int>(o.has("matrix_cells") ? o.integer("matrix_cells", 1, 9) : (o.skip("matrix_cells"), 5));
     b.recall_question = o.boolean_or("recall_question", true);
     b.balance_order = o.boolean_or("balance_order", false);
+    const std::string base = o.has("base_textures") ? o.string("base_textures") : (o.skip("base_textures"), "per-trial");
+    if (base != "per-trial" && base != "per-texture")
+      throw FormatError(o.field("base_textures") + " is '" + base + "'; allowed: per-trial, per-texture");
+    b.base_per_texture = base == "per-texture";
+    if (b.base_per_texture)
+      for (const MemoryStimulus& ms : b.memory_stimuli)
+        for (const TextureTemplate* t : {&ms.texture, &ms.different}) {
+          const auto j = nlohmann::json::parse(t->json);
+          if (j.value("kind", std::string()) != "reference" || !j.value("name", std::string()).starts_with("patch-"))
+            throw FormatError(o.field("base_textures") + " is 'per-texture', which rearranges gap sets; " + o.field("stimuli") +
+                              "." + ms.name + " has a texture that is not a patch-* reference");
+        }
   }
 
   std::optional<int> planned_trials(const Block& b) const override {

@@ -54,9 +54,9 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     assert.match(await page.textContent('[data-testid=active-progress]'), /^\d+ trials \(adaptive\)|^\d+ \/ \d+ trials/);
     await screenshot(page, 'experimenter-live-track');
 
-    // Stop: the row becomes suspended (resumable) and offers Resume.
+    // Stop: the row becomes stopped (resumable) and offers Resume.
     await page.click('[data-testid=stop]');
-    await run.locator('[data-testid=session-state]:text-is("suspended")').waitFor({ timeout: 30_000 });
+    await run.locator('[data-testid=session-state]:text-is("stopped")').waitFor({ timeout: 30_000 });
     assert.equal(await run.getByRole('button', { name: /^Resume/ }).count(), 1);
 
     // Starting it again without "resume": a plain-word refusal.
