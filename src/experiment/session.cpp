@@ -167,8 +167,11 @@ std::string Question::to_json() const { return question_view(*this).dump(); }
 
 std::string Question::participant_json() const {
   ordered_json j = question_view(*this);
-  if (!show_maps)
-    for (auto& s : j["stimuli"]) s.erase("document");
+  // Nothing a participant must not know: the block (its name and place give the
+  // condition away) and the stimuli's documents (parameters and seeds; a
+  // show_maps question's maps are drawn from the rendered maps instead).
+  for (const char* key : {"block_index", "block", "trial_in_block", "block_trials"}) j.erase(key);
+  for (auto& s : j["stimuli"]) s.erase("document");
   return j.dump();
 }
 
@@ -184,6 +187,7 @@ ordered_json response_view(const Response& r) {
   if (r.swipe_mean_speed_mm_s) j["swipe_mean_speed_mm_s"] = *r.swipe_mean_speed_mm_s;
   if (r.swipe_sd_speed_mm_s) j["swipe_sd_speed_mm_s"] = *r.swipe_sd_speed_mm_s;
   if (r.directional_proportion) j["directional_proportion"] = *r.directional_proportion;
+  if (!r.swipe_flag.empty()) j["swipe_flag"] = r.swipe_flag;
   if (!r.strokes.empty()) {
     ordered_json list = ordered_json::array();
     const auto number = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); };
@@ -313,6 +317,7 @@ Response response_from(const json& j) {
                                               "swipe_mean_speed_mm_s",
                                               "swipe_sd_speed_mm_s",
                                               "directional_proportion",
+                                              "swipe_flag",
                                               "shown_at",
                                               "answered_at",
                                               "events",
@@ -335,6 +340,10 @@ Response response_from(const json& j) {
   r.swipe_mean_speed_mm_s = opt("swipe_mean_speed_mm_s");
   r.swipe_sd_speed_mm_s = opt("swipe_sd_speed_mm_s");
   r.directional_proportion = opt("directional_proportion");
+  if (j.contains("swipe_flag") && !j["swipe_flag"].is_null()) {
+    if (!j["swipe_flag"].is_string()) throw FormatError("response.swipe_flag must be a string, got " + j["swipe_flag"].dump());
+    r.swipe_flag = j["swipe_flag"].get<std::string>();
+  }
   if (j.contains("shown_at") && j["shown_at"].is_string()) r.shown_at = j["shown_at"].get<std::string>();
   if (j.contains("answered_at") && j["answered_at"].is_string()) r.answered_at = j["answered_at"].get<std::string>();
   if (j.contains("events") && !j["events"].is_null()) r.events = events_from_json(j["events"]);
@@ -422,6 +431,7 @@ struct Session::Impl : SessionCore {
     if (r.swipe_mean_speed_mm_s) row.swipe_mean_speed_mm_s = *r.swipe_mean_speed_mm_s;
     if (r.swipe_sd_speed_mm_s) row.swipe_sd_speed_mm_s = *r.swipe_sd_speed_mm_s;
     if (r.directional_proportion) row.directional_proportion = *r.directional_proportion;
+    row.swipe_flag = r.swipe_flag;
     fill_stroke_columns(r.strokes, q.stimuli.size(), row);
     require(!(std::isfinite(r.rt_ms) && r.rt_ms < 0), "rt_ms is " + texel::detail::num(r.rt_ms) + "; allowed: >= 0 ms");
     if (!q.choices.empty()) {

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <numbers>
 #include <thread>
@@ -104,12 +105,22 @@ TEST(Service, MalformedAndHostileMessagesGetErrors) {
   expect_error(c.ask({{"type", "rm -rf"}}), "bad_message");
   expect_error(c.ask({{"type", "experiment.delete"}}), "bad_message");
   expect_error(c.ask({{"type", "hello"}, {"extra", 1}}), "bad_message");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", "1"}, {"x_mm", 1}, {"touch", true}}), "bad_message");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", "NaN"}, {"touch", true}}), "bad_message");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 1e300}, {"touch", true}}), "invalid");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", -1}, {"x_mm", 1}, {"touch", true}}), "invalid");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 18446744073709551615u}, {"x_mm", 1}, {"touch", true}}), "invalid");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 1}, {"touch", 1}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", "1"}, {"t_ms", 0}, {"x_mm", 1}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", "NaN"}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", 1e300}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", -1}, {"t_ms", 0}, {"x_mm", 1}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 18446744073709551615u}, {"t_ms", 0}, {"x_mm", 1}, {"touch", true}}),
+               "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", 1}, {"touch", 1}}), "bad_message");
+  // Every sample carries the browser's time of it (PointerEvent.timeStamp, ms): required, finite, in range.
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 1}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", "5"}, {"x_mm", 1}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", -1}, {"x_mm", 1}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 1e13}, {"x_mm", 1}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 5}, {"x_mm", 1}, {"coalesced", {{6, 1}}}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 5}, {"x_mm", 1}, {"coalesced", {{3, 1}, {2, 1}}}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 5}, {"x_mm", 1}, {"coalesced", {{3}}}}), "bad_message");
+
   expect_error(c.ask({{"type", "design"}}), "bad_message");
   expect_error(c.ask({{"type", "design"}, {"document", "tpad"}}), "bad_message");
   expect_error(c.ask({{"type", "design"}, {"document", {{"format", "texel-document"}}}}), "invalid");
@@ -285,20 +296,133 @@ TEST(Service, ResponseOptionIsValidated) {
   EXPECT_EQ(c.ask({{"type", "feel.select"}, {"document", tpad_document()}})["type"], "feel.selected");
 }
 
+// Every limit the designer states (hello's texture_limits and device_limits)
+// is the one the engine applies: each bound is accepted by `design`, a hair
+// beyond it refused (issue #37).
+TEST(Service, EveryStatedTextureLimitIsTheEngines) {
+  texel::test_support::TempDir dir("studio");
+  Service s(options(dir.at("db")));
+  Client c(s);
+  const json hello = c.ask({{"type", "hello"}});
+  const json& lim = hello["texture_limits"];
+  // Where each limit goes in a document's texture (and what else that texture needs).
+  struct Case {
+    std::string key;
+    std::function<void(json& texture, double v)> set;
+    json range;
+  };
+  const auto plain = [](const char* k) { return [k](json& t, double v) { t[k] = v; }; };
+  json pitch;
+  for (const auto& d : hello["device_limits"])
+    if (d["device"] == "tpad") pitch = d["central_pitch_db"];
+  ASSERT_TRUE(pitch.is_object()) << hello["device_limits"].dump();
+  const double shortest = 19200 * 0.0053 / hello["limits"]["max_map_samples"].get<double>();
+  std::vector<Case> cases{
+      {"central_pitch_db (tpad)", plain("central_pitch_db"), pitch},
+      {"irregularity_db", plain("irregularity_db"), lim["irregularity_db"]},
+      {"irregularity_db_log",
+       [](json& t, double v) {
+         t["parameterization"] = "log";
+         t["irregularity_db"] = v;
+       },
+       lim["irregularity_db_log"]},
+      {"texel_length_mm (tpad)", plain("texel_length_mm"), json{{"min", shortest}, {"max", lim["texel_length_mm"]["max"]}}},
+      {"quantization_db", plain("quantization_db"), lim["quantization_db"]},
+      {"coarse_strength", plain("coarse_strength"), lim["coarse_strength"]},
+      {"fine_strength", plain("fine_strength"), lim["fine_strength"]},
+      {"coarse_value",
+       [](json& t, double v) {
+         t["coarse"] = {{"kind", "constant"}, {"value", v}};
+       },
+       lim["coarse_value"]},
+      {"sine_period_mm",
+       [](json& t, double v) {
+         t["coarse"] = {{"kind", "sine"}, {"period_mm", v}, {"phase_deg", 0}};
+       },
+       lim["sine_period_mm"]},
+      {"sine_phase_deg",
+       [](json& t, double v) {
+         t["coarse"] = {{"kind", "sine"}, {"period_mm", 5}, {"phase_deg", v}};
+       },
+       lim["sine_phase_deg"]},
+  };
+  ASSERT_EQ(lim.size(), 10u) << "a new limit needs its case here: " << lim.dump();
+  const auto design = [&](const Case& k, double v) {
+    json doc = tpad_document();
+    k.set(doc["texture"], v);
+    return c.ask({{"type", "design"}, {"document", doc}});
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.key + " " + k.range.dump());
+    ASSERT_TRUE(k.range.is_object());
+    const double hair = 1e-6;
+    if (k.range["min"].is_number()) {
+      const double lo = k.range["min"];
+      const double below = lo - std::max(hair, std::abs(lo) * 1e-9);
+      if (k.range.value("exclusive_min", false)) {
+        EXPECT_EQ(design(k, lo)["type"], "error");
+        EXPECT_EQ(design(k, lo + hair)["type"], "design");
+      } else {
+        const json at = design(k, lo);
+        EXPECT_EQ(at["type"], "design") << at.dump().substr(0, 300);
+      }
+      EXPECT_EQ(design(k, below)["type"], "error") << below;
+    }
+    if (k.range["max"].is_number()) {
+      const double hi = k.range["max"];
+      const json at = design(k, hi);
+      EXPECT_EQ(at["type"], "design") << at.dump().substr(0, 300);
+      EXPECT_EQ(design(k, hi + std::max(hair, std::abs(hi) * 1e-9))["type"], "error");
+    }
+    if (k.range["min"].is_null() && k.range["max"].is_null()) {
+      EXPECT_EQ(design(k, -1e300)["type"], "design");
+      EXPECT_EQ(design(k, 1e300)["type"], "design");
+    }
+  }
+}
+
+// feel.move's times are the page's clock (one connection, one page): never
+// back, never ahead of the studio's clock by more than 100 ms from one message
+// to the next; each page has its own.
+TEST(Service, FeelMoveTimesAreThePagesClock) {
+  texel::test_support::TempDir dir("studio");
+  Service s(options(dir.at("db")));
+  Client c(s), other(s);
+  const auto move = [](Client& k, int seq, double t_ms, const json& coalesced = nullptr) {
+    json m{{"type", "feel.move"}, {"seq", seq}, {"t_ms", t_ms}, {"x_mm", 10}, {"touch", true}};
+    if (!coalesced.is_null()) m["coalesced"] = coalesced;
+    return k.ask(m);
+  };
+  EXPECT_EQ(move(c, 1, 1000)["type"], "feel.ack");
+  EXPECT_EQ(move(c, 2, 1000)["type"], "feel.ack");  // the same time again: non-decreasing
+  const json back = move(c, 3, 999.5);
+  expect_error(back, "invalid");
+  EXPECT_NE(back["message"].get<std::string>().find("before this page's previous sample"), std::string::npos) << back.dump();
+  expect_error(move(c, 4, 1005, json{{1003, 10}, {999, 10}}), "invalid");  // a coalesced sample goes back
+  EXPECT_EQ(move(c, 5, 1012, json{{1004, 10}, {1008, 10}})["type"], "feel.ack");
+  const json ahead = move(c, 6, 1012 + 60'000);  // a minute ahead, a moment later
+  expect_error(ahead, "invalid");
+  EXPECT_NE(ahead["message"].get<std::string>().find("ahead of the studio's clock"), std::string::npos) << ahead.dump();
+  json many = json::array();
+  for (int k = 0; k < 65; ++k) many.push_back({1012, 10});
+  expect_error(move(c, 7, 1013, many), "bad_message");
+  EXPECT_EQ(move(other, 1, 3)["type"], "feel.ack");  // another page, its own clock
+}
+
 TEST(Service, FeelMovesReachThePlayer) {
   texel::test_support::TempDir dir("studio");
   Service s(options(dir.at("db")));
   Client c(s);
   EXPECT_EQ(c.ask({{"type", "feel.select"}, {"document", tpad_document()}})["type"], "feel.selected");
   for (int i = 0; i < 20; ++i) {
-    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 30.0 + 0.1 * i}, {"touch", true}});
+    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 30.0 + 0.1 * i}, {"touch", true}});
     ASSERT_EQ(a["type"], "feel.ack") << a.dump();
     EXPECT_EQ(a["seq"], i);
     std::this_thread::sleep_for(1ms);
   }
   // Hold still so the player's velocity estimate settles (it extrapolates a moving finger).
   for (int i = 20; i < 60; ++i) {
-    c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 31.9}, {"touch", true}});
+    c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 31.9}, {"touch", true}});
     std::this_thread::sleep_for(1ms);
   }
   std::this_thread::sleep_for(60ms);  // the null backend plays past the samples' lead
@@ -380,15 +504,21 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
       ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
       EXPECT_EQ(static_cast<int>(st.trials(session_id).size()), r["question"]["trial"].get<int>());
     };
-    // Some swipes during the trial feed the swipe measures.
-    for (int i = 0; i < 30; ++i) c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 20.0 + i}, {"touch", true}});
+    // The swipes of each trial give its swipe measures, from the samples' own times (t_ms), not
+    // their arrival: trial 0, 30 samples 1 mm and 10 ms apart sent in one burst, is 100 mm/s; trial
+    // 1's, 10 µs apart, cannot be a hand's (flagged, not stored); trial 2 has no swipe.
+    double t_ms = 0;
     for (trial = 0; trial < 3; ++trial) {
+      for (int i = 0; i < 30 && trial < 2; ++i, t_ms += trial == 0 ? 10.0 : 0.01)
+        ASSERT_EQ(c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", t_ms}, {"x_mm", 20.0 + i}, {"touch", true}})["type"],
+                  "feel.ack");
       const std::string choice = q["question"]["choices"][0];
       const std::string token = q["handout"]["token"];
+      // The page's own swipe figures are not taken.
       q = c.ask({{"type", "experiment.answer"},
                  {"trial", trial},
                  {"token", token},
-                 {"response", {{"choice", choice}, {"rt_ms", 900}}}});
+                 {"response", {{"choice", choice}, {"rt_ms", 900}, {"swipe_mean_speed_mm_s", 5}}}});
       ASSERT_EQ(q["type"], "experiment.question") << q.dump();
       EXPECT_EQ(q["question"]["trial"], trial + 1);
       EXPECT_EQ(q["progress"]["done"], trial + 1);
@@ -403,7 +533,19 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
       ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
       const auto trials = st.trials(session_id);
       ASSERT_EQ(trials.size(), 3u);
-      EXPECT_NE(json::parse(trials[0].response_json).value("swipe_mean_speed_mm_s", -1.0), -1.0);
+      const json r0 = json::parse(trials[0].response_json), r1 = json::parse(trials[1].response_json),
+                 r2 = json::parse(trials[2].response_json);
+      EXPECT_NEAR(r0.value("swipe_mean_speed_mm_s", -1.0), 100.0, 0.01) << r0.dump();
+      EXPECT_NEAR(r0.value("swipe_sd_speed_mm_s", -1.0), 0.0, 0.01) << r0.dump();
+      EXPECT_EQ(r0.value("directional_proportion", -1.0), 1.0) << r0.dump();
+      EXPECT_FALSE(r0.contains("swipe_flag")) << r0.dump();
+      EXPECT_FALSE(r1.contains("swipe_mean_speed_mm_s")) << r1.dump();
+      EXPECT_EQ(r1.value("swipe_flag", "").rfind("implausible_speed: mean 100000.0 mm/s", 0), 0u) << r1.dump();
+      EXPECT_FALSE(r2.contains("swipe_mean_speed_mm_s") || r2.contains("swipe_flag")) << r2.dump();
+      const auto rows = st.rows(session_id);
+      EXPECT_NEAR(rows[0].swipe_mean_speed_mm_s, 100.0, 0.01);
+      EXPECT_TRUE(std::isnan(rows[1].swipe_mean_speed_mm_s));
+      EXPECT_EQ(rows[1].swipe_flag, r1["swipe_flag"]);  // the export shows why
     }
     // A second start is refused while this one runs; a reload sees the same question.
     expect_error(c.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "P02"}}), "conflict");
@@ -519,7 +661,7 @@ TEST(Service, ManyThreadsAtOnce) {
     threads.emplace_back([&, t] {
       Client c(s);
       for (int i = 0; i < 50; ++i) {
-        s.handle(c.id, json{{"type", "feel.move"}, {"seq", i}, {"x_mm", 10.0 * t}, {"touch", true}}.dump());
+        s.handle(c.id, json{{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 10.0 * t}, {"touch", true}}.dump());
         if (i % 10 == 0) s.handle(c.id, json{{"type", "design"}, {"document", tpad_document(5 + i * 0.1)}}.dump());
       }
       if (t % 2) s.disconnect(c.id);

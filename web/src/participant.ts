@@ -29,7 +29,6 @@
 import { studio, StudioError } from './ws';
 import { h, isoNow, decodeF32 } from './util';
 import { FeelStrip } from './feel';
-import { getHello, deviceLength } from './designer';
 import { Store } from './store';
 import type { ExperimentQuestionReply, Question, Response, ServerMessages, TrialEvent } from './generated/messages';
 
@@ -376,15 +375,8 @@ export function mountParticipant(root: HTMLElement): void {
       : null;
     if (surface) endQuestion = () => (clearTimers(), surface.dispose());
 
-    try {
-      const hi = await getHello();
-      const dev = q.stimuli.find((x) => x.document)?.document?.device ?? 'tpad';
-      const p = typeof dev === 'object' ? dev : hi.devices.find((d) => d.name === dev);
-      if (p) strip.setLength(deviceLength(p));
-    } catch {
-      /* keep the default length */
-    }
-    if (!current()) return; // the session moved on while the device was looked up
+    // The strip's length is the protocol's device's (the question carries no documents).
+    if (typeof reply.strip_mm === 'number') strip.setLength(reply.strip_mm);
 
     // ---- the trial's one state: inputs write it, render() enables Submit from it
     type Answer = Pick<Response, 'choice' | 'rating' | 'confidence' | 'digit' | 'slider_p' | 'slider_i'>;
@@ -491,20 +483,12 @@ export function mountParticipant(root: HTMLElement): void {
       if (q.show_maps) {
         const maps = h('div', { class: 'maps' });
         parts.push(maps);
-        // One at a time: the service keeps only the newest queued design per client.
-        void (async () => {
-          for (const s of q.stimuli) {
-            const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
-            maps.append(h('div', {}, h('span', {}, s.label), c));
-            if (!s.document) continue;
-            try {
-              const r = await client.call('design', { document: s.document }, 60000);
-              drawMiniMap(c, decodeF32(r.map_f32));
-            } catch {
-              /* maps are an aid only */
-            }
-          }
-        })();
+        // The studio sends the rendered maps (never the documents: their parameters and seeds).
+        for (const s of q.stimuli) {
+          const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
+          maps.append(h('div', {}, h('span', {}, s.label), c));
+          if (s.map_f32) drawMiniMap(c, decodeF32(s.map_f32));
+        }
       }
     } else {
       parts.push(phaseArea);

@@ -106,9 +106,10 @@ struct Question {
   /// The engine's JSON view (JSON text; stored with every trial, so its bytes
   /// are part of the store format: docs/format.md "Result field names").
   [[nodiscard]] std::string to_json() const;
-  /// What a participant's screen may see: to_json() without the stimulus
-  /// documents (their parameters would give the odd one away) unless the
-  /// question asks to draw the maps.
+  /// What a participant's screen may see: to_json() without the block (name,
+  /// index, place in it) and without the stimulus documents (their parameters
+  /// would give the odd one away, their seeds are the session's); a front end
+  /// that draws a show_maps question's maps sends the rendered maps.
   [[nodiscard]] std::string participant_json() const;
 };
 
@@ -122,6 +123,9 @@ struct Response {
   double rt_ms = missing;                    ///< first presentation → answer
   std::vector<TrialEvent> events;            ///< presentation / selection events
   std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
+  /// Why a finger trace gave no swipe measures (swipe_check.hpp: "too_short: …",
+  /// "implausible_speed: …"); empty when they are stored or there was no trace.
+  std::string swipe_flag;
   /// A 2-D display's strokes, one entry per interval felt (strokes.hpp); fills
   /// the row's stroke columns.
   std::vector<IntervalStrokes> strokes;
