@@ -128,7 +128,7 @@ ojson make_hello(const State& s) {
     h["references"].push_back(std::move(r));
   }
   h["parameterizations"] = {"moments", "log"};
-  h["export_formats"] = {"document", "bitstream", "device", "npy", "csv"};
+  h["export_formats"] = {"document", "bitstream", "device", "npy", "csv", "hjif"};
   h["import_extensions"] = {".texel.json", ".json", ".texel", ".bin", ".npy", ".csv", ".wav"};
   h["limits"] = {{"max_message_bytes", s.options.max_message_bytes},
                  {"max_messages_per_s", s.options.max_messages_per_s},
@@ -206,6 +206,7 @@ void on_design(State& s, Client& c, const Job& job) {
     r["irregularity_cpm"] = nullptr;
   }
   r["texels"] = v.texels;
+  r["uncovered_mm"] = v.uncovered_mm;
   r["queued_ms"] = std::chrono::duration<double, std::milli>(t0 - job.received).count();
   r["elapsed_ms"] = ms_since(t0);
   send(c, r);

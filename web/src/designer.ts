@@ -414,6 +414,7 @@ export function mountDesigner(root: HTMLElement): void {
   const driveWarn = h('p', { class: 'drive-warning', 'data-testid': 'drive-warning', hidden: true });
   const hzNote = h('p', { class: 'hint', 'data-testid': 'hz-note' });
   const texelsEl = h('span', { 'data-testid': 'texels' });
+  const flatWarn = h('p', { class: 'drive-warning', 'data-testid': 'flat-warning', role: 'status', hidden: true });
   const elapsedEl = h('span', { 'data-testid': 'elapsed' });
 
   // --- design requests and redraw timing
@@ -538,6 +539,15 @@ export function mountDesigner(root: HTMLElement): void {
       hexEl.textContent = r.encoded?.error ?? '';
     }
     texelsEl.textContent = r.texels !== undefined ? `${r.texels} texels` : '';
+    // Whole texels only: what the last texel does not reach stays flat. Say so (it was silent) when a
+    // finger can feel it: 1 mm or more (0.25 mm texels leave 0.04 mm of the tpad, not worth a word).
+    const flat = r.uncovered_mm ?? 0;
+    const L = store.get().texel.texel_length_mm;
+    flatWarn.hidden = !(flat >= 1);
+    flatWarn.textContent = flatWarn.hidden
+      ? ''
+      : `With ${L} mm texels, ${r.texels} whole texel${r.texels === 1 ? '' : 's'} cover the texture region; the last ${fmt(flat, 2)} mm of it are flat (no texel fits there). ` +
+        'A shorter texel length, or a length that divides the region, textures all of it.';
     elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
     strip.setLength(r.grid.count * r.grid.spacing_mm);
     strip.setMap(values, r.grid.origin_mm, r.grid.spacing_mm);
@@ -1004,7 +1014,7 @@ export function mountDesigner(root: HTMLElement): void {
     'form',
     { class: 'controls', 'aria-label': 'Texture parameters', onsubmit: (e: Event) => e.preventDefault() },
     h('div', { class: 'btn-row history' }, undoBtn, redoBtn, freshBtn, savedNote),
-    h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row,
+    h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row, flatWarn,
       h('div', { class: 'ctl' }, h('label', { for: 'seed' }, 'Seed ', h('span', { class: 'unit' }, '(whole number ≥ 0)')), h('div', { class: 'ctl-row' }, seedIn, newDraw), seedErr),
       param.row, quant.row, fStrength.row),
     h('fieldset', {}, h('legend', {}, 'Swipe speed'), speed.row, driveWarn),
@@ -1016,7 +1026,8 @@ export function mountDesigner(root: HTMLElement): void {
         fileIn,
         h('button', { type: 'button', onclick: () => void exportAs('document'), 'data-testid': 'export-document' }, 'Export .texel.json'),
         exportBits,
-        h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin')),
+        h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin'),
+        h('button', { type: 'button', onclick: () => void exportAs('hjif'), 'data-testid': 'export-hjif', title: 'MPEG-I Haptics interchange (texel export -o x.hjif)' }, 'Export .hjif')),
       bitsNote, filesErr,
       h('p', { class: 'hint' }, 'Or drop a file anywhere on the page. The design is also kept in this browser.'),
       stimulusSaver(() => buildDocument(store.get()))),

@@ -341,6 +341,18 @@ test('designer: ranges cover every shipped protocol', { timeout: 120_000 }, asyn
     await nextDraw(page, n);
     assert.equal(await page.inputValue('#texel-length'), '26');
     assert.equal(await page.isVisible('[data-testid=texel-length-error]'), false);
+    // Three whole 26 mm texels on the tpad's 101.76 mm: the last 23.76 mm are flat, and the page says so (issue #37).
+    assert.match(await page.textContent('[data-testid=flat-warning]'), /With 26 mm texels, 3 whole texels .* the last 23\.76 mm of it are flat/);
+    assert.ok(await page.isVisible('[data-testid=flat-warning]'));
+    // .hjif, as the CLI writes it.
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('[data-testid=export-hjif]')]);
+    assert.equal(download.suggestedFilename(), 'texture.hjif');
+    const hjif = JSON.parse(readFileSync(await download.path(), 'utf8'));
+    assert.ok(Array.isArray(hjif.perceptions) && hjif.perceptions.length > 0, 'an MPEG-I Haptics file with its perceptions');
+    const n2 = (await stats(page)).designsDrawn;
+    await typeInto(page, '#texel-length-value', '0.25');
+    await nextDraw(page, n2);
+    assert.equal(await page.isVisible('[data-testid=flat-warning]'), false, 'no warning once texels cover the device');
     assert.deepEqual(errors, []);
   });
 });
