@@ -151,10 +151,10 @@ ojson make_hello(const State& s) {
       {"quantization_db", range(0.0, quantization_db_max)},
       {"coarse_strength", range(0.0, 1.0)},
       {"fine_strength", range(0.0, 1.0)},
-      // The coarse profiles' rules (validate(CoarseProfile), src/core/coarse.cpp).
+      // The coarse profiles' ranges as the document reader checks them (src/io/document.cpp).
       {"coarse_value", range(0.0, 1.0)},
-      {"sine_period_mm", ojson{{"min", 0.0}, {"max", nullptr}, {"exclusive_min", true}}},
-      {"sine_phase_deg", ojson{{"min", nullptr}, {"max", nullptr}}}};
+      {"sine_period_mm", range(1e-9, 1e9)},
+      {"sine_phase_deg", range(-1e9, 1e9)}};
   // On a device, a Central Pitch must also lie in the renderable band: the texel
   // texture's band_min (default 0.01 cpm) up to the device's band top (its
   // band_max or Nyquist frequency) — PitchDistribution's rule, which allows

@@ -56,11 +56,11 @@ std::vector<std::pair<double, double>> coalesced_samples(const Fields& f, double
       throw Reject{"bad_message", where + " must be [t_ms, x_mm] (two numbers), got " + clipped(e.dump())};
     const double t = e[0].get<double>(), x = e[1].get<double>();
     if (!(t >= 0 && t <= max_t_ms) || !(std::abs(x) <= max_abs_mm))
-      throw Reject{"invalid", where + " is " + clipped(e.dump()) + "; allowed: t_ms 0 … " + detail::num(max_t_ms) +
-                                  ", |x_mm| <= " + detail::num(max_abs_mm)};
+      throw Reject{"invalid", where + " is " + clipped(e.dump()) + "; allowed: t_ms 0 … " + texel::detail::num(max_t_ms) +
+                                  ", |x_mm| <= " + texel::detail::num(max_abs_mm)};
     if (t > t_ms || (!out.empty() && t < out.back().first))
-      throw Reject{"invalid", where + ": t_ms " + detail::num(t) + " is out of order; allowed: non-decreasing and at most t_ms " +
-                                  detail::num(t_ms)};
+      throw Reject{"invalid", where + ": t_ms " + texel::detail::num(t) + " is out of order; allowed: non-decreasing and at most t_ms " +
+                                  texel::detail::num(t_ms)};
     out.emplace_back(t, x);
   }
   return out;
@@ -86,13 +86,13 @@ void on_feel_move(State& s, Client& c, const Job& job) {
     std::lock_guard lock(s.feel_mutex);
     const double first_ms = earlier.empty() ? t_ms : earlier.front().first;
     if (first_ms < c.pointer_t_ms)
-      throw Reject{"invalid", "feel.move: t_ms " + detail::num(first_ms) + " is before this page's previous sample (" +
-                                  detail::num(c.pointer_t_ms) +
+      throw Reject{"invalid", "feel.move: t_ms " + texel::detail::num(first_ms) + " is before this page's previous sample (" +
+                                  texel::detail::num(c.pointer_t_ms) +
                                   " ms); allowed: non-decreasing (the page's PointerEvent.timeStamp, a monotonic clock)"};
     const double lag_ms = arrival_ms - t_ms;
     if (std::isfinite(c.pointer_lag_ms) && lag_ms < c.pointer_lag_ms - max_ahead_ms)
-      throw Reject{"invalid", "feel.move: t_ms " + detail::num(t_ms) + " runs " + detail::fixed(c.pointer_lag_ms - lag_ms, 1) +
-                                  " ms ahead of the studio's clock; allowed: at most " + detail::num(max_ahead_ms) +
+      throw Reject{"invalid", "feel.move: t_ms " + texel::detail::num(t_ms) + " runs " + texel::detail::fixed(c.pointer_lag_ms - lag_ms, 1) +
+                                  " ms ahead of the studio's clock; allowed: at most " + texel::detail::num(max_ahead_ms) +
                                   " ms (the page's PointerEvent.timeStamp)"};
     c.pointer_lag_ms = std::min(c.pointer_lag_ms, lag_ms);
     c.pointer_t_ms = t_ms;

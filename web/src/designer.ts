@@ -666,9 +666,9 @@ export function mountDesigner(root: HTMLElement): void {
 
   const constVal: FieldCtl = field('coarse-value', 'Constant value', { min: 0, max: 1, step: 0.01 }, lim('coarse_value', { min: 0, max: 1 }), t.coarse_value, '0…1',
     (v, typed) => commitTexel(() => constVal, { coarse_value: v }, typed));
-  const sinePeriod: FieldCtl = field('sine-period', 'Sine period', { min: 0.5, max: 100, step: 0.1 }, lim('sine_period_mm', { min: 0, max: null, exclusiveMin: true }), t.sine_period_mm, 'mm',
+  const sinePeriod: FieldCtl = field('sine-period', 'Sine period', { min: 0.5, max: 100, step: 0.1 }, lim('sine_period_mm', { min: 1e-9, max: 1e9 }), t.sine_period_mm, 'mm',
     (v, typed) => commitTexel(() => sinePeriod, { sine_period_mm: v }, typed), periodCpm);
-  const sinePhase: FieldCtl = field('sine-phase', 'Sine phase', { min: 0, max: 360, step: 1 }, lim('sine_phase_deg', { min: null, max: null }), t.sine_phase_deg, 'degrees',
+  const sinePhase: FieldCtl = field('sine-phase', 'Sine phase', { min: 0, max: 360, step: 1 }, lim('sine_phase_deg', { min: -1e9, max: 1e9 }), t.sine_phase_deg, 'degrees',
     (v, typed) => commitTexel(() => sinePhase, { sine_phase_deg: v }, typed));
   const speed: FieldCtl = field('swipe-speed', 'Swipe speed', { min: 10, max: 500, step: 1 }, () => ({ min: 0, max: 10000, exclusiveMin: true }), store.get().speed_mm_s, 'mm/s',
     (v) => store.update({ speed_mm_s: v }));

@@ -292,7 +292,8 @@ test('designer: typed values are stored exactly as typed, or refused with the ra
     assert.ok(lengthText.includes(`range ${shortest} … 1000 mm`), `${lengthText} states ${shortest} … 1000 mm`);
     const pitch = hello.device_limits.find((d) => d.device === 'tpad').central_pitch_db;
     await refusedWith('central-pitch', '19.8', new RegExp(`outside the allowed range ${pitch.min} … ${String(pitch.max).replace('.', '\\.')} dB`));
-    await refusedWith('sine-period', '0', /outside the allowed range above 0 mm/);
+    await refusedWith('sine-period', '0', /outside the allowed range 1e-9 … 1000000000 mm/);
+    await refusedWith('sine-phase', '2e9', /outside the allowed range -1000000000 … 1000000000 degrees/);
     await page.selectOption('#coarse-kind', 'constant');
     await refusedWith('coarse-value', '1.5', /outside the allowed range 0 … 1/);
     const doc = (texel_length_mm, central_pitch_db = 10) => ({

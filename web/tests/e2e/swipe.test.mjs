@@ -90,6 +90,7 @@ test('swipe: a scripted stroke at a known speed is stored at that speed, paced o
     for (const [i, row] of t.rows.entries()) {
       const got = Number(row.swipe_mean_speed_mm_s);
       const how = i === 0 ? 'paced' : 'one burst';
+      console.log(`${how}: stored ${got} mm/s (SD ${row.swipe_sd_speed_mm_s}) for a ${want[i].toFixed(3)} mm/s stroke`);
       assert.equal(row.swipe_flag, '', `${how}: not flagged (${row.swipe_flag})`);
       assert.ok(Math.abs(got - want[i]) <= 0.02 * want[i], `${how}: stored ${got} mm/s for a ${want[i].toFixed(2)} mm/s stroke`);
       assert.ok(Number(row.directional_proportion) > 0.9, `${how}: left to right (${row.directional_proportion})`);
