@@ -194,8 +194,10 @@ ojson current_state(State& s, const json& id, bool screen, bool reload = false) 
                      : s.active->suspended        ? "experiment.suspended"
                                                   : "experiment.question";
   ojson r = reply(type, id);
-  // A participant screen gets nothing of the session (its participant code, protocol, seed).
-  if (!screen) r["session"] = session_json(s);
+  // Only a direct reply to the experimenter's side carries the session (its participant code,
+  // protocol, seed): never a participant screen, nor a push, which every connection of a
+  // participant's browser gets (the page's finger worker too).
+  if (!screen && !id.is_null()) r["session"] = session_json(s);
   r["progress"] = progress_json(s);
   if (!s.active->session.finished() && !s.active->suspended) {
     const ex::Question& q = s.active->session.question();
