@@ -25,6 +25,8 @@
 #include "base64.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/records.hpp"
+#include "texel/experiment/session.hpp"
+#include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/studio/service.hpp"
@@ -889,4 +891,53 @@ TEST(Service, TwoDStudyPreloadsItsBitmapsFromTheSessionStart) {
   EXPECT_EQ(sel["type"], "experiment.selected") << sel.dump();
   RecordProperty("answer_to_bitmap_question_s", std::to_string(waited_s));
   std::printf("answer to the bitmap question's hand-out: %.3f s\n", waited_s);
+}
+
+// What a participant's screen gets of a question (issue #37): the library's
+// participant view holds no block and no documents (their seeds), and its
+// wording is what the page and the terminal both lay out — the recall cell
+// in words, the confidence scale's labels, each choice's label.
+TEST(ParticipantView, NoBlockNoDocumentsAndTheLibrarysWording) {
+  for (const char* name : {"working-memory", "free-exploration", "quantization", "texel-length", "guided-exploration"}) {
+    SCOPED_TRACE(name);
+    const ex::Protocol p = ex::load_protocol(protocols_dir + "/" + name + ".json");
+    ex::SessionContext ctx;
+    ctx.participant = "W1";
+    ctx.seed = ex::session_seed(p.seed, ctx.participant);
+    ex::Session s(p, ctx);
+    const ex::SimulatedParticipant who(ex::simulation_observer(p.observer, "default"), s);
+    for (int k = 0; k < 3 && !s.finished(); ++k) {
+      const ex::Question& q = s.question();
+      const json j = json::parse(q.participant_json());
+      for (const char* key : {"block", "block_index", "trial_in_block", "block_trials"}) EXPECT_FALSE(j.contains(key)) << key;
+      for (const auto& st : j["stimuli"]) EXPECT_FALSE(st.contains("document")) << st.dump();
+      // No text of it is the block's name (one named after its task kind says no more than `task`).
+      std::function<void(const json&)> no_block = [&](const json& v) {
+        if (v.is_string() && q.block != q.task) EXPECT_NE(v.get<std::string>(), q.block) << j.dump();
+        if (v.is_structured())
+          for (const auto& e : v) no_block(e);
+      };
+      no_block(j);
+      const json& w = j["wording"];
+      EXPECT_EQ(w["stimulus_names"].size(), q.stimuli.size());
+      EXPECT_EQ(w["choice_labels"].size(), q.choices.size());
+      EXPECT_EQ(!q.choices.empty(), !w["choice_question"].get<std::string>().empty());
+      EXPECT_EQ(q.confidence, w.contains("confidence"));
+      if (q.confidence) {
+        EXPECT_EQ(w["confidence"]["min"], 1);
+        EXPECT_EQ(w["confidence"]["max"], 5);
+        EXPECT_FALSE(w["confidence"]["min_label"].get<std::string>().empty());
+      }
+      EXPECT_EQ(q.rating_scale.has_value(), w.contains("rating"));
+      if (q.recall) {
+        const std::string rq = w["recall"]["question"];
+        if (q.recall->cell)
+          EXPECT_NE(
+              rq.find("row " + std::to_string(*q.recall->cell / 4 + 1) + ", column " + std::to_string(*q.recall->cell % 4 + 1)),
+              std::string::npos)
+              << rq;
+      }
+      (void)s.answer(who.respond(s));
+    }
+  }
 }
