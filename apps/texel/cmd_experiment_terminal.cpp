@@ -283,6 +283,12 @@ void countdown_phase(ex::Presenter* presenter, double seconds) {
   if (interactive()) std::cout << "\r\033[2K";
 }
 
+// A scale's ends as the studio's page shows them: "1 (not at all) to 5 (very)".
+std::string scale_words(const ex::Scale& s) {
+  const auto end = [](int v, const std::string& label) { return std::to_string(v) + (label.empty() ? "" : " (" + label + ")"); };
+  return end(s.min, s.min_label) + " to " + end(s.max, s.max_label);
+}
+
 std::string how_to_answer(const ex::Question& q, bool two_d) {
   std::string out;
   const std::size_t n = q.stimuli.size();
@@ -311,14 +317,18 @@ std::string how_to_answer(const ex::Question& q, bool two_d) {
     out += "  When it feels the same: type 'a' to accept.\n";
   }
   if (!q.choices.empty()) {
+    // The library's words for each choice (Question::wording), and what to type for it.
     std::vector<std::string> examples;
-    for (const auto& c : q.choices) examples.push_back("'a " + c + "'");
-    out += "  Answer: type 'a' and your answer: " + spoken_list(examples) + ".\n";
+    for (std::size_t k = 0; k < q.choices.size(); ++k)
+      examples.push_back("'a " + q.choices[k] + "'" +
+                         (k < q.wording.choice_labels.size() && q.wording.choice_labels[k] != q.choices[k]
+                              ? " (" + q.wording.choice_labels[k] + ")"
+                              : std::string()));
+    out += "  " + q.wording.choice_question + ": type 'a' and your answer: " + spoken_list(examples) + ".\n";
   }
-  if (q.rating_scale)
-    out += "  Answer: type 'a' and a whole number from " + detail::num((*q.rating_scale)[0]) + " to " +
-           detail::num((*q.rating_scale)[1]) + ", e.g. 'a " +
-           detail::num(std::round(((*q.rating_scale)[0] + (*q.rating_scale)[1]) / 2)) + "'.\n";
+  if (const auto& s = q.wording.rating)
+    out += "  " + s->question + " Type 'a' and a whole number from " + scale_words(*s) + ", e.g. 'a " +
+           std::to_string((s->min + s->max + 1) / 2) + "'.\n";
   out += "  Help: 'h'.  Pause and quit (your answers are kept): 'q'.\n";
   return out;
 }
@@ -358,14 +368,8 @@ void wait_pumping(ex::Presenter* presenter, double seconds) {
 
 void tell_participant(const std::string& text) { std::cout << text << "\n" << std::flush; }
 
-std::string stimulus_name(const std::string& label) {
-  if (label == "Reference | Rendering") return "the reference (left half) and the rendering (right half)";
-  if (label == "Test") return "the test texture";
-  if (label == "Reference") return "the reference";
-  if (label.size() <= 2) return "texture " + label;
-  if (label.rfind("Texture ", 0) == 0) return "t" + label.substr(1);  // "Texture 1" → "texture 1"
-  return label;
-}
+// The library's words (Question::wording), as the studio's page shows them.
+std::string stimulus_name(const std::string& label) { return ex::stimulus_name(label); }
 
 // ------------------------------------------------------------- terminal UI
 
@@ -619,15 +623,14 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
       }
     }
     if (q.confidence) {
-      const auto c = ask_number(presenter, "How confident are you in this match? 1 (not at all) to 5 (very)", 1, 5, stop);
+      const ex::Scale& s = *q.wording.confidence;
+      const auto c = ask_number(presenter, s.question + " " + scale_words(s), s.min, s.max, stop);
       if (!c) return ended(stop);
       r.confidence = *c;
     }
     if (q.recall) {
-      const std::string question = q.recall->cell ? "Which digit was in row " + std::to_string(*q.recall->cell / 4 + 1) +
-                                                        ", column " + std::to_string(*q.recall->cell % 4 + 1) + "? (1 to 9)"
-                                                  : std::string("Which digit was in the cells? (1 to 9)");
-      const auto d = ask_number(presenter, question, 1, 9, stop);
+      const ex::Scale& s = *q.wording.recall;
+      const auto d = ask_number(presenter, s.question + " (" + scale_words(s) + ")", s.min, s.max, stop);
       if (!d) return ended(stop);
       r.digit = *d;
     }

@@ -144,6 +144,7 @@ const std::vector<Field>& fields() {
       TEXEL_NUMBER(over_time_limit),
       TEXEL_NUMBER(interrupted),
       TEXEL_NUMBER(suspended_ms),
+      TEXEL_STRING(swipe_flag),
   };
   return f;
 }

@@ -165,10 +165,68 @@ ordered_json question_view(const Question& q) {
 
 std::string Question::to_json() const { return question_view(*this).dump(); }
 
+std::string stimulus_name(const std::string& label) {
+  if (label == "Reference | Rendering") return "the reference (left half) and the rendering (right half)";
+  if (label == "Test") return "the test texture";
+  if (label == "Reference") return "the reference";
+  if (label.size() <= 2) return "texture " + label;
+  if (label.rfind("Texture ", 0) == 0) return "t" + label.substr(1);  // "Texture 1" → "texture 1"
+  return label;
+}
+
+namespace {
+
+ordered_json scale_json(const Scale& s) {
+  return {{"min", s.min}, {"max", s.max}, {"question", s.question}, {"min_label", s.min_label}, {"max_label", s.max_label}};
+}
+
+// The words the task kind left to the engine: stimulus names, choice labels,
+// the scales' defaults, the recall cell in words (front doors never compute it).
+void complete_wording(Question& q) {
+  Wording& w = q.wording;
+  w.stimulus_names.clear();
+  for (const auto& s : q.stimuli) w.stimulus_names.push_back(stimulus_name(s.label));
+  if (w.choice_labels.size() != q.choices.size()) {
+    w.choice_labels.clear();
+    for (const auto& c : q.choices) {
+      const bool digits = !c.empty() && std::all_of(c.begin(), c.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+      std::string text = digits ? "texture " + c : c;
+      if (!digits && !text.empty() && text[0] >= 'a' && text[0] <= 'z') text[0] = static_cast<char>(text[0] - 'a' + 'A');
+      w.choice_labels.push_back(text);
+    }
+  }
+  if (!q.choices.empty() && w.choice_question.empty()) w.choice_question = "Your answer";
+  if (q.rating_scale && !w.rating)
+    w.rating = Scale{static_cast<int>((*q.rating_scale)[0]), static_cast<int>((*q.rating_scale)[1]), "How similar do they feel?",
+                     "not at all", "identical"};
+  if (q.confidence && !w.confidence) w.confidence = Scale{1, 5, "How confident are you in this match?", "not at all", "very"};
+  if (q.recall) {
+    const auto& cell = q.recall->cell;
+    w.recall = Scale{1, 9,
+                     cell ? "Which digit was in row " + std::to_string(*cell / 4 + 1) + ", column " + std::to_string(*cell % 4 + 1) +
+                                " of the matrix?"
+                          : std::string("Which digit was in the cells of the matrix?"),
+                     "", ""};
+  }
+}
+
+}  // namespace
+
 std::string Question::participant_json() const {
   ordered_json j = question_view(*this);
-  if (!show_maps)
-    for (auto& s : j["stimuli"]) s.erase("document");
+  // Nothing a participant must not know: the block (its name and place give the
+  // condition away) and the stimuli's documents (parameters and seeds; a
+  // show_maps question's maps are drawn from the rendered maps instead).
+  for (const char* key : {"block_index", "block", "trial_in_block", "block_trials"}) j.erase(key);
+  for (auto& s : j["stimuli"]) s.erase("document");
+  ordered_json w;
+  w["stimulus_names"] = wording.stimulus_names;
+  w["choice_question"] = wording.choice_question;
+  w["choice_labels"] = wording.choice_labels;
+  if (wording.rating) w["rating"] = scale_json(*wording.rating);
+  if (wording.confidence) w["confidence"] = scale_json(*wording.confidence);
+  if (wording.recall) w["recall"] = scale_json(*wording.recall);
+  j["wording"] = std::move(w);
   return j.dump();
 }
 
@@ -184,6 +242,7 @@ ordered_json response_view(const Response& r) {
   if (r.swipe_mean_speed_mm_s) j["swipe_mean_speed_mm_s"] = *r.swipe_mean_speed_mm_s;
   if (r.swipe_sd_speed_mm_s) j["swipe_sd_speed_mm_s"] = *r.swipe_sd_speed_mm_s;
   if (r.directional_proportion) j["directional_proportion"] = *r.directional_proportion;
+  if (!r.swipe_flag.empty()) j["swipe_flag"] = r.swipe_flag;
   if (!r.strokes.empty()) {
     ordered_json list = ordered_json::array();
     const auto number = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); };
@@ -313,6 +372,7 @@ Response response_from(const json& j) {
                                               "swipe_mean_speed_mm_s",
                                               "swipe_sd_speed_mm_s",
                                               "directional_proportion",
+                                              "swipe_flag",
                                               "shown_at",
                                               "answered_at",
                                               "events",
@@ -335,6 +395,10 @@ Response response_from(const json& j) {
   r.swipe_mean_speed_mm_s = opt("swipe_mean_speed_mm_s");
   r.swipe_sd_speed_mm_s = opt("swipe_sd_speed_mm_s");
   r.directional_proportion = opt("directional_proportion");
+  if (j.contains("swipe_flag") && !j["swipe_flag"].is_null()) {
+    if (!j["swipe_flag"].is_string()) throw FormatError("response.swipe_flag must be a string, got " + j["swipe_flag"].dump());
+    r.swipe_flag = j["swipe_flag"].get<std::string>();
+  }
   if (j.contains("shown_at") && j["shown_at"].is_string()) r.shown_at = j["shown_at"].get<std::string>();
   if (j.contains("answered_at") && j["answered_at"].is_string()) r.answered_at = j["answered_at"].get<std::string>();
   if (j.contains("events") && !j["events"].is_null()) r.events = events_from_json(j["events"]);
@@ -394,6 +458,7 @@ struct Session::Impl : SessionCore {
     q.show_maps = b.show_maps;
     t.condition = b.condition;
     run->prepare(*this, q, t);
+    complete_wording(q);
     question = std::move(q);
     truth = std::move(t);
   }
@@ -422,6 +487,7 @@ struct Session::Impl : SessionCore {
     if (r.swipe_mean_speed_mm_s) row.swipe_mean_speed_mm_s = *r.swipe_mean_speed_mm_s;
     if (r.swipe_sd_speed_mm_s) row.swipe_sd_speed_mm_s = *r.swipe_sd_speed_mm_s;
     if (r.directional_proportion) row.directional_proportion = *r.directional_proportion;
+    row.swipe_flag = r.swipe_flag;
     fill_stroke_columns(r.strokes, q.stimuli.size(), row);
     require(!(std::isfinite(r.rt_ms) && r.rt_ms < 0), "rt_ms is " + texel::detail::num(r.rt_ms) + "; allowed: >= 0 ms");
     if (!q.choices.empty()) {

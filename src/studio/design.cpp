@@ -13,6 +13,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/detmath.hpp"
 #include "texel/error.hpp"
+#include "texel/interchange.hpp"
 #include "texel/io.hpp"
 #include "texel/plot.hpp"
 #include "texel/spectrum.hpp"
@@ -170,6 +171,9 @@ DesignView design_view(const Document& doc, const DesignOptions& options) {
 
   if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get())) {
     v.texels = t->texel_count();
+    const double L = t->spec().texel_length.value();
+    if (t->spec().fill == Fill::whole_texels)
+      v.uncovered_mm = std::max(0.0, r.length.value() - static_cast<double>(v.texels) * L);
     v.histogram = histogram_of(*t, options.histogram_bins);
     v.central_pitch = to_cpm(t->spec().central_pitch);
     v.irregularity = to_cpm(t->spec().irregularity);
@@ -275,15 +279,16 @@ std::string_view to_string(ExportFormat f) {
     case ExportFormat::device: return "device";
     case ExportFormat::npy: return "npy";
     case ExportFormat::csv: return "csv";
+    case ExportFormat::hjif: return "hjif";
   }
   return "?";
 }
 
 ExportFormat parse_export_format(std::string_view text, std::string_view field) {
-  for (const ExportFormat f :
-       {ExportFormat::document, ExportFormat::bitstream, ExportFormat::device, ExportFormat::npy, ExportFormat::csv})
+  for (const ExportFormat f : {ExportFormat::document, ExportFormat::bitstream, ExportFormat::device, ExportFormat::npy,
+                               ExportFormat::csv, ExportFormat::hjif})
     if (text == to_string(f)) return f;
-  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: document, bitstream, device, npy, csv");
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: document, bitstream, device, npy, csv, hjif");
 }
 
 ExportFile export_file(const Document& doc, ExportFormat as, std::optional<std::size_t> region) {
@@ -291,6 +296,11 @@ ExportFile export_file(const Document& doc, ExportFormat as, std::optional<std::
   ExportFile f;
   if (as == ExportFormat::document) {
     f = {base + ".texel.json", "application/json", document_json(doc)};
+    return f;
+  }
+  if (as == ExportFormat::hjif) {
+    // The library's MPEG-I Haptics export, as `texel export a.texel.json -o a.hjif` writes it.
+    f = {base + ".hjif", "application/json", hjif::export_hjif(doc).json};
     return f;
   }
   const Surface surface = prepare_surface(doc);

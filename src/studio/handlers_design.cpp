@@ -4,6 +4,7 @@
 // (document_of). Every number comes from design.hpp; this file formats.
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <variant>
 
 #include "base64.hpp"
@@ -52,10 +53,12 @@ void check_cost(const State& s, const json& j, const DeviceProfile& device, cons
   for (const json* t : textures) {
     if (!t->is_object() || !t->contains("texel_length_mm") || !(*t)["texel_length_mm"].is_number()) continue;
     const double length = (*t)["texel_length_mm"].get<double>();
-    if (length > 0 && device.length().value() / length > static_cast<double>(cap))
+    // The designer states this bound as the same quotient (samples × spacing / cap), so a length
+    // it accepts is one this accepts, to the last bit.
+    const double shortest = device.length().value() / static_cast<double>(cap);
+    if (length > 0 && length < shortest)
       throw Reject{"too_large", where + ": texel_length_mm " + json(length).dump() + " makes more than " + std::to_string(cap) +
-                                    " texels; allowed: at least " +
-                                    json(device.length().value() / static_cast<double>(cap)).dump() + " mm on this device"};
+                                    " texels; allowed: at least " + json(shortest).dump() + " mm on this device"};
   }
 }
 
@@ -125,22 +128,44 @@ ojson make_hello(const State& s) {
     h["references"].push_back(std::move(r));
   }
   h["parameterizations"] = {"moments", "log"};
-  h["export_formats"] = {"document", "bitstream", "device", "npy", "csv"};
+  h["export_formats"] = {"document", "bitstream", "device", "npy", "csv", "hjif"};
   h["import_extensions"] = {".texel.json", ".json", ".texel", ".bin", ".npy", ".csv", ".wav"};
   h["limits"] = {{"max_message_bytes", s.options.max_message_bytes},
                  {"max_messages_per_s", s.options.max_messages_per_s},
                  {"max_queued_jobs", max_queued_jobs},
                  {"max_map_samples", s.options.max_map_samples},
                  {"max_name_chars", max_name_chars}};
-  // The library's own ranges of a Texel texture's fields (the designer's typed
-  // values are checked against them; the renderable band is the document's).
+  // The library's own ranges of a Texel texture's fields: the designer checks
+  // typed values against them and states them, so each must be the engine's
+  // rule exactly (tests/studio checks both sides of every bound against
+  // `design`). null = unbounded (finite); exclusive_min: the bound itself is
+  // refused. Texel length's lower bound on a device is also at least the
+  // device's length / limits.max_map_samples (check_cost above).
   auto range = [](double lo, double hi) { return ojson{{"min", lo}, {"max", hi}}; };
-  h["texture_limits"] = {{"central_pitch_db", range(central_pitch_db_min, central_pitch_db_max)},
-                         {"irregularity_db", range(irregularity_db_min, irregularity_db_max)},
-                         {"texel_length_mm", range(texel_length_mm_min, texel_length_mm_max)},
-                         {"quantization_db", range(0.0, quantization_db_max)},
-                         {"coarse_strength", range(0.0, 1.0)},
-                         {"fine_strength", range(0.0, 1.0)}};
+  h["texture_limits"] = {
+      {"central_pitch_db", range(central_pitch_db_min, central_pitch_db_max)},
+      {"irregularity_db", range(irregularity_db_min, irregularity_db_max)},
+      // Under the log parameterization the spread is a dB of log-spread, >= 0 (PitchDistribution's constructor).
+      {"irregularity_db_log", range(0.0, irregularity_db_max)},
+      {"texel_length_mm", range(texel_length_mm_min, texel_length_mm_max)},
+      {"quantization_db", range(0.0, quantization_db_max)},
+      {"coarse_strength", range(0.0, 1.0)},
+      {"fine_strength", range(0.0, 1.0)},
+      // The coarse profiles' ranges as the document reader checks them (src/io/document.cpp).
+      {"coarse_value", range(0.0, 1.0)},
+      {"sine_period_mm", range(1e-9, 1e9)},
+      {"sine_phase_deg", range(-1e9, 1e9)}};
+  // On a device, a Central Pitch must also lie in the renderable band: the texel
+  // texture's band_min (default 0.01 cpm) up to the device's band top (its
+  // band_max or Nyquist frequency) — PitchDistribution's rule, which allows
+  // 1e-9 dB beyond either edge.
+  h["device_limits"] = ojson::array();
+  for (const auto& name : builtin_device_names()) {
+    const DeviceProfile d = load_device(name);
+    const double lo = std::max(central_pitch_db_min, 10.0 * std::log10(TexelSpec{}.band_min.value()));
+    const double hi = std::min(central_pitch_db_max, 10.0 * std::log10(d.band_top().value()));
+    h["device_limits"].push_back({{"device", name}, {"central_pitch_db", range(lo, hi)}});
+  }
   return h;
 }
 
@@ -181,6 +206,7 @@ void on_design(State& s, Client& c, const Job& job) {
     r["irregularity_cpm"] = nullptr;
   }
   r["texels"] = v.texels;
+  r["uncovered_mm"] = v.uncovered_mm;
   r["queued_ms"] = std::chrono::duration<double, std::milli>(t0 - job.received).count();
   r["elapsed_ms"] = ms_since(t0);
   send(c, r);

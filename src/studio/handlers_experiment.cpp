@@ -12,12 +12,14 @@
 
 #include "base64.hpp"
 #include "messages.hpp"
+#include "texel/device.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/export_mat.hpp"
 #include "texel/experiment/session_state.hpp"
 #include "texel/experiment/strokes.hpp"
 #include "texel/experiment/surface_maps.hpp"
+#include "texel/experiment/swipe_check.hpp"
 #include "texel/matfile.hpp"
 #include "texel/serial_link.hpp"
 #include "texel/surface2d.hpp"
@@ -159,8 +161,30 @@ ojson progress_json(const State& s) {
   return ojson{{"done", s.active->session.trials_done()}, {"planned", s.active->session.trials_planned()}};
 }
 
-// What participant screens may see of a question (the library's participant view).
-ojson participant_question(const ex::Question& q) { return ojson::parse(q.participant_json()); }
+// What participant screens may see of a question (the library's participant view:
+// no block, no documents), with a show_maps question's maps as rendered
+// float32 samples (map_f32) to draw: the maps, not the parameters and seeds
+// they were made from.
+ojson participant_question(const ex::Question& q) {
+  ojson j = ojson::parse(q.participant_json());
+  if (q.show_maps)
+    for (std::size_t i = 0; i < q.stimuli.size(); ++i) {
+      const auto map = PlayerMap::from_document(parse_document(q.stimuli[i].document_json, "stimulus"));
+      const std::span<const float> v = map->values();
+      j["stimuli"][i]["map_f32"] =
+          base64_encode(std::span(reinterpret_cast<const unsigned char*>(v.data()), v.size() * sizeof(float)));
+    }
+  return j;
+}
+
+/// The strip a 1-D question is felt on: the protocol's device length (mm), nothing of the trial.
+std::optional<double> strip_length_mm(const State& s) {
+  try {
+    return load_device(s.active->session.protocol().device).length().value();
+  } catch (const Error&) {
+    return std::nullopt;
+  }
+}
 
 ojson handout_json(const ex::Handout& h) { return ojson::parse(ex::to_json(h)); }
 
@@ -173,12 +197,18 @@ ojson current_state(State& s, const json& id, bool screen, bool reload = false) 
                      : s.active->suspended        ? "experiment.suspended"
                                                   : "experiment.question";
   ojson r = reply(type, id);
-  r["session"] = session_json(s);
+  // Only a direct reply to the experimenter's side carries the session (its participant code,
+  // protocol, seed): never a participant screen, nor a push, which every connection of a
+  // participant's browser gets (the page's finger worker too).
+  if (!screen && !id.is_null()) r["session"] = session_json(s);
   r["progress"] = progress_json(s);
   if (!s.active->session.finished() && !s.active->suspended) {
     const ex::Question& q = s.active->session.question();
     r["question"] = participant_question(q);
-    if (!q.surfaces.empty()) r["surface"] = surface_size_json(q);      // the page is the touch surface
+    if (!q.surfaces.empty())
+      r["surface"] = surface_size_json(q);  // the page is the touch surface
+    else if (const auto mm = strip_length_mm(s))
+      r["strip_mm"] = *mm;
     if (screen && s.active->simulate.empty()) prepare_surfaces(s, q);  // before the hand-out starts the trial's clock
     if (!screen && s.strokes2d->maps && !q.surfaces.empty()) {
       // The experimenter's view: bitmaps the preload rendered, and those a participant waited for.
@@ -447,14 +477,21 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
     if (s.active && !s.active->session.finished() && !s.active->session.question().surfaces.empty())
       response.strokes = stroke_summaries(strokes_of(s), s.active->session.question());
   }
-  if (!response.swipe_mean_speed_mm_s) {
+  if (!f.boolean("simulated", false)) {
+    // Swipe measures are the studio's, from the finger samples at the page's own times
+    // (feel.move t_ms), never the page's claim; an implausible trace stores none and says why.
+    response.swipe_mean_speed_mm_s.reset();
+    response.swipe_sd_speed_mm_s.reset();
+    response.directional_proportion.reset();
+    response.swipe_flag.clear();
     std::lock_guard lock(s.feel_mutex);
-    const SwipeMeasures m = swipe_measures(s.trace);
-    if (m.intervals > 0) {
-      response.swipe_mean_speed_mm_s = m.mean_speed_mm_s;
-      response.swipe_sd_speed_mm_s = m.sd_speed_mm_s;
-      response.directional_proportion = m.directional_proportion;
+    const ex::CheckedSwipe checked = ex::checked_swipe(s.trace);
+    if (checked.measures) {
+      response.swipe_mean_speed_mm_s = checked.measures->mean_speed_mm_s;
+      response.swipe_sd_speed_mm_s = checked.measures->sd_speed_mm_s;
+      response.directional_proportion = checked.measures->directional_proportion;
     }
+    response.swipe_flag = checked.flag;
   }
   try {
     // The token rule (docs/studio.md): committed before the next question goes out, or refused.

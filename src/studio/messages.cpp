@@ -21,7 +21,7 @@ const std::array<MessageSpec, 29> table{{
     {"import", Lane::fifo, {"name", "data_base64", "device"}, on_import},
     {"export", Lane::fifo, {"document", "as", "region"}, on_export},
     {"feel.select", Lane::design, {"document"}, on_feel_select},
-    {"feel.move", Lane::now, {"seq", "x_mm", "touch"}, on_feel_move},
+    {"feel.move", Lane::now, {"seq", "t_ms", "x_mm", "touch", "coalesced"}, on_feel_move},
     {"feel.state", Lane::now, {}, on_feel_state},
     {"experiment.list", Lane::fifo, {}, on_experiment_list},
     {"experiment.stations", Lane::fifo, {}, on_experiment_stations},

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -48,6 +49,10 @@ inline constexpr std::size_t max_id_chars = 64;
 inline constexpr std::size_t max_name_chars = 255;          // file names, participant codes, protocol names
 inline constexpr std::size_t max_trace_samples = 1u << 18;  // finger samples kept per trial for swipe measures
 inline constexpr double max_abs_mm = 1e6;
+// feel.move's times (the page's PointerEvent.timeStamp, ms; docs/studio.md "Feel it"):
+inline constexpr std::size_t max_coalesced = 64;  // earlier samples of one pointer event
+inline constexpr double max_t_ms = 1e12;          // ~31 years of a page's clock
+inline constexpr double max_ahead_ms = 100.0;     // how far a page's clock may run ahead of the studio's between messages
 
 /// A refused message: the error code and one line naming field, value, allowed.
 struct Reject {
@@ -98,6 +103,13 @@ struct Client {
   std::size_t fifo_jobs = 0;
   // Touched by the FIFO worker only:
   bool participant_screen = false;  // asked experiment.current with screen: true (its hand-outs start trial clocks)
+  // The page's pointer clock (feel.move t_ms), guarded by State::feel_mutex: one
+  // connection is one page, so one clock, which never goes back.
+  double pointer_t_ms = -1.0;  // its newest sample's time (−1: none yet)
+  // Least (arrival − t_ms) seen, ms: a sample cannot arrive before it was taken,
+  // so one arriving with less lag than that (beyond max_ahead_ms) comes from a
+  // clock running ahead (none yet: +inf).
+  double pointer_lag_ms = std::numeric_limits<double>::infinity();
 };
 
 struct Surface2DState;  // handlers_surface2d.cpp: the prepared 2-D surface and the 2-D pad's player
@@ -125,7 +137,11 @@ struct State {
   std::uint64_t finger_client = 0;                 // who touched last (lifted on disconnect)
   double finger_x = 0.0;
   bool finger_down = false;
-  std::vector<FingerSample> trace;  // finger samples of the current trial (swipe measures)
+  // Finger samples of the current trial for its swipe measures, each at its
+  // page's own time (feel.move t_ms, s), never its arrival; a stroke from
+  // another page starts after a lift (its clock is another).
+  std::vector<FingerSample> trace;
+  std::uint64_t trace_client = 0;  // whose clock the trace's newest sample is on
 
   std::shared_ptr<Surface2DState> surface2d = make_surface2d_state();  // its own mutexes
   std::shared_ptr<Strokes2DState> strokes2d = make_strokes2d_state();  // FIFO worker only

@@ -48,10 +48,11 @@ std::string cell(const std::string& csv_text, const std::string& column, std::si
 
 TEST(TrialCsv, HeaderIsTheColumnList) {
   const auto& cols = ex::trial_columns();
-  ASSERT_EQ(cols.size(), 54u);  // with the 2-D display's stroke columns
+  ASSERT_EQ(cols.size(), 55u);  // with the 2-D display's stroke columns and swipe_flag
   EXPECT_EQ(cols.front(), "participant");
   EXPECT_EQ(cols[48], "answered_at");
-  EXPECT_EQ(cols.back(), "suspended_ms");  // trial_number and the timing flags come last (issue #22)
+  EXPECT_EQ(cols[53], "suspended_ms");   // trial_number and the timing flags come last (issue #22)
+  EXPECT_EQ(cols.back(), "swipe_flag");  // then why the swipe columns are empty (issue #36)
   const auto csv = ex::trials_csv({});
   std::string header;
   for (const auto& c : cols) header += (header.empty() ? "" : ",") + c;

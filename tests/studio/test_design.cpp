@@ -5,12 +5,16 @@
 // round-trip through the codec and the file formats.
 #include <gtest/gtest.h>
 
+#include <stdlib.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 
 #include "texel/bitstream.hpp"
 #include "texel/error.hpp"
+#include "texel/interchange.hpp"
 #include "texel/io.hpp"
 #include "texel/studio/design.hpp"
 
@@ -144,6 +148,22 @@ TEST(ImportExport, DocumentAndBitstreamRoundTrip) {
   EXPECT_EQ(decoded.document.regions.size(), 1u);
   EXPECT_NEAR(decoded.document.regions[0].texel.central_pitch.value(), 8.0, 1e-9);
   EXPECT_THROW((void)export_file(doc, ExportFormat::bitstream, 0), InvalidArgument);
+}
+
+// The studio writes .hjif as `texel export -o x.hjif` does: the library's export, byte for byte (issue #37).
+TEST(ImportExport, HjifIsTheLibrarysExport) {
+  ::setenv("SOURCE_DATE_EPOCH", "1764165989", 1);  // both files dated alike
+  const Document doc = two_regions();
+  const ExportFile f = export_file(doc, ExportFormat::hjif);
+  ::unsetenv("SOURCE_DATE_EPOCH");
+  EXPECT_EQ(f.name, "texture.hjif");
+  EXPECT_EQ(f.mime, "application/json");
+  ::setenv("SOURCE_DATE_EPOCH", "1764165989", 1);
+  const std::string want = hjif::export_hjif(doc).json;
+  ::unsetenv("SOURCE_DATE_EPOCH");
+  EXPECT_EQ(f.data, want);
+  EXPECT_TRUE(hjif::conformance_errors(f.data).empty());
+  EXPECT_EQ(parse_export_format("hjif"), ExportFormat::hjif);
 }
 
 TEST(ImportExport, DeviceFilesAndSignalsGoThroughTheCodec) {

@@ -27,7 +27,7 @@ const std::vector<std::string> seeds = {
     R"({"type":"hello","id":1})",
     R"({"type":"design","id":"d","document":)" + doc + R"(,"region":1,"bins":20})",
     R"({"type":"feel.select","document":)" + doc + "}",
-    R"({"type":"feel.move","id":2,"seq":5,"x_mm":12.5,"touch":true})",
+    R"({"type":"feel.move","id":2,"seq":5,"t_ms":16.5,"x_mm":12.5,"touch":true,"coalesced":[[8.2,12.1],[12.4,12.3]]})",
     R"({"type":"feel.state"})",
     R"({"type":"export","document":)" + doc + R"(,"as":"bitstream"})",
     R"({"type":"import","name":"a.texel.json","data_base64":"eyJmb3JtYXQiOiJ0ZXhlbC1kb2N1bWVudCJ9"})",

@@ -106,7 +106,7 @@ TEST(StudioMessages, RepliesHaveTheSchemasKeys) {
   const std::string doc = R"({"format":"texel-document","version":1,"device":"tpad","texture":{"kind":"texel",
     "central_pitch_db":10,"irregularity_db":-5,"texel_length_mm":0.25,"seed":1}})";
   service.handle(c, R"({"type":"hello","id":1})");
-  service.handle(c, R"({"type":"feel.move","id":2,"seq":1,"x_mm":3})");
+  service.handle(c, R"({"type":"feel.move","id":2,"seq":1,"t_ms":0,"x_mm":3})");
   service.handle(c, R"({"type":"feel.state","id":3})");
   service.handle(c, R"({"type":"nonsense","id":4})");
   service.handle(c, R"({"type":"design","id":5,"document":)" + doc + "}");

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <numbers>
 #include <thread>
@@ -24,6 +25,8 @@
 #include "base64.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/records.hpp"
+#include "texel/experiment/session.hpp"
+#include "texel/experiment/simulate.hpp"
 #include "texel/experiment/store.hpp"
 #include "texel/studio/design.hpp"
 #include "texel/studio/service.hpp"
@@ -104,12 +107,22 @@ TEST(Service, MalformedAndHostileMessagesGetErrors) {
   expect_error(c.ask({{"type", "rm -rf"}}), "bad_message");
   expect_error(c.ask({{"type", "experiment.delete"}}), "bad_message");
   expect_error(c.ask({{"type", "hello"}, {"extra", 1}}), "bad_message");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", "1"}, {"x_mm", 1}, {"touch", true}}), "bad_message");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", "NaN"}, {"touch", true}}), "bad_message");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 1e300}, {"touch", true}}), "invalid");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", -1}, {"x_mm", 1}, {"touch", true}}), "invalid");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 18446744073709551615u}, {"x_mm", 1}, {"touch", true}}), "invalid");
-  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 1}, {"touch", 1}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", "1"}, {"t_ms", 0}, {"x_mm", 1}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", "NaN"}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", 1e300}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", -1}, {"t_ms", 0}, {"x_mm", 1}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 18446744073709551615u}, {"t_ms", 0}, {"x_mm", 1}, {"touch", true}}),
+               "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", 1}, {"touch", 1}}), "bad_message");
+  // Every sample carries the browser's time of it (PointerEvent.timeStamp, ms): required, finite, in range.
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 1}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", "5"}, {"x_mm", 1}, {"touch", true}}), "bad_message");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", -1}, {"x_mm", 1}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 1e13}, {"x_mm", 1}, {"touch", true}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 5}, {"x_mm", 1}, {"coalesced", {{6, 1}}}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 5}, {"x_mm", 1}, {"coalesced", {{3, 1}, {2, 1}}}}), "invalid");
+  expect_error(c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 5}, {"x_mm", 1}, {"coalesced", {{3}}}}), "bad_message");
+
   expect_error(c.ask({{"type", "design"}}), "bad_message");
   expect_error(c.ask({{"type", "design"}, {"document", "tpad"}}), "bad_message");
   expect_error(c.ask({{"type", "design"}, {"document", {{"format", "texel-document"}}}}), "invalid");
@@ -274,20 +287,134 @@ TEST(Service, ResponseOptionIsValidated) {
   EXPECT_EQ(c.ask({{"type", "feel.select"}, {"document", tpad_document()}})["type"], "feel.selected");
 }
 
+// Every limit the designer states (hello's texture_limits and device_limits)
+// is the one the engine applies: each bound is accepted by `design`, a hair
+// beyond it refused (issue #37).
+TEST(Service, EveryStatedTextureLimitIsTheEngines) {
+  texel::test_support::TempDir dir("studio");
+  Service s(options(dir.at("db")));
+  Client c(s);
+  const json hello = c.ask({{"type", "hello"}});
+  const json& lim = hello["texture_limits"];
+  // Where each limit goes in a document's texture (and what else that texture needs).
+  struct Case {
+    std::string key;
+    std::function<void(json& texture, double v)> set;
+    json range;
+  };
+  const auto plain = [](const char* k) { return [k](json& t, double v) { t[k] = v; }; };
+  json pitch;
+  for (const auto& d : hello["device_limits"])
+    if (d["device"] == "tpad") pitch = d["central_pitch_db"];
+  ASSERT_TRUE(pitch.is_object()) << hello["device_limits"].dump();
+  const double shortest = 19200 * 0.0053 / hello["limits"]["max_map_samples"].get<double>();
+  std::vector<Case> cases{
+      {"central_pitch_db (tpad)", plain("central_pitch_db"), pitch},
+      {"irregularity_db", plain("irregularity_db"), lim["irregularity_db"]},
+      {"irregularity_db_log",
+       [](json& t, double v) {
+         t["parameterization"] = "log";
+         t["irregularity_db"] = v;
+       },
+       lim["irregularity_db_log"]},
+      {"texel_length_mm (tpad)", plain("texel_length_mm"), json{{"min", shortest}, {"max", lim["texel_length_mm"]["max"]}}},
+      {"quantization_db", plain("quantization_db"), lim["quantization_db"]},
+      {"coarse_strength", plain("coarse_strength"), lim["coarse_strength"]},
+      {"fine_strength", plain("fine_strength"), lim["fine_strength"]},
+      {"coarse_value",
+       [](json& t, double v) {
+         t["coarse"] = {{"kind", "constant"}, {"value", v}};
+       },
+       lim["coarse_value"]},
+      {"sine_period_mm",
+       [](json& t, double v) {
+         t["coarse"] = {{"kind", "sine"}, {"period_mm", v}, {"phase_deg", 0}};
+       },
+       lim["sine_period_mm"]},
+      {"sine_phase_deg",
+       [](json& t, double v) {
+         t["coarse"] = {{"kind", "sine"}, {"period_mm", 5}, {"phase_deg", v}};
+       },
+       lim["sine_phase_deg"]},
+  };
+  ASSERT_EQ(lim.size(), 10u) << "a new limit needs its case here: " << lim.dump();
+  const auto design = [&](const Case& k, double v) {
+    json doc = tpad_document();
+    k.set(doc["texture"], v);
+    return c.ask({{"type", "design"}, {"document", doc}});
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.key + " " + k.range.dump());
+    ASSERT_TRUE(k.range.is_object());
+    const double hair = 1e-6;
+    if (k.range["min"].is_number()) {
+      const double lo = k.range["min"];
+      const double below = lo - std::max(hair, std::abs(lo) * 1e-9);
+      if (k.range.value("exclusive_min", false)) {
+        EXPECT_EQ(design(k, lo)["type"], "error");
+        EXPECT_EQ(design(k, lo + hair)["type"], "design");
+      } else {
+        const json at = design(k, lo);
+        EXPECT_EQ(at["type"], "design") << at.dump().substr(0, 300);
+      }
+      EXPECT_EQ(design(k, below)["type"], "error") << below;
+    }
+    if (k.range["max"].is_number()) {
+      const double hi = k.range["max"];
+      const json at = design(k, hi);
+      EXPECT_EQ(at["type"], "design") << at.dump().substr(0, 300);
+      EXPECT_EQ(design(k, hi + std::max(hair, std::abs(hi) * 1e-9))["type"], "error");
+    }
+    if (k.range["min"].is_null() && k.range["max"].is_null()) {
+      const json lo = design(k, -1e300), hi = design(k, 1e300);
+      EXPECT_EQ(lo["type"], "design") << lo.dump().substr(0, 300);
+      EXPECT_EQ(hi["type"], "design") << hi.dump().substr(0, 300);
+    }
+  }
+}
+
+// feel.move's times are the page's clock (one connection, one page): never
+// back, never ahead of the studio's clock by more than 100 ms from one message
+// to the next; each page has its own.
+TEST(Service, FeelMoveTimesAreThePagesClock) {
+  texel::test_support::TempDir dir("studio");
+  Service s(options(dir.at("db")));
+  Client c(s), other(s);
+  const auto move = [](Client& k, int seq, double t_ms, const json& coalesced = nullptr) {
+    json m{{"type", "feel.move"}, {"seq", seq}, {"t_ms", t_ms}, {"x_mm", 10}, {"touch", true}};
+    if (!coalesced.is_null()) m["coalesced"] = coalesced;
+    return k.ask(m);
+  };
+  EXPECT_EQ(move(c, 1, 1000)["type"], "feel.ack");
+  EXPECT_EQ(move(c, 2, 1000)["type"], "feel.ack");  // the same time again: non-decreasing
+  const json back = move(c, 3, 999.5);
+  expect_error(back, "invalid");
+  EXPECT_NE(back["message"].get<std::string>().find("before this page's previous sample"), std::string::npos) << back.dump();
+  expect_error(move(c, 4, 1005, json{{1003, 10}, {999, 10}}), "invalid");  // a coalesced sample goes back
+  EXPECT_EQ(move(c, 5, 1012, json{{1004, 10}, {1008, 10}})["type"], "feel.ack");
+  const json ahead = move(c, 6, 1012 + 60'000);  // a minute ahead, a moment later
+  expect_error(ahead, "invalid");
+  EXPECT_NE(ahead["message"].get<std::string>().find("ahead of the studio's clock"), std::string::npos) << ahead.dump();
+  json many = json::array();
+  for (int k = 0; k < 65; ++k) many.push_back({1012, 10});
+  expect_error(move(c, 7, 1013, many), "bad_message");
+  EXPECT_EQ(move(other, 1, 3)["type"], "feel.ack");  // another page, its own clock
+}
+
 TEST(Service, FeelMovesReachThePlayer) {
   texel::test_support::TempDir dir("studio");
   Service s(options(dir.at("db")));
   Client c(s);
   EXPECT_EQ(c.ask({{"type", "feel.select"}, {"document", tpad_document()}})["type"], "feel.selected");
   for (int i = 0; i < 20; ++i) {
-    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 30.0 + 0.1 * i}, {"touch", true}});
+    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 30.0 + 0.1 * i}, {"touch", true}});
     ASSERT_EQ(a["type"], "feel.ack") << a.dump();
     EXPECT_EQ(a["seq"], i);
     std::this_thread::sleep_for(1ms);
   }
   // Hold still so the player's velocity estimate settles (it extrapolates a moving finger).
   for (int i = 20; i < 60; ++i) {
-    c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 31.9}, {"touch", true}});
+    c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 31.9}, {"touch", true}});
     std::this_thread::sleep_for(1ms);
   }
   std::this_thread::sleep_for(60ms);  // the null backend plays past the samples' lead
@@ -369,15 +496,33 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
       ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
       EXPECT_EQ(static_cast<int>(st.trials(session_id).size()), r["question"]["trial"].get<int>());
     };
-    // Some swipes during the trial feed the swipe measures.
-    for (int i = 0; i < 30; ++i) c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 20.0 + i}, {"touch", true}});
+    // The swipes of each trial give its swipe measures, from the samples' own times (t_ms), not
+    // their arrival: trial 0, 30 samples 1 mm and 10 ms apart sent in one burst, is 100 mm/s; trial
+    // 1's, 1 mm every 0.25 ms for 0.125 s (4,000 mm/s, 50 samples a message as coalesced pointer
+    // events), cannot be a hand's (flagged, not stored); trial 2 has no swipe.
+    double t_ms = 0;
     for (trial = 0; trial < 3; ++trial) {
+      if (trial == 0)
+        for (int i = 0; i < 30; ++i, t_ms += 10.0)
+          ASSERT_EQ(c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", t_ms}, {"x_mm", 20.0 + i}, {"touch", true}})["type"],
+                    "feel.ack");
+      if (trial == 1)
+        for (int m = 0, i = 0; m < 10; ++m) {
+          json earlier = json::array();
+          for (int k = 0; k < 49; ++k, ++i, t_ms += 0.25) earlier.push_back({t_ms, 20.0 + i});
+          const json a = c.ask(
+              {{"type", "feel.move"}, {"seq", m}, {"t_ms", t_ms}, {"x_mm", 20.0 + i}, {"touch", true}, {"coalesced", earlier}});
+          ASSERT_EQ(a["type"], "feel.ack") << a.dump();
+          ++i;
+          t_ms += 0.25;
+        }
       const std::string choice = q["question"]["choices"][0];
       const std::string token = q["handout"]["token"];
+      // The page's own swipe figures are not taken.
       q = c.ask({{"type", "experiment.answer"},
                  {"trial", trial},
                  {"token", token},
-                 {"response", {{"choice", choice}, {"rt_ms", 900}}}});
+                 {"response", {{"choice", choice}, {"rt_ms", 900}, {"swipe_mean_speed_mm_s", 5}}}});
       ASSERT_EQ(q["type"], "experiment.question") << q.dump();
       EXPECT_EQ(q["question"]["trial"], trial + 1);
       EXPECT_EQ(q["progress"]["done"], trial + 1);
@@ -392,7 +537,20 @@ TEST(Service, ExperimentFlowCommitsBeforeTheNextQuestionAndResumes) {
       ex::Store st = ex::Store::open(db, ex::StoreMode::read_only);
       const auto trials = st.trials(session_id);
       ASSERT_EQ(trials.size(), 3u);
-      EXPECT_NE(json::parse(trials[0].response_json).value("swipe_mean_speed_mm_s", -1.0), -1.0);
+      const json r0 = json::parse(trials[0].response_json), r1 = json::parse(trials[1].response_json),
+                 r2 = json::parse(trials[2].response_json);
+      EXPECT_NEAR(r0.value("swipe_mean_speed_mm_s", -1.0), 100.0, 0.01) << r0.dump();
+      EXPECT_NEAR(r0.value("swipe_sd_speed_mm_s", -1.0), 0.0, 0.01) << r0.dump();
+      EXPECT_EQ(r0.value("directional_proportion", -1.0), 1.0) << r0.dump();
+      EXPECT_FALSE(r0.contains("swipe_flag")) << r0.dump();
+      EXPECT_FALSE(r1.contains("swipe_mean_speed_mm_s")) << r1.dump();
+      EXPECT_EQ(r1.value("swipe_flag", "").rfind("implausible_speed: mean 4000.0 mm/s, sustained 4000.0 mm/s", 0), 0u)
+          << r1.dump();
+      EXPECT_FALSE(r2.contains("swipe_mean_speed_mm_s") || r2.contains("swipe_flag")) << r2.dump();
+      const auto rows = st.rows(session_id);
+      EXPECT_NEAR(rows[0].swipe_mean_speed_mm_s, 100.0, 0.01);
+      EXPECT_TRUE(std::isnan(rows[1].swipe_mean_speed_mm_s));
+      EXPECT_EQ(rows[1].swipe_flag, r1["swipe_flag"]);  // the export shows why
     }
     // A second start is refused while this one runs; a reload sees the same question.
     expect_error(c.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "P02"}}), "conflict");
@@ -508,7 +666,7 @@ TEST(Service, ManyThreadsAtOnce) {
     threads.emplace_back([&, t] {
       Client c(s);
       for (int i = 0; i < 50; ++i) {
-        s.handle(c.id, json{{"type", "feel.move"}, {"seq", i}, {"x_mm", 10.0 * t}, {"touch", true}}.dump());
+        s.handle(c.id, json{{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 10.0 * t}, {"touch", true}}.dump());
         if (i % 10 == 0) s.handle(c.id, json{{"type", "design"}, {"document", tpad_document(5 + i * 0.1)}}.dump());
       }
       if (t % 2) s.disconnect(c.id);
@@ -722,4 +880,53 @@ TEST(Service, TwoDStudyPreloadsItsBitmapsFromTheSessionStart) {
   EXPECT_EQ(sel["type"], "experiment.selected") << sel.dump();
   RecordProperty("answer_to_bitmap_question_s", std::to_string(waited_s));
   std::printf("answer to the bitmap question's hand-out: %.3f s\n", waited_s);
+}
+
+// What a participant's screen gets of a question (issue #37): the library's
+// participant view holds no block and no documents (their seeds), and its
+// wording is what the page and the terminal both lay out — the recall cell
+// in words, the confidence scale's labels, each choice's label.
+TEST(ParticipantView, NoBlockNoDocumentsAndTheLibrarysWording) {
+  for (const char* name : {"working-memory", "free-exploration", "quantization", "texel-length", "guided-exploration"}) {
+    SCOPED_TRACE(name);
+    const ex::Protocol p = ex::load_protocol(protocols_dir + "/" + name + ".json");
+    ex::SessionContext ctx;
+    ctx.participant = "W1";
+    ctx.seed = ex::session_seed(p.seed, ctx.participant);
+    ex::Session s(p, ctx);
+    const ex::SimulatedParticipant who(ex::simulation_observer(p.observer, "default"), s);
+    for (int k = 0; k < 3 && !s.finished(); ++k) {
+      const ex::Question& q = s.question();
+      const json j = json::parse(q.participant_json());
+      for (const char* key : {"block", "block_index", "trial_in_block", "block_trials"}) EXPECT_FALSE(j.contains(key)) << key;
+      for (const auto& st : j["stimuli"]) EXPECT_FALSE(st.contains("document")) << st.dump();
+      // No text of it is the block's name (one named after its task kind says no more than `task`).
+      std::function<void(const json&)> no_block = [&](const json& v) {
+        if (v.is_string() && q.block != q.task) EXPECT_NE(v.get<std::string>(), q.block) << j.dump();
+        if (v.is_structured())
+          for (const auto& e : v) no_block(e);
+      };
+      no_block(j);
+      const json& w = j["wording"];
+      EXPECT_EQ(w["stimulus_names"].size(), q.stimuli.size());
+      EXPECT_EQ(w["choice_labels"].size(), q.choices.size());
+      EXPECT_EQ(!q.choices.empty(), !w["choice_question"].get<std::string>().empty());
+      EXPECT_EQ(q.confidence, w.contains("confidence"));
+      if (q.confidence) {
+        EXPECT_EQ(w["confidence"]["min"], 1);
+        EXPECT_EQ(w["confidence"]["max"], 5);
+        EXPECT_FALSE(w["confidence"]["min_label"].get<std::string>().empty());
+      }
+      EXPECT_EQ(q.rating_scale.has_value(), w.contains("rating"));
+      if (q.recall) {
+        const std::string rq = w["recall"]["question"];
+        if (q.recall->cell)
+          EXPECT_NE(
+              rq.find("row " + std::to_string(*q.recall->cell / 4 + 1) + ", column " + std::to_string(*q.recall->cell % 4 + 1)),
+              std::string::npos)
+              << rq;
+      }
+      (void)s.answer(who.respond(s));
+    }
+  }
 }

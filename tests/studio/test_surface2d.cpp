@@ -352,7 +352,7 @@ TEST(Surface2DStudio, PadPlaysOnTheStudiosSerialDisplayAndHandsItOver) {
   // The Feel-it strip is touched: the pad's finger ramps out, the Presenter takes the display back.
   DriveRecorder handover(*rig.hal);
   for (int i = 0; i < 150; ++i) {
-    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"x_mm", 20.0 + 0.1 * i}, {"touch", true}});
+    const json a = c.ask({{"type", "feel.move"}, {"seq", i}, {"t_ms", i}, {"x_mm", 20.0 + 0.1 * i}, {"touch", true}});
     ASSERT_EQ(a["type"], "feel.ack") << a.dump();
     std::this_thread::sleep_for(1ms);
   }
@@ -369,7 +369,7 @@ TEST(Surface2DStudio, PadPlaysOnTheStudiosSerialDisplayAndHandsItOver) {
   const json fs = c.ask({{"type", "feel.state"}});
   EXPECT_NE(fs["backend"].get<std::string>().find("serial"), std::string::npos) << fs.dump();
   EXPECT_EQ(fs["error"], "") << fs.dump();
-  c.ask({{"type", "feel.move"}, {"seq", 999}, {"x_mm", 35.0}, {"touch", false}});
+  c.ask({{"type", "feel.move"}, {"seq", 999}, {"t_ms", 150}, {"x_mm", 35.0}, {"touch", false}});
 
   // And the pad takes it once more (the display says HELLO again).
   for (int i = 0; i < 30; ++i) {
@@ -447,7 +447,7 @@ TEST(Surface2DStudio, ADisplaysOwnFingerDrivesThePadsPlayerAndThePadShowsIt) {
   EXPECT_GT(largest(values), 65535 / 20) << "the display's finger on the map drives the display";
   EXPECT_EQ(st["samples"].get<int>(), 0) << "the pad's own samples are not played meanwhile";
   // The Feel-it strip takes the display back: it stops reporting, and the pad's pointer is the finger again.
-  c.ask({{"type", "feel.move"}, {"seq", 1}, {"x_mm", 10}, {"touch", true}});
+  c.ask({{"type", "feel.move"}, {"seq", 1}, {"t_ms", 0}, {"x_mm", 10}, {"touch", true}});
   const json back = c.ask({{"type", "feel2d.state"}});
   EXPECT_EQ(back["finger"], "pad");
   EXPECT_FALSE(back["holds_device"].get<bool>());

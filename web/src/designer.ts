@@ -104,9 +104,10 @@ function texelTexture(t: TexelParams, extra: Record<string, unknown>): TexelText
   const tex: TexelTexture = {
     ...(extra as object),
     kind: 'texel',
-    central_pitch_db: round(t.central_pitch_db, 2),
-    irregularity_db: round(t.irregularity_db, 2),
-    texel_length_mm: round(t.texel_length_mm, 3),
+    // Exactly as typed or set (never rounded: the document is what the page shows).
+    central_pitch_db: t.central_pitch_db,
+    irregularity_db: t.irregularity_db,
+    texel_length_mm: t.texel_length_mm,
     seed: t.seed,
     parameterization: t.parameterization,
     quantization_db: t.quantization_db,
@@ -196,17 +197,31 @@ function applyTexel(s: DesignerState, t: TexelTexture): void {
 
 // ---------------------------------------------------------------- controls
 
-/** A typed value's allowed range (the library's, from hello) and whether it must be a whole number. */
+/**
+ * A typed value's allowed range and whether it must be a whole number: the engine's own rule
+ * (hello's texture_limits, from the library's constants), so what the page states is what the
+ * engine applies. null = unbounded (any finite number).
+ */
 interface Rule {
-  min: number;
-  max: number;
+  min: number | null;
+  max: number | null;
   exclusiveMin?: boolean;
   integer?: boolean;
 }
 
+/** The allowed range in words: "0.25 … 1000 mm", "above 0 mm", "any finite number". */
+export function rangeText(rule: Rule, unit: string): string {
+  const u = unit ? ` ${unit}` : '';
+  const { min, max } = rule;
+  if (min !== null && max !== null) return `${rule.exclusiveMin ? 'above ' : ''}${min} … ${max}${u}`;
+  if (min !== null) return `${rule.exclusiveMin ? 'above' : 'at least'} ${min}${u}`;
+  if (max !== null) return `at most ${max}${u}`;
+  return 'any finite number';
+}
+
 /**
  * Reads a typed value: a number inside `rule`, or the reason it is refused
- * (never clamped, never read as 0).
+ * (never clamped, never rounded, never read as 0).
  */
 export function parseTyped(text: string, rule: Rule, unit: string): { value: number } | { error: string } {
   const t = text.trim().replace(/\u2212/g, '-');
@@ -215,9 +230,8 @@ export function parseTyped(text: string, rule: Rule, unit: string): { value: num
   if (!Number.isFinite(v) || !/^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$/i.test(t)) return { error: `"${text.trim()}" is not a number` };
   const u = unit ? ` ${unit}` : '';
   if (rule.integer && !Number.isInteger(v)) return { error: `${t} is not a whole number` };
-  const low = rule.exclusiveMin ? v <= rule.min : v < rule.min;
-  if (low || v > rule.max)
-    return { error: `${t}${u} is outside the allowed range ${rule.exclusiveMin ? 'above ' : ''}${rule.min} … ${rule.max}${u}` };
+  const low = rule.min !== null && (rule.exclusiveMin ? v <= rule.min : v < rule.min);
+  if (low || (rule.max !== null && v > rule.max)) return { error: `${t}${u} is outside the allowed range ${rangeText(rule, unit)}` };
   return { value: v };
 }
 
@@ -271,6 +285,7 @@ function field(
       if (document.activeElement !== num || num.getAttribute('aria-invalid') === 'true') num.value = String(v);
     },
     refuse(message: string) {
+      editedSinceRefusal = false;
       num.value = String(shownValue);
       num.setAttribute('aria-invalid', 'true');
       err.textContent = `${label}: ${message}. The design keeps ${shownValue} ${unit}.`;
@@ -288,17 +303,28 @@ function field(
     num.value = input.value;
     onValue(Number(input.value), false);
   });
+  const unitWord = unit.startsWith('dB') ? 'dB' : unit === 'mm' || unit === 'degrees' || unit === 'mm/s' ? unit : '';
+  // The range the engine accepts, stated at the field (its tooltip) as in its refusals.
+  num.addEventListener('focus', () => (num.title = `Allowed: ${rangeText(rule(), unitWord)}`));
   const commit = () => {
     if (num.value.trim() === String(shownValue) && num.getAttribute('aria-invalid') !== 'true') return;
-    const r = parseTyped(num.value, rule(), unit.startsWith('dB') ? 'dB' : unit === 'mm' || unit === 'degrees' || unit === 'mm/s' ? unit : '');
+    const r = parseTyped(num.value, rule(), unitWord);
     if ('error' in r) {
       ctl.refuse(r.error);
       return;
     }
     ctl.clear();
-    onValue(r.value, true);
+    if (r.value !== shownValue) onValue(r.value, true);
   };
   num.addEventListener('change', commit);
+  // Leaving a refused field after typing in it commits what it holds: a value the browser's own
+  // change event misses (one equal to the value on focus, as the kept value typed back) clears the
+  // refusal too. (A Tab fires change, then blur: the refusal that change shows stays.)
+  let editedSinceRefusal = false;
+  num.addEventListener('input', () => (editedSinceRefusal = true));
+  num.addEventListener('blur', () => {
+    if (num.getAttribute('aria-invalid') === 'true' && editedSinceRefusal) commit();
+  });
   num.addEventListener('keydown', (e) => {
     if (e.key === 'Enter') {
       e.preventDefault();
@@ -343,6 +369,19 @@ function loadSaved(): Saved | null {
   }
 }
 
+/**
+ * Writes the mounted designer's waiting save at once. The page's end (reload,
+ * close, navigation, a hidden tab that may be discarded) calls it: pagehide
+ * and beforeunload fire on a reload or close, visibilitychange to "hidden"
+ * also on mobile browsers, which may skip the other two.
+ */
+let flushSavedDesign: (() => void) | null = null;
+window.addEventListener('pagehide', () => flushSavedDesign?.());
+window.addEventListener('beforeunload', () => flushSavedDesign?.());
+document.addEventListener('visibilitychange', () => {
+  if (document.visibilityState === 'hidden') flushSavedDesign?.();
+});
+
 /** The state without what belongs to one moment (match overlays): what undo, redo and saving keep. */
 function lasting(s: DesignerState): string {
   return JSON.stringify(buildDocument(s)) + `|${s.speed_mm_s}`;
@@ -375,6 +414,7 @@ export function mountDesigner(root: HTMLElement): void {
   const driveWarn = h('p', { class: 'drive-warning', 'data-testid': 'drive-warning', hidden: true });
   const hzNote = h('p', { class: 'hint', 'data-testid': 'hz-note' });
   const texelsEl = h('span', { 'data-testid': 'texels' });
+  const flatWarn = h('p', { class: 'drive-warning', 'data-testid': 'flat-warning', role: 'status', hidden: true });
   const elapsedEl = h('span', { 'data-testid': 'elapsed' });
 
   // --- design requests and redraw timing
@@ -499,6 +539,15 @@ export function mountDesigner(root: HTMLElement): void {
       hexEl.textContent = r.encoded?.error ?? '';
     }
     texelsEl.textContent = r.texels !== undefined ? `${r.texels} texels` : '';
+    // Whole texels only: what the last texel does not reach stays flat. Say so (it was silent) when a
+    // finger can feel it: 1 mm or more (0.25 mm texels leave 0.04 mm of the tpad, not worth a word).
+    const flat = r.uncovered_mm ?? 0;
+    const L = store.get().texel.texel_length_mm;
+    flatWarn.hidden = !(flat >= 1);
+    flatWarn.textContent = flatWarn.hidden
+      ? ''
+      : `With ${L} mm texels, ${r.texels} whole texel${r.texels === 1 ? '' : 's'} cover the texture region; the last ${fmt(flat, 2)} mm of it are flat (no texel fits there). ` +
+        'A shorter texel length, or a length that divides the region, textures all of it.';
     elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
     strip.setLength(r.grid.count * r.grid.spacing_mm);
     strip.setMap(values, r.grid.origin_mm, r.grid.spacing_mm);
@@ -542,7 +591,25 @@ export function mountDesigner(root: HTMLElement): void {
   // --- controls: each writes the store; render() shows the store in them
   const lim = (k: keyof NonNullable<HelloReply['texture_limits']>, fallback: Rule): (() => Rule) => () => {
     const r = hello?.texture_limits?.[k];
-    return r ? { min: r.min, max: r.max } : fallback;
+    return r ? { min: r.min, max: r.max, exclusiveMin: r.exclusive_min } : fallback;
+  };
+  // Central Pitch on a device lies in its renderable band too (hello's device_limits).
+  const pitchRule = (): Rule => {
+    const dev = store.get().device;
+    const name = typeof dev === 'string' ? dev : dev.name;
+    const d = hello?.device_limits.find((x) => x.device === name)?.central_pitch_db;
+    return d ? { min: d.min, max: d.max } : lim('central_pitch_db', { min: -40, max: 40 })();
+  };
+  // Irregularity under the log parameterization is a dB of log-spread (>= 0).
+  const irrRule = () => lim(store.get().texel.parameterization === 'log' ? 'irregularity_db_log' : 'irregularity_db', { min: -60, max: 40 })();
+  // A texel length also makes at most max_map_samples texels on the device (the studio's cap, checked
+  // by the engine as this same quotient).
+  const lengthRule = (): Rule => {
+    const r = lim('texel_length_mm', { min: 1e-6, max: 1000 })();
+    const cap = hello?.limits.max_map_samples;
+    const len = deviceLength(store.get().device);
+    const shortest = cap && Number.isFinite(len) ? len / cap : 0;
+    return { ...r, min: Math.max(r.min ?? 0, shortest) };
   };
   /** Commits a value; a typed one stays pending until the engine accepts it (design() refuses it otherwise). */
   const commitTexel = (ctl: () => FieldCtl, p: Partial<TexelParams>, typed: boolean) => {
@@ -551,11 +618,11 @@ export function mountDesigner(root: HTMLElement): void {
     if (typed) pending = { g: gen, ctl: ctl(), prev };
   };
   const t = store.get().texel;
-  const pitch: FieldCtl = field('central-pitch', 'Central Pitch', { min: -10, max: 19.5, step: 0.1 }, lim('central_pitch_db', { min: -40, max: 40 }), t.central_pitch_db, 'dB re 1 cycle/mm',
+  const pitch: FieldCtl = field('central-pitch', 'Central Pitch', { min: -10, max: 19.5, step: 0.1 }, pitchRule, t.central_pitch_db, 'dB re 1 cycle/mm',
     (v, typed) => commitTexel(() => pitch, { central_pitch_db: v }, typed), pitchCpm);
-  const irr: FieldCtl = field('irregularity', 'Irregularity', { min: -30, max: 20, step: 0.1 }, lim('irregularity_db', { min: -60, max: 40 }), t.irregularity_db, 'dB',
+  const irr: FieldCtl = field('irregularity', 'Irregularity', { min: -30, max: 20, step: 0.1 }, irrRule, t.irregularity_db, 'dB',
     (v, typed) => commitTexel(() => irr, { irregularity_db: v }, typed), irrCpm);
-  const length: FieldCtl = field('texel-length', 'Texel length', { min: 0.05, max: 100, step: 0.01 }, lim('texel_length_mm', { min: 1e-6, max: 1000 }), t.texel_length_mm, 'mm',
+  const length: FieldCtl = field('texel-length', 'Texel length', { min: 0.05, max: 100, step: 0.01 }, lengthRule, t.texel_length_mm, 'mm',
     (v, typed) => commitTexel(() => length, { texel_length_mm: v }, typed));
   const seedErr = h('p', { class: 'field-error', id: 'seed-error', 'data-testid': 'seed-error', hidden: true });
   const seedIn = h('input', { type: 'text', inputmode: 'numeric', id: 'seed', value: t.seed, 'data-testid': 'seed', class: 'num', 'aria-describedby': 'seed-error' }) as HTMLInputElement;
@@ -597,11 +664,11 @@ export function mountDesigner(root: HTMLElement): void {
   const fStrength: FieldCtl = field('fine-strength', 'Fine strength F', { min: 0, max: 1, step: 0.01 }, lim('fine_strength', { min: 0, max: 1 }), t.fine_strength, '0…1',
     (v, typed) => commitTexel(() => fStrength, { fine_strength: v }, typed));
 
-  const constVal: FieldCtl = field('coarse-value', 'Constant value', { min: 0, max: 1, step: 0.01 }, () => ({ min: 0, max: 1 }), t.coarse_value, '0…1',
+  const constVal: FieldCtl = field('coarse-value', 'Constant value', { min: 0, max: 1, step: 0.01 }, lim('coarse_value', { min: 0, max: 1 }), t.coarse_value, '0…1',
     (v, typed) => commitTexel(() => constVal, { coarse_value: v }, typed));
-  const sinePeriod: FieldCtl = field('sine-period', 'Sine period', { min: 0.5, max: 100, step: 0.1 }, () => ({ min: 0, max: 1e6, exclusiveMin: true }), t.sine_period_mm, 'mm',
+  const sinePeriod: FieldCtl = field('sine-period', 'Sine period', { min: 0.5, max: 100, step: 0.1 }, lim('sine_period_mm', { min: 1e-9, max: 1e9 }), t.sine_period_mm, 'mm',
     (v, typed) => commitTexel(() => sinePeriod, { sine_period_mm: v }, typed), periodCpm);
-  const sinePhase: FieldCtl = field('sine-phase', 'Sine phase', { min: 0, max: 360, step: 1 }, () => ({ min: -1e6, max: 1e6 }), t.sine_phase_deg, 'degrees',
+  const sinePhase: FieldCtl = field('sine-phase', 'Sine phase', { min: 0, max: 360, step: 1 }, lim('sine_phase_deg', { min: -1e9, max: 1e9 }), t.sine_phase_deg, 'degrees',
     (v, typed) => commitTexel(() => sinePhase, { sine_phase_deg: v }, typed));
   const speed: FieldCtl = field('swipe-speed', 'Swipe speed', { min: 10, max: 500, step: 1 }, () => ({ min: 0, max: 10000, exclusiveMin: true }), store.get().speed_mm_s, 'mm/s',
     (v) => store.update({ speed_mm_s: v }));
@@ -700,9 +767,8 @@ export function mountDesigner(root: HTMLElement): void {
     }
   });
 
-  function shown(v: number): number {
-    return Math.round(v * 1e4) / 1e4;
-  }
+  // A field shows the document's value exactly (String(v): the shortest form that reads back as v).
+  const shown = (v: number): number => v;
 
   // --- undo / redo and the design saved in this browser
   const undoStack: DesignerState[] = [];
@@ -752,21 +818,33 @@ export function mountDesigner(root: HTMLElement): void {
     else return;
     e.preventDefault();
   });
+  // Saving waits 250 ms for a slider drag to settle, but never past the page's end: a reload,
+  // a closed tab or a hidden page writes what is waiting at once (flushSavedDesign, below).
   let saveTimer: ReturnType<typeof setTimeout> | null = null;
-  function save(s: DesignerState): void {
+  let unsaved: DesignerState | null = null;
+  function flushSave(): void {
     if (saveTimer) clearTimeout(saveTimer);
-    saveTimer = setTimeout(() => {
-      try {
-        const v: Saved = { document: buildDocument(s), speed_mm_s: s.speed_mm_s };
-        localStorage.setItem(SAVED_KEY, JSON.stringify(v));
-        root.dataset.saved = 'true';
-      } catch (e) {
-        showError(`The design could not be saved in this browser: ${message(e)}`);
-      }
-    }, 250);
+    saveTimer = null;
+    const s = unsaved;
+    unsaved = null;
+    if (!s) return;
+    try {
+      const v: Saved = { document: buildDocument(s), speed_mm_s: s.speed_mm_s };
+      localStorage.setItem(SAVED_KEY, JSON.stringify(v));
+      root.dataset.saved = 'true';
+    } catch (e) {
+      showError(`The design could not be saved in this browser: ${message(e)}`);
+    }
   }
+  function save(s: DesignerState): void {
+    unsaved = s;
+    if (saveTimer) clearTimeout(saveTimer);
+    saveTimer = setTimeout(flushSave, 250);
+  }
+  flushSavedDesign = flushSave;
   const freshBtn = h('button', { type: 'button', 'data-testid': 'new-design', onclick: () => {
     if (saveTimer) clearTimeout(saveTimer);
+    unsaved = null;
     localStorage.removeItem(SAVED_KEY);
     undoStack.push(store.get());
     redoStack.length = 0;
@@ -936,7 +1014,7 @@ export function mountDesigner(root: HTMLElement): void {
     'form',
     { class: 'controls', 'aria-label': 'Texture parameters', onsubmit: (e: Event) => e.preventDefault() },
     h('div', { class: 'btn-row history' }, undoBtn, redoBtn, freshBtn, savedNote),
-    h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row,
+    h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row, flatWarn,
       h('div', { class: 'ctl' }, h('label', { for: 'seed' }, 'Seed ', h('span', { class: 'unit' }, '(whole number ≥ 0)')), h('div', { class: 'ctl-row' }, seedIn, newDraw), seedErr),
       param.row, quant.row, fStrength.row),
     h('fieldset', {}, h('legend', {}, 'Swipe speed'), speed.row, driveWarn),
@@ -948,7 +1026,8 @@ export function mountDesigner(root: HTMLElement): void {
         fileIn,
         h('button', { type: 'button', onclick: () => void exportAs('document'), 'data-testid': 'export-document' }, 'Export .texel.json'),
         exportBits,
-        h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin')),
+        h('button', { type: 'button', onclick: () => void exportAs('device'), 'data-testid': 'export-device' }, 'Export device .bin'),
+        h('button', { type: 'button', onclick: () => void exportAs('hjif'), 'data-testid': 'export-hjif', title: 'MPEG-I Haptics interchange (texel export -o x.hjif)' }, 'Export .hjif')),
       bitsNote, filesErr,
       h('p', { class: 'hint' }, 'Or drop a file anywhere on the page. The design is also kept in this browser.'),
       stimulusSaver(() => buildDocument(store.get()))),

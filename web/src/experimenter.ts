@@ -485,6 +485,7 @@ export function mountExperimenter(root: HTMLElement): void {
   }
   async function validate(): Promise<Record<string, unknown> | null> {
     const v = editor.value();
+    editor.clearErrors();
     if ('error' in v) {
       editorSay(v.error, true);
       return null;
@@ -494,7 +495,9 @@ export function mountExperimenter(root: HTMLElement): void {
       editorSay(`Valid: ${r.name} (${r.study}), ${r.trials_planned > 0 ? `${r.trials_planned} trials` : 'adaptive length'}.`);
       return v.protocol;
     } catch (e) {
-      editorSay(plain(e), true);
+      // At the field the engine names (1-based blocks, as the form's legends), and here.
+      const shown = editor.showError(plain(e));
+      editorSay(shown.atField ? `${shown.text} (shown at the field)` : shown.text, true);
       return null;
     }
   }

@@ -10,8 +10,13 @@ import { StudioClient, studioUrl } from './ws';
 /** Page → worker: one finger sample. */
 export interface FingerSample {
   seq: number;
+  /** When the browser took the sample: the page's event timeStamp (ms, the page's clock). */
+  t_ms: number;
   x_mm: number;
   touch: boolean;
+  /** Earlier samples of the same pointer event, [t_ms, x_mm], oldest first. */
+  coalesced?: [number, number][];
+  /** When the page posted it (timeOrigin + now), for the measured ack latency. */
   t0: number;
 }
 
@@ -30,7 +35,7 @@ let waiting: FingerSample | null = null; // while connecting, only the newest sa
 function send(m: FingerSample): boolean {
   if (sent.size > 4096) sent.clear();
   sent.set(m.seq, m.t0);
-  return client.send('feel.move', { seq: m.seq, x_mm: m.x_mm, touch: m.touch });
+  return client.send('feel.move', { seq: m.seq, t_ms: m.t_ms, x_mm: m.x_mm, touch: m.touch, ...(m.coalesced ? { coalesced: m.coalesced } : {}) });
 }
 
 client.on('feel.ack', (m) => {

@@ -1,7 +1,14 @@
 // The "Feel it" strip: the display on the page. Pointer Events (mouse, pen,
 // touch; `touch-action: none`) and the arrow keys stream finger samples to the
-// engine's player as `feel.move {seq, x_mm, touch}`; the player's own report
-// (`feel.state`, polled at 10 Hz) is shown as #player-position.
+// engine's player as `feel.move {seq, t_ms, x_mm, touch, coalesced?}`; the
+// player's own report (`feel.state`, polled at 10 Hz) is shown as #player-position.
+//
+// Every sample carries the time the browser took it (the event's timeStamp:
+// the page's monotonic clock, ms), and a pointermove carries the samples
+// coalesced into it (getCoalescedEvents, where the browser has it): the
+// studio plays each sample on arrival but measures the swipe (speed, its SD,
+// direction) from these times, so a message that waited in a queue does not
+// make the finger look fast.
 //
 // Touch semantics [choice]: a finger or pen touches while in contact
 // (pointerdown … pointerup/cancel). A mouse touches while its button is held;
@@ -61,18 +68,34 @@ function installAck(): void {
   });
 }
 
-export function sendMove(x_mm: number, touch: boolean): void {
+let lastT = 0; // the newest time sent: the studio refuses a clock that goes back
+
+/**
+ * Sends one finger sample taken at `t_ms` (an event's timeStamp, the page's clock) and, before it, the
+ * samples coalesced into the same pointer event ([t_ms, x_mm], oldest first).
+ */
+export function sendMove(x_mm: number, touch: boolean, t_ms: number = performance.now(), coalesced: [number, number][] = []): void {
   const s = ++seq;
+  // Input events carry the time of the input, others (blur, a key) their dispatch: one may trail the
+  // other by a fraction of a millisecond, so the times sent never go back.
+  const earlier: [number, number][] = [];
+  for (const [t, x] of coalesced.slice(-64)) {
+    lastT = Math.max(lastT, t);
+    earlier.push([lastT, x]);
+  }
+  lastT = Math.max(lastT, t_ms);
+  const t = lastT;
   const w = feelWorker();
   if (w) {
-    const sample: FingerSample = { seq: s, x_mm, touch, t0: performance.timeOrigin + performance.now() };
+    const sample: FingerSample = { seq: s, t_ms: t, x_mm, touch, t0: performance.timeOrigin + performance.now(), ...(earlier.length ? { coalesced: earlier } : {}) };
     w.postMessage(sample);
     if (__TEXEL_TEST_HOOKS__) stats.feelMovesSent++;
   } else {
     installAck();
     if (sentAt.size > 2000) sentAt.clear();
     sentAt.set(s, performance.now());
-    if (studio().send('feel.move', { seq: s, x_mm, touch }) && __TEXEL_TEST_HOOKS__) stats.feelMovesSent++;
+    if (studio().send('feel.move', { seq: s, t_ms: t, x_mm, touch, ...(earlier.length ? { coalesced: earlier } : {}) }) && __TEXEL_TEST_HOOKS__)
+      stats.feelMovesSent++;
   }
   hearIt.pointer(x_mm, touch);
 }
@@ -146,13 +169,14 @@ export class FeelStrip {
     feelWorker(); // connect before the first touch
   }
 
-  private xOf(e: PointerEvent): number {
+  private xOf(e: { clientX: number }): number {
     const r = this.strip.getBoundingClientRect();
     const f = Math.min(1, Math.max(0, (e.clientX - r.left) / r.width));
     return f * this.length_mm;
   }
 
-  private move(x: number, touch: boolean): void {
+  /** Moves the finger to `x` as of event `e` (its timeStamp), after the samples coalesced into it. */
+  private move(x: number, touch: boolean, e?: Event, coalesced: [number, number][] = []): void {
     if (!Number.isFinite(x)) return; // the device's length is not known yet (hello)
     this.lastX = x;
     // A transform, not `left`: the marker moves on the compositor without a
@@ -161,7 +185,7 @@ export class FeelStrip {
     this.finger.style.transform = `translateX(${(100 * x) / this.length_mm}%)`;
     this.finger.classList.toggle('touching', touch);
     this.strip.setAttribute('aria-valuenow', x.toFixed(1));
-    sendMove(x, touch);
+    sendMove(x, touch, e ? e.timeStamp : performance.now(), coalesced);
   }
 
   private bind(): void {
@@ -172,23 +196,27 @@ export class FeelStrip {
       s.setPointerCapture(e.pointerId);
       e.preventDefault();
       s.focus({ preventScroll: true });
-      this.move(this.xOf(e), true);
+      this.move(this.xOf(e), true, e);
     });
     s.addEventListener('pointermove', (e) => {
       const touch = this.pressed || (e.pointerType === 'mouse' && this.hoverTouches);
       if (!touch && e.pointerType !== 'mouse') return;
-      this.move(this.xOf(e), touch);
+      // The samples the browser coalesced into this event, oldest first; the newest is the event itself.
+      const all = typeof e.getCoalescedEvents === 'function' ? e.getCoalescedEvents() : [];
+      const last = all.length ? all[all.length - 1] : e;
+      const earlier = all.slice(0, -1).map((c): [number, number] => [c.timeStamp, this.xOf(c)]);
+      this.move(this.xOf(last), touch, last, earlier);
     });
     const lift = (e: PointerEvent) => {
       this.pressed = false;
       const stillHover = e.type === 'pointerup' && e.pointerType === 'mouse' && this.hoverTouches;
-      this.move(this.xOf(e), stillHover);
+      this.move(this.xOf(e), stillHover, e);
     };
     s.addEventListener('pointerup', lift);
     s.addEventListener('pointercancel', lift);
     s.addEventListener('pointerleave', (e) => {
       if (this.pressed) return; // captured: leave comes with pointerup
-      this.move(this.xOf(e), false);
+      this.move(this.xOf(e), false, e);
     });
     s.addEventListener('keydown', (e) => {
       const step = e.shiftKey ? 10 : 1;
@@ -200,12 +228,12 @@ export class FeelStrip {
       else return;
       e.preventDefault();
       this.opts.onEnter?.();
-      this.move(Math.min(this.length_mm, Math.max(0, x)), true);
+      this.move(Math.min(this.length_mm, Math.max(0, x)), true, e);
     });
     s.addEventListener('keyup', (e) => {
-      if (e.key.startsWith('Arrow') || e.key === 'Home' || e.key === 'End') this.move(this.lastX, false);
+      if (e.key.startsWith('Arrow') || e.key === 'Home' || e.key === 'End') this.move(this.lastX, false, e);
     });
-    s.addEventListener('blur', () => this.move(this.lastX, false));
+    s.addEventListener('blur', (e) => this.move(this.lastX, false, e));
   }
 
   setLength(length_mm: number): void {

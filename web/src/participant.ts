@@ -29,11 +29,9 @@
 import { studio, StudioError } from './ws';
 import { h, isoNow, decodeF32 } from './util';
 import { FeelStrip } from './feel';
-import { getHello, deviceLength } from './designer';
 import { Store } from './store';
-import type { ExperimentQuestionReply, Question, Response, ServerMessages, TrialEvent } from './generated/messages';
+import type { ExperimentQuestionReply, Question, Response, Scale, ServerMessages, TrialEvent } from './generated/messages';
 
-const niceChoice: Record<string, string> = { unsure: 'Unsure', same: 'Same', different: 'Different' };
 
 function radioGroup(label: string, options: { value: string; text: string }[], onPick: (v: string) => void, testid: string, labelledBy?: string): { el: HTMLElement; value: () => string | null } {
   let picked: string | null = null;
@@ -82,9 +80,6 @@ function drawMiniMap(canvas: HTMLCanvasElement, values: Float32Array): void {
   }
   ctx.stroke();
 }
-
-// "1" → "texture 1"; named stimuli ("Reference", "A", "Test") keep their name.
-const stimulusName = (label: string) => (/^\d+$/.test(label) ? `texture ${label}` : label);
 
 /** Test hooks of the 2-D touch surface (test builds only). */
 const hooks2d = { samplesSent: 0, samplesRecorded: 0, refused: 0, line: null as number | null };
@@ -350,6 +345,8 @@ export function mountParticipant(root: HTMLElement): void {
 
   async function renderQuestion(reply: ExperimentQuestionReply): Promise<void> {
     const q: Question = reply.question;
+    const w = q.wording;
+    const named = (i: number) => w.stimulus_names[i] ?? `texture ${i + 1}`;
     const handout = reply.handout;
     const shownPerf = performance.now();
     const events: TrialEvent[] = [];
@@ -376,15 +373,8 @@ export function mountParticipant(root: HTMLElement): void {
       : null;
     if (surface) endQuestion = () => (clearTimers(), surface.dispose());
 
-    try {
-      const hi = await getHello();
-      const dev = q.stimuli.find((x) => x.document)?.document?.device ?? 'tpad';
-      const p = typeof dev === 'object' ? dev : hi.devices.find((d) => d.name === dev);
-      if (p) strip.setLength(deviceLength(p));
-    } catch {
-      /* keep the default length */
-    }
-    if (!current()) return; // the session moved on while the device was looked up
+    // The strip's length is the protocol's device's (the question carries no documents).
+    if (typeof reply.strip_mm === 'number') strip.setLength(reply.strip_mm);
 
     // ---- the trial's one state: inputs write it, render() enables Submit from it
     type Answer = Pick<Response, 'choice' | 'rating' | 'confidence' | 'digit' | 'slider_p' | 'slider_i'>;
@@ -414,8 +404,8 @@ export function mountParticipant(root: HTMLElement): void {
     });
 
     // ---- stimuli
-    const stimulusButtons = q.stimuli.map((s, i) => {
-      const b = h('button', { type: 'button', class: 'big stimulus', 'aria-pressed': 'false', 'data-stimulus': i }, `Feel ${stimulusName(s.label)}`) as HTMLButtonElement;
+    const stimulusButtons = q.stimuli.map((_, i) => {
+      const b = h('button', { type: 'button', class: 'big stimulus', 'aria-pressed': 'false', 'data-stimulus': i }, `Feel ${named(i)}`) as HTMLButtonElement;
       b.addEventListener('click', () => void selectStimulus(i));
       return b;
     });
@@ -434,7 +424,7 @@ export function mountParticipant(root: HTMLElement): void {
         const r = await client.call('experiment.select', { trial: q.trial, stimulus: i }, 30000);
         if (surface && current() && r.stroke_deg !== undefined) {
           surface.show(i, r.stroke_deg);
-          lineText.textContent = `Stroke ${stimulusName(q.stimuli[i]?.label ?? String(i + 1))} along the line: ${r.stroke_words ?? ''}`;
+          lineText.textContent = `Stroke ${named(i)} along the line: ${r.stroke_words ?? ''}`;
           if (r.reminder) {
             ev('stroke_reminder', q.stimuli[left]?.label ?? String(left)); // the interval left, as the terminal records it
             showNotice(r.reminder);
@@ -491,20 +481,12 @@ export function mountParticipant(root: HTMLElement): void {
       if (q.show_maps) {
         const maps = h('div', { class: 'maps' });
         parts.push(maps);
-        // One at a time: the service keeps only the newest queued design per client.
-        void (async () => {
-          for (const s of q.stimuli) {
-            const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
-            maps.append(h('div', {}, h('span', {}, s.label), c));
-            if (!s.document) continue;
-            try {
-              const r = await client.call('design', { document: s.document }, 60000);
-              drawMiniMap(c, decodeF32(r.map_f32));
-            } catch {
-              /* maps are an aid only */
-            }
-          }
-        })();
+        // The studio sends the rendered maps (never the documents: their parameters and seeds).
+        for (const s of q.stimuli) {
+          const c = h('canvas', { width: 600, height: 60, class: 'mini-map', 'aria-label': `Map of ${s.label}`, role: 'img' }) as HTMLCanvasElement;
+          maps.append(h('div', {}, h('span', {}, s.label), c));
+          if (s.map_f32) drawMiniMap(c, decodeF32(s.map_f32));
+        }
       }
     } else {
       parts.push(phaseArea);
@@ -547,44 +529,31 @@ export function mountParticipant(root: HTMLElement): void {
         answerArea.append(h('div', { class: 'ctl' }, h('label', { for: id }, s.label || s.name), input));
       });
     }
+    // Every word the participant reads is the library's (question.wording), as the terminal prints it.
     if (needs.choice) {
       // Visibly different from the row above: a heading says this row answers.
-      // The 2-D oddity (oddity-2d) asks the same question as the oddity: which of three differs.
-      const odd = q.task === 'oddity' || q.task === 'oddity-2d';
-      const question = odd ? 'Answer: the odd one is …' : q.task === 'two-alternative' ? 'Answer: the test texture is like …' : 'Your answer';
-      const g = radioGroup(question, q.choices.map((c) => ({ value: c, text: niceChoice[c] ?? (odd ? stimulusName(c) : c) })), (v) => {
+      const question = w.choice_question;
+      const g = radioGroup(question, q.choices.map((c, i) => ({ value: c, text: w.choice_labels[i] ?? c })), (v) => {
         ev('choice', v);
         setAnswer({ choice: v });
       }, 'choices', 'answer-heading');
       answerArea.append(h('h2', { id: 'answer-heading', class: 'group-label' }, question), g.el);
     }
-    if (q.rating_scale) {
-      const [lo, hi] = q.rating_scale;
+    /** A numbered scale: its question, its ends' words, one button per step. */
+    const scale = (s: Scale, testid: string, pick: (v: number) => void) => {
       const opts = [];
-      for (let v = lo; v <= hi; v++) opts.push({ value: String(v), text: String(v) });
-      const g = radioGroup(`Similarity from ${lo} (different) to ${hi} (the same)`, opts, (v) => {
-        ev('rating', v);
-        setAnswer({ rating: Number(v) });
-      }, 'rating');
-      answerArea.append(h('p', { class: 'scale-label' }, `${lo} = very different … ${hi} = identical`), g.el);
-    }
-    if (needs.digit) {
-      const where =
-        q.recall_cell >= 0 ? `in row ${Math.floor(q.recall_cell / 4) + 1}, column ${(q.recall_cell % 4) + 1}` : 'in the cells';
-      const opts = [];
-      for (let v = 1; v <= 9; v++) opts.push({ value: String(v), text: String(v) });
-      const g = radioGroup(`Digit ${where}`, opts, (v) => {
-        setAnswer({ digit: Number(v) });
-      }, 'digit');
-      answerArea.append(h('p', { class: 'prompt' }, `Which digit was ${where} of the matrix?`), g.el);
-    }
-    if (q.confidence) {
-      const opts = [1, 2, 3, 4, 5].map((v) => ({ value: String(v), text: String(v) }));
-      const g = radioGroup('Confidence from 1 (guess) to 5 (certain)', opts, (v) => {
-        setAnswer({ confidence: Number(v) });
-      }, 'confidence');
-      answerArea.append(h('p', { class: 'scale-label' }, 'How confident are you? 1 = guess … 5 = certain'), g.el);
-    }
+      for (let v = s.min; v <= s.max; v++) opts.push({ value: String(v), text: String(v) });
+      const ends = `${s.min}${s.min_label ? ` (${s.min_label})` : ''} to ${s.max}${s.max_label ? ` (${s.max_label})` : ''}`;
+      const g = radioGroup(`${s.question} ${ends}`, opts, (v) => pick(Number(v)), testid);
+      answerArea.append(h('p', { class: 'scale-label', 'data-testid': `${testid}-question` }, `${s.question} ${ends}`), g.el);
+    };
+    if (q.rating_scale && w.rating)
+      scale(w.rating, 'rating', (v) => {
+        ev('rating', String(v));
+        setAnswer({ rating: v });
+      });
+    if (needs.digit && w.recall) scale(w.recall, 'digit', (v) => setAnswer({ digit: v }));
+    if (q.confidence && w.confidence) scale(w.confidence, 'confidence', (v) => setAnswer({ confidence: v }));
     answerArea.append(submit, msg);
 
     submit.addEventListener('click', async () => {
@@ -640,8 +609,7 @@ export function mountParticipant(root: HTMLElement): void {
         const end = performance.now() + ph.duration_s * 1000;
         const left = h('span', { class: 'countdown' });
         if (ph.kind === 'stimulus') {
-          const label = q.stimuli[ph.stimulus]?.label ?? `texture ${ph.stimulus + 1}`;
-          phaseArea.replaceChildren(h('p', { class: 'prompt' }, `Feel ${label} on the strip.`), left);
+          phaseArea.replaceChildren(h('p', { class: 'prompt' }, `Feel ${named(ph.stimulus)} on the strip.`), left);
           void selectStimulus(ph.stimulus);
         } else if (ph.kind === 'matrix') {
           ev('matrix', 'shown');

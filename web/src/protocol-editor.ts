@@ -46,6 +46,23 @@ for (const b of resolve(schema.properties!.blocks).items?.oneOf ?? []) {
 }
 
 let uid = 0;
+
+/**
+ * A path as the form names it: the engine's 0-based "blocks[0].time_limit_s" is "Block 1 › time_limit_s",
+ * as the block's legend says ("Block 1: …"); nested lists stay as the engine gives them.
+ */
+export function formPath(path: string): string {
+  return path
+    .replace(/^protocol\./, '')
+    .replace(/\bblocks\[(\d+)\]\.?/g, (_, n: string) => `Block ${Number(n) + 1} › `)
+    .replace(/ › $/, '');
+}
+
+/** The engine's message with every block path 1-based, as the form shows blocks. */
+export function formMessage(message: string): string {
+  return message.replace(/\bblocks\[(\d+)\](\.[A-Za-z_][\w.[\]]*)?/g, (m) => formPath(m));
+}
+
 const clone = <T>(v: T): T => JSON.parse(JSON.stringify(v)) as T;
 const label = (key: string) => key.replace(/_/g, ' ');
 
@@ -55,12 +72,23 @@ export interface ProtocolEditor {
   load(p: Obj): void;
   /** The protocol as the form holds it, or an error naming the first field that is not valid JSON. */
   value(): { protocol: Obj } | { error: string };
+  /**
+   * Shows the engine's refusal at the field it names ("blocks[0].time_limit_s …" at Block 1's
+   * time_limit_s; a top-level key at the protocol's field) and returns the message as the form words
+   * it (1-based blocks); false when no field of the form matches (the caller shows it elsewhere).
+   */
+  showError(message: string): { text: string; atField: boolean };
+  /** Removes every refusal shown at a field. */
+  clearErrors(): void;
 }
 
 export function protocolEditor(): ProtocolEditor {
   let proto: Obj = {};
   const broken = new Map<string, string>(); // field id → JSON error
   const form = h('div', { class: 'protocol-form', 'data-testid': 'protocol-form' });
+
+  /** The slot at a field where the engine's refusal of it is shown (showError). */
+  const engineError = (id: string) => h('p', { class: 'field-error engine-error', id: `${id}-engine`, role: 'alert', hidden: true, 'data-testid': 'field-error' });
 
   /** One input for `obj[key]` described by `s`. */
   function field(obj: Obj, key: string, s0: Schema, required: boolean, path: string): HTMLElement {
@@ -75,7 +103,7 @@ export function protocolEditor(): ProtocolEditor {
     const hint = s.description || s0.description;
     const lab = h('label', { for: id }, label(key), required ? '' : h('span', { class: 'unit' }, ' (optional)'));
     const wrap = (input: HTMLElement, ...extra: (HTMLElement | null)[]) =>
-      h('div', { class: 'ctl', 'data-field': path }, lab, input, ...extra, hint ? h('p', { class: 'hint', id: hintId }, hint) : null);
+      h('div', { class: 'ctl', 'data-field': path }, lab, input, ...extra, hint ? h('p', { class: 'hint', id: hintId }, hint) : null, engineError(id));
     const described = hint ? hintId : undefined;
 
     if (s.const !== undefined) {
@@ -112,7 +140,7 @@ export function protocolEditor(): ProtocolEditor {
       const input = h('input', { id, type: 'checkbox', 'aria-describedby': described }) as HTMLInputElement;
       input.checked = v === undefined ? s.default === true : v === true;
       input.addEventListener('change', () => set(input.checked));
-      return h('div', { class: 'ctl', 'data-field': path }, h('label', { class: 'inline', for: id }, input, ` ${label(key)}`), hint ? h('p', { class: 'hint', id: hintId }, hint) : null);
+      return h('div', { class: 'ctl', 'data-field': path }, h('label', { class: 'inline', for: id }, input, ` ${label(key)}`), hint ? h('p', { class: 'hint', id: hintId }, hint) : null, engineError(id));
     }
     // Deeper structures: a JSON field, checked as it is typed.
     const area = h('textarea', { id, rows: 4, class: 'json', spellcheck: 'false', 'aria-describedby': `${id}-err${described ? ` ${described}` : ''}` }) as HTMLTextAreaElement;
@@ -131,7 +159,7 @@ export function protocolEditor(): ProtocolEditor {
         err.textContent = '';
         area.removeAttribute('aria-invalid');
       } catch (e) {
-        const msg = `${path} is not valid JSON (${e instanceof Error ? e.message : String(e)})`;
+        const msg = `${formPath(path)} is not valid JSON (${e instanceof Error ? e.message : String(e)})`;
         broken.set(id, msg);
         err.textContent = msg;
         area.setAttribute('aria-invalid', 'true');
@@ -208,12 +236,61 @@ export function protocolEditor(): ProtocolEditor {
     );
   }
 
+  function clearErrors(): void {
+    for (const e of form.querySelectorAll<HTMLElement>('.engine-error')) {
+      e.hidden = true;
+      e.textContent = '';
+    }
+    for (const e of form.querySelectorAll('[data-engine-invalid]')) {
+      e.removeAttribute('aria-invalid');
+      e.removeAttribute('data-engine-invalid');
+    }
+  }
+
+  /** The form's field for the engine's path: the longest path the message names that the form has. */
+  function fieldFor(message: string): HTMLElement | null {
+    const paths = message.match(/\b[a-z_]+(\[\d+\])?(\.[a-z_]+(\[\d+\])?)*/g) ?? [];
+    for (const p of paths) {
+      // "blocks[0].staircase.step_mm": the form's field is "blocks[0].staircase" (a JSON field) if not the whole path.
+      const parts = p.split('.');
+      for (let n = parts.length; n > 0; n--) {
+        const at = parts.slice(0, n).join('.');
+        // A protocol's own fields are "protocol.<key>" in the form.
+        for (const q of at.startsWith('blocks[') ? [at] : [at, `protocol.${at}`]) {
+          const el = form.querySelector<HTMLElement>(`[data-field="${CSS.escape(q)}"]`);
+          if (el) return el;
+        }
+      }
+    }
+    return null;
+  }
+
   return {
     el: form,
     load(p) {
       proto = clone(p);
       render();
     },
+    showError(message) {
+      clearErrors();
+      const text = formMessage(message);
+      const at = fieldFor(message);
+      const slot = at?.querySelector<HTMLElement>(':scope > .engine-error');
+      if (!at || !slot) return { text, atField: false };
+      slot.textContent = text;
+      slot.hidden = false;
+      const input = at.querySelector<HTMLElement>('input, select, textarea');
+      if (input) {
+        input.setAttribute('aria-invalid', 'true');
+        input.setAttribute('data-engine-invalid', '');
+        // The refusal stays until the field changes.
+        input.addEventListener('input', () => clearErrors(), { once: true });
+        input.addEventListener('change', () => clearErrors(), { once: true });
+      }
+      at.scrollIntoView({ block: 'nearest' });
+      return { text, atField: true };
+    },
+    clearErrors,
     value() {
       const first = [...broken.values()][0];
       return first ? { error: first } : { protocol: clone(proto) };

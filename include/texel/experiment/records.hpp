@@ -94,6 +94,10 @@ struct TrialRow {
   double over_time_limit = missing;  ///< 1 when rt_ms exceeded the time limit, 0 when not
   double interrupted = missing;      ///< 1 when the trial spanned a suspend, a stop/resume, a restart or a reload-restart
   double suspended_ms = missing;     ///< time the session was suspended during the trial (not in rt_ms)
+
+  /// Why the swipe columns are empty although the finger touched ("too_short: …",
+  /// "implausible_speed: …"; experiment/swipe_check.hpp); empty otherwise.
+  std::string swipe_flag;
 };
 
 /// The current time, UTC, ISO 8601 with milliseconds ("2026-11-23T14:02:08.123Z"):

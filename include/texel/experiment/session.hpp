@@ -78,6 +78,32 @@ struct SliderSpec {
   double min = 0.0, max = 100.0, start = 50.0;
 };
 
+/// A numbered scale a participant answers on, in whole steps: what it asks
+/// and the words at its two ends.
+struct Scale {
+  int min = 1, max = 5;
+  std::string question;   ///< "How confident are you in this match?"
+  std::string min_label;  ///< words at `min`: "not at all" ("" = none)
+  std::string max_label;  ///< words at `max`: "very"
+};
+
+/// Everything a participant reads for one question besides the prompt,
+/// worded once here so every front door (terminal, studio page) asks the
+/// same: the front doors only lay it out. Not part of the stored question.
+struct Wording {
+  std::vector<std::string> stimulus_names;  ///< per stimulus, as a sentence names it: "texture 1", "the reference"
+  std::string choice_question;              ///< heading of the choice ("The odd one is"); "" when no choice is asked
+  std::vector<std::string> choice_labels;   ///< per Question::choices entry, the words shown: "texture 1", "Same"
+  std::optional<Scale> rating;              ///< the similarity scale (Question::rating_scale)
+  std::optional<Scale> confidence;          ///< the confidence scale (Question::confidence)
+  std::optional<Scale> recall;              ///< working memory's digit question, the cell in words
+};
+
+/// How sentences name a stimulus of this label: "1" → "texture 1", "Test" →
+/// "the test texture", "Reference | Rendering" → "the reference (left half)
+/// and the rendering (right half)".
+std::string stimulus_name(const std::string& label);
+
 /// What a front end shows for the current trial. Holds nothing that would
 /// reveal the answer.
 struct Question {
@@ -102,13 +128,18 @@ struct Question {
   std::vector<Phase> phases;                  ///< timed sequence before the questions (working memory)
   std::optional<std::array<int, 16>> matrix;  ///< working memory: 4 × 4 digits, 0 = empty cell
   std::optional<RecallQuestion> recall;       ///< working memory: the digit question, if asked
+  /// What the participant reads (the task kind words choice_question and the
+  /// scales' labels where it has its own; the engine fills the rest).
+  Wording wording;
 
   /// The engine's JSON view (JSON text; stored with every trial, so its bytes
   /// are part of the store format: docs/format.md "Result field names").
   [[nodiscard]] std::string to_json() const;
-  /// What a participant's screen may see: to_json() without the stimulus
-  /// documents (their parameters would give the odd one away) unless the
-  /// question asks to draw the maps.
+  /// What a participant's screen may see: to_json() without the block (name,
+  /// index, place in it) and without the stimulus documents (their parameters
+  /// would give the odd one away, their seeds are the session's), with
+  /// "wording" (Wording); a front end that draws a show_maps question's maps
+  /// sends the rendered maps.
   [[nodiscard]] std::string participant_json() const;
 };
 
@@ -122,6 +153,9 @@ struct Response {
   double rt_ms = missing;                    ///< first presentation → answer
   std::vector<TrialEvent> events;            ///< presentation / selection events
   std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
+  /// Why a finger trace gave no swipe measures (swipe_check.hpp: "too_short: …",
+  /// "implausible_speed: …"); empty when they are stored or there was no trace.
+  std::string swipe_flag;
   /// A 2-D display's strokes, one entry per interval felt (strokes.hpp); fills
   /// the row's stroke columns.
   std::vector<IntervalStrokes> strokes;

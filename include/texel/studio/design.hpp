@@ -73,6 +73,10 @@ struct DesignView {
   SpectrumView spectrum;     ///< of the analysed region's samples
   // Texel regions only (empty / 0 for a reference region):
   std::size_t texels = 0;
+  /// Length at the region's end that no texel covers (mm): with whole texels
+  /// only (fill whole_texels), the rest of a region shorter than the next
+  /// texel stays flat (26 mm texels on the tpad's 101.76 mm: 23.76 mm).
+  double uncovered_mm = 0.0;
   HistogramView histogram;
   std::vector<std::byte> encoded;  ///< the region's .texel bitstream
   std::string encoded_error;       ///< why `encoded` is empty for a Texel region (not representable)
@@ -143,9 +147,10 @@ struct ImportResult {
 /// InvalidArgument / FormatError naming `name` and the problem.
 ImportResult import_file(std::string_view name, std::span<const std::byte> bytes, const ImportOptions& options);
 
-enum class ExportFormat { document, bitstream, device, npy, csv };
+enum class ExportFormat { document, bitstream, device, npy, csv, hjif };
 std::string_view to_string(ExportFormat f);
-/// "document" | "bitstream" | "device" | "npy" | "csv"; throws InvalidArgument naming `field`.
+/// "document" | "bitstream" | "device" | "npy" | "csv" | "hjif" (MPEG-I Haptics, as `texel export -o x.hjif`);
+/// throws InvalidArgument naming `field`.
 ExportFormat parse_export_format(std::string_view text, std::string_view field = "as");
 
 struct ExportFile {

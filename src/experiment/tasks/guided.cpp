@@ -39,6 +39,7 @@ class GuidedBlock : public TaskBlock {
     q.stimuli.push_back({"A", s.single(texel_texture(base, seed, MatchResult{mq.a.pitch_db, mq.a.irregularity_db}))});
     q.stimuli.push_back({"B", s.single(texel_texture(base, seed, MatchResult{mq.b.pitch_db, mq.b.irregularity_db}))});
     q.choices = {"A", "B", "unsure"};
+    q.wording.choice_question = "More like the reference";
     q.prompt = b.prompt.empty() ? "Which texture feels more like the reference: A, B, or unsure?" : b.prompt;
   }
 

@@ -92,6 +92,8 @@ class RatingBlock : public TaskBlock {
     t.rendering = params;
     q.stimuli.push_back({"Reference | Rendering", s.halves(reference_texture(pair.reference, 1), right)});
     q.rating_scale = std::array<double, 2>{b.scale_min, b.scale_max};
+    q.wording.rating = Scale{static_cast<int>(b.scale_min), static_cast<int>(b.scale_max), "How similar do the two halves feel?",
+                             "not at all", "identical"};
     q.prompt = b.prompt.empty() ? "How similar do the two halves feel? (" + detail::num(b.scale_min) + " = not at all, " +
                                       detail::num(b.scale_max) + " = identical)"
                                 : b.prompt;

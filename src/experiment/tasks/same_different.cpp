@@ -70,6 +70,7 @@ class SameDifferentBlock : public TaskBlock {
                 {PhaseKind::matrix, std::nullopt, b.matrix_s},
                 {PhaseKind::stimulus, 1, b.texture_s}};
     q.choices = {"same", "different"};
+    q.wording.choice_question = "The two textures were";
     t.correct_answer = same ? "same" : "different";
     q.prompt = b.prompt.empty() ? "Were the two textures the same or different?" : b.prompt;
   }

@@ -98,6 +98,7 @@ class ThresholdBlock : public TaskBlock {
       q.stimuli.push_back({"B", s.single(reference_texture(b.references[1], 1), b.display_mm)});
       q.stimuli.push_back({"Test", s.single(texel_texture(base, s.seed_draw(1)), b.display_mm)});
       q.choices = {"A", "B"};
+      q.wording.choice_question = "The test texture feels like";
       t.correct_answer = which == 0 ? "A" : "B";
       t.reference = b.references[static_cast<std::size_t>(which)];
       q.prompt = b.prompt.empty() ? "Feel A, B and the test texture. Which reference does the test texture feel like?" : b.prompt;
@@ -115,6 +116,7 @@ class ThresholdBlock : public TaskBlock {
       q.stimuli.push_back(
           {std::to_string(i + 1), s.single(texel_texture(base, i == odd ? single_seed : pair_seed), b.display_mm)});
     q.choices = {"1", "2", "3"};
+    q.wording.choice_question = "The odd one is";
     t.correct_answer = std::to_string(odd + 1);
     q.prompt =
         b.prompt.empty() ? "Feel the three textures (switch freely). Which one is different from the other two?" : b.prompt;

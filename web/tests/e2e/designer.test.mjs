@@ -4,7 +4,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { withStudio, openDesigner, nextDraw, stats, screenshot, artifact, setRange, canvasHash, mapChanged, paths, startStudio, launchFirefox } from './studio.mjs';
+import { withStudio, openDesigner, nextDraw, stats, screenshot, artifact, setRange, canvasHash, mapChanged, paths, startStudio, launchFirefox, askStudio } from './studio.mjs';
 
 test('designer: slider, drawn coarse profile, export and re-import', { timeout: 180_000 }, async () => {
   await withStudio(async ({ studio, page, errors }) => {
@@ -169,7 +169,8 @@ test('designer: invalid typed values are refused at the field, never clamped or 
     const s0 = await stats(page);
 
     // "abc" and an empty field became 0 dB on main.
-    for (const [text, why] of [['abc', /"abc" is not a number/], ['', /enter a number/], ['45', /outside the allowed range -40 … 40 dB/]]) {
+    // The range stated is the engine's on this device: the library's -40 … 40 dB within tpad's renderable band.
+    for (const [text, why] of [['abc', /"abc" is not a number/], ['', /enter a number/], ['45', /outside the allowed range -20 … 19\.74\d* dB/]]) {
       await typeInto(page, '#central-pitch-value', text);
       const r = await refusal(page, 'central-pitch');
       assert.ok(r.visible, `refusal of "${text}" shown`);
@@ -184,10 +185,10 @@ test('designer: invalid typed values are refused at the field, never clamped or 
     const s1 = await stats(page);
     assert.equal(s1.lastMapChecksum, s0.lastMapChecksum, 'no refused value reached the design');
 
-    // Inside the library's range but above this display's renderable band: the engine refuses it, at the field.
+    // Inside the library's range but above this display's renderable band: refused with that band, at the field.
     await typeInto(page, '#central-pitch-value', '25');
     await page.waitForFunction(() => !document.querySelector('[data-testid=central-pitch-error]').hidden, null, { timeout: 30_000 });
-    assert.match((await refusal(page, 'central-pitch')).text, /renderable band/);
+    assert.match((await refusal(page, 'central-pitch')).text, /outside the allowed range -20 … 19\.74/);
     await page.waitForFunction(() => document.querySelector('#central-pitch-value').value === '10');
     assert.equal(await page.inputValue('#central-pitch'), '10', 'the document kept 10 dB');
 
@@ -214,6 +215,100 @@ test('designer: invalid typed values are refused at the field, never clamped or 
     // Irregularity "" is not 0 dB either.
     await typeInto(page, '#irregularity-value', ' ');
     assert.match((await refusal(page, 'irregularity')).text, /enter a number.*keeps -5 dB/);
+
+    // Issue #37: a refusal no longer stays red once the field holds a value the engine takes and is
+    // left with Tab, be it the kept value typed back (no change event) or a new one.
+    for (const [text, want] of [['-5', '-5'], ['-7.25', '-7.25']]) {
+      await typeInto(page, '#irregularity-value', 'abc');
+      assert.ok((await refusal(page, 'irregularity')).visible);
+      await page.fill('#irregularity-value', text);
+      await page.press('#irregularity-value', 'Tab');
+      await page.waitForFunction(() => document.querySelector('[data-testid=irregularity-error]').hidden, null, { timeout: 10_000 });
+      assert.equal(await page.getAttribute('#irregularity-value', 'aria-invalid'), null, `${text}: not marked invalid`);
+      assert.equal(await page.inputValue('#irregularity-value'), want);
+    }
+    // A refusal shown by Tab itself stays (change, then blur).
+    await page.fill('#irregularity-value', 'xyz');
+    await page.press('#irregularity-value', 'Tab');
+    assert.ok((await refusal(page, 'irregularity')).visible, 'refused on Tab');
+    assert.deepEqual(errors, []);
+  });
+});
+
+// Issue #37: typed values are stored exactly as typed (the document, the
+// browser's saved copy and the engine's export hold them to the last digit),
+// or refused with the range the engine applies, stated as the engine states it.
+test('designer: typed values are stored exactly as typed, or refused with the range the engine applies', { timeout: 240_000 }, async () => {
+  await withStudio(async ({ studio, page, errors }) => {
+    await openDesigner(page, studio.url);
+    await page.waitForSelector('[data-testid=encoded-bytes][data-bytes]');
+    const savedTexture = () => page.evaluate(() => JSON.parse(localStorage.getItem('texel.designer.v1') ?? 'null')?.document?.texture ?? null);
+    /** Types `text` into field `id` and finds it in the field, the saved document and the engine's exported document. */
+    async function storedExactly(id, text, read) {
+      const n = (await stats(page)).designsDrawn;
+      await typeInto(page, `#${id}-value`, text);
+      await nextDraw(page, n);
+      assert.equal((await refusal(page, id)).visible, false, `${id} ${text} accepted: ${(await refusal(page, id)).text}`);
+      assert.equal(await page.inputValue(`#${id}-value`), text, `the ${id} field shows ${text}`);
+      const want = Number(text);
+      // The saved copy follows (debounced).
+      await page.waitForFunction(([k, v]) => {
+        const t = JSON.parse(localStorage.getItem('texel.designer.v1') ?? 'null')?.document?.texture;
+        return !!t && (k in t ? t[k] : t.coarse?.[k]) === v;
+      }, [read, want], { timeout: 10_000 }).catch(() => undefined);
+      const tex = await savedTexture();
+      const got = read in tex ? tex[read] : tex.coarse[read];
+      assert.equal(got, want, `the saved document holds ${read} ${text}, got ${got}`);
+      const doc = await page.evaluate(() => JSON.parse(localStorage.getItem('texel.designer.v1')).document);
+      const [ex] = await askStudio(page, [{ type: 'export', as: 'document', document: doc }]);
+      assert.equal(ex.type, 'export', JSON.stringify(ex).slice(0, 300));
+      const engine = JSON.parse(Buffer.from(ex.data_base64, 'base64').toString('utf8'));
+      const t = engine.texture ?? engine.regions.at(-1).texture;
+      assert.equal(read in t ? t[read] : t.coarse[read], want, `the engine's document holds ${read} ${text}`);
+    }
+    async function refusedWith(id, text, why) {
+      await typeInto(page, `#${id}-value`, text);
+      const r = await refusal(page, id);
+      assert.ok(r.visible && r.invalid === 'true', `${id} ${text} refused`);
+      assert.match(r.text, why);
+      return r.text;
+    }
+
+    // Central Pitch 6.0206 dB showed 6.0206 while the document held 6.02 ("= 3.999 cycles/mm").
+    await storedExactly('central-pitch', '6.0206', 'central_pitch_db');
+    assert.match(await page.textContent('[data-testid=pitch-cpm]'), /^= 4\.000 cycles\/mm/);
+    // 0.0004 mm was refused as "texel_length_mm is 0"; 0.0006 was stored as 0.001.
+    await storedExactly('texel-length', '0.0004', 'texel_length_mm');
+    await storedExactly('texel-length', '0.0006', 'texel_length_mm');
+    await storedExactly('coarse-strength', '0.123456789', 'coarse_strength');
+    await page.selectOption('#coarse-kind', 'sine');
+    await storedExactly('sine-period', '0.0003', 'period_mm');
+    await storedExactly('sine-phase', '12345678.9', 'phase_deg');
+
+    // Refused with the range stated, which is the engine's: its bound is accepted, a hair beyond is refused.
+    const [hello] = await askStudio(page, [{ type: 'hello' }]);
+    const shortest = (19200 * 0.0053) / hello.limits.max_map_samples;
+    const lengthText = await refusedWith('texel-length', '0.000001', /outside the allowed range /);
+    assert.ok(lengthText.includes(`range ${shortest} … 1000 mm`), `${lengthText} states ${shortest} … 1000 mm`);
+    const pitch = hello.device_limits.find((d) => d.device === 'tpad').central_pitch_db;
+    await refusedWith('central-pitch', '19.8', new RegExp(`outside the allowed range ${pitch.min} … ${String(pitch.max).replace('.', '\\.')} dB`));
+    await refusedWith('sine-period', '0', /outside the allowed range 1e-9 … 1000000000 mm/);
+    await refusedWith('sine-phase', '2e9', /outside the allowed range -1000000000 … 1000000000 degrees/);
+    await page.selectOption('#coarse-kind', 'constant');
+    await refusedWith('coarse-value', '1.5', /outside the allowed range 0 … 1/);
+    const doc = (texel_length_mm, central_pitch_db = 10) => ({
+      format: 'texel-document', version: 1, device: 'tpad',
+      texture: { kind: 'texel', central_pitch_db, irregularity_db: -5, texel_length_mm, seed: 1 },
+    });
+    const verdicts = await askStudio(page, [
+      { type: 'design', document: doc(shortest) },
+      { type: 'design', document: doc(shortest * (1 - 1e-9)) },
+      { type: 'design', document: doc(0.25, pitch.max) },
+      { type: 'design', document: doc(0.25, pitch.max + 1e-6) },
+      { type: 'design', document: doc(0.25, pitch.min) },
+      { type: 'design', document: doc(0.25, pitch.min - 1e-6) },
+    ]);
+    assert.deepEqual(verdicts.map((v) => v.type), ['design', 'error', 'design', 'error', 'design', 'error'], verdicts.map((v) => v.message ?? v.type).join(' | '));
     assert.deepEqual(errors, []);
   });
 });
@@ -247,6 +342,18 @@ test('designer: ranges cover every shipped protocol', { timeout: 120_000 }, asyn
     await nextDraw(page, n);
     assert.equal(await page.inputValue('#texel-length'), '26');
     assert.equal(await page.isVisible('[data-testid=texel-length-error]'), false);
+    // Three whole 26 mm texels on the tpad's 101.76 mm: the last 23.76 mm are flat, and the page says so (issue #37).
+    assert.match(await page.textContent('[data-testid=flat-warning]'), /With 26 mm texels, 3 whole texels .* the last 23\.76 mm of it are flat/);
+    assert.ok(await page.isVisible('[data-testid=flat-warning]'));
+    // .hjif, as the CLI writes it.
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('[data-testid=export-hjif]')]);
+    assert.equal(download.suggestedFilename(), 'texture.hjif');
+    const hjif = JSON.parse(readFileSync(await download.path(), 'utf8'));
+    assert.ok(Array.isArray(hjif.perceptions) && hjif.perceptions.length > 0, 'an MPEG-I Haptics file with its perceptions');
+    const n2 = (await stats(page)).designsDrawn;
+    await typeInto(page, '#texel-length-value', '0.25');
+    await nextDraw(page, n2);
+    assert.equal(await page.isVisible('[data-testid=flat-warning]'), false, 'no warning once texels cover the device');
     assert.deepEqual(errors, []);
   });
 });
@@ -379,8 +486,8 @@ test('designer: the design survives a reload; undo, redo and a fresh start', { t
     await setRange(page, '#central-pitch', 5);
     await page.waitForTimeout(700); // a separate step (changes within 0.5 s join one)
     await setRange(page, '#texel-length', 2);
-    await page.waitForTimeout(700);
-    // Reload: the design is restored from this browser.
+    // Reload within 100 ms of the change, inside the save's 250 ms debounce: the page's end writes
+    // it (pagehide), so the design is restored from this browser whatever the machine's load.
     await page.reload();
     await page.waitForFunction(() => window.__texelStats && window.__texelStats.designsDrawn >= 1, null, { timeout: 30_000 });
     assert.equal(await page.inputValue('#central-pitch'), '5');

@@ -102,9 +102,16 @@ test('experimenter view: live track, sessions, exports, protocol editor', { time
     await page.click('[data-testid=validate]');
     await page.waitForFunction(() => document.querySelector('[data-testid=editor-status]').classList.contains('error'));
     const why = await page.textContent('[data-testid=editor-status]');
-    assert.match(why, /blocks\[0\]\.time_limit_s/);
-    assert.doesNotMatch(why, /^experiment\./);
+    // 1-based, as the form's legend "Block 1: …" (the engine's path is 0-based), and at the field.
+    assert.match(why, /Block 1 › time_limit_s/);
+    assert.doesNotMatch(why, /^experiment\.|blocks\[0\]/);
+    const atField = page.locator('[data-field="blocks[0].time_limit_s"] [data-testid=field-error]');
+    assert.ok(await atField.isVisible(), 'the refusal is shown at the field');
+    assert.match(await atField.textContent(), /Block 1 › time_limit_s/);
+    assert.equal(await limit.getAttribute('aria-invalid'), 'true');
     await limit.fill('20');
+    assert.equal(await atField.isVisible(), false, 'a changed field is no longer marked refused');
+    assert.equal(await limit.getAttribute('aria-invalid'), null);
     // The designed texture as the block's stimulus.
     await page.locator('[data-field="blocks[0].texture"] select').selectOption('fine grating');
     const texture = JSON.parse(await page.locator('[data-field="blocks[0].texture"] textarea').inputValue());

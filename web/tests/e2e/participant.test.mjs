@@ -18,7 +18,7 @@
 //                   38 s of it suspended → rt_ms ≈ 5 s, interrupted, not over;
 //   restart         the server stops: "Please wait"; a new server on the
 //                   same database, session resumed: the same trial again;
-//   labels + keys   "Feel texture N" vs "Answer: the odd one is …", every
+//   labels + keys   "Feel texture N" vs "The odd one is" (the library's wording), every
 //                   control named, the whole trial answered from the keyboard,
 //                   no staircase value, block name or engineering figure.
 // Screenshots: $TEXEL_ARTIFACTS/participant-*.png.
@@ -89,7 +89,7 @@ test('participant screen: wrong session, stale screens, paused answer, reload, t
     // ---- Labels: the feel row and the answer row are told apart; every control has a name; nothing revealing.
     assert.deepEqual(await p.locator('button.stimulus').allTextContents(), ['Feel texture 1', 'Feel texture 2', 'Feel texture 3']);
     assert.equal(await p.locator('#feel-heading').textContent(), 'Feel each texture');
-    assert.equal(await p.locator('#answer-heading').textContent(), 'Answer: the odd one is …');
+    assert.equal(await p.locator('#answer-heading').textContent(), 'The odd one is');
     assert.equal(await p.locator('[data-testid=choices]').getAttribute('aria-labelledby'), 'answer-heading');
     assert.deepEqual(await p.locator('[data-testid=choices] button').allTextContents(), ['texture 1', 'texture 2', 'texture 3']);
     const unnamed = await p.evaluate(() =>
