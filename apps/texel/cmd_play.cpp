@@ -183,6 +183,21 @@ void run(const PlayArgs& a) {
     player = std::move(p);
   }
   const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
+  // At rest on every exit — the end, Ctrl-C, SIGTERM, an error or an
+  // exception: the stream stops, then a serial display is told SELECT none
+  // (its map or drive no longer plays; docs/serial-protocol.md "Playing").
+  struct AtRest {
+    Backend& backend;
+    void operator()() noexcept {
+      backend.stop();
+      if (SerialLink* l = backend.serial_link()) try {
+          l->select(serial::no_map);
+        } catch (const std::exception&) {
+          // The link is gone: the display's watchdog puts it at rest.
+        }
+    }
+    ~AtRest() { (*this)(); }
+  } at_rest{*backend};
   // The display that senses the finger: the one the backend drives, or another.
   std::unique_ptr<SerialLink> own_link;
   SerialLink* sensor_link = nullptr;
@@ -201,6 +216,7 @@ void run(const PlayArgs& a) {
 
   interrupted = false;
   auto old_handler = std::signal(SIGINT, on_sigint);
+  auto old_term = std::signal(SIGTERM, on_sigint);  // a handler that only sets the flag: the real-time side is untouched
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   // Feed the finger like a sensor with 50 ms of buffering: samples are queued
   // shortly before their time, so the player interpolates between them.
@@ -237,8 +253,9 @@ void run(const PlayArgs& a) {
       // Already gone: nothing to stop.
     }
   }
-  backend->stop();
+  at_rest();
   std::signal(SIGINT, old_handler);
+  std::signal(SIGTERM, old_term);
   if (tty) std::fprintf(stderr, "\r%*s\r", 110, "");
   if (!error.empty()) throw IoError("play: " + error);
 
