@@ -135,6 +135,8 @@ void run(const PlayArgs& a) {
   bo.block_frames = a.block;
   bo.audio_device = a.audio_device;
   bo.baud = a.baud;
+  if (surface && choice.kind == BackendChoice::Kind::serial)
+    bo.serial_map = std::make_shared<const NativeMap>(native_map(*surface));
   PlayerConfig config;
   if (choice.kind == BackendChoice::Kind::serial) {
     if (a.stream == "position")

@@ -19,6 +19,7 @@ void register_export(CLI::App& app);
 void register_swipe(CLI::App& app);
 void register_play(CLI::App& app);
 void register_controller(CLI::App& app);
+void register_display_check(CLI::App& app);
 void register_staircase(CLI::App& app);
 void register_stats(CLI::App& app);
 void register_experiment(CLI::App& app);

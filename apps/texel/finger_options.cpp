@@ -25,7 +25,8 @@ void add_finger_options(CLI::App& cmd, FingerOptions& o) {
   cmd.add_option("--start", o.start_mm, "Where the simulated finger lands (mm) [0]");
   cmd.add_option("--extent", o.extent_mm, "Travel of one stroke (mm) [to the end of the surface]");
   cmd.add_option("--turn", o.turn_s, "Back-and-forth: time to stop and turn (s) [0.1]");
-  cmd.add_option("--rate", o.rate_hz, "Output rate (Hz) [48000]; e.g. 8333 for the tpad's refresh rate");
+  cmd.add_option("--rate", o.rate_hz,
+                 "Output rate (Hz) [48000; play to a serial display: 1000]; e.g. 8333 for the tpad's refresh rate");
   cmd.add_option("--output", o.output,
                  "amplitude (friction map value), vibration (zero-mean, band-limited) or carrier [vibration]");
   cmd.add_option("--carrier", o.carrier_hz, "Carrier frequency for --output carrier (Hz) [250]");

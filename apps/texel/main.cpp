@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   texel::cli::register_swipe(app);
   texel::cli::register_play(app);
   texel::cli::register_controller(app);
+  texel::cli::register_display_check(app);
   texel::cli::register_experiment(app);
   texel::cli::register_store(app);
   texel::cli::register_staircase(app);

@@ -6,6 +6,16 @@
 // timeout and are retried; a NACK becomes a SerialError carrying the
 // display's error code; a link that goes away (unplugged cable, closed pty)
 // becomes an IoError naming the port — never a crash.
+//
+// The host's session (docs/serial-protocol.md "The host's sequence"):
+//   hello()                       learn the display's limits (kept: info())
+//   start_reports(interval)       if the host wants the display's finger
+//   upload(slot, native_map(doc)) per slot, the document's exact bytes
+//   select(slot)                  the display plays it from its own sensor,
+//   or stream_position / stream_drive at the host's rate
+//   rest()                        on every way out: end, pause, error, signal
+// After hello() every upload keeps to what the display announced: MAP_DATA
+// payloads of at most max_payload bytes, slots, max_samples.
 #pragma once
 
 #include <algorithm>
@@ -15,6 +25,7 @@
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
@@ -26,6 +37,8 @@
 namespace texel {
 
 class PlayerMap;
+class Surface;
+struct Document;
 
 /// The display refused a request (NACK).
 class SerialError : public IoError {
@@ -36,12 +49,13 @@ class SerialError : public IoError {
   std::uint32_t detail;
 };
 
+/// What a display announced in HELLO_REPLY.
 struct DisplayInfo {
   int version = 0;
-  int slots = 0;
-  std::uint32_t max_samples = 0;
-  double refresh_hz = 0.0;
-  std::size_t max_payload = 0;
+  int slots = 0;                  ///< map slots, >= 1
+  std::uint32_t max_samples = 0;  ///< samples per map, >= 1
+  double refresh_hz = 0.0;        ///< output rate (the wire carries millihertz: refresh_mhz / 1000)
+  std::size_t max_payload = 0;    ///< the largest payload the display accepts, 14 … 1024 bytes
   std::string name;
 };
 
@@ -56,7 +70,31 @@ struct DisplayStatus {
   serial::ErrorCode last_error = serial::ErrorCode::none;
   std::uint32_t map_samples = 0;
   std::uint32_t uptime_ms = 0;
+  /// Revision 1.2 (absent from older displays, whose STATUS is 26 bytes):
+  std::optional<std::uint32_t> link_errors;  ///< times the display found its link down
+  std::optional<std::uint8_t> flags;         ///< serial::status_flag_* bits
+  /// The display says it has a finger sensor (1.2); absent: it did not say.
+  [[nodiscard]] std::optional<bool> sensor() const {
+    return flags ? std::optional<bool>((*flags & serial::status_flag_sensor) != 0) : std::nullopt;
+  }
 };
+
+/// A map as the display stores it: format-0 samples (round(a·65535)) on a
+/// grid in nanometres. native_map() gives a document's exact bytes — the
+/// ones `texel render --format bin` writes — with no float rounding on the
+/// way (a PlayerMap holds float32, which moves 10 of tpad's 19,200 samples by
+/// one step).
+struct NativeMap {
+  std::vector<std::uint16_t> samples;
+  std::uint32_t spacing_nm = 0;
+  std::int32_t origin_nm = 0;
+};
+/// The whole map of `surface` (all regions, gaps at rest), as `texel render`
+/// encodes it. Throws InvalidArgument if the spacing or origin do not fit
+/// the protocol (spacing 1 nm … 4.29 m, origin within ±2.1 m).
+NativeMap native_map(const Surface& surface);
+/// The map of a 1-D document on its device (prepare_surface, then the above).
+NativeMap native_map(const Document& doc);
 
 /// One FINGER report of a display's own sensor (protocol 1.1).
 struct FingerReport {
@@ -125,14 +163,52 @@ class SerialLink {
   int timeout_ms = 300;
   int attempts = 3;
 
+  /// Host-side checks of the display's announced limits before a request
+  /// is sent (slot < slots, samples <= max_samples: a SerialError with the
+  /// code and detail the display would give). `texel display-check` turns
+  /// them off to see the display refuse by itself.
+  bool check_limits = true;
+
+  /// HELLO: learns the display's limits (kept, see info()). Throws IoError
+  /// if the reply is malformed or announces limits the protocol does not
+  /// allow (max_payload below 14, no slot, no sample, refresh 0).
   DisplayInfo hello();
-  /// Uploads amplitudes (clamped to [0, 1], encoded round(a·65535)) into slot `id`.
+  /// The last HELLO_REPLY (version 0 before hello()).
+  [[nodiscard]] const DisplayInfo& info() const noexcept { return info_; }
+  /// The largest MAP_DATA payload sent: the display's max_payload after
+  /// hello(), the protocol's 1,024 bytes before.
+  [[nodiscard]] std::size_t payload_limit() const noexcept { return payload_limit_; }
+
+  /// Uploads a map into slot `id` exactly as given: MAP_BEGIN, MAP_DATA in
+  /// chunks that fit the display's max_payload, MAP_END with the CRC-32.
+  /// The way to upload a document: upload(id, native_map(doc)).
+  void upload(std::uint8_t id, const NativeMap& map);
+  /// Uploads amplitudes (clamped to [0, 1], encoded round(a·65535)) into slot
+  /// `id`. For signals that exist only as floats; a document goes through
+  /// native_map() instead, which keeps `texel render`'s exact bytes.
   void upload_map(std::uint8_t id, std::span<const float> amplitudes, double spacing_mm, double origin_mm = 0.0);
+  /// A PlayerMap's float32 values (not a document's exact bytes: see NativeMap).
   void upload_map(std::uint8_t id, const PlayerMap& map);
-  /// Uploads raw u16 samples (for tests of the display's checks).
+  /// Uploads raw u16 samples; `corrupt_crc` sends a wrong CRC-32 (tests of
+  /// the display's checks: it must answer map_checksum and keep its map).
   void upload_raw(std::uint8_t id, std::span<const std::uint16_t> samples, std::uint32_t spacing_nm, std::int32_t origin_nm,
                   bool corrupt_crc = false);
+  /// SELECT: the slot to play (serial::no_map: none, output at rest).
   void select(std::uint8_t id);
+
+  /// Puts the display at rest: DRIVE 0, then SELECT none, waiting for its
+  /// ACK (one attempt of timeout_ms). Best effort and safe on every exit
+  /// path: never throws — a dead link, a refusal or no reply give false
+  /// (the display's own 200 ms watchdog then rests a driven plate). True:
+  /// the display acknowledged. Not from a signal handler (set a flag, call
+  /// it from the thread that owns the link), and like every request not
+  /// while another thread uses the link (stop a ReportReader, or the
+  /// serial Backend — whose stop() rests the display itself — first).
+  bool rest() noexcept;
+  /// The destructor sends DRIVE 0 and SELECT none without waiting (a link
+  /// destroyed while unwinding still leaves the display at rest); false
+  /// leaves the display as it is (a test that hands the display on).
+  bool rest_on_close = true;
   /// Streams (no reply). Throw IoError if the link is gone.
   void stream_position(double x_mm, bool touch);
   void stream_drive(double amplitude);
@@ -162,9 +238,13 @@ class SerialLink {
   std::string request(serial::Type type, const std::uint8_t* payload, std::size_t n, serial::Type expect, const char* what);
   void write_all(const std::uint8_t* p, std::size_t n);
 
+  void send_rest_frames() noexcept;
+
   int fd_ = -1;
   std::string name_;
   std::uint8_t seq_ = 0;
+  DisplayInfo info_{};
+  std::size_t payload_limit_ = serial::max_payload;
   serial::Decoder decoder_{};
   // Finger reports read but not yet taken (bounded: the oldest are dropped,
   // in constant time).

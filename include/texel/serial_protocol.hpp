@@ -24,12 +24,31 @@ namespace texel::serial {
 inline constexpr std::uint8_t sync0 = 0xA5;
 inline constexpr std::uint8_t sync1 = 0x5A;
 inline constexpr std::uint8_t protocol_version = 1;
+/// The revision this header implements (docs/serial-protocol.md): 1.0 the
+/// maps and streams, 1.1 the finger reports, 1.2 the longer STATUS. A
+/// revision only appends (messages, error codes, STATUS fields at the end),
+/// so HELLO still carries version 1 and every revision talks to every other.
+inline constexpr std::uint8_t protocol_revision_minor = 2;
 inline constexpr std::size_t header_size = 6;  ///< sync0 sync1 type seq len(2)
 inline constexpr std::size_t crc_size = 2;
 inline constexpr std::size_t max_payload = 1024;
 inline constexpr std::size_t max_frame = header_size + max_payload + crc_size;
-/// Samples per MAP_DATA frame the host sends (5-byte header + 2 bytes each).
-inline constexpr std::size_t samples_per_chunk = (max_payload - 5) / 2;
+/// Samples per MAP_DATA frame whose payload may be at most `payload` bytes
+/// (5-byte header + 2 bytes each): 509 at 1,024 bytes, 125 at 256.
+constexpr std::size_t samples_per_chunk_for(std::size_t payload) { return payload >= 7 ? (payload - 5) / 2 : 0; }
+/// Samples per MAP_DATA frame at the protocol's largest payload.
+inline constexpr std::size_t samples_per_chunk = samples_per_chunk_for(max_payload);
+/// The smallest max_payload a display may announce: room for MAP_BEGIN (14
+/// bytes) and a MAP_DATA of one sample.
+inline constexpr std::size_t min_max_payload = 14;
+/// STATUS payload sizes: 26 bytes in revisions 1.0 and 1.1; 1.2 appends
+/// link_errors u32 and flags u8 (a host reads what is there).
+inline constexpr std::size_t status_payload_1_0 = 26;
+inline constexpr std::size_t status_payload = 31;
+/// STATUS flags (1.2, byte 30).
+inline constexpr std::uint8_t status_flag_sensor = 0x01;     ///< the display has a finger sensor
+inline constexpr std::uint8_t status_flag_reporting = 0x02;  ///< FINGER reports are on
+inline constexpr std::uint8_t status_flag_stale = 0x04;      ///< streamed values expired: output at rest
 inline constexpr std::uint8_t no_map = 0xFF;
 /// FINGER payload: t_us u32, x_nm i32, y_nm i32, touch u8.
 inline constexpr std::size_t finger_payload = 13;

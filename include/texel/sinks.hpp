@@ -28,6 +28,7 @@
 namespace texel {
 
 class SerialLink;
+struct NativeMap;
 
 enum class WavEncoding { pcm16, pcm24, float32 };
 
@@ -128,13 +129,20 @@ enum class SerialStream { position, drive };
 struct SerialOptions {
   std::string path;
   int baud = 921600;
-  double rate_hz = 1000.0;  ///< frames streamed per second
+  double rate_hz = 1000.0;  ///< frames streamed per second; at most the display's refresh rate (lowered to it)
   SerialStream stream = SerialStream::position;
+  /// Position stream: the exact map to upload (native_map(doc): `texel
+  /// render`'s bytes). Absent: the PlayerMap's float32 values.
+  std::shared_ptr<const NativeMap> map;
 };
-/// A serial friction display: start() says HELLO, uploads `map` to slot 0,
-/// selects it, then streams the player's finger position (or its output as
-/// drive values) at options.rate_hz. Link failures end streaming and are
-/// reported by error(). Throws IoError / SerialError from the set-up.
+/// A serial friction display: the constructor says HELLO, and (position
+/// stream) uploads options.map or `map` to slot 0 within the display's
+/// announced limits and selects it; start() streams the player's finger
+/// position (or its output as drive values) at options.rate_hz. Every
+/// stop() — and the destructor — puts the display at rest (DRIVE 0, SELECT
+/// none: SerialLink::rest) once streaming has ended; a later start()
+/// selects the map again. Link failures end streaming and are reported by
+/// error(). Throws IoError / SerialError from the set-up.
 std::unique_ptr<Backend> make_serial_backend(const SerialOptions& options, const PlayerMap& map);
 
 /// The output a backend name selects. Every front door (the CLI's
@@ -156,6 +164,7 @@ struct BackendOptions {
   std::string audio_device;       ///< audio: PortAudio device index or name substring
   int baud = 921600;              ///< serial
   SerialStream stream = SerialStream::position;
+  std::shared_ptr<const NativeMap> serial_map;  ///< serial, position stream: SerialOptions::map
 };
 /// Opens the backend `choice` names. A serial display is given `map` first.
 /// Throws like the make_*_backend functions.

@@ -120,6 +120,10 @@ void HostHal::write_amplitude(std::uint16_t a) {
   writes.fetch_add(1, std::memory_order_relaxed);
 }
 
+void HostHal::on_tick(std::uint32_t t_us, const Status& status) {
+  if (tick_observer) tick_observer(t_us, status);
+}
+
 void HostHal::idle_until(std::uint32_t t_us) {
   const auto wait_us = static_cast<std::int32_t>(t_us - micros());
   if (down_ || fd_ < 0) {

@@ -11,10 +11,14 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include "texel/controller/host_hal.hpp"
+#include "texel/detail/format.hpp"
+#include "texel/document.hpp"
 #include "texel/player.hpp"
+#include "texel/surface.hpp"
 
 namespace texel {
 
@@ -29,7 +33,48 @@ SerialLink::SerialLink(int fd, std::string name) : fd_(fd), name_(std::move(name
 }
 
 SerialLink::~SerialLink() {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ < 0) return;
+  if (rest_on_close) send_rest_frames();
+  ::close(fd_);
+}
+
+namespace {
+// One write attempt that never raises SIGPIPE (a socket whose peer is gone)
+// and never waits: for the rest frames of a link that may be dead.
+bool write_once(int fd, const std::uint8_t* p, std::size_t n) noexcept {
+  ssize_t w = ::send(fd, p, n, MSG_NOSIGNAL | MSG_DONTWAIT);
+  if (w < 0 && errno == ENOTSOCK) w = ::write(fd, p, n);
+  return w == static_cast<ssize_t>(n);
+}
+}  // namespace
+
+void SerialLink::send_rest_frames() noexcept {
+  std::uint8_t frame[serial::header_size + 2 + serial::crc_size];
+  const std::uint8_t drive0[2] = {0, 0};
+  std::size_t len = serial::encode_frame(Type::drive, seq_++, drive0, 2, frame);
+  write_once(fd_, frame, len);
+  const std::uint8_t none[1] = {serial::no_map};
+  len = serial::encode_frame(Type::select, seq_++, none, 1, frame);
+  write_once(fd_, frame, len);
+}
+
+bool SerialLink::rest() noexcept {
+  if (fd_ < 0) return false;
+  try {
+    stream_drive(0.0);
+    const int saved = attempts;
+    attempts = 1;
+    try {
+      select(serial::no_map);
+    } catch (...) {
+      attempts = saved;
+      throw;
+    }
+    attempts = saved;
+    return true;
+  } catch (...) {
+    return false;
+  }
 }
 
 void SerialLink::write_all(const std::uint8_t* p, std::size_t n) {
@@ -127,11 +172,54 @@ DisplayInfo SerialLink::hello() {
   info.refresh_hz = serial::get_u32(b + 6) / 1000.0;
   info.max_payload = serial::get_u16(b + 10);
   info.name = r.substr(12);
+  const auto bad = [&](const char* field, const std::string& value, const char* allowed) {
+    return IoError("serial link " + name_ + ": HELLO_REPLY " + field + " is " + value + "; allowed " + allowed);
+  };
+  if (info.slots < 1) throw bad("slots", std::to_string(info.slots), "1 … 254");
+  if (info.max_samples < 1) throw bad("max_samples", std::to_string(info.max_samples), ">= 1");
+  if (!(info.refresh_hz > 0)) throw bad("refresh_mhz", "0", ">= 1 (millihertz)");
+  if (info.max_payload < serial::min_max_payload) throw bad("max_payload", std::to_string(info.max_payload), "14 … 1024 bytes");
+  info_ = info;
+  // A display may announce more than a frame can carry; the frame's limit holds.
+  payload_limit_ = std::min<std::size_t>(info.max_payload, serial::max_payload);
   return info;
 }
 
+NativeMap native_map(const Surface& surface) {
+  const Grid& g = surface.grid();
+  const double spacing_nm = g.spacing.value() * 1e6, origin_nm = g.origin.value() * 1e6;
+  if (!(spacing_nm >= 0.5 && spacing_nm < 4294967295.5))
+    throw InvalidArgument("serial: map spacing is " + detail::num(g.spacing.value()) + " mm; allowed 1e-6 … 4294 mm");
+  if (!(std::abs(origin_nm) < 2.1e9))
+    throw InvalidArgument("serial: map origin is " + detail::num(g.origin.value()) + " mm; allowed −2100 … 2100 mm");
+  const std::vector<std::byte> bytes = surface.render_native(SampleFormat::u16le);  // `texel render`'s bytes
+  NativeMap m;
+  m.samples.resize(bytes.size() / 2);
+  for (std::size_t i = 0; i < m.samples.size(); ++i)
+    m.samples[i] =
+        static_cast<std::uint16_t>(std::to_integer<unsigned>(bytes[2 * i]) | (std::to_integer<unsigned>(bytes[2 * i + 1]) << 8));
+  m.spacing_nm = static_cast<std::uint32_t>(std::llround(spacing_nm));
+  m.origin_nm = static_cast<std::int32_t>(std::llround(origin_nm));
+  return m;
+}
+
+NativeMap native_map(const Document& doc) { return native_map(prepare_surface(doc)); }
+
+void SerialLink::upload(std::uint8_t id, const NativeMap& map) { upload_raw(id, map.samples, map.spacing_nm, map.origin_nm); }
+
 void SerialLink::upload_raw(std::uint8_t id, std::span<const std::uint16_t> samples, std::uint32_t spacing_nm,
                             std::int32_t origin_nm, bool corrupt_crc) {
+  if (check_limits && info_.version != 0) {
+    // What the display would answer, without the round trip.
+    if (id >= info_.slots)
+      throw SerialError("serial link " + name_ + ": slot " + std::to_string(id) + " does not exist; the display has " +
+                            std::to_string(info_.slots) + " (0 … " + std::to_string(info_.slots - 1) + ")",
+                        ErrorCode::unknown_map, static_cast<std::uint32_t>(info_.slots));
+    if (samples.size() > info_.max_samples)
+      throw SerialError("serial link " + name_ + ": the map has " + std::to_string(samples.size()) +
+                            " samples; the display holds at most " + std::to_string(info_.max_samples) + " (oversize_map)",
+                        ErrorCode::oversize_map, info_.max_samples);
+  }
   std::uint8_t begin[14] = {id, 0};
   serial::put_u32(begin + 2, static_cast<std::uint32_t>(samples.size()));
   serial::put_u32(begin + 6, spacing_nm);
@@ -139,8 +227,9 @@ void SerialLink::upload_raw(std::uint8_t id, std::span<const std::uint16_t> samp
   request(Type::map_begin, begin, sizeof begin, Type::ack, "MAP_BEGIN");
   std::uint8_t chunk[serial::max_payload];
   std::uint32_t crc = 0;
-  for (std::size_t first = 0; first < samples.size(); first += serial::samples_per_chunk) {
-    const std::size_t n = std::min(serial::samples_per_chunk, samples.size() - first);
+  const std::size_t per_chunk = serial::samples_per_chunk_for(payload_limit_);  // >= 4 (payload >= 14)
+  for (std::size_t first = 0; first < samples.size(); first += per_chunk) {
+    const std::size_t n = std::min(per_chunk, samples.size() - first);
     chunk[0] = id;
     serial::put_u32(chunk + 1, static_cast<std::uint32_t>(first));
     for (std::size_t i = 0; i < n; ++i) serial::put_u16(chunk + 5 + 2 * i, samples[first + i]);
@@ -195,7 +284,8 @@ void SerialLink::stream_drive(double amplitude) {
 
 DisplayStatus SerialLink::status() {
   const std::string r = request(Type::status_request, nullptr, 0, Type::status, "STATUS");
-  if (r.size() < 26) throw IoError("serial link " + name_ + ": STATUS has " + std::to_string(r.size()) + " bytes; expected 26");
+  if (r.size() < serial::status_payload_1_0)
+    throw IoError("serial link " + name_ + ": STATUS has " + std::to_string(r.size()) + " bytes; expected >= 26");
   const auto* b = reinterpret_cast<const std::uint8_t*>(r.data());
   DisplayStatus s;
   s.selected = b[0] == serial::no_map ? -1 : b[0];
@@ -208,6 +298,10 @@ DisplayStatus SerialLink::status() {
   s.last_error = static_cast<ErrorCode>(b[17]);
   s.map_samples = serial::get_u32(b + 18);
   s.uptime_ms = serial::get_u32(b + 22);
+  if (r.size() >= serial::status_payload) {  // revision 1.2; longer: fields of a later revision, ignored
+    s.link_errors = serial::get_u32(b + 26);
+    s.flags = b[30];
+  }
   return s;
 }
 

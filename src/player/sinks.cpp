@@ -154,6 +154,12 @@ class PacedBackend : public Backend {
   // One period's work. process() inside it stays real-time safe; the tick
   // itself may do I/O (it runs on this backend's thread, not an audio one).
   virtual void tick(PlayerBase& player) = 0;
+  // Before the thread starts (may throw: start() fails) and after it has
+  // stopped (every stop, whatever ended the run).
+  virtual void before_run() {}
+  virtual void after_run() noexcept {}
+  // Only before start().
+  void set_period(double period_s) { period_ = std::chrono::duration<double>(period_s); }
 
  private:
   void do_start(PlayerBase& player) final {
@@ -161,12 +167,15 @@ class PacedBackend : public Backend {
       std::lock_guard lock(error_mutex_);
       error_.clear();
     }
+    before_run();
     running_ = true;
     thread_ = std::thread([this, &player] { loop(player); });
   }
   void do_stop() noexcept final {
     running_ = false;
-    if (thread_.joinable()) thread_.join();
+    if (!thread_.joinable()) return;
+    thread_.join();
+    after_run();
   }
   void loop(PlayerBase& player) {
     scheduling_.store(detail::make_thread_realtime(), std::memory_order_relaxed);
@@ -377,13 +386,26 @@ class AudioBackend final : public Backend {
 
 // ---------------------------------------------------------------- serial
 
+// Safe by default: every stop (end, pause, error, a signal handled by the
+// caller, destruction while unwinding) sends rest — DRIVE 0 and SELECT none —
+// once the streaming thread has ended; the display's 200 ms watchdog covers
+// the host that cannot (SIGKILL, a cut cable).
 class SerialBackend final : public PacedBackend {
  public:
   SerialBackend(const SerialOptions& o, const PlayerMap& map)
       : PacedBackend(checked_period(o.rate_hz), false), options_(o), link_(o.path, o.baud) {
     info_ = link_.hello();
+    // Positions or values streamed faster than the display refreshes are
+    // never output: stream at most at its refresh rate.
+    if (options_.rate_hz > info_.refresh_hz) {
+      options_.rate_hz = info_.refresh_hz;
+      set_period(1.0 / info_.refresh_hz);
+    }
     if (o.stream == SerialStream::position) {
-      link_.upload_map(0, map);
+      if (o.map)
+        link_.upload(0, *o.map);
+      else
+        link_.upload_map(0, map);
       link_.select(0);
     }
   }
@@ -402,6 +424,14 @@ class SerialBackend final : public PacedBackend {
       throw InvalidArgument("serial backend: rate is " + detail::num(rate_hz) + " Hz; allowed 1 … 20000");
     return 1.0 / rate_hz;
   }
+  void before_run() override {
+    if (options_.stream == SerialStream::position && rested_) link_.select(0);  // rest() deselected it
+    rested_ = false;
+  }
+  void after_run() noexcept override {
+    link_.rest();
+    rested_ = true;
+  }
   // The streaming thread does I/O by nature; process() itself stays
   // real-time safe.
   void tick(PlayerBase& player) override {
@@ -418,6 +448,7 @@ class SerialBackend final : public PacedBackend {
   SerialOptions options_;
   SerialLink link_;
   DisplayInfo info_;
+  bool rested_ = false;
 };
 
 }  // namespace
@@ -457,6 +488,7 @@ std::unique_ptr<Backend> make_backend(const BackendChoice& choice, const Backend
   o.baud = options.baud;
   o.rate_hz = options.rate_hz;
   o.stream = options.stream;
+  o.map = options.serial_map;
   return make_serial_backend(o, map);
 }
 

@@ -31,14 +31,20 @@ struct DisplayRig {
   std::thread thread;
 
   /// `sensor_2d`: the display's own 2-D finger sensor (none: positions from the host).
-  explicit DisplayRig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
+  explicit DisplayRig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {})
+      : DisplayRig(controller::Info{}, {}, std::move(sensor_2d)) {}
+  /// A display with the limits and faults of `info` and optionally a 1-D
+  /// (`sensor_1d`) or 2-D finger sensor.
+  DisplayRig(const controller::Info& info, std::function<bool(std::int32_t&, bool&)> sensor_1d,
+             std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {}) {
     char name[256];
     if (openpty(&master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
     path = name;
     controller::make_raw(slave);
     hal = std::make_unique<controller::HostHal>(master);
+    hal->sensor = std::move(sensor_1d);
     hal->sensor_2d = std::move(sensor_2d);
-    ctl = std::make_unique<SmallController>(*hal, controller::Info{});
+    ctl = std::make_unique<SmallController>(*hal, info);
     thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
   }
   ~DisplayRig() {

@@ -14,8 +14,14 @@
 // resynchronises on the next sync; a map is uploaded into a staging buffer
 // and only installed when its CRC-32 checks, so the controller always keeps
 // its last good map; a link that goes down is counted and retried, and
-// streamed positions that stop arriving for stream_timeout_us put the output
-// at rest rather than freezing a stale amplitude.
+// puts the output at rest (the selection is cleared, the maps are kept).
+//
+// Safe by default: only frames from the host refresh the watchdog. Streamed
+// positions or drive values older than stream_timeout_us (200 ms) put the
+// output at rest, even on a display whose own sensor still senses the finger
+// — a host that dies (SIGKILL, a cut cable) cannot leave the plate driven.
+// A display playing its selected map from its own sensor needs no stream: it
+// outputs the map under the finger, and 0 while the finger is lifted.
 #pragma once
 
 #include <cstddef>
@@ -25,6 +31,8 @@
 #include "texel/serial_protocol.hpp"
 
 namespace texel::controller {
+
+struct Status;
 
 /// The hardware abstraction: everything the controller touches.
 class Hal {
@@ -49,15 +57,36 @@ class Hal {
   virtual void write_amplitude(std::uint16_t amplitude) = 0;
   /// Idles until about `t_us` (or returns early when bytes arrive).
   virtual void idle_until(std::uint32_t t_us) = 0;
+  /// Called after every output update with the controller's state (a log,
+  /// a test probe). The default does nothing; keep it short, it runs on
+  /// every tick.
+  virtual void on_tick(std::uint32_t /*t_us*/, const Status& /*status*/) {}
 
  protected:
   ~Hal() = default;
 };
 
+/// Deliberate misbehaviour, for testing a host's conformance check
+/// (`texel display-check`) against displays that break the protocol. Never
+/// set in firmware.
+enum Fault : std::uint8_t {
+  fault_none = 0,
+  fault_wrong_crc = 0x01,        ///< installs an uploaded map whatever MAP_END's CRC-32 says
+  fault_ignore_watchdog = 0x02,  ///< keeps playing streamed values however old
+  fault_drop_reports = 0x04,     ///< loses every 7th FINGER report (its seq is skipped)
+};
+
 struct Info {
   const char* name = "texel-reference";      ///< reported in HELLO_REPLY (≤ 32 bytes used)
-  std::uint32_t refresh_mhz = 8333000;       ///< output rate in millihertz (8,333 Hz)
+  std::uint32_t refresh_mhz = 8333000;       ///< output rate in millihertz (8,333,000 mHz = 8,333 Hz)
   std::uint32_t stream_timeout_us = 200000;  ///< streamed position/drive older than this: output at rest
+  /// The largest payload the display accepts, announced in HELLO_REPLY:
+  /// serial::min_max_payload … serial::max_payload. Longer frames are
+  /// refused (NACK bad_length, detail = this), streamed ones counted.
+  std::uint16_t max_payload = static_cast<std::uint16_t>(serial::max_payload);
+  std::uint8_t slots = 0;            ///< slots announced and used, 1 … Slots; 0 = Slots
+  std::uint32_t max_samples = 0;     ///< samples per map announced and accepted, 1 … MaxSamples; 0 = MaxSamples
+  std::uint8_t faults = fault_none;  ///< Fault bits (tests only)
 };
 
 enum class Mode : std::uint8_t { idle = 0, position = 1, drive = 2 };
@@ -71,12 +100,15 @@ struct Status {
   std::int32_t y_nm = 0;  ///< a 2-D sensor's y (0 on a 1-D display)
   bool touch = false;
   std::uint32_t frames_ok = 0;
-  std::uint32_t frames_bad = 0;  ///< CRC and length errors
+  std::uint32_t frames_bad = 0;  ///< frames dropped unanswered: CRC and length errors, malformed streamed frames
   std::uint32_t nacks = 0;
   std::uint32_t link_errors = 0;         ///< times the link was found down
   std::uint32_t ticks = 0;               ///< output updates
   std::uint32_t reports = 0;             ///< FINGER reports sent
   std::uint32_t report_interval_us = 0;  ///< 0: not reporting
+  bool stale = false;                    ///< streamed values expired: the output is at rest
+  /// The latest error (NACK sent or frame dropped) since the last STATUS
+  /// reply, which reports and clears it.
   serial::ErrorCode last_error = serial::ErrorCode::none;
 };
 
@@ -89,8 +121,13 @@ class Controller {
   static constexpr std::size_t slots = Slots;
 
   Controller(Hal& hal, const Info& info) : hal_(hal), info_(info) {
+    if (info_.slots == 0 || info_.slots > Slots) info_.slots = static_cast<std::uint8_t>(Slots);
+    if (info_.max_samples == 0 || info_.max_samples > MaxSamples) info_.max_samples = static_cast<std::uint32_t>(MaxSamples);
+    if (info_.max_payload < serial::min_max_payload) info_.max_payload = static_cast<std::uint16_t>(serial::min_max_payload);
+    if (info_.max_payload > serial::max_payload) info_.max_payload = static_cast<std::uint16_t>(serial::max_payload);
     start_us_ = hal_.micros();
     next_tick_us_ = start_us_;
+    stream_us_ = start_us_ - info_.stream_timeout_us - 1;  // nothing streamed yet: stale
   }
 
   /// One pass of the main loop: drains the serial port, answers frames and,
@@ -123,6 +160,8 @@ class Controller {
 
   [[nodiscard]] const Status& status() const { return status_; }
   [[nodiscard]] bool link_up() const { return link_up_; }
+  /// The limits in force (Info's, bounded by the template's).
+  [[nodiscard]] const Info& info() const { return info_; }
   /// Samples held in slot `id` (0 if empty or out of range).
   [[nodiscard]] std::uint32_t map_samples(std::uint8_t id) const { return id < Slots ? maps_[id].samples : 0; }
   /// Sample i of slot id (for tests).
@@ -147,11 +186,7 @@ class Controller {
     for (int rounds = 0; rounds < 64; ++rounds) {  // bounded work per poll
       const int n = hal_.serial_read(buf, static_cast<int>(sizeof buf));
       if (n < 0) {
-        if (link_up_) {
-          ++status_.link_errors;
-          link_up_ = false;
-          decoder_.reset();  // a half frame from before the break is worthless
-        }
+        if (link_up_) link_lost();
         return;
       }
       link_up_ = true;
@@ -168,6 +203,19 @@ class Controller {
     }
   }
 
+  // The host is gone (or the cable): nothing it asked for stands. The output
+  // goes to rest until a host selects or streams again; the maps are kept.
+  void link_lost() {
+    ++status_.link_errors;
+    link_up_ = false;
+    decoder_.reset();  // a half frame from before the break is worthless
+    upload_active_ = false;
+    status_.selected = serial::no_map;
+    status_.mode = Mode::idle;
+    drive_ = 0;
+    stream_us_ = hal_.micros() - info_.stream_timeout_us - 1;
+  }
+
   void bad_frame(serial::ErrorCode e) {
     ++status_.frames_bad;
     status_.last_error = e;
@@ -176,19 +224,22 @@ class Controller {
   void tick(std::uint32_t now) {
     std::int32_t x = 0, y = 0;
     bool touch = false;
-    bool fresh = true;
-    if (hal_.read_position_2d(x, y, touch)) {
-      status_.mode = status_.mode == Mode::drive ? Mode::drive : Mode::position;
+    // Only host frames refresh the watchdog: a sensor reading says where the
+    // finger is, not that the host still wants the plate driven.
+    const bool stale =
+        (info_.faults & fault_ignore_watchdog) == 0 && static_cast<std::uint32_t>(now - stream_us_) > info_.stream_timeout_us;
+    const bool sensed = hal_.read_position_2d(x, y, touch);
+    if (sensed) {
       if (status_.report_interval_us != 0 && static_cast<std::int32_t>(now - next_report_us_) >= 0) report(now, x, y, touch);
     } else {
       x = stream_x_nm_;
       touch = stream_touch_;
-      fresh = static_cast<std::uint32_t>(now - stream_us_) <= info_.stream_timeout_us;
     }
     std::uint16_t a = 0;
     if (status_.mode == Mode::drive) {
-      a = fresh ? drive_ : 0;
-    } else if (touch && fresh && status_.selected < Slots) {
+      a = stale ? 0 : drive_;
+      status_.stale = stale;
+    } else if (touch && (sensed || !stale) && status_.selected < info_.slots) {
       const Map& m = maps_[status_.selected];
       // Nearest sample, as the TPaD's firmware does: its sensor resolution
       // equals the map spacing.
@@ -197,6 +248,11 @@ class Controller {
         const std::int64_t idx = (rel + m.spacing_nm / 2) / m.spacing_nm;
         if (idx < static_cast<std::int64_t>(m.samples)) a = m.data[idx];
       }
+      status_.stale = false;
+    } else {
+      // Position mode from streamed positions that stopped arriving, or
+      // lifted, off the map, nothing selected.
+      status_.stale = status_.mode == Mode::position && !sensed && stale;
     }
     status_.x_nm = x;
     status_.y_nm = y;
@@ -204,6 +260,7 @@ class Controller {
     status_.amplitude = a;
     ++status_.ticks;
     hal_.write_amplitude(a);
+    hal_.on_tick(now, status_);
   }
 
   // A FINGER report of the sensor's reading at `now`; its seq counts reports,
@@ -215,17 +272,16 @@ class Controller {
     serial::put_i32(p + 4, x);
     serial::put_i32(p + 8, y);
     p[12] = touch ? 1 : 0;
-    send(serial::Type::finger, static_cast<std::uint8_t>(status_.reports++), p, sizeof p);
+    const std::uint32_t k = status_.reports++;
+    if ((info_.faults & fault_drop_reports) == 0 || k % 7 != 3)
+      send(serial::Type::finger, static_cast<std::uint8_t>(k), p, sizeof p);
     next_report_us_ += status_.report_interval_us;
     if (static_cast<std::int32_t>(now - next_report_us_) >= 0) next_report_us_ = now + status_.report_interval_us;
   }
 
   void send(serial::Type type, std::uint8_t seq, const std::uint8_t* payload, std::size_t n) {
     const std::size_t len = serial::encode_frame(type, seq, payload, n, tx_);
-    if (!hal_.serial_write(tx_, static_cast<int>(len))) {
-      if (link_up_) ++status_.link_errors;
-      link_up_ = false;
-    }
+    if (!hal_.serial_write(tx_, static_cast<int>(len)) && link_up_) link_lost();
   }
   void ack(const serial::Frame& f) {
     const std::uint8_t p[1] = {static_cast<std::uint8_t>(f.type)};
@@ -244,30 +300,34 @@ class Controller {
     using serial::Type;
     ++status_.frames_ok;
     const std::uint8_t* p = f.payload;
+    if (f.length > info_.max_payload) {
+      if (f.type == Type::position || f.type == Type::drive) return bad_stream(f);
+      return nack(f, ErrorCode::bad_length, info_.max_payload);
+    }
     switch (f.type) {
       case Type::hello: {
-        if (f.length != 1) return nack(f, ErrorCode::bad_length);
+        if (f.length != 1) return nack(f, ErrorCode::bad_length, 1);
         if (p[0] != serial::protocol_version) return nack(f, ErrorCode::bad_version, serial::protocol_version);
         std::uint8_t r[12 + 32];
         r[0] = serial::protocol_version;
-        r[1] = static_cast<std::uint8_t>(Slots);
-        serial::put_u32(r + 2, static_cast<std::uint32_t>(MaxSamples));
+        r[1] = info_.slots;
+        serial::put_u32(r + 2, info_.max_samples);
         serial::put_u32(r + 6, info_.refresh_mhz);
-        serial::put_u16(r + 10, static_cast<std::uint16_t>(serial::max_payload));
+        serial::put_u16(r + 10, info_.max_payload);
         std::size_t name_len = std::strlen(info_.name);
         if (name_len > 32) name_len = 32;
         std::memcpy(r + 12, info_.name, name_len);
         return send(Type::hello_reply, f.seq, r, 12 + name_len);
       }
       case Type::map_begin: {
-        if (f.length != 14) return nack(f, ErrorCode::bad_length);
+        if (f.length != 14) return nack(f, ErrorCode::bad_length, 14);
         const std::uint8_t id = p[0];
         const std::uint32_t samples = serial::get_u32(p + 2);
         const std::uint32_t spacing = serial::get_u32(p + 6);
-        upload_active_ = false;
-        if (id >= Slots) return nack(f, ErrorCode::unknown_map, Slots);
+        upload_active_ = false;  // a MAP_BEGIN abandons any open upload, whatever its answer
+        if (id >= info_.slots) return nack(f, ErrorCode::unknown_map, info_.slots);
         if (p[1] != 0) return nack(f, ErrorCode::unsupported_format);
-        if (samples > MaxSamples) return nack(f, ErrorCode::oversize_map, static_cast<std::uint32_t>(MaxSamples));
+        if (samples > info_.max_samples) return nack(f, ErrorCode::oversize_map, info_.max_samples);
         if (samples == 0 || spacing == 0) return nack(f, ErrorCode::bad_value);
         staging_.samples = samples;
         staging_.spacing_nm = spacing;
@@ -291,11 +351,12 @@ class Controller {
         return ack(f);
       }
       case Type::map_end: {
-        if (f.length != 5) return nack(f, ErrorCode::bad_length);
+        if (f.length != 5) return nack(f, ErrorCode::bad_length, 5);
         if (!upload_active_ || p[0] != upload_id_) return nack(f, ErrorCode::no_upload);
         upload_active_ = false;
         if (upload_next_ != staging_.samples) return nack(f, ErrorCode::out_of_order, upload_next_);
-        if (serial::get_u32(p + 1) != upload_crc_) return nack(f, ErrorCode::map_checksum, upload_crc_);
+        if (serial::get_u32(p + 1) != upload_crc_ && (info_.faults & fault_wrong_crc) == 0)
+          return nack(f, ErrorCode::map_checksum, upload_crc_);
         Map& dst = maps_[upload_id_];
         dst.samples = staging_.samples;
         dst.spacing_nm = staging_.spacing_nm;
@@ -304,8 +365,9 @@ class Controller {
         return ack(f);
       }
       case Type::select: {
-        if (f.length != 1) return nack(f, ErrorCode::bad_length);
-        if (p[0] != serial::no_map && (p[0] >= Slots || maps_[p[0]].samples == 0)) return nack(f, ErrorCode::unknown_map);
+        if (f.length != 1) return nack(f, ErrorCode::bad_length, 1);
+        if (p[0] != serial::no_map && (p[0] >= info_.slots || maps_[p[0]].samples == 0))
+          return nack(f, ErrorCode::unknown_map, info_.slots);
         status_.selected = p[0];
         status_.mode = Mode::position;
         return ack(f);
@@ -326,7 +388,7 @@ class Controller {
         return;
       }
       case Type::reports: {
-        if (f.length != 4) return nack(f, ErrorCode::bad_length);
+        if (f.length != 4) return nack(f, ErrorCode::bad_length, 4);
         const std::uint32_t interval = serial::get_u32(p);
         if (interval != 0 && interval < serial::min_report_interval_us)
           return nack(f, ErrorCode::bad_value, serial::min_report_interval_us);
@@ -338,8 +400,8 @@ class Controller {
         return ack(f);
       }
       case Type::status_request: {
-        if (f.length != 0) return nack(f, ErrorCode::bad_length);
-        std::uint8_t r[26];
+        if (f.length != 0) return nack(f, ErrorCode::bad_length, 0);
+        std::uint8_t r[serial::status_payload];
         r[0] = status_.selected;
         r[1] = static_cast<std::uint8_t>(status_.mode);
         serial::put_u16(r + 2, status_.amplitude);
@@ -350,6 +412,14 @@ class Controller {
         r[17] = static_cast<std::uint8_t>(status_.last_error);
         serial::put_u32(r + 18, status_.selected < Slots ? maps_[status_.selected].samples : 0);
         serial::put_u32(r + 22, static_cast<std::uint32_t>(hal_.micros() - start_us_) / 1000u);
+        // Revision 1.2: appended, so a 1.0 host reads the 26 bytes it knows.
+        serial::put_u32(r + 26, status_.link_errors);
+        std::int32_t sx = 0, sy = 0;
+        bool st = false;
+        r[30] = static_cast<std::uint8_t>((hal_.read_position_2d(sx, sy, st) ? serial::status_flag_sensor : 0) |
+                                          (status_.report_interval_us != 0 ? serial::status_flag_reporting : 0) |
+                                          (status_.stale ? serial::status_flag_stale : 0));
+        status_.last_error = ErrorCode::none;  // reported: cleared
         return send(Type::status, f.seq, r, sizeof r);
       }
       default: return nack(f, ErrorCode::unknown_type);

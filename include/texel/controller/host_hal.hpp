@@ -28,12 +28,16 @@ class HostHal final : public Hal {
   bool read_position_2d(std::int32_t& x_nm, std::int32_t& y_nm, bool& touch) override;
   void write_amplitude(std::uint16_t amplitude) override;
   void idle_until(std::uint32_t t_us) override;
+  void on_tick(std::uint32_t t_us, const Status& status) override;
 
   /// Optional local finger sensor (tests); unset = positions come from the host.
   std::function<bool(std::int32_t&, bool&)> sensor;
   /// Optional local 2-D finger sensor (a 2-D display; `texel controller
   /// --sensor`); takes precedence over `sensor`.
   std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d;
+  /// Called on the controller's thread after every output update (a log:
+  /// `texel controller --log`); unset = nothing.
+  std::function<void(std::uint32_t t_us, const Status&)> tick_observer;
   /// The last amplitude written and how many writes.
   std::atomic<std::uint16_t> amplitude{0};
   std::atomic<std::uint64_t> writes{0};
