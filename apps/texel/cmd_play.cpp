@@ -186,18 +186,11 @@ void run(const PlayArgs& a) {
   }
   const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
   // At rest on every exit — the end, Ctrl-C, SIGTERM, an error or an
-  // exception: the stream stops, then a serial display is told SELECT none
-  // (its map or drive no longer plays; docs/serial-protocol.md "Playing").
+  // exception: Backend::stop() ends the stream and puts a serial display at
+  // rest (SerialLink::rest: DRIVE 0, SELECT none).
   struct AtRest {
     Backend& backend;
-    void operator()() noexcept {
-      backend.stop();
-      if (SerialLink* l = backend.serial_link()) try {
-          l->select(serial::no_map);
-        } catch (const std::exception&) {
-          // The link is gone: the display's watchdog puts it at rest.
-        }
-    }
+    void operator()() noexcept { backend.stop(); }
     ~AtRest() { (*this)(); }
   } at_rest{*backend};
   // The display that senses the finger: the one the backend drives, or another.

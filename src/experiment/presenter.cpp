@@ -331,12 +331,9 @@ void Presenter::stop() {
   // leaves direct drive at a SELECT; one playing a map stops). Whatever the
   // exit — end, pause, 'q', Ctrl-C, an error unwinding past the presenter.
   if (was_running && rest_link) {
-    try {
-      rest_link->select(serial::no_map);
-      if (display1d_) display1d_->selected = -1;
-    } catch (const std::exception&) {
-      // The link is gone: the display's own watchdog puts it at rest.
-    }
+    // (The serial backend's stop() rests too; display-plays never started it.)
+    (void)rest_link->rest();  // DRIVE 0, SELECT none; a link that is gone: the display's watchdog
+    if (display1d_) display1d_->selected = -1;
     if (display1d_ && display1d_->sensor) try {
         display1d_->sensor = false;
         display1d_->link->start_reports(0);  // the display stops reporting

@@ -43,6 +43,7 @@
 #include "texel/experiment/store.hpp"
 #include "texel/io.hpp"
 #include "texel/serial_link.hpp"
+#include "texel/stroke_script.hpp"
 #include "texel/surface.hpp"
 
 namespace ex = texel::experiment;
@@ -298,16 +299,18 @@ TEST(DisplayLoop, TheDisplayPlaysEachStimulusFromItsOwnSensor) {
               touched, lifted, blank, uploads.uploads, uploads.at_switch, uploads.seconds);
 }
 
-// `texel experiment run` against the controller as a child process with the
-// same script: texel-length and quantization, the simulated observer
-// answering while the display's finger explores.
+// `texel experiment run` against the controller as a child process whose
+// sensor is the reference stroke script (`--sensor strokes`: speed varying
+// from stroke to stroke, pauses, lifts; stroke_script.hpp): texel-length and
+// quantization, the simulated observer answering while the display's finger
+// explores. The expected measures come from the script itself, at the
+// display's clock (its log gives the script's t = 0 on that clock).
 TEST(DisplayLoop, StudiesRunEndToEndAndStoreTheFingerThatExplored) {
   texel::test_support::TempDir tmp("display-loop");
-  texel::write_file_atomic(tmp.at("strokes.csv"), script_csv);
   texel::write_file_atomic(tmp.at("texel-length.json"), short_texel_length(3));
   texel::write_file_atomic(tmp.at("quantization.json"), short_quantization());
   texel::test_support::ControllerProcess display(
-      TEXEL_CLI, {"--sensor", tmp.at("strokes.csv"), "--sensor-lift", "0.15", "--duration", "120", "--quiet"});
+      TEXEL_CLI, {"--sensor", "strokes", "--log", tmp.at("display.csv"), "--duration", "120", "--quiet"});
   ASSERT_FALSE(display.pty().empty());
   const std::string backend = "serial:" + display.pty();
   for (const std::string study : {"texel-length", "quantization"}) {
@@ -328,6 +331,24 @@ TEST(DisplayLoop, StudiesRunEndToEndAndStoreTheFingerThatExplored) {
     EXPECT_EQ(st.selected, -1);
     EXPECT_EQ(st.amplitude, 0);
   }
+  EXPECT_NE(display.stop().find("bad 0"), std::string::npos);
+  // The script's t = 0 on the display's clock (t_us of its reports).
+  const std::string log = texel::read_file(tmp.at("display.csv"));
+  const std::size_t row1 = log.find('\n') + 1;
+  double log_t = 0, log_us = 0;
+  ASSERT_EQ(std::sscanf(log.c_str() + row1, "%lf,%lf", &log_t, &log_us), 2) << log.substr(0, 200);
+  const double t0_s = log_us * 1e-6 - log_t;
+  const texel::StrokeScript script{texel::StrokeScriptConfig{}};
+  const auto script_measures_at = [&](const std::vector<texel::FingerSample>& trace) {
+    std::vector<texel::FingerSample> s;
+    for (const auto& sample : trace) {
+      texel::FingerSample f = script.at(std::fmod(sample.t_s - t0_s + 4294.967296, 4294.967296));
+      f.t_s = sample.t_s;
+      s.push_back(f);
+    }
+    return texel::swipe_measures(s, ex::still_speed_mm_s);
+  };
+
   const auto csv = texel::test_support::run_cli(TEXEL_CLI, "experiment export --db " + tmp.at("s.db") + " -o " + tmp.at("t.csv"));
   ASSERT_EQ(csv.status, 0) << csv.out;
   const auto rows = ex::parse_trials_csv(texel::read_file(tmp.at("t.csv")), "t.csv");
@@ -342,12 +363,15 @@ TEST(DisplayLoop, StudiesRunEndToEndAndStoreTheFingerThatExplored) {
       EXPECT_EQ(row.finger_source, "display");
       EXPECT_EQ(t.trace.source, ex::TraceSource::display);
       ASSERT_GT(t.trace.samples.size(), 300u);  // 1.2 s of reports (a starved controller skips some)
-      const texel::SwipeMeasures want = script_measures(t.trace.samples);
+      const texel::SwipeMeasures want = script_measures_at(t.trace.samples);
+      EXPECT_GT(want.mean_speed_mm_s, 10.0);  // the script moved during the trial
       EXPECT_NEAR(row.swipe_mean_speed_mm_s, want.mean_speed_mm_s, 0.02 * want.mean_speed_mm_s);
-      EXPECT_NEAR(row.swipe_sd_speed_mm_s, want.sd_speed_mm_s, 0.02 * want.sd_speed_mm_s + 0.5);
+      EXPECT_NEAR(row.swipe_sd_speed_mm_s, want.sd_speed_mm_s, 0.02 * want.sd_speed_mm_s);
       EXPECT_NEAR(row.directional_proportion, want.directional_proportion, 0.02);
+      std::printf("%s trial %d: %zu reports; mean %.2f mm/s (script %.2f), SD %.2f (%.2f), directional %.3f (%.3f)\n",
+                  row.protocol.c_str(), row.trial, t.trace.samples.size(), row.swipe_mean_speed_mm_s, want.mean_speed_mm_s,
+                  row.swipe_sd_speed_mm_s, want.sd_speed_mm_s, row.directional_proportion, want.directional_proportion);
     }
-  EXPECT_NE(display.stop().find("bad 0"), std::string::npos);
 }
 
 // Every way a run ends leaves the display at rest (STATUS from a new host):
@@ -381,12 +405,14 @@ TEST(DisplayLoop, EveryExitLeavesTheDisplayAtRest) {
     ::waitpid(pid, &s, 0);
     return WIFEXITED(s) ? WEXITSTATUS(s) : 128 + WTERMSIG(s);
   };
-  auto at_rest = [&](const std::string& how) {
+  // Rest: nothing selected, output 0; after a clean exit also out of drive
+  // mode (after SIGKILL the display's watchdog zeroes a drive that stays).
+  auto at_rest = [&](const std::string& how, bool clean = true) {
     SCOPED_TRACE(how);
     const texel::DisplayStatus st = status_of(display.pty());
     EXPECT_EQ(st.selected, -1);
     EXPECT_EQ(st.amplitude, 0);
-    EXPECT_NE(st.mode, 2) << "left in drive mode";
+    if (clean) EXPECT_NE(st.mode, 2) << "left in drive mode";
   };
   // 'q' after feeling texture 2.
   {
@@ -394,6 +420,12 @@ TEST(DisplayLoop, EveryExitLeavesTheDisplayAtRest) {
     EXPECT_EQ(exit_status(pid), 0);
     at_rest("q");
     EXPECT_NE(texel::read_file(tmp.at("P1.txt")).find(" play "), std::string::npos);  // it was playing
+    // The resume line repeats the display (a resume on the null backend would be silent).
+    const std::string out = texel::read_file(tmp.at("P1.out"));
+    EXPECT_NE(out.find("--participant P1 --db " + tmp.at("s.db") + " --backend " + backend + " --monitor " + tmp.at("P1.txt") +
+                       " --resume"),
+              std::string::npos)
+        << out;
   }
   // Ctrl-C and SIGTERM mid-trial, display-plays and drive (host-streams).
   for (const std::string mode : {"display-plays", "host-streams"})
@@ -404,6 +436,16 @@ TEST(DisplayLoop, EveryExitLeavesTheDisplayAtRest) {
       EXPECT_EQ(exit_status(pid), 0);
       at_rest(mode + " signal " + std::to_string(sig));
     }
+  // kill -9 in drive mode: nothing can be sent; the display rests by itself
+  // (its watchdog, or the link's loss) within 200 ms.
+  {
+    const pid_t pid = start("--simulate default --pace 3 --mode host-streams", "");
+    std::this_thread::sleep_for(2500ms);
+    ::kill(pid, SIGKILL);
+    EXPECT_EQ(exit_status(pid), 128 + SIGKILL);
+    std::this_thread::sleep_for(200ms);
+    at_rest("kill -9, drive mode", false);
+  }
   // An error mid-run: another process takes the writer lock; the run stops with exit 2.
   {
     const pid_t pid = start("--simulate default --pace 1.5", "");
