@@ -10,6 +10,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -54,6 +55,7 @@ struct RunArgs {
   std::string audio_device;
   std::string response = "limit";
   std::optional<std::string> finger;  // serial:PATH — the participant strokes a 2-D display
+  std::optional<std::string> mode;    // display-plays | host-streams | passive (default: the display's own)
   double direction_tolerance_deg = ex::StrokeRules{}.tolerance_deg;
   bool json = false;
   bool quiet = false;
@@ -61,6 +63,37 @@ struct RunArgs {
 };
 
 std::string count_text(int n) { return n >= 0 ? std::to_string(n) : std::string("adaptive"); }
+
+// A word for a POSIX shell: as is when it is plain, else in single quotes.
+std::string shell_word(const std::string& w) {
+  const bool plain = !w.empty() && std::all_of(w.begin(), w.end(), [](unsigned char c) {
+    return std::isalnum(c) || std::strchr("@%+=:,./_-", c) != nullptr;
+  });
+  if (plain) return w;
+  std::string q = "'";
+  for (const char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// The command that continues this session: every option that decides where
+// the stimuli go, where the finger comes from, how they are presented and
+// where the answers are stored (a resume on another backend would run the
+// rest of the study on other hardware, silently).
+std::string resume_command(const RunArgs& a) {
+  std::string c = "texel experiment run " + shell_word(a.protocol) + " --participant " + shell_word(a.participant) + " --db " +
+                  shell_word(a.db);
+  if (!a.journal.empty()) c += " --journal " + shell_word(a.journal);
+  c += " --backend " + shell_word(a.backend);
+  if (!a.audio_device.empty()) c += " --audio-device " + shell_word(a.audio_device);
+  if (a.finger) c += " --finger " + shell_word(*a.finger);
+  if (a.finger && a.direction_tolerance_deg != ex::StrokeRules{}.tolerance_deg)
+    c += " --direction-tolerance " + detail::num(a.direction_tolerance_deg);
+  if (a.mode) c += " --mode " + shell_word(*a.mode);
+  if (a.response != "limit") c += " --response " + shell_word(a.response);
+  if (a.pace > 0) c += " --pace " + detail::num(a.pace);
+  if (a.monitor) c += " --monitor " + shell_word(*a.monitor);
+  return c + " --resume";
+}
 
 // A station whose server is not there runs on its journal, and says so.
 void warn_if_offline(const ex::Store& store) {
@@ -120,6 +153,7 @@ void run(const RunArgs& a) {
   po.backend = a.backend;
   po.audio_device = a.audio_device;
   po.response_handling = parse_response_handling(a.response, "--response");
+  if (a.mode) po.mode = ex::parse_presentation_mode(*a.mode, "--mode");
   if (a.finger) {
     // The participant strokes a 2-D display: every block must be a 2-D oddity.
     if (a.simulate)
@@ -178,8 +212,7 @@ void run(const RunArgs& a) {
   auto old_term = std::signal(SIGTERM, on_experiment_signal);
   auto old_pipe = std::signal(SIGPIPE, SIG_IGN);  // a monitor FIFO whose reader left ends the stream, not the run
   const bool tty = ::isatty(STDERR_FILENO) == 1;
-  const std::string resume_command = "texel experiment run " + a.protocol + " --participant " + a.participant + " --db " + a.db +
-                                     (a.journal.empty() ? std::string() : " --journal " + a.journal) + " --resume";
+  const std::string resume_command = cli::resume_command(a);
   monitor.event("start", {{"session", std::to_string(info.id)},
                           {"participant", a.participant},
                           {"protocol", protocol.name},
@@ -189,7 +222,14 @@ void run(const RunArgs& a) {
                           {"trials_planned", count_text(session.trials_planned())},
                           {"simulated", sim ? (simulate.empty() ? std::string("default") : simulate) : std::string()},
                           {"db", a.db}});
+  // What this display cannot do for the protocol, before the first trial.
+  if (!session.finished())
+    for (const std::string& w : presenter.check(session.question())) {
+      monitor.event("presentation_warning", {{"mode", std::string(to_string(presenter.mode()))}, {"warning", w}});
+      if (!a.quiet) std::cerr << "texel: warning: " << w << "\n";
+    }
   monitor.event("audio", {{"backend", presenter.describe()},
+                          {"mode", std::string(to_string(presenter.mode()))},
                           {"response", std::string(to_string(po.response_handling))},
                           {"block_ms", detail::fixed(presenter.block_period_s() * 1e3, 3)},
                           {"finger", a.finger ? *a.finger : std::string()},
@@ -219,6 +259,7 @@ void run(const RunArgs& a) {
       report_question(monitor, session);
       // Present as a participant would: each stimulus in turn (the pace
       // shared among them), then answer.
+      presenter.prepare(q);
       for (std::size_t k = 0; k < q.stimuli.size(); ++k) {
         presenter.show(q, k);
         wait_pumping(&presenter, a.pace / static_cast<double>(std::max<std::size_t>(1, q.stimuli.size())));
@@ -227,6 +268,8 @@ void run(const RunArgs& a) {
       if (experiment_interrupted) break;
       r = sim->respond(session);
       r.shown_at = r.answered_at = ex::utc_timestamp();
+      presenter.blank();
+      r.trace = presenter.take_trace();  // the finger that explored (a display's, while the simulated observer answers)
     } else {
       StopReason stop = StopReason::none;
       auto answer = ask_terminal(session, &presenter, monitor, stop);
@@ -271,9 +314,9 @@ void run(const RunArgs& a) {
           std::isfinite(t.row.next_intensity) ? (t.row.variable + " → " + detail::num(t.row.next_intensity)).c_str() : "");
   }
   if (sim && tty && !a.quiet) std::fprintf(stderr, "\n");
+  presenter.stop();  // the display at rest before a second Ctrl-C could end the process
   std::signal(SIGINT, old_int);
   std::signal(SIGTERM, old_term);
-  presenter.stop();
   std::signal(SIGPIPE, old_pipe);
   const bool finished = session.finished();
 
@@ -304,6 +347,19 @@ void run(const RunArgs& a) {
   j["mean_block_ms"] = s.blocks ? s.total_block_s / static_cast<double>(s.blocks) * 1e3 : 0.0;
   j["late_blocks"] = s.underruns;
   j["stimuli_shown"] = presenter.shown();
+  j["mode"] = std::string(to_string(presenter.mode()));
+  if (presenter.mode() == ex::PresentationMode::display_plays) {
+    const ex::Presenter::UploadCounts u = presenter.upload_counts();
+    j["maps_uploaded"] = u.uploads;
+    j["maps_uploaded_at_switch"] = u.at_switch;
+    j["upload_s"] = u.seconds;
+  }
+  if (!a.finger && presenter.mode() != ex::PresentationMode::passive) {
+    const ex::Presenter::FingerCounts f = presenter.finger_counts();
+    j["finger_reports"] = f.reports;
+    j["finger_reports_lost"] = f.lost;
+  }
+  if (!finished) j["resume"] = resume_command;
   if (a.finger) {
     const ex::Presenter::FingerCounts f = presenter.finger_counts();
     j["finger"] = *a.finger;
@@ -401,6 +457,11 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_option("--finger", a->finger,
                       "The participant strokes a 2-D display that reports the finger: serial:PATH (oddity-2d studies; "
                       "the same PATH as --backend serial:PATH, or another display)");
+  run_cmd->add_option("--mode", a->mode,
+                      "How the stimuli reach the finger: display-plays (the display stores each stimulus and plays it "
+                      "from its own finger sensor), host-streams (the host streams the drive from the display's reported "
+                      "finger) or passive (a simulated sweep, where no finger exists) [the display's own: display-plays "
+                      "with map slots and a sensor, host-streams with a sensor only, passive without one]");
   run_cmd->add_option("--direction-tolerance", a->direction_tolerance_deg,
                       "--finger: largest deviation (degrees) of an interval's mean stroke direction from the one asked for [20]");
   run_cmd->add_option("--response", a->response,

@@ -398,6 +398,8 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
   const ex::Question& q = session.question();
   const std::string trial_number = std::to_string(q.trial + 1);  // the export's trial_number
   stop = StopReason::none;
+  // The stimuli into a map-storing display's slots before onset; the trial's finger trace starts.
+  if (presenter && !presenter->two_d()) presenter->prepare(q);
   if (presenter && presenter->two_d()) {
     // The display's maps, before the trial's clock starts (a friction
     // bitmap takes about a second to render).
@@ -605,7 +607,10 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
       r.slider_i = slider_i;
     }
     const double rt = seconds_since(t0) * 1000.0;  // from the first stimulus onset (shown with the question)
-    if (presenter) presenter->blank();
+    if (presenter) {
+      presenter->blank();
+      r.trace = presenter->take_trace();  // the finger that explored, stored with the trial
+    }
     if (two_d) {
       r.strokes = presenter->strokes(q);  // stored with the trial; the experimenter's monitor gets each interval
       for (std::size_t k = 0; k < r.strokes.size(); ++k) {

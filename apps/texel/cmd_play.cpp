@@ -185,6 +185,14 @@ void run(const PlayArgs& a) {
     player = std::move(p);
   }
   const std::unique_ptr<Backend> backend = make_backend(choice, bo, *map);
+  // At rest on every exit — the end, Ctrl-C, SIGTERM, an error or an
+  // exception: Backend::stop() ends the stream and puts a serial display at
+  // rest (SerialLink::rest: DRIVE 0, SELECT none).
+  struct AtRest {
+    Backend& backend;
+    void operator()() noexcept { backend.stop(); }
+    ~AtRest() { (*this)(); }
+  } at_rest{*backend};
   // The display that senses the finger: the one the backend drives, or another.
   std::unique_ptr<SerialLink> own_link;
   SerialLink* sensor_link = nullptr;
@@ -203,6 +211,7 @@ void run(const PlayArgs& a) {
 
   interrupted = false;
   auto old_handler = std::signal(SIGINT, on_sigint);
+  auto old_term = std::signal(SIGTERM, on_sigint);  // a handler that only sets the flag: the real-time side is untouched
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   // Feed the finger like a sensor with 50 ms of buffering: samples are queued
   // shortly before their time, so the player interpolates between them.
@@ -239,8 +248,9 @@ void run(const PlayArgs& a) {
       // Already gone: nothing to stop.
     }
   }
-  backend->stop();
+  at_rest();
   std::signal(SIGINT, old_handler);
+  std::signal(SIGTERM, old_term);
   if (tty) std::fprintf(stderr, "\r%*s\r", 110, "");
   if (!error.empty()) throw IoError("play: " + error);
 

@@ -37,7 +37,10 @@ struct Columns {
                                                                        {"response", &TrialRow::response},
                                                                        {"correct_answer", &TrialRow::correct_answer},
                                                                        {"shown_at", &TrialRow::shown_at},
-                                                                       {"answered_at", &TrialRow::answered_at}};
+                                                                       {"answered_at", &TrialRow::answered_at},
+                                                                       {"presentation_mode", &TrialRow::presentation_mode},
+                                                                       {"finger_source", &TrialRow::finger_source},
+                                                                       {"swipe_flag", &TrialRow::swipe_flag}};
   std::vector<std::pair<const char*, int TrialRow::*>> ints{
       {"block_index", &TrialRow::block_index}, {"trial", &TrialRow::trial}, {"trial_in_block", &TrialRow::trial_in_block}};
   std::vector<std::pair<const char*, bool TrialRow::*>> bools{{"practice", &TrialRow::practice},

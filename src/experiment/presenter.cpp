@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <list>
 #include <map>
@@ -19,7 +20,9 @@
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/serial_link.hpp"
+#include "texel/surface.hpp"
 #include "texel/surface2d.hpp"
+#include "texel/texture.hpp"
 
 namespace texel::experiment {
 namespace {
@@ -96,6 +99,127 @@ struct Presenter::Display2D {
   std::optional<ReportReader> reader;  // last: stopped first
 };
 
+// --------------------------------------------------------- 1-D serial display
+
+// A 1-D serial display with a finger sensor: its reports (read on the
+// control thread by pump() in display-plays, where requests and reports
+// share the thread, or on their own thread in host-streams, where the
+// player takes them) become the trial's finger trace; in display-plays the
+// display's slots hold the trial's stimuli.
+struct Presenter::Display1D {
+  SerialLink* link = nullptr;
+  DisplayInfo info;
+  bool sensor = false;
+  std::uint32_t report_interval_us = 1000;
+  ReportClock clock;        // the display's t_us unwrapped (the trace's time)
+  ReportTimeline timeline;  // host-streams: the reports on the player's clock
+
+  // display-plays: which stimulus each slot holds (its document), and when it was last felt.
+  struct Slot {
+    std::string document;
+    std::uint64_t used = 0;
+  };
+  std::vector<Slot> slots;
+  int selected = -1;
+  std::uint64_t tick = 0;
+  // Rendered maps (u16 samples), most recent first: a reference recurs.
+  struct Rendered {
+    std::string document;
+    std::vector<std::uint16_t> samples;
+    std::uint32_t spacing_nm = 0;
+    std::int32_t origin_nm = 0;
+  };
+  std::list<Rendered> rendered;
+  UploadCounts uploads;
+
+  mutable std::mutex mutex;  // guards what follows (host-streams: the reader thread writes it)
+  bool recording = false;
+  std::vector<FingerSample> trace;
+  std::uint64_t reports = 0, dropped = 0;
+  double first_s = 0.0;
+  std::string error;
+  std::optional<ReportReader> reader;  // host-streams only; last: stopped first
+
+  void record(const FingerReport& r) {  // under mutex
+    ++reports;
+    // The display's own clock, unwrapped: its t_us at the first report plus the time since.
+    if (reports == 1) first_s = static_cast<double>(r.t_us) * 1e-6;
+    const double t = first_s + clock.seconds(r.t_us);
+    if (recording) trace.push_back(FingerSample{t, r.x_mm, r.touch});
+  }
+
+  // display-plays: drains the reports that arrived (control thread).
+  void drain() {
+    std::array<FingerReport, 256> buf;
+    for (;;) {
+      const std::size_t n = link->read_reports(buf, 0);
+      std::lock_guard<std::mutex> lock(mutex);
+      for (std::size_t i = 0; i < n; ++i) record(buf[i]);
+      if (n < buf.size()) return;
+    }
+  }
+
+  const Rendered& render(const std::string& document_json) {
+    auto it = std::find_if(rendered.begin(), rendered.end(), [&](const Rendered& r) { return r.document == document_json; });
+    if (it != rendered.end()) {
+      rendered.splice(rendered.begin(), rendered, it);
+      return rendered.front();
+    }
+    // texel render's bytes: the document's surface encoded as u16le (round(a·65535)).
+    const Surface surface = prepare_surface(parse_document(document_json, "stimulus"));
+    const Grid& g = surface.grid();
+    if (static_cast<std::uint64_t>(g.count) > info.max_samples)
+      throw InvalidArgument("a stimulus map has " + std::to_string(g.count) + " samples; the display '" + info.name +
+                            "' holds at most " + std::to_string(info.max_samples) +
+                            " (its HELLO): use a device profile the display can hold, or --mode host-streams");
+    const std::vector<std::byte> bytes = surface.render_native(SampleFormat::u16le);
+    Rendered r;
+    r.document = document_json;
+    r.samples.resize(bytes.size() / 2);
+    for (std::size_t i = 0; i < r.samples.size(); ++i)
+      r.samples[i] = static_cast<std::uint16_t>(std::to_integer<unsigned>(bytes[2 * i]) |
+                                                (std::to_integer<unsigned>(bytes[2 * i + 1]) << 8));
+    r.spacing_nm = static_cast<std::uint32_t>(std::lround(g.spacing.value() * 1e6));
+    r.origin_nm = static_cast<std::int32_t>(std::lround(g.origin.value() * 1e6));
+    rendered.push_front(std::move(r));
+    if (rendered.size() > 8) rendered.pop_back();
+    return rendered.front();
+  }
+
+  // The slot holding `document_json`, uploading it over the least recently
+  // felt slot that is not playing (or, with one slot, after SELECT none).
+  int hold(const std::string& document_json, bool at_switch) {
+    for (std::size_t k = 0; k < slots.size(); ++k)
+      if (slots[k].document == document_json) {
+        slots[k].used = ++tick;
+        return static_cast<int>(k);
+      }
+    const Rendered& r = render(document_json);
+    int victim = -1;
+    for (std::size_t k = 0; k < slots.size(); ++k)
+      if (static_cast<int>(k) != selected && (victim < 0 || slots[k].used < slots[static_cast<std::size_t>(victim)].used))
+        victim = static_cast<int>(k);
+    if (victim < 0) {  // one slot, playing: rest while it is replaced
+      select(-1);
+      victim = 0;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    slots[static_cast<std::size_t>(victim)].document.clear();  // a failed upload leaves the slot unknown
+    link->upload_raw(static_cast<std::uint8_t>(victim), r.samples, r.spacing_nm, r.origin_nm);
+    uploads.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++uploads.uploads;
+    if (at_switch) ++uploads.at_switch;
+    slots[static_cast<std::size_t>(victim)] = Slot{document_json, ++tick};
+    return victim;
+  }
+
+  void select(int slot) {
+    if (slot == selected) return;
+    link->select(slot < 0 ? serial::no_map : static_cast<std::uint8_t>(slot));
+    selected = slot;
+  }
+};
+
 Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   if (!(options_.swipe_speed_mm_s > 0 && options_.swipe_speed_mm_s <= 10000))
     throw InvalidArgument("swipe speed is " + std::to_string(options_.swipe_speed_mm_s) + "; allowed: 0 … 10000 mm/s");
@@ -116,8 +240,9 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   PlayerConfig config;
   BackendOptions bo;
   if (choice.kind == BackendChoice::Kind::serial) {
-    // A friction display takes amplitudes; the player's output is streamed
-    // as drive values, so switching stimuli needs no map upload.
+    // A friction display takes amplitudes: in host-streams and passive the
+    // player's output is streamed as drive values (display-plays streams
+    // nothing: the display plays its own copy of the map).
     config.rate_hz = 1000.0;
     config.mode = OutputMode::amplitude;
     period_s_ = 1.0 / config.rate_hz;
@@ -137,11 +262,29 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
   backend_ = make_backend(choice, bo, blank_map);
   if (options_.finger != FingerSource::display) {
+    choose_mode(choice);
+    if (mode_ == PresentationMode::display_plays) {
+      running_ = true;  // nothing streams: the display plays; pump() reads its reports
+      return;
+    }
     pump();
     backend_->start(*player_);
     running_ = true;
+    if (mode_ == PresentationMode::host_streams && display1d_) {
+      Display1D& d = *display1d_;
+      d.reader.emplace(*d.link, [this](std::span<const FingerReport> batch) {
+        Display1D& dd = *display1d_;
+        std::lock_guard<std::mutex> lock(dd.mutex);
+        for (const FingerReport& r : batch) {
+          const double t = dd.timeline.place(r.t_us, player_->time_s());
+          if (!player_->push(FingerSample{t, r.x_mm, r.touch})) ++dd.dropped;
+          dd.record(r);
+        }
+      });
+    }
     return;
   }
+  mode_ = PresentationMode::host_streams;  // the 2-D player streams from the display's reports
   // The 2-D display: the player plays Player2D maps under the display's
   // finger, reported over the backend's own link or another display's.
   display_ = std::make_unique<Display2D>(config, options_.stroke_rules);
@@ -171,6 +314,8 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
 Presenter::~Presenter() { stop(); }
 
 void Presenter::stop() {
+  SerialLink* rest_link = backend_ ? backend_->serial_link() : nullptr;
+  if (display1d_ && display1d_->reader) display1d_->reader->stop();
   if (display_ && display_->running()) {
     display_->stop();
     if (display_->error().empty()) try {
@@ -179,8 +324,22 @@ void Presenter::stop() {
         // Already gone: nothing to stop.
       }
   }
+  const bool was_running = running_;
   if (running_) backend_->stop();
   running_ = false;
+  // At rest: once nothing streams, SELECT none (a display in drive mode
+  // leaves direct drive at a SELECT; one playing a map stops). Whatever the
+  // exit — end, pause, 'q', Ctrl-C, an error unwinding past the presenter.
+  if (was_running && rest_link) {
+    // (The serial backend's stop() rests too; display-plays never started it.)
+    (void)rest_link->rest();  // DRIVE 0, SELECT none; a link that is gone: the display's watchdog
+    if (display1d_) display1d_->selected = -1;
+    if (display1d_ && display1d_->sensor) try {
+        display1d_->sensor = false;
+        display1d_->link->start_reports(0);  // the display stops reporting
+      } catch (const std::exception&) {
+      }
+  }
   if (player_) player_->collect();
   if (display_) display_->player.collect();
 }
@@ -189,6 +348,11 @@ void Presenter::show(const std::string& document_json) {
   if (display_)
     throw InvalidArgument(
         "this presenter plays a 2-D display the participant strokes; it plays stimuli with a surface (oddity-2d)");
+  if (mode_ == PresentationMode::display_plays) {
+    display1d_->select(display1d_->hold(document_json, true));
+    ++shown_;
+    return;
+  }
   // Participants switch back and forth among a trial's few stimuli, and a
   // reference recurs over many trials: keep the last few rendered maps (a
   // noise reference takes ~0.1 s to synthesise; copying its map, 0.1 ms).
@@ -210,6 +374,8 @@ void Presenter::show(const std::string& document_json) {
 }
 
 void Presenter::show(std::unique_ptr<const PlayerMap> map) {
+  if (mode_ == PresentationMode::display_plays)
+    throw InvalidArgument("display-plays: the display is given documents (texel render's bytes), not prepared maps");
   if (map) last_response_ = map->response();
   player_->set_map(std::move(map));
   ++shown_;
@@ -241,6 +407,26 @@ Presenter::BitmapCounts Presenter::bitmap_counts() const {
 }
 
 void Presenter::prepare(const Question& question) {
+  if (display1d_) {
+    Display1D& d = *display1d_;
+    if (mode_ == PresentationMode::display_plays) {
+      d.select(-1);
+      // As many of the trial's distinct stimuli as the display holds, before
+      // onset (an oddity trial shows one texture twice: two maps for three).
+      std::vector<const std::string*> distinct;
+      for (const auto& st : question.stimuli)
+        if (distinct.size() < d.slots.size() &&
+            std::none_of(distinct.begin(), distinct.end(), [&](const std::string* p) { return *p == st.document_json; }))
+          distinct.push_back(&st.document_json);
+      for (const std::string* doc : distinct) (void)d.hold(*doc, false);
+      d.drain();  // reports from before onset are not this trial's
+    }
+    std::lock_guard<std::mutex> lock(d.mutex);
+    d.trace.clear();
+    d.recording = true;
+  }
+  simulated_trace_.clear();
+  recording_ = true;
   if (!display_) return;
   display_->maps.prepare(question);
   std::lock_guard<std::mutex> lock(display_->mutex);
@@ -263,12 +449,20 @@ std::vector<IntervalStrokes> Presenter::strokes(const Question& question) const 
 }
 
 Presenter::FingerCounts Presenter::finger_counts() const {
+  if (display1d_) {
+    std::lock_guard<std::mutex> lock(display1d_->mutex);
+    return {display1d_->reports, display1d_->link->reports_lost(), display1d_->dropped};
+  }
   if (!display_) return {};
   std::lock_guard<std::mutex> lock(display_->mutex);
   return {display_->reports, display_->link ? display_->link->reports_lost() : 0, display_->dropped};
 }
 
 void Presenter::blank() {
+  if (mode_ == PresentationMode::display_plays) {
+    display1d_->select(-1);
+    return;
+  }
   if (display_) {
     // A one-sample bitmap far off the display: the finger is off it, so the
     // player fades out.
@@ -289,7 +483,16 @@ void Presenter::pump() {
     display_->player.collect();
     return;
   }
-  if (options_.finger == FingerSource::external) {
+  if (mode_ == PresentationMode::display_plays) {
+    try {
+      display1d_->drain();
+    } catch (const IoError& e) {
+      display1d_->error = e.what();
+      throw;
+    }
+    return;
+  }
+  if (options_.finger == FingerSource::external || mode_ == PresentationMode::host_streams) {
     player_->collect();
     return;
   }
@@ -297,9 +500,136 @@ void Presenter::pump() {
   while (next_finger_s_ <= horizon) {
     const FingerSample s{next_finger_s_, finger_x(next_finger_s_, options_.swipe_speed_mm_s, 10.0, 90.0), true};
     if (!player_->push(s)) break;
+    // The simulated finger is the trial's trace (passive; bounded at an hour).
+    if (recording_ && simulated_trace_.size() < 3'600'000) simulated_trace_.push_back(s);
     next_finger_s_ += 1.0 / finger_rate_hz;
   }
   player_->collect();
+}
+
+void Presenter::choose_mode(const BackendChoice& choice) {
+  const bool external = options_.finger == FingerSource::external;
+  if (choice.kind != BackendChoice::Kind::serial || external) {
+    // A sound card or no hardware: no map storage; a finger only if pushed from outside.
+    mode_ = options_.mode.value_or(external ? PresentationMode::host_streams : PresentationMode::passive);
+    if (mode_ == PresentationMode::display_plays)
+      throw InvalidArgument("--mode display-plays: " + backend_->describe() +
+                            " stores no maps; give a serial display that does (--backend serial:PATH)");
+    if (mode_ == PresentationMode::host_streams && !external)
+      throw InvalidArgument("--mode host-streams: " + backend_->describe() +
+                            " has no finger to stream from; give a display that senses it (--backend serial:PATH) or "
+                            "--mode passive");
+    if (mode_ == PresentationMode::passive && external)
+      throw InvalidArgument("mode passive: this presenter is given a finger (external); passive plays a simulated sweep");
+    return;
+  }
+  // A serial display: what its HELLO says it holds, and whether it senses the finger.
+  auto d = std::make_unique<Display1D>();
+  d->link = backend_->serial_link();
+  d->info = d->link->hello();
+  d->report_interval_us = options_.report_interval_us;
+  if (d->report_interval_us < serial::min_report_interval_us)
+    throw InvalidArgument("report interval is " + std::to_string(d->report_interval_us) +
+                          " µs; allowed >= " + std::to_string(serial::min_report_interval_us));
+  try {
+    d->link->start_reports(d->report_interval_us);
+    d->sensor = true;
+  } catch (const SerialError& e) {
+    if (e.code != serial::ErrorCode::no_sensor && e.code != serial::ErrorCode::unknown_type) throw;
+  }
+  const PresentationMode chosen = d->sensor
+                                      ? (d->info.slots >= 1 ? PresentationMode::display_plays : PresentationMode::host_streams)
+                                      : PresentationMode::passive;
+  mode_ = options_.mode.value_or(chosen);
+  const std::string who = "the display '" + d->info.name + "' on " + choice.serial_path;
+  auto refuse = [&](const std::string& why) {
+    if (d->sensor) try {
+        d->link->start_reports(0);
+      } catch (const Error&) {
+      }
+    throw InvalidArgument("--mode " + std::string(to_string(mode_)) + ": " + who + " " + why);
+  };
+  if (mode_ == PresentationMode::display_plays && d->info.slots < 1) refuse("stores no maps (0 slots in its HELLO)");
+  if (mode_ != PresentationMode::passive && !d->sensor)
+    refuse("does not sense the finger (it refused FINGER reports); give --mode passive for a passive hand");
+  if (mode_ == PresentationMode::passive && d->sensor)
+    refuse("senses the finger; passive would ignore the participant's exploration (give display-plays or host-streams)");
+  if (mode_ == PresentationMode::passive) return;  // streams the simulated sweep's drive, as before
+  d->slots.resize(static_cast<std::size_t>(std::max(0, d->info.slots)));
+  display1d_ = std::move(d);
+}
+
+FingerTrace Presenter::take_trace() {
+  FingerTrace t;
+  t.mode = mode_;
+  if (display_) return t;  // a 2-D display's strokes are strokes()
+  if (display1d_) {
+    if (mode_ == PresentationMode::display_plays) display1d_->drain();
+    std::lock_guard<std::mutex> lock(display1d_->mutex);
+    t.source = TraceSource::display;
+    t.samples.swap(display1d_->trace);
+    display1d_->recording = false;
+  } else if (mode_ == PresentationMode::passive && recording_) {
+    t.source = TraceSource::simulated;
+    t.samples.swap(simulated_trace_);
+  }
+  recording_ = false;
+  return t;
+}
+
+Presenter::UploadCounts Presenter::upload_counts() const { return display1d_ ? display1d_->uploads : UploadCounts{}; }
+
+std::vector<std::string> Presenter::check(const Question& first) const {
+  std::vector<std::string> out;
+  if (display_ || first.stimuli.empty()) return out;
+  constexpr double swipe_mm_s = 100.0;  // the studies' typical swipe
+  if (mode_ == PresentationMode::display_plays) {
+    Display1D& d = *display1d_;
+    std::uint64_t samples = 0;
+    std::vector<std::string> distinct;  // an oddity trial shows one texture twice
+    for (const auto& s : first.stimuli) {
+      const Document doc = parse_document(s.document_json, "stimulus");
+      samples = std::max<std::uint64_t>(samples, static_cast<std::uint64_t>(doc.device.samples));
+      if (std::find(distinct.begin(), distinct.end(), s.document_json) == distinct.end()) distinct.push_back(s.document_json);
+    }
+    if (samples > d.info.max_samples)
+      throw InvalidArgument("a stimulus map has " + std::to_string(samples) + " samples; the display '" + d.info.name +
+                            "' holds at most " + std::to_string(d.info.max_samples) + " (its HELLO)");
+    if (d.slots.size() < distinct.size()) {
+      // Each MAP_DATA frame carries up to 509 samples (1,032 bytes with framing) and waits for its ACK.
+      const double bytes = std::ceil(static_cast<double>(samples) / 509.0) * 1032.0;
+      const double s = bytes * 10.0 / static_cast<double>(options_.baud);
+      out.push_back("the display holds " + std::to_string(d.slots.size()) + " map(s) and a trial has " +
+                    std::to_string(distinct.size()) + " different stimuli: a switch to a stimulus not held uploads its " +
+                    std::to_string(samples) + " samples first (about " + detail::fixed(s * 1e3, 0) + " ms at " +
+                    std::to_string(options_.baud) + " baud; less on a USB link), during which the display is at rest");
+    }
+    return out;
+  }
+  if (mode_ != PresentationMode::host_streams) return out;
+  // What the stream can carry: at rate R and speed v, spatial frequencies up to R / (2 v).
+  const double rate = player_->config().rate_hz;
+  const double limit = rate / (2.0 * swipe_mm_s);
+  std::size_t texels = 0, above = 0;
+  double highest = 0.0;
+  for (const auto& s : first.stimuli) {
+    const Surface surface = prepare_surface(parse_document(s.document_json, "stimulus"));
+    for (const auto& r : surface.regions())
+      if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get()))
+        for (const auto& texel : t->texels()) {
+          ++texels;
+          highest = std::max(highest, texel.frequency.value());
+          if (texel.frequency.value() > limit) ++above;
+        }
+  }
+  if (above > 0)
+    out.push_back("host-streams at " + detail::num(rate) + " Hz carries at most " + detail::fixed(limit, 2) + " cycles/mm at a " +
+                  detail::num(swipe_mm_s) + " mm/s swipe (" + detail::fixed(20.0 * std::log10(limit), 1) + " dB); " +
+                  detail::fixed(100.0 * static_cast<double>(above) / static_cast<double>(texels), 0) +
+                  " % of the first trial's texels lie above it (up to " + detail::fixed(highest, 2) +
+                  " cycles/mm): the display cannot render them this way; a display that stores maps plays them "
+                  "(display-plays)");
+  return out;
 }
 
 std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
@@ -314,11 +644,26 @@ std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
 }
 
 BackendStats Presenter::stats() { return backend_->stats(); }
-std::string Presenter::describe() const { return backend_->describe(); }
-double Presenter::block_period_s() const { return period_s_; }
+std::string Presenter::describe() const {
+  if (mode_ == PresentationMode::display_plays) {
+    const DisplayInfo& i = display1d_->info;
+    return "serial " + display1d_->link->name() + " → '" + i.name + "' (protocol " + std::to_string(i.version) + ", " +
+           detail::num(i.refresh_hz) +
+           " Hz refresh), display-plays: the display plays each stimulus from its own "
+           "finger sensor (" +
+           std::to_string(i.slots) + " slots)";
+  }
+  return backend_->describe() + ", " + std::string(to_string(mode_));
+}
+double Presenter::block_period_s() const { return mode_ == PresentationMode::display_plays ? 0.0 : period_s_; }
 std::string Presenter::error() const {
   std::string e = backend_->error();
   if (e.empty() && display_) e = display_->error();
+  if (e.empty() && display1d_) {
+    std::lock_guard<std::mutex> lock(display1d_->mutex);
+    e = display1d_->error;
+    if (e.empty() && display1d_->reader) e = display1d_->reader->error();
+  }
   return e;
 }
 

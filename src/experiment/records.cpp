@@ -144,6 +144,8 @@ const std::vector<Field>& fields() {
       TEXEL_NUMBER(over_time_limit),
       TEXEL_NUMBER(interrupted),
       TEXEL_NUMBER(suspended_ms),
+      TEXEL_STRING(presentation_mode),
+      TEXEL_STRING(finger_source),
       TEXEL_STRING(swipe_flag),
   };
   return f;

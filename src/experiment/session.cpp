@@ -38,6 +38,28 @@ json region(const std::string& name, double start_mm, std::optional<double> leng
 std::mutex position_mutex;
 std::map<std::pair<std::string, std::string>, MatchResult> position_cache;
 
+// The swipe columns from the finger that explored (finger_trace.hpp): a
+// display's or a pointer's trace replaces whatever the response carried; a
+// simulated finger (passive presentation) fills them only where nothing
+// else did, so a simulated observer's drawn swipe behaviour is kept. A
+// flagged trace leaves them empty and says why.
+void fill_swipe_columns(const FingerTrace& trace, TrialRow& row) {
+  if (trace.mode) row.presentation_mode = std::string(to_string(*trace.mode));
+  if (trace.source == TraceSource::none) return;
+  row.finger_source = std::string(to_string(trace.source));
+  const bool real = trace.source != TraceSource::simulated;
+  if (!real && std::isfinite(row.swipe_mean_speed_mm_s)) return;
+  const TraceMeasures m = measure_trace(trace);
+  row.swipe_flag = m.flag;
+  if (!m.measures) {
+    row.swipe_mean_speed_mm_s = row.swipe_sd_speed_mm_s = row.directional_proportion = missing;
+    return;
+  }
+  row.swipe_mean_speed_mm_s = m.measures->mean_speed_mm_s;
+  row.swipe_sd_speed_mm_s = m.measures->sd_speed_mm_s;
+  row.directional_proportion = m.measures->directional_proportion;
+}
+
 }  // namespace
 
 // ------------------------------------------------------------ task support
@@ -488,6 +510,7 @@ struct Session::Impl : SessionCore {
     if (r.swipe_sd_speed_mm_s) row.swipe_sd_speed_mm_s = *r.swipe_sd_speed_mm_s;
     if (r.directional_proportion) row.directional_proportion = *r.directional_proportion;
     row.swipe_flag = r.swipe_flag;
+    fill_swipe_columns(r.trace, row);
     fill_stroke_columns(r.strokes, q.stimuli.size(), row);
     require(!(std::isfinite(r.rt_ms) && r.rt_ms < 0), "rt_ms is " + texel::detail::num(r.rt_ms) + "; allowed: >= 0 ms");
     if (!q.choices.empty()) {
@@ -513,6 +536,7 @@ struct Session::Impl : SessionCore {
     st.response_json = response_view(r).dump();
     st.state_json = state;
     st.events = r.events;
+    st.trace = r.trace;
     st.row = std::move(row);
 
     // Advance.

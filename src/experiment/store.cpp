@@ -54,7 +54,7 @@ constexpr std::int64_t texel_application_id = 0x54584558;
 // version v to v + 1, in one transaction that also sets user_version. A
 // released entry is never edited; a change to the schema appends one.
 // Version 0 is an empty file.
-const std::array<const char*, 1> migrations = {
+const std::array<const char*, 2> migrations = {
     // 0 → 1: the first schema.
     R"sql(
 CREATE TABLE participants (
@@ -102,6 +102,21 @@ CREATE TABLE writers (
   process_start INTEGER NOT NULL,
   host          TEXT NOT NULL,
   acquired_at   TEXT NOT NULL
+);
+)sql",
+    // 1 → 2: the finger that explored each trial (finger_trace.hpp): its
+    // source, the presentation mode and the samples ("t_s,x_mm,touch" lines
+    // on the source's own clock). Trials stored before have no row here.
+    R"sql(
+CREATE TABLE finger_traces (
+  session_id INTEGER NOT NULL,
+  trial      INTEGER NOT NULL,
+  source     TEXT NOT NULL CHECK (source IN ('display', 'pointer', 'simulated')),
+  mode       TEXT NOT NULL CHECK (mode IN ('', 'display-plays', 'host-streams', 'passive')),
+  samples    INTEGER NOT NULL CHECK (samples >= 0),
+  trace      TEXT NOT NULL,
+  PRIMARY KEY (session_id, trial),
+  FOREIGN KEY (session_id, trial) REFERENCES trials(session_id, trial)
 );
 )sql",
 };
@@ -668,6 +683,15 @@ void Store::append_trial(const WriterLock& lock, const StoredTrial& t) {
     ev.run();
     ev.reset();
   }
+  if (t.trace.source != TraceSource::none)
+    Stmt(*impl_, "INSERT INTO finger_traces(session_id, trial, source, mode, samples, trace) VALUES (?, ?, ?, ?, ?, ?)", op)
+        .bind(1, sid)
+        .bind(2, t.trial)
+        .bind(3, std::string(to_string(t.trace.source)))
+        .bind(4, t.trace.mode ? std::string(to_string(*t.trace.mode)) : std::string())
+        .bind(5, static_cast<std::int64_t>(t.trace.samples.size()))
+        .bind(6, trace_samples_text(t.trace.samples))
+        .run();
   Stmt(*impl_, "UPDATE sessions SET updated_at = ? WHERE id = ?", op).bind(1, now).bind(2, sid).run();
   tx.commit();                                 // synchronous=FULL: the WAL is fsynced before COMMIT returns
   if (impl_->station) impl_->station->poke();  // shipped in the background
@@ -720,6 +744,17 @@ std::vector<StoredTrial> Store::trials(std::int64_t session_id) const {
       throw FormatError(impl_->path + ": session " + std::to_string(session_id) + " has events for a missing trial " +
                         std::to_string(trial));
     out[trial].events.push_back(TrialEvent{ev.dbl(1), ev.text(2), ev.text(3), ev.text(4)});
+  }
+  Stmt tr(*impl_, "SELECT trial, source, mode, trace FROM finger_traces WHERE session_id = ? ORDER BY trial", op);
+  tr.bind(1, session_id);
+  while (tr.step()) {
+    const auto trial = static_cast<std::size_t>(tr.i64(0));
+    const std::string where = impl_->path + ": session " + std::to_string(session_id) + " trial " + std::to_string(trial);
+    if (trial >= out.size()) throw FormatError(where + ": a finger trace for a missing trial");
+    FingerTrace& f = out[trial].trace;
+    f.source = parse_trace_source(tr.text(1));
+    if (!tr.text(2).empty()) f.mode = parse_presentation_mode(tr.text(2));
+    f.samples = parse_trace_samples(tr.text(3), where);
   }
   return out;
 }

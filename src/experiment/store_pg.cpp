@@ -278,7 +278,7 @@ std::string station_rows(PGconn* c, const std::string& label) {
 // Server migrations, numbered like the SQLite ones: migrations[v] takes the
 // texel schema from version v to v + 1 in the owner's transaction. A
 // released entry is never edited. Version 0 is no texel schema.
-const std::array<const char*, 1> server_migrations = {
+const std::array<const char*, 2> server_migrations = {
     R"sql(
 CREATE SCHEMA texel;
 CREATE TABLE texel.meta (key text PRIMARY KEY, value text NOT NULL);
@@ -421,6 +421,26 @@ CREATE POLICY analyst_read ON texel.events FOR SELECT TO texel_analyst USING (tr
 CREATE POLICY analyst_read ON texel.completions FOR SELECT TO texel_analyst USING (true);
 CREATE POLICY analyst_read ON texel.station_progress FOR SELECT TO texel_analyst USING (true);
 )sql",
+    // 1 → 2: the finger that explored each trial (the journal's
+    // finger_traces, schema version 2), with the same rights as events.
+    R"sql(
+CREATE TABLE texel.finger_traces (
+  station      text NOT NULL,
+  session_uuid uuid NOT NULL,
+  trial        integer NOT NULL,
+  source       text NOT NULL CHECK (source IN ('display', 'pointer', 'simulated')),
+  mode         text NOT NULL CHECK (mode IN ('', 'display-plays', 'host-streams', 'passive')),
+  samples      integer NOT NULL CHECK (samples >= 0),
+  trace        text NOT NULL,
+  PRIMARY KEY (station, session_uuid, trial),
+  FOREIGN KEY (station, session_uuid, trial) REFERENCES texel.trials(station, session_uuid, trial)
+);
+GRANT SELECT, INSERT ON texel.finger_traces TO texel_station;
+GRANT SELECT ON texel.finger_traces TO texel_analyst;
+ALTER TABLE texel.finger_traces ENABLE ROW LEVEL SECURITY;
+CREATE POLICY station_own ON texel.finger_traces TO texel_station USING (station = session_user) WITH CHECK (station = session_user);
+CREATE POLICY analyst_read ON texel.finger_traces FOR SELECT TO texel_analyst USING (true);
+)sql",
 };
 static_assert(server_migrations.size() == current_server_schema);
 
@@ -528,6 +548,19 @@ class ReaderImpl final : public Reader {
                           std::to_string(trial));
       out[trial].events.push_back(
           TrialEvent{std::strtod(e.text(i, 1).c_str(), nullptr), e.text(i, 2), e.text(i, 3), e.text(i, 4)});
+    }
+    Result f = query(
+        "SELECT f.trial, f.source, f.mode, f.trace FROM texel.finger_traces f JOIN texel.sessions s ON s.station = f.station "
+        "AND s.uuid = f.session_uuid WHERE s.id = $1 ORDER BY f.trial",
+        {std::to_string(id)}, op);
+    for (int i = 0; i < f.rows(); ++i) {
+      const auto trial = static_cast<std::size_t>(f.i64(i, 0));
+      const std::string where = t_.label + ": session " + std::to_string(id) + " trial " + std::to_string(trial);
+      if (trial >= out.size()) throw FormatError(where + ": a finger trace for a missing trial");
+      FingerTrace& ft = out[trial].trace;
+      ft.source = parse_trace_source(f.text(i, 1));
+      if (!f.text(i, 2).empty()) ft.mode = parse_presentation_mode(f.text(i, 2));
+      ft.samples = parse_trace_samples(f.text(i, 3), where);
     }
     return out;
   }
@@ -973,6 +1006,16 @@ class StationImpl final : public Station {
           {sid, std::to_string(shipped), std::to_string(upto)});
       Result ev = insert_rows("INSERT INTO texel.events(station, session_uuid, trial, seq, t_s, kind, detail, at)", uuid, events);
       if (!ev.ok()) return failed(ev, "shipping the events of session " + sid), false;
+      // Finger traces one statement each: a trace may hold a minute of 1 kHz samples.
+      const auto traced = journal_.query("SELECT trial FROM finger_traces WHERE session_id = ? AND trial >= ? AND trial < ?",
+                                         {sid, std::to_string(shipped), std::to_string(upto)});
+      for (const auto& tr : traced) {
+        const auto trace = journal_.query(
+            "SELECT trial, source, mode, samples, trace FROM finger_traces WHERE session_id = ? AND trial = ?", {sid, tr[0]});
+        Result ft = insert_rows("INSERT INTO texel.finger_traces(station, session_uuid, trial, source, mode, samples, trace)",
+                                uuid, trace);
+        if (!ft.ok()) return failed(ft, "shipping the finger traces of session " + sid), false;
+      }
       const bool complete = upto == total && s[7] == "finished";
       if (complete) {
         Result c = run(pg_,

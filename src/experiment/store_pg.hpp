@@ -15,7 +15,7 @@
 namespace texel::experiment::pg {
 
 /// The server's schema version this build writes and reads.
-constexpr int current_server_schema = 1;
+constexpr int current_server_schema = 2;
 
 /// Reads the server through a role's rights (status, export, analyze).
 class Reader {

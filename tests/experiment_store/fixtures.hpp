@@ -66,11 +66,20 @@ inline experiment::StoredTrial full_trial(int i) {
   r.swipe_mean_speed_mm_s = 101.5;
   r.swipe_sd_speed_mm_s = 20.25;
   r.directional_proportion = 0.875;
+  r.presentation_mode = "display-plays";
+  r.finger_source = "display";
+  r.swipe_flag = i == 1 ? "implausible_speed" : "";
   r.shown_at = "2026-11-23T10:00:00.000Z";
   r.answered_at = "2026-11-23T10:00:01.234Z";
   t.events = {{0.0, "show", "stimulus 1", "2026-11-23T10:00:00.000Z"},
               {0.5, "select", "stimulus 2, \"B\"", "2026-11-23T10:00:00.500Z"},
               {1.2345, "answer", "", ""}};
+  // Odd trials have no finger trace; even ones one from a display (µs and nm resolution).
+  if (i % 2 == 0) {
+    t.trace.source = experiment::TraceSource::display;
+    t.trace.mode = experiment::PresentationMode::display_plays;
+    t.trace.samples = {{0.0, 10.0, true}, {0.001, 10.1, true}, {4294.967296, -0.000001, false}, {4294.968, 12.345678, true}};
+  }
   return t;
 }
 
@@ -124,6 +133,9 @@ inline experiment::StoredTrial full_trial(int i) {
     EXPECT_PRED2(same_, ra_.swipe_mean_speed_mm_s, rb_.swipe_mean_speed_mm_s);                        \
     EXPECT_PRED2(same_, ra_.swipe_sd_speed_mm_s, rb_.swipe_sd_speed_mm_s);                            \
     EXPECT_PRED2(same_, ra_.directional_proportion, rb_.directional_proportion);                      \
+    EXPECT_EQ(ra_.presentation_mode, rb_.presentation_mode);                                          \
+    EXPECT_EQ(ra_.finger_source, rb_.finger_source);                                                  \
+    EXPECT_EQ(ra_.swipe_flag, rb_.swipe_flag);                                                        \
     EXPECT_EQ(ra_.shown_at, rb_.shown_at);                                                            \
     EXPECT_EQ(ra_.answered_at, rb_.answered_at);                                                      \
   } while (0)

@@ -41,11 +41,11 @@ TEST(Store, CreatesVersionedWalSchema) {
     EXPECT_TRUE(s.participants().empty());
   }
   RawDb raw(path);
-  EXPECT_EQ(raw.one("PRAGMA user_version"), "1");
+  EXPECT_EQ(raw.one("PRAGMA user_version"), "2");
   EXPECT_EQ(raw.one("PRAGMA application_id"), std::to_string(0x54584558));
   EXPECT_EQ(raw.one("PRAGMA journal_mode"), "wal");
   EXPECT_EQ(raw.one("SELECT group_concat(name, ',') FROM (SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name)"),
-            "events,participants,sessions,trials,writers");
+            "events,finger_traces,participants,sessions,trials,writers");
 }
 
 TEST(Store, MigratesAnEmptyFileFromVersionZero) {
@@ -56,7 +56,7 @@ TEST(Store, MigratesAnEmptyFileFromVersionZero) {
   { RawDb(bare).exec("PRAGMA page_size = 4096; VACUUM"); }
   for (const auto& path : {empty, bare}) {
     auto s = ex::Store::open(path, ex::StoreMode::read_write);
-    EXPECT_EQ(s.schema_version(), 1) << path;
+    EXPECT_EQ(s.schema_version(), 2) << path;
     EXPECT_GT(new_session(s), 0);
   }
   // read_only never migrates: an empty file has nothing to read.
@@ -67,7 +67,7 @@ TEST(Store, MigratesAnEmptyFileFromVersionZero) {
   EXPECT_EQ(file_bytes(empty2), "");
 }
 
-TEST(Store, VersionOneReopensUnchanged) {
+TEST(Store, CurrentVersionReopensUnchanged) {
   TempDir dir("store");
   const auto path = dir.at("exp.db");
   {
@@ -81,15 +81,75 @@ TEST(Store, VersionOneReopensUnchanged) {
   ASSERT_FALSE(std::filesystem::exists(path + "-wal"));  // checkpointed on close
   {
     auto s = ex::Store::open(path, ex::StoreMode::read_write);
-    EXPECT_EQ(s.schema_version(), 1);
+    EXPECT_EQ(s.schema_version(), 2);
     ASSERT_EQ(s.trials(1).size(), 1u);
   }
   {
     const auto s = ex::Store::open(path, ex::StoreMode::read_only);
-    EXPECT_EQ(s.schema_version(), 1);
+    EXPECT_EQ(s.schema_version(), 2);
     EXPECT_EQ(s.sessions().size(), 1u);
   }
   EXPECT_EQ(file_bytes(path), before);
+}
+
+// Version 1 → 2 (finger_traces): a version-1 file with a stored trial is
+// migrated on opening for writing, in one transaction; its trial reads back
+// unchanged (no trace), a read-only opening refuses it untouched, and new
+// trials then store their traces.
+TEST(Store, MigratesVersionOneAddingFingerTraces) {
+  TempDir dir("store");
+  const auto path = dir.at("v1.db");
+  {
+    auto s = ex::Store::open(path, ex::StoreMode::read_write);
+    const auto id = new_session(s);
+    auto lock = s.acquire_writer(id);
+    auto t = full_trial(0);
+    t.trace = {};
+    s.append_trial(lock, t);
+  }
+  // The version-1 layout: migration 0 → 1 is what created every other table.
+  RawDb(path).exec("DROP TABLE finger_traces; PRAGMA user_version = 1");
+  const auto v1_bytes = file_bytes(path);
+  {
+    const auto msg = message_of<texel::FormatError>([&] { (void)ex::Store::open(path, ex::StoreMode::read_only); });
+    EXPECT_NE(msg.find("older schema version 1"), std::string::npos) << msg;
+  }
+  EXPECT_EQ(file_bytes(path), v1_bytes);
+  {
+    auto s = ex::Store::open(path, ex::StoreMode::read_write);
+    EXPECT_EQ(s.schema_version(), 2);
+    const auto trials = s.trials(1);
+    ASSERT_EQ(trials.size(), 1u);
+    EXPECT_EQ(trials[0].question_json, full_trial(0).question_json);
+    EXPECT_EQ(trials[0].trace.source, ex::TraceSource::none);
+    EXPECT_TRUE(trials[0].trace.samples.empty());
+    auto lock = s.acquire_writer(1);
+    s.append_trial(lock, full_trial(1));
+    s.append_trial(lock, full_trial(2));
+  }
+  RawDb raw(path);
+  EXPECT_EQ(raw.one("PRAGMA user_version"), "2");
+  EXPECT_EQ(raw.one("SELECT COUNT(*) FROM finger_traces"), "1");  // trial 2's; trial 1 has none
+  const auto s = ex::Store::open(path, ex::StoreMode::read_only);
+  EXPECT_EQ(s.trials(1)[2].trace.samples.size(), full_trial(2).trace.samples.size());
+}
+
+// A trace the store is asked to keep that the schema refuses (a mode that
+// is none of the three) stores nothing of the trial.
+TEST(Store, TraceRowIsPartOfTheTrialsTransaction) {
+  TempDir dir("store");
+  const auto path = dir.at("exp.db");
+  auto s = ex::Store::open(path, ex::StoreMode::read_write);
+  const auto id = new_session(s);
+  auto lock = s.acquire_writer(id);
+  s.append_trial(lock, full_trial(0));
+  RawDb(path).exec(
+      "DROP TABLE finger_traces; CREATE TABLE finger_traces (session_id INTEGER, trial INTEGER CHECK (trial < 1), "
+      "source TEXT, mode TEXT, samples INTEGER, trace TEXT)");
+  auto t1 = full_trial(1);
+  t1.trace = full_trial(0).trace;
+  EXPECT_THROW(s.append_trial(lock, t1), texel::Error);  // trial 1's trace row is refused, so trial 1 is not stored
+  EXPECT_EQ(s.trials(id).size(), 1u);
 }
 
 TEST(Store, RefusesFutureVersionAndForeignFiles) {
@@ -97,12 +157,12 @@ TEST(Store, RefusesFutureVersionAndForeignFiles) {
   const auto future = dir.at("future.db");
   {
     { auto s = ex::Store::open(future, ex::StoreMode::read_write); }
-    RawDb(future).exec("PRAGMA user_version = 2");
+    RawDb(future).exec("PRAGMA user_version = 3");
   }
   const auto future_bytes = file_bytes(future);
   for (auto mode : {ex::StoreMode::read_write, ex::StoreMode::read_only}) {
     const auto msg = message_of<texel::FormatError>([&] { (void)ex::Store::open(future, mode); });
-    EXPECT_NE(msg.find("schema version 2, newer than this build's 1"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("schema version 3, newer than this build's 2"), std::string::npos) << msg;
     EXPECT_NE(msg.find(future), std::string::npos) << msg;
   }
   EXPECT_EQ(file_bytes(future), future_bytes);
@@ -339,6 +399,15 @@ TEST(Store, TrialsRoundTripWithEventsAndEveryRowField) {
     auto want_row = want.row;
     want_row.session_id = 2;
     TEXEL_EXPECT_ROW_EQ(got.row, want_row);
+    // The finger trace, sample for sample (µs and nm resolution).
+    EXPECT_EQ(got.trace.source, want.trace.source);
+    EXPECT_EQ(got.trace.mode, want.trace.mode);
+    ASSERT_EQ(got.trace.samples.size(), want.trace.samples.size());
+    for (std::size_t k = 0; k < want.trace.samples.size(); ++k) {
+      EXPECT_NEAR(got.trace.samples[k].t_s, want.trace.samples[k].t_s, 5e-7);
+      EXPECT_NEAR(got.trace.samples[k].x_mm, want.trace.samples[k].x_mm, 5e-7);
+      EXPECT_EQ(got.trace.samples[k].touch, want.trace.samples[k].touch);
+    }
     ASSERT_EQ(got.events.size(), want.events.size());
     for (std::size_t e = 0; e < want.events.size(); ++e) {
       EXPECT_EQ(got.events[e].t_s, want.events[e].t_s);

@@ -118,11 +118,11 @@ class PgStore : public ::testing::Test {
 TEST_F(PgStore, InitMigratesOnceAndCreatesTheRoles) {
   const auto again = ex::init_postgres(admin_uri(), {"st1"}, {});
   ASSERT_FALSE(again.empty());
-  EXPECT_EQ(again[0], "schema texel is at version 1");
+  EXPECT_EQ(again[0], "schema texel is at version 2");
   EXPECT_EQ(again[1], "role st1 is a member of texel_station");
   std::string v;
   EXPECT_EQ(as("an1", "SELECT value FROM texel.meta WHERE key = 'schema_version'", &v), "");
-  EXPECT_EQ(v, "1");
+  EXPECT_EQ(v, "2");
   EXPECT_THROW((void)ex::init_postgres(admin_uri(), {"Bad Name"}, {}), texel::InvalidArgument);
 }
 
@@ -157,6 +157,11 @@ TEST_F(PgStore, StationShipsItsJournalAndTheAnalystReadsTheSame) {
       EXPECT_EQ(a[i].events[e].kind, b[i].events[e].kind);
       EXPECT_EQ(a[i].events[e].t_s, b[i].events[e].t_s);
     }
+    // The finger traces (even trials have one) arrive sample for sample.
+    EXPECT_EQ(a[i].trace.source, b[i].trace.source);
+    EXPECT_EQ(a[i].trace.mode, b[i].trace.mode);
+    EXPECT_EQ(ex::trace_samples_text(a[i].trace.samples), ex::trace_samples_text(b[i].trace.samples));
+    EXPECT_EQ(b[i].trace.samples.size(), i % 2 == 0 ? full_trial(0).trace.samples.size() : 0u);
   }
   const auto ra = journal.rows(), rb = server.rows();
   ASSERT_EQ(ra.size(), rb.size());
@@ -192,6 +197,28 @@ TEST_F(PgStore, RepeatedShippingStoresNothingTwice) {
   EXPECT_EQ(n, "1");
   EXPECT_EQ(as("an1", "SELECT count(*) FROM texel.sessions", &n), "");
   EXPECT_EQ(n, "1");
+  EXPECT_EQ(as("an1", "SELECT count(*) FROM texel.finger_traces", &n), "");
+  EXPECT_EQ(n, "3");  // trials 0, 2 and 4
+}
+
+// Server version 1 → 2 (texel.finger_traces): store init migrates a server
+// of the previous version, its trials kept, and the analyst reads the new table.
+TEST_F(PgStore, InitMigratesAVersionOneServerAddingFingerTraces) {
+  {
+    auto s = station("st1", "st1.db");
+    (void)run_session(s, "S01", 1, false);
+    ASSERT_TRUE(s.sync(20));
+  }
+  admin_sql(db_, "DROP TABLE texel.finger_traces; UPDATE texel.meta SET value = '1' WHERE key = 'schema_version'");
+  EXPECT_THROW((void)ex::Store::open(uri("an1"), ex::StoreMode::read_only), texel::FormatError);
+  const auto report = ex::init_postgres(admin_uri(), {}, {});
+  ASSERT_FALSE(report.empty());
+  EXPECT_EQ(report[0], "schema texel migrated from version 1 to 2");
+  std::string n;
+  EXPECT_EQ(as("an1", "SELECT count(*) FROM texel.trials", &n), "");
+  EXPECT_EQ(n, "1");
+  EXPECT_EQ(as("an1", "SELECT count(*) FROM texel.finger_traces", &n), "");
+  EXPECT_EQ(n, "0");  // the trace shipped before went with the dropped table
 }
 
 TEST_F(PgStore, SecondStationIsRefusedTheSameParticipantUntilTheFirstLetsGo) {
@@ -320,11 +347,11 @@ TEST_F(PgStore, BadInputIsOneLineAndLosesNothing) {
   });
   EXPECT_NE(m.find("no texel schema"), std::string::npos) << m;
   admin_sql("postgres", "DROP DATABASE " + db_ + "_empty WITH (FORCE)");
-  admin_sql(db_, "UPDATE texel.meta SET value = '2' WHERE key = 'schema_version'");
+  admin_sql(db_, "UPDATE texel.meta SET value = '3' WHERE key = 'schema_version'");
   m = message_of<texel::FormatError>([&] { (void)ex::Store::open(uri("an1"), ex::StoreMode::read_only); });
-  EXPECT_NE(m.find("has schema version 2, newer than this build's 1; use a newer texel"), std::string::npos) << m;
+  EXPECT_NE(m.find("has schema version 3, newer than this build's 2; use a newer texel"), std::string::npos) << m;
   EXPECT_THROW((void)station("st1", "st1.db"), texel::FormatError);
-  admin_sql(db_, "UPDATE texel.meta SET value = '1' WHERE key = 'schema_version'");
+  admin_sql(db_, "UPDATE texel.meta SET value = '2' WHERE key = 'schema_version'");
   // Server down at start: the station runs on its journal and says so; a reader cannot.
   const std::string down = "postgresql://st1@127.0.0.1:1/" + db_;
   m = message_of<texel::IoError>([&] { (void)ex::Store::open(down, ex::StoreMode::read_only); });

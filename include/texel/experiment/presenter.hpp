@@ -38,6 +38,34 @@
 // (StrokeRules). A display without a finger sensor is refused at
 // construction (InvalidArgument, one line).
 //
+// Presentation modes (finger_trace.hpp), chosen per display from its HELLO
+// and whether it senses the finger (PresenterOptions::mode, [choice] the
+// display's own):
+//   display-plays  a serial display with map slots and a finger sensor:
+//                  prepare() uploads the trial's stimuli (texel render's
+//                  exact u16 samples: Surface::render_native) into its slots
+//                  before onset, show() SELECTs one, blank() SELECTs none. The
+//                  display plays from its own sensed position at its own
+//                  rate; the host only reads its FINGER reports (pump()). With
+//                  fewer slots than stimuli a switch to a stimulus not held
+//                  uploads it over the one least recently felt
+//                  (upload_counts() says how often and how long).
+//   host-streams   a serial display with a sensor but no slots (or asked so),
+//                  or a pointer pushed from outside (FingerSource::external):
+//                  the player computes the drive from the reported finger and
+//                  streams it at 1 kHz (serial) or the sound card's rate;
+//                  check() says what that rate cannot carry.
+//   passive        no finger (audio actuators, null, a display without a
+//                  sensor): the simulated sweep above.
+// A display that cannot do the mode asked is refused at construction
+// (InvalidArgument, one line). Every trial's finger trace is kept from
+// prepare() to take_trace() (display reports on the display's clock, or the
+// simulated finger), for the swipe measures.
+//
+// At rest on every exit: stop() (and the destructor, so an exception
+// unwinding past the presenter) SELECTs none on a serial display after the
+// stream has stopped, so the plate is never left driven.
+//
 // Trade-off: one control thread, no callback into the engine; the real-time
 // side is the player's (no allocation, locks or I/O).
 #pragma once
@@ -51,6 +79,7 @@
 #include <utility>
 #include <vector>
 
+#include "texel/experiment/finger_trace.hpp"
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/strokes.hpp"
 #include "texel/sinks.hpp"
@@ -83,6 +112,10 @@ struct PresenterOptions {
   int baud = 921600;
   /// FingerSource::display: what a stroke must be (strokes.hpp).
   StrokeRules stroke_rules;
+  /// How stimuli reach the finger (see the banner). [choice] nullopt: the
+  /// display's own — display-plays with slots and a sensor, host-streams with
+  /// a sensor only or an external finger, passive without a finger.
+  std::optional<PresentationMode> mode;
 };
 
 class Presenter {
@@ -101,10 +134,31 @@ class Presenter {
   /// is shown or blank()), else its document. A 2-D display refuses a
   /// question without surfaces (InvalidArgument).
   void show(const Question& question, std::size_t i);
-  /// Renders the question's 2-D maps ahead, so switching costs a copy (no-op
-  /// without a 2-D display). Clears the strokes recorded so far. Waits for
-  /// a bitmap the preload is rendering rather than rendering it again.
+  /// Gets the question ready before its onset: a 2-D display's maps are
+  /// rendered (switching then costs a copy; waits for a bitmap the preload
+  /// is rendering rather than rendering it again) and its strokes cleared;
+  /// display-plays uploads the stimuli into the display's slots (as many as
+  /// it holds). Starts the trial's finger trace (take_trace()).
   void prepare(const Question& question);
+  /// The finger trace since prepare() (empty on a 2-D display, whose strokes
+  /// are strokes()); recording stops until the next prepare().
+  FingerTrace take_trace();
+  /// The mode in force.
+  [[nodiscard]] PresentationMode mode() const { return mode_; }
+  /// What the presentation cannot do for `first` (the session's first
+  /// question), as lines for the experimenter, before the first trial:
+  /// host-streams at a rate that cannot carry the stimuli's finest texels at
+  /// a 100 mm/s swipe (with the figures), display-plays with fewer slots than
+  /// stimuli (what a switch costs). Throws InvalidArgument when a stimulus's
+  /// map is larger than the display holds.
+  [[nodiscard]] std::vector<std::string> check(const Question& first) const;
+  /// display-plays: maps uploaded, how many of them at a switch (the
+  /// participant waited), and the time spent uploading (s).
+  struct UploadCounts {
+    int uploads = 0, at_switch = 0;
+    double seconds = 0.0;
+  };
+  [[nodiscard]] UploadCounts upload_counts() const;
   /// Starts rendering, on a background thread at a lower priority, every
   /// friction bitmap a session of `protocol` with `context` will show (the
   /// questions the session asks, in order, up to the presenter's cache of
@@ -140,7 +194,8 @@ class Presenter {
   /// Returns the sample as queued, or nothing if the player's queue is full
   /// (or the presenter simulates its finger). Control thread only.
   std::optional<FingerSample> push_finger(double x_mm, bool touching);
-  /// Stops the backend; statistics stay readable. Safe to call twice.
+  /// Stops the backend and puts a serial display at rest (SELECT none);
+  /// statistics stay readable. Safe to call twice; never throws.
   void stop();
 
   [[nodiscard]] BackendStats stats();
@@ -160,6 +215,12 @@ class Presenter {
  private:
   struct Display2D;
   std::unique_ptr<Display2D> display_;  // FingerSource::display only
+  struct Display1D;
+  std::unique_ptr<Display1D> display1d_;  // a 1-D serial display in display-plays or host-streams
+  PresentationMode mode_ = PresentationMode::passive;
+  // The simulated finger's trace (passive), recorded between prepare() and take_trace().
+  bool recording_ = false;
+  std::vector<FingerSample> simulated_trace_;
   static constexpr std::size_t cache_size = 8;
   std::list<std::pair<std::string, std::unique_ptr<const PlayerMap>>> cache_;  // most recent first
   PresenterOptions options_;
@@ -170,6 +231,7 @@ class Presenter {
   double period_s_ = 0.0;
   std::size_t shown_ = 0;
   bool running_ = false;
+  void choose_mode(const BackendChoice& choice);
 };
 
 }  // namespace texel::experiment

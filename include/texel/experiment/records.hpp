@@ -79,6 +79,10 @@ struct TrialRow {
   double swipe_mean_speed_mm_s = missing;
   double swipe_sd_speed_mm_s = missing;
   double directional_proportion = missing;
+  // -- the finger behind the swipe columns (finger_trace.hpp); empty in rows stored before them
+  std::string presentation_mode;  ///< display-plays, host-streams or passive
+  std::string finger_source;      ///< display, pointer or simulated: where the trace came from
+  std::string swipe_flag;         ///< why the swipe columns are empty despite a trace: no_touch, implausible_speed, …
   // -- strokes on a 2-D display (the 2-D display presenter; strokes.hpp), missing otherwise
   double strokes = missing;               ///< strokes over the trial's intervals
   double stroke_deviation_deg = missing;  ///< largest deviation of an interval's mean direction from its instructed one
@@ -95,9 +99,6 @@ struct TrialRow {
   double interrupted = missing;      ///< 1 when the trial spanned a suspend, a stop/resume, a restart or a reload-restart
   double suspended_ms = missing;     ///< time the session was suspended during the trial (not in rt_ms)
 
-  /// Why the swipe columns are empty although the finger touched ("too_short: …",
-  /// "implausible_speed: …"; experiment/swipe_check.hpp); empty otherwise.
-  std::string swipe_flag;
 };
 
 /// The current time, UTC, ISO 8601 with milliseconds ("2026-11-23T14:02:08.123Z"):

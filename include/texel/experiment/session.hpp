@@ -159,6 +159,12 @@ struct Response {
   /// A 2-D display's strokes, one entry per interval felt (strokes.hpp); fills
   /// the row's stroke columns.
   std::vector<IntervalStrokes> strokes;
+  /// The finger that explored the trial (a display's reports, the studio's
+  /// pointer, or the simulated finger), stored with the trial. A display's
+  /// or pointer's trace fills the swipe columns (its measures replace the
+  /// three fields above); a simulated one only where they are unset.
+  /// Not part of to_json() (the store keeps it in a table of its own).
+  FingerTrace trace;
   std::string shown_at, answered_at;  ///< ISO 8601 UTC
 
   [[nodiscard]] std::string to_json() const;  ///< JSON text (stored with every trial)

@@ -33,6 +33,7 @@
 #include <string_view>
 #include <vector>
 
+#include "texel/experiment/finger_trace.hpp"
 #include "texel/experiment/records.hpp"
 
 namespace texel::experiment {
@@ -51,6 +52,9 @@ struct StoredTrial {
   std::string state_json;     ///< adaptive procedure state after the answer
   TrialRow row;               ///< the long-format row
   std::vector<TrialEvent> events;
+  /// The finger that explored the trial (finger_trace.hpp); empty when none
+  /// was recorded. Stored in its own table (schema version 2).
+  FingerTrace trace;
 };
 
 struct SessionInfo {
@@ -141,7 +145,7 @@ class WriterLock {
 
 class Store {
  public:
-  static constexpr int current_schema_version = 1;
+  static constexpr int current_schema_version = 2;
 
   /// read_write creates the file if missing (and migrates older schemas);
   /// read_only never creates or writes. Throws IoError (missing, unreadable,
