@@ -242,15 +242,15 @@ TEST(HostThreads, AReportReadersKeepalivesHoldTheHostWatchdogAndItsSilenceRestsT
     link.hello();
     link.upload_raw(0, std::vector<std::uint16_t>(1000, 20000), 100000, 0);
     link.select(0);
-    ASSERT_TRUE(link.arm_host_watchdog(100));
+    ASSERT_TRUE(link.arm_host_watchdog(300));  // roomy: a loaded CI host may stall for 100 ms
     link.start_reports(1000);
     ReportReader reader(
         link, [](std::span<const FingerReport>) {}, 25);
-    std::this_thread::sleep_for(400ms);  // 4 timeouts: the keepalives hold it
+    std::this_thread::sleep_for(700ms);  // over 2 timeouts: the keepalives hold it
     EXPECT_EQ(rig.hal->amplitude.load(), 20000);
     reader.stop();
   }
-  EXPECT_TRUE(wait_for([&] { return rig.hal->amplitude.load() == 0; }, 1000ms));
+  EXPECT_TRUE(wait_for([&] { return rig.hal->amplitude.load() == 0; }, 2000ms));
   rig.halt();
   EXPECT_EQ(rig.ctl->status().selected, ser::no_map);
   EXPECT_EQ(rig.ctl->status().host_timeouts, 1u);
