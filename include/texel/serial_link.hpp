@@ -213,6 +213,17 @@ class SerialLink {
   /// would overwrite the DRIVE 0: stop it instead (its stop() rests the
   /// display).
   bool rest() noexcept;
+  /// Arms the display's host watchdog (HOST_WATCHDOG, revision 1.2): if no
+  /// frame from this host arrives for `silence_ms` (20 … 60,000; 0 disarms)
+  /// the display rests as on a lost link — for a display that plays its own
+  /// map, which no stream's watchdog covers. Feed it with keepalive() (a
+  /// ReportReader does, see its `keepalive_ms`). False: the display predates
+  /// 1.2 (NACK unknown_type); other refusals throw SerialError.
+  bool arm_host_watchdog(std::uint32_t silence_ms);
+  /// KEEPALIVE (streamed, no reply): feeds the host watchdog. Throws IoError
+  /// if the link is gone.
+  void keepalive();
+
   /// The destructor sends DRIVE 0 and SELECT none without waiting (a link
   /// destroyed while unwinding still leaves the display at rest); false
   /// leaves the display as it is (a test that hands the display on).
@@ -273,11 +284,15 @@ class SerialLink {
 /// handed to `on_reports` on that thread, until stop() or destruction. A link
 /// error ends the thread and is kept (error()). The handler places reports on
 /// its player's clock (ReportTimeline) and queues them; it may check
-/// stopping() while it waits for a lock its stopper may hold.
+/// stopping() while it waits for a lock its stopper may hold. With
+/// `keepalive_ms` > 0 it also sends KEEPALIVE that often, feeding a host
+/// watchdog armed with SerialLink::arm_host_watchdog (a timeout of about
+/// 4 × keepalive_ms leaves room for a late one): when this host dies, the
+/// display rests.
 class ReportReader {
  public:
   using Handler = std::function<void(std::span<const FingerReport>)>;
-  ReportReader(SerialLink& link, Handler on_reports);
+  ReportReader(SerialLink& link, Handler on_reports, int keepalive_ms = 0);
   ~ReportReader() { stop(); }
   ReportReader(const ReportReader&) = delete;
   ReportReader& operator=(const ReportReader&) = delete;

@@ -52,6 +52,9 @@ inline constexpr std::uint8_t status_flag_stale = 0x04;      ///< streamed value
 inline constexpr std::uint8_t no_map = 0xFF;
 /// FINGER payload: t_us u32, x_nm i32, y_nm i32, touch u8.
 inline constexpr std::size_t finger_payload = 13;
+/// The host watchdog's timeout range (ms), HOST_WATCHDOG (1.2).
+inline constexpr std::uint32_t min_host_timeout_ms = 20;
+inline constexpr std::uint32_t max_host_timeout_ms = 60000;
 /// The shortest interval between finger reports a display accepts (µs).
 inline constexpr std::uint32_t min_report_interval_us = 100;
 
@@ -65,6 +68,8 @@ enum class Type : std::uint8_t {
   drive = 0x07,           ///< [amplitude u16] — streamed, no reply
   status_request = 0x08,  ///< empty
   reports = 0x09,         ///< host → display: [interval_us u32] (0 = stop) — the display's finger reports (1.1)
+  host_watchdog = 0x0A,   ///< host → display: [timeout_ms u32] (0 = off): rest if the host goes silent (1.2)
+  keepalive = 0x0B,       ///< host → display: empty — streamed, no reply; keeps the host watchdog fed (1.2)
   ack = 0x7E,             ///< display → host: [type u8]
   nack = 0x7F,            ///< display → host: [type u8][error u8][detail u32]
   hello_reply = 0x81,     ///< [version u8][slots u8][max_samples u32][refresh_mhz u32][max_payload u16][name…]

@@ -305,6 +305,23 @@ DisplayStatus SerialLink::status() {
   return s;
 }
 
+bool SerialLink::arm_host_watchdog(std::uint32_t silence_ms) {
+  if (silence_ms != 0 && (silence_ms < serial::min_host_timeout_ms || silence_ms > serial::max_host_timeout_ms))
+    throw InvalidArgument("serial link " + name_ + ": host watchdog timeout is " + std::to_string(silence_ms) +
+                          " ms; allowed 0 (off) or 20 … 60000");
+  std::uint8_t p[4];
+  serial::put_u32(p, silence_ms);
+  try {
+    request(Type::host_watchdog, p, sizeof p, Type::ack, "HOST_WATCHDOG");
+  } catch (const SerialError& e) {
+    if (e.code == ErrorCode::unknown_type) return false;  // older than revision 1.2
+    throw;
+  }
+  return true;
+}
+
+void SerialLink::keepalive() { send(Type::keepalive, nullptr, 0); }
+
 void SerialLink::keep_report(const serial::Frame& f) {
   if (f.length != serial::finger_payload) return;  // malformed: not a report
   if (have_report_seq_ && f.seq != next_report_seq_)
@@ -377,13 +394,19 @@ std::size_t SerialLink::read_reports(std::span<FingerReport> out, int wait_ms) {
   return k;
 }
 
-ReportReader::ReportReader(SerialLink& link, Handler on_reports) : link_(link), on_reports_(std::move(on_reports)) {
-  thread_ = std::thread([this] {
+ReportReader::ReportReader(SerialLink& link, Handler on_reports, int keepalive_ms)
+    : link_(link), on_reports_(std::move(on_reports)) {
+  thread_ = std::thread([this, keepalive_ms] {
     std::array<FingerReport, 64> buf;
+    auto fed = std::chrono::steady_clock::now();
     try {
       while (!stop_) {
         const std::size_t n = link_.read_reports(buf, 5);
         if (n > 0) on_reports_(std::span<const FingerReport>(buf.data(), n));
+        if (keepalive_ms > 0 && std::chrono::steady_clock::now() - fed >= std::chrono::milliseconds(keepalive_ms)) {
+          link_.keepalive();
+          fed = std::chrono::steady_clock::now();
+        }
       }
     } catch (const std::exception& e) {
       std::lock_guard lock(error_mutex_);

@@ -228,6 +228,34 @@ TEST(HostThreads, RequestsGoThroughWhileAReportReaderReadsTheSameLink) {
   EXPECT_EQ(link.reports_lost(), 0u);
 }
 
+TEST(HostThreads, AReportReadersKeepalivesHoldTheHostWatchdogAndItsSilenceRestsTheDisplay) {
+  // A display playing its own map, finger always down: nothing but the host
+  // watchdog can rest it when the host dies without the link going down.
+  Rig rig(controller::Info{}, [](std::int32_t& x, bool& touch) {
+    x = 5000000;
+    touch = true;
+    return true;
+  });
+  {
+    SerialLink link(rig.path);
+    link.rest_on_close = false;  // the host dies without a word
+    link.hello();
+    link.upload_raw(0, std::vector<std::uint16_t>(1000, 20000), 100000, 0);
+    link.select(0);
+    ASSERT_TRUE(link.arm_host_watchdog(300));  // roomy: a loaded CI host may stall for 100 ms
+    link.start_reports(1000);
+    ReportReader reader(
+        link, [](std::span<const FingerReport>) {}, 25);
+    std::this_thread::sleep_for(700ms);  // over 2 timeouts: the keepalives hold it
+    EXPECT_EQ(rig.hal->amplitude.load(), 20000);
+    reader.stop();
+  }
+  EXPECT_TRUE(wait_for([&] { return rig.hal->amplitude.load() == 0; }, 2000ms));
+  rig.halt();
+  EXPECT_EQ(rig.ctl->status().selected, ser::no_map);
+  EXPECT_EQ(rig.ctl->status().host_timeouts, 1u);
+}
+
 // ------------------------------------------------------ the scripted finger
 
 TEST(StrokeScript, IsDeterministicStrokesBackAndForthAndLifts) {

@@ -318,3 +318,37 @@ TEST(DisplayRules, TheDeliberateFaultsMisbehaveAsNamed) {
     EXPECT_TRUE(gap);
   }
 }
+
+TEST(DisplayRules, AnArmedHostWatchdogRestsADisplayPlayingItsOwnMapWhenTheHostFallsSilent) {
+  FakeHal hal;
+  hal.has_sensor = true;
+  hal.sensor_x = 2000000;
+  hal.sensor_touch = true;
+  Ctl c(hal, controller::Info{});
+  upload(hal, 0, ramp(100));
+  hal.frame(ser::Type::select, {0});
+  hal.frame(ser::Type::host_watchdog, u32le(100));
+  run_for(c, hal, 200);
+  expect_acks(hal, 5);
+  for (int k = 0; k < 10; ++k) {  // fed every 80 ms: keeps playing
+    run_for(c, hal, 80000);
+    hal.frame(ser::Type::keepalive, {});
+  }
+  run_for(c, hal, 1000);
+  EXPECT_EQ(hal.amplitude, ramp(100)[20]);
+  EXPECT_EQ(c.status().host_timeouts, 0u);
+  run_for(c, hal, 99000);  // 100 ms of silence
+  EXPECT_EQ(hal.amplitude, ramp(100)[20]);
+  run_for(c, hal, 2000);  // past it: at rest, selection cleared, disarmed
+  EXPECT_EQ(hal.amplitude, 0);
+  EXPECT_EQ(c.status().selected, ser::no_map);
+  EXPECT_EQ(c.status().host_timeouts, 1u);
+  EXPECT_EQ(c.status().host_timeout_us, 0u);
+  // Out of range: refused with the shortest allowed.
+  hal.frame(ser::Type::host_watchdog, u32le(5));
+  run_for(c, hal, 100);
+  const Reply r = only_reply(hal);
+  ASSERT_EQ(r.type, ser::Type::nack);
+  EXPECT_EQ(r.payload[1], static_cast<std::uint8_t>(ser::ErrorCode::bad_value));
+  EXPECT_EQ(ser::get_u32(r.payload.data() + 2), 20u);
+}

@@ -21,7 +21,9 @@
 // output at rest, even on a display whose own sensor still senses the finger
 // — a host that dies (SIGKILL, a cut cable) cannot leave the plate driven.
 // A display playing its selected map from its own sensor needs no stream: it
-// outputs the map under the finger, and 0 while the finger is lifted.
+// outputs the map under the finger, and 0 while the finger is lifted; a host
+// that arms the host watchdog (HOST_WATCHDOG, 1.2) and then goes silent for
+// its timeout puts it at rest as a lost link does.
 #pragma once
 
 #include <cstddef>
@@ -106,6 +108,8 @@ struct Status {
   std::uint32_t ticks = 0;               ///< output updates
   std::uint32_t reports = 0;             ///< FINGER reports sent
   std::uint32_t report_interval_us = 0;  ///< 0: not reporting
+  std::uint32_t host_timeout_us = 0;     ///< the armed host watchdog (0: off)
+  std::uint32_t host_timeouts = 0;       ///< times the host went silent past it
   bool stale = false;                    ///< streamed values expired: the output is at rest
   /// The latest error (NACK sent or frame dropped) since the last STATUS
   /// reply, which reports and clears it.
@@ -209,6 +213,10 @@ class Controller {
     ++status_.link_errors;
     link_up_ = false;
     decoder_.reset();  // a half frame from before the break is worthless
+    rest_now();
+  }
+  void rest_now() {
+    status_.host_timeout_us = 0;  // disarmed: the next host arms it again
     upload_active_ = false;
     status_.selected = serial::no_map;
     status_.mode = Mode::idle;
@@ -222,6 +230,11 @@ class Controller {
   }
 
   void tick(std::uint32_t now) {
+    if (status_.host_timeout_us != 0 && static_cast<std::uint32_t>(now - last_host_us_) > status_.host_timeout_us) {
+      // The host that armed the watchdog went silent: as if the link were lost.
+      ++status_.host_timeouts;
+      rest_now();
+    }
     std::int32_t x = 0, y = 0;
     bool touch = false;
     // Only host frames refresh the watchdog: a sensor reading says where the
@@ -299,9 +312,10 @@ class Controller {
     using serial::ErrorCode;
     using serial::Type;
     ++status_.frames_ok;
+    last_host_us_ = hal_.micros();  // any valid frame feeds the host watchdog
     const std::uint8_t* p = f.payload;
     if (f.length > info_.max_payload) {
-      if (f.type == Type::position || f.type == Type::drive) return bad_stream(f);
+      if (f.type == Type::position || f.type == Type::drive || f.type == Type::keepalive) return bad_stream(f);
       return nack(f, ErrorCode::bad_length, info_.max_payload);
     }
     switch (f.type) {
@@ -399,6 +413,18 @@ class Controller {
         next_report_us_ = hal_.micros();
         return ack(f);
       }
+      case Type::host_watchdog: {
+        if (f.length != 4) return nack(f, ErrorCode::bad_length, 4);
+        const std::uint32_t ms = serial::get_u32(p);
+        if (ms != 0 && (ms < serial::min_host_timeout_ms || ms > serial::max_host_timeout_ms))
+          return nack(f, ErrorCode::bad_value, serial::min_host_timeout_ms);
+        status_.host_timeout_us = ms * 1000u;
+        return ack(f);
+      }
+      case Type::keepalive: {
+        if (f.length != 0) return bad_stream(f);
+        return;  // fed above
+      }
       case Type::status_request: {
         if (f.length != 0) return nack(f, ErrorCode::bad_length, 0);
         std::uint8_t r[serial::status_payload];
@@ -449,6 +475,7 @@ class Controller {
   std::uint32_t stream_us_ = 0;
   std::uint16_t drive_ = 0;
   std::uint32_t next_report_us_ = 0;
+  std::uint32_t last_host_us_ = 0;
   bool link_up_ = true;
   std::uint32_t start_us_ = 0;
   std::uint32_t last_byte_us_ = 0;
