@@ -58,7 +58,9 @@ test('experiment: guided-exploration through the participant screen, with a relo
       if (task === 'guided') {
         const labels = await p.locator('[data-testid=choices] button').allTextContents();
         assert.deepEqual(labels, ['A', 'B', 'Unsure']);
-        await p.getByRole('radio', { name: `Your answer: ${['A', 'B', 'Unsure'][rand(3)]}` }).click();
+        // The choice's heading is the library's wording (question.wording.choice_question), as the terminal's.
+        assert.equal(await p.locator('#answer-heading').textContent(), 'More like the reference');
+        await p.getByRole('radio', { name: `More like the reference: ${['A', 'B', 'Unsure'][rand(3)]}` }).click();
       } else if (task === 'rating') {
         const buttons = p.locator('[data-testid=rating] button');
         await buttons.nth(rand(await buttons.count())).click();
