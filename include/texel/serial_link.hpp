@@ -16,6 +16,14 @@
 //   rest()                        on every way out: end, pause, error, signal
 // After hello() every upload keeps to what the display announced: MAP_DATA
 // payloads of at most max_payload bytes, slots, max_samples.
+//
+// Threads: one thread may read finger reports (read_reports, a ReportReader)
+// while another sends requests (SELECT per interval, STATUS, rest()) and a
+// third streams (the serial Backend): frames are written whole, one at a
+// time, and a request waits for a report read in progress (at most its
+// wait_ms: 5 ms in a ReportReader), then reads its reply itself, keeping the
+// reports that arrive meanwhile. timeout_ms, attempts and check_limits are
+// set before the threads start.
 #pragma once
 
 #include <algorithm>
@@ -201,9 +209,9 @@ class SerialLink {
   /// path: never throws — a dead link, a refusal or no reply give false
   /// (the display's own 200 ms watchdog then rests a driven plate). True:
   /// the display acknowledged. Not from a signal handler (set a flag, call
-  /// it from the thread that owns the link), and like every request not
-  /// while another thread uses the link (stop a ReportReader, or the
-  /// serial Backend — whose stop() rests the display itself — first).
+  /// it from the thread that owns the link). A streaming serial Backend
+  /// would overwrite the DRIVE 0: stop it instead (its stop() rests the
+  /// display).
   bool rest() noexcept;
   /// The destructor sends DRIVE 0 and SELECT none without waiting (a link
   /// destroyed while unwinding still leaves the display at rest); false
@@ -222,11 +230,12 @@ class SerialLink {
   /// Reads the finger reports that have arrived, waiting
   /// for the first (`wait_ms`); returns how many were written to `out`. Reports that
   /// came during a request are kept for this call. May run on one thread
-  /// while another streams (stream_position/stream_drive); never together
-  /// with a request. Throws IoError if the link is gone.
+  /// while others stream and send requests (a request waiting for the link
+  /// makes this call return 0 at once, so it is not starved). Throws IoError
+  /// if the link is gone.
   std::size_t read_reports(std::span<FingerReport> out, int wait_ms);
   /// Reports the display sent that never arrived (gaps in their seq).
-  [[nodiscard]] std::uint64_t reports_lost() const { return reports_lost_; }
+  [[nodiscard]] std::uint64_t reports_lost() const { return reports_lost_.load(std::memory_order_relaxed); }
   /// Sends raw bytes (tests: garbage, truncated frames).
   void send_raw(std::span<const std::byte> bytes);
 
@@ -235,7 +244,8 @@ class SerialLink {
  private:
   std::uint8_t send(serial::Type type, const std::uint8_t* payload, std::size_t n);
   /// Sends a request and waits for its reply; returns the reply's payload.
-  std::string request(serial::Type type, const std::uint8_t* payload, std::size_t n, serial::Type expect, const char* what);
+  std::string request(serial::Type type, const std::uint8_t* payload, std::size_t n, serial::Type expect, const char* what,
+                      int tries = 0);  // 0: `attempts`
   void write_all(const std::uint8_t* p, std::size_t n);
 
   void send_rest_frames() noexcept;
@@ -252,7 +262,10 @@ class SerialLink {
   std::deque<FingerReport> pending_;
   bool have_report_seq_ = false;
   std::uint8_t next_report_seq_ = 0;
-  std::uint64_t reports_lost_ = 0;
+  std::atomic<std::uint64_t> reports_lost_{0};
+  std::mutex write_mutex_;  // one frame at a time on the wire, and seq_
+  std::mutex read_mutex_;   // the decoder, pending_ and the report seq: one reader at a time
+  std::atomic<int> requests_waiting_{0};
 };
 
 /// A display's finger reports read on a thread of their own (the display

@@ -49,6 +49,7 @@ bool write_once(int fd, const std::uint8_t* p, std::size_t n) noexcept {
 }  // namespace
 
 void SerialLink::send_rest_frames() noexcept {
+  std::lock_guard lock(write_mutex_);
   std::uint8_t frame[serial::header_size + 2 + serial::crc_size];
   const std::uint8_t drive0[2] = {0, 0};
   std::size_t len = serial::encode_frame(Type::drive, seq_++, drive0, 2, frame);
@@ -62,15 +63,8 @@ bool SerialLink::rest() noexcept {
   if (fd_ < 0) return false;
   try {
     stream_drive(0.0);
-    const int saved = attempts;
-    attempts = 1;
-    try {
-      select(serial::no_map);
-    } catch (...) {
-      attempts = saved;
-      throw;
-    }
-    attempts = saved;
+    const std::uint8_t none[1] = {serial::no_map};
+    request(Type::select, none, 1, Type::ack, "SELECT", 1);
     return true;
   } catch (...) {
     return false;
@@ -99,6 +93,7 @@ void SerialLink::write_all(const std::uint8_t* p, std::size_t n) {
 }
 
 std::uint8_t SerialLink::send(Type type, const std::uint8_t* payload, std::size_t n) {
+  std::lock_guard lock(write_mutex_);
   std::uint8_t frame[serial::max_frame];
   const std::uint8_t seq = seq_++;
   const std::size_t len = serial::encode_frame(type, seq, payload, n, frame);
@@ -107,11 +102,16 @@ std::uint8_t SerialLink::send(Type type, const std::uint8_t* payload, std::size_
 }
 
 void SerialLink::send_raw(std::span<const std::byte> bytes) {
+  std::lock_guard lock(write_mutex_);
   write_all(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
 }
 
-std::string SerialLink::request(Type type, const std::uint8_t* payload, std::size_t n, Type expect, const char* what) {
-  for (int attempt = 0; attempt < attempts; ++attempt) {
+std::string SerialLink::request(Type type, const std::uint8_t* payload, std::size_t n, Type expect, const char* what, int tries) {
+  if (tries <= 0) tries = attempts;
+  requests_waiting_.fetch_add(1);
+  std::unique_lock read_lock(read_mutex_);  // the reply is read here, not by a report reader
+  requests_waiting_.fetch_sub(1);
+  for (int attempt = 0; attempt < tries; ++attempt) {
     const std::uint8_t seq = send(type, payload, n);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
     bool got = false;
@@ -155,7 +155,7 @@ std::string SerialLink::request(Type type, const std::uint8_t* payload, std::siz
     }
     return reply;
   }
-  throw IoError("serial link " + name_ + ": no reply to " + what + " after " + std::to_string(attempts) + " attempts of " +
+  throw IoError("serial link " + name_ + ": no reply to " + what + " after " + std::to_string(tries) + " attempt(s) of " +
                 std::to_string(timeout_ms) + " ms (is the display connected and running?)");
 }
 
@@ -307,13 +307,14 @@ DisplayStatus SerialLink::status() {
 
 void SerialLink::keep_report(const serial::Frame& f) {
   if (f.length != serial::finger_payload) return;  // malformed: not a report
-  if (have_report_seq_ && f.seq != next_report_seq_) reports_lost_ += static_cast<std::uint8_t>(f.seq - next_report_seq_);
+  if (have_report_seq_ && f.seq != next_report_seq_)
+    reports_lost_.fetch_add(static_cast<std::uint8_t>(f.seq - next_report_seq_), std::memory_order_relaxed);
   have_report_seq_ = true;
   next_report_seq_ = static_cast<std::uint8_t>(f.seq + 1);
   constexpr std::size_t max_pending = 4096;  // about 4 s at 1 kHz
   if (pending_.size() >= max_pending) {
     pending_.pop_front();
-    ++reports_lost_;
+    reports_lost_.fetch_add(1, std::memory_order_relaxed);
   }
   FingerReport r;
   r.t_us = serial::get_u32(f.payload);
@@ -339,10 +340,16 @@ void SerialLink::start_reports(std::uint32_t interval_us) {
                           "protocol 1.1)",
                       e.code, e.detail);
   }
+  std::lock_guard lock(read_mutex_);
   have_report_seq_ = false;
 }
 
 std::size_t SerialLink::read_reports(std::span<FingerReport> out, int wait_ms) {
+  if (requests_waiting_.load() > 0) {  // let the request have the link (the mutex is not fair)
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    return 0;
+  }
+  std::lock_guard lock(read_mutex_);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(0, wait_ms));
   while (pending_.size() < out.size()) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
