@@ -161,7 +161,8 @@ void run(const RunArgs& a) {
     for (const auto& b : protocol_file.blocks)
       if (b.task != "oddity-2d")
         throw InvalidArgument("--finger: block '" + b.name + "' is task '" + b.task +
-                              "'; a participant strokes a 2-D display in task oddity-2d only");
+                              "'; --finger is a 2-D display for task oddity-2d; a 1-D study takes the finger from the "
+                              "--backend serial:PATH display's own sensor (--mode display-plays or host-streams)");
     po.finger = ex::FingerSource::display;
     po.finger_display = *a.finger;
     po.stroke_rules.tolerance_deg = a.direction_tolerance_deg;

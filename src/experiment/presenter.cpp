@@ -500,8 +500,10 @@ void Presenter::pump() {
   while (next_finger_s_ <= horizon) {
     const FingerSample s{next_finger_s_, finger_x(next_finger_s_, options_.swipe_speed_mm_s, 10.0, 90.0), true};
     if (!player_->push(s)) break;
-    // The simulated finger is the trial's trace (passive; bounded at an hour).
-    if (recording_ && simulated_trace_.size() < 3'600'000) simulated_trace_.push_back(s);
+    // The simulated finger is the trial's trace (passive), kept at 100 Hz —
+    // a known triangle sweep needs no more — and bounded at an hour.
+    if (recording_ && std::llround(next_finger_s_ * finger_rate_hz) % 10 == 0 && simulated_trace_.size() < 360'000)
+      simulated_trace_.push_back(s);
     next_finger_s_ += 1.0 / finger_rate_hz;
   }
   player_->collect();

@@ -337,8 +337,11 @@ TEST(ExperimentCli, SerialFrictionDisplayThroughTheReferenceController) {
   EXPECT_TRUE(j["finished"].get<bool>());
   EXPECT_GT(j["blocks_processed"].get<double>(), 50);
   EXPECT_EQ(j["late_blocks"].get<double>(), 0);
-  // The controller took every frame the study sent: none bad, no link error.
-  EXPECT_NE(rest.find("bad 0, nacks 0, link errors 0"), std::string::npos) << rest;
+  // No sensor: no finger explores, so the stimuli play under the simulated sweep, labelled passive.
+  EXPECT_EQ(j["mode"], "passive");
+  // The controller took every frame the study sent: none bad, no link error;
+  // one NACK, its answer to the host asking for finger reports (no_sensor).
+  EXPECT_NE(rest.find("bad 0, nacks 1, link errors 0"), std::string::npos) << rest;
 }
 
 TEST(ExperimentCli, AudioBackendThroughPortAudioOnAnAlsaNullPcm) {

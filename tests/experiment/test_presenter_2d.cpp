@@ -282,7 +282,7 @@ TEST(Presenter2D, TerminalRunStoresStrokesAndShowsNothingOfTheCondition) {
   texel::test_support::ControllerProcess blind(TEXEL_CLI, {"--duration", "30", "--quiet"});
   for (const auto& [args, words] : std::vector<std::pair<std::string, std::string>>{
            {tmp.at("p.json") + " --finger serial:" + blind.pty(), "no finger sensor"},
-           {protocols + "texel-length.json --finger " + port, "task oddity-2d only"},
+           {protocols + "texel-length.json --finger " + port, "a 1-D study takes the finger from the --backend"},
            {tmp.at("p.json") + " --finger " + port + " --simulate default", "does not stroke"}}) {
     const auto no = texel::test_support::run_cli(
         TEXEL_CLI, "experiment run " + args + " --participant P02 --db " + tmp.at("n.db") + " --backend null");
