@@ -392,10 +392,11 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
     if (!(in > 1e-6 * all)) top_cpm = std::numeric_limits<double>::infinity();
   }
   // Version 3 with nothing in its band: the Pacinian branch without the edge.
-  PerceptualModel unbounded = model;
-  unbounded.speed_spread = 0.0, unbounded.felt_rolloff_db_per_octave = 0.0, unbounded.felt_band_top = Hertz(1e300);
-  const PerceptualModel& weigh = std::isinf(top_cpm) ? unbounded : model;
-  auto threshold = [&](double hz) { return felt_band ? felt_weight_threshold_db(Hertz(hz), weigh) : threshold_db(Hertz(hz)); };
+  auto threshold = [&](double hz) {
+    if (!felt_band) return threshold_db(Hertz(hz));
+    return std::isinf(top_cpm) ? felt_threshold_db(Hertz(hz), Hertz(std::numeric_limits<double>::infinity()))
+                               : felt_weight_threshold_db(Hertz(hz), model);
+  };
   const double f_lo = std::max(0.01, f_min_cpm);
   const bool display = display_in_loop(model);
   const double corner = display ? model.display.corner.value() : 0.0;
