@@ -126,11 +126,30 @@ std::string fmt(double v) {
 
 int main(int argc, char** argv) {
   const bool felt_band = argc > 1 && std::string(argv[1]) == "--felt-band";
-  const bool quick = felt_band || (argc > 1 && std::string(argv[1]) == "--quick");
+  // --v3 SPREAD SLOPE KNEE TOP: version 3's (s, γ) grid alone, with that
+  // speed spread (SD of ln speed), roll-off (dB/octave above KNEE Hz; 0: the
+  // hard top) and top (Hz) (docs/encoder.md §2, "Version 3").
+  const bool variant = argc > 5 && std::string(argv[1]) == "--v3";
+  const bool quick = felt_band || variant || (argc > 1 && std::string(argv[1]) == "--quick");
   const auto sig = signals();
   std::vector<Family> fam;
   using W = PerceptualModel::Weighting;
-  {
+  if (variant) {
+    const double spread = std::stod(argv[2]), slope = std::stod(argv[3]), knee = std::stod(argv[4]), top = std::stod(argv[5]);
+    Family o{"version 3: spread " + fmt(spread) + ", roll-off " + fmt(slope) + " dB/oct above " + fmt(knee) + " Hz, top " +
+                 fmt(top) + " Hz (s, γ)",
+             {}};
+    for (double s : {0.0, 0.5, 1.0})
+      for (double g : {1.0, 2.0, 3.0, 4.0}) {
+        PerceptualModel m = v2(W::power, s, g, 1.0);
+        m.version = 3;
+        m.speed_spread = spread, m.felt_rolloff_db_per_octave = slope, m.felt_rolloff_knee = Hertz(knee);
+        m.felt_band_top = Hertz(top);
+        o.grid.push_back(point("s " + fmt(s) + ", γ " + fmt(g), m));
+      }
+    fam.push_back(o);
+  }
+  if (!variant) {
     Family f{"v1 (as shipped: s 0.5, γ 1.75; no parameter fitted)", {}};
     f.grid.push_back(point("s 0.5, γ 1.75", model_defaults(1)));
     fam.push_back(f);
@@ -154,7 +173,7 @@ int main(int argc, char** argv) {
       for (double g : {1.0, 2.0, 3.0, 4.0}) c.grid.push_back(point("s " + fmt(s) + ", γ " + fmt(g), v2(W::channels, s, g)));
     fam.push_back(c);
   }
-  {
+  if (!variant) {
     Family o{"**band energy, 9 octave bands (s, γ): version 2**", {}};
     for (double s : {0.0, 0.5, 1.0})
       for (double g : {1.0, 2.0, 3.0, 4.0}) o.grid.push_back(point("s " + fmt(s) + ", γ " + fmt(g), v2(W::power, s, g, 1.0)));

@@ -308,8 +308,9 @@ void register_encode(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
   cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
   cmd->add_option("--model", a->model,
-                  "Perceptual model version: 2 (calibrated against people's matches), 3 (version 2 within the felt band: "
-                  "nothing above 1 kHz at the swipe speed is felt) or 1 (the model before) [2]")
+                  "Perceptual model version: 2 (calibrated against people's matches), 3 (the felt band, weighed over a "
+                  "range of stroke speeds; a recording's content above 1 kHz at its speed is not felt) or 1 (the model "
+                  "before) [2]")
       ->group(g);
   cmd->add_option("--weight-exponent", a->weight_exponent,
                   "Perceptual model: exponent of a component's felt weight [the model version's]")

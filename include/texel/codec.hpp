@@ -76,8 +76,9 @@ Signal encoder_signal(const texel::Signal& signal);
 struct PerceptualModel {
   /// Which model (docs/encoder.md §2, "Model versions"): 2 [default] the
   /// band model calibrated against people's matches; 1 the model before
-  /// (per-bin weighting); 3 version 2 within the felt band (nothing above
-  /// felt_band_top is felt, at any level). Each version's defaults:
+  /// (per-bin weighting); 3 version 2 within the felt band, weighed over a
+  /// lognormal range of stroke speeds (speed_spread; a recording's content
+  /// above felt_band_top at its speed is not felt). Each version's defaults:
   /// model_defaults(version). Named in every EncodeResult and `--json`
   /// ("model_version").
   int version = 2;
@@ -133,11 +134,28 @@ struct PerceptualModel {
   /// sets it; off, the field stays 0 and perceiving costs nothing more).
   bool centroid = false;
   /// The top of the felt band (docs/encoder.md §2, "Version 3"), Hz at the
-  /// swipe speed: version 3 gives content above it no weight at any level
-  /// (felt, drawn, the physical tie-break and the centroid target alike).
+  /// swipe speed: at that speed version 3 gives content above it no weight
+  /// at any level (felt, drawn, the physical tie-break and the centroid
+  /// target alike); over its range of stroke speeds (speed_spread) content
+  /// up to felt_band_reach_cpm is felt on the slower strokes. A recording's
+  /// content above it is cut before the analysis.
   /// Every version reports the input's power above it
   /// (EncodeResult::beyond_felt_band). [choice] 1000 Hz; > 0.
   Hertz felt_band_top{1000.0};
+  /// Version 3 (docs/encoder.md §2, "Version 3: speeds"): people stroke at a
+  /// range of speeds; the felt weight of a spatial frequency is its weight
+  /// averaged over a lognormal distribution of speed with median
+  /// swipe_speed and this standard deviation of ln(speed). 0: one speed.
+  /// model_defaults(3): [fitted] 0.6 (with sensitivity_scale 1 and
+  /// weight_exponent 4; not measured, see docs/encoder.md); 0 … 1.5.
+  double speed_spread = 0.0;
+  /// Version 3: a soft roll-off instead of the hard top, dB/octave added
+  /// above felt_rolloff_knee (no floor: sensitivity keeps falling); content
+  /// is then analysed up to where the threshold reaches 80 dB. 0: the hard
+  /// top felt_band_top. [choice] 0 (a roll-off was measured and not
+  /// chosen: docs/encoder.md §2, "Version 3"); 0 … 200.
+  double felt_rolloff_db_per_octave = 0.0;
+  Hertz felt_rolloff_knee{500.0};  ///< Hz at the swipe speed; > 250
 };
 
 /// The log-spectral centroid's band (Percept::log_centroid_db): from
@@ -172,6 +190,13 @@ double threshold_db(Hertz f);
 double felt_threshold_db(Hertz f, Hertz top);
 /// The felt band's top in cycles/mm at the model's swipe speed.
 CyclesPerMm felt_band_top_cpm(const PerceptualModel& model);
+/// Version 3's threshold of `model` at temporal frequency f (Hz at the
+/// model's swipe speed): felt_threshold_db (or the soft roll-off) averaged
+/// in sensitivity over the model's speed spread. +infinity: no weight.
+double felt_weight_threshold_db(Hertz f, const PerceptualModel& model);
+/// The highest spatial frequency version 3 gives any weight (cycles/mm):
+/// the band its percept and the encoder's analysis see.
+CyclesPerMm felt_band_reach_cpm(const PerceptualModel& model);
 
 /// What the model extracts from a fine-texture signal.
 struct Percept {

@@ -132,8 +132,13 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
   // with next to nothing in the felt band are analysed as they are.
   const bool felt_only = cfg.model.version == 3 && !res.no_texture && !rec && !stepped && res.beyond_felt_band > 1e-4 &&
                          res.beyond_felt_band < 1.0 - 1e-6;
+  // A recording was captured at one speed, its nominal one: what lies above
+  // the felt band there (airborne sound, a sensor's resonance) is cut at the
+  // band's top. A map is a surface people explore at a range of speeds
+  // (PerceptualModel::speed_spread): cut only where no speed feels it.
+  const double cut_cpm = signal.recording ? felt_band_top_cpm(cfg.model).value() : felt_band_reach_cpm(cfg.model).value();
   if (felt_only) {
-    lowpass_felt(a, dx, felt_band_top_cpm(cfg.model).value());
+    lowpass_felt(a, dx, cut_cpm);
     if (signal.recording) {
       double mean = 0.0, peak = 0.0;
       for (double v : a) mean += v;
@@ -187,7 +192,7 @@ EncodeResult encode(const Signal& signal, const EncoderConfig& cfg) {
     std::vector<double> r(n);
     fine_texture(flat_fit.p_db, flat_fit.i_db, fit_cfg, band_max, Millimetres(len))
         .render(Grid{Millimetres(0.0), Millimetres(dx), static_cast<std::int64_t>(n)}, 0, r);
-    if (felt_only) lowpass_felt(r, dx, felt_band_top_cpm(cfg.model).value());  // compared as the input is
+    if (felt_only) lowpass_felt(r, dx, cut_cpm);  // compared as the input is
     const Split own = split(r, dx, fit_cfg);
     const double shape = shape_distance_db(a, r, dx);
     if (sp.range <= own.range + coarse_margin && shape <= max_shape_db) {

@@ -95,6 +95,53 @@ CyclesPerMm felt_band_top_cpm(const PerceptualModel& model) {
 
 namespace {
 
+/// Version 3's threshold at one speed: the hard top, or the soft roll-off.
+double felt_threshold_one_db(double hz, const PerceptualModel& m) {
+  if (!(m.felt_rolloff_db_per_octave > 0.0)) return felt_threshold_db(Hertz(hz), m.felt_band_top);
+  if (hz < 250.0) return std::min(12.0 * std::log2(250.0 / std::max(hz, 1e-6)), 30.0);
+  return 12.0 * std::log2(hz / 250.0) + m.felt_rolloff_db_per_octave * std::max(0.0, std::log2(hz / m.felt_rolloff_knee.value()));
+}
+
+/// Speed ratios (to the median) and their weights: a lognormal with
+/// standard deviation `sigma` of ln(speed), 41 nodes over ±3 SD.
+constexpr int speed_nodes = 41;
+double speed_ratio(int j, double sigma) { return std::exp(sigma * (-3.0 + 6.0 * j / (speed_nodes - 1))); }
+double speed_weight(int j) {
+  const double z = -3.0 + 6.0 * j / (speed_nodes - 1);
+  double sum = 0.0;
+  for (int i = 0; i < speed_nodes; ++i) {
+    const double u = -3.0 + 6.0 * i / (speed_nodes - 1);
+    sum += std::exp(-0.5 * u * u);
+  }
+  return std::exp(-0.5 * z * z) / sum;
+}
+
+}  // namespace
+
+double felt_weight_threshold_db(Hertz f, const PerceptualModel& m) {
+  if (!(m.speed_spread > 0.0)) return felt_threshold_one_db(f.value(), m);
+  double sens = 0.0;
+  for (int j = 0; j < speed_nodes; ++j) {
+    const double t = felt_threshold_one_db(f.value() * speed_ratio(j, m.speed_spread), m);
+    if (std::isfinite(t)) sens += speed_weight(j) * std::pow(10.0, -t / 10.0);
+  }
+  return sens > 0.0 ? -10.0 * std::log10(sens) : std::numeric_limits<double>::infinity();
+}
+
+CyclesPerMm felt_band_reach_cpm(const PerceptualModel& m) {
+  const double slowest = m.speed_spread > 0.0 ? speed_ratio(0, m.speed_spread) : 1.0;
+  double top_hz = m.felt_band_top.value();
+  if (m.felt_rolloff_db_per_octave > 0.0) {
+    // Where the single-speed threshold reaches 80 dB: beyond it nothing is felt.
+    const double knee = m.felt_rolloff_knee.value();
+    const double octaves = (80.0 - 12.0 * std::log2(knee / 250.0)) / (12.0 + m.felt_rolloff_db_per_octave);
+    top_hz = knee * std::exp2(std::max(0.0, octaves));
+  }
+  return CyclesPerMm(top_hz / slowest / m.swipe_speed.value());
+}
+
+namespace {
+
 /// Percept::log_centroid_db of a power spectrum `p` whose bins are at
 /// frequencies `f` (cpm) and levels `d` (dB), on a grid of spacing dx, at
 /// most up to `top` cpm (version 3: the felt band's top).
@@ -329,7 +376,7 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
   power_spectrum(fine, p, m);
   const double v = model.swipe_speed.value();
   // Version 3: the felt band's top, cpm (infinite: every bin, version 2).
-  double top_cpm = felt_band ? model.felt_band_top.value() / v : std::numeric_limits<double>::infinity();
+  double top_cpm = felt_band ? felt_band_reach_cpm(model).value() : std::numeric_limits<double>::infinity();
   if (felt_band) {
     // Nothing in the felt band (less than 10⁻⁶ of the power above f_min):
     // the whole spectrum, weighed by the Pacinian branch without the edge.
@@ -344,8 +391,12 @@ Percept perceive_v2(std::span<const double> fine, double spacing_mm, const Perce
     }
     if (!(in > 1e-6 * all)) top_cpm = std::numeric_limits<double>::infinity();
   }
-  const Hertz top_hz(top_cpm * v);
-  auto threshold = [&](double hz) { return felt_band ? felt_threshold_db(Hertz(hz), top_hz) : threshold_db(Hertz(hz)); };
+  // Version 3 with nothing in its band: the Pacinian branch without the edge.
+  auto threshold = [&](double hz) {
+    if (!felt_band) return threshold_db(Hertz(hz));
+    return std::isinf(top_cpm) ? felt_threshold_db(Hertz(hz), Hertz(std::numeric_limits<double>::infinity()))
+                               : felt_weight_threshold_db(Hertz(hz), model);
+  };
   const double f_lo = std::max(0.01, f_min_cpm);
   const bool display = display_in_loop(model);
   const double corner = display ? model.display.corner.value() : 0.0;
@@ -504,7 +555,12 @@ PerceptualModel model_defaults(int version) {
     return m;
   }
   if (version == 3) {
+    // docs/encoder.md §2, "Version 3": strokes at a lognormal range of
+    // speeds (SD 0.6 of ln speed), sensitivity scale and exponent refitted.
     m.version = 3;
+    m.speed_spread = 0.6;
+    m.sensitivity_scale = 1.0;
+    m.weight_exponent = 4.0;
     return m;
   }
   if (version != 2) throw FieldError("model", "is " + std::to_string(version) + "; allowed: 1, 2, 3");
@@ -527,6 +583,12 @@ Percept perceive(std::span<const double> fine, double spacing_mm, const Perceptu
     throw FieldError("band_octaves", "is " + num(model.band_octaves) + "; allowed: 0.05 … 2");
   if (model.version == 3 && !(model.felt_band_top.value() > 0.0 && std::isfinite(model.felt_band_top.value())))
     throw FieldError("felt_band_top", "is " + num(model.felt_band_top.value()) + " Hz; it must be > 0");
+  if (model.version == 3 && !(model.speed_spread >= 0.0 && model.speed_spread <= 1.5))
+    throw FieldError("speed_spread", "is " + num(model.speed_spread) + "; allowed: 0 … 1.5");
+  if (model.version == 3 && !(model.felt_rolloff_db_per_octave >= 0.0 && model.felt_rolloff_db_per_octave <= 200.0))
+    throw FieldError("felt_rolloff_db_per_octave", "is " + num(model.felt_rolloff_db_per_octave) + "; allowed: 0 … 200");
+  if (model.version == 3 && !(model.felt_rolloff_knee.value() > 250.0 && std::isfinite(model.felt_rolloff_knee.value())))
+    throw FieldError("felt_rolloff_knee", "is " + num(model.felt_rolloff_knee.value()) + " Hz; it must be > 250");
   return perceive_v2(fine, spacing_mm, model, f_min_cpm, model.version == 3);
 }
 

@@ -203,29 +203,47 @@ TEST(FeltBand, VersionThreeThresholdHasNoFloorAboveThePacinianRangeAndNothingBey
   EXPECT_NEAR(codec::felt_threshold_db(Hertz(1000.0), top), 24.0, 1e-9);  // version 2 capped this side at 30 dB (at 1.41 kHz)
   EXPECT_EQ(codec::threshold_db(Hertz(4000.0)), 30.0);
   EXPECT_EQ(codec::felt_threshold_db(Hertz(1000.5), top), std::numeric_limits<double>::infinity());
-  // A percept does not see what lies beyond the band, at any level: a
-  // 200 Hz line alone, and with a 3 kHz line 40 dB stronger, feel the same.
+  // Averaged over the strokes' speeds (lognormal, SD 0.6 of ln speed): what
+  // lies just above the top at the median speed is felt on the slower
+  // strokes (4sin's 1.1 kHz, the 2 kHz band-pass references), ever more
+  // weakly, and nothing beyond the slowest stroke's reach.
+  const codec::PerceptualModel m3 = codec::model_defaults(3);
+  EXPECT_EQ(m3.speed_spread, 0.6);
+  const double t1100 = codec::felt_weight_threshold_db(Hertz(1100.0), m3);
+  const double t2000 = codec::felt_weight_threshold_db(Hertz(2000.0), m3);
+  const double t4000 = codec::felt_weight_threshold_db(Hertz(4000.0), m3);
+  EXPECT_TRUE(std::isfinite(t1100) && std::isfinite(t4000));
+  EXPECT_LT(codec::felt_weight_threshold_db(Hertz(250.0), m3), t1100);
+  EXPECT_LT(t1100, t2000);
+  EXPECT_LT(t2000 + 10.0, t4000);
+  const double reach_hz = codec::felt_band_reach_cpm(m3).value() * speed;
+  EXPECT_NEAR(reach_hz, 1000.0 * std::exp(3.0 * 0.6), 1e-6);
+  EXPECT_EQ(codec::felt_weight_threshold_db(Hertz(reach_hz * 1.01), m3), std::numeric_limits<double>::infinity());
+  // A percept does not see what lies beyond the reach, at any level: a
+  // 200 Hz line alone, and with an 8 kHz line 40 dB stronger, feel the same.
   const double dx = speed / fs;
   std::vector<double> a(44100), b(44100);
   for (std::size_t i = 0; i < a.size(); ++i) {
     const double x = static_cast<double>(i) * dx;
     a[i] = 0.01 * std::sin(2.0 * std::numbers::pi * 2.0 * x);
-    b[i] = a[i] + 1.0 * std::sin(2.0 * std::numbers::pi * 30.0 * x);
+    b[i] = a[i] + 1.0 * std::sin(2.0 * std::numbers::pi * 80.0 * x);
   }
-  const codec::PerceptualModel m3 = codec::model_defaults(3);
   const codec::Percept qa = codec::perceive(a, dx, m3), qb = codec::perceive(b, dx, m3);
   EXPECT_NEAR(qb.pitch_db, qa.pitch_db, 1e-6);
   EXPECT_NEAR(qb.noisiness_db, qa.noisiness_db, 1e-6);
   EXPECT_NEAR(qb.mean_db, qa.mean_db, 1e-6);  // the physical tie-break too
-  // Model 2 is pulled to the 3 kHz line.
+  // Model 2 is pulled to the 8 kHz line.
   const codec::PerceptualModel m2 = codec::model_defaults(2);
   EXPECT_GT(codec::perceive(b, dx, m2).pitch_db, codec::perceive(a, dx, m2).pitch_db + 5.0);
   // Nothing in the felt band: the whole spectrum decides (the fit stays defined).
   std::vector<double> c(44100);
-  for (std::size_t i = 0; i < c.size(); ++i) c[i] = std::sin(2.0 * std::numbers::pi * 30.0 * static_cast<double>(i) * dx);
-  EXPECT_NEAR(codec::perceive(c, dx, m3).pitch_db, 10.0 * std::log10(30.0), 0.05);
+  for (std::size_t i = 0; i < c.size(); ++i) c[i] = std::sin(2.0 * std::numbers::pi * 80.0 * static_cast<double>(i) * dx);
+  EXPECT_NEAR(codec::perceive(c, dx, m3).pitch_db, 10.0 * std::log10(80.0), 0.05);
   codec::PerceptualModel bad = m3;
   bad.felt_band_top = Hertz(0.0);
+  EXPECT_THROW((void)codec::perceive(a, dx, bad), InvalidArgument);
+  bad = m3;
+  bad.speed_spread = 2.0;
   EXPECT_THROW((void)codec::perceive(a, dx, bad), InvalidArgument);
 }
 
