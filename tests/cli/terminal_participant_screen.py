@@ -180,7 +180,9 @@ def main():
     check({1, -1} <= moves, f"the staircase moved both ways (values {sorted(values)})")
 
     # Nothing on any screen depends on correctness or the procedure's state.
-    whole = "\n".join(screens)
+    # The resume line after 'q' is the experimenter's (it repeats the options
+    # a resume needs, --backend among them); everything else is the participant's.
+    whole = "\n".join(ln for ln in "\n".join(screens).splitlines() if not ln.startswith("(experimenter: "))
     forbidden = ["narrow", "texel_length", "staircase", "reversal", "correct", "wrong", "→", "Hz", "frames",
                  "late block", "backend", "block ", "underrun", "worst", "intensity", "48000"]
     for word in forbidden:
