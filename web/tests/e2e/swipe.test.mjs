@@ -32,6 +32,10 @@ async function stroke(p, cdp, { burst }) {
   const stepPx = 8;
   const y = r.top + r.height / 2;
   const x0 = r.left + 0.2 * r.width;
+  // Queued input is newer than any input the page has already had: the pointer's
+  // way to the stimulus button may have crossed the strip just now, so a burst
+  // (times up to 0.4 s in the past) waits until that is further back.
+  if (burst) await new Promise((res) => setTimeout(res, 600));
   // The page's clock as epoch time (CDP's timestamp); the stroke's times end before "now".
   const now = await p.evaluate(() => performance.timeOrigin + performance.now());
   const start = burst ? now - (SAMPLES + 10) * STEP_MS : now - 5 * STEP_MS;
