@@ -105,8 +105,9 @@ static double* tm_map(const char* name, const mxArray* a, size_t* count) {
                       "give amplitudes as double in [0, 1] (texel_render's default output) or uint16 (its 'u16' output)",
                       name);
   if (c != mxDOUBLE_CLASS && c != mxSINGLE_CLASS && c != mxUINT16_CLASS && c != mxINT16_CLASS)
-    mexErrMsgIdAndTxt("texel:invalidArgument", "%s is %s; allowed: double or single amplitudes, uint16 (/65535) or int16 (/32768)",
-                      name, mxGetClassName(a));
+    mexErrMsgIdAndTxt("texel:invalidArgument",
+                      "%s is %s; allowed: double or single amplitudes, uint16 (/65535) or int16 (/32768)", name,
+                      mxGetClassName(a));
   n = mxGetNumberOfElements(a);
   if (n > 0 && mxGetM(a) != 1 && mxGetN(a) != 1)
     mexErrMsgIdAndTxt("texel:invalidArgument", "%s must be a vector (N×1 or 1×N)", name);

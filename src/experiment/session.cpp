@@ -225,8 +225,8 @@ void complete_wording(Question& q) {
   if (q.recall) {
     const auto& cell = q.recall->cell;
     w.recall = Scale{1, 9,
-                     cell ? "Which digit was in row " + std::to_string(*cell / 4 + 1) + ", column " + std::to_string(*cell % 4 + 1) +
-                                " of the matrix?"
+                     cell ? "Which digit was in row " + std::to_string(*cell / 4 + 1) + ", column " +
+                                std::to_string(*cell % 4 + 1) + " of the matrix?"
                           : std::string("Which digit was in the cells of the matrix?"),
                      "", ""};
   }

@@ -288,7 +288,8 @@ ExportFormat parse_export_format(std::string_view text, std::string_view field) 
   for (const ExportFormat f : {ExportFormat::document, ExportFormat::bitstream, ExportFormat::device, ExportFormat::npy,
                                ExportFormat::csv, ExportFormat::hjif})
     if (text == to_string(f)) return f;
-  throw InvalidArgument(std::string(field) + " is '" + std::string(text) + "'; allowed: document, bitstream, device, npy, csv, hjif");
+  throw InvalidArgument(std::string(field) + " is '" + std::string(text) +
+                        "'; allowed: document, bitstream, device, npy, csv, hjif");
 }
 
 ExportFile export_file(const Document& doc, ExportFormat as, std::optional<std::size_t> region) {

@@ -59,8 +59,8 @@ std::vector<std::pair<double, double>> coalesced_samples(const Fields& f, double
       throw Reject{"invalid", where + " is " + clipped(e.dump()) + "; allowed: t_ms 0 … " + texel::detail::num(max_t_ms) +
                                   ", |x_mm| <= " + texel::detail::num(max_abs_mm)};
     if (t > t_ms || (!out.empty() && t < out.back().first))
-      throw Reject{"invalid", where + ": t_ms " + texel::detail::num(t) + " is out of order; allowed: non-decreasing and at most t_ms " +
-                                  texel::detail::num(t_ms)};
+      throw Reject{"invalid", where + ": t_ms " + texel::detail::num(t) +
+                                  " is out of order; allowed: non-decreasing and at most t_ms " + texel::detail::num(t_ms)};
     out.emplace_back(t, x);
   }
   return out;
@@ -91,7 +91,8 @@ void on_feel_move(State& s, Client& c, const Job& job) {
                                   " ms); allowed: non-decreasing (the page's PointerEvent.timeStamp, a monotonic clock)"};
     const double lag_ms = arrival_ms - t_ms;
     if (std::isfinite(c.pointer_lag_ms) && lag_ms < c.pointer_lag_ms - max_ahead_ms)
-      throw Reject{"invalid", "feel.move: t_ms " + texel::detail::num(t_ms) + " runs " + texel::detail::fixed(c.pointer_lag_ms - lag_ms, 1) +
+      throw Reject{"invalid", "feel.move: t_ms " + texel::detail::num(t_ms) + " runs " +
+                                  texel::detail::fixed(c.pointer_lag_ms - lag_ms, 1) +
                                   " ms ahead of the studio's clock; allowed: at most " + texel::detail::num(max_ahead_ms) +
                                   " ms (the page's PointerEvent.timeStamp)"};
     c.pointer_lag_ms = std::min(c.pointer_lag_ms, lag_ms);

@@ -98,7 +98,6 @@ struct TrialRow {
   double over_time_limit = missing;  ///< 1 when rt_ms exceeded the time limit, 0 when not
   double interrupted = missing;      ///< 1 when the trial spanned a suspend, a stop/resume, a restart or a reload-restart
   double suspended_ms = missing;     ///< time the session was suspended during the trial (not in rt_ms)
-
 };
 
 /// The current time, UTC, ISO 8601 with milliseconds ("2026-11-23T14:02:08.123Z"):
