@@ -536,6 +536,13 @@ Document parse_document(std::string_view text, std::string_view origin) {
 }
 
 Document load_document(const std::string& path) {
+  // An MPEG-I Haptics file is no Texel document (a .hmpg is not even JSON):
+  // say what it is and what reads it, rather than a JSON parser's complaint.
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".hjif" || ext == ".hmpg")
+    throw FormatError(path + ": an MPEG-I Haptics file, not a Texel document; encode it to one (texel encode " + path +
+                      " -o x.texel.json: the document it carries, exactly, when Texel wrote it) or read it as a signal "
+                      "(texel spectrum, texel info)");
   Document doc = parse_document(read_file(path), path);
   // A 2-D coarse image named by a relative path is found beside the document.
   if (doc.surface2d) {

@@ -243,6 +243,14 @@ TEST_F(Cli, RejectsMalformedJson) {
   expect_rejected({"render", "bad.texel.json", "-o", "out.bin"}, "malformed JSON");
 }
 
+TEST_F(Cli, RenderOfAnMpegHapticsFileSaysWhatItIsAndWhatReadsIt) {
+  // Issue #37: a .hmpg (binary) was refused as "malformed JSON … line 1, column 1".
+  write("x.hmpg", std::string("\x01\x02binary", 8));
+  expect_rejected({"render", "x.hmpg", "-o", "out.png"}, "an MPEG-I Haptics file, not a Texel document");
+  write("x.hjif", "{\"version\": \"2023\"}");
+  expect_rejected({"render", "x.hjif", "-o", "out.png"}, "texel encode");
+}
+
 TEST_F(Cli, RejectsTruncatedDocument) {
   const std::string doc = valid_document();
   write("cut.texel.json", doc.substr(0, doc.size() / 2));
