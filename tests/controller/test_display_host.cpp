@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -189,9 +190,10 @@ TEST(HostThreads, RequestsGoThroughWhileAReportReaderReadsTheSameLink) {
   // A display that plays its own map: the host SELECTs per interval while
   // its finger reports arrive on another thread.
   const StrokeScript script(StrokeScriptConfig{});
-  controller::HostHal* hal = nullptr;
+  std::atomic<controller::HostHal*> hal{nullptr};
   Rig rig(controller::Info{}, [&](std::int32_t& x, bool& touch) {
-    const FingerSample f = script.at(hal->micros() * 1e-6);
+    controller::HostHal* h = hal.load();  // null until the test has the rig's HAL: lifted
+    const FingerSample f = h ? script.at(h->micros() * 1e-6) : FingerSample{0.0, 0.0, false};
     x = static_cast<std::int32_t>(std::lround(f.x_mm * 1e6));
     touch = f.touch;
     return true;
@@ -296,16 +298,22 @@ TEST(StrokeScript, TheDisplaysReportsGiveTheScriptsSwipeMeasures) {
   c.seed = 11;
   c.duration_s = 20;
   const StrokeScript script(c);
-  controller::HostHal* hal = nullptr;
-  std::uint32_t t0 = 0;
+  std::atomic<controller::HostHal*> hal{nullptr};
+  std::atomic<std::uint32_t> t0{0};
   Rig rig(controller::Info{}, [&](std::int32_t& x, bool& touch) {
-    const FingerSample f = script.at(static_cast<std::uint32_t>(hal->micros() - t0) * 1e-6);
+    controller::HostHal* h = hal.load();
+    if (h == nullptr) {  // the rig's thread runs before the test has its HAL: lifted until then
+      x = 0;
+      touch = false;
+      return true;
+    }
+    const FingerSample f = script.at(static_cast<std::uint32_t>(h->micros() - t0.load()) * 1e-6);
     x = static_cast<std::int32_t>(std::lround(f.x_mm * 1e6));
     touch = f.touch;
     return true;
   });
+  t0 = rig.hal->micros();
   hal = rig.hal.get();
-  t0 = hal->micros();
   SerialLink link(rig.path);
   link.hello();
   link.start_reports(1000);
@@ -359,8 +367,16 @@ std::string outcome(const DisplayCheckReport& r, const std::string& name) {
   return c ? std::string(to_string(c->outcome)) : "missing";
 }
 
-bool strokes(controller::HostHal*& hal, const StrokeScript& script, std::int32_t& x, bool& touch) {
-  const FingerSample f = script.at(hal->micros() * 1e-6);
+// The rig's controller thread starts inside the rig's constructor, so it may
+// read the sensor before the test has the rig's HAL: until then, lifted.
+bool strokes(std::atomic<controller::HostHal*>& hal, const StrokeScript& script, std::int32_t& x, bool& touch) {
+  controller::HostHal* h = hal.load();
+  if (h == nullptr) {
+    x = 0;
+    touch = false;
+    return true;
+  }
+  const FingerSample f = script.at(h->micros() * 1e-6);
   x = static_cast<std::int32_t>(std::lround(f.x_mm * 1e6));
   touch = f.touch;
   return true;
@@ -380,7 +396,7 @@ TEST(DisplayCheck, TheReferenceControllerPassesWithAndWithoutASensor) {
   }
   {
     const StrokeScript script(StrokeScriptConfig{});
-    controller::HostHal* hal = nullptr;
+    std::atomic<controller::HostHal*> hal{nullptr};
     Rig rig(controller::Info{}, [&](std::int32_t& x, bool& touch) { return strokes(hal, script, x, touch); });
     hal = rig.hal.get();
     const DisplayCheckReport r = check(rig);
@@ -414,7 +430,7 @@ TEST(DisplayCheck, EachBrokenDisplayFailsTheCheckNamedForWhatItBreaks) {
         Case{controller::fault_drop_reports, "reports"}}) {
     controller::Info info;
     info.faults = k.fault;
-    controller::HostHal* hal = nullptr;
+    std::atomic<controller::HostHal*> hal{nullptr};
     Rig rig(info, [&](std::int32_t& x, bool& touch) { return strokes(hal, script, x, touch); });
     hal = rig.hal.get();
     const DisplayCheckReport r = check(rig);
