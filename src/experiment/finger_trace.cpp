@@ -1,6 +1,7 @@
 // The finger that explored a trial (finger_trace.hpp).
 #include "texel/experiment/finger_trace.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -41,43 +42,79 @@ TraceSource parse_trace_source(std::string_view text, std::string_view field) {
   throw FieldError(std::string(field), "is '" + std::string(text) + "'; allowed: display, pointer, simulated (or empty)");
 }
 
-TraceMeasures measure_trace(const FingerTrace& trace) {
+std::string_view flag_code(std::string_view flag) { return flag.substr(0, flag.find(':')); }
+
+TraceMeasures measure_trace(std::span<const FingerSample> s, const SwipeLimits& limits) {
+  if (!(limits.max_speed_mm_s > 0) || !(limits.min_touched_s >= 0) || !(limits.still_speed_mm_s >= 0) ||
+      !(limits.time_resolution_s > 0 && limits.time_resolution_s < 1))
+    throw InvalidArgument("swipe limits: max_speed_mm_s is " + detail::num(limits.max_speed_mm_s) +
+                          ", min_touched_s " + detail::num(limits.min_touched_s) + ", still_speed_mm_s " +
+                          detail::num(limits.still_speed_mm_s) + ", time_resolution_s " +
+                          detail::num(limits.time_resolution_s) + "; allowed: > 0, >= 0, >= 0, 0 < … < 1");
   TraceMeasures out;
-  const auto& s = trace.samples;
   bool touched = false;
+  // Spans of consecutive touching samples at least two clock ticks long,
+  // timed generously: a source's rounding cannot make a hand look fast; a
+  // jump (a missed lift) or a burst stamped at one instant still does.
+  const double min_span = 2 * limits.time_resolution_s;
+  std::size_t span_from = 0;
+  double span_path = 0.0;
+  const auto close_span = [&](std::size_t to) {
+    if (to > span_from) {
+      // The span lasted at least its stamps' difference less one tick and at most plus one: only the
+      // longer time is certain not to exaggerate the speed.
+      const double dt = s[to].t_s - s[span_from].t_s + limits.time_resolution_s;
+      out.max_speed_mm_s = std::max(out.max_speed_mm_s, span_path / dt);
+    }
+    span_from = to;
+    span_path = 0.0;
+  };
   for (std::size_t i = 0; i < s.size(); ++i) {
     touched = touched || s[i].touch;
     if (!std::isfinite(s[i].t_s) || !std::isfinite(s[i].x_mm)) {
-      out.flag = "time_not_increasing";  // a sample without a usable time or place is no measurement
+      out.flag = "time_not_increasing: sample " + std::to_string(i + 1) + " has no finite time or place";
       return out;
     }
     if (i == 0) continue;
-    const double dt = s[i].t_s - s[i - 1].t_s;
-    if (dt < 0) {
-      out.flag = "time_not_increasing";
+    if (s[i].t_s < s[i - 1].t_s) {
+      out.flag = "time_not_increasing: sample " + std::to_string(i + 1) + " at " + detail::fixed(s[i].t_s, 6) +
+                 " s follows one at " + detail::fixed(s[i - 1].t_s, 6) + " s";
       return out;
     }
-    if (!s[i].touch || !s[i - 1].touch) continue;
-    const double dx = std::fabs(s[i].x_mm - s[i - 1].x_mm);
-    // Two touching samples at one instant in two places: an infinite speed.
-    const double v = dt > 0 ? dx / dt : (dx > 0 ? INFINITY : 0.0);
-    out.max_speed_mm_s = std::max(out.max_speed_mm_s, v);
+    if (!s[i].touch || !s[i - 1].touch) {
+      close_span(i - 1);
+      span_from = i;
+      continue;
+    }
+    span_path += std::fabs(s[i].x_mm - s[i - 1].x_mm);
+    if (s[i].t_s - s[span_from].t_s >= min_span) close_span(i);
   }
-  if (!touched) {
-    out.flag = "no_touch";
+  if (!s.empty()) close_span(s.size() - 1);
+  const SwipeMeasures m = swipe_measures(s, limits.still_speed_mm_s);
+  if (!touched || (m.intervals == 0 && out.max_speed_mm_s == 0)) {
+    out.flag = "no_touch";  // touched in single samples only, or never: nothing to measure
     return out;
   }
-  if (out.max_speed_mm_s > max_plausible_speed_mm_s) {
-    out.flag = "implausible_speed";
+  const double sustained = m.touched_s > 0 ? m.distance_mm / m.touched_s : 0.0;
+  const double fastest = std::max({m.mean_speed_mm_s, sustained, out.max_speed_mm_s});
+  if (fastest > limits.max_speed_mm_s) {
+    out.flag = "implausible_speed: mean " + detail::fixed(m.mean_speed_mm_s, 1) + " mm/s, sustained " +
+               detail::fixed(sustained, 1) + " mm/s, fastest span " + detail::fixed(out.max_speed_mm_s, 1) +
+               " mm/s; allowed: at most " + detail::num(limits.max_speed_mm_s) + " mm/s";
     return out;
   }
-  const SwipeMeasures m = swipe_measures(s, still_speed_mm_s);
-  if (m.intervals == 0) {
-    out.flag = "no_touch";  // touched in single samples only: no interval to measure
+  if (m.intervals < limits.min_intervals || m.touched_s < limits.min_touched_s) {
+    out.flag = "too_short: " + std::to_string(m.intervals) + " intervals over " + detail::fixed(m.touched_s, 3) +
+               " s touched; needed: at least " + std::to_string(limits.min_intervals) + " intervals and " +
+               detail::num(limits.min_touched_s) + " s";
     return out;
   }
   out.measures = m;
   return out;
+}
+
+TraceMeasures measure_trace(const FingerTrace& trace, const SwipeLimits& limits) {
+  return measure_trace(std::span<const FingerSample>(trace.samples), limits);
 }
 
 std::string trace_samples_text(std::span<const FingerSample> samples) {

@@ -533,7 +533,19 @@ struct Session::Impl : SessionCore {
       tj["rendering"] = {{"pitch_db", truth.rendering->pitch_db}, {"irregularity_db", truth.rendering->irregularity_db}};
     qj["truth"] = tj;
     st.question_json = qj.dump();
-    st.response_json = response_view(r).dump();
+    ordered_json rv = response_view(r);
+    if (r.trace.source == TraceSource::display || r.trace.source == TraceSource::pointer) {
+      // The stored answer shows what the trial's finger measured, not what a front end claimed.
+      for (const char* k : {"swipe_mean_speed_mm_s", "swipe_sd_speed_mm_s", "directional_proportion", "swipe_flag"})
+        rv.erase(k);
+      if (std::isfinite(row.swipe_mean_speed_mm_s)) {
+        rv["swipe_mean_speed_mm_s"] = row.swipe_mean_speed_mm_s;
+        rv["swipe_sd_speed_mm_s"] = row.swipe_sd_speed_mm_s;
+        rv["directional_proportion"] = row.directional_proportion;
+      }
+      if (!row.swipe_flag.empty()) rv["swipe_flag"] = row.swipe_flag;
+    }
+    st.response_json = rv.dump();
     st.state_json = state;
     st.events = r.events;
     st.trace = r.trace;

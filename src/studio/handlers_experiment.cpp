@@ -19,7 +19,6 @@
 #include "texel/experiment/session_state.hpp"
 #include "texel/experiment/strokes.hpp"
 #include "texel/experiment/surface_maps.hpp"
-#include "texel/experiment/swipe_check.hpp"
 #include "texel/matfile.hpp"
 #include "texel/serial_link.hpp"
 #include "texel/surface2d.hpp"
@@ -249,6 +248,7 @@ void new_trial(State& s) {
   s.presenter->blank();
   pad_blank(s);
   s.trace.clear();
+  s.trace_client = 0;
   s.strokes2d->selected = -1;
 }
 
@@ -478,20 +478,19 @@ void on_experiment_answer(State& s, Client& c, const Job& job) {
       response.strokes = stroke_summaries(strokes_of(s), s.active->session.question());
   }
   if (!f.boolean("simulated", false)) {
-    // Swipe measures are the studio's, from the finger samples at the page's own times
-    // (feel.move t_ms), never the page's claim; an implausible trace stores none and says why.
+    // The finger that explored is the studio's record of the pointer (feel.move, on the page's own
+    // clock), never the page's claim: the library measures it by the one rule (finger_trace.hpp),
+    // stores it with the trial and flags a trace that cannot be a hand's.
     response.swipe_mean_speed_mm_s.reset();
     response.swipe_sd_speed_mm_s.reset();
     response.directional_proportion.reset();
     response.swipe_flag.clear();
     std::lock_guard lock(s.feel_mutex);
-    const ex::CheckedSwipe checked = ex::checked_swipe(s.trace);
-    if (checked.measures) {
-      response.swipe_mean_speed_mm_s = checked.measures->mean_speed_mm_s;
-      response.swipe_sd_speed_mm_s = checked.measures->sd_speed_mm_s;
-      response.directional_proportion = checked.measures->directional_proportion;
+    if (!s.trace.empty()) {
+      response.trace.source = ex::TraceSource::pointer;
+      response.trace.mode = ex::PresentationMode::host_streams;
+      response.trace.samples = s.trace;
     }
-    response.swipe_flag = checked.flag;
   }
   try {
     // The token rule (docs/studio.md): committed before the next question goes out, or refused.

@@ -104,15 +104,18 @@ void on_feel_move(State& s, Client& c, const Job& job) {
       s.finger_x = x;
       s.finger_down = touch;
       // Another page's clock: its samples start after a lift, so no interval spans two clocks.
-      if (s.trace_client != c.id && !s.trace.empty() && s.trace.back().touch && s.trace.size() < max_trace_samples) {
-        FingerSample lift = s.trace.back();
-        lift.touch = false;
-        s.trace.push_back(lift);
+      if (s.trace_client != c.id) {
+        if (!s.trace.empty() && s.trace.back().touch && s.trace.size() < max_trace_samples) {
+          FingerSample lift = s.trace.back();
+          lift.touch = false;
+          s.trace.push_back(lift);
+        }
+        s.trace_offset_ms = s.trace.empty() ? 0.0 : s.trace.back().t_s * 1000.0 - first_ms;
       }
       s.trace_client = c.id;
       for (const auto& [t, xe] : earlier)
-        if (s.trace.size() < max_trace_samples) s.trace.push_back({t / 1000.0, xe, touch});
-      if (s.trace.size() < max_trace_samples) s.trace.push_back({t_ms / 1000.0, x, touch});
+        if (s.trace.size() < max_trace_samples) s.trace.push_back({(t + s.trace_offset_ms) / 1000.0, xe, touch});
+      if (s.trace.size() < max_trace_samples) s.trace.push_back({(t_ms + s.trace_offset_ms) / 1000.0, x, touch});
     }
     s.presenter->pump();
   }

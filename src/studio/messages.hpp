@@ -142,6 +142,9 @@ struct State {
   // another page starts after a lift (its clock is another).
   std::vector<FingerSample> trace;
   std::uint64_t trace_client = 0;  // whose clock the trace's newest sample is on
+  // Added to that page's times (ms): a page taking over the trace starts where the last one ended
+  // (after a lift), so the stored trace's time never runs backwards across two pages' clocks.
+  double trace_offset_ms = 0.0;
 
   std::shared_ptr<Surface2DState> surface2d = make_surface2d_state();  // its own mutexes
   std::shared_ptr<Strokes2DState> strokes2d = make_strokes2d_state();  // FIFO worker only

@@ -88,7 +88,7 @@ texel::FingerSample script_at(double t_s) {
 texel::SwipeMeasures script_measures(const std::vector<texel::FingerSample>& trace) {
   std::vector<texel::FingerSample> s;
   for (const auto& sample : trace) s.push_back(script_at(sample.t_s));
-  return texel::swipe_measures(s, ex::still_speed_mm_s);
+  return texel::swipe_measures(s, ex::SwipeLimits{}.still_speed_mm_s);
 }
 
 // The display: the reference controller with the scripted sensor, every
@@ -346,7 +346,7 @@ TEST(DisplayLoop, StudiesRunEndToEndAndStoreTheFingerThatExplored) {
       f.t_s = sample.t_s;
       s.push_back(f);
     }
-    return texel::swipe_measures(s, ex::still_speed_mm_s);
+    return texel::swipe_measures(s, ex::SwipeLimits{}.still_speed_mm_s);
   };
 
   const auto csv = texel::test_support::run_cli(TEXEL_CLI, "experiment export --db " + tmp.at("s.db") + " -o " + tmp.at("t.csv"));

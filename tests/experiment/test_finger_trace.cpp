@@ -69,19 +69,41 @@ TEST(FingerTrace, ImplausibleTracesAreFlaggedNotMeasured) {
   for (int i = 0; i < 30; ++i) t.samples.push_back({1.0, static_cast<double>(i), true});
   ex::TraceMeasures m = measure_trace(t);
   EXPECT_FALSE(m.measures);
-  EXPECT_EQ(m.flag, "implausible_speed");
+  EXPECT_EQ(ex::flag_code(m.flag), "implausible_speed") << m.flag;
   // A jump between two touching samples (a missed lift): 50 mm in 1 ms.
   t.samples = strokes(100.0, 0.3, 1, 0.001);
   t.samples.insert(t.samples.begin() + 100, {t.samples[99].t_s + 0.0005, t.samples[99].x_mm + 50, true});
   m = measure_trace(t);
-  EXPECT_EQ(m.flag, "implausible_speed");
+  EXPECT_EQ(ex::flag_code(m.flag), "implausible_speed") << m.flag;
   EXPECT_GT(m.max_speed_mm_s, ex::max_plausible_speed_mm_s);
   // Time running backwards.
   t.samples = {{0.0, 1, true}, {0.002, 1.2, true}, {0.001, 1.3, true}};
-  EXPECT_EQ(measure_trace(t).flag, "time_not_increasing");
+  EXPECT_EQ(measure_trace(t).flag, "time_not_increasing: sample 3 at 0.001000 s follows one at 0.002000 s");
   // Never touched.
   t.samples = {{0.0, 1, false}, {0.1, 5, false}};
   EXPECT_EQ(measure_trace(t).flag, "no_touch");
+}
+
+TEST(FingerTrace, OneRuleForEverySourceShortTracesAndCoarseClocks) {
+  // Too little of a swipe to measure: 3 intervals over 3 ms.
+  std::vector<texel::FingerSample> s = {{0.0, 1, true}, {0.001, 1.1, true}, {0.002, 1.2, true}, {0.003, 1.3, true}};
+  ex::TraceMeasures m = ex::measure_trace(s);
+  EXPECT_FALSE(m.measures);
+  EXPECT_EQ(m.flag, "too_short: 3 intervals over 0.003 s touched; needed: at least 5 intervals and 0.1 s");
+  // A browser rounding PointerEvent.timeStamp to 1 ms at a 4 kHz pointer: pairs of samples share a
+  // stamp (0.025 mm apart, an infinite speed between them) yet the hand moves at 100 mm/s.
+  s.clear();
+  for (int i = 0; i < 2000; ++i) s.push_back({std::floor(i * 0.25) * 1e-3, 10 + i * 0.025, true});
+  m = ex::measure_trace(s);
+  ASSERT_TRUE(m.measures) << m.flag;
+  EXPECT_GT(m.max_speed_mm_s, 50.0);  // a lower bound: 2 ms of stamps timed as 3 ms
+  EXPECT_LE(m.max_speed_mm_s, 100.0);
+  EXPECT_EQ(ex::flag_code("implausible_speed: mean 1 mm/s"), "implausible_speed");
+  EXPECT_EQ(ex::flag_code("no_touch"), "no_touch");
+  // The limits are checked.
+  EXPECT_THROW(ex::measure_trace(s, {.max_speed_mm_s = 0}), texel::InvalidArgument);
+  // Stricter limits flag what the defaults take.
+  EXPECT_EQ(ex::flag_code(ex::measure_trace(s, {.max_speed_mm_s = 50}).flag), "implausible_speed");
 }
 
 TEST(FingerTrace, StoredTextRoundTripsAndBadLinesNameThemselves) {
@@ -166,5 +188,5 @@ TEST(FingerTrace, SessionFillsTheSwipeColumnsFromTheTrace) {
   t = answer(bad);
   EXPECT_TRUE(std::isnan(t.row.swipe_mean_speed_mm_s));
   EXPECT_TRUE(std::isnan(t.row.swipe_sd_speed_mm_s));
-  EXPECT_EQ(t.row.swipe_flag, "implausible_speed");
+  EXPECT_EQ(ex::flag_code(t.row.swipe_flag), "implausible_speed") << t.row.swipe_flag;
 }

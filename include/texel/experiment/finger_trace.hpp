@@ -52,22 +52,48 @@ struct FingerTrace {
   [[nodiscard]] bool empty() const { return samples.empty(); }
 };
 
-/// Fastest speed a finger exploring a texture plausibly reaches (mm/s): a
-/// faster interval is a sensor glitch, a missed lift or a clock error.
-inline constexpr double max_plausible_speed_mm_s = 2000.0;
-/// Intervals slower than this move neither way (sensor noise; mm/s).
-inline constexpr double still_speed_mm_s = 1.0;
+/// What a trace must be to give swipe measures: the one rule every front
+/// door applies (a display's reports, the studio's pointer, a simulated
+/// finger). A trace stamped on the wrong clock (arrival at a server, a burst
+/// of queued messages) gives speeds of 10⁵–10⁶ mm/s that look like data; a
+/// few samples give a mean of nothing; stored, either would enter the
+/// swipe-vs-threshold correlations silently. The limits are generous for a
+/// finger exploring a texture: 2,000 mm/s is twenty times the studies'
+/// typical swipe (100 mm/s), and 0.1 s of contact is shorter than any
+/// deliberate swipe.
+struct SwipeLimits {
+  double max_speed_mm_s = 2000.0;  ///< fastest plausible speed (mm/s), > 0
+  double min_touched_s = 0.1;      ///< least touched time for measures (s), >= 0
+  std::size_t min_intervals = 5;   ///< least touched intervals (consecutive touching samples)
+  double still_speed_mm_s = 1.0;   ///< intervals slower than this move neither way (sensor noise; mm/s)
+  /// The coarsest clock a source may stamp with (s): a browser may round
+  /// PointerEvent.timeStamp to 1 ms, so speeds are judged over spans of at
+  /// least twice this, each timed as its stamps' difference plus this.
+  double time_resolution_s = 0.001;
+};
+/// The defaults' fastest plausible speed (mm/s).
+inline constexpr double max_plausible_speed_mm_s = SwipeLimits{}.max_speed_mm_s;
 
 /// The swipe measures of a trace, or why there are none.
 struct TraceMeasures {
   std::optional<SwipeMeasures> measures;  ///< none when flagged or never touched
-  /// "" (measured), "no_touch", "time_not_increasing" (a sample older than the
-  /// one before it), "implausible_speed" (an interval faster than
-  /// max_plausible_speed_mm_s).
+  /// Empty when measured; otherwise a code, then ": " and the figures:
+  ///   no_touch             the finger never touched while moving
+  ///   time_not_increasing  a sample without a finite time or place, or older than the one before
+  ///   too_short            fewer than min_intervals touched intervals or under min_touched_s of contact
+  ///   implausible_speed    the mean, the sustained (path / touched time) or the fastest span's speed
+  ///                        above max_speed_mm_s: a glitch, a missed lift or a clock error
   std::string flag;
-  double max_speed_mm_s = 0.0;  ///< fastest touched interval seen
+  /// Fastest touched span (mm/s): a span's path over its stamps' time plus one
+  /// clock tick, so a lower bound of the true speed.
+  double max_speed_mm_s = 0.0;
 };
-TraceMeasures measure_trace(const FingerTrace& trace);
+/// The code of a flag ("implausible_speed" of "implausible_speed: mean …").
+std::string_view flag_code(std::string_view flag);
+
+/// Measures a trace and applies `limits` (InvalidArgument for bad limits).
+TraceMeasures measure_trace(std::span<const FingerSample> samples, const SwipeLimits& limits = {});
+TraceMeasures measure_trace(const FingerTrace& trace, const SwipeLimits& limits = {});
 
 /// The samples as stored: one "t_s,x_mm,touch" line each (µs and nm
 /// resolution), and back (FormatError naming `origin` and the line).

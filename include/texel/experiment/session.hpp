@@ -153,8 +153,8 @@ struct Response {
   double rt_ms = missing;                    ///< first presentation → answer
   std::vector<TrialEvent> events;            ///< presentation / selection events
   std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
-  /// Why a finger trace gave no swipe measures (swipe_check.hpp: "too_short: …",
-  /// "implausible_speed: …"); empty when they are stored or there was no trace.
+  /// Why a finger trace gave no swipe measures (TraceMeasures::flag in
+  /// finger_trace.hpp); empty when they are stored or there was no trace.
   std::string swipe_flag;
   /// A 2-D display's strokes, one entry per interval felt (strokes.hpp); fills
   /// the row's stroke columns.
