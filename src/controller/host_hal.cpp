@@ -60,6 +60,7 @@ int open_serial_port(const std::string& path, int baud) {
 HostHal::HostHal(int fd) : fd_(fd) {
   const int flags = fcntl(fd_, F_GETFL);
   if (flags >= 0) fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
+  tx_.reserve(tx_capacity);
 }
 
 HostHal::~HostHal() { close_link(); }
@@ -77,6 +78,10 @@ std::uint32_t HostHal::micros() {
 
 int HostHal::serial_read(std::uint8_t* buf, int max) {
   if (fd_ < 0) return -1;
+  if (!flush()) {
+    down_ = true;
+    return -1;
+  }
   const ssize_t n = ::read(fd_, buf, static_cast<std::size_t>(max));
   if (n > 0) {
     down_ = false;
@@ -87,21 +92,37 @@ int HostHal::serial_read(std::uint8_t* buf, int max) {
   return -1;
 }
 
-bool HostHal::serial_write(const std::uint8_t* buf, int n) {
-  if (fd_ < 0) return false;
-  int done = 0;
-  for (int spins = 0; done < n && spins < 1000; ++spins) {
-    const ssize_t w = ::write(fd_, buf + done, static_cast<std::size_t>(n - done));
+bool HostHal::flush() {
+  while (tx_head_ < tx_.size()) {
+    const ssize_t w = ::write(fd_, tx_.data() + tx_head_, tx_.size() - tx_head_);
     if (w > 0) {
-      done += static_cast<int>(w);
-    } else if (w < 0 && (errno == EAGAIN || errno == EINTR)) {
-      pollfd p{fd_, POLLOUT, 0};
-      ::poll(&p, 1, 1);
+      tx_head_ += static_cast<std::size_t>(w);
+    } else if (w < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) {
+      break;  // the link takes no more now: the rest waits in the queue
     } else {
       return false;
     }
   }
-  return done == n;
+  if (tx_head_ == tx_.size()) {
+    tx_.clear();
+    tx_head_ = 0;
+  } else if (tx_head_ > tx_capacity / 2) {
+    tx_.erase(tx_.begin(), tx_.begin() + static_cast<std::ptrdiff_t>(tx_head_));
+    tx_head_ = 0;
+  }
+  return true;
+}
+
+bool HostHal::serial_write(const std::uint8_t* buf, int n) {
+  if (fd_ < 0) return false;
+  if (!flush()) return false;
+  const auto bytes = static_cast<std::size_t>(n);
+  if (tx_.size() + bytes > tx_capacity) {
+    tx_dropped.fetch_add(1, std::memory_order_relaxed);  // the host stopped reading: this frame is lost whole
+    return true;
+  }
+  tx_.insert(tx_.end(), buf, buf + n);
+  return flush();
 }
 
 bool HostHal::read_position(std::int32_t& x_nm, bool& touch) {

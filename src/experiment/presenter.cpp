@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <list>
 #include <map>
 #include <mutex>
@@ -139,6 +140,41 @@ struct Presenter::Display1D {
   double first_s = 0.0;
   std::string error;
   std::optional<ReportReader> reader;  // host-streams only; last: stopped first
+
+  // display-plays: nothing streams, so no stream watchdog covers the map the
+  // display plays under the finger. A display of revision 1.2 has its host
+  // watchdog armed (host_watchdog_ms) and fed from a thread of its own every
+  // keepalive_ms, whatever the control thread is doing (rendering, an
+  // upload, waiting for a key): when this host dies (kill -9) or hangs, the
+  // display rests by itself within host_watchdog_ms. Re-armed at every
+  // trial (a display that timed out disarms itself).
+  static constexpr std::uint32_t host_watchdog_ms = 200;
+  static constexpr auto keepalive_every = std::chrono::milliseconds(40);
+  bool host_watchdog = false;  // the display took HOST_WATCHDOG
+  std::mutex keepalive_mutex;
+  std::condition_variable_any keepalive_wake;
+  std::jthread keepalive;  // stopped before the link is rested or goes
+
+  void arm_host_watchdog() {
+    host_watchdog = link->arm_host_watchdog(host_watchdog_ms);
+    if (!host_watchdog || keepalive.joinable()) return;
+    keepalive = std::jthread([this](std::stop_token stop) {
+      std::unique_lock lock(keepalive_mutex);
+      while (!stop.stop_requested()) {
+        try {
+          link->keepalive();
+        } catch (const std::exception&) {
+          return;  // the link is gone: the display's watchdog rests it
+        }
+        keepalive_wake.wait_for(lock, stop, keepalive_every, [] { return false; });
+      }
+    });
+  }
+  void stop_keepalive() {
+    if (!keepalive.joinable()) return;
+    keepalive.request_stop();
+    keepalive.join();
+  }
 
   void record(const FingerReport& r) {  // under mutex
     ++reports;
@@ -316,6 +352,7 @@ Presenter::~Presenter() { stop(); }
 void Presenter::stop() {
   SerialLink* rest_link = backend_ ? backend_->serial_link() : nullptr;
   if (display1d_ && display1d_->reader) display1d_->reader->stop();
+  if (display1d_) display1d_->stop_keepalive();  // the rest below, or the display's own watchdog
   if (display_ && display_->running()) {
     display_->stop();
     if (display_->error().empty()) try {
@@ -411,6 +448,7 @@ void Presenter::prepare(const Question& question) {
     Display1D& d = *display1d_;
     if (mode_ == PresentationMode::display_plays) {
       d.select(-1);
+      d.arm_host_watchdog();
       // As many of the trial's distinct stimuli as the display holds, before
       // onset (an oddity trial shows one texture twice: two maps for three).
       std::vector<const std::string*> distinct;
@@ -558,6 +596,7 @@ void Presenter::choose_mode(const BackendChoice& choice) {
     refuse("senses the finger; passive would ignore the participant's exploration (give display-plays or host-streams)");
   if (mode_ == PresentationMode::passive) return;  // streams the simulated sweep's drive, as before
   d->slots.resize(static_cast<std::size_t>(std::max(0, d->info.slots)));
+  if (mode_ == PresentationMode::display_plays) d->arm_host_watchdog();
   display1d_ = std::move(d);
 }
 

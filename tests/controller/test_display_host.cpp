@@ -18,6 +18,8 @@
 
 #include <csignal>
 
+#include <fcntl.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -616,6 +618,59 @@ TEST(HostSafety, AKilledHostLeavesTheDisplayAtRestWithin200MsAndCtrlCRestsItAtOn
       EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0);
     }
   }
+}
+
+// A study in display-plays streams nothing: the display plays its stored map
+// under its own finger, so no stream watchdog covers it. A host that hangs
+// with the link open (SIGSTOP: a frozen host, a debugger) is caught only by
+// the host watchdog the presenter arms and feeds from a thread of its own.
+TEST(HostSafety, AHungHostOfADisplayPlaysStudyLeavesTheDisplayAtRestWithin200Ms) {
+  test_support::TempDir tmp;
+  const std::string log = tmp.at("log.csv");
+  test_support::ControllerProcess display(TEXEL_CLI, {"--sensor", "strokes", "--sensor-lift-probability", "0", "--sensor-pause",
+                                                      "0", "--log", log, "--log-every", "1", "--quiet"});
+  ASSERT_FALSE(display.pty().empty());
+  const std::string backend = "serial:" + display.pty(), db = tmp.at("s.db");
+  const std::string protocol = std::string(TEXEL_PROTOCOLS_DIR) + "/texel-length.json";
+  const pid_t host = ::fork();
+  if (host == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    ::execl(TEXEL_CLI, TEXEL_CLI, "experiment", "run", protocol.c_str(), "--participant", "P01", "--db", db.c_str(), "--backend",
+            backend.c_str(), "--simulate", "default", "--pace", "3", "--mode", "display-plays", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Until the display plays a stimulus of the study (its log's latest row selects one), then a little longer.
+  bool playing = false;
+  for (int i = 0; i < 200 && !playing; ++i) {
+    std::this_thread::sleep_for(50ms);
+    const std::vector<LogRow> rows = read_log(log);
+    playing = !rows.empty() && rows.back().selected >= 0;
+  }
+  std::this_thread::sleep_for(300ms);
+  const std::uint32_t t_stop = display_clock_us();
+  ::kill(host, SIGSTOP);
+  std::this_thread::sleep_for(600ms);
+  const std::vector<LogRow> rows = read_log(log);
+  ::kill(host, SIGKILL);
+  int status = 0;
+  ::waitpid(host, &status, 0);
+  (void)display.stop();
+  ASSERT_TRUE(playing) << "the study never selected a stimulus on the display";
+  // The first logged tick from which the display stays at rest (a display
+  // stalled writing reports nobody reads logs no ticks: its rest comes late).
+  int selected_before = 0;
+  double rest_ms = 1e9;
+  for (const LogRow& r : rows) {
+    const double ms = static_cast<std::int32_t>(r.t_us - t_stop) / 1000.0;
+    if (ms > -100 && ms <= 0 && r.selected >= 0) ++selected_before;
+    const bool at_rest = r.selected < 0 && r.amplitude == 0;
+    if (!at_rest) rest_ms = 1e9;
+    else if (ms > 0 && rest_ms == 1e9) rest_ms = ms;
+  }
+  EXPECT_GT(selected_before, 100) << "the display was playing a stimulus when the host hung";
+  EXPECT_LE(rest_ms, 230.0) << "at rest " << rest_ms << " ms after the host hung";
 }
 
 TEST(ControllerCli, ARecorded1DTraceIsTheSensorAndBadOptionsAreRefusedWithTheirRange) {

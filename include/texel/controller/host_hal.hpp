@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "texel/controller/controller.hpp"
 
@@ -41,12 +42,24 @@ class HostHal final : public Hal {
   /// The last amplitude written and how many writes.
   std::atomic<std::uint16_t> amplitude{0};
   std::atomic<std::uint64_t> writes{0};
+  /// Frames dropped whole because the host stopped reading (the transmit
+  /// queue was full).
+  std::atomic<std::uint64_t> tx_dropped{0};
   /// Closes the descriptor (simulates unplugging the display).
   void close_link();
 
+  /// The transmit queue (bytes): what the link has not taken yet waits here,
+  /// so the output loop never blocks on a host that stopped reading — as a
+  /// firmware's USB or UART transmit buffer. A frame that does not fit is
+  /// dropped whole (the host sees the gap in the report sequence).
+  static constexpr std::size_t tx_capacity = 16384;
+
  private:
+  bool flush();  // writes what is queued, without blocking; false: the link is gone
   int fd_ = -1;
   bool down_ = false;
+  std::vector<std::uint8_t> tx_;  // reserved to tx_capacity once: no allocation in the loop
+  std::size_t tx_head_ = 0;       // the first byte not yet written
 };
 
 /// Opens a serial device or pty path read/write, non-blocking, raw 8N1 at
