@@ -89,10 +89,20 @@ class PySession {
     return parse_document(q.stimuli[i].document_json, "stimulus " + q.stimuli[i].label);
   }
 
-  void present(Presenter& presenter, std::size_t i) {
-    const Question& q = active().session.question();
+  // The first presentation of a trial prepares the presenter for it (a
+  // display that stores maps gets the trial's stimuli; the finger trace
+  // starts), as the terminal runner does; record() stores that trace.
+  void present(const py::object& presenter_object, std::size_t i) {
+    auto& presenter = presenter_object.cast<Presenter&>();
+    ActiveSession& a = active();
+    const Question& q = a.session.question();
     if (i >= q.stimuli.size())
       throw InvalidArgument("stimulus is " + std::to_string(i) + "; this question has " + std::to_string(q.stimuli.size()));
+    if (!traced() || traced_trial_ != q.trial || !traced_.is(presenter_object)) {
+      presenter.prepare(q);
+      traced_ = presenter_object;
+      traced_trial_ = q.trial;
+    }
     presenter.show(q.stimuli[i].document_json);
     if (shown_at_.empty()) shown_at_ = utc_timestamp();
   }
@@ -108,9 +118,13 @@ class PySession {
     ActiveSession& a = active();
     Response r = Response::from_json(to_json(response));
     if (r.shown_at.empty()) r.shown_at = shown_at_;
+    // The finger that explored this trial on the presenter it was played on.
+    if (traced() && !a.session.finished() && traced_trial_ == a.session.question().trial)
+      r.trace = traced_.cast<Presenter&>().take_trace();
     const std::string t_token = token ? *token : hand_out(a).token;
     const StoredTrial t = experiment::record(store_->get(), &a, t_token, std::move(r));  // committed before it returns
     shown_at_.clear();
+    traced_ = py::object();
     return rows_records({t.row})[0].cast<py::dict>();
   }
 
@@ -118,11 +132,16 @@ class PySession {
   std::shared_ptr<StoreHandle> store_;
   std::optional<ActiveSession> active_;
   std::string shown_at_;  // when the current question's first stimulus was presented
+  py::object traced_;     // the Presenter prepared for the current trial (null: none yet)
+  [[nodiscard]] bool traced() const { return static_cast<bool>(traced_); }
+  int traced_trial_ = -1;
 };
 
 PresenterOptions presenter_options(const std::string& backend, double rate_hz, double swipe_speed_mm_s,
-                                   const std::string& audio_device, const std::string& response) {
+                                   const std::string& audio_device, const std::string& response,
+                                   const std::optional<std::string>& mode) {
   PresenterOptions o;
+  if (mode) o.mode = parse_presentation_mode(*mode, "mode");
   o.backend = backend;
   o.rate_hz = rate_hz;
   o.swipe_speed_mm_s = swipe_speed_mm_s;
@@ -144,15 +163,23 @@ rate_hz           output rate of 'null' / 'audio' (Hz) [48000]
 swipe_speed_mm_s  the simulated finger's speed where the backend senses none (mm/s) [100]
 audio_device      PortAudio device index or name part ['' = default]
 response          'limit' (never drive what the display attenuates by 20 dB or more) or 'off' ['limit']
+mode              how stimuli reach the finger: 'display-plays' (a serial display that stores maps
+                  plays them from its own finger sensor), 'host-streams' (the host streams the
+                  output from the display's reported finger) or 'passive' (a simulated sweep, where
+                  no finger exists) [None: what the display's HELLO allows, in that order]
 
 Call pump() often (every ≤ 20 ms) from the loop that owns the window; close() (or the end of
 a with block) stops the backend.)doc")
       .def(py::init([](const std::string& backend, double rate_hz, double swipe_speed_mm_s, const std::string& audio_device,
-                       const std::string& response) {
-             return std::make_unique<Presenter>(presenter_options(backend, rate_hz, swipe_speed_mm_s, audio_device, response));
+                       const std::string& response, const std::optional<std::string>& mode) {
+             return std::make_unique<Presenter>(
+                 presenter_options(backend, rate_hz, swipe_speed_mm_s, audio_device, response, mode));
            }),
            py::arg("backend") = "null", py::kw_only(), py::arg("rate_hz") = 48000.0, py::arg("swipe_speed_mm_s") = 100.0,
-           py::arg("audio_device") = "", py::arg("response") = "limit")
+           py::arg("audio_device") = "", py::arg("response") = "limit", py::arg("mode") = py::none())
+      .def_property_readonly(
+          "mode", [](const Presenter& p) { return std::string(to_string(p.mode())); },
+          "The presentation mode in force: 'display-plays', 'host-streams' or 'passive'.")
       .def(
           "show", [](Presenter& p, const py::object& stimulus) { p.show(document_text(stimulus)); }, py::arg("stimulus"),
           "Plays a stimulus: a question's stimulus dict, a document dict, a texel.Document or JSON text.")
@@ -235,7 +262,9 @@ later Session(..., resume=True) continues where it stopped.)doc")
       .def("stimulus", &PySession::stimulus, py::arg("index"),
            "Stimulus `index` of the current question as a texel.Document (render() it for your own output).")
       .def("present", &PySession::present, py::arg("presenter"), py::arg("index") = 0,
-           "Plays stimulus `index` of the current question on a Presenter (the first call stamps shown_at).")
+           "Plays stimulus `index` of the current question on a Presenter. The trial's first call stamps\n"
+           "shown_at and prepares the presenter (a display that stores maps gets the trial's stimuli; the\n"
+           "finger trace starts); record() stores that trace and its swipe measures with the trial.")
       .def("simulated_response", &PySession::simulated_response,
            "The simulated participant's answer to the current question (sessions opened with simulate=).")
       .def("record", &PySession::record, py::arg("response"), py::arg("token") = py::none(),

@@ -1,6 +1,9 @@
 """texel.experiment: a protocol run from Python, one question at a time, on
 the engine the terminal runner drives — so a simulated participant's rows
 equal `texel experiment run --simulate`'s, and resume is exact."""
+import os
+import subprocess
+
 import pytest
 
 import texel
@@ -144,3 +147,38 @@ def test_answers_are_bound_to_the_question_token(protocol, tmp_path):
         assert s.trials_done == 1
         row = s.record({"choice": s.question["choices"][0]})  # the current token by default
         assert row["trial_number"] == 2 and row["interrupted"] == 0
+
+
+def test_a_display_plays_the_trials_and_its_finger_fills_the_swipe_columns(protocol, tmp_path, cli):
+    """A script on a real display: the reference controller with a scripted 1-D finger. The display
+    stores each trial's stimuli and plays them from its own sensor; the rows carry its finger."""
+    exe = os.environ.get("TEXEL_BIN") or str(cli("--version").args[0])
+    ctl = subprocess.Popen([exe, "controller", "--pty", "--sensor", "strokes", "--quiet"], stdout=subprocess.PIPE,
+                           stderr=subprocess.DEVNULL, text=True)
+    try:
+        pty = ctl.stdout.readline().strip()
+        assert pty.startswith("/dev/"), pty
+        with pytest.raises(texel.InvalidArgument, match="passive"):
+            Presenter("serial:" + pty, mode="passive")  # the display senses the finger: passive would ignore it
+        with pytest.raises(texel.InvalidArgument, match="allowed: display-plays, host-streams, passive"):
+            Presenter("null", mode="sideways")
+        db = tmp_path / "display.db"
+        with texel.Store(db, mode="rw") as store, Session(store, protocol, "P01", simulate="default") as s, \
+                Presenter("serial:" + pty) as player:
+            assert player.mode == "display-plays"
+            for _ in range(3):
+                q = s.question
+                for i in range(len(q["stimuli"])):
+                    s.present(player, i)
+                    player.wait(0.35)
+                row = s.record(s.simulated_response())
+                assert row["presentation_mode"] == "display-plays"
+                assert row["finger_source"] == "display"
+                assert row["swipe_flag"] == "", row["swipe_flag"]
+                # The scripted strokes: tens of mm/s, never the simulated observer's drawn figures alone.
+                assert 5 < row["swipe_mean_speed_mm_s"] < 1000
+        with texel.Store(db) as store:
+            assert len(store.rows()) == 3
+    finally:
+        ctl.terminate()
+        ctl.wait(5)
