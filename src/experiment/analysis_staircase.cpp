@@ -103,6 +103,11 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
   std::map<std::string, std::map<std::string, std::vector<double>>> conv, thr;
   std::map<std::string, std::map<std::string, std::vector<double>>> swipe[3];
   std::map<std::string, double> block_fine;
+  // The fingers behind the swipe measures (trials of counted runs): a
+  // display's or a pointer's, the simulated sweep of a passive presentation
+  // or the simulated observer's draws (finger_source "simulated"), flagged
+  // traces (no measures) and trials without any.
+  std::map<std::string, std::size_t> fingers;
   for (const Run& run : staircase_runs(rows)) {
     const TrialRow& last = *run.rows.back();
     // Texel length: the group is the block's condition (one group per participant).
@@ -162,6 +167,12 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     runs.push_back(std::move(j));
     if (!counted) continue;
     if (!coarse) {
+      for (const TrialRow* r : run.rows)
+        ++fingers[!r->swipe_flag.empty()                     ? "flagged"
+                  : !std::isfinite(r->swipe_mean_speed_mm_s) ? "none"
+                  : r->finger_source.empty()                 ? "unlabelled"
+                  : r->presentation_mode == "passive"        ? "simulated (passive)"
+                                                             : r->finger_source];
       swipe[0][group][run.participant].push_back(speed);
       swipe[1][group][run.participant].push_back(speed_sd);
       swipe[2][group][run.participant].push_back(dir);
@@ -216,6 +227,20 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
         cv.push_back(v);
         for (int k = 0; k < 3; ++k) m[static_cast<std::size_t>(k)].second.push_back(mean_of(swipe[k][b][p]));
       }
+    // What the swipe measures are: a correlation over simulated sweeps says
+    // nothing of how participants explore, so the report names the fingers.
+    json f = json::object();
+    std::string listed;
+    for (const auto& [source, n] : fingers) {
+      f[source] = n;
+      listed += (listed.empty() ? "" : ", ") + std::to_string(n) + " " + source;
+    }
+    out["swipe_fingers"] = f;
+    text += "  swipe measures (trials by finger): " + (listed.empty() ? std::string("none") : listed) + "\n";
+    if (fingers.count("simulated (passive)") || fingers.count("simulated"))
+      text +=
+          "  (simulated: a passive presentation's sweep or the simulated observer's draws, not a participant's "
+          "exploration)\n";
     out["swipe_vs_convergent"] = swipe_correlations(m, cv, o, text);
     return out;
   }

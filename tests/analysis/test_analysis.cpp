@@ -797,6 +797,25 @@ TEST(Analysis, TexelLengthBetweenGroupsAndSwipeCorrelations) {
   EXPECT_NEAR(bg["t_tests"][1]["welch"]["p"].get<double>(), 0.007118114438, 1e-11);
   EXPECT_NEAR(bg["t_tests"][2]["student"]["t"].get<double>(), 0.2253846897, 1e-9);
   EXPECT_NEAR(bg["t_tests"][2]["student"]["p"].get<double>(), 0.8306024562, 1e-9);
+  // The fingers behind the swipe measures are named: these rows predate the finger columns...
+  EXPECT_EQ(s["swipe_fingers"], json({{"unlabelled", 33}}));
+  EXPECT_NE(report.text.find("swipe measures (trials by finger): 33 unlabelled\n"), std::string::npos) << report.text;
+  {
+    // ...and a passive presentation's simulated sweep is said to be one, beside a display's finger.
+    std::vector<TrialRow> rows = texel_length_groups();
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      rows[i].finger_source = i % 3 ? "display" : "simulated";
+      rows[i].presentation_mode = i % 3 ? "display-plays" : "passive";
+    }
+    rows[1].swipe_flag = "too_short: 2 intervals over 0.004 s touched";
+    const AnalysisReport labelled = analyze(rows, {});
+    EXPECT_EQ(summary_of(labelled)["texel-length"]["swipe_fingers"],
+              json({{"display", 21}, {"flagged", 1}, {"simulated (passive)", 11}}));
+    EXPECT_NE(labelled.text.find("swipe measures (trials by finger): 21 display, 1 flagged, 11 simulated (passive)\n  "
+                                 "(simulated: a passive presentation's sweep"),
+              std::string::npos)
+        << labelled.text;
+  }
   // scipy.stats.pearsonr against the 11 convergent values, Fisher CI.
   const json& sw = s["swipe_vs_convergent"];
   ASSERT_EQ(sw.size(), 3u);
