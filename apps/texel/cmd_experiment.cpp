@@ -373,7 +373,7 @@ void run(const RunArgs& a) {
   } else if (!sim && !a.quiet) {
     // The participant's screen: no figures; the experimenter's line last.
     tell_participant(finished ? "\nThe study is complete. Thank you for taking part!"
-                              : "\nThe study is paused and your answers are saved. Please tell the experimenter.");
+                              : "\nThe study has stopped here and your answers are saved. Please tell the experimenter.");
     if (!finished) tell_participant("(experimenter: continue with " + resume_command + ")");
   } else if (!a.quiet) {
     std::cout << (finished ? "finished" : "stopped") << " session " << info.id << " (" << protocol.name << ", " << a.participant
