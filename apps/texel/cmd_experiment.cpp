@@ -154,15 +154,20 @@ void run(const RunArgs& a) {
   po.audio_device = a.audio_device;
   po.response_handling = parse_response_handling(a.response, "--response");
   if (a.mode) po.mode = ex::parse_presentation_mode(*a.mode, "--mode");
-  if (a.finger) {
+  const auto two_d = [](const ex::Block& b) { return b.task == "oddity-2d"; };
+  const bool all_2d = std::all_of(protocol_file.blocks.begin(), protocol_file.blocks.end(), two_d);
+  if (a.finger && !std::any_of(protocol_file.blocks.begin(), protocol_file.blocks.end(), two_d)) {
+    // A 1-D study: the finger from a sensor on a link of its own, streamed to the backend (host-streams).
+    po.finger = ex::FingerSource::sensor;
+    po.finger_display = *a.finger;
+  } else if (a.finger) {
     // The participant strokes a 2-D display: every block must be a 2-D oddity.
     if (a.simulate)
       throw InvalidArgument("--finger: a simulated participant does not stroke a display; give --finger or --simulate");
-    for (const auto& b : protocol_file.blocks)
-      if (b.task != "oddity-2d")
-        throw InvalidArgument("--finger: block '" + b.name + "' is task '" + b.task +
-                              "'; --finger is a 2-D display for task oddity-2d; a 1-D study takes the finger from the "
-                              "--backend serial:PATH display's own sensor (--mode display-plays or host-streams)");
+    if (!all_2d)
+      throw InvalidArgument(
+          "--finger: the protocol mixes 2-D (oddity-2d) and 1-D blocks; a 2-D display's finger plays "
+          "the 2-D blocks only: run them as a protocol of their own");
     po.finger = ex::FingerSource::display;
     po.finger_display = *a.finger;
     po.stroke_rules.tolerance_deg = a.direction_tolerance_deg;
@@ -456,8 +461,10 @@ void register_experiment(CLI::App& app) {
   run_cmd->add_option("--backend", a->backend, "Stimulus output: null (no hardware), audio (PortAudio) or serial:PATH [null]");
   run_cmd->add_option("--audio-device", a->audio_device, "PortAudio output: index or name substring [default output]");
   run_cmd->add_option("--finger", a->finger,
-                      "The participant strokes a 2-D display that reports the finger: serial:PATH (oddity-2d studies; "
-                      "the same PATH as --backend serial:PATH, or another display)");
+                      "Where the participant's finger comes from, serial:PATH. oddity-2d studies: the 2-D display the "
+                      "participant strokes (the --backend serial:PATH display, or another). 1-D studies: a sensor on a "
+                      "link of its own (a display or strip that reports the finger) while the --backend plays, e.g. a "
+                      "sound card's actuators (host-streams)");
   run_cmd->add_option("--mode", a->mode,
                       "How the stimuli reach the finger: display-plays (the display stores each stimulus and plays it "
                       "from its own finger sensor), host-streams (the host streams the drive from the display's reported "

@@ -108,6 +108,7 @@ struct Presenter::Display2D {
 // player takes them) become the trial's finger trace; in display-plays the
 // display's slots hold the trial's stimuli.
 struct Presenter::Display1D {
+  std::unique_ptr<SerialLink> own_link;  // FingerSource::sensor: the sensor's own link (the backend has another)
   SerialLink* link = nullptr;
   DisplayInfo info;
   bool sensor = false;
@@ -298,7 +299,10 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
   backend_ = make_backend(choice, bo, blank_map);
   if (options_.finger != FingerSource::display) {
-    choose_mode(choice);
+    if (options_.finger == FingerSource::sensor)
+      open_sensor(choice);
+    else
+      choose_mode(choice);
     if (mode_ == PresentationMode::display_plays) {
       running_ = true;  // nothing streams: the display plays; pump() reads its reports
       return;
@@ -377,6 +381,11 @@ void Presenter::stop() {
       } catch (const std::exception&) {
       }
   }
+  if (display1d_ && display1d_->own_link && display1d_->sensor) try {
+      display1d_->sensor = false;
+      display1d_->link->start_reports(0);  // the sensor stops reporting (its link rests as it closes)
+    } catch (const std::exception&) {
+    }
   if (player_) player_->collect();
   if (display_) display_->player.collect();
 }
@@ -600,6 +609,38 @@ void Presenter::choose_mode(const BackendChoice& choice) {
   display1d_ = std::move(d);
 }
 
+void Presenter::open_sensor(const BackendChoice& choice) {
+  const std::string& f = options_.finger_display;
+  if (!f.starts_with("serial:") || f.size() <= 7)
+    throw InvalidArgument("finger sensor is '" + f + "'; allowed: serial:PATH (a display or strip that reports the finger)");
+  const std::string path = f.substr(7);
+  if (choice.kind == BackendChoice::Kind::serial && choice.serial_path == path)
+    throw InvalidArgument("--finger " + f +
+                          " is the backend's own display: a display with a sensor is its own finger (give no --finger)");
+  mode_ = options_.mode.value_or(PresentationMode::host_streams);
+  if (mode_ != PresentationMode::host_streams)
+    throw InvalidArgument("--mode " + std::string(to_string(mode_)) + ": with a separate finger sensor (" + f +
+                          ") the host streams the stimulus from its reports; give --mode host-streams or none");
+  if (options_.report_interval_us < serial::min_report_interval_us)
+    throw InvalidArgument("report interval is " + std::to_string(options_.report_interval_us) +
+                          " µs; allowed >= " + std::to_string(serial::min_report_interval_us));
+  auto d = std::make_unique<Display1D>();
+  d->own_link = std::make_unique<SerialLink>(path, options_.baud);
+  d->link = d->own_link.get();
+  d->info = d->link->hello();
+  d->report_interval_us = options_.report_interval_us;
+  try {
+    d->link->start_reports(d->report_interval_us);
+  } catch (const SerialError& e) {
+    if (e.code == serial::ErrorCode::no_sensor || e.code == serial::ErrorCode::unknown_type)
+      throw InvalidArgument("--finger " + f + ": the display '" + d->info.name +
+                            "' does not report the finger (it refused FINGER reports); give a sensor that does");
+    throw;
+  }
+  d->sensor = true;
+  display1d_ = std::move(d);
+}
+
 FingerTrace Presenter::take_trace() {
   FingerTrace t;
   t.mode = mode_;
@@ -694,7 +735,10 @@ std::string Presenter::describe() const {
            "finger sensor (" +
            std::to_string(i.slots) + " slots)";
   }
-  return backend_->describe() + ", " + std::string(to_string(mode_));
+  std::string out = backend_->describe() + ", " + std::string(to_string(mode_));
+  if (display1d_ && display1d_->own_link)
+    out += " from the finger sensor " + display1d_->link->name() + " ('" + display1d_->info.name + "')";
+  return out;
 }
 double Presenter::block_period_s() const { return mode_ == PresentationMode::display_plays ? 0.0 : period_s_; }
 std::string Presenter::error() const {

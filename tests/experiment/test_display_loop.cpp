@@ -23,6 +23,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <mutex>
 #include <thread>
 
@@ -372,6 +373,51 @@ TEST(DisplayLoop, StudiesRunEndToEndAndStoreTheFingerThatExplored) {
                   row.protocol.c_str(), row.trial, t.trace.samples.size(), row.swipe_mean_speed_mm_s, want.mean_speed_mm_s,
                   row.swipe_sd_speed_mm_s, want.sd_speed_mm_s, row.directional_proportion, want.directional_proportion);
     }
+}
+
+// A 1-D study whose stimuli play on another backend (here the null one, as a
+// sound card's actuators would) with the finger from a sensor on a link of
+// its own (`--finger serial:PATH`): host-streams from the sensor's reports,
+// and every trial stores that finger. What cannot work is refused with one
+// line before the first trial.
+TEST(DisplayLoop, AOneDStudyTakesItsFingerFromASeparateSensor) {
+  texel::test_support::TempDir tmp("display-sensor");
+  texel::write_file_atomic(tmp.at("p.json"), short_texel_length(3));
+  texel::test_support::ControllerProcess sensor(TEXEL_CLI, {"--sensor", "strokes", "--duration", "120", "--quiet"});
+  texel::test_support::ControllerProcess no_sensor(TEXEL_CLI, {"--duration", "120", "--quiet"});
+  ASSERT_FALSE(sensor.pty().empty());
+  ASSERT_FALSE(no_sensor.pty().empty());
+  const std::string base = "experiment run " + tmp.at("p.json") + " --participant P1 --db " + tmp.at("s.db") + " ";
+  const auto run = [&](const std::string& extra) { return texel::test_support::run_cli(TEXEL_CLI, base + extra, false); };
+  const auto refused = [&](const std::string& extra, const std::string& why) {
+    const auto r = texel::test_support::run_cli(TEXEL_CLI, base + extra);
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(why), std::string::npos) << r.out;
+  };
+  refused("--simulate default --finger serial:" + no_sensor.pty(), "does not report the finger");
+  refused("--simulate default --backend serial:" + sensor.pty() + " --finger serial:" + sensor.pty(),
+          "is the backend's own display");
+  refused("--simulate default --finger serial:" + sensor.pty() + " --mode display-plays", "give --mode host-streams");
+  refused("--simulate default --finger usb:1", "allowed: serial:PATH");
+  EXPECT_FALSE(std::filesystem::exists(tmp.at("s.db"))) << "a refused run stores nothing";
+
+  const auto r = run("--simulate default --pace 1.2 --backend null --finger serial:" + sensor.pty() + " --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["mode"], "host-streams");
+  EXPECT_TRUE(j["finished"].get<bool>());
+  EXPECT_GT(j["finger_reports"].get<int>(), 500);
+  EXPECT_NE(j["backend"].get<std::string>().find("from the finger sensor " + sensor.pty()), std::string::npos);
+  const ex::Store store = ex::Store::open(tmp.at("s.db"), ex::StoreMode::read_only);
+  const auto rows = store.rows(store.sessions().at(0).id);
+  ASSERT_EQ(rows.size(), 3u);
+  for (const ex::TrialRow& row : rows) {
+    EXPECT_EQ(row.presentation_mode, "host-streams");
+    EXPECT_EQ(row.finger_source, "display");
+    EXPECT_EQ(row.swipe_flag, "");
+    EXPECT_GT(row.swipe_mean_speed_mm_s, 5.0);  // the stroke script's, not a simulated sweep's 100 mm/s
+  }
+  EXPECT_NE(sensor.stop().find("bad 0"), std::string::npos);
 }
 
 // Every way a run ends leaves the display at rest (STATUS from a new host):

@@ -87,8 +87,11 @@
 namespace texel::experiment {
 
 /// Where finger positions come from (see the banner): simulated, pushed from
-/// outside (the studio's strip), or a 2-D display's own sensor.
-enum class FingerSource { simulated, external, display };
+/// outside (the studio's strip), a 2-D display's own sensor, or a 1-D
+/// sensor on a link of its own (`sensor`: a display or touch strip that
+/// reports the finger while the backend — a sound card's actuators, or a
+/// display without a sensor — plays; always host-streams).
+enum class FingerSource { simulated, external, display, sensor };
 
 struct PresenterOptions {
   std::string backend = "null";  ///< "null", "audio", "serial:PATH"
@@ -106,7 +109,9 @@ struct PresenterOptions {
   /// limit: attenuation (dB) at which the display no longer reproduces, 3 … 60 [20].
   double response_limit_db = 20.0;
   /// FingerSource::display: the display that reports the finger, "serial:PATH"
-  /// (the backend's own path, or another display's).
+  /// (the backend's own path, or another display's); FingerSource::sensor:
+  /// the 1-D sensor's "serial:PATH" (never the backend's own: a display with
+  /// a sensor is its own finger).
   std::string finger_display;
   std::uint32_t report_interval_us = 1000;  ///< FINGER report interval asked of the display
   int baud = 921600;
@@ -232,6 +237,7 @@ class Presenter {
   std::size_t shown_ = 0;
   bool running_ = false;
   void choose_mode(const BackendChoice& choice);
+  void open_sensor(const BackendChoice& choice);  // FingerSource::sensor
 };
 
 }  // namespace texel::experiment
