@@ -278,11 +278,12 @@ TEST(Presenter2D, TerminalRunStoresStrokesAndShowsNothingOfTheCondition) {
   EXPECT_EQ(compliance["compliant"], 0);
   EXPECT_NEAR(compliance["deviation_deg_median"].get<double>(), 60, 0.5);
 
-  // A display without a sensor, a 1-D protocol, a simulated participant: one line each, nothing written.
+  // A display without a sensor, a 1-D protocol in another mode than host-streams, a simulated participant:
+  // one line each, nothing written.
   texel::test_support::ControllerProcess blind(TEXEL_CLI, {"--duration", "30", "--quiet"});
   for (const auto& [args, words] : std::vector<std::pair<std::string, std::string>>{
            {tmp.at("p.json") + " --finger serial:" + blind.pty(), "no finger sensor"},
-           {protocols + "texel-length.json --finger " + port, "a 1-D study takes the finger from the --backend"},
+           {protocols + "texel-length.json --finger " + port + " --mode display-plays", "give --mode host-streams"},
            {tmp.at("p.json") + " --finger " + port + " --simulate default", "does not stroke"}}) {
     const auto no = texel::test_support::run_cli(
         TEXEL_CLI, "experiment run " + args + " --participant P02 --db " + tmp.at("n.db") + " --backend null");
