@@ -525,8 +525,13 @@ typedef struct texel_encode2d_options {
 
 TEXEL_API texel_encode2d_options texel_encode2d_options_default(void);
 
-/* Encodes a map of width_px × height_px amplitudes in [0, 1] (row-major, rows
- * along y, pixel pitch pitch_mm): the 1-D encoder's settings from `options`
+/* Encodes a map of width_px × height_px values (row-major, rows
+ * along y, pixel pitch pitch_mm), read by the library's one input rule: all in
+ * [0, 1], amplitudes as they are; any value outside, the map scaled to full
+ * range (a = 0.5 + 0.5·y/max|y|, y the zero-mean values; never clamped);
+ * refused with TEXEL_INVALID_ARGUMENT naming `amplitudes` when a value is not
+ * finite or the map is constant outside [0, 1] (as texel_encode; c-api.md
+ * "Input amplitudes"). The 1-D encoder's settings from `options`
  * (the perceptual model, target, …; NULL = the defaults), the 2-D encoder's
  * from `options2d` (NULL = the defaults). With the defaults a 400 × 400 map
  * takes about ten seconds. */

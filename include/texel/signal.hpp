@@ -107,6 +107,15 @@ struct Signal {
   [[nodiscard]] Millimetres length() const { return spacing * static_cast<double>(samples.size()); }
 };
 
+/// The one input rule for amplitude maps, 1-D or 2-D, at every front door
+/// (a file, a Python array, a C or MEX array): values all in [0, 1] are kept
+/// as they are; a map with any value outside [0, 1] (raw counts, signed
+/// data, a map ×100) is scaled to full range, a = 0.5 + 0.5·y/max|y| for the
+/// zero-mean values y — never clamped. Returns true when it scaled. Throws
+/// FormatError naming `origin`: a non-finite value (its element), a constant
+/// map outside [0, 1] (it holds no texture).
+bool to_amplitudes(std::span<double> values, std::string_view origin);
+
 /// Loads any texture signal from a file (format by extension). Throws as
 /// described above; messages name the file.
 Signal load_signal(const std::string& path, const SignalOptions& options = {});

@@ -6,13 +6,15 @@
 #include "common.hpp"
 #include "texel/codec.hpp"
 #include "texel/error.hpp"
+#include "texel/signal.hpp"
 
 namespace texel::python {
 namespace {
 
-/// A 2-D array of amplitudes in [0, 1] (rows along y) as a raster of pitch `pitch_mm`.
+/// A 2-D array (rows along y) as a raster of pitch `pitch_mm`, read by the
+/// one input rule (texel::to_amplitudes, on the values as doubles).
 Raster2D raster_of(const py::handle& values, double pitch_mm) {
-  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(values);
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
   if (!a) throw py::type_error("the map must be a 2-D array of numbers");
   if (a.ndim() != 2)
     throw InvalidArgument("the map has " + std::to_string(a.ndim()) + " dimensions; it must be 2-D (rows along y)");
@@ -20,7 +22,9 @@ Raster2D raster_of(const py::handle& values, double pitch_mm) {
   r.height = static_cast<int>(a.shape(0));
   r.width = static_cast<int>(a.shape(1));
   r.pitch = Millimetres(pitch_mm);
-  r.values.assign(a.data(), a.data() + a.size());
+  std::vector<double> v(a.data(), a.data() + a.size());
+  (void)to_amplitudes(v, "the map");  // texel/signal.hpp
+  r.values.assign(v.begin(), v.end());
   return r;
 }
 
@@ -160,9 +164,11 @@ void register_encode2d(py::module_& m) {
       R"doc(Encodes a 2-D texture into a version-4 2-D document (one region covering the map) with the 1-D
 encoder's perceptual model, as `texel encode map.png` (docs/encoder.md, "2-D inputs").
 
-source            a 2-D array of amplitudes in [0, 1] (rows along y; needs pitch_mm or a device with a
-                  bitmap), a path to a grey 8/16-bit .png or a 2-D .npy (a height map, values outside
-                  [0, 1], is scaled), or a .scans.json bundle of 1-D scans along several directions
+source            a 2-D array (rows along y; needs pitch_mm or a device with a bitmap), a path to a
+                  grey 8/16-bit .png or a 2-D .npy, or a .scans.json bundle of 1-D scans along several
+                  directions. An array or .npy with values all in [0, 1] is taken as amplitudes; one
+                  with any value outside (a height map, raw counts) is scaled to full range — the rule
+                  of every front door (the CLI, C, MEX)
 pitch_mm          pixel pitch (mm) [the device's bitmap pitch]
 device            the display the document is for (name, path or DeviceProfile) [an inline profile of
                   the map's size]

@@ -1036,7 +1036,14 @@ texel_status texel_encode_2d(const double* amplitudes, int width_px, int height_
     map.width = width_px;
     map.height = height_px;
     map.pitch = texel::Millimetres(pitch_mm);
-    map.values.assign(amplitudes, amplitudes + static_cast<std::size_t>(width_px) * static_cast<std::size_t>(height_px));
+    // The one input rule, on the doubles given (as the CLI applies it to a .npy's): texel::to_amplitudes.
+    std::vector<double> values(amplitudes, amplitudes + static_cast<std::size_t>(width_px) * static_cast<std::size_t>(height_px));
+    try {
+      (void)texel::to_amplitudes(values, "amplitudes");
+    } catch (const texel::FormatError& e) {
+      throw InvalidArgument(e.what());  // an argument, not a file (as map_signal)
+    }
+    map.values.assign(values.begin(), values.end());
     return std::make_unique<texel_encode2d_result>(texel_encode2d_result{texel::codec::encode_surface2d(map, config)});
   });
 }

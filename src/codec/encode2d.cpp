@@ -14,6 +14,7 @@
 #include "texel/encode2d.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/signal.hpp"
 #include "texel/surface2d.hpp"
 
 namespace texel::codec {
@@ -604,22 +605,26 @@ double strength(double v) {
 
 }  // namespace
 
-Encode2DResult encode_surface2d(const Raster2D& map, const Encode2DConfig& config) {
+Encode2DResult encode_surface2d(const Raster2D& given, const Encode2DConfig& config) {
   check_config(config);
-  const int w = map.width, h = map.height;
-  const double p = map.pitch.value();
+  const int w = given.width, h = given.height;
+  const double p = given.pitch.value();
   if (!(std::isfinite(p) && p > 0.0)) throw InvalidArgument("the map's pitch is " + detail::num(p) + " mm; it must be > 0");
-  if (w < 16 || h < 16 || map.values.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h))
+  if (w < 16 || h < 16 || given.values.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h))
     throw InvalidArgument("the map is " + std::to_string(w) + " × " + std::to_string(h) +
                           " pixels; a 2-D encode needs at least 16 × 16 (and width·height values)");
-  double mean = 0.0;
-  for (std::size_t k = 0; k < map.values.size(); ++k) {
-    const double v = map.values[k];
-    if (!(v >= 0.0 && v <= 1.0))
-      throw InvalidArgument("the map's value " + detail::num(v) + " at pixel (" + std::to_string(k % w) + ", " +
-                            std::to_string(k / w) + ") is outside 0 … 1");
-    mean += v;
+  // The one input rule (signal.hpp to_amplitudes): a map outside [0, 1] is
+  // scaled to full range, as every front door scales it.
+  std::optional<Raster2D> scaled;
+  if (std::any_of(given.values.begin(), given.values.end(), [](float v) { return !(v >= 0.0f && v <= 1.0f); })) {
+    std::vector<double> v(given.values.begin(), given.values.end());
+    (void)to_amplitudes(v, "the map");
+    scaled = given;
+    scaled->values.assign(v.begin(), v.end());
   }
+  const Raster2D& map = scaled ? *scaled : given;
+  double mean = 0.0;
+  for (const float v : map.values) mean += v;
   mean /= static_cast<double>(map.values.size());
   double var = 0.0;
   for (float v : map.values) var += (v - mean) * (v - mean);

@@ -15,6 +15,7 @@
 #include "texel/encode2d.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/signal.hpp"
 
 namespace texel::codec {
 namespace {
@@ -46,23 +47,6 @@ int png_depth(const std::string& path) {
   return static_cast<unsigned char>(head[24]);
 }
 
-/// Finite values; a map outside [0, 1] (a height map) scaled as the 1-D
-/// encoder scales one: a = 0.5 + 0.5·y/max|y| for the zero-mean values y.
-void to_amplitudes(std::vector<double>& v, const std::string& path) {
-  double lo = 0.0, hi = 0.0, sum = 0.0;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!std::isfinite(v[i]))
-      throw FormatError(path + ": value " + detail::num(v[i]) + " at element " + std::to_string(i) + " is not a finite number");
-    lo = i == 0 ? v[i] : std::min(lo, v[i]);
-    hi = i == 0 ? v[i] : std::max(hi, v[i]);
-    sum += v[i];
-  }
-  if (lo >= 0.0 && hi <= 1.0) return;
-  const double mean = sum / static_cast<double>(v.size());
-  const double peak = std::max(hi - mean, mean - lo);
-  for (double& x : v) x = 0.5 + 0.5 * (x - mean) / peak;
-}
-
 }  // namespace
 
 Input2D load_input2d(const std::string& path, const Raster2DLoadOptions& options) {
@@ -80,7 +64,7 @@ Input2D load_input2d(const std::string& path, const Raster2DLoadOptions& options
       for (float& v : in.map.values) v = 1.0f - v;
   } else if (ext == ".npy") {
     NpyArray a = parse_npy_array(read_file(path), path, 2);
-    to_amplitudes(a.values, path);
+    texel::to_amplitudes(a.values, path);
     in.map.width = static_cast<int>(a.columns);
     in.map.height = static_cast<int>(a.rows);
     in.map.values.assign(a.values.begin(), a.values.end());

@@ -72,7 +72,7 @@ double uniform_step(const std::vector<double>& axis, std::string_view origin, co
 }
 
 /// Full range: a = 0.5 + 0.5·y/max|y|, y the zero-mean signal (docs/references.md §1).
-void scale_full_range(std::vector<double>& y, std::string_view origin) {
+void scale_full_range(std::span<double> y, std::string_view origin) {
   double mean = 0.0;
   for (double v : y) mean += v;
   mean /= static_cast<double>(y.size());
@@ -359,6 +359,18 @@ Signal finish(Signal s, SignalFormat format, const SignalOptions& o, std::string
 }
 
 }  // namespace
+
+bool to_amplitudes(std::span<double> values, std::string_view origin) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      throw FormatError(in_quotes(origin) + " holds a non-finite value (" + num(values[i]) + " at element " + std::to_string(i) +
+                        ")");
+  if (values.empty()) return false;
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  if (*lo >= 0.0 && *hi <= 1.0) return false;
+  scale_full_range(values, origin);
+  return true;
+}
 
 std::string_view to_string(SignalFormat f) {
   switch (f) {

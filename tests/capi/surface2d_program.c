@@ -295,9 +295,16 @@ int main(int argc, char** argv) {
     CHECK(texel_encode_2d(map, side, 0, 0.05, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && bad == NULL &&
               strstr(texel_last_error(), "height_px"),
           "an empty map");
+    /* The one input rule: a value outside [0, 1] scales the map to full range (never refused or clamped); a
+       non-finite one is refused, naming the argument. */
     map[7] = 1.5;
-    CHECK(texel_encode_2d(map, side, side, 0.05, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && strstr(texel_last_error(), "1.5"),
-          "a value outside [0, 1]");
+    CHECK(texel_encode_2d(map, side, side, 0.05, NULL, &o2, &bad) == TEXEL_OK && bad != NULL, "a map outside [0, 1]");
+    texel_encode2d_result_destroy(bad);
+    bad = NULL;
+    map[7] = NAN;
+    CHECK(texel_encode_2d(map, side, side, 0.05, NULL, &o2, &bad) == TEXEL_INVALID_ARGUMENT && bad == NULL &&
+              strstr(texel_last_error(), "'amplitudes' holds a non-finite value"),
+          "a non-finite value");
     printf("encode_2d: %s\n", json);
     free(json);
     texel_surface2d_destroy(es);

@@ -17,9 +17,11 @@
 #include "../support/expect.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/bitmap_file.hpp"
+#include "texel/document.hpp"
 #include "texel/encode2d.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/signal.hpp"
 #include "texel/surface2d.hpp"
 
 using namespace texel;
@@ -378,19 +380,29 @@ TEST(Encode2D, InvalidInputsGiveClearErrors) {
   const double nan = std::nan(""), zero = 0.0;
   for (double v : {zero, nan, zero, zero}) nan_bytes.append(reinterpret_cast<const char*>(&v), 8);
   write_file_atomic(dir.at("nan.npy"), nan_bytes);
-  EXPECT_NE(message_of<FormatError>([&] { codec::load_input2d(dir.at("nan.npy"), lo); }).find("element 1 is not a finite"),
-            std::string::npos);
+  EXPECT_NE(
+      message_of<FormatError>([&] { codec::load_input2d(dir.at("nan.npy"), lo); }).find("non-finite value (nan at element 1)"),
+      std::string::npos);
   // Maps: too small, outside [0, 1], a device it does not fit.
   Raster2D tiny;
   tiny.width = tiny.height = 8;
   tiny.values.assign(64, 0.5f);
   EXPECT_NE(message_of<InvalidArgument>([&] { codec::encode_surface2d(tiny, quick_config()); }).find("at least 16 × 16"),
             std::string::npos);
+  // A map outside [0, 1] is read by the one input rule (texel::to_amplitudes): scaled to full range, never refused
+  // or clamped; a constant one outside holds no texture.
   Raster2D out = map;
   out.values[5] = 1.5f;
-  EXPECT_NE(
-      message_of<InvalidArgument>([&] { codec::encode_surface2d(out, quick_config()); }).find("pixel (5, 0) is outside 0 … 1"),
-      std::string::npos);
+  std::vector<double> scaled(out.values.begin(), out.values.end());
+  EXPECT_TRUE(to_amplitudes(scaled, "the map"));
+  Raster2D in_range = out;
+  in_range.values.assign(scaled.begin(), scaled.end());
+  EXPECT_EQ(document_json(codec::encode_surface2d(out, quick_config()).document),
+            document_json(codec::encode_surface2d(in_range, quick_config()).document));
+  Raster2D constant = map;
+  constant.values.assign(constant.values.size(), 2.0f);
+  EXPECT_NE(message_of<FormatError>([&] { codec::encode_surface2d(constant, quick_config()); }).find("holds no texture"),
+            std::string::npos);
   codec::Encode2DConfig small_device;
   small_device.device = grid_device(100, 100);
   EXPECT_NE(message_of<InvalidArgument>([&] { codec::encode_surface2d(map, small_device); }).find("larger than device"),

@@ -254,10 +254,20 @@ def test_encode_2d_of_a_png_keeps_its_depth_and_polarity_as_the_cli_does(golden,
 @pytest.mark.parametrize("source,kwargs,match", [
     (np.zeros((2, 20, 20)), dict(pitch_mm=0.05), "3 dimensions"),
     (np.zeros((20, 20)), {}, "needs pitch_mm"),
-    (np.full((64, 64), 2.0), dict(pitch_mm=0.05), "outside 0 … 1"),
     (np.zeros((64, 64)), dict(pitch_mm=0.05, field="round"), "field is 'round'"),
     (np.zeros((64, 64)), dict(pitch_mm=0.05, target="loudest"), "target is 'loudest'"),
 ])
 def test_encode_2d_refuses_bad_input(source, kwargs, match):
     with pytest.raises(texel.InvalidArgument, match=match):
         texel.encode_2d(source, **{**CHEAP, **kwargs})
+
+
+def test_encode_2d_reads_an_array_by_the_one_input_rule():
+    """Values outside [0, 1] are scaled to full range (as the CLI and C scale them), never clamped; a constant
+    map outside [0, 1] holds no texture; a non-finite value is refused."""
+    with pytest.raises(texel.FormatError, match="constant: it holds no texture"):
+        texel.encode_2d(np.full((64, 64), 2.0), pitch_mm=0.05, **CHEAP)
+    bad = np.full((64, 64), 0.5)
+    bad[3, 4] = np.inf
+    with pytest.raises(texel.FormatError, match="non-finite value"):
+        texel.encode_2d(bad, pitch_mm=0.05, **CHEAP)
