@@ -36,6 +36,10 @@ enum class WavEncoding { pcm16, pcm24, float32 };
 /// [−1, 1] by the PCM encodings. Throws IoError naming the path.
 void write_wav(const std::string& path, std::span<const float> samples, double rate_hz,
                WavEncoding encoding = WavEncoding::pcm16);
+/// The same with `channels` (1 … 64) interleaved: samples[i·channels + c] is
+/// channel c's frame i (a WAV file's own layout).
+void write_wav(const std::string& path, std::span<const float> samples, std::size_t channels, double rate_hz,
+               WavEncoding encoding = WavEncoding::pcm16);
 // WAV files are read by the one signal loader's audio reader
 // (texel::read_recording, texel/signal.hpp).
 

@@ -29,12 +29,20 @@ using Clock = std::chrono::steady_clock;
 // ----------------------------------------------------------------- files
 
 void write_wav(const std::string& path, std::span<const float> samples, double rate_hz, WavEncoding encoding) {
+  write_wav(path, samples, 1, rate_hz, encoding);
+}
+
+void write_wav(const std::string& path, std::span<const float> samples, std::size_t channels, double rate_hz,
+               WavEncoding encoding) {
   if (!(rate_hz >= 1 && rate_hz <= 1e6)) throw InvalidArgument("wav: rate is " + detail::num(rate_hz) + " Hz; allowed 1 … 1e6");
+  if (channels < 1 || channels > 64 || samples.size() % channels != 0)
+    throw InvalidArgument("wav: " + std::to_string(samples.size()) + " samples in " + std::to_string(channels) +
+                          " channels; allowed: 1 … 64 channels and whole frames");
   check_writable(path);
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
   SF_INFO info{};
   info.samplerate = static_cast<int>(std::lround(rate_hz));
-  info.channels = 1;
+  info.channels = static_cast<int>(channels);
   info.format = SF_FORMAT_WAV | (encoding == WavEncoding::pcm16   ? SF_FORMAT_PCM_16
                                  : encoding == WavEncoding::pcm24 ? SF_FORMAT_PCM_24
                                                                   : SF_FORMAT_FLOAT);
@@ -42,7 +50,7 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
   if (!f) throw IoError("cannot write '" + path + "': " + sf_strerror(nullptr));
   // Clip rather than let libsndfile wrap out-of-range floats.
   sf_command(f, SFC_SET_CLIPPING, nullptr, SF_TRUE);
-  const sf_count_t n = static_cast<sf_count_t>(samples.size());
+  const sf_count_t n = static_cast<sf_count_t>(samples.size() / channels);  // frames
   const sf_count_t written = n ? sf_writef_float(f, samples.data(), n) : 0;
   const std::string err = written == n ? "" : sf_strerror(f);
   if (sf_close(f) != 0 || written != n) {
