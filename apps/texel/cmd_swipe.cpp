@@ -110,10 +110,11 @@ void run(const SwipeArgs& a) {
     mean_speed = m.mean_speed_mm_s, sd_speed = m.sd_speed_mm_s, directional = m.directional_proportion, touched = m.touched_s;
   }
   const std::size_t frames = out.size() / channels;
-  // The spectrum of the first channel (the only one of a one-channel swipe).
-  std::vector<float> first_channel(frames);
-  for (std::size_t i = 0; i < frames; ++i) first_channel[i] = out[i * channels];
-  const SignalSpectrum spectrum = signal_spectrum(first_channel, config.rate_hz);
+  // The spectrum of one channel: the one that plays, or the first (the only one of a one-channel swipe).
+  const std::size_t shown = multi ? playback_of(doc).channel.value_or(0) : 0;
+  std::vector<float> shown_channel(frames);
+  for (std::size_t i = 0; i < frames; ++i) shown_channel[i] = out[i * channels + shown];
+  const SignalSpectrum spectrum = signal_spectrum(shown_channel, config.rate_hz);
   const double peak = spectrum.peak_hz(config.mode == OutputMode::amplitude ? 1.0 : 0.0);
 
   // Prepare every output before writing any, so a failure leaves none.
@@ -162,6 +163,7 @@ void run(const SwipeArgs& a) {
   if (multi) j["playback"] = std::string(to_string(playback_of(doc).mode));
   j["duration_s"] = static_cast<double>(frames) / config.rate_hz;
   j["peak_frequency_hz"] = peak;
+  if (multi) j["spectrum_channel"] = shown;
   j["spectrum_bin_hz"] = spectrum.frequency_hz.size() > 1 ? spectrum.frequency_hz[1] : 0.0;
   j["swipe"] = {{"mean_speed_mm_s", mean_speed}, {"sd_speed_mm_s", sd_speed}, {"touched_s", touched}};
   if (two_d)
@@ -175,7 +177,8 @@ void run(const SwipeArgs& a) {
     if (multi) std::cout << " × " << channels << " channels (" << to_string(playback_of(doc).mode) << ")";
     std::cout << " at " << detail::num(config.rate_hz) << " Hz ("
               << detail::fixed(static_cast<double>(frames) / config.rate_hz, 3) << " s), " << to_string(config.mode)
-              << ", spectrum peak " << detail::fixed(peak, 1) << " Hz\n"
+              << ", spectrum peak " << detail::fixed(peak, 1) << " Hz"
+              << (multi ? " (channel " + std::to_string(shown) + ")" : "") << "\n"
               << "swipe" << (two_d ? " (2-D)" : "") << ": mean speed " << detail::fixed(mean_speed, 2) << " mm/s, SD "
               << detail::fixed(sd_speed, 2) << " mm/s";
     if (!two_d) std::cout << ", directional proportion " << detail::fixed(directional, 3);
