@@ -135,7 +135,7 @@ int on_process(jack_nframes_t n, void* arg) {
   std::span<float> outs[max_ports];
   for (std::size_t c = 0; c < r.channels; ++c) outs[c] = std::span(static_cast<float*>(jack_port_get_buffer(r.ports[c], n)), n);
   if (r.player)
-    r.player->process(std::span<const std::span<float>>(outs, r.channels));
+    r.player->process_planar(std::span<const std::span<float>>(outs, r.channels));
   else
     for (std::size_t c = 0; c < r.channels; ++c) std::fill(outs[c].begin(), outs[c].end(), 0.0f);
   alloc::counting = false;
@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
   for (int k = 0; k < runs; ++k) {
     const Result floor = run_client(server, channels, seconds, nullptr);
     ChannelPlayer player(config, plan, period);
-    Result played = run_client(server, channels, seconds, &player);
+    const Result played = run_client(server, channels, seconds, &player);
     for (const Result* r : {&floor, &played})
       std::printf("%-8s %8zu | %8.3f %8.3f %8.3f %8.3f | %6llu %5llu | %s\n", r == &floor ? "floor" : "player", r->blocks,
                   r->block_time.p50, r->block_time.p99, r->block_time.p999, r->block_time.max,

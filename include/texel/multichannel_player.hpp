@@ -12,6 +12,10 @@
 // config → prepare → process: the constructor allocates every player, its
 // rings and a planar scratch block of `max_block` frames per channel;
 // process() writes caller memory only.
+//
+// It is a PlayerBase, so the backends drive it (sinks.hpp: the null and the
+// PortAudio backend opened with as many channels, AudioOptions::channels):
+// PlayerBase::process's buffer is then frames × channels, interleaved.
 #pragma once
 
 #include <cstddef>
@@ -25,7 +29,7 @@
 
 namespace texel {
 
-class ChannelPlayer {
+class ChannelPlayer final : public PlayerBase {
  public:
   /// prepare: one Player per channel with `config` (its response replaced
   /// by the channel's), playing the channel's surface (none: silence).
@@ -33,9 +37,8 @@ class ChannelPlayer {
   /// before it loops (the scratch block's size), 1 … 65536.
   /// Throws InvalidArgument for no channels or an invalid config.
   ChannelPlayer(const PlayerConfig& config, std::span<const Channel> channels, std::size_t max_block = 1024);
-  ~ChannelPlayer();
-  ChannelPlayer(const ChannelPlayer&) = delete;
-  ChannelPlayer& operator=(const ChannelPlayer&) = delete;
+  /// Stops an attached driver first (see player.hpp "Lifetime"), then frees every player.
+  ~ChannelPlayer() override;
 
   [[nodiscard]] std::size_t channels() const { return players_.size(); }
   /// Channel c's player (its statistics; control-thread calls such as set_gain).
@@ -46,7 +49,7 @@ class ChannelPlayer {
   /// offset): all or none, false if any channel's queue is full.
   bool push(const FingerSample& s);
   /// Frees the maps the players have retired. Returns how many.
-  std::size_t collect();
+  std::size_t collect() override;
 
   // ------------------------------------------------------- real-time thread
   /// Fills one buffer per channel (outs[c], all the same size) with the next
@@ -56,11 +59,13 @@ class ChannelPlayer {
   /// Real-time safe: never allocates, frees, locks, logs, throws or does
   /// I/O (each channel is a Player::process call); bounded work per sample
   /// and channel.
-  void process(std::span<const std::span<float>> outs, std::span<float> position_mm = {}) noexcept;
+  /// Returns channel 0's block information with the peak over every channel.
+  BlockInfo process_planar(std::span<const std::span<float>> outs, std::span<float> position_mm = {}) noexcept;
   /// The same into one interleaved buffer: out[i·N + c] is channel c's frame
   /// i (out.size() a multiple of N; a remainder is left untouched), through
-  /// the scratch block. Real-time safe as process().
-  void process_interleaved(std::span<float> out, std::span<float> position_mm = {}) noexcept;
+  /// the scratch block; `position_mm` empty or out.size() / N long. What a
+  /// backend calls (PlayerBase). Real-time safe as process_planar().
+  BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept override;
 
  private:
   std::vector<std::unique_ptr<Player>> players_;
@@ -68,6 +73,7 @@ class ChannelPlayer {
   std::vector<float> scratch_;   // max_block_ frames × channels, planar
   std::vector<float> scratch_position_;
   std::size_t max_block_;
+  std::uint64_t frames_ = 0;  // frames produced (real-time thread)
 };
 
 /// Off-line rendering of a whole trace on every channel (render_trace per

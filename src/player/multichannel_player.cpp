@@ -9,7 +9,7 @@
 namespace texel {
 
 ChannelPlayer::ChannelPlayer(const PlayerConfig& config, std::span<const Channel> channels, std::size_t max_block)
-    : max_block_(max_block) {
+    : PlayerBase(config.rate_hz), max_block_(max_block) {
   if (channels.empty()) throw InvalidArgument("ChannelPlayer: no channels; allowed: 1 … " + std::to_string(max_actuators));
   if (max_block < 1 || max_block > 65536)
     throw InvalidArgument("ChannelPlayer: max_block is " + std::to_string(max_block) + "; allowed: 1 … 65536");
@@ -25,7 +25,7 @@ ChannelPlayer::ChannelPlayer(const PlayerConfig& config, std::span<const Channel
   scratch_position_.assign(max_block_, 0.0f);
 }
 
-ChannelPlayer::~ChannelPlayer() = default;
+ChannelPlayer::~ChannelPlayer() { stop_driver(); }
 
 bool ChannelPlayer::push(const FingerSample& s) {
   // One producer: the space seen here can only grow before the pushes below.
@@ -45,31 +45,48 @@ std::size_t ChannelPlayer::collect() {
   return n;
 }
 
-void ChannelPlayer::process(std::span<const std::span<float>> outs, std::span<float> position_mm) noexcept {
+BlockInfo ChannelPlayer::process_planar(std::span<const std::span<float>> outs, std::span<float> position_mm) noexcept {
   // Real-time: one Player::process per channel, then arithmetic on caller memory.
   const std::size_t n = std::min(outs.size(), players_.size());
-  for (std::size_t c = 0; c < n; ++c)
-    players_[c]->process(outs[c], c == 0 && position_mm.size() == outs[0].size() ? position_mm : std::span<float>{});
-  if (n > 0 && position_mm.size() == outs[0].size()) {
-    const auto offset = static_cast<float>(offsets_[0]);
-    for (float& x : position_mm) x -= offset;
+  BlockInfo info;
+  for (std::size_t c = 0; c < n; ++c) {
+    const BlockInfo ci =
+        players_[c]->process(outs[c], c == 0 && position_mm.size() == outs[0].size() ? position_mm : std::span<float>{});
+    if (c == 0) info = ci;
+    info.peak = std::max(info.peak, ci.peak);
+    info.crossfading = info.crossfading || ci.crossfading;
   }
+  if (n > 0) {
+    info.position_mm -= offsets_[0];
+    if (position_mm.size() == outs[0].size()) {
+      const auto offset = static_cast<float>(offsets_[0]);
+      for (float& x : position_mm) x -= offset;
+    }
+    frames_ += outs[0].size();
+    publish_samples(frames_);
+  }
+  return info;
 }
 
-void ChannelPlayer::process_interleaved(std::span<float> out, std::span<float> position_mm) noexcept {
+BlockInfo ChannelPlayer::process(std::span<float> out, std::span<float> position_mm) noexcept {
   // Real-time: the scratch block was allocated at prepare; spans are views.
   const std::size_t n = players_.size();
   const std::size_t frames = out.size() / n;
   const bool positions = position_mm.size() == frames;
   std::span<float> planar[max_actuators];
+  BlockInfo info;
   for (std::size_t done = 0; done < frames;) {
     const std::size_t m = std::min(max_block_, frames - done);
     for (std::size_t c = 0; c < n; ++c) planar[c] = std::span(scratch_).subspan(c * max_block_, m);
-    process(std::span<const std::span<float>>(planar, n), positions ? position_mm.subspan(done, m) : std::span<float>{});
+    const float peak = info.peak;
+    info = process_planar(std::span<const std::span<float>>(planar, n),
+                          positions ? position_mm.subspan(done, m) : std::span<float>{});
+    info.peak = std::max(info.peak, peak);
     for (std::size_t i = 0; i < m; ++i)
       for (std::size_t c = 0; c < n; ++c) out[(done + i) * n + c] = planar[c][i];
     done += m;
   }
+  return info;
 }
 
 std::vector<float> render_trace_channels(std::span<const Channel> channels, const PlayerConfig& config,
@@ -85,8 +102,8 @@ std::vector<float> render_trace_channels(std::span<const Channel> channels, cons
   for (std::size_t done = 0; done < frames;) {
     while (next < trace.size() && player.push(trace[next])) ++next;
     const std::size_t m = std::min(block, frames - done);
-    player.process_interleaved(std::span(out).subspan(done * n, m * n),
-                               positions ? std::span(*positions).subspan(done, m) : std::span<float>{});
+    player.process(std::span(out).subspan(done * n, m * n),
+                   positions ? std::span(*positions).subspan(done, m) : std::span<float>{});
     done += m;
   }
   return out;

@@ -392,7 +392,7 @@ TEST(MultichannelPlayer, ProcessAllocatesNothingOnEightChannels) {
     for (int block = 0; block < 2000; ++block) {
       // Pushes are the control thread's (they allocate nothing either: the rings exist).
       if (block % 2 == 0) player.push(FingerSample{t, 10.0 + 50.0 * t, block < 1900});
-      player.process_interleaved(out, pos);
+      player.process(out, pos);
       for (const float v : out) peak = std::max(peak, v);
       t += 64.0 / 48000.0;
     }
