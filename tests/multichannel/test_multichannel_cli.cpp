@@ -77,6 +77,26 @@ TEST(MultichannelCli, SequentialOnOneChannelLeavesTheOthersAtRest) {
   }
 }
 
+TEST(MultichannelCli, RenderWritesOneMapPerChannel) {
+  texel::test_support::TempDir tmp{"texel-mc-cli"};
+  const CliRun r = run("render " + golden_doc + " -o " + tmp.at("m.npy"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const texel::NpyArray a = texel::parse_npy_array(texel::read_file(tmp.at("m.npy")), "m.npy", 2);
+  ASSERT_EQ(a.rows, 2000u);
+  ASSERT_EQ(a.columns, 4u);
+  // The bytes the golden digest holds (texel-golden's .f64 is the same array without the header).
+  const std::string bytes = texel::read_file(tmp.at("m.npy"));
+  ASSERT_EQ(run("render " + golden_doc + " -o " + tmp.at("m2.npy")).status, 0);
+  EXPECT_EQ(texel::read_file(tmp.at("m2.npy")), bytes);
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < a.rows; ++i) same += a.values[i * 4] == a.values[i * 4 + 1];
+  EXPECT_LT(same, a.rows / 10) << "channels 0 and 1 are one map";
+  const CliRun bin = run("render " + golden_doc + " -o " + tmp.at("m.bin"));
+  EXPECT_EQ(bin.status, 2);
+  EXPECT_NE(bin.out.find("a simultaneous document has one map per channel"), std::string::npos) << bin.out;
+  EXPECT_FALSE(std::filesystem::exists(tmp.at("m.bin")));
+}
+
 TEST(MultichannelCli, RefusalsExit2AndLeaveNoOutput) {
   texel::test_support::TempDir tmp{"texel-mc-cli"};
   const auto refused = [&](const std::string& args, const std::string& message) {
