@@ -64,6 +64,7 @@ pid_t spawn_jackd(const std::string& server, bool realtime, const std::string& l
     args.emplace_back("-r");
   args.insert(args.end(), {"-d", "dummy", "-r", "48000", "-p", std::to_string(period)});
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   posix_spawn_file_actions_t fa;
