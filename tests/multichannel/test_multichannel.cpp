@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "../support/alloc_counter.hpp"
@@ -21,6 +23,7 @@
 #include "texel/multichannel_player.hpp"
 #include "texel/player.hpp"
 #include "texel/random.hpp"
+#include "texel/sinks.hpp"
 
 namespace {
 
@@ -399,6 +402,28 @@ TEST(MultichannelPlayer, ProcessAllocatesNothingOnEightChannels) {
   }
   EXPECT_EQ(texel::test_support::alloc::counted_allocations.load() - before, 0u);
   EXPECT_GT(peak, 0.1f) << "the channels played";
+}
+
+TEST(MultichannelPlayer, BackendsDriveAPlayerOfTheirOwnChannelCountOnly) {
+  const Document doc = parse_document(document(pad_device(1000), R"({"mode": "simultaneous"})"));
+  ChannelPlayer player(PlayerConfig{}, prepare_channels(doc), 64);
+  const auto mono = make_null_backend(48000, 64);
+  EXPECT_NE(message_of<InvalidArgument>([&] { mono->start(player); }).find("has 1 output channel; the player has 4"),
+            std::string::npos);
+  EXPECT_FALSE(player.attached());
+  Player one(PlayerConfig{});
+  const auto four = make_null_backend(48000, 64, 4);
+  EXPECT_NE(message_of<InvalidArgument>([&] { four->start(one); }).find("has 4 output channels; the player has 1"),
+            std::string::npos);
+  EXPECT_NE(message_of<InvalidArgument>([] { (void)make_null_backend(48000, 64, 65); }).find("channels is 65; allowed 1 … 64"),
+            std::string::npos);
+  player.push(FingerSample{0.0, 5.0, true});
+  four->start(player);
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  four->stop();
+  EXPECT_GT(four->stats().blocks, 0u);
+  EXPECT_GT(player.samples(), 0u);  // frames, not frames × channels
+  EXPECT_EQ(player.samples() % 64, 0u);
 }
 
 }  // namespace
