@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 #include <thread>
@@ -286,6 +287,7 @@ TEST(MultichannelSwipe, FourSimultaneousChannelsAreSingleFrequencySegmentsOfTheT
   const Swipe s = swipe_4(R"({"mode": "simultaneous"})");
   ASSERT_EQ(s.out.size(), 24000u * 4);
   std::size_t segments = 0;
+  double worst_residual = 0.0, worst_error = 0.0;
   std::vector<double> estimates, drawn;
   for (std::size_t c = 0; c < 4; ++c) {
     const std::vector<double> f = channel_texel_frequencies(s.channels[c]);
@@ -304,8 +306,9 @@ TEST(MultichannelSwipe, FourSimultaneousChannelsAreSingleFrequencySegmentsOfTheT
       ASSERT_GT(x.size(), 80u) << "channel " << c << " texel " << k;
       // The drawn frequency explains the segment: one sinusoid, nothing left over.
       const double at_drawn = sinusoid_residual(x, y, f[k]);
-      EXPECT_LT(at_drawn, 2e-3) << "channel " << c << " texel " << k << " f " << f[k];
-      // … and it is the one frequency that does: a grid search finds it within 1 %.
+      EXPECT_LT(at_drawn, 5e-4) << "channel " << c << " texel " << k << " f " << f[k];
+      worst_residual = std::max(worst_residual, at_drawn);
+      // … and it is the one frequency that does: a grid search finds it within 0.2 %.
       double best = 0.0, best_e = 1e9;
       for (double g = 0.5; g < 45.0; g *= 1.01) {
         const double e = sinusoid_residual(x, y, g);
@@ -315,13 +318,16 @@ TEST(MultichannelSwipe, FourSimultaneousChannelsAreSingleFrequencySegmentsOfTheT
         const double e = sinusoid_residual(x, y, g);
         if (e < best_e) best_e = e, best = g;
       }
-      EXPECT_NEAR(best / f[k], 1.0, 0.01) << "channel " << c << " texel " << k;
+      EXPECT_NEAR(best / f[k], 1.0, 0.002) << "channel " << c << " texel " << k;
+      worst_error = std::max(worst_error, std::fabs(best / f[k] - 1.0));
       estimates.push_back(best);
       drawn.push_back(f[k]);
       ++segments;
     }
   }
   EXPECT_EQ(segments, 4u * 54u);
+  std::printf("segments: %zu, RMS residual at the drawn frequency <= %.2e, estimated/drawn frequency within %.3f %%\n", segments,
+              worst_residual, 100.0 * worst_error);
   // Over channels the segments' frequencies are not one chain played four times.
   std::size_t equal_across = 0;
   for (std::size_t i = 0; i < 54; ++i) equal_across += std::fabs(estimates[i] - estimates[54 + i]) < 1e-9;
