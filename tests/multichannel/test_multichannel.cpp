@@ -425,7 +425,8 @@ TEST(MultichannelPlayer, BackendsDriveAPlayerOfTheirOwnChannelCountOnly) {
             std::string::npos);
   player.push(FingerSample{0.0, 5.0, true});
   four->start(player);
-  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  // Wait for blocks (a loaded machine may take a while to schedule the thread), up to 5 s.
+  for (int i = 0; i < 500 && player.samples() < 64 * 4; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   four->stop();
   EXPECT_GT(four->stats().blocks, 0u);
   EXPECT_GT(player.samples(), 0u);  // frames, not frames × channels
