@@ -8,7 +8,9 @@
 //                                     float64: the exact bits of every
 //                                     amplitude, which a u16 file rounds away
 //                                     (a 2-D document: its bitmap's
-//                                     amplitudes, row-major)
+//                                     amplitudes, row-major; a multi-channel
+//                                     document: its channels' maps
+//                                     interleaved, [samples, channels])
 #include <filesystem>
 #include <iostream>
 #include <span>
@@ -18,6 +20,7 @@
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/multichannel.hpp"
 #if TEXEL_GOLDEN_2D
 #include "texel/surface2d.hpp"
 #endif
@@ -51,6 +54,14 @@ int main(int argc, char** argv) {
         continue;
       }
 #endif
+      if (doc.playback || doc.device.channels() > 1) {  // multi-channel: [samples, channels], interleaved
+        const auto channels = texel::prepare_channels(doc);
+        std::vector<double> map(static_cast<std::size_t>(doc.device.samples) * channels.size());
+        texel::render_channels(channels, 0, map);
+        texel::write_file_atomic(path,
+                                 std::span<const std::byte>(reinterpret_cast<const std::byte*>(map.data()), map.size() * 8));
+        continue;
+      }
       const texel::Surface surface = texel::prepare_surface(doc);
       texel::write_file_atomic(path, surface.render_native(texel::SampleFormat::f64le));
     }

@@ -25,6 +25,8 @@
 #include "finger_options.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
+#include "texel/multichannel.hpp"
+#include "texel/multichannel_player.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/serial_link.hpp"
@@ -160,7 +162,17 @@ void run(const PlayArgs& a) {
   // Everything from the command line is read and checked before the device opens.
   std::unique_ptr<PlayerBase> player;
   std::function<bool(double)> feed_until;  // queues the trace up to a time; false once it is all queued
-  if (sensor_path) {
+  // Multi-channel (docs/rendering.md): a device with actuators or a document with a playback.
+  const bool multi = !two_d && (doc.playback.has_value() || doc.device.channels() > 1);
+  if (multi && sensor_path) throw InvalidArgument("--finger serial:PATH plays one channel; this document has several");
+  if (multi) {
+    const std::vector<Channel> plan = prepare_channels(doc);
+    bo.channels = plan.size();
+    auto trace = finger_trace(a.finger, surface->grid().length().value(), duration);
+    auto p = std::make_unique<ChannelPlayer>(config, plan, a.block);
+    feed_until = feeder(*p, std::move(trace));
+    player = std::move(p);
+  } else if (sensor_path) {
     // Live: until --duration (0 or absent: until Ctrl-C).
     duration = a.finger.duration_s.value_or(0.0);
     if (!(duration >= 0))

@@ -1,6 +1,7 @@
 // texel render: a Texel texture (from a document and/or flags) to a device
 // file, CSV, NumPy array, document or plot.
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <numeric>
@@ -12,6 +13,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/multichannel.hpp"
 
 namespace texel::cli {
 namespace {
@@ -149,6 +151,33 @@ void register_render(CLI::App& app) {
       check_writable(*args->texels_csv);
     }
     const Document doc = build_document(args->document, args->device, args->texture);
+    if (doc.playback && doc.playback->mode == ChannelMode::simultaneous && output_extension(args->output) != ".texel.json") {
+      // One map per channel (docs/rendering.md): [samples, channels], float64.
+      if (output_extension(args->output) != ".npy" || args->texels_csv)
+        throw InvalidArgument("--output '" + args->output +
+                              "': a simultaneous document has one map per channel; render it to .npy ([samples, channels]) "
+                              "or .texel.json, without --texels");
+      const std::vector<Channel> channels = prepare_channels(doc);
+      const auto samples = static_cast<std::size_t>(doc.device.samples);
+      std::vector<double> map(samples * channels.size());
+      render_channels(channels, 0, map);
+      std::string bytes = npy_header(samples, channels.size());
+      const std::size_t header = bytes.size();
+      bytes.resize(header + map.size() * sizeof(double));
+      std::memcpy(bytes.data() + header, map.data(), map.size() * sizeof(double));  // as npy_bytes
+      write_file_atomic(args->output, bytes);
+      if (args->json) {
+        nlohmann::ordered_json j;
+        j["output"] = args->output;
+        j["samples"] = samples;
+        j["channels"] = channels.size();
+        j["playback"] = "simultaneous";
+        print_json(j);
+      } else {
+        std::cout << args->output << ": " << samples << " samples × " << channels.size() << " channels (simultaneous)\n";
+      }
+      return;
+    }
     const Surface surface = prepare_surface(doc);
     std::vector<PendingFile> extra;
     if (args->texels_csv) extra.push_back({*args->texels_csv, texels_csv(surface)});

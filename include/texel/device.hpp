@@ -84,6 +84,22 @@ struct BitmapGeometry {
   [[nodiscard]] CyclesPerMm nyquist() const { return CyclesPerMm(0.5 / pitch.value()); }
 };
 
+/// One actuator (output channel) of a multi-channel display: a voice coil
+/// or pin of an array under the finger pad, or a channel of a multi-channel
+/// sound card (docs/format.md "Device profiles", JSON "actuators";
+/// docs/rendering.md). An actuator at `offset` along the swipe axis touches
+/// the surface at finger position + offset, so it plays the texture there.
+struct Actuator {
+  std::string name;          ///< label, unique in the profile, 1 … 64 characters
+  Millimetres offset{0.0};   ///< along the swipe axis from the finger's contact point, −50 … 50 mm
+  Millimetres lateral{0.0};  ///< across the swipe axis, −50 … 50 mm (a 1-D texture does not vary across it)
+  /// This channel's response; absent = the device's (DeviceProfile::response).
+  std::optional<FrequencyResponse> response;
+};
+/// Channels a profile may declare, and the range of actuator positions.
+inline constexpr std::size_t max_actuators = 64;
+inline constexpr double actuator_offset_mm_max = 50.0;
+
 struct DeviceProfile {
   std::string name;  ///< e.g. "tpad"
   std::string description;
@@ -100,7 +116,17 @@ struct DeviceProfile {
   FrequencyResponse response;
   /// The 2-D pixel grid ("bitmap" in the JSON; optional: 1-D devices have none).
   std::optional<BitmapGeometry> bitmap;
+  /// The output channels ("actuators" in the JSON; optional: absent = one
+  /// channel, the display as a whole, and the profile reads and writes as
+  /// before). 1 … max_actuators when present.
+  std::vector<Actuator> actuators;
 
+  /// Output channels: the actuators, or 1.
+  [[nodiscard]] std::size_t channels() const { return actuators.empty() ? 1 : actuators.size(); }
+  /// The response channel `c` plays through: its actuator's, else the device's.
+  [[nodiscard]] const FrequencyResponse& channel_response(std::size_t c) const {
+    return c < actuators.size() && actuators[c].response ? *actuators[c].response : response;
+  }
   [[nodiscard]] Grid grid() const { return Grid{Millimetres(0.0), spacing, samples}; }
   [[nodiscard]] Millimetres length() const { return Millimetres(static_cast<double>(samples) * spacing.value()); }
   [[nodiscard]] CyclesPerMm nyquist() const { return CyclesPerMm(0.5 / spacing.value()); }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "texel/device.hpp"
+#include "texel/multichannel.hpp"
 #include "texel/reference.hpp"
 #include "texel/surface.hpp"
 #include "texel/surface2d_spec.hpp"
@@ -49,8 +50,10 @@ struct Document {
   /// a version-4 document holds a 2-D surface and no 1-D texture. Version 5
   /// is a 2-D document whose regions' field defaults to "tile" (the fast
   /// isotropic field; version 4's default, "spectral", stays selectable and
-  /// renders version 4's bytes); "tile" needs version 5.
-  static constexpr int current_version = 5;
+  /// renders version 4's bytes); "tile" needs version 5. Version 6 is a 1-D
+  /// document with "playback" (multi-channel: texel/multichannel.hpp); its
+  /// references synthesise as version 3's.
+  static constexpr int current_version = 6;
   /// The version read (parse_document) or current_version; writers use
   /// required_version instead.
   int version = current_version;
@@ -62,6 +65,9 @@ struct Document {
   /// prepares it.
   std::optional<Surface2DSpec> surface2d;
   std::string description;  ///< free text
+  /// Set: how the texture plays on the device's channels (version 6); none =
+  /// sequential on every channel (playback_of), as every earlier version.
+  std::optional<ChannelPlayback> playback;
 };
 
 /// Parses and validates a document. `origin` names the source in errors.
@@ -76,7 +82,7 @@ Document make_document(const DeviceProfile& device, const TexelSpec& spec);
 Document make_reference_document(const DeviceProfile& device, const ReferenceSpec& spec);
 /// The lowest format version that renders `doc`'s bytes: 1 without
 /// references, 2 when its references use the direct synthesis, 3 when they
-/// use the chirp-z one, 4 for a 2-D document. Throws InvalidArgument when references of one
+/// use the chirp-z one, 4 for a 2-D document, 6 with a playback. Throws InvalidArgument when references of one
 /// document use both (no version holds that; documents never parse to it).
 int required_version(const Document& doc);
 /// The reference synthesis a document of format `version` renders with.

@@ -55,6 +55,7 @@ enum class Stream : std::uint64_t {
   frequency = 1,  ///< texel frequencies (counter = texel index · 2^20 + attempt)
   phase = 2,      ///< initial phase (continuous) or per-texel phases (reset)
   reference = 3,  ///< reference-texture noise and shuffles
+  channel = 4,    ///< per-channel seeds of a simultaneous texture (counter = channel index; texel/multichannel.hpp)
   user = 16,      ///< first stream free for other modules
 };
 

@@ -36,6 +36,10 @@ enum class WavEncoding { pcm16, pcm24, float32 };
 /// [−1, 1] by the PCM encodings. Throws IoError naming the path.
 void write_wav(const std::string& path, std::span<const float> samples, double rate_hz,
                WavEncoding encoding = WavEncoding::pcm16);
+/// The same with `channels` (1 … 64) interleaved: samples[i·channels + c] is
+/// channel c's frame i (a WAV file's own layout).
+void write_wav(const std::string& path, std::span<const float> samples, std::size_t channels, double rate_hz,
+               WavEncoding encoding = WavEncoding::pcm16);
 // WAV files are read by the one signal loader's audio reader
 // (texel::read_recording, texel/signal.hpp).
 
@@ -72,6 +76,10 @@ class Backend : private PlayerDriver {
   [[nodiscard]] const PlayerBase* player() const noexcept { return attachment_.player(); }
   /// A one-line description ("null 48000 Hz, 64 frames").
   [[nodiscard]] virtual std::string describe() const = 0;
+  /// Output channels the backend was opened with: start() drives only a
+  /// player of as many (1: Player, Player2D; N: a ChannelPlayer of N,
+  /// texel/multichannel_player.hpp, whose blocks are N channels interleaved).
+  [[nodiscard]] virtual std::size_t channels() const noexcept { return 1; }
   /// How the real-time thread is scheduled, once started: "SCHED_FIFO
   /// priority 70 (real-time)", "SCHED_OTHER (real-time not permitted: ...)",
   /// or what the sound system chose ("set by PortAudio").
@@ -110,14 +118,18 @@ class Backend : private PlayerDriver {
 };
 
 /// Runs the player in real time with no output device: a thread wakes every
-/// block period and processes one block into a scratch buffer.
-std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames);
+/// block period and processes one block into a scratch buffer (of `channels`
+/// interleaved, 1 … 64).
+std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames, std::size_t channels = 1);
 
 struct AudioOptions {
   std::string device;  ///< PortAudio device index or name substring; empty = default output
   double rate_hz = 48000.0;
   std::size_t block_frames = 64;  ///< frames per buffer
   double latency_s = 0.0;         ///< suggested latency; 0 = the device's low default
+  /// Output channels, 1 … 64 (at most the device's): one per actuator of a
+  /// ChannelPlayer, interleaved as PortAudio takes them.
+  std::size_t channels = 1;
 };
 /// A sound-card output through PortAudio. Throws IoError if PortAudio or the
 /// device cannot be opened (naming the device and listing the outputs).
@@ -165,6 +177,7 @@ struct BackendOptions {
   int baud = 921600;              ///< serial
   SerialStream stream = SerialStream::position;
   std::shared_ptr<const NativeMap> serial_map;  ///< serial, position stream: SerialOptions::map
+  std::size_t channels = 1;                     ///< null and audio: output channels (a ChannelPlayer's), 1 … 64; serial: 1
 };
 /// Opens the backend `choice` names. A serial display is given `map` first.
 /// Throws like the make_*_backend functions.

@@ -27,6 +27,24 @@ constexpr Embedded builtin_profiles[] = {
 #include "builtin_devices.inc"
 };
 
+FrequencyResponse parse_response(const nlohmann::json& j, const std::string& path) {
+  detail::JsonObject r(j, path);
+  FrequencyResponse out;
+  out.corner = Hertz(r.number("corner_hz", 1e-6, 1e6));
+  out.order = static_cast<int>(r.integer("order", 1, 4));
+  out.source = r.string_or("source", "");
+  r.finish();
+  return out;
+}
+
+nlohmann::ordered_json response_json(const FrequencyResponse& response) {
+  nlohmann::ordered_json r;
+  r["corner_hz"] = response.corner.value();
+  r["order"] = response.order;
+  if (!response.source.empty()) r["source"] = response.source;
+  return r;
+}
+
 }  // namespace
 
 std::string_view to_string(SampleFormat f) {
@@ -113,6 +131,30 @@ void validate(const DeviceProfile& p) {
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(at + e.what());
   }
+  if (p.actuators.size() > max_actuators)
+    throw InvalidArgument(at + "actuators has " + std::to_string(p.actuators.size()) + " entries; allowed: 1 … " +
+                          std::to_string(max_actuators) + " (omit it for one channel)");
+  for (std::size_t i = 0; i < p.actuators.size(); ++i) {
+    const Actuator& a = p.actuators[i];
+    const std::string f = "actuators[" + std::to_string(i) + "]";
+    if (a.name.empty() || a.name.size() > 64)
+      throw InvalidArgument(at + f + ".name is '" + a.name + "'; allowed: 1 … 64 characters");
+    for (std::size_t k = 0; k < i; ++k)
+      if (p.actuators[k].name == a.name)
+        throw InvalidArgument(at + f + ".name is '" + a.name + "', already the name of actuators[" + std::to_string(k) +
+                              "]; names must be unique");
+    for (const auto& [key, v] : {std::pair{".offset_mm", a.offset.value()}, std::pair{".lateral_mm", a.lateral.value()}})
+      if (!(std::isfinite(v) && std::fabs(v) <= actuator_offset_mm_max))
+        throw InvalidArgument(at + f + key + " is " + num(v) + "; allowed: " + num(-actuator_offset_mm_max) + " … " +
+                              num(actuator_offset_mm_max) + " mm");
+    if (a.response) {
+      try {
+        validate(*a.response, f + ".response");
+      } catch (const InvalidArgument& e) {
+        throw InvalidArgument(at + e.what());
+      }
+    }
+  }
   if (p.bitmap) {
     const BitmapGeometry& b = *p.bitmap;
     if (b.width < 1 || b.width > 65535 || b.height < 1 || b.height > 65535)
@@ -166,13 +208,32 @@ DeviceProfile parse_device_profile(std::string_view json_text, std::string_view 
     }
     if (o.has("response")) {
       // Optional; absent (or null) = flat, so older and user profiles load unchanged.
-      detail::JsonObject r(o.raw("response"), "response");
-      p.response.corner = Hertz(r.number("corner_hz", 1e-6, 1e6));
-      p.response.order = static_cast<int>(r.integer("order", 1, 4));
-      p.response.source = r.string_or("source", "");
-      r.finish();
+      p.response = parse_response(o.raw("response"), "response");
     } else {
       o.skip("response");
+    }
+    if (o.has("actuators")) {
+      // Optional; absent = one channel, so every profile before it reads and writes as before.
+      const auto& arr = o.raw("actuators");
+      if (!arr.is_array() || arr.empty() || arr.size() > max_actuators)
+        throw FormatError("actuators must be an array of 1 … " + std::to_string(max_actuators) + " actuators, got " +
+                          (arr.is_array() ? std::to_string(arr.size()) + " entries" : std::string(arr.type_name())));
+      for (std::size_t i = 0; i < arr.size(); ++i) {
+        const std::string at = "actuators[" + std::to_string(i) + "]";
+        detail::JsonObject r(arr[i], at);
+        Actuator a;
+        a.name = r.string("name");
+        a.offset = Millimetres(r.number("offset_mm", -actuator_offset_mm_max, actuator_offset_mm_max));
+        a.lateral = Millimetres(r.number_or("lateral_mm", 0.0, -actuator_offset_mm_max, actuator_offset_mm_max));
+        if (r.has("response"))
+          a.response = parse_response(r.raw("response"), at + ".response");
+        else
+          r.skip("response");
+        r.finish();
+        p.actuators.push_back(std::move(a));
+      }
+    } else {
+      o.skip("actuators");
     }
     if (o.has("bitmap")) {
       // Optional; 1-D profiles have none and read and write as before.
@@ -219,13 +280,7 @@ std::string device_profile_json(const DeviceProfile& p) {
     j["layout"].push_back({{"name", r.name}, {"start_mm", r.start.value()}, {"length_mm", r.length.value()}});
   // Written only when not flat: a profile without a response reads and
   // writes the text it always had.
-  if (!p.response.flat()) {
-    nlohmann::ordered_json r;
-    r["corner_hz"] = p.response.corner.value();
-    r["order"] = p.response.order;
-    if (!p.response.source.empty()) r["source"] = p.response.source;
-    j["response"] = r;
-  }
+  if (!p.response.flat()) j["response"] = response_json(p.response);
   if (p.bitmap) {
     nlohmann::ordered_json b;
     b["width_px"] = p.bitmap->width;
@@ -234,6 +289,17 @@ std::string device_profile_json(const DeviceProfile& p) {
     b["depth_bits"] = p.bitmap->depth;
     b["polarity"] = std::string(to_string(p.bitmap->polarity));
     j["bitmap"] = b;
+  }
+  if (!p.actuators.empty()) {  // written only when declared: a one-channel profile keeps its text
+    j["actuators"] = nlohmann::ordered_json::array();
+    for (const auto& a : p.actuators) {
+      nlohmann::ordered_json r;
+      r["name"] = a.name;
+      r["offset_mm"] = a.offset.value();
+      r["lateral_mm"] = a.lateral.value();
+      if (a.response) r["response"] = response_json(*a.response);
+      j["actuators"].push_back(r);
+    }
   }
   return j.dump(2) + "\n";
 }

@@ -485,8 +485,8 @@ Document parse_document(std::string_view text, std::string_view origin) {
     const bool has_texture = o.has("texture");
     const bool has_regions = o.has("regions");
     if (o.has("surface2d")) {
-      if (doc.version < 4)
-        throw FormatError("surface2d needs version 4 (a 2-D document); version is " + std::to_string(doc.version));
+      if (doc.version < 4 || doc.version > 5)
+        throw FormatError("surface2d needs version 4 or 5 (a 2-D document); version is " + std::to_string(doc.version));
       if (has_texture || has_regions) throw FormatError("a 2-D document gives 'surface2d' and neither 'texture' nor 'regions'");
       if (!doc.device.bitmap)
         throw FormatError("device: '" + doc.device.name + "' has no bitmap grid (device.bitmap), which a 2-D document needs");
@@ -497,8 +497,35 @@ Document parse_document(std::string_view text, std::string_view origin) {
       return doc;
     }
     o.skip("surface2d");
-    if (doc.version >= 4)
+    if (doc.version == 4 || doc.version == 5)
       throw FormatError("version " + std::to_string(doc.version) + " is a 2-D document and needs 'surface2d'");
+    if (o.has("playback")) {
+      if (doc.version < 6)
+        throw FormatError("playback needs version 6 (multi-channel playback); version is " + std::to_string(doc.version));
+      JsonObject p(o.raw("playback"), "playback");
+      ChannelPlayback playback;
+      playback.mode = enum_field(p, "mode", ChannelMode::sequential,
+                                 [](std::string_view t, std::string_view f) { return parse_channel_mode(t, f); });
+      if (p.has("channel")) {
+        const std::int64_t c = p.integer("channel", 0, static_cast<std::int64_t>(max_actuators) - 1);
+        if (static_cast<std::size_t>(c) >= doc.device.channels())
+          throw FormatError("playback.channel is " + std::to_string(c) + "; allowed: 0 … " +
+                            std::to_string(doc.device.channels() - 1) + " (device '" + doc.device.name + "' has " +
+                            std::to_string(doc.device.channels()) + " channels)");
+        playback.channel = static_cast<std::size_t>(c);
+      } else {
+        p.skip("channel");
+      }
+      p.finish();
+      try {
+        validate(playback, doc.device.channels());
+      } catch (const InvalidArgument& e) {
+        throw FormatError(e.what());
+      }
+      doc.playback = playback;
+    } else {
+      o.skip("playback");
+    }
     if (has_texture == has_regions) throw FormatError("give exactly one of 'texture' (whole device) or 'regions'");
     if (has_texture) {
       o.skip("regions");
@@ -529,6 +556,7 @@ Document parse_document(std::string_view text, std::string_view origin) {
       if (r.coarse_reference) r.coarse_reference->synthesis = reference_synthesis(doc.version);
     }
     (void)prepare_surface(doc);  // layout and distribution errors surface at load time
+    if (doc.playback && doc.playback->mode == ChannelMode::simultaneous) (void)prepare_channels(doc);
     return doc;
   } catch (const Error& e) {
     throw FormatError(where + ": " + e.what());
@@ -586,6 +614,12 @@ std::string document_json(const Document& doc) {
       j["regions"].push_back(std::move(rj));
     }
   }
+  if (doc.playback) {
+    ordered p;
+    p["mode"] = std::string(to_string(doc.playback->mode));
+    if (doc.playback->channel) p["channel"] = *doc.playback->channel;
+    j["playback"] = p;
+  }
   return j.dump(2) + "\n";
 }
 
@@ -633,6 +667,14 @@ int required_version(const Document& doc) {
       if (version == 1) first = i;
       version = v;
     }
+  }
+  if (doc.playback) {
+    // Version 6 synthesises references as version 3 does; version-2 references cannot be in it.
+    if (version == 2)
+      throw InvalidArgument("region " + std::to_string(first) +
+                            " holds a version-2 (direct synthesis) reference, and playback needs version 6, whose references "
+                            "use the chirp-z synthesis");
+    return 6;
   }
   return version;
 }

@@ -20,6 +20,7 @@
 #include "texel/detail/shared_object.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
+#include "texel/multichannel_player.hpp"
 #include "texel/serial_link.hpp"
 
 namespace texel {
@@ -29,12 +30,20 @@ using Clock = std::chrono::steady_clock;
 // ----------------------------------------------------------------- files
 
 void write_wav(const std::string& path, std::span<const float> samples, double rate_hz, WavEncoding encoding) {
+  write_wav(path, samples, 1, rate_hz, encoding);
+}
+
+void write_wav(const std::string& path, std::span<const float> samples, std::size_t channels, double rate_hz,
+               WavEncoding encoding) {
   if (!(rate_hz >= 1 && rate_hz <= 1e6)) throw InvalidArgument("wav: rate is " + detail::num(rate_hz) + " Hz; allowed 1 … 1e6");
+  if (channels < 1 || channels > 64 || samples.size() % channels != 0)
+    throw InvalidArgument("wav: " + std::to_string(samples.size()) + " samples in " + std::to_string(channels) +
+                          " channels; allowed: 1 … 64 channels and whole frames");
   check_writable(path);
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
   SF_INFO info{};
   info.samplerate = static_cast<int>(std::lround(rate_hz));
-  info.channels = 1;
+  info.channels = static_cast<int>(channels);
   info.format = SF_FORMAT_WAV | (encoding == WavEncoding::pcm16   ? SF_FORMAT_PCM_16
                                  : encoding == WavEncoding::pcm24 ? SF_FORMAT_PCM_24
                                                                   : SF_FORMAT_FLOAT);
@@ -42,7 +51,7 @@ void write_wav(const std::string& path, std::span<const float> samples, double r
   if (!f) throw IoError("cannot write '" + path + "': " + sf_strerror(nullptr));
   // Clip rather than let libsndfile wrap out-of-range floats.
   sf_command(f, SFC_SET_CLIPPING, nullptr, SF_TRUE);
-  const sf_count_t n = static_cast<sf_count_t>(samples.size());
+  const sf_count_t n = static_cast<sf_count_t>(samples.size() / channels);  // frames
   const sf_count_t written = n ? sf_writef_float(f, samples.data(), n) : 0;
   const std::string err = written == n ? "" : sf_strerror(f);
   if (sf_close(f) != 0 || written != n) {
@@ -100,6 +109,13 @@ BackendStats Backend::stats() {
 
 void Backend::start(PlayerBase& player) {
   stop();
+  // A block holds frames × channels: the player's must be the backend's.
+  const auto* multi = dynamic_cast<const ChannelPlayer*>(&player);
+  const std::size_t player_channels = multi ? multi->channels() : 1;
+  if (player_channels != channels())
+    throw InvalidArgument("backend " + describe() + " has " + std::to_string(channels()) + " output channel" +
+                          (channels() == 1 ? "" : "s") + "; the player has " + std::to_string(player_channels) +
+                          " (open the backend with as many)");
   attachment_.attach(player);  // throws if another backend drives the player
   try {
     do_start(player);
@@ -217,11 +233,17 @@ class PacedBackend : public Backend {
 
 class NullBackend final : public PacedBackend {
  public:
-  NullBackend(double rate, std::size_t block) : PacedBackend(checked_period(rate, block), true), rate_(rate), buffer_(block) {}
+  NullBackend(double rate, std::size_t block, std::size_t channels)
+      : PacedBackend(checked_period(rate, block), true),
+        rate_(rate),
+        channels_(checked_channels(channels)),
+        buffer_(block * channels_) {}
   ~NullBackend() override { stop(); }
   [[nodiscard]] std::string describe() const override {
-    return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size()) + " frames per block";
+    return "null (no output device), " + detail::num(rate_) + " Hz, " + std::to_string(buffer_.size() / channels_) +
+           " frames per block" + (channels_ > 1 ? ", " + std::to_string(channels_) + " channels" : "");
   }
+  [[nodiscard]] std::size_t channels() const noexcept override { return channels_; }
 
  private:
   static double checked_period(double rate, std::size_t block) {
@@ -231,12 +253,18 @@ class NullBackend final : public PacedBackend {
       throw InvalidArgument("null backend: block is " + std::to_string(block) + " frames; allowed 1 … 65536");
     return static_cast<double>(block) / rate;
   }
+  static std::size_t checked_channels(std::size_t channels) {
+    if (channels < 1 || channels > 64)
+      throw InvalidArgument("null backend: channels is " + std::to_string(channels) + "; allowed 1 … 64");
+    return channels;
+  }
   void tick(PlayerBase& player) override {
     const auto b0 = Clock::now();
     const BlockInfo info = player.process(buffer_);
     record(info, seconds_since(b0));
   }
   double rate_;
+  std::size_t channels_;
   std::vector<float> buffer_;
 };
 
@@ -339,7 +367,11 @@ class AudioBackend final : public Backend {
     device_name_ = info->name;
     PaStreamParameters p{};
     p.device = dev;
-    p.channelCount = 1;
+    if (o.channels < 1 || o.channels > 64 || static_cast<int>(o.channels) > info->maxOutputChannels)
+      throw IoError("audio: '" + device_name_ + "' has " + std::to_string(info->maxOutputChannels) +
+                    " output channels; asked for " + std::to_string(o.channels) + " (allowed 1 … " +
+                    std::to_string(std::min(64, info->maxOutputChannels)) + ")");
+    p.channelCount = static_cast<int>(o.channels);
     p.sampleFormat = paFloat32;
     p.suggestedLatency = o.latency_s > 0 ? o.latency_s : info->defaultLowOutputLatency;
     pa_check(
@@ -353,8 +385,9 @@ class AudioBackend final : public Backend {
   }
   [[nodiscard]] std::string describe() const override {
     return "audio '" + device_name_ + "', " + detail::num(options_.rate_hz) + " Hz, " + std::to_string(options_.block_frames) +
-           " frames per block";
+           " frames per block" + (options_.channels > 1 ? ", " + std::to_string(options_.channels) + " channels" : "");
   }
+  [[nodiscard]] std::size_t channels() const noexcept override { return options_.channels; }
 
  private:
   void do_start(PlayerBase& player) override {
@@ -373,7 +406,8 @@ class AudioBackend final : public Backend {
     auto* self = static_cast<AudioBackend*>(self_ptr);
     if (flags & paOutputUnderflow) self->record_underrun();
     const auto t0 = Clock::now();
-    const BlockInfo info = self->player_->process(std::span(static_cast<float*>(output), frames));
+    // Interleaved frames × channels (a ChannelPlayer's, or one channel).
+    const BlockInfo info = self->player_->process(std::span(static_cast<float*>(output), frames * self->options_.channels));
     self->record(info, seconds_since(t0));
     return paContinue;
   }
@@ -453,8 +487,8 @@ class SerialBackend final : public PacedBackend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames) {
-  return std::make_unique<NullBackend>(rate_hz, block_frames);
+std::unique_ptr<Backend> make_null_backend(double rate_hz, std::size_t block_frames, std::size_t channels) {
+  return std::make_unique<NullBackend>(rate_hz, block_frames, channels);
 }
 
 std::unique_ptr<Backend> make_audio_backend(const AudioOptions& options) { return std::make_unique<AudioBackend>(options); }
@@ -473,16 +507,19 @@ BackendChoice parse_backend(std::string_view name) {
 
 std::unique_ptr<Backend> make_backend(const BackendChoice& choice, const BackendOptions& options, const PlayerMap& map) {
   switch (choice.kind) {
-    case BackendChoice::Kind::null: return make_null_backend(options.rate_hz, options.block_frames);
+    case BackendChoice::Kind::null: return make_null_backend(options.rate_hz, options.block_frames, options.channels);
     case BackendChoice::Kind::audio: {
       AudioOptions o;
       o.device = options.audio_device;
       o.rate_hz = options.rate_hz;
       o.block_frames = options.block_frames;
+      o.channels = options.channels;
       return make_audio_backend(o);
     }
     case BackendChoice::Kind::serial: break;
   }
+  if (options.channels != 1)
+    throw InvalidArgument("backend serial: a display takes one channel; the player has " + std::to_string(options.channels));
   SerialOptions o;
   o.path = choice.serial_path;
   o.baud = options.baud;

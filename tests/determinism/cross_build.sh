@@ -14,6 +14,9 @@
 # version 3: chirp-z over detfft) as float64 maps — every bit of every
 # amplitude — against tests/golden/references.sha256 (also held by the
 # reference.golden_sha256 test of the main build).
+# Multi-channel documents (issue #40) are in the same set: a version-6
+# document (v6-simultaneous-4ch) is written as its channels' maps,
+# interleaved [samples, channels], so every channel's draw is compared.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 golden="$root/tests/golden/demo.sha256"

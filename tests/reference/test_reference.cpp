@@ -355,7 +355,7 @@ TEST(ReferenceDocument, VersionPicksTheSynthesisAndIsKeptWhenWritten) {
   EXPECT_EQ(required_version(v1), 2);
   // New documents take the current synthesis and say so.
   const Document fresh = make_reference_document(load_device("tpad"), spec("white"));
-  EXPECT_EQ(Document::current_version, 5);
+  EXPECT_EQ(Document::current_version, 6);  // 6: multi-channel playback (docs/rendering.md)
   EXPECT_NE(document_json(fresh).find("\"version\": 3"), std::string::npos);
   // One document, one synthesis: a mix cannot be written.
   Document mixed = parse_document(doc_text(2));

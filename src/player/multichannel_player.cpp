@@ -1,0 +1,112 @@
+// The multi-channel player: one Player per channel (texel/multichannel_player.hpp).
+#include "texel/multichannel_player.hpp"
+
+#include <algorithm>
+
+#include "texel/detail/format.hpp"
+#include "texel/error.hpp"
+
+namespace texel {
+
+ChannelPlayer::ChannelPlayer(const PlayerConfig& config, std::span<const Channel> channels, std::size_t max_block)
+    : PlayerBase(config.rate_hz), max_block_(max_block) {
+  if (channels.empty()) throw InvalidArgument("ChannelPlayer: no channels; allowed: 1 … " + std::to_string(max_actuators));
+  if (max_block < 1 || max_block > 65536)
+    throw InvalidArgument("ChannelPlayer: max_block is " + std::to_string(max_block) + "; allowed: 1 … 65536");
+  players_.reserve(channels.size());
+  for (const Channel& ch : channels) {
+    PlayerConfig c = config;
+    c.response = ch.response;
+    players_.push_back(
+        std::make_unique<Player>(c, ch.surface ? PlayerMap::from_surface(*ch.surface) : std::unique_ptr<const PlayerMap>()));
+    offsets_.push_back(ch.offset.value());
+  }
+  scratch_.assign(max_block_ * channels.size(), 0.0f);
+  scratch_position_.assign(max_block_, 0.0f);
+}
+
+ChannelPlayer::~ChannelPlayer() { stop_driver(); }
+
+bool ChannelPlayer::push(const FingerSample& s) {
+  // One producer: the space seen here can only grow before the pushes below.
+  for (const auto& p : players_)
+    if (p->event_space() == 0) return false;
+  for (std::size_t c = 0; c < players_.size(); ++c) {
+    FingerSample shifted = s;
+    shifted.x_mm += offsets_[c];
+    players_[c]->push(shifted);
+  }
+  return true;
+}
+
+std::size_t ChannelPlayer::collect() {
+  std::size_t n = 0;
+  for (const auto& p : players_) n += p->collect();
+  return n;
+}
+
+BlockInfo ChannelPlayer::process_planar(std::span<const std::span<float>> outs, std::span<float> position_mm) noexcept {
+  // Real-time: one Player::process per channel, then arithmetic on caller memory.
+  const std::size_t n = std::min(outs.size(), players_.size());
+  BlockInfo info;
+  for (std::size_t c = 0; c < n; ++c) {
+    const BlockInfo ci =
+        players_[c]->process(outs[c], c == 0 && position_mm.size() == outs[0].size() ? position_mm : std::span<float>{});
+    if (c == 0) info = ci;
+    info.peak = std::max(info.peak, ci.peak);
+    info.crossfading = info.crossfading || ci.crossfading;
+  }
+  if (n > 0) {
+    info.position_mm -= offsets_[0];
+    if (position_mm.size() == outs[0].size()) {
+      const auto offset = static_cast<float>(offsets_[0]);
+      for (float& x : position_mm) x -= offset;
+    }
+    frames_ += outs[0].size();
+    publish_samples(frames_);
+  }
+  return info;
+}
+
+BlockInfo ChannelPlayer::process(std::span<float> out, std::span<float> position_mm) noexcept {
+  // Real-time: the scratch block was allocated at prepare; spans are views.
+  const std::size_t n = players_.size();
+  const std::size_t frames = out.size() / n;
+  const bool positions = position_mm.size() == frames;
+  std::span<float> planar[max_actuators];
+  BlockInfo info;
+  for (std::size_t done = 0; done < frames;) {
+    const std::size_t m = std::min(max_block_, frames - done);
+    for (std::size_t c = 0; c < n; ++c) planar[c] = std::span(scratch_).subspan(c * max_block_, m);
+    const float peak = info.peak;
+    info = process_planar(std::span<const std::span<float>>(planar, n),
+                          positions ? position_mm.subspan(done, m) : std::span<float>{});
+    info.peak = std::max(info.peak, peak);
+    for (std::size_t i = 0; i < m; ++i)
+      for (std::size_t c = 0; c < n; ++c) out[(done + i) * n + c] = planar[c][i];
+    done += m;
+  }
+  return info;
+}
+
+std::vector<float> render_trace_channels(std::span<const Channel> channels, const PlayerConfig& config,
+                                         std::span<const FingerSample> trace, std::size_t frames, std::vector<float>* positions,
+                                         std::size_t block) {
+  if (block == 0 || block > 65536)
+    throw InvalidArgument("render_trace_channels: block is " + std::to_string(block) + "; allowed: 1 … 65536");
+  ChannelPlayer player(config, channels, block);
+  const std::size_t n = player.channels();
+  std::vector<float> out(frames * n);
+  if (positions) positions->assign(frames, 0.0f);
+  std::size_t next = 0;
+  for (std::size_t done = 0; done < frames;) {
+    while (next < trace.size() && player.push(trace[next])) ++next;
+    const std::size_t m = std::min(block, frames - done);
+    player.process(std::span(out).subspan(done * n, m * n),
+                   positions ? std::span(*positions).subspan(done, m) : std::span<float>{});
+    done += m;
+  }
+  return out;
+}
+
+}  // namespace texel
