@@ -128,6 +128,7 @@ bench: deps-web build web web-test
 	$(PY) bench/summarize.py $(BUILD)/bench.json
 	$(BUILD)/bin/texel_bench_player 1000000 --json $(BUILD)/bench_player.json
 	$(BUILD)/bin/texel_bench_player_paced --json $(BUILD)/bench_player_paced.json
+	$(BUILD)/bin/texel_bench_multichannel_paced --seconds 10 --runs 2
 	$(BUILD)/bin/texel_bench_match --json $(BUILD)/bench_match.json
 	$(BUILD)/bin/texel_bench_design 40 --json $(BUILD)/bench_design.json
 	$(BUILD)/bin/texel_bench_encode --json $(BUILD)/bench_encode.json
