@@ -150,7 +150,8 @@ class PlayerMap {
                                                        std::optional<FrequencyResponse> response = std::nullopt);
   /// The whole map of a document on its device, carrying the device's
   /// frequency response (doc.device.response): what the experiments'
-  /// Presenter, the studio's Feel-it and the C API play.
+  /// Presenter, the studio's Feel-it and the C API play. A document of
+  /// simultaneous channels (multichannel.hpp) has no one map: InvalidArgument.
   static std::unique_ptr<const PlayerMap> from_document(const Document& doc);
   /// A single texture laid on `grid` (texture coordinates = grid positions).
   static std::unique_ptr<const PlayerMap> from_texture(const Texture& texture, const Grid& grid);

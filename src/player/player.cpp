@@ -11,6 +11,7 @@
 #include "texel/detmath.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
+#include "texel/multichannel.hpp"
 #include "texel/surface.hpp"
 #include "texel/texture.hpp"
 
@@ -63,6 +64,13 @@ std::unique_ptr<const PlayerMap> PlayerMap::from_surface(const Surface& surface,
 }
 
 std::unique_ptr<const PlayerMap> PlayerMap::from_document(const Document& doc) {
+  // One map plays one channel: a document whose channels each draw their own
+  // texels has no one map (its base seed's chain is none of its channels).
+  if (doc.playback && doc.playback->mode == ChannelMode::simultaneous)
+    throw InvalidArgument("the document plays simultaneous texels on the " + std::to_string(doc.device.channels()) +
+                          " actuators of device '" + doc.device.name +
+                          "'; this player has one channel: play it with texel play or texel swipe (the multi-channel "
+                          "player, multichannel_player.hpp), or give it \"playback\": {\"mode\": \"sequential\"}");
   return from_surface(prepare_surface(doc), doc.device.response);
 }
 

@@ -161,6 +161,16 @@ TEST(MultichannelChannels, SequentialChannelsReadTheDocumentsOwnMap) {
   for (std::size_t c = 0; c < 4; ++c) EXPECT_EQ(only2[c].surface != nullptr, c == 2) << c;
 }
 
+// A one-channel player (the studio's Feel-it, the experiments' presenter, the
+// C API, Python) has no one map for a simultaneous document: refused, naming
+// what plays it; a sequential one plays the document's own map.
+TEST(MultichannelChannels, OneChannelPlayersRefuseASimultaneousDocument) {
+  const Document sim = parse_document(document(pad_device(1000), R"({"mode": "simultaneous"})"));
+  EXPECT_NE(message_of<InvalidArgument>([&] { (void)PlayerMap::from_document(sim); }).find("simultaneous texels on the 4"),
+            std::string::npos);
+  EXPECT_NO_THROW((void)PlayerMap::from_document(parse_document(document(pad_device(1000), R"({"mode": "sequential"})"))));
+}
+
 TEST(MultichannelChannels, SimultaneousChannelDrawsArePureFunctionsOfSeedChannelAndTexel) {
   const Document doc = parse_document(document(pad_device(1000), R"({"mode": "simultaneous"})"));
   const auto channels = prepare_channels(doc);
