@@ -129,6 +129,8 @@ void validate_observer_object(const json& o) {
       s.skip("p_correct");
     }
     (void)s.number_or("p_digit", 0.8, 0.0, 1.0);
+    (void)s.number_or("p_hit", 0.85, 0.0, 1.0);
+    (void)s.number_or("p_false_alarm", 0.05, 0.0, 1.0);
   });
   section("explorer", [&](JsonObject& s) {
     (void)s.number_or("speed_mm_s", 100.0, 1.0, 10000.0);
@@ -312,6 +314,10 @@ double SimulatedParticipant::memory_p_correct(const std::string& condition) cons
 }
 
 double SimulatedParticipant::memory_p_digit() const { return get(section_of(model_->observer, "memory"), "p_digit", 0.8); }
+double SimulatedParticipant::memory_p_hit() const { return get(section_of(model_->observer, "memory"), "p_hit", 0.85); }
+double SimulatedParticipant::memory_p_false_alarm() const {
+  return get(section_of(model_->observer, "memory"), "p_false_alarm", 0.05);
+}
 
 Response SimulatedParticipant::respond(const Session& session) const {
   const Question& q = session.question();

@@ -71,6 +71,9 @@ class SimulatedParticipant {
   [[nodiscard]] double memory_p_correct(const std::string& condition) const;
   /// Working memory: P(digit recalled).
   [[nodiscard]] double memory_p_digit() const;
+  /// Working memory's executive distractor: P(respond) to a target, and to a non-target.
+  [[nodiscard]] double memory_p_hit() const;
+  [[nodiscard]] double memory_p_false_alarm() const;
   /// A wrong choice (never "unsure"), drawn from the behaviour stream.
   [[nodiscard]] std::string wrong_choice(const Question& q, const std::string& correct) const;
 
