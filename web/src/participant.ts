@@ -623,6 +623,7 @@ export function mountParticipant(root: HTMLElement): void {
           // press of Respond is a response to the digit on screen (or just gone).
           ev('sequence', 'shown');
           const seq = q.sequence ?? [];
+          let stopKeys = () => {};
           const slot = (ph.duration_s * 1000) / Math.max(1, seq.length);
           const start = performance.now();
           const digit = h('div', { class: 'sequence-digit', 'data-testid': 'sequence-digit', 'aria-live': 'off' });
@@ -640,13 +641,20 @@ export function mountParticipant(root: HTMLElement): void {
             });
             children.push(respond);
             timers.push(setTimeout(() => respond.focus(), 0));
+            // The space bar responds wherever the focus is (a focused button clicks itself).
+            const onKey = (e: KeyboardEvent) => {
+              if (e.code !== 'Space' || document.activeElement === respond) return;
+              e.preventDefault();
+              respond.click();
+            };
+            document.addEventListener('keydown', onKey);
+            stopKeys = () => document.removeEventListener('keydown', onKey);
           }
           phaseArea.replaceChildren(...children, left);
           const draw = () => {
-            if (!current()) return;
             const t = performance.now() - start;
             const i = Math.floor(t / slot);
-            if (i >= seq.length) return;
+            if (!current() || i >= seq.length) return stopKeys();
             const blank = t - i * slot >= 0.8 * slot;
             digit.textContent = blank ? '' : String(seq[i]);
             digit.dataset.item = blank ? '' : String(i);

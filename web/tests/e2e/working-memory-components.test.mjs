@@ -27,7 +27,8 @@ function protocol() {
 }
 
 // In the page: watch the sequence until the answers show; Respond while a
-// digit equal to the one two before it is on screen (2-back).
+// digit equal to the one two before it is on screen (2-back): the button,
+// then the space bar.
 function followSequence(respondToTargets) {
   return new Promise((resolve) => {
     const seen = [];
@@ -38,7 +39,12 @@ function followSequence(respondToTargets) {
         seen.push(Number(d.textContent));
         const n = seen.length;
         if (respondToTargets && n >= 3 && seen[n - 1] === seen[n - 3]) {
-          document.querySelector('[data-testid=respond]').click();
+          // The first press on the button, the others with the space bar (focus elsewhere).
+          if (pressed === 0) document.querySelector('[data-testid=respond]').click();
+          else {
+            document.activeElement?.blur();
+            document.dispatchEvent(new KeyboardEvent('keydown', { code: 'Space', key: ' ', bubbles: true }));
+          }
           pressed++;
         }
       }
