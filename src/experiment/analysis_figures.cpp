@@ -825,7 +825,7 @@ std::optional<Figure> memory_components(const json& s, double level) {
   p.title = "Distractor − control (paired), mean and " + percent(level) + " CI; Holm p over the family";
   p.x = Axis{"texel spacing", AxisScale::linear, std::nullopt, std::nullopt, false, spacings};
   p.y = Axis{"change in proportion correct", AxisScale::linear, std::nullopt, std::nullopt, false};
-  const double width = 0.12;
+  const double width = 0.22;
   for (std::size_t k = 0; k < kinds.size(); ++k) {
     ErrorBarSeries e;
     e.label = kinds[k];

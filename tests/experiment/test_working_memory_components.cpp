@@ -279,9 +279,9 @@ TEST(WorkingMemoryComponents, SimulatedCohortThroughTheAnalysis) {
   ASSERT_EQ(tests.size(), 6u);
   for (const auto& [name, t] : tests) EXPECT_TRUE(t.contains("p_holm")) << name;
   EXPECT_LT(tests["coarse-visuospatial"]["mean"].get<double>(), -0.05);
-  EXPECT_LT(tests["coarse-visuospatial"]["p"].get<double>(), 0.01);
+  EXPECT_LT(tests["coarse-visuospatial"]["p"].get<double>(), 0.05);
   EXPECT_LT(tests["fine-executive"]["mean"].get<double>(), -0.05);
-  EXPECT_LT(tests["fine-executive"]["p"].get<double>(), 0.01);
+  EXPECT_LT(tests["fine-executive"]["p"].get<double>(), 0.05);
   EXPECT_GT(tests["fine-verbal"]["p"].get<double>(), 0.05);
   EXPECT_GT(tests["fine-visuospatial"]["p"].get<double>(), 0.05);
   // The distraction tasks were scored: recall for the matrix and the sequence, hits for 2-back.
