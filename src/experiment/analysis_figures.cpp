@@ -754,14 +754,14 @@ Figure guided_convergence(const Rows& rows) {
 
 // ----------------------------------------------------------- working memory
 
-Figure memory_figure(const json& s) {
+Figure memory_figure(const Study& study, const json& s) {
   std::vector<std::string> spacings, kinds;
   for (const auto& c : s["conditions"]) {
     const auto sp = c["spacing"].get<std::string>(), kd = c["distractor"].get<std::string>();
     if (std::find(spacings.begin(), spacings.end(), sp) == spacings.end()) spacings.push_back(sp);
     if (std::find(kinds.begin(), kinds.end(), kd) == kinds.end()) kinds.push_back(kd);
   }
-  Figure f = figure("Working memory: same/different accuracy (" + std::to_string(s["included"].get<std::size_t>()) +
+  Figure f = figure(std::string(study.title) + ": same/different accuracy (" + std::to_string(s["included"].get<std::size_t>()) +
                         " participants after exclusions)",
                     1280, 480, 2);
   Panel a;
@@ -820,7 +820,7 @@ std::optional<Figure> memory_components(const json& s, double level) {
     if (std::find(kinds.begin(), kinds.end(), kd) == kinds.end()) kinds.push_back(kd);
   }
   if (kinds.size() < 2) return std::nullopt;
-  Figure f = figure("Working-memory components: effect of each distractor on same/different accuracy", 900, 520);
+  Figure f = figure("Working memory: effect of each distractor on same/different accuracy", 900, 520);
   Panel p;
   p.title = "Distractor − control (paired), mean and " + percent(level) + " CI; Holm p over the family";
   p.x = Axis{"texel spacing", AxisScale::linear, std::nullopt, std::nullopt, false, spacings};
@@ -855,7 +855,7 @@ std::optional<Figure> memory_components(const json& s, double level) {
 /// The source's trend figure: each participant's main-task errors against
 /// their distraction-task errors, the kept participants' least-squares line
 /// and its R², the excluded participants marked apart.
-std::optional<Figure> memory_errors_trend(const json& s) {
+std::optional<Figure> memory_errors_trend(const Study& study, const json& s) {
   StemSeries kept, out;
   kept.stems = out.stems = false;
   kept.marker_radius_px = out.marker_radius_px = 4.5;
@@ -871,7 +871,7 @@ std::optional<Figure> memory_errors_trend(const json& s) {
   }
   if (kept.x.empty() && out.x.empty()) return std::nullopt;
   const json& r = s["r2"];
-  Figure f = figure("Working memory: main-task against distraction-task errors", 700, 520);
+  Figure f = figure(std::string(study.title) + ": main-task against distraction-task errors", 700, 520);
   Panel p;
   p.title = r.contains("r2") ? "R² = " + texel::detail::fixed(d(r["r2"]), 4) +
                                    " (kept participants, n = " + std::to_string(r["n"].get<std::size_t>()) + "), " + p_text(r)
@@ -989,9 +989,9 @@ std::vector<std::string> study_figures(const Study& study, const nlohmann::order
       if (auto f = match_similarity(rows)) w.save(*f, "match-similarity");
       break;
     case StudyDesign::memory:
-      w.save(memory_figure(summary), "performance");
-      if (auto f = memory_errors_trend(summary)) w.save(*f, "errors-trend");
-      if (auto f = memory_components(summary, options.level)) w.save(*f, "components");
+      w.save(memory_figure(study, summary), "performance");
+      if (auto f = memory_errors_trend(study, summary)) w.save(*f, "errors-trend");
+      if (auto f = memory_components(summary, options.level)) w.save(*f, "effects");
       break;
     case StudyDesign::oddity: w.save(oddity_figure(study, summary, options.level), "proportion-correct"); break;
   }

@@ -211,7 +211,7 @@ json excluded_list(const Excluded& e) {
 
 }  // namespace
 
-json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& text) {
+json memory_summary(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
   std::map<std::string, MemoryPerson> people;
   Ordered conditions;
   for (const TrialRow* r : rows) {
@@ -330,7 +330,7 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   }
   out["rules_compared"] = rules;
 
-  text += "working-memory: " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) +
+  text += study + ": " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) +
           " excluded (rule: " + o.memory_rule + ")\n";
   for (const auto& [id, why] : excluded) text += "  excluded " + id + ": " + why + "\n";
   for (const auto& c : cj)

@@ -75,8 +75,8 @@ std::vector<bool> two_back_targets(const std::vector<int>& s) {
 
 TEST(WorkingMemoryComponents, ShippedProtocolCrossesDistractorWithCoarseAndFine) {
   const ex::Protocol p = ex::load_protocol(shipped_path.string());
-  EXPECT_EQ(p.study, "working-memory");
-  EXPECT_EQ(p.planned_trials(), 1 + 16 + 64);  // familiarisation, 2 training and 8 test trials per condition
+  EXPECT_EQ(p.study, "working-memory-components");  // its own study: analysed apart from the source's
+  EXPECT_EQ(p.planned_trials(), 1 + 16 + 64);       // familiarisation, 2 training and 8 test trials per condition
   const ex::Block& test = *p.block("test");
   std::set<std::pair<std::string, std::string>> cells;
   for (const auto& c : test.conditions) {
@@ -264,7 +264,7 @@ TEST(WorkingMemoryComponents, SimulatedCohortThroughTheAnalysis) {
   ex::AnalysisOptions o;
   o.out_dir = out.string();
   const ex::AnalysisReport report = ex::analyze(rows, o);
-  const json s = json::parse(report.summary)["working-memory"];
+  const json s = json::parse(report.summary)["working-memory-components"];
   // The RM-ANOVA has the distractor factor with its four levels.
   std::map<std::string, json> effects;
   for (const auto& e : s["rm_anova"]["effects"]) effects[e["effect"].get<std::string>()] = e;
@@ -292,8 +292,8 @@ TEST(WorkingMemoryComponents, SimulatedCohortThroughTheAnalysis) {
   EXPECT_NEAR(tasks["executive"]["hit_rate"]["mean"].get<double>(), 0.85, 0.06);
   EXPECT_NEAR(tasks["executive"]["false_alarms_per_trial"]["mean"].get<double>(), 7 * 0.05, 0.1);
   // The figure of the per-component effects.
-  EXPECT_TRUE(fs::exists(out / "working-memory-components.png"));
-  EXPECT_TRUE(fs::exists(out / "working-memory-performance.png"));
+  EXPECT_TRUE(fs::exists(out / "working-memory-components-effects.png"));
+  EXPECT_TRUE(fs::exists(out / "working-memory-components-performance.png"));
   EXPECT_NE(report.text.find("fine spacing, executive − control (paired): t(23) = "), std::string::npos) << report.text;
 
   // The source's exclusion rule over every distractor's errors: a participant
@@ -308,7 +308,7 @@ TEST(WorkingMemoryComponents, SimulatedCohortThroughTheAnalysis) {
     }
     if (r.participant == "P02" && std::isfinite(r.nback_hits)) r.nback_false_alarms = 2;  // every 2-back trial an error
   }
-  const json x = json::parse(ex::analyze(rows, {}).summary)["working-memory"];
+  const json x = json::parse(ex::analyze(rows, {}).summary)["working-memory-components"];
   std::map<std::string, json> people;
   for (const auto& q : x["participants"]) people[q["participant"].get<std::string>()] = q;
   EXPECT_TRUE(people["P01"]["excluded"].is_string()) << people["P01"].dump();

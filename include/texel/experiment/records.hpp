@@ -23,7 +23,7 @@ struct TrialRow {
   std::string participant;  ///< pseudonymous code, e.g. "S01"
   std::int64_t session_id = 0;
   std::string protocol;  ///< protocol name, e.g. "texel-length"
-  std::string study;     ///< one of: working-memory, texel-length, parameter-mapping,
+  std::string study;     ///< one of: working-memory, working-memory-components, texel-length, parameter-mapping,
                          ///< free-exploration, quantization, guided-exploration, coarse-features,
                          ///< direction-independence, rendering-2d
   std::string block;     ///< block name, e.g. "narrow", "fine-50"
