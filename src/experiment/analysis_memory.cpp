@@ -360,7 +360,7 @@ json memory_summary(const std::string& study, const Rows& rows, const AnalysisOp
     text += "  " + t["spacing"].get<std::string>() + " spacing, " + t["distractor"].get<std::string>() +
             " − control (paired): " + t_text(tt);
     if (tt.contains("cohen_d")) text += ", d = " + fmt(val(tt, "cohen_d"));
-    if (tt.contains("p_holm")) text += ", Holm " + fmt_p(val(tt, "p_holm"));
+    if (std::isfinite(val(tt, "p_holm"))) text += ", Holm " + fmt_p(val(tt, "p_holm"));
     text += "\n";
   }
   for (const auto& r : rules) {

@@ -116,7 +116,7 @@ def main():
     with open(os.path.join(PROTOCOLS, "working-memory-components.json")) as f:
         p = json.load(f)
     test = [b for b in p["blocks"] if b["name"] == "test"][0]
-    test.update(texture_s=0.5, matrix_s=6, trials_per_condition=1)
+    test.update(texture_s=0.5, matrix_s=8, trials_per_condition=1)  # 0.8 s a digit in the 2-back: room for a loaded machine
     test["conditions"] = [c for c in test["conditions"] if c["stimulus"] == "coarse"]
     p["blocks"] = [test]
     protocol = os.path.join(WORK, "wm.json")
