@@ -190,6 +190,10 @@ std::string simulation_observer(std::string_view protocol_observer_json, const s
       o["memory"]["p_correct"] = number_with_unit(key, value, {"%"});
     } else if (key == "digit") {
       o["memory"]["p_digit"] = number_with_unit(key, value, {"%"});
+    } else if (key == "hit") {
+      o["memory"]["p_hit"] = number_with_unit(key, value, {"%"});
+    } else if (key == "false-alarm") {
+      o["memory"]["p_false_alarm"] = number_with_unit(key, value, {"%"});
     } else if (key == "rating-noise") {
       o["rater"]["noise"] = number_with_unit(key, value, {});
     } else if (key == "speed") {
@@ -202,9 +206,11 @@ std::string simulation_observer(std::string_view protocol_observer_json, const s
         throw InvalidArgument("--simulate seed=" + value + ": allowed: a whole number 0 … 2^53");
       o["seed"] = static_cast<std::uint64_t>(s);
     } else {
-      throw InvalidArgument("--simulate: unknown key '" + key +
-                            "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, rating-noise, "
-                            "speed, spread, seed, default");
+      throw InvalidArgument(
+          "--simulate: unknown key '" + key +
+          "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, hit, false-alarm, "
+          "rating-noise, "
+          "speed, spread, seed, default");
     }
   }
   try {

@@ -318,3 +318,25 @@ TEST(WorkingMemoryComponents, SimulatedCohortThroughTheAnalysis) {
   EXPECT_EQ(x["included"], 23);
   fs::remove_all(out);
 }
+
+TEST(WorkingMemoryComponents, SimulateSpecSetsTheTwoBackObserver) {
+  const ex::Protocol p = ex::load_protocol(shipped_path.string());
+  const json o = json::parse(ex::simulation_observer(p.observer, "hit=60%,false-alarm=0.2"));
+  EXPECT_DOUBLE_EQ(o["memory"]["p_hit"].get<double>(), 0.6);
+  EXPECT_DOUBLE_EQ(o["memory"]["p_false_alarm"].get<double>(), 0.2);
+  EXPECT_EQ(o["memory"]["p_correct"]["fine-executive"], 0.62);  // the protocol's hypothesis kept
+  EXPECT_NE(error_of([&] { (void)ex::simulation_observer(p.observer, "hit=1.5"); }).find("p_hit"), std::string::npos);
+  // An observer who never responds scores no hit and no false alarm.
+  auto s = session_of(p);
+  const ex::SimulatedParticipant sim(ex::simulation_observer(p.observer, "hit=0,false-alarm=0"), s);
+  int executive = 0;
+  while (!s.finished()) {
+    const ex::StoredTrial t = s.answer(sim.respond(s));
+    if (std::isfinite(t.row.nback_targets)) {
+      ++executive;
+      EXPECT_EQ(t.row.nback_hits, 0);
+      EXPECT_EQ(t.row.nback_false_alarms, 0);
+    }
+  }
+  EXPECT_EQ(executive, 20);  // coarse and fine, 2 training and 8 test trials each
+}

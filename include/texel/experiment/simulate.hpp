@@ -14,7 +14,8 @@
 //                   model), or target=8dB/-3dB (Central Pitch/Irregularity);
 //                   default: each trial's own reference
 //   noise=1.5dB     matcher noise; unsure=0.5dB (unsure band)
-//   p=0.85          working memory: P(correct) for every condition; digit=0.8
+//   p=0.85          working memory: P(correct) for every condition; digit=0.8;
+//                   hit=0.85, false-alarm=0.05 (2-back: P(respond) to a target, a non-target)
 //   rating-noise=0.5, speed=100 (mm/s swipe speed), seed=7
 //   spread=0.25     between-participant variability (participant_sd): each
 //                   participant's threshold, matcher target and memory
