@@ -26,30 +26,39 @@ function protocol() {
   return p;
 }
 
-// In the page: watch the sequence until the answers show; Respond while a
-// digit equal to the one two before it is on screen (2-back): the button,
-// then the space bar.
-function followSequence(respondToTargets) {
+// In the page, from the moment the question is on screen until its answers
+// show: what the distractor shows — the matrix's cells, or the sequence's
+// digits by their item number — and, when there is a Respond button (2-back),
+// a response while a digit equal to the one two before it is on screen: the
+// first with the button, the others with the space bar (focus elsewhere).
+function followDistractor() {
   return new Promise((resolve) => {
-    const seen = [];
-    let pressed = 0;
+    const out = { kind: null, cells: null, seen: [], pressed: 0 };
     const poll = () => {
+      const m = document.querySelector('[data-testid=matrix]');
+      if (m && !out.cells) {
+        out.kind = 'matrix';
+        out.cells = [...m.querySelectorAll('.cell')].map((c) => c.textContent);
+      }
       const d = document.querySelector('[data-testid=sequence-digit]');
-      if (d && d.dataset.item !== undefined && d.dataset.item !== '' && Number(d.dataset.item) === seen.length) {
-        seen.push(Number(d.textContent));
-        const n = seen.length;
-        if (respondToTargets && n >= 3 && seen[n - 1] === seen[n - 3]) {
-          // The first press on the button, the others with the space bar (focus elsewhere).
-          if (pressed === 0) document.querySelector('[data-testid=respond]').click();
-          else {
-            document.activeElement?.blur();
-            document.dispatchEvent(new KeyboardEvent('keydown', { code: 'Space', key: ' ', bubbles: true }));
+      if (d) {
+        const respond = document.querySelector('[data-testid=respond]');
+        out.kind = respond ? '2-back' : 'sequence';
+        const i = d.dataset.item === undefined || d.dataset.item === '' ? -1 : Number(d.dataset.item);
+        if (i >= 0 && out.seen[i] === undefined) {
+          out.seen[i] = Number(d.textContent);
+          if (respond && i >= 2 && out.seen[i] === out.seen[i - 2]) {
+            if (out.pressed === 0) respond.click();
+            else {
+              document.activeElement?.blur();
+              document.dispatchEvent(new KeyboardEvent('keydown', { code: 'Space', key: ' ', bubbles: true }));
+            }
+            out.pressed++;
           }
-          pressed++;
         }
       }
-      if (document.querySelector('.answers:not([hidden])')) resolve({ seen, pressed });
-      else setTimeout(poll, 15);
+      if (out.kind && document.querySelector('.answers:not([hidden])')) resolve(out);
+      else setTimeout(poll, 10);
     };
     poll();
   });
@@ -61,6 +70,8 @@ test('working-memory components: matrix, digit sequence and 2-back on the partic
     await page.waitForSelector('#protocol option', { state: 'attached' });
     const p = await context.newPage();
     p.on('pageerror', (e) => errors.push(String(e)));
+    const frames = []; // what the participant's page receives (readable in devtools)
+    p.on('websocket', (ws) => ws.on('framereceived', (f) => typeof f.payload === 'string' && frames.push(f.payload)));
     const r = await startSession(page, protocol(), 'S-wmc');
     assert.equal(r.type, 'experiment.started', JSON.stringify(r));
     await p.goto(`${studio.url}#/participant`);
@@ -70,36 +81,31 @@ test('working-memory components: matrix, digit sequence and 2-back on the partic
       const q = p.locator('.question');
       await q.waitFor({ timeout: 60_000 });
       const trial = Number(await q.getAttribute('data-trial'));
+      const following = p.evaluate(followDistractor); // watches from now on, in the page
       await p.waitForSelector('[data-testid=matrix], [data-testid=sequence-digit]', { timeout: 20_000 });
+      texts.push(await p.textContent('.question'));
+      // The distractor on screen (the watcher in the page keeps following meanwhile).
+      const shown = (await p.locator('[data-testid=matrix]').count()) ? 'matrix' : (await p.locator('[data-testid=respond]').count()) ? '2back' : 'sequence';
+      await screenshot(p, `screen-wm-components-${shown}`);
+      const { kind, cells, seen, pressed } = await following;
+      kinds.push(kind);
       let answerDigit = null;
-      if (await p.locator('[data-testid=matrix]').count()) {
-        kinds.push('matrix');
-        const cells = await p.locator('[data-testid=matrix] .cell').allTextContents();
+      if (kind === 'matrix') {
         assert.equal(cells.length, 16);
-        texts.push(await p.textContent('.question'));
-        await screenshot(p, 'screen-wm-components-matrix');
-        await p.locator('.answers:not([hidden])').waitFor({ timeout: 20_000 });
         const question = await p.textContent('[data-testid=digit-question]');
         const at = question.match(/row (\d), column (\d)/);
         answerDigit = at ? cells[(Number(at[1]) - 1) * 4 + Number(at[2]) - 1] : '1';
         if (!at) assert.ok(cells.every((c) => c === '1'), `the control matrix holds only 1s: ${cells}`);
+      } else if (kind === '2-back') {
+        assert.equal(seen.filter((x) => x !== undefined).length, 10, `ten digits one at a time: ${seen}`);
+        assert.equal(pressed, 3, `three 2-back targets on screen: ${seen}`);
+        assert.equal(await p.locator('[data-testid=digit-question]').count(), 0, 'the 2-back has no recall question');
       } else {
-        const executive = (await p.locator('[data-testid=respond]').count()) > 0;
-        kinds.push(executive ? '2-back' : 'sequence');
-        texts.push(await p.textContent('.question'));
-        await screenshot(p, executive ? 'screen-wm-components-2back' : 'screen-wm-components-sequence');
-        const { seen, pressed } = await p.evaluate(followSequence, executive);
-        if (executive) {
-          assert.equal(seen.length, 10, `ten digits one at a time: ${seen}`);
-          assert.equal(pressed, 3, `three 2-back targets on screen: ${seen}`);
-          assert.equal(await p.locator('[data-testid=digit-question]').count(), 0, 'the 2-back has no recall question');
-        } else {
-          const question = await p.textContent('[data-testid=digit-question]');
-          const at = question.match(/number (\d) of the (\d)/);
-          assert.ok(at, question);
-          assert.equal(seen.length, 5, `five digits one at a time: ${seen}`);
-          answerDigit = String(seen[Number(at[1]) - 1]);
-        }
+        const question = await p.textContent('[data-testid=digit-question]');
+        const at = question.match(/number (\d) of the (\d)/);
+        assert.ok(at, question);
+        assert.equal(seen.filter((x) => x !== undefined).length, 5, `five digits one at a time: ${seen}`);
+        answerDigit = String(seen[Number(at[1]) - 1]);
       }
       assert.equal(await p.locator('[data-testid=sequence-digit], [data-testid=matrix]').count(), 0, 'the distractor is gone when the questions come');
       texts.push(await p.textContent('.question'));
@@ -116,6 +122,11 @@ test('working-memory components: matrix, digit sequence and 2-back on the partic
     const whole = texts.join('\n').toLowerCase();
     for (const word of ['coarse', 'control', 'visuospatial', 'verbal', 'executive', 'back', 'target', 'correct', 'patch'])
       assert.ok(!whole.includes(word), `the participant's screen never shows '${word}'`);
+    // Nor do the frames the page receives: no condition, block, correct answer or stimulus document.
+    const received = frames.join('\n');
+    assert.ok(frames.some((f) => f.includes('"sequence"')), 'the page received a digit sequence');
+    for (const word of ['coarse-', 'fine-', '"condition"', '"block"', 'correct_answer', '"document"', 'patch-', 'visuospatial', 'executive'])
+      assert.ok(!received.includes(word), `no frame to the participant's page holds ${word}`);
 
     const rows = exportRows(join(studio.dir, 's.db')).filter((x) => x.protocol === 'working-memory-components-fast');
     assert.equal(rows.length, 4);
