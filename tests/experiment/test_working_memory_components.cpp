@@ -19,6 +19,7 @@
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/protocol.hpp"
+#include "texel/experiment/records.hpp"
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/simulate.hpp"
 #include "texel/io.hpp"
@@ -339,4 +340,24 @@ TEST(WorkingMemoryComponents, SimulateSpecSetsTheTwoBackObserver) {
     }
   }
   EXPECT_EQ(executive, 20);  // coarse and fine, 2 training and 8 test trials each
+}
+
+TEST(WorkingMemoryComponents, NBackColumnsRoundTripAndOlderRowsReadThemEmpty) {
+  ex::TrialRow row;
+  row.task = "same-different";
+  row.nback_targets = 3, row.nback_hits = 2, row.nback_false_alarms = 1;
+  const ex::TrialRow back = ex::row_from_json(ex::row_json(row), "row");
+  EXPECT_EQ(back.nback_targets, 3);
+  EXPECT_EQ(back.nback_hits, 2);
+  EXPECT_EQ(back.nback_false_alarms, 1);
+  const auto csv = ex::parse_trials_csv(ex::trials_csv({row}), "csv");
+  ASSERT_EQ(csv.size(), 1u);
+  EXPECT_EQ(csv[0].nback_false_alarms, 1);
+  // A row stored before the columns existed (the store keeps rows as their
+  // JSON cells; nothing is migrated): the three read back missing.
+  json old = json::parse(ex::row_json(row));
+  for (const char* k : {"nback_targets", "nback_hits", "nback_false_alarms"}) old.erase(k);
+  const ex::TrialRow before = ex::row_from_json(old.dump(), "row");
+  EXPECT_TRUE(std::isnan(before.nback_targets) && std::isnan(before.nback_hits) && std::isnan(before.nback_false_alarms));
+  EXPECT_EQ(before.task, "same-different");
 }
