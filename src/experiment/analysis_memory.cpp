@@ -84,19 +84,36 @@ Excluded recall_accuracy_rule(const std::map<std::string, MemoryPerson>& people,
   return excluded;
 }
 
+bool is_component(const std::string& k) { return k == "visuospatial" || k == "verbal" || k == "executive"; }
+
+/// "<spacing>-<distractor>" → (spacing, distractor); a component's own
+/// control, "<spacing>-<component>-control", → (spacing, "<component>-control").
 std::pair<std::string, std::string> split_condition(const std::string& c) {
   const auto dash = c.rfind('-');
-  return dash == std::string::npos ? std::pair{c, std::string()} : std::pair{c.substr(0, dash), c.substr(dash + 1)};
+  if (dash == std::string::npos) return {c, std::string()};
+  std::pair<std::string, std::string> out{c.substr(0, dash), c.substr(dash + 1)};
+  if (out.second == "control")
+    if (const auto d2 = out.first.rfind('-'); d2 != std::string::npos && is_component(out.first.substr(d2 + 1)))
+      return {out.first.substr(0, d2), out.first.substr(d2 + 1) + "-control"};
+  return out;
 }
 
 /// Whether a condition's distractor part names a loaded task ("distractor"
-/// in the source's protocol, a component otherwise), not the control.
-bool loaded(const std::string& kind) { return !kind.empty() && kind != "control"; }
+/// in the source's protocol, a component otherwise), not a control.
+bool loaded(const std::string& kind) { return !kind.empty() && kind != "control" && !kind.ends_with("-control"); }
+
+/// What a loaded distractor is compared with: its component's own control
+/// where the spacing has it, else the common one.
+std::string control_of(const std::string& kind, const std::map<std::string, std::map<std::string, double>>& kinds) {
+  return kinds.count(kind + "-control") ? kind + "-control" : "control";
+}
 
 /// The order the components are reported in: control, then the source's
-/// matrix, then the new ones; other names after them in first-seen order.
+/// matrix, then the new ones (each followed by its own control); other
+/// names after them in first-seen order.
 int kind_rank(const std::string& kind) {
-  static const std::vector<std::string> order = {"control", "distractor", "visuospatial", "verbal", "executive"};
+  static const std::vector<std::string> order = {"control", "distractor",     "visuospatial", "visuospatial-control",
+                                                 "verbal",  "verbal-control", "executive",    "executive-control"};
   const auto it = std::find(order.begin(), order.end(), kind);
   return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
 }
@@ -186,11 +203,12 @@ json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::
   for (auto& [spacing, kinds] : by)
     for (const auto& kind : kind_names) {
       std::vector<double> d, c;
-      if (kinds.count(kind) && kinds.count("control"))
+      const std::string control = control_of(kind, kinds);
+      if (kinds.count(kind) && kinds.count(control))
         for (const auto& [id, x] : kinds[kind])
-          if (kinds["control"].count(id)) d.push_back(x), c.push_back(kinds["control"][id]);
+          if (kinds[control].count(id)) d.push_back(x), c.push_back(kinds[control][id]);
       json t = guarded([&] { return ttest_json(stats::t_test_paired(d, c, o.level)); });
-      t["comparison"] = kind + " − control";
+      t["comparison"] = kind + " − " + control;
       ps.push_back(val(t, "p"));
       tests.push_back(json{{"spacing", spacing}, {"distractor", kind}, {"t_test", t}});
     }
@@ -240,17 +258,15 @@ json memory_summary(const std::string& study, const Rows& rows, const AnalysisOp
   // The source's order of first appearance, unless the distractors are
   // components: then spacing by first appearance, control first.
   bool components = false;
-  for (const auto& c : conditions.names) {
-    const auto k = split_condition(c).second;
-    components = components || k == "visuospatial" || k == "verbal" || k == "executive";
-  }
+  for (const auto& c : conditions.names) components = components || is_component(split_condition(c).second);
   if (components) {
     Ordered spacings;
     for (const auto& c : conditions.names) spacings.add(split_condition(c).first);
     std::stable_sort(conditions.names.begin(), conditions.names.end(), [&](const std::string& a, const std::string& b) {
       const auto [sa, ka] = split_condition(a);
       const auto [sb, kb] = split_condition(b);
-      const auto ia = spacings.add(sa), ib = spacings.add(sb);
+      const auto at = [&](const std::string& x) { return std::find(spacings.names.begin(), spacings.names.end(), x); };
+      const auto ia = at(sa), ib = at(sb);
       return ia != ib ? ia < ib : kind_rank(ka) < kind_rank(kb);
     });
   }
@@ -357,8 +373,8 @@ json memory_summary(const std::string& study, const Rows& rows, const AnalysisOp
   }
   for (const auto& t : out["spacing_t_tests"]) {
     const json& tt = t["t_test"];
-    text += "  " + t["spacing"].get<std::string>() + " spacing, " + t["distractor"].get<std::string>() +
-            " − control (paired): " + t_text(tt);
+    text +=
+        "  " + t["spacing"].get<std::string>() + " spacing, " + tt["comparison"].get<std::string>() + " (paired): " + t_text(tt);
     if (tt.contains("cohen_d")) text += ", d = " + fmt(val(tt, "cohen_d"));
     if (std::isfinite(val(tt, "p_holm"))) text += ", Holm " + fmt_p(val(tt, "p_holm"));
     text += "\n";

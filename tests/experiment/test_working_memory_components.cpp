@@ -361,3 +361,25 @@ TEST(WorkingMemoryComponents, NBackColumnsRoundTripAndOlderRowsReadThemEmpty) {
   EXPECT_TRUE(std::isnan(before.nback_targets) && std::isnan(before.nback_hits) && std::isnan(before.nback_false_alarms));
   EXPECT_EQ(before.task, "same-different");
 }
+
+TEST(WorkingMemoryComponents, EachComponentIsComparedWithItsOwnControlWhereItHasOne) {
+  // Conditions "coarse-<component>" and "coarse-<component>-control".
+  const ex::Protocol p = with_every_control();
+  std::vector<ex::TrialRow> rows;
+  for (const char* who : {"A1", "A2", "A3", "A4"}) {
+    auto s = session_of(p, who);
+    const ex::SimulatedParticipant sim(ex::simulation_observer(p.observer, "default"), s);
+    while (!s.finished()) rows.push_back(s.answer(sim.respond(s)).row);
+  }
+  const json s = json::parse(ex::analyze(rows, {}).summary)["working-memory-components"];
+  std::vector<std::string> comparisons;
+  for (const auto& t : s["spacing_t_tests"]) {
+    EXPECT_EQ(t["spacing"], "coarse");
+    comparisons.push_back(t["t_test"]["comparison"].get<std::string>());
+  }
+  EXPECT_EQ(comparisons, (std::vector<std::string>{"visuospatial − visuospatial-control", "verbal − verbal-control",
+                                                   "executive − executive-control"}));
+  std::set<std::string> levels;
+  for (const auto& c : s["conditions"]) levels.insert(c["distractor"].get<std::string>());
+  EXPECT_EQ(levels.size(), 6u);  // one factor of six levels in the RM-ANOVA
+}
