@@ -283,6 +283,59 @@ void countdown_phase(ex::Presenter* presenter, double seconds) {
   if (interactive()) std::cout << "\r\033[2K";
 }
 
+// Working memory's digit sequence (verbal, executive): each digit in turn on
+// one line redrawn in place, for 80 % of its slot then a blank (so a repeated
+// digit is seen twice). Executive (q.nback): every Enter is a response to the
+// digit on screen (or just gone); only empty lines count, so an answer typed
+// ahead stays for the question. Returns the items responded to, increasing.
+std::vector<int> sequence_phase(ex::Presenter* presenter, const ex::Question& q, double seconds,
+                                const std::function<void(const std::string&, const std::string&)>& event) {
+  std::vector<int> presses;
+  const auto n = static_cast<int>(q.sequence.size());
+  const double slot = seconds / std::max(1, n);
+  const auto t0 = Clock::now();
+  int shown = -2;  // item drawn (-1: the blank)
+  for (;;) {
+    const double t = seconds_since(t0);
+    if (experiment_interrupted || t >= seconds) break;
+    if (presenter) presenter->pump();
+    const int item = std::min(n - 1, static_cast<int>(t / slot));
+    const bool blank = t - item * slot >= 0.8 * slot;
+    const int draw = blank ? -1 : item;
+    if (draw != shown) {
+      if (interactive())
+        std::cout << "\r\033[2K"
+                  << (blank ? std::string() : "        " + std::to_string(q.sequence[static_cast<std::size_t>(item)]))
+                  << std::flush;
+      else if (!blank)
+        std::cout << "        " << q.sequence[static_cast<std::size_t>(item)] << "\n" << std::flush;
+      if (!blank) event("digit", std::to_string(item));
+      shown = draw;
+    }
+    if (q.nback) {
+      pollfd p{STDIN_FILENO, POLLIN, 0};
+      if (::poll(&p, 1, 0) > 0) {
+        char chunk[512];
+        const ssize_t got = ::read(STDIN_FILENO, chunk, sizeof chunk);
+        if (got > 0) input_buffer.append(chunk, static_cast<std::size_t>(got));
+      }
+      for (auto nl = input_buffer.find('\n'); nl != std::string::npos; nl = input_buffer.find('\n')) {
+        const std::string line = input_buffer.substr(0, nl);
+        if (!std::all_of(line.begin(), line.end(), [](char c) { return std::isspace(static_cast<unsigned char>(c)); })) break;
+        input_buffer.erase(0, nl + 1);
+        if (presses.empty() || presses.back() != item) presses.push_back(item);  // one response per digit
+        event("respond", std::to_string(item));
+        if (interactive()) std::cout << "\033[1A" << std::flush;  // the echoed Enter moved the line down
+        shown = -2;                                               // redraw it there
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (presenter) presenter->pump();
+  if (interactive()) std::cout << "\r\033[2K" << std::flush;
+  return presses;
+}
+
 // A scale's ends as the studio's page shows them: "1 (not at all) to 5 (very)".
 std::string scale_words(const ex::Scale& s) {
   const auto end = [](int v, const std::string& label) { return std::to_string(v) + (label.empty() ? "" : " (" + label + ")"); };
@@ -479,6 +532,22 @@ std::optional<ex::Response> ask_terminal(const ex::Session& session, ex::Present
       feel(*ph.stimulus);
       std::cout << "  Feel it for " << detail::num(ph.duration_s) << " s.\n" << std::flush;
       countdown_phase(presenter, ph.duration_s);
+    } else if (ph.kind == ex::PhaseKind::sequence) {
+      if (presenter) presenter->blank();
+      event("sequence", "");
+      monitor.event("sequence", {{"trial_number", trial_number}, {"t_s", detail::fixed(seconds_since(t0), 3)}});
+      std::cout << "  " << q.wording.sequence_instruction << (q.nback ? " Press Enter to respond." : "") << " ("
+                << detail::num(ph.duration_s) << " s)\n"
+                << std::flush;
+      r.presses = sequence_phase(presenter, q, ph.duration_s, event);
+      if (q.nback)
+        monitor.event("responses", {{"trial_number", trial_number}, {"items", [&] {
+                                                                       std::string items;
+                                                                       for (int i : r.presses)
+                                                                         items += (items.empty() ? "" : ",") + std::to_string(i);
+                                                                       return items.empty() ? std::string("none") : items;
+                                                                     }()}});
+      if (interactive()) std::cout << "\033[1A\r\033[J" << std::flush;  // hide the instruction again
     } else {
       if (presenter) presenter->blank();
       event("matrix", "");

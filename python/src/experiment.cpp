@@ -79,7 +79,10 @@ struct Columns {
       {"time_limit_s", &TrialRow::time_limit_s},
       {"over_time_limit", &TrialRow::over_time_limit},
       {"interrupted", &TrialRow::interrupted},
-      {"suspended_ms", &TrialRow::suspended_ms}};
+      {"suspended_ms", &TrialRow::suspended_ms},
+      {"nback_targets", &TrialRow::nback_targets},
+      {"nback_hits", &TrialRow::nback_hits},
+      {"nback_false_alarms", &TrialRow::nback_false_alarms}};
 
   // Cell of `row` in column `name` as a Python value: str, int, bool, float
   // (NaN = missing; iteration −1 = missing).

@@ -112,7 +112,7 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       case StudyDesign::matching: s = match_study(study, rs, options, report.text); break;
       case StudyDesign::quantization: s = quantization_summary(rs, options, report.text); break;
       case StudyDesign::guided: s = guided_summary(rs, options, report.text); break;
-      case StudyDesign::memory: s = memory_summary(rs, options, report.text); break;
+      case StudyDesign::memory: s = memory_summary(study, rs, options, report.text); break;
       case StudyDesign::oddity: s = oddity_summary(st, rs, options, report.text); break;
     }
     json head{{"participants", participants.size()}, {"rows", rs.size()}};

@@ -121,8 +121,9 @@ json guided_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
 json spread_comparison(const json& free, const json& guided, const AnalysisOptions& o, std::string& text);
 /// Quantization: rating changes per texture and level.
 json quantization_summary(const Rows& rows, const AnalysisOptions& o, std::string& text);
-/// Working memory: the outlier rules, the 2 × 2 RM-ANOVA, R².
-json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& text);
+/// Working memory (and its components' study): the outlier rules, the
+/// spacing × distractor RM-ANOVA, the per-distractor t-tests, R².
+json memory_summary(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text);
 /// The 2-D oddity studies: proportion correct against chance.
 json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions& o, std::string& text);
 

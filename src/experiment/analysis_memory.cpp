@@ -1,7 +1,11 @@
 // The working-memory study's analysis (docs/analysis.md §7): the outlier
-// rules, the 2 × 2 RM-ANOVA, the source's R².
+// rules, the texture × distractor RM-ANOVA (2 × 2 in the source; 2 × 4 with
+// the components' distractors, docs/experiments.md "Working-memory
+// components"), per texture a paired t-test of each distractor against the
+// control, the distraction tasks' own scores, the source's R².
 #include "analysis_common.hpp"
 
+#include <array>
 #include <map>
 
 namespace texel::experiment::analysis_common {
@@ -11,9 +15,13 @@ namespace {
 // ----------------------------------------------------------- working memory
 
 struct MemoryPerson {
-  std::vector<double> all, recall;
+  std::vector<double> all, recall;  // recall: digit recall (matrix, sequence), 1/0
   std::map<std::string, std::vector<double>> cond;
   double main_errors = 0, distraction_errors = 0;
+  int distraction_trials = 0;  // loaded distractor trials scored (recall or n-back)
+  // Per distractor kind: recall 1/0, and the n-back's summed counts.
+  std::map<std::string, std::vector<double>> kind_recall;
+  std::map<std::string, std::array<double, 4>> kind_nback;  // trials, targets, hits, false alarms
 };
 using Excluded = std::map<std::string, std::string>;  // participant → reason
 
@@ -29,7 +37,7 @@ Excluded source_rule(const std::map<std::string, MemoryPerson>& people, const An
   std::vector<double> main, distraction;
   for (const auto& [id, p] : people) {
     main.push_back(p.main_errors);
-    if (!p.recall.empty()) distraction.push_back(p.distraction_errors);
+    if (p.distraction_trials > 0) distraction.push_back(p.distraction_errors);
   }
   const auto dm = stats::describe(main), dd = stats::describe(distraction);
   const double limit = memory_errors_limit(dm.mean, dm.sd, o);
@@ -43,7 +51,7 @@ Excluded source_rule(const std::map<std::string, MemoryPerson>& people, const An
   for (const auto& [id, p] : people) {
     if (!(p.main_errors >= limit)) continue;
     // No recall data: no increase can be shown, so the main-task errors stand alone.
-    const bool increase = !p.recall.empty() && std::isfinite(dd.mean) && p.distraction_errors > dd.mean;
+    const bool increase = p.distraction_trials > 0 && std::isfinite(dd.mean) && p.distraction_errors > dd.mean;
     if (increase) continue;
     out[id] = fmt(p.main_errors, 0) + " main-task errors (z " + fmt((p.main_errors - dm.mean) / dm.sd) + ") >= mean + " +
               fmt(k - o.memory_errors_sd_tolerance) + " SD = " + fmt(limit) + " without more distraction errors (" +
@@ -76,13 +84,59 @@ Excluded recall_accuracy_rule(const std::map<std::string, MemoryPerson>& people,
   return excluded;
 }
 
+bool is_component(const std::string& k) { return k == "visuospatial" || k == "verbal" || k == "executive"; }
+
+/// "<spacing>-<distractor>" → (spacing, distractor); a component's own
+/// control, "<spacing>-<component>-control", → (spacing, "<component>-control").
 std::pair<std::string, std::string> split_condition(const std::string& c) {
   const auto dash = c.rfind('-');
-  return dash == std::string::npos ? std::pair{c, std::string()} : std::pair{c.substr(0, dash), c.substr(dash + 1)};
+  if (dash == std::string::npos) return {c, std::string()};
+  std::pair<std::string, std::string> out{c.substr(0, dash), c.substr(dash + 1)};
+  if (out.second == "control")
+    if (const auto d2 = out.first.rfind('-'); d2 != std::string::npos && is_component(out.first.substr(d2 + 1)))
+      return {out.first.substr(0, d2), out.first.substr(d2 + 1) + "-control"};
+  return out;
 }
 
-/// The 2 × 2 analysis on the participants a rule keeps: RM-ANOVA (Type III),
-/// per spacing a paired t-test distractor − control, and R².
+/// Whether a condition's distractor part names a loaded task ("distractor"
+/// in the source's protocol, a component otherwise), not a control.
+bool loaded(const std::string& kind) { return !kind.empty() && kind != "control" && !kind.ends_with("-control"); }
+
+/// What a loaded distractor is compared with: its component's own control
+/// where the spacing has it, else the common one.
+std::string control_of(const std::string& kind, const std::map<std::string, std::map<std::string, double>>& kinds) {
+  return kinds.count(kind + "-control") ? kind + "-control" : "control";
+}
+
+/// The order the components are reported in: control, then the source's
+/// matrix, then the new ones (each followed by its own control); other
+/// names after them in first-seen order.
+int kind_rank(const std::string& kind) {
+  static const std::vector<std::string> order = {"control", "distractor",     "visuospatial", "visuospatial-control",
+                                                 "verbal",  "verbal-control", "executive",    "executive-control"};
+  const auto it = std::find(order.begin(), order.end(), kind);
+  return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
+}
+
+/// Holm's step-down adjustment of a family of p values (NaN stays NaN).
+std::vector<double> holm(const std::vector<double>& p) {
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (std::isfinite(p[i])) idx.push_back(i);
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return p[a] < p[b]; });
+  std::vector<double> out(p.size(), missing);
+  double running = 0;
+  for (std::size_t r = 0; r < idx.size(); ++r) {
+    running = std::max(running, std::min(1.0, static_cast<double>(idx.size() - r) * p[idx[r]]));
+    out[idx[r]] = running;
+  }
+  return out;
+}
+
+/// The analysis on the participants a rule keeps: RM-ANOVA (Type III,
+/// spacing × distractor), per spacing a paired t-test of each distractor
+/// against the control (Holm-adjusted over the family when there are
+/// several), and R².
 json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::vector<std::string>& conditions,
                   const Excluded& excluded, const AnalysisOptions& o) {
   std::vector<stats::Observation> obs;
@@ -104,7 +158,7 @@ json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::
   {
     std::vector<double> x, y;
     for (const auto& [id, p] : people)
-      if (!excluded.count(id) && !p.recall.empty()) x.push_back(p.distraction_errors), y.push_back(p.main_errors);
+      if (!excluded.count(id) && p.distraction_trials > 0) x.push_back(p.distraction_errors), y.push_back(p.main_errors);
     json r = guarded([&] {
       const stats::Correlation c = stats::pearson(x, y, o.level);
       const auto dx = stats::describe(x), dy = stats::describe(y);
@@ -138,14 +192,30 @@ json memory_tests(const std::map<std::string, MemoryPerson>& people, const std::
     out["effect_share"] = skipped("the ANOVA did not run");
   }
   json tests = json::array();
-  for (auto& [spacing, kinds] : by) {
-    std::vector<double> d, c;
-    if (kinds.count("distractor") && kinds.count("control"))
-      for (const auto& [id, x] : kinds["distractor"])
-        if (kinds["control"].count(id)) d.push_back(x), c.push_back(kinds["control"][id]);
-    json t = guarded([&] { return ttest_json(stats::t_test_paired(d, c, o.level)); });
-    t["comparison"] = "distractor − control";
-    tests.push_back(json{{"spacing", spacing}, {"t_test", t}});
+  std::vector<std::string> kind_names;
+  for (const auto& c : conditions)
+    if (const auto k = split_condition(c).second;
+        loaded(k) && std::find(kind_names.begin(), kind_names.end(), k) == kind_names.end())
+      kind_names.push_back(k);
+  std::stable_sort(kind_names.begin(), kind_names.end(),
+                   [](const auto& a, const auto& b) { return kind_rank(a) < kind_rank(b); });
+  std::vector<double> ps;
+  for (auto& [spacing, kinds] : by)
+    for (const auto& kind : kind_names) {
+      std::vector<double> d, c;
+      const std::string control = control_of(kind, kinds);
+      if (kinds.count(kind) && kinds.count(control))
+        for (const auto& [id, x] : kinds[kind])
+          if (kinds[control].count(id)) d.push_back(x), c.push_back(kinds[control][id]);
+      json t = guarded([&] { return ttest_json(stats::t_test_paired(d, c, o.level)); });
+      t["comparison"] = kind + " − " + control;
+      ps.push_back(val(t, "p"));
+      tests.push_back(json{{"spacing", spacing}, {"distractor", kind}, {"t_test", t}});
+    }
+  // Several components against one control are a family: Holm's adjusted p beside each.
+  if (kind_names.size() > 1) {
+    const auto adjusted = holm(ps);
+    for (std::size_t i = 0; i < tests.size(); ++i) tests[i]["t_test"]["p_holm"] = num(adjusted[i]);
   }
   out["spacing_t_tests"] = tests;
   return out;
@@ -159,7 +229,7 @@ json excluded_list(const Excluded& e) {
 
 }  // namespace
 
-json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& text) {
+json memory_summary(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
   std::map<std::string, MemoryPerson> people;
   Ordered conditions;
   for (const TrialRow* r : rows) {
@@ -169,10 +239,36 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
     p.all.push_back(r->correct);
     p.cond[r->condition].push_back(r->correct);
     if (r->correct == 0) p.main_errors += 1;
-    if (r->condition.ends_with("-distractor") && std::isfinite(r->digit_correct)) {
+    const std::string kind = split_condition(r->condition).second;
+    if (!loaded(kind)) continue;
+    // A loaded distractor trial: its task's own score. Recall (matrix,
+    // sequence): the digit; n-back: an error is any miss or false alarm.
+    if (std::isfinite(r->digit_correct)) {
       p.recall.push_back(r->digit_correct);
+      p.kind_recall[kind].push_back(r->digit_correct);
+      p.distraction_trials += 1;
       if (r->digit_correct == 0) p.distraction_errors += 1;
+    } else if (std::isfinite(r->nback_targets) && std::isfinite(r->nback_hits) && std::isfinite(r->nback_false_alarms)) {
+      auto& k = p.kind_nback[kind];
+      k[0] += 1, k[1] += r->nback_targets, k[2] += r->nback_hits, k[3] += r->nback_false_alarms;
+      p.distraction_trials += 1;
+      if (r->nback_hits < r->nback_targets || r->nback_false_alarms > 0) p.distraction_errors += 1;
     }
+  }
+  // The source's order of first appearance, unless the distractors are
+  // components: then spacing by first appearance, control first.
+  bool components = false;
+  for (const auto& c : conditions.names) components = components || is_component(split_condition(c).second);
+  if (components) {
+    Ordered spacings;
+    for (const auto& c : conditions.names) spacings.add(split_condition(c).first);
+    std::stable_sort(conditions.names.begin(), conditions.names.end(), [&](const std::string& a, const std::string& b) {
+      const auto [sa, ka] = split_condition(a);
+      const auto [sb, kb] = split_condition(b);
+      const auto at = [&](const std::string& x) { return std::find(spacings.names.begin(), spacings.names.end(), x); };
+      const auto ia = at(sa), ib = at(sb);
+      return ia != ib ? ia < ib : kind_rank(ka) < kind_rank(kb);
+    });
   }
   json out = json::object();
   json source_stats;
@@ -193,7 +289,7 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
                       {"accuracy", num(mean_of(p.all))},
                       {"recall_accuracy", num(mean_of(p.recall))},
                       {"main_errors", p.main_errors},
-                      {"distraction_errors", p.recall.empty() ? json(nullptr) : json(p.distraction_errors)},
+                      {"distraction_errors", p.distraction_trials == 0 ? json(nullptr) : json(p.distraction_errors)},
                       {"conditions", c},
                       {"excluded", excluded.count(id) ? json(excluded.at(id)) : json(false)}});
   }
@@ -208,6 +304,35 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
     cj.push_back(json{{"condition", c}, {"spacing", spacing}, {"distractor", distractor}, {"accuracy", describe_json(v)}});
   }
   out["conditions"] = cj;
+  // The distraction tasks' own scores per distractor (kept participants):
+  // recall accuracy, or the n-back's hit rate and false alarms per trial —
+  // whether each task was done, beside what it did to the main task.
+  json dj = json::array();
+  {
+    Ordered kinds;
+    for (const auto& c : conditions.names)
+      if (const auto k = split_condition(c).second; loaded(k)) kinds.add(k);
+    for (const auto& kind : kinds.names) {
+      std::vector<double> recall, hit_rate, false_alarms;
+      for (auto& [id, p] : people) {
+        if (excluded.count(id)) continue;
+        if (p.kind_recall.count(kind)) recall.push_back(mean_of(p.kind_recall[kind]));
+        if (p.kind_nback.count(kind)) {
+          const auto& k = p.kind_nback[kind];
+          hit_rate.push_back(k[1] > 0 ? k[2] / k[1] : missing);
+          false_alarms.push_back(k[3] / k[0]);
+        }
+      }
+      json e{{"distractor", kind}};
+      if (!recall.empty()) e["recall_accuracy"] = describe_json(recall);
+      if (!hit_rate.empty()) {
+        e["hit_rate"] = describe_json(hit_rate);
+        e["false_alarms_per_trial"] = describe_json(false_alarms);
+      }
+      dj.push_back(std::move(e));
+    }
+  }
+  out["distraction_tasks"] = dj;
   const json tests = memory_tests(people, conditions.names, excluded, o);
   out.update(tests);
   // What each rule excludes, and what the interaction test becomes under it.
@@ -221,7 +346,7 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   }
   out["rules_compared"] = rules;
 
-  text += "working-memory: " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) +
+  text += study + ": " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) +
           " excluded (rule: " + o.memory_rule + ")\n";
   for (const auto& [id, why] : excluded) text += "  excluded " + id + ": " + why + "\n";
   for (const auto& c : cj)
@@ -234,10 +359,26 @@ json memory_summary(const Rows& rows, const AnalysisOptions& o, std::string& tex
   else
     text += "  R² (main-task against distraction-task errors) skipped: " + out["r2"]["skipped"].get<std::string>() + "\n";
   if (out["effect_share"].contains("share"))
-    text += "  share of variance explained by the 2 × 2 effects: " + fmt(val(out["effect_share"], "share")) +
+    text += "  share of variance explained by the spacing × distractor effects: " + fmt(val(out["effect_share"], "share")) +
             " (with participants: " + fmt(val(out["effect_share"], "share_with_subjects")) + ")\n";
-  for (const auto& t : out["spacing_t_tests"])
-    text += "  " + t["spacing"].get<std::string>() + " spacing, distractor − control (paired): " + t_text(t["t_test"]) + "\n";
+  for (const auto& t : dj) {
+    text += "  distraction task " + t["distractor"].get<std::string>() + ":";
+    if (t.contains("recall_accuracy"))
+      text +=
+          " recall " + fmt(val(t["recall_accuracy"], "mean")) + " correct (SEM " + fmt(val(t["recall_accuracy"], "sem")) + ")";
+    if (t.contains("hit_rate"))
+      text += " hit rate " + fmt(val(t["hit_rate"], "mean")) + " (SEM " + fmt(val(t["hit_rate"], "sem")) + "), " +
+              fmt(val(t["false_alarms_per_trial"], "mean")) + " false alarms per trial";
+    text += "\n";
+  }
+  for (const auto& t : out["spacing_t_tests"]) {
+    const json& tt = t["t_test"];
+    text +=
+        "  " + t["spacing"].get<std::string>() + " spacing, " + tt["comparison"].get<std::string>() + " (paired): " + t_text(tt);
+    if (tt.contains("cohen_d")) text += ", d = " + fmt(val(tt, "cohen_d"));
+    if (std::isfinite(val(tt, "p_holm"))) text += ", Holm " + fmt_p(val(tt, "p_holm"));
+    text += "\n";
+  }
   for (const auto& r : rules) {
     std::string ids;
     for (const auto& e : r["excluded"]) ids += (ids.empty() ? "" : ", ") + e["participant"].get<std::string>();

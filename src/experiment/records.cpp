@@ -147,6 +147,9 @@ const std::vector<Field>& fields() {
       TEXEL_STRING(presentation_mode),
       TEXEL_STRING(finger_source),
       TEXEL_STRING(swipe_flag),
+      TEXEL_NUMBER(nback_targets),
+      TEXEL_NUMBER(nback_hits),
+      TEXEL_NUMBER(nback_false_alarms),
   };
   return f;
 }

@@ -154,7 +154,9 @@ std::string joined(const std::vector<std::string>& items) {
 
 // ----------------------------------------------------------------- JSON views
 
-std::string_view to_string(PhaseKind k) { return k == PhaseKind::stimulus ? "stimulus" : "matrix"; }
+std::string_view to_string(PhaseKind k) {
+  return k == PhaseKind::stimulus ? "stimulus" : k == PhaseKind::matrix ? "matrix" : "sequence";
+}
 
 ordered_json question_view(const Question& q) {
   ordered_json j;
@@ -182,6 +184,13 @@ ordered_json question_view(const Question& q) {
   if (q.matrix) j["matrix"] = *q.matrix;
   // -2 = no recall question, -1 = "the digit in the cells", else the cell (the stored form).
   j["recall_cell"] = q.recall ? q.recall->cell.value_or(-1) : -2;
+  // The verbal and executive distractors (keys absent otherwise, so stored
+  // questions of the matrix task keep their bytes).
+  if (!q.sequence.empty()) {
+    j["sequence"] = q.sequence;
+    if (q.recall) j["recall_position"] = q.recall->position.value_or(-1);  // -1 = "the digit of the sequence"
+    if (q.nback) j["nback"] = {{"n", q.nback->n}, {"target", q.nback->target}};
+  }
   return j;
 }
 
@@ -222,7 +231,14 @@ void complete_wording(Question& q) {
     w.rating = Scale{static_cast<int>((*q.rating_scale)[0]), static_cast<int>((*q.rating_scale)[1]), "How similar do they feel?",
                      "not at all", "identical"};
   if (q.confidence && !w.confidence) w.confidence = Scale{1, 5, "How confident are you in this match?", "not at all", "very"};
-  if (q.recall) {
+  if (q.recall && !q.sequence.empty()) {
+    const auto& at = q.recall->position;
+    w.recall = Scale{1, 9,
+                     at ? "Which digit was number " + std::to_string(*at + 1) + " of the " + std::to_string(q.sequence.size()) +
+                              " in the sequence?"
+                        : std::string("Which digit did the sequence show?"),
+                     "", ""};
+  } else if (q.recall) {
     const auto& cell = q.recall->cell;
     w.recall = Scale{1, 9,
                      cell ? "Which digit was in row " + std::to_string(*cell / 4 + 1) + ", column " +
@@ -248,6 +264,7 @@ std::string Question::participant_json() const {
   if (wording.rating) w["rating"] = scale_json(*wording.rating);
   if (wording.confidence) w["confidence"] = scale_json(*wording.confidence);
   if (wording.recall) w["recall"] = scale_json(*wording.recall);
+  if (!wording.sequence_instruction.empty()) w["sequence_instruction"] = wording.sequence_instruction;
   j["wording"] = std::move(w);
   return j.dump();
 }
@@ -260,6 +277,7 @@ ordered_json response_view(const Response& r) {
   if (r.slider_p) j["slider_p"] = *r.slider_p;
   if (r.slider_i) j["slider_i"] = *r.slider_i;
   if (r.digit) j["digit"] = *r.digit;
+  if (!r.presses.empty()) j["presses"] = r.presses;
   if (std::isfinite(r.rt_ms)) j["rt_ms"] = r.rt_ms;
   if (r.swipe_mean_speed_mm_s) j["swipe_mean_speed_mm_s"] = *r.swipe_mean_speed_mm_s;
   if (r.swipe_sd_speed_mm_s) j["swipe_sd_speed_mm_s"] = *r.swipe_sd_speed_mm_s;
@@ -390,6 +408,7 @@ Response response_from(const json& j) {
                                               "slider_p",
                                               "slider_i",
                                               "digit",
+                                              "presses",
                                               "rt_ms",
                                               "swipe_mean_speed_mm_s",
                                               "swipe_sd_speed_mm_s",
@@ -412,6 +431,16 @@ Response response_from(const json& j) {
   if (auto d = opt("digit")) {
     if (*d != std::floor(*d) || *d < -1e6 || *d > 1e6) throw FormatError("response.digit must be a whole number");
     r.digit = static_cast<int>(*d);
+  }
+  if (j.contains("presses") && !j["presses"].is_null()) {
+    const json& p = j["presses"];
+    if (!p.is_array() || p.size() > 1000) throw FormatError("response.presses must be an array of at most 1000 item indices");
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!p[k].is_number_integer() || p[k].get<long long>() < 0 || p[k].get<long long>() > 1000)
+        throw FormatError("response.presses[" + std::to_string(k) + "] is " + p[k].dump() +
+                          "; allowed: a whole number 0 … 1000 (a sequence item)");
+      r.presses.push_back(p[k].get<int>());
+    }
   }
   if (auto rt = opt("rt_ms")) r.rt_ms = *rt;
   r.swipe_mean_speed_mm_s = opt("swipe_mean_speed_mm_s");
@@ -536,8 +565,7 @@ struct Session::Impl : SessionCore {
     ordered_json rv = response_view(r);
     if (r.trace.source == TraceSource::display || r.trace.source == TraceSource::pointer) {
       // The stored answer shows what the trial's finger measured, not what a front end claimed.
-      for (const char* k : {"swipe_mean_speed_mm_s", "swipe_sd_speed_mm_s", "directional_proportion", "swipe_flag"})
-        rv.erase(k);
+      for (const char* k : {"swipe_mean_speed_mm_s", "swipe_sd_speed_mm_s", "directional_proportion", "swipe_flag"}) rv.erase(k);
       if (std::isfinite(row.swipe_mean_speed_mm_s)) {
         rv["swipe_mean_speed_mm_s"] = row.swipe_mean_speed_mm_s;
         rv["swipe_sd_speed_mm_s"] = row.swipe_sd_speed_mm_s;

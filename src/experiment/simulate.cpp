@@ -129,6 +129,8 @@ void validate_observer_object(const json& o) {
       s.skip("p_correct");
     }
     (void)s.number_or("p_digit", 0.8, 0.0, 1.0);
+    (void)s.number_or("p_hit", 0.85, 0.0, 1.0);
+    (void)s.number_or("p_false_alarm", 0.05, 0.0, 1.0);
   });
   section("explorer", [&](JsonObject& s) {
     (void)s.number_or("speed_mm_s", 100.0, 1.0, 10000.0);
@@ -188,6 +190,10 @@ std::string simulation_observer(std::string_view protocol_observer_json, const s
       o["memory"]["p_correct"] = number_with_unit(key, value, {"%"});
     } else if (key == "digit") {
       o["memory"]["p_digit"] = number_with_unit(key, value, {"%"});
+    } else if (key == "hit") {
+      o["memory"]["p_hit"] = number_with_unit(key, value, {"%"});
+    } else if (key == "false-alarm") {
+      o["memory"]["p_false_alarm"] = number_with_unit(key, value, {"%"});
     } else if (key == "rating-noise") {
       o["rater"]["noise"] = number_with_unit(key, value, {});
     } else if (key == "speed") {
@@ -200,9 +206,11 @@ std::string simulation_observer(std::string_view protocol_observer_json, const s
         throw InvalidArgument("--simulate seed=" + value + ": allowed: a whole number 0 … 2^53");
       o["seed"] = static_cast<std::uint64_t>(s);
     } else {
-      throw InvalidArgument("--simulate: unknown key '" + key +
-                            "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, rating-noise, "
-                            "speed, spread, seed, default");
+      throw InvalidArgument(
+          "--simulate: unknown key '" + key +
+          "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, hit, false-alarm, "
+          "rating-noise, "
+          "speed, spread, seed, default");
     }
   }
   try {
@@ -312,6 +320,10 @@ double SimulatedParticipant::memory_p_correct(const std::string& condition) cons
 }
 
 double SimulatedParticipant::memory_p_digit() const { return get(section_of(model_->observer, "memory"), "p_digit", 0.8); }
+double SimulatedParticipant::memory_p_hit() const { return get(section_of(model_->observer, "memory"), "p_hit", 0.85); }
+double SimulatedParticipant::memory_p_false_alarm() const {
+  return get(section_of(model_->observer, "memory"), "p_false_alarm", 0.05);
+}
 
 Response SimulatedParticipant::respond(const Session& session) const {
   const Question& q = session.question();

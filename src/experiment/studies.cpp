@@ -13,6 +13,7 @@ constexpr Study table[] = {
     {"guided-exploration", "Guided exploration", StudyDesign::guided},
     {"coarse-features", "Coarse strength", StudyDesign::staircase, "coarse strength (0 … 1)", true, false, false},
     {"working-memory", "Working memory", StudyDesign::memory},
+    {"working-memory-components", "Working-memory components", StudyDesign::memory},
     {"direction-independence", "Direction independence", StudyDesign::oddity, {}, false, false, false, true},
     {"rendering-2d", "2-D rendering against the 1-D original", StudyDesign::oddity},
 };

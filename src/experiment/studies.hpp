@@ -16,7 +16,7 @@ enum class StudyDesign {
   matching,      ///< slider matches (+ ratings): matched vs reference, ellipses
   quantization,  ///< rating changes under quantization, one-sample t-tests
   guided,        ///< guided / Bayesian matches: as matching, plus convergence and similarity
-  memory,        ///< same/different under a memory load: 2 × 2 RM-ANOVA
+  memory,        ///< same/different under a memory load: spacing × distractor RM-ANOVA
   oddity,        ///< proportion correct per condition against chance (the 2-D oddity studies)
 };
 

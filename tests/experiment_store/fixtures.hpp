@@ -63,6 +63,9 @@ inline experiment::StoredTrial full_trial(int i) {
   r.digit_cell = 15;
   r.digit_response = 9;
   r.digit_correct = 1;
+  r.nback_targets = 3;
+  r.nback_hits = 2;
+  r.nback_false_alarms = i;
   r.swipe_mean_speed_mm_s = 101.5;
   r.swipe_sd_speed_mm_s = 20.25;
   r.directional_proportion = 0.875;
@@ -130,6 +133,9 @@ inline experiment::StoredTrial full_trial(int i) {
     EXPECT_PRED2(same_, ra_.digit_cell, rb_.digit_cell);                                              \
     EXPECT_PRED2(same_, ra_.digit_response, rb_.digit_response);                                      \
     EXPECT_PRED2(same_, ra_.digit_correct, rb_.digit_correct);                                        \
+    EXPECT_PRED2(same_, ra_.nback_targets, rb_.nback_targets);                                        \
+    EXPECT_PRED2(same_, ra_.nback_hits, rb_.nback_hits);                                              \
+    EXPECT_PRED2(same_, ra_.nback_false_alarms, rb_.nback_false_alarms);                              \
     EXPECT_PRED2(same_, ra_.swipe_mean_speed_mm_s, rb_.swipe_mean_speed_mm_s);                        \
     EXPECT_PRED2(same_, ra_.swipe_sd_speed_mm_s, rb_.swipe_sd_speed_mm_s);                            \
     EXPECT_PRED2(same_, ra_.directional_proportion, rb_.directional_proportion);                      \

@@ -48,14 +48,17 @@ std::string cell(const std::string& csv_text, const std::string& column, std::si
 
 TEST(TrialCsv, HeaderIsTheColumnList) {
   const auto& cols = ex::trial_columns();
-  ASSERT_EQ(cols.size(), 57u);  // with the 2-D display's stroke columns and the finger behind the swipe columns
+  ASSERT_EQ(cols.size(), 60u);  // with the 2-D display's stroke columns, the finger behind the swipe columns, the n-back's
   EXPECT_EQ(cols.front(), "participant");
   EXPECT_EQ(cols[48], "answered_at");
   EXPECT_EQ(cols[53], "suspended_ms");  // trial_number and the timing flags (issue #22)
   // The finger behind the swipe columns come last (issue #36).
   EXPECT_EQ(cols[54], "presentation_mode");
   EXPECT_EQ(cols[55], "finger_source");
-  EXPECT_EQ(cols.back(), "swipe_flag");
+  EXPECT_EQ(cols[56], "swipe_flag");
+  // The executive distractor's scores come last (issue #40).
+  EXPECT_EQ(cols[57], "nback_targets");
+  EXPECT_EQ(cols.back(), "nback_false_alarms");
   const auto csv = ex::trials_csv({});
   std::string header;
   for (const auto& c : cols) header += (header.empty() ? "" : ",") + c;

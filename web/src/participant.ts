@@ -377,7 +377,7 @@ export function mountParticipant(root: HTMLElement): void {
     if (typeof reply.strip_mm === 'number') strip.setLength(reply.strip_mm);
 
     // ---- the trial's one state: inputs write it, render() enables Submit from it
-    type Answer = Pick<Response, 'choice' | 'rating' | 'confidence' | 'digit' | 'slider_p' | 'slider_i'>;
+    type Answer = Pick<Response, 'choice' | 'rating' | 'confidence' | 'digit' | 'slider_p' | 'slider_i' | 'presses'>;
     const trial = new Store<{ answer: Answer; inputsReady: boolean; timedOut: boolean; saving: boolean }>({
       answer: {},
       inputsReady: q.phases.length === 0,
@@ -616,6 +616,51 @@ export function mountParticipant(root: HTMLElement): void {
           const cells = (q.matrix ?? []).map((d, i) => h('div', { class: 'cell', role: 'gridcell', 'aria-label': `row ${Math.floor(i / 4) + 1}, column ${(i % 4) + 1}: ${d || 'empty'}` }, d ? String(d) : ''));
           const rows = [0, 1, 2, 3].map((r) => h('div', { role: 'row', class: 'mrow' }, ...cells.slice(r * 4, r * 4 + 4)));
           phaseArea.replaceChildren(h('p', { class: 'prompt' }, 'Remember the digits.'), h('div', { class: 'matrix', role: 'grid', 'aria-label': 'Digit matrix', 'data-testid': 'matrix' }, ...rows), left);
+        } else if (ph.kind === 'sequence') {
+          // Working memory's digit sequence (verbal, executive): one digit at a
+          // time, each shown for 80 % of its slot then blank (a repeated digit
+          // is seen twice), as the terminal does. Executive (q.nback): each
+          // press of Respond is a response to the digit on screen (or just gone).
+          ev('sequence', 'shown');
+          const seq = q.sequence ?? [];
+          let stopKeys = () => {};
+          const slot = (ph.duration_s * 1000) / Math.max(1, seq.length);
+          const start = performance.now();
+          const digit = h('div', { class: 'sequence-digit', 'data-testid': 'sequence-digit', 'aria-live': 'off' });
+          const item = () => Math.min(seq.length - 1, Math.floor((performance.now() - start) / slot));
+          const children: HTMLElement[] = [h('p', { class: 'prompt' }, `${w.sequence_instruction ?? ''}${q.nback ? ' Press Respond (or the space bar) each time.' : ''}`), digit];
+          if (q.nback) {
+            const presses: number[] = [];
+            const respond = h('button', { type: 'button', class: 'big primary respond', 'data-testid': 'respond' }, 'Respond') as HTMLButtonElement;
+            respond.addEventListener('click', () => {
+              const i = item();
+              if (!current() || i < 0 || presses[presses.length - 1] === i) return; // one response per digit
+              presses.push(i);
+              ev('respond', String(i));
+              setAnswer({ presses: [...presses] });
+            });
+            children.push(respond);
+            timers.push(setTimeout(() => respond.focus(), 0));
+            // The space bar responds wherever the focus is (a focused button clicks itself).
+            const onKey = (e: KeyboardEvent) => {
+              if (e.code !== 'Space' || document.activeElement === respond) return;
+              e.preventDefault();
+              respond.click();
+            };
+            document.addEventListener('keydown', onKey);
+            stopKeys = () => document.removeEventListener('keydown', onKey);
+          }
+          phaseArea.replaceChildren(...children, left);
+          const draw = () => {
+            const t = performance.now() - start;
+            const i = Math.floor(t / slot);
+            if (!current() || i >= seq.length) return stopKeys();
+            const blank = t - i * slot >= 0.8 * slot;
+            digit.textContent = blank ? '' : String(seq[i]);
+            digit.dataset.item = blank ? '' : String(i);
+            timers.push(setTimeout(draw, 20));
+          };
+          draw();
         } else {
           phaseArea.replaceChildren(h('p', {}, 'Please wait.'), left);
         }

@@ -73,11 +73,23 @@ struct RatingPair {
   std::string condition;  ///< label for the analysis ("unquantized", "q3", "rendering:4sin", …)
 };
 
-/// Working memory: one condition (spacing × distractor).
+/// Working memory: the component of working memory a distractor task loads
+/// (docs/experiments.md "Working-memory components").
+enum class MemoryComponent {
+  visuospatial,  ///< the source's 4 × 4 digit matrix (control: every cell holds 1)
+  verbal,        ///< a digit sequence to hold in order (control: every digit is 1)
+  executive,     ///< 2-back on a digit stream (control: 0-back, respond to every 1)
+};
+std::string_view to_string(MemoryComponent c);
+/// "visuospatial" | "verbal" | "executive"; FormatError naming `field` otherwise.
+MemoryComponent parse_memory_component(std::string_view text, std::string_view field);
+
+/// Working memory: one condition (texture × distractor).
 struct MemoryCondition {
-  std::string name;      ///< e.g. "wide-distractor"
-  std::string stimulus;  ///< key into Block::memory_stimuli
-  bool distractor = true;
+  std::string name;        ///< e.g. "wide-distractor"; the analysis reads "<texture>-<distractor>"
+  std::string stimulus;    ///< key into Block::memory_stimuli
+  bool distractor = true;  ///< false: the component's control task (same display and timing, no load)
+  MemoryComponent component = MemoryComponent::visuospatial;
 };
 struct MemoryStimulus {
   std::string name;
@@ -133,6 +145,9 @@ struct Block {
   int trials_per_condition = 8;
   double texture_s = 10.0, matrix_s = 10.0;
   int matrix_cells = 5;
+  int sequence_length = 5;  ///< verbal: digits in the sequence, 1 … 9 (distinct), shown matrix_s / length each
+  int nback_items = 10;     ///< executive: digits in the stream, 4 … 30, shown matrix_s / items each
+  int nback_targets = 3;    ///< executive: targets in the stream, 1 … nback_items − 2
   bool recall_question = true;
   bool balance_order = false;  ///< draw per trial which stimulus texture comes first (and is repeated on "same")
   /// `base_textures` "per-texture": each stimulus texture (a `patch-*`

@@ -23,7 +23,7 @@ struct TrialRow {
   std::string participant;  ///< pseudonymous code, e.g. "S01"
   std::int64_t session_id = 0;
   std::string protocol;  ///< protocol name, e.g. "texel-length"
-  std::string study;     ///< one of: working-memory, texel-length, parameter-mapping,
+  std::string study;     ///< one of: working-memory, working-memory-components, texel-length, parameter-mapping,
                          ///< free-exploration, quantization, guided-exploration, coarse-features,
                          ///< direction-independence, rendering-2d
   std::string block;     ///< block name, e.g. "narrow", "fine-50"
@@ -71,7 +71,8 @@ struct TrialRow {
   double quantization_db = missing;
 
   // -- working memory
-  double digit_cell = missing;      ///< matrix cell asked (0 … 15, row-major), or missing
+  double digit_cell =
+      missing;  ///< matrix cell asked (0 … 15, row-major), or (verbal) sequence position asked (0-based), or missing
   double digit_response = missing;  ///< digit answered
   double digit_correct = missing;   ///< 1 / 0
 
@@ -98,6 +99,11 @@ struct TrialRow {
   double over_time_limit = missing;  ///< 1 when rt_ms exceeded the time limit, 0 when not
   double interrupted = missing;      ///< 1 when the trial spanned a suspend, a stop/resume, a restart or a reload-restart
   double suspended_ms = missing;     ///< time the session was suspended during the trial (not in rt_ms)
+
+  // -- working memory's executive distractor (n-back); missing otherwise and in rows stored before them
+  double nback_targets = missing;       ///< target items in the trial's sequence
+  double nback_hits = missing;          ///< targets responded to
+  double nback_false_alarms = missing;  ///< non-targets responded to
 };
 
 /// The current time, UTC, ISO 8601 with milliseconds ("2026-11-23T14:02:08.123Z"):

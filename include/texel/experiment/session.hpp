@@ -58,9 +58,10 @@ struct Stimulus {
 };
 
 /// One timed phase of a trial (working memory): show a stimulus, the digit
-/// matrix, or nothing, for a fixed time.
-enum class PhaseKind { stimulus, matrix };
-std::string_view to_string(PhaseKind k);  ///< "stimulus" | "matrix"
+/// matrix, or the digit sequence (Question::sequence, one digit at a time,
+/// each for duration_s / its length), for a fixed time.
+enum class PhaseKind { stimulus, matrix, sequence };
+std::string_view to_string(PhaseKind k);  ///< "stimulus" | "matrix" | "sequence"
 struct Phase {
   PhaseKind kind = PhaseKind::stimulus;
   std::optional<int> stimulus;  ///< index into Question::stimuli (stimulus phases)
@@ -68,8 +69,22 @@ struct Phase {
 };
 
 /// Working memory's recall question after the same/different answer.
+/// The matrix (visuospatial) asks for a cell; the digit sequence (verbal)
+/// for a position.
 struct RecallQuestion {
   std::optional<int> cell;  ///< the cell asked (0 … 15, row-major); nullopt = "the digit in the cells" (control)
+  /// Sequence recall: the position asked (0-based); nullopt with a sequence =
+  /// "the digit of the sequence" (control: every digit is 1).
+  std::optional<int> position;
+};
+
+/// Working memory's executive distractor: while Question::sequence is shown
+/// the participant responds (a key, a button) to each target digit — a digit
+/// equal to the one `n` before it (2-back), or with n = 0 every `target`
+/// digit (0-back, the control: attention without updating).
+struct NBackTask {
+  int n = 2;       ///< 0 (control) or 1 … 3
+  int target = 0;  ///< n = 0: the target digit 1 … 9; 0 otherwise
 };
 
 struct SliderSpec {
@@ -97,6 +112,9 @@ struct Wording {
   std::optional<Scale> rating;              ///< the similarity scale (Question::rating_scale)
   std::optional<Scale> confidence;          ///< the confidence scale (Question::confidence)
   std::optional<Scale> recall;              ///< working memory's digit question, the cell in words
+  /// Working memory's sequence phase: what to do with the digits ("Remember
+  /// these digits in their order.", "Respond whenever …"); "" otherwise.
+  std::string sequence_instruction;
 };
 
 /// How sentences name a stimulus of this label: "1" → "texture 1", "Test" →
@@ -128,6 +146,10 @@ struct Question {
   std::vector<Phase> phases;                  ///< timed sequence before the questions (working memory)
   std::optional<std::array<int, 16>> matrix;  ///< working memory: 4 × 4 digits, 0 = empty cell
   std::optional<RecallQuestion> recall;       ///< working memory: the digit question, if asked
+  /// Working memory (verbal, executive): the digits shown one at a time
+  /// during the sequence phase (1 … 9); empty otherwise.
+  std::vector<int> sequence;
+  std::optional<NBackTask> nback;  ///< working memory (executive): respond to targets during the sequence
   /// What the participant reads (the task kind words choice_question and the
   /// scales' labels where it has its own; the engine fills the rest).
   Wording wording;
@@ -150,8 +172,12 @@ struct Response {
   std::optional<double> confidence;          ///< 1 … 5
   std::optional<double> slider_p, slider_i;  ///< final slider positions
   std::optional<int> digit;                  ///< recall answer 1 … 9
-  double rt_ms = missing;                    ///< first presentation → answer
-  std::vector<TrialEvent> events;            ///< presentation / selection events
+  /// Executive distractor: the sequence items (0-based) at which the
+  /// participant responded, increasing; the front end maps a response to the
+  /// digit on screen at that moment.
+  std::vector<int> presses;
+  double rt_ms = missing;          ///< first presentation → answer
+  std::vector<TrialEvent> events;  ///< presentation / selection events
   std::optional<double> swipe_mean_speed_mm_s, swipe_sd_speed_mm_s, directional_proportion;
   /// Why a finger trace gave no swipe measures (TraceMeasures::flag in
   /// finger_trace.hpp); empty when they are stored or there was no trace.

@@ -14,7 +14,8 @@
 //                   model), or target=8dB/-3dB (Central Pitch/Irregularity);
 //                   default: each trial's own reference
 //   noise=1.5dB     matcher noise; unsure=0.5dB (unsure band)
-//   p=0.85          working memory: P(correct) for every condition; digit=0.8
+//   p=0.85          working memory: P(correct) for every condition; digit=0.8;
+//                   hit=0.85, false-alarm=0.05 (2-back: P(respond) to a target, a non-target)
 //   rating-noise=0.5, speed=100 (mm/s swipe speed), seed=7
 //   spread=0.25     between-participant variability (participant_sd): each
 //                   participant's threshold, matcher target and memory
@@ -71,6 +72,9 @@ class SimulatedParticipant {
   [[nodiscard]] double memory_p_correct(const std::string& condition) const;
   /// Working memory: P(digit recalled).
   [[nodiscard]] double memory_p_digit() const;
+  /// Working memory's executive distractor: P(respond) to a target, and to a non-target.
+  [[nodiscard]] double memory_p_hit() const;
+  [[nodiscard]] double memory_p_false_alarm() const;
   /// A wrong choice (never "unsure"), drawn from the behaviour stream.
   [[nodiscard]] std::string wrong_choice(const Question& q, const std::string& correct) const;
 
