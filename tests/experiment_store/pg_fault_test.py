@@ -229,6 +229,8 @@ def main():
               % (STATIONS, PARTICIPANTS, kills["n"], run_s))
         print("server rows %d, reference rows %d: lost %d, duplicated %d, extra %d, differing %d"
               % (len(got), len(ref), lost, duplicated, extra, differing))
+        if lost:
+            print("participants with lost trials:", sorted({k[0] for k in set(ref_keys) - set(got_keys)}))
         if lost or duplicated or extra or differing or kills["n"] == 0:
             sys.exit("FAILED")
         # Every session complete on the server (completion records shipped).
