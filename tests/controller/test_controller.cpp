@@ -301,8 +301,17 @@ bool circling_finger(controller::HostHal& hal, std::int32_t& x, std::int32_t& y,
 }  // namespace
 
 TEST(FingerReports, ADisplayWithASensorReportsItsFingerAtTheIntervalAskedFor) {
-  controller::HostHal* hal_ptr = nullptr;
-  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) { return circling_finger(*hal_ptr, x, y, touch); });
+  // The rig's controller thread starts in its constructor: lifted until the test has its HAL.
+  std::atomic<controller::HostHal*> hal_ptr{nullptr};
+  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) {
+    controller::HostHal* hal = hal_ptr.load();
+    if (hal == nullptr) {
+      x = y = 0;
+      touch = false;
+      return true;
+    }
+    return circling_finger(*hal, x, y, touch);
+  });
   hal_ptr = rig.hal.get();
   SerialLink link(rig.path);
   link.hello();
@@ -387,8 +396,17 @@ TEST(FingerReports, TheTimelineNeverPlacesAReportAfterItArrivedAndFollowsASlowCl
 }
 
 TEST(FingerReports, A2DPlayerDrivesTheDisplayThatReportsTheFinger) {
-  controller::HostHal* hal_ptr = nullptr;
-  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) { return circling_finger(*hal_ptr, x, y, touch); });
+  // The rig's controller thread starts in its constructor: lifted until the test has its HAL.
+  std::atomic<controller::HostHal*> hal_ptr{nullptr};
+  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) {
+    controller::HostHal* hal = hal_ptr.load();
+    if (hal == nullptr) {
+      x = y = 0;
+      touch = false;
+      return true;
+    }
+    return circling_finger(*hal, x, y, touch);
+  });
   hal_ptr = rig.hal.get();
   SerialOptions o;
   o.path = rig.path;
