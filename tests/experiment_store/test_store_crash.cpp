@@ -68,6 +68,12 @@ TEST(StoreCrash, SigkillAtRandomMomentsLosesAndDuplicatesNothing) {
       append_forever(path, id, pipe_fds[1]);
     }
     ::close(pipe_fds[1]);
+    // Every other kill lands after the child has confirmed a trial: a loaded
+    // machine (ASan, -j2) can start it later than any random delay.
+    if (iteration % 2 == 0) {
+      int first = 0;
+      if (::read(pipe_fds[0], &first, sizeof first) == sizeof first) confirmed = std::max(confirmed, first + 1);
+    }
     std::this_thread::sleep_for(std::chrono::microseconds(delay_us(rng)));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
