@@ -298,12 +298,10 @@ bool circling_finger(controller::HostHal& hal, std::int32_t& x, std::int32_t& y,
   return true;
 }
 
-}  // namespace
-
-TEST(FingerReports, ADisplayWithASensorReportsItsFingerAtTheIntervalAskedFor) {
-  // The rig's controller thread starts in its constructor: lifted until the test has its HAL.
-  std::atomic<controller::HostHal*> hal_ptr{nullptr};
-  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) {
+// The rig's sensor: lifted until the test has the rig's HAL (its controller
+// thread starts in the constructor), then the circling finger.
+auto circling_sensor(std::atomic<controller::HostHal*>& hal_ptr) {
+  return [&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) {
     controller::HostHal* hal = hal_ptr.load();
     if (hal == nullptr) {
       x = y = 0;
@@ -311,7 +309,14 @@ TEST(FingerReports, ADisplayWithASensorReportsItsFingerAtTheIntervalAskedFor) {
       return true;
     }
     return circling_finger(*hal, x, y, touch);
-  });
+  };
+}
+
+}  // namespace
+
+TEST(FingerReports, ADisplayWithASensorReportsItsFingerAtTheIntervalAskedFor) {
+  std::atomic<controller::HostHal*> hal_ptr{nullptr};
+  Rig rig(circling_sensor(hal_ptr));
   hal_ptr = rig.hal.get();
   SerialLink link(rig.path);
   link.hello();
@@ -396,17 +401,8 @@ TEST(FingerReports, TheTimelineNeverPlacesAReportAfterItArrivedAndFollowsASlowCl
 }
 
 TEST(FingerReports, A2DPlayerDrivesTheDisplayThatReportsTheFinger) {
-  // The rig's controller thread starts in its constructor: lifted until the test has its HAL.
   std::atomic<controller::HostHal*> hal_ptr{nullptr};
-  Rig rig([&hal_ptr](std::int32_t& x, std::int32_t& y, bool& touch) {
-    controller::HostHal* hal = hal_ptr.load();
-    if (hal == nullptr) {
-      x = y = 0;
-      touch = false;
-      return true;
-    }
-    return circling_finger(*hal, x, y, touch);
-  });
+  Rig rig(circling_sensor(hal_ptr));
   hal_ptr = rig.hal.get();
   SerialOptions o;
   o.path = rig.path;
