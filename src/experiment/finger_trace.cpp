@@ -47,10 +47,10 @@ std::string_view flag_code(std::string_view flag) { return flag.substr(0, flag.f
 TraceMeasures measure_trace(std::span<const FingerSample> s, const SwipeLimits& limits) {
   if (!(limits.max_speed_mm_s > 0) || !(limits.min_touched_s >= 0) || !(limits.still_speed_mm_s >= 0) ||
       !(limits.time_resolution_s > 0 && limits.time_resolution_s < 1))
-    throw InvalidArgument("swipe limits: max_speed_mm_s is " + detail::num(limits.max_speed_mm_s) +
-                          ", min_touched_s " + detail::num(limits.min_touched_s) + ", still_speed_mm_s " +
-                          detail::num(limits.still_speed_mm_s) + ", time_resolution_s " +
-                          detail::num(limits.time_resolution_s) + "; allowed: > 0, >= 0, >= 0, 0 < … < 1");
+    throw InvalidArgument("swipe limits: max_speed_mm_s is " + detail::num(limits.max_speed_mm_s) + ", min_touched_s " +
+                          detail::num(limits.min_touched_s) + ", still_speed_mm_s " + detail::num(limits.still_speed_mm_s) +
+                          ", time_resolution_s " + detail::num(limits.time_resolution_s) +
+                          "; allowed: > 0, >= 0, >= 0, 0 < … < 1");
   TraceMeasures out;
   bool touched = false;
   // Spans of consecutive touching samples at least two clock ticks long,

@@ -385,9 +385,8 @@ class Checks {
       if (driven_at > limit)
         fail(std::string("still driven ") + detail::fixed(driven_at * 1e3, 0) + " ms after the last " + what +
              " frame; allowed " + detail::fixed(limit * 1e3, 0) + " ms");
-      return std::string("at rest ") + detail::fixed(std::max(driven_at, 0.0) * 1e3, 0) + "–" +
-             detail::fixed(rest_by * 1e3, 0) + " ms after the last " + what + " frame (allowed " +
-             detail::fixed(limit * 1e3, 0) + " ms)";
+      return std::string("at rest ") + detail::fixed(std::max(driven_at, 0.0) * 1e3, 0) + "–" + detail::fixed(rest_by * 1e3, 0) +
+             " ms after the last " + what + " frame (allowed " + detail::fixed(limit * 1e3, 0) + " ms)";
     }
     fail(std::string("still driven (") + std::to_string(s.amplitude) + ") 1 s after the last " + what + " frame");
   }
