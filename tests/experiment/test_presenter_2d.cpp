@@ -238,7 +238,14 @@ TEST(Presenter2D, TerminalRunStoresStrokesAndShowsNothingOfTheCondition) {
                                                              "--sensor-period", "0.6", "--duration", "30", "--quiet"});
   ASSERT_FALSE(display.pty().empty());
   const std::string port = "serial:" + display.pty();
-  const std::string cmd = "(sleep 0.9; echo 2; sleep 0.9; echo 3; sleep 0.9; echo 'a 2') | " + std::string(TEXEL_CLI) +
+  // The participant feels each interval for 0.9 s from the moment it plays
+  // (the monitor's `play` line), however long the run took to start.
+  const std::string m = tmp.at("m.txt");
+  auto felt = [&](int stimulus) {
+    return "until grep -q 'play .*stimulus=" + std::to_string(stimulus) + "' " + m +
+           " 2>/dev/null; do sleep 0.05; done; sleep 0.9; ";
+  };
+  const std::string cmd = "(" + felt(1) + "echo 2; " + felt(2) + "echo 3; " + felt(3) + "echo 'a 2') | " + std::string(TEXEL_CLI) +
                           " experiment run " + tmp.at("p.json") + " --participant P01 --db " + tmp.at("s.db") +
                           " --backend null --finger " + port + " --monitor " + tmp.at("m.txt") + " 2>&1";
   std::string screen;
