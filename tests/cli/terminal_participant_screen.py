@@ -18,8 +18,7 @@ pane with a pseudo-terminal and the null stimulus output, types answers with
 
 Usage: terminal_participant_screen.py TEXEL PROTOCOL_DIR WORK_DIR [--no-monitor]
 (--no-monitor runs a texel without the flag, to check the test fails
-against the old runner.) Uses its own tmux server (-L texel-terminal-PID) and
-kills only that; every wait has a deadline.
+against the old runner.) The pane: participant_pane.py.
 """
 
 import csv
@@ -31,81 +30,14 @@ import subprocess
 import sys
 import time
 
+from participant_pane import Pane, monitor_events
+
 TEXEL, PROTOCOLS, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
 USE_MONITOR = "--no-monitor" not in sys.argv[4:]
-SOCKET = f"texel-terminal-{os.getpid()}"
-ENV = {k: v for k, v in os.environ.items() if k not in ("TMUX", "TMUX_PANE")}
-
-failures = []
-screens = []  # every capture, in order
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAIL:", what, flush=True)
-
-
-def tmux(*args, check_rc=True):
-    r = subprocess.run(["tmux", "-L", SOCKET, "-f", "/dev/null", *args], env=ENV, capture_output=True, text=True, timeout=20)
-    if check_rc and r.returncode != 0:
-        raise RuntimeError(f"tmux {' '.join(args)}: {r.stderr.strip()}")
-    return r.stdout
-
-
-def capture():
-    text = tmux("capture-pane", "-p", "-J", "-S", "-", "-t", "p")
-    screens.append(text)
-    return text
-
-
-def wait_for(pattern, timeout=20.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        text = capture()
-        m = re.search(pattern, text)
-        if m:
-            return text, m
-        time.sleep(0.1)
-    raise RuntimeError(f"timed out after {timeout} s waiting for /{pattern}/ on the screen:\n{screens[-1]}")
-
-
-def soft_wait(pattern, what, timeout=10.0):
-    """wait_for that records a failed check instead of ending the test."""
-    try:
-        return wait_for(pattern, timeout)[0]
-    except RuntimeError:
-        check(False, what)
-        return screens[-1]
-
-
-def new_line_after(keys, line, what, timeout=10.0):
-    """Sends keys and waits until one more `line` is on the screen than before."""
-    before = capture().count(line)
-    send(keys)
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if capture().count(line) > before:
-            return
-        time.sleep(0.1)
-    check(False, what)
-
-
-def send(keys):
-    tmux("send-keys", "-t", "p", "-l", keys)
-    tmux("send-keys", "-t", "p", "Enter")
-
-
-def monitor_events(path, name):
-    if not os.path.exists(path):
-        return []
-    out = []
-    for line in open(path, encoding="utf-8"):
-        parts = line.rstrip("\n").split(" ", 2)
-        if len(parts) >= 2 and parts[1] == name:
-            fields = dict(re.findall(r'(\w+)=("(?:[^"\\]|\\.)*"|\S+)', parts[2] if len(parts) > 2 else ""))
-            out.append({k: v.strip('"') for k, v in fields.items()})
-    return out
+PANE = Pane("texel-terminal")
+check, capture, wait_for, soft_wait, send, new_line_after = (PANE.check, PANE.capture, PANE.wait_for, PANE.soft_wait,
+                                                             PANE.send, PANE.new_line_after)
+screens = PANE.screens
 
 
 def countdown(text):
@@ -129,7 +61,7 @@ def main():
     if USE_MONITOR:
         cmd += f" --monitor '{mon}'"
     # The pane stays open after the run so its last screen can be read.
-    tmux("new-session", "-d", "-s", "p", "-x", "120", "-y", "50", f"{cmd}; echo TEXEL-EXIT $?; sleep 120")
+    PANE.start(cmd)
 
     # Trial 1: the countdown is visible and decreases, in place.
     wait_for(r"(?i)trial 1\b")
@@ -226,18 +158,4 @@ def main():
         check(not os.path.exists(os.path.join(WORK, "none.db")), "an unopenable --monitor leaves no database")
 
 
-try:
-    main()
-except Exception as e:  # a deadline or tmux failure is a test failure, with the last screen
-    failures.append(str(e))
-    print("FAIL:", e, flush=True)
-finally:
-    subprocess.run(["tmux", "-L", SOCKET, "kill-server"], env=ENV, capture_output=True, timeout=20)
-    socket_path = os.path.join(ENV.get("TMUX_TMPDIR", "/tmp"), f"tmux-{os.getuid()}", SOCKET)
-    if os.path.exists(socket_path):
-        os.remove(socket_path)
-
-if failures:
-    print(f"{len(failures)} failed checks; last screen:\n{screens[-1] if screens else '(none)'}")
-    sys.exit(1)
-print("participant screen: all checks passed")
+PANE.run(main, "participant screen: all checks passed")

@@ -20,8 +20,7 @@ digit on screen — and that nothing on the participant's screen names the
 condition (coarse, control, the component, targets, correctness).
 
 Usage: terminal_working_memory_components.py TEXEL PROTOCOL_DIR WORK_DIR.
-Uses its own tmux server (-L texel-wm-PID) and kills only that; every wait
-has a deadline.
+The pane: participant_pane.py.
 """
 
 import csv
@@ -33,49 +32,18 @@ import subprocess
 import sys
 import time
 
+from participant_pane import Pane, monitor_events
+
 TEXEL, PROTOCOLS, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
-SOCKET = f"texel-wm-{os.getpid()}"
-ENV = {k: v for k, v in os.environ.items() if k not in ("TMUX", "TMUX_PANE")}
 TRIALS = 4
 
-failures = []
-screens = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAIL:", what, flush=True)
-
-
-def tmux(*args):
-    r = subprocess.run(["tmux", "-L", SOCKET, "-f", "/dev/null", *args], env=ENV, capture_output=True, text=True, timeout=20)
-    if r.returncode != 0:
-        raise RuntimeError(f"tmux {' '.join(args)}: {r.stderr.strip()}")
-    return r.stdout
-
-
-def capture():
-    text = tmux("capture-pane", "-p", "-J", "-S", "-", "-t", "p")
-    screens.append(text)
-    return text
+PANE = Pane("texel-wm")
+check, capture, send = PANE.check, PANE.capture, PANE.send
+screens = PANE.screens
 
 
 def wait_for(pattern, timeout=30.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        text = capture()
-        m = re.search(pattern, text)
-        if m:
-            return text, m
-        time.sleep(0.05)
-    raise RuntimeError(f"timed out after {timeout} s waiting for /{pattern}/ on the screen:\n{screens[-1]}")
-
-
-def send(keys):
-    if keys:
-        tmux("send-keys", "-t", "p", "-l", keys)
-    tmux("send-keys", "-t", "p", "Enter")
+    return PANE.wait_for(pattern, timeout, poll=0.05)
 
 
 def digit_on_screen(text):
@@ -123,7 +91,7 @@ def main():
     with open(protocol, "w") as f:
         json.dump(p, f)
     cmd = f"'{TEXEL}' experiment run '{protocol}' --participant WM1 --db '{db}' --backend null --monitor '{mon}'"
-    tmux("new-session", "-d", "-s", "p", "-x", "120", "-y", "50", f"{cmd}; echo TEXEL-EXIT $?; sleep 120")
+    PANE.start(cmd)
 
     kinds = []
     for n in range(1, TRIALS + 1):
@@ -199,24 +167,5 @@ def main():
         check(word not in whole.lower(), f"the participant's screen never shows '{word}'")
 
 
-def monitor_events(path, name):
-    out = []
-    if not os.path.exists(path):
-        return out
-    for line in open(path, encoding="utf-8"):
-        parts = line.rstrip("\n").split(" ", 2)
-        if len(parts) >= 2 and parts[1] == name:
-            fields = dict(re.findall(r'(\w+)=("(?:[^"\\]|\\.)*"|\S+)', parts[2] if len(parts) > 2 else ""))
-            out.append({k: v.strip('"') for k, v in fields.items()})
-    return out
-
-
 if __name__ == "__main__":
-    try:
-        main()
-    except RuntimeError as e:
-        check(False, str(e))
-    finally:
-        subprocess.run(["tmux", "-L", SOCKET, "kill-server"], env=ENV, capture_output=True)
-    print(f"{len(failures)} failure(s)")
-    sys.exit(1 if failures else 0)
+    PANE.run(main, "working-memory components at the terminal: all checks passed")
