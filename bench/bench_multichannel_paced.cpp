@@ -41,67 +41,20 @@
 #include <vector>
 
 #include "../tests/support/alloc_counter.hpp"
+#include "jack_bench.hpp"
 #include "texel/document.hpp"
 #include "texel/multichannel.hpp"
 #include "texel/multichannel_player.hpp"
 
-extern char** environ;
-
 using namespace texel;
 namespace alloc = texel::test_support::alloc;
+using namespace texel::bench;
 
 namespace {
 
 constexpr double rate = 48000.0;
 constexpr std::size_t period = 64;
 constexpr std::size_t max_ports = 64;
-
-pid_t spawn_jackd(const std::string& server, bool realtime, const std::string& log) {
-  std::vector<std::string> args{"jackd", "-n", server};
-  if (realtime)
-    args.insert(args.end(), {"-R", "-P", "80"});
-  else
-    args.emplace_back("-r");
-  args.insert(args.end(), {"-d", "dummy", "-r", "48000", "-p", std::to_string(period)});
-  std::vector<char*> argv;
-  argv.reserve(args.size() + 1);
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t pid = -1;
-  if (posix_spawnp(&pid, "jackd", &fa, nullptr, argv.data(), environ) != 0) pid = -1;
-  posix_spawn_file_actions_destroy(&fa);
-  return pid;
-}
-
-bool alive(pid_t pid) { return pid > 0 && ::waitpid(pid, nullptr, WNOHANG) == 0; }
-
-void stop_jackd(pid_t pid) {
-  if (pid <= 0) return;
-  ::kill(pid, SIGTERM);
-  for (int i = 0; i < 50 && alive(pid); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  if (alive(pid)) ::kill(pid, SIGKILL);
-  ::waitpid(pid, nullptr, 0);
-}
-
-struct Stats {
-  double p50 = 0, p99 = 0, p999 = 0, max = 0;  // % of the period
-};
-
-Stats percentiles(std::vector<double> v) {
-  Stats s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  const double p = static_cast<double>(period) / rate;
-  const auto at = [&](double q) {
-    return 100.0 * v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))] / p;
-  };
-  s.p50 = at(0.5), s.p99 = at(0.99), s.p999 = at(0.999), s.max = 100.0 * v.back() / p;
-  return s;
-}
 
 struct Run {
   jack_client_t* client = nullptr;
@@ -111,7 +64,7 @@ struct Run {
   std::vector<double> block_s;
   std::atomic<std::size_t> blocks{0};
   std::atomic<std::uint64_t> xruns{0};
-  std::atomic<int> policy{-1}, priority{0};
+  Scheduling scheduling;
 };
 
 int on_xrun(void* arg) {
@@ -123,13 +76,7 @@ int on_xrun(void* arg) {
 // calls or N fills, clock reads, a store into an array sized before activation).
 int on_process(jack_nframes_t n, void* arg) {
   auto& r = *static_cast<Run*>(arg);
-  if (r.policy.load(std::memory_order_relaxed) < 0) {
-    int pol = 0;
-    sched_param sp{};
-    pthread_getschedparam(pthread_self(), &pol, &sp);
-    r.priority.store(sp.sched_priority, std::memory_order_relaxed);
-    r.policy.store(pol, std::memory_order_relaxed);
-  }
+  r.scheduling.note();
   timespec a{}, b{};
   ::clock_gettime(CLOCK_MONOTONIC, &a);
   alloc::counting = true;
@@ -163,12 +110,7 @@ Result run_client(const std::string& server, std::size_t channels, double second
   r.channels = channels;
   r.player = player;
   r.block_s.assign(static_cast<std::size_t>(seconds * rate / static_cast<double>(period)) + 2000, 0.0);
-  jack_status_t status{};
-  for (int attempt = 0; attempt < 25 && !r.client; ++attempt) {
-    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    r.client =
-        jack_client_open("texel-mc", static_cast<jack_options_t>(JackNoStartServer | JackServerName), &status, server.c_str());
-  }
+  r.client = open_client("texel-mc", server);
   if (!r.client) {
     res.scheduling = "JACK client failed to open";
     return res;
@@ -211,14 +153,11 @@ Result run_client(const std::string& server, std::size_t channels, double second
   const std::size_t done = r.blocks.load();
   res.blocks = done - warm;
   res.block_time = percentiles(std::vector<double>(r.block_s.begin() + static_cast<std::ptrdiff_t>(warm),
-                                                   r.block_s.begin() + static_cast<std::ptrdiff_t>(done)));
+                                                   r.block_s.begin() + static_cast<std::ptrdiff_t>(done)),
+                               static_cast<double>(period) / rate);
   res.allocations = alloc::counted_allocations.load();
   res.xruns = r.xruns.load() - xruns0;
-  const int pol = r.policy.load();
-  res.scheduling = pol == SCHED_FIFO ? "SCHED_FIFO " + std::to_string(r.priority.load())
-                   : pol == SCHED_RR ? "SCHED_RR " + std::to_string(r.priority.load())
-                   : pol < 0         ? "no callback"
-                                     : "SCHED_OTHER (JACK not real-time)";
+  res.scheduling = r.scheduling.name();
   return res;
 }
 
@@ -254,21 +193,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: texel_bench_multichannel_paced [--seconds S > 0] [--channels 1 … 64] [--runs R >= 1]\n");
     return 2;
   }
-  const std::string server = "texel-mc-" + std::to_string(::getpid());
-  const std::string log = "/tmp/" + server + "-jackd.log";
-  pid_t jackd = spawn_jackd(server, true, log);
-  std::this_thread::sleep_for(std::chrono::milliseconds(800));
-  std::string mode = "jackd -R -P 80";
-  if (!alive(jackd)) {
-    stop_jackd(jackd);
-    jackd = spawn_jackd(server, false, log);
-    std::this_thread::sleep_for(std::chrono::milliseconds(800));
-    mode = "jackd -r (no real-time)";
-  }
-  if (!alive(jackd)) {
-    std::printf("texel_bench_multichannel_paced: jackd did not start (see %s); skipped\n", log.c_str());
+  JackServer jackd = start_jack("texel-mc", period, false);
+  if (!jackd.started()) {
+    std::printf("texel_bench_multichannel_paced: jackd did not start (see %s); skipped\n", jackd.log.c_str());
     return 0;
   }
+  const std::string& server = jackd.name;
+  const std::string& mode = jackd.mode;
   const auto plan = prepare_channels(simultaneous_document(channels));
   PlayerConfig config;
   config.rate_hz = rate;
@@ -295,6 +226,6 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(floor.xruns));
     allocations += played.allocations + floor.allocations;
   }
-  stop_jackd(jackd);
+  stop(jackd.process);
   return allocations == 0 ? 0 : 1;
 }

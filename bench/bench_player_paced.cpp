@@ -54,84 +54,21 @@
 #include <vector>
 
 #include "../tests/support/alloc_counter.hpp"
+#include "jack_bench.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/sinks.hpp"
 
-extern char** environ;
-
 using namespace texel;
 namespace alloc = texel::test_support::alloc;
+using namespace texel::bench;
 
 namespace {
 
 constexpr double rate = 48000.0;
 constexpr double step_mm = 0.004;  // finger advance per sensor sample (4 mm/s … a marker, not a swipe)
 
-// ---------------------------------------------------------------- processes
-
-struct Child {
-  pid_t pid = -1;
-  bool own_group = false;
-};
-
-Child spawn(const std::vector<std::string>& args, const std::string& log, bool own_group) {
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  posix_spawnattr_t at;
-  posix_spawnattr_init(&at);
-  if (own_group) {
-    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP);
-    posix_spawnattr_setpgroup(&at, 0);
-  }
-  Child c;
-  if (posix_spawnp(&c.pid, argv[0], &fa, &at, argv.data(), environ) != 0) c.pid = -1;
-  c.own_group = own_group;
-  posix_spawn_file_actions_destroy(&fa);
-  posix_spawnattr_destroy(&at);
-  return c;
-}
-
-bool running(const Child& c) { return c.pid > 0 && ::waitpid(c.pid, nullptr, WNOHANG) == 0; }
-
-void stop(Child& c) {
-  if (c.pid <= 0) return;
-  ::kill(c.own_group ? -c.pid : c.pid, SIGTERM);  // the group we started: stress-ng and its workers
-  for (int i = 0; i < 50 && ::waitpid(c.pid, nullptr, WNOHANG) == 0; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  if (::waitpid(c.pid, nullptr, WNOHANG) == 0) {
-    ::kill(c.own_group ? -c.pid : c.pid, SIGKILL);
-    ::waitpid(c.pid, nullptr, 0);
-  }
-  c.pid = -1;
-}
-
-bool on_path(const char* tool) {
-  const std::string cmd = std::string("command -v ") + tool + " >/dev/null 2>&1";
-  return std::system(cmd.c_str()) == 0;
-}
-
 // ------------------------------------------------------------------ one run
-
-struct Stats {
-  double p50 = 0, p99 = 0, p999 = 0, max = 0;  // % of the period
-};
-
-Stats percentiles(std::vector<double> v, double period) {
-  Stats s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  const auto at = [&](double q) {
-    return 100.0 * v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))] / period;
-  };
-  s.p50 = at(0.5), s.p99 = at(0.99), s.p999 = at(0.999), s.max = 100.0 * v.back() / period;
-  return s;
-}
 
 struct Result {
   std::string load, dim;
@@ -168,7 +105,7 @@ struct Run {
   long last_marker = -1;
   std::atomic<jack_nframes_t> playback_latency{0};
   std::atomic<std::uint64_t> xruns{0};
-  std::atomic<int> policy{-1}, priority{0};
+  Scheduling scheduling;
 };
 
 int on_xrun(void* arg) {
@@ -181,13 +118,7 @@ int on_xrun(void* arg) {
 int on_process(jack_nframes_t n, void* arg) {
   auto& r = *static_cast<Run*>(arg);
   auto* out = static_cast<float*>(jack_port_get_buffer(r.port, n));
-  if (r.policy.load(std::memory_order_relaxed) < 0) {
-    int pol = 0;
-    sched_param sp{};
-    pthread_getschedparam(pthread_self(), &pol, &sp);
-    r.priority.store(sp.sched_priority, std::memory_order_relaxed);
-    r.policy.store(pol, std::memory_order_relaxed);
-  }
+  r.scheduling.note();
   const std::size_t frames = std::min<std::size_t>(n, r.positions.size());
   timespec a{}, b{};
   ::clock_gettime(CLOCK_MONOTONIC, &a);
@@ -237,14 +168,7 @@ Result run_client(const std::string& server, std::size_t block, double seconds, 
   r.latency_us.assign(markers, 0.0);
   r.wait_us.assign(markers, 0.0);
   r.offset_us.assign(markers, 0.0);
-  jack_status_t status{};
-  // A loaded machine may take longer than the wait in jack_runs to bring the
-  // server up: try for up to 5 s before giving up on this run.
-  for (int attempt = 0; attempt < 25 && !r.client; ++attempt) {
-    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    r.client =
-        jack_client_open("texel-bench", static_cast<jack_options_t>(JackNoStartServer | JackServerName), &status, server.c_str());
-  }
+  r.client = open_client("texel-bench", server);
   if (!r.client) {
     res.scheduling = "JACK client failed to open";
     return res;
@@ -311,11 +235,7 @@ Result run_client(const std::string& server, std::size_t block, double seconds, 
   }
   res.allocations = alloc::counted_allocations.load();
   res.xruns = r.xruns.load() - xruns0;
-  const int pol = r.policy.load();
-  res.scheduling = pol == SCHED_FIFO ? "SCHED_FIFO " + std::to_string(r.priority.load())
-                   : pol == SCHED_RR ? "SCHED_RR " + std::to_string(r.priority.load())
-                   : pol < 0         ? "no callback"
-                                     : "SCHED_OTHER (JACK not real-time)";
+  res.scheduling = r.scheduling.name();
   return res;
 }
 
@@ -436,31 +356,13 @@ bool jack_sync = false;
 
 std::vector<Result> jack_runs(const std::string& load, std::size_t block, double seconds) {
   std::vector<Result> out;
-  const std::string server = "texel-bench-" + std::to_string(::getpid());
-  const std::string log = "/tmp/" + server + "-jackd.log";
-  const std::string period = std::to_string(block);
-  // -P 80: JACK's clients run just below the server's priority, above anything else here.
-  const auto args = [&](std::vector<std::string> scheduling) {
-    std::vector<std::string> a{"jackd", "-n", server};
-    if (jack_sync) a.emplace_back("-S");
-    a.insert(a.end(), scheduling.begin(), scheduling.end());
-    a.insert(a.end(), {"-d", "dummy", "-r", "48000", "-p", period});
-    return a;
-  };
-  const std::string sync = jack_sync ? " -S" : "";
-  Child jackd = spawn(args({"-R", "-P", "80"}), log, false);
-  std::this_thread::sleep_for(std::chrono::milliseconds(800));
-  std::string mode = "jackd" + sync + " -R -P 80";
-  if (!running(jackd)) {  // real-time refused: run without it and say so
-    stop(jackd);
-    jackd = spawn(args({"-r"}), log, false);
-    std::this_thread::sleep_for(std::chrono::milliseconds(800));
-    mode = "jackd" + sync + " -r (no real-time)";
-  }
-  if (!running(jackd)) {
-    std::fprintf(stderr, "jackd did not start (see %s); JACK runs skipped\n", log.c_str());
+  JackServer jackd = start_jack("texel-bench", block, jack_sync);
+  if (!jackd.started()) {
+    std::fprintf(stderr, "jackd did not start (see %s); JACK runs skipped\n", jackd.log.c_str());
     return out;
   }
+  const std::string& server = jackd.name;
+  const std::string& mode = jackd.mode;
   {
     FloorClient f;
     Result r = run_client(server, block, seconds, f, [&](double, double x) { f.push(x); });
@@ -479,7 +381,7 @@ std::vector<Result> jack_runs(const std::string& load, std::size_t block, double
     r.load = load, r.dim = "2-D", r.scheduling += ", " + mode;
     out.push_back(r);
   }
-  stop(jackd);
+  stop(jackd.process);
   return out;
 }
 
