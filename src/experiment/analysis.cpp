@@ -114,6 +114,7 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       case StudyDesign::guided: s = guided_summary(rs, options, report.text); break;
       case StudyDesign::memory: s = memory_summary(study, rs, options, report.text); break;
       case StudyDesign::oddity: s = oddity_summary(st, rs, options, report.text); break;
+      case StudyDesign::playback: s = playback_summary(st, rs, options, report.text); break;
     }
     json head{{"participants", participants.size()}, {"rows", rs.size()}};
     // Reaction times: each participant's median (robust to a trial left

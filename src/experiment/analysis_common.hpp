@@ -4,7 +4,7 @@
 // appearance, the source's printed forms of a test, and each study's
 // summary function (one study's analysis per file: analysis_staircase.cpp,
 // analysis_matching.cpp, analysis_quantization.cpp, analysis_memory.cpp,
-// analysis_oddity.cpp; analyze() in analysis.cpp calls them).
+// analysis_oddity.cpp, analysis_playback.cpp; analyze() in analysis.cpp calls them).
 #pragma once
 
 #include <algorithm>
@@ -126,5 +126,9 @@ json quantization_summary(const Rows& rows, const AnalysisOptions& o, std::strin
 json memory_summary(const std::string& study, const Rows& rows, const AnalysisOptions& o, std::string& text);
 /// The 2-D oddity studies: proportion correct against chance.
 json oddity_summary(const Study& study, const Rows& rows, const AnalysisOptions& o, std::string& text);
+/// Distributed irregularity: proportion correct per shift, the PSE with its bootstrap CI, the control.
+json playback_summary(const Study& study, const Rows& rows, const AnalysisOptions& o, std::string& text);
+/// The fitted oddity dip at `shift` (the figure's curve).
+double playback_dip(double shift, double pse, double alpha);
 
 }  // namespace texel::experiment::analysis_common

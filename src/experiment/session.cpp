@@ -123,6 +123,17 @@ std::string SessionCore::single(const json& texture, double length_mm) const {
                            {region("display", 0.0, length_mm > 0 ? std::optional<double>(length_mm) : std::nullopt, texture)});
 }
 
+std::string SessionCore::single_played(const json& texture, std::string_view playback, double length_mm) const {
+  json d = {{"format", "texel-document"},
+            {"version", 6},
+            {"device", protocol.device},
+            {"regions", {region("display", 0.0, length_mm > 0 ? std::optional<double>(length_mm) : std::nullopt, texture)}},
+            {"playback", {{"mode", std::string(playback)}}}};
+  const std::string text = d.dump();
+  (void)parse_document(text, "stimulus");
+  return text;
+}
+
 std::string SessionCore::halves(const json& left, const json& right) const {
   return stimulus_document(protocol.device, {region("left", 0.0, half_mm, left), region("right", half_mm, half_mm, right)});
 }

@@ -132,6 +132,11 @@ void validate_observer_object(const json& o) {
     (void)s.number_or("p_hit", 0.85, 0.0, 1.0);
     (void)s.number_or("p_false_alarm", 0.05, 0.0, 1.0);
   });
+  section("playback", [&](JsonObject& s) {
+    (void)s.number_or("integration", 1.0, 0.0, 1.0);
+    (void)s.number_or("threshold_db", 4.0, 0.01, 100.0);
+    (void)s.number_or("slope", 2.0, 0.1, 20.0);
+  });
   section("explorer", [&](JsonObject& s) {
     (void)s.number_or("speed_mm_s", 100.0, 1.0, 10000.0);
     (void)s.number_or("speed_sd_mm_s", 15.0, 0.0, 10000.0);
@@ -194,6 +199,8 @@ std::string simulation_observer(std::string_view protocol_observer_json, const s
       o["memory"]["p_hit"] = number_with_unit(key, value, {"%"});
     } else if (key == "false-alarm") {
       o["memory"]["p_false_alarm"] = number_with_unit(key, value, {"%"});
+    } else if (key == "integration") {
+      o["playback"]["integration"] = number_with_unit(key, value, {});
     } else if (key == "rating-noise") {
       o["rater"]["noise"] = number_with_unit(key, value, {});
     } else if (key == "speed") {
@@ -209,7 +216,7 @@ std::string simulation_observer(std::string_view protocol_observer_json, const s
       throw InvalidArgument(
           "--simulate: unknown key '" + key +
           "'; allowed: threshold, slope, shape, guess, lapse, target, noise, unsure, p, digit, hit, false-alarm, "
-          "rating-noise, "
+          "integration, rating-noise, "
           "speed, spread, seed, default");
     }
   }
@@ -298,6 +305,24 @@ Matcher SimulatedParticipant::matcher(const MatchResult& fallback, const Session
   }
   mc.target = MatchPoint{target.pitch_db + model_->bias_pitch_db, target.irregularity_db + model_->bias_irregularity_db};
   return Matcher(mc);
+}
+
+double SimulatedParticipant::playback_shift_db(std::size_t channels) const {
+  const double w = get(section_of(model_->observer, "playback"), "integration", 1.0);
+  const double k = static_cast<double>(std::max<std::size_t>(channels, 1));
+  return 5.0 * std::log10((1.0 - w) + w / k);
+}
+
+bool SimulatedParticipant::playback_correct(double felt_difference_db, std::uint64_t trial) const {
+  const json& pb = section_of(model_->observer, "playback");
+  PsychometricConfig pc;
+  pc.shape = PsychometricShape::weibull;
+  pc.threshold = model_->threshold_scale * get(pb, "threshold_db", 4.0);
+  pc.slope = get(pb, "slope", 2.0);
+  pc.guess = guess_oddity3;
+  pc.lapse = get(section_of(model_->observer, "psychometric"), "lapse", 0.02);
+  pc.seed = seed_;
+  return PsychometricObserver(pc).respond(felt_difference_db, trial);
 }
 
 Rater SimulatedParticipant::rater(double scale_min, double scale_max) const {

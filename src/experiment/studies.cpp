@@ -16,6 +16,7 @@ constexpr Study table[] = {
     {"working-memory-components", "Working-memory components", StudyDesign::memory},
     {"direction-independence", "Direction independence", StudyDesign::oddity, {}, false, false, false, true},
     {"rendering-2d", "2-D rendering against the 1-D original", StudyDesign::oddity},
+    {"distributed-irregularity", "Distributed irregularity", StudyDesign::playback},
 };
 
 }  // namespace

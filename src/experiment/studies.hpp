@@ -18,6 +18,7 @@ enum class StudyDesign {
   guided,        ///< guided / Bayesian matches: as matching, plus convergence and similarity
   memory,        ///< same/different under a memory load: spacing × distractor RM-ANOVA
   oddity,        ///< proportion correct per condition against chance (the 2-D oddity studies)
+  playback,      ///< playback oddity: proportion correct per shift, the PSE of the dip (distributed irregularity)
 };
 
 struct Study {

@@ -69,6 +69,10 @@ TEST(MultichannelDevice, ActuatorsParseAndRoundTrip) {
 TEST(MultichannelDevice, ProfilesWithoutActuatorsAreOneChannelAndWriteTheirOldText) {
   for (const auto& name : builtin_device_names()) {
     const DeviceProfile d = load_device(name);
+    if (name == "pad-4") {  // the one built-in array (the distributed-irregularity study's)
+      EXPECT_EQ(d.channels(), 4u);
+      continue;
+    }
     EXPECT_EQ(d.channels(), 1u) << name;
     EXPECT_EQ(device_profile_json(d).find("actuators"), std::string::npos) << name;
   }

@@ -17,6 +17,9 @@
 //   p=0.85          working memory: P(correct) for every condition; digit=0.8;
 //                   hit=0.85, false-alarm=0.05 (2-back: P(respond) to a target, a non-target)
 //   rating-noise=0.5, speed=100 (mm/s swipe speed), seed=7
+//   integration=1   distributed irregularity: how much touch pools simultaneous
+//                   texels' frequencies (0 … 1; "playback" section, with
+//                   threshold_db and slope of the felt difference)
 //   spread=0.25     between-participant variability (participant_sd): each
 //                   participant's threshold, matcher target and memory
 //                   accuracy deviate from the group by a draw from the seed
@@ -75,6 +78,17 @@ class SimulatedParticipant {
   /// Working memory's executive distractor: P(respond) to a target, and to a non-target.
   [[nodiscard]] double memory_p_hit() const;
   [[nodiscard]] double memory_p_false_alarm() const;
+  /// Distributed irregularity (the observer's "playback" section): the
+  /// shift (dB) of a simultaneous texture's felt Irregularity on `channels`
+  /// actuators, 5·log10((1 − w) + w/K) for pooling w = `integration` (the
+  /// spread of K log-frequencies averaged with weight w: 1 pools fully,
+  /// −3 dB on four actuators; 0 feels each texel apart, no shift).
+  [[nodiscard]] double playback_shift_db(std::size_t channels) const;
+  /// Whether the odd one of a playback oddity is found when the felt
+  /// Irregularities differ by `felt_difference_db`: a Weibull with the
+  /// section's threshold_db (scaled by this participant's threshold) and
+  /// slope, chance 1/3, the psychometric section's lapse.
+  [[nodiscard]] bool playback_correct(double felt_difference_db, std::uint64_t trial) const;
   /// A wrong choice (never "unsure"), drawn from the behaviour stream.
   [[nodiscard]] std::string wrong_choice(const Question& q, const std::string& correct) const;
 

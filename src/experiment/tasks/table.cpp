@@ -17,7 +17,8 @@ namespace texel::experiment {
   X(guided)                 \
   X(same_different)         \
   X(familiarisation)        \
-  X(oddity_2d)
+  X(oddity_2d)              \
+  X(playback_oddity)
 
 #define TEXEL_DECLARE_TASK(kind) std::unique_ptr<TaskType> make_##kind##_task();
 TEXEL_TASK_TABLE(TEXEL_DECLARE_TASK)
