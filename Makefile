@@ -69,7 +69,8 @@ $(WEB_TEST_OUT)/index.html: web/node_modules/.package-lock.json $(WEB_SRC) docs/
 # its matches), then each study's summaries and figures. The 2-D
 # direction-independence study runs short: two simulated participants (~10 s).
 PROTOCOLS := $(addprefix examples/protocols/,free-exploration.json quantization.json parameter-mapping.json \
-  guided-exploration.json coarse-features.json working-memory.json working-memory-components.json)
+  guided-exploration.json coarse-features.json working-memory.json working-memory-components.json \
+  distributed-irregularity.json)
 # Texel length is a between-groups study: each group has its own participants.
 TEXEL_LENGTH_GROUPS := N:texel-length W:texel-length-wide V:texel-length-visual-practice
 

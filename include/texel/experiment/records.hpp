@@ -25,13 +25,13 @@ struct TrialRow {
   std::string protocol;  ///< protocol name, e.g. "texel-length"
   std::string study;     ///< one of: working-memory, working-memory-components, texel-length, parameter-mapping,
                          ///< free-exploration, quantization, guided-exploration, coarse-features,
-                         ///< direction-independence, rendering-2d
+                         ///< direction-independence, rendering-2d, distributed-irregularity
   std::string block;     ///< block name, e.g. "narrow", "fine-50"
   int block_index = 0;   ///< 0-based position of the block in the protocol
   int trial = 0;         ///< 0-based trial index within the session (all blocks)
   int trial_in_block = 0;
   bool practice = false;
-  std::string task;       ///< oddity, two-alternative, match, rating, guided, same-different, oddity-2d
+  std::string task;       ///< oddity, two-alternative, match, rating, guided, same-different, oddity-2d, playback-oddity
   std::string condition;  ///< task-specific condition label ("wide-distractor", "q3", ...); may be empty
   std::string reference;  ///< reference name (matching, rating, guided, coarse); oddity-2d: the pair's mode; may be empty
 
