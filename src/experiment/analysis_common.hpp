@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -108,6 +109,13 @@ inline std::string anova_lines(const json& a, const std::string& indent) {
   }
   return out;
 }
+
+// ------------------------------------------------------ proportions correct
+
+/// Wilson score interval of k successes in n at `level` (two-sided).
+std::pair<double, double> wilson(double k, double n, double level);
+/// Exact one-sided binomial test: P(X >= k) for X ~ Bin(n, p0).
+double binomial_above(double k, double n, double p0);
 
 // ------------------------------------------------------- the studies' summaries
 

@@ -11,11 +11,6 @@
 
 namespace texel::experiment::analysis_common {
 
-namespace {
-
-// --------------------------------------------------------- 2-D oddity studies
-
-// Wilson score interval of k successes in n at `level` (two-sided).
 std::pair<double, double> wilson(double k, double n, double level) {
   const double z = boost::math::quantile(boost::math::normal_distribution<>(), 0.5 + level / 2);
   const double p = k / n, z2 = z * z / n;
@@ -23,11 +18,14 @@ std::pair<double, double> wilson(double k, double n, double level) {
   return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
-// Exact one-sided binomial test: P(X >= k) for X ~ Bin(n, p0).
 double binomial_above(double k, double n, double p0) {
   if (k <= 0) return 1.0;
   return boost::math::cdf(boost::math::complement(boost::math::binomial_distribution<>(n, p0), k - 1));
 }
+
+namespace {
+
+// --------------------------------------------------------- 2-D oddity studies
 
 // Fisher's exact test, one-sided: is the proportion correct of (k1 of n1)
 // lower than that of (k0 of n0)? P(X <= k1), X hypergeometric given the margins.

@@ -8,8 +8,6 @@
 #include <map>
 #include <set>
 
-#include <boost/math/distributions/binomial.hpp>
-#include <boost/math/distributions/normal.hpp>
 #include <boost/math/tools/minima.hpp>
 
 #include "texel/random.hpp"
@@ -22,18 +20,6 @@ constexpr double chance = 1.0 / 3.0;
 constexpr double lapse = 0.02;  // [choice] fixed, as the observers' default
 constexpr int bootstrap_samples = 1000;
 constexpr std::uint64_t bootstrap_stream = 0x5053450000000000ULL;  // "PSE"
-
-std::pair<double, double> wilson(double k, double n, double level) {
-  const double z = boost::math::quantile(boost::math::normal_distribution<>(), 0.5 + level / 2);
-  const double p = k / n, z2 = z * z / n;
-  const double centre = (p + z2 / 2) / (1 + z2), half = z * std::sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z2);
-  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
-}
-
-double binomial_above(double k, double n, double p0) {
-  if (k <= 0) return 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::binomial_distribution<>(n, p0), k - 1));
-}
 
 // The dip: p(Δ) = γ + (1 − γ − λ)·(1 − exp(−((Δ − PSE)/α)²)), chance γ = 1/3
 // at the PSE, a Weibull of slope 2 on |Δ − PSE| on either side.

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/expect.hpp"
+#include "../support/sessions.hpp"
 #include "../support/temp_dir.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
@@ -36,13 +37,7 @@ namespace {
 
 const fs::path shipped_path = fs::path(TEXEL_TEST_SOURCE_DIR) / "examples" / "protocols" / "distributed-irregularity.json";
 
-ex::Session session_of(const ex::Protocol& p, const std::string& participant = "S01") {
-  ex::SessionContext c;
-  c.participant = participant;
-  c.session_id = 1;
-  c.seed = ex::session_seed(p.seed, participant);
-  return ex::Session(p, std::move(c));
-}
+using texel::test_support::session_of;
 
 std::string playback_of(const std::string& document) { return json::parse(document)["playback"]["mode"].get<std::string>(); }
 double irregularity_of(const std::string& document) {

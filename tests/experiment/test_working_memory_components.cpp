@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/expect.hpp"
+#include "../support/sessions.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
 #include "texel/experiment/protocol.hpp"
@@ -32,13 +33,7 @@ namespace {
 
 const fs::path shipped_path = fs::path(TEXEL_TEST_SOURCE_DIR) / "examples" / "protocols" / "working-memory-components.json";
 
-ex::Session session_of(const ex::Protocol& p, const std::string& participant = "S01") {
-  ex::SessionContext c;
-  c.participant = participant;
-  c.session_id = 1;
-  c.seed = ex::session_seed(p.seed, participant);
-  return ex::Session(p, std::move(c));
-}
+using texel::test_support::session_of;
 
 // The shipped protocol's test block with every component's own control, one
 // trial per condition pair (same, different), short timings.
