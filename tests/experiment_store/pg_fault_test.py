@@ -15,13 +15,14 @@ The first run of the first station is killed the moment its journal file
 appears, while `run` is still creating (migrating) it: the next run must
 migrate that file and lose nothing.
 
-Only real loss may fail the test as "lost": every participant must first
-have finished on its station (a run exited 0, or the journal says finished).
-A station that could not get there (a refused run, a failing command, an
-exception in the script's own station thread) fails the test as a station
-failure naming it. (Before, a `sys.exit` inside a station thread ended only
-that thread, silently: its participants were never run and showed up as
-"lost" — see journal_state().)
+Only real loss may fail the test as "lost": every participant's session
+must first be finished in its station's journal. A station that could not
+get there (a refused run, a failing command, an exception in the script's
+own station thread) fails the test as a station failure naming it.
+(Before, a `sys.exit` inside a station thread ended only that thread,
+silently: when a kill left an unmigrated journal, its station's
+participants were never run and showed up as 123 "lost" trials — see
+journal_state().)
 
 usage: pg_fault_test.py TEXEL PG_ENV_FILE SERVER_SCRIPT PROTOCOL [SEED]
 """
@@ -34,12 +35,13 @@ import shutil
 import signal
 import socket
 import subprocess
-import sys
 import sqlite3
+import sys
 import tempfile
 import threading
 import time
 import traceback
+import urllib.parse
 
 TEXEL, ENV_FILE, SERVER_SCRIPT, PROTOCOL = sys.argv[1:5]
 SEED = int(sys.argv[5]) if len(sys.argv) > 5 else 27
@@ -140,7 +142,7 @@ class StationFailure(Exception):
 def sessions_in_file(journal, participant):
     """The participant's sessions in a journal, read from the file itself (read-only); None if unreadable."""
     try:
-        con = sqlite3.connect("file:%s?mode=ro" % journal, uri=True)
+        con = sqlite3.connect("file:%s?mode=ro" % urllib.parse.quote(journal), uri=True)
         try:
             if not con.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'sessions'").fetchone():
                 return 0
