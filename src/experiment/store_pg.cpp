@@ -677,9 +677,23 @@ class Journal {
     // again, which the server ignores.
     exec(("ATTACH DATABASE '" + shipping_path(path) + "' AS ship").c_str());
     exec("PRAGMA ship.journal_mode = WAL; PRAGMA ship.synchronous = NORMAL");
+    // `uuid`: the server session the row speaks for (see Station::check_records).
+    // A record file from before it had the column gets it empty, so its rows
+    // vouch for nothing and everything is shipped once more (harmless). No
+    // transaction: BEGIN IMMEDIATE would lock the journal too; a second
+    // process adding the column at the same moment is told apart below.
     exec(
         "CREATE TABLE IF NOT EXISTS ship.journal_ship (session_id INTEGER PRIMARY KEY, session_shipped INTEGER NOT NULL DEFAULT "
-        "0, trials_shipped INTEGER NOT NULL DEFAULT 0, finished_shipped INTEGER NOT NULL DEFAULT 0)");
+        "0, trials_shipped INTEGER NOT NULL DEFAULT 0, finished_shipped INTEGER NOT NULL DEFAULT 0, uuid TEXT NOT NULL DEFAULT "
+        "'')");
+    const char* has_uuid = "SELECT 1 FROM pragma_table_info('journal_ship', 'ship') WHERE name = 'uuid'";
+    if (query(has_uuid).empty()) {
+      try {
+        exec("ALTER TABLE ship.journal_ship ADD COLUMN uuid TEXT NOT NULL DEFAULT ''");
+      } catch (const Error&) {
+        if (query(has_uuid).empty()) throw;
+      }
+    }
   }
   ~Journal() { sqlite3_close_v2(db_); }
   Journal(const Journal&) = delete;
@@ -752,6 +766,7 @@ class StationImpl final : public Station {
         std::lock_guard<std::mutex> st(state_mu_);
         state_.connected = false;
       }
+      check_records();
       refresh_counts();
     }
     thread_ = std::thread([this] { loop(); });
@@ -932,9 +947,32 @@ class StationImpl final : public Station {
     }
   }
 
+  // The shipping record is keyed by the journal's session id, which starts
+  // at 1 again in a journal deleted and created anew at the same path (the
+  // record beside it survives): a row vouches for a session only when its
+  // uuid is that session's for this station; any other row is dropped, so
+  // the session is shipped (again — the server ignores what it has). Done
+  // before anything is counted or shipped, again when the station's name
+  // changes (a service's role is known once connected). Under io_mu_.
+  void check_records() {
+    if (station_.empty() || records_checked_for_ == station_) return;
+    try {
+      for (const auto& r :
+           journal_.query("SELECT j.session_id, j.uuid, s.id IS NOT NULL FROM ship.journal_ship j LEFT JOIN sessions s ON s.id = "
+                          "j.session_id"))
+        if (r[2] != "1" || r[1] != journal_.uuid(std::stoll(r[0]), station_))
+          (void)journal_.query("DELETE FROM ship.journal_ship WHERE session_id = ?", {r[0]});
+      records_checked_for_ = station_;
+    } catch (const Error& e) {
+      set_error(e.what());  // the journal is busy: the next pass checks again, before shipping
+    }
+  }
+
   // One shipping pass, under io_mu_.
   void pass() {
     if (!ensure_connected(false)) return;
+    check_records();
+    if (records_checked_for_ != station_) return;
     // The study-wide locks: renew ours, take the ones asked for offline.
     for (auto& [sid, l] : leases_) {
       if (l.uuid.empty()) l.uuid = journal_.uuid(sid, station_);  // asked for offline
@@ -1031,10 +1069,12 @@ class StationImpl final : public Station {
       // The server has it: record that (a crash before this line only means
       // shipping it again, which the server ignores).
       (void)journal_.query(
-          "INSERT INTO ship.journal_ship(session_id, session_shipped, trials_shipped, finished_shipped) VALUES (?, 1, ?, ?) "
-          "ON CONFLICT(session_id) DO UPDATE SET session_shipped = 1, trials_shipped = max(trials_shipped, "
-          "excluded.trials_shipped), finished_shipped = max(finished_shipped, excluded.finished_shipped)",
-          {sid, std::to_string(upto), complete ? "1" : "0"});
+          "INSERT INTO ship.journal_ship(session_id, session_shipped, trials_shipped, finished_shipped, uuid) VALUES (?, 1, ?, "
+          "?, ?) ON CONFLICT(session_id) DO UPDATE SET session_shipped = 1, trials_shipped = CASE WHEN uuid = excluded.uuid "
+          "THEN max(trials_shipped, excluded.trials_shipped) ELSE excluded.trials_shipped END, finished_shipped = CASE WHEN "
+          "uuid = excluded.uuid THEN max(finished_shipped, excluded.finished_shipped) ELSE excluded.finished_shipped END, "
+          "uuid = excluded.uuid",
+          {sid, std::to_string(upto), complete ? "1" : "0", uuid});
       shipped = upto;
     } while (shipped < total);
     return true;
@@ -1106,6 +1146,7 @@ class StationImpl final : public Station {
   std::string journal_path_;
   Journal journal_;
   std::string host_, station_;
+  std::string records_checked_for_;  // the station name check_records() last verified the shipping record for
   PGconn* pg_ = nullptr;
   std::map<std::int64_t, Lease> leases_;
   std::vector<std::int64_t> releases_;

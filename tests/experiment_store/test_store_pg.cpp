@@ -201,6 +201,62 @@ TEST_F(PgStore, RepeatedShippingStoresNothingTwice) {
   EXPECT_EQ(n, "3");  // trials 0, 2 and 4
 }
 
+// A journal deleted and started again at the same path numbers its sessions
+// from 1 again, while the shipping record beside it (JOURNAL-shipping.db)
+// still says session 1 is on the server: the record must not vouch for the
+// new journal's sessions. And a record written before the records named
+// their session (no uuid column) vouches for nothing: shipped again.
+TEST_F(PgStore, AJournalStartedAgainBesideAnOldShippingRecordIsShippedWhole) {
+  {
+    auto s = station("st1", "st1.db");
+    (void)run_session(s, "S01", 5, true);
+    ASSERT_TRUE(s.sync(20));
+  }
+  for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(dir_.at(std::string("st1.db") + suffix));
+  std::string n;
+  {
+    auto s = station("st1", "st1.db");
+    (void)run_session(s, "S02", 3, true);
+    ASSERT_TRUE(s.sync(20)) << s.shipping().last_error;
+    EXPECT_EQ(s.shipping().trials_local, 3);
+    EXPECT_EQ(s.shipping().trials_shipped, 3);
+  }
+  EXPECT_EQ(as("an1",
+               "SELECT count(*) FROM texel.trials t JOIN texel.sessions s ON s.uuid = t.session_uuid WHERE "
+               "s.participant = 'S02'",
+               &n),
+            "");
+  EXPECT_EQ(n, "3");
+  EXPECT_EQ(as("an1", "SELECT count(*) FROM texel.completions", &n), "");
+  EXPECT_EQ(n, "2");
+
+  // A new journal (written as a plain store: nothing shipped yet) beside an
+  // older build's record file that says session 1 is on the server.
+  for (const char* file :
+       {"st1.db", "st1.db-wal", "st1.db-shm", "st1.db-shipping.db", "st1.db-shipping.db-wal", "st1.db-shipping.db-shm"})
+    std::filesystem::remove(dir_.at(file));
+  {
+    auto journal = ex::Store::open(dir_.at("st1.db"), ex::StoreMode::read_write);
+    (void)run_session(journal, "S03", 4, true);
+  }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(dir_.at("st1.db-shipping.db").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "CREATE TABLE journal_ship (session_id INTEGER PRIMARY KEY, session_shipped INTEGER NOT NULL DEFAULT "
+                         "0, trials_shipped INTEGER NOT NULL DEFAULT 0, finished_shipped INTEGER NOT NULL DEFAULT 0); "
+                         "INSERT INTO journal_ship VALUES (1, 1, 5, 1)",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  {
+    auto s = station("st1", "st1.db");
+    ASSERT_TRUE(s.sync(20)) << s.shipping().last_error;
+    EXPECT_EQ(s.shipping().trials_shipped, 4);
+  }
+  EXPECT_EQ(as("an1", "SELECT count(*) FROM texel.trials", &n), "");
+  EXPECT_EQ(n, "12");  // 5 + 3 + 4, nothing twice
+}
+
 // Server version 1 → 2 (texel.finger_traces): store init migrates a server
 // of the previous version, its trials kept, and the analyst reads the new table.
 TEST_F(PgStore, InitMigratesAVersionOneServerAddingFingerTraces) {
