@@ -521,7 +521,35 @@ void Presenter::play(const Prepared& prepared) {
     maps.push_back(std::make_unique<const PlayerMap>(*prepared.maps[c]));
     channel_responses_[c] = prepared.maps[c]->response();
   }
-  multi_->set_maps(std::move(maps), prepared.offsets);
+  deferred_maps_.clear();  // a later show supersedes one still waiting
+  const std::span<const double> now = multi_->offsets_mm();
+  const bool moved = !std::equal(now.begin(), now.end(), prepared.offsets.begin(), prepared.offsets.end(),
+                                 [](double a, Millimetres b) { return a == b.value(); });
+  if (moved) {
+    // Another actuator layout (the first stimulus, or another device): the
+    // new offsets apply to the samples pushed from now on, and the maps wait
+    // until the samples already queued with the old ones have played
+    // (passive: up to finger_lead_s; external: finger_lead_s), so the new
+    // maps never see the finger jump by an offset. A separate sensor's
+    // reader pushes under its mutex, and places reports at their arrival:
+    // nothing of it is queued ahead.
+    std::unique_lock<std::mutex> lock;
+    if (display1d_) lock = std::unique_lock<std::mutex>(display1d_->mutex);
+    multi_->set_offsets(prepared.offsets);
+    const bool queued = mode_ == PresentationMode::passive || options_.finger == FingerSource::external;
+    if (queued && next_finger_s_ > output().time_s()) {
+      deferred_maps_ = std::move(maps);
+      deferred_until_s_ = next_finger_s_;
+      return;
+    }
+  }
+  multi_->set_maps(std::move(maps));
+}
+
+void Presenter::swap_deferred() {
+  if (deferred_maps_.empty() || output().time_s() < deferred_until_s_) return;
+  multi_->set_maps(std::move(deferred_maps_));
+  deferred_maps_.clear();
 }
 
 void Presenter::show(std::unique_ptr<const PlayerMap> map) {
@@ -647,6 +675,7 @@ void Presenter::blank() {
   // It carries the last stimulus's display response, so what fades out
   // during the crossfade is still limited as that display needs.
   if (multi_) {
+    deferred_maps_.clear();  // a stimulus still waiting never plays
     std::vector<std::unique_ptr<const PlayerMap>> maps;
     for (const auto& response : channel_responses_)
       maps.push_back(
@@ -672,6 +701,7 @@ void Presenter::pump() {
     }
     return;
   }
+  if (multi_) swap_deferred();
   if (options_.finger == FingerSource::external || mode_ == PresentationMode::host_streams) {
     output().collect();
     return;

@@ -195,6 +195,35 @@ TEST(PresenterChannels, SimultaneousDocumentPlaysEachActuatorsOwnTexels) {
     }
 }
 
+// The session's first stimulus brings the actuators' offsets, while the
+// simulated finger is already queued 50 ms ahead with none: its maps wait
+// until those samples have played (presenter.hpp), so it starts from
+// silence about 50 ms later (not at once, reading the finger without its
+// offset until the jump), and 60 ms after its onset is what the off-line
+// render plays.
+TEST(PresenterChannels, FirstStimulusWaitsForTheFingerQueuedBeforeIt) {
+  const std::string doc = document(pad_device(), R"({"mode": "simultaneous"})");
+  Rig rig(4);
+  rig.presenter->show(doc);
+  const std::vector<float> out = rig.run(0.3);
+  std::size_t onset = out.size() / 4;
+  for (std::size_t i = 0; i < out.size() / 4 && onset == out.size() / 4; ++i)
+    for (std::size_t c = 0; c < 4; ++c)
+      if (out[i * 4 + c] != 0.0f) onset = i;
+  std::printf("onset at %.1f ms\n", 1e3 * static_cast<double>(onset) / rate);
+  EXPECT_GE(onset, static_cast<std::size_t>(0.045 * rate));
+  EXPECT_LE(onset, static_cast<std::size_t>(0.06 * rate));
+  const std::vector<float> reference =
+      render_trace_channels(prepare_channels(parse_document(doc)), vibration_config(), simulated_finger(0.4), out.size() / 4);
+  // After the 20 ms crossfade from silence and 40 ms of the DC blocker's settling.
+  const std::size_t from = onset + static_cast<std::size_t>(0.06 * rate);
+  for (std::size_t c = 0; c < 4; ++c) {
+    const float d = largest_difference(out, reference, 4, c, from);
+    std::printf("channel %zu from onset + 60 ms: largest difference %.2e\n", c, d);
+    EXPECT_LT(d, 5e-3f) << "channel " << c;
+  }
+}
+
 // Sequential: the one chain on every channel, each at its actuator's
 // offset: channel 1 (−1 mm) plays 20 ms (2 mm at 100 mm/s) after channel 2
 // (+1 mm) what channel 2 played; every channel as the off-line render.

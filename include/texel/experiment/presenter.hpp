@@ -71,10 +71,13 @@
 // actuator's response, and swaps them in together (each channel crossfades;
 // a channel at rest gets silence); blank() silences every channel. Every
 // finger (simulated, external, a separate sensor) drives every channel,
-// shifted by each actuator's offset (the document's device's: samples
-// queued before a show keep the previous device's offsets, so after a
-// change of device the first 50 ms of a simulated sweep read the new maps at
-// the old offsets; within one device, as in a study, nothing changes). A
+// shifted by each actuator's offset (the document's device's). Finger
+// samples are queued ahead of the player (the simulated sweep 50 ms, an
+// external finger finger_lead_s) with the offsets in force when pushed, so
+// when a show brings other offsets (the session's first stimulus, or a
+// document of another device) its maps wait in pump() until the samples
+// queued before it have played: that stimulus starts up to 50 ms later,
+// and its maps never see the finger jump by an offset. A
 // one-channel document (a device without actuators) plays on every channel
 // at offset 0, as a sequential document does. Refused in one line
 // (InvalidArgument): a document whose device has other than 1 or N channels
@@ -293,6 +296,11 @@ class Presenter {
   std::unique_ptr<Backend> backend_;
   std::optional<FrequencyResponse> last_response_;                   // of the last map shown (blank() keeps it)
   std::vector<std::optional<FrequencyResponse>> channel_responses_;  // channels > 1: of each channel's last map
+  // channels > 1: maps waiting (until the player's clock reaches
+  // deferred_until_s_) for the finger samples queued with the previous
+  // actuators' offsets to play out; swapped in by pump().
+  std::vector<std::unique_ptr<const PlayerMap>> deferred_maps_;
+  double deferred_until_s_ = 0.0;
   double next_finger_s_ = 0.0;  // simulated: next sample's time; external: newest sample's time
   double period_s_ = 0.0;
   double rate_hz_ = 0.0;  // the player's output rate (Hz)
@@ -303,6 +311,7 @@ class Presenter {
   Prepared prepare_stimulus(const std::string& document_json) const;
   const Prepared& cached(const std::string& document_json);  // prepared once, most recent first
   void play(const Prepared& prepared);
+  void swap_deferred();
   void choose_mode(const BackendChoice& choice);
   void open_sensor(const BackendChoice& choice);  // FingerSource::sensor
 };
