@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "../support/alloc_counter.hpp"
+#include "../support/controller_process.hpp"
 #include "../support/expect.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
@@ -387,6 +388,40 @@ TEST(PresenterChannels, PresentationChannelsAreTheDevicesActuators) {
   EXPECT_EQ(texel::experiment::presentation_channels(p), 1u);
   EXPECT_THROW((void)texel::experiment::presentation_channels("no-such-device"), InvalidArgument);
 }
+
+#ifdef TEXEL_CLI
+// A finger sensor on a link of its own (FingerSource::sensor: the reference
+// controller's scripted strokes over 10 … 90 mm, `texel controller --sensor
+// strokes`) while the 4 actuators play: host-streams, its reports drive
+// every channel. Paced by the wall clock, since the reports are placed on
+// the player's clock at their arrival (about 1 s).
+TEST(PresenterChannels, SeparateSensorDrivesEveryChannel) {
+  texel::test_support::ControllerProcess sensor(TEXEL_CLI, {"--sensor", "strokes", "--duration", "60", "--quiet"});
+  ASSERT_FALSE(sensor.pty().empty());
+  PresenterOptions o = options(4);
+  o.finger = FingerSource::sensor;
+  o.finger_display = "serial:" + sensor.pty();
+  Rig rig(4, o);
+  EXPECT_EQ(rig.presenter->mode(), texel::experiment::PresentationMode::host_streams);
+  rig.presenter->show(document(pad_device(), R"({"mode": "simultaneous"})"));
+  std::vector<float> out;
+  const auto start = std::chrono::steady_clock::now();
+  const auto period = std::chrono::duration<double>(block / rate);
+  for (int b = 0; b < 750; ++b) {  // 1 s
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(b * period));
+    const std::vector<float> one = rig.run(block / rate);
+    out.insert(out.end(), one.begin(), one.end());
+  }
+  EXPECT_GT(rig.presenter->finger_counts().reports, 300u);
+  for (std::size_t c = 0; c < 4; ++c) {
+    const float rms = channel_rms(out, 4, c, out.size() / 40);
+    std::printf("channel %zu: RMS %.4f under the sensor's finger\n", c, rms);
+    EXPECT_GT(rms, 0.02f) << "channel " << c << " is not driven";
+  }
+  rig.presenter->stop();
+  EXPECT_NE(sensor.stop().find("bad 0"), std::string::npos);
+}
+#endif
 
 // The real null backend (a paced real-time thread), as a session without
 // hardware runs: opened with 4 channels, it plays, blanks and stops.
