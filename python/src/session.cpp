@@ -179,8 +179,7 @@ a with block) stops the backend.)doc")
                  presenter_options(backend, rate_hz, swipe_speed_mm_s, audio_device, response, mode, channels));
            }),
            py::arg("backend") = "null", py::kw_only(), py::arg("rate_hz") = 48000.0, py::arg("swipe_speed_mm_s") = 100.0,
-           py::arg("audio_device") = "", py::arg("response") = "limit", py::arg("mode") = py::none(),
-           py::arg("channels") = 1)
+           py::arg("audio_device") = "", py::arg("response") = "limit", py::arg("mode") = py::none(), py::arg("channels") = 1)
       .def_property_readonly("channels", &Presenter::channels, "Output channels (one per actuator).")
       .def_property_readonly(
           "mode", [](const Presenter& p) { return std::string(to_string(p.mode())); },
