@@ -154,6 +154,7 @@ void run(const RunArgs& a) {
   po.audio_device = a.audio_device;
   po.response_handling = parse_response_handling(a.response, "--response");
   if (a.mode) po.mode = ex::parse_presentation_mode(*a.mode, "--mode");
+  po.channels = ex::presentation_channels(protocol_file);  // one per actuator of the protocol's device
   const auto two_d = [](const ex::Block& b) { return b.task == "oddity-2d"; };
   const bool all_2d = std::all_of(protocol_file.blocks.begin(), protocol_file.blocks.end(), two_d);
   if (a.finger && !std::any_of(protocol_file.blocks.begin(), protocol_file.blocks.end(), two_d)) {

@@ -40,6 +40,7 @@ struct StudioArgs {
   std::string backend = "null";
   std::string audio_device;
   std::string response = "limit";
+  std::size_t channels = 1;
   std::string web;
   std::string protocols;
   bool open = false;
@@ -73,6 +74,7 @@ void run(const StudioArgs& a) {
   so.backend = a.backend;
   so.audio_device = a.audio_device;
   so.response = a.response;
+  so.channels = a.channels;
   (void)parse_response_handling(a.response, "--response");  // named as the flag (the service says "response")
   so.protocols_dir = a.protocols.empty() ? default_protocols_dir() : a.protocols;
   studio::Service service(so);  // declared first: the server, destroyed before it, drops its clients first
@@ -116,6 +118,9 @@ void register_studio(CLI::App& app) {
   cmd->add_option("--response", args->response,
                   "The shown document's display frequency response (device profile): limit (never drive what the "
                   "display attenuates by 20 dB or more) or off")
+      ->capture_default_str();
+  cmd->add_option("--channels", args->channels,
+                  "output channels, one per actuator of a multi-actuator display (its device profile's actuators), 1 … 64")
       ->capture_default_str();
   cmd->add_option("--web", args->web, "the built front end (default: <texel dir>/../web, built by make demo)");
   cmd->add_option("--protocols", args->protocols,

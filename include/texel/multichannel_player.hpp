@@ -48,6 +48,26 @@ class ChannelPlayer final : public PlayerBase {
   /// Queues a finger sample on every channel (shifted by each actuator's
   /// offset): all or none, false if any channel's queue is full.
   bool push(const FingerSample& s);
+  /// Swaps in one map per channel (maps.size() == channels(), none null; a
+  /// channel at rest is given a silent map, e.g. one sample of 0): each
+  /// channel's Player crossfades to its map as Player::set_map does, so a
+  /// stimulus switch on a multi-actuator display is N crossfades. `offsets`
+  /// (empty: unchanged) as set_offsets. The channels take their maps at the
+  /// start of a block each, so they begin their crossfades in the same
+  /// block, or one block apart when the swap lands while process() is
+  /// between channels. Throws InvalidArgument (nothing swapped) for a wrong
+  /// count, a null map or an offset out of range. Control thread; allocates
+  /// nothing itself, frees retired maps.
+  void set_maps(std::vector<std::unique_ptr<const PlayerMap>> maps, std::span<const Millimetres> offsets = {});
+  /// Replaces the actuators' offsets (one per channel, −50 … 50 mm) for the
+  /// finger samples pushed from now on: a document of another device brings
+  /// its own actuators. Samples already queued keep the offsets they were
+  /// pushed with. push() reads them: call it on the thread that pushes (or
+  /// under the lock it pushes under). Throws InvalidArgument (nothing
+  /// changed) for a wrong count or an offset out of range.
+  void set_offsets(std::span<const Millimetres> offsets);
+  /// The actuators' offsets in force for pushed samples (mm), one per channel.
+  [[nodiscard]] std::span<const double> offsets_mm() const { return offsets_; }
   /// Frees the maps the players have retired. Returns how many.
   std::size_t collect() override;
 
@@ -68,6 +88,7 @@ class ChannelPlayer final : public PlayerBase {
   BlockInfo process(std::span<float> out, std::span<float> position_mm = {}) noexcept override;
 
  private:
+  void check_offsets(std::span<const Millimetres> offsets) const;
   std::vector<std::unique_ptr<Player>> players_;
   std::vector<double> offsets_;  // mm, per channel
   std::vector<float> scratch_;   // max_block_ frames × channels, planar

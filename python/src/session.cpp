@@ -139,8 +139,9 @@ class PySession {
 
 PresenterOptions presenter_options(const std::string& backend, double rate_hz, double swipe_speed_mm_s,
                                    const std::string& audio_device, const std::string& response,
-                                   const std::optional<std::string>& mode) {
+                                   const std::optional<std::string>& mode, std::size_t channels) {
   PresenterOptions o;
+  o.channels = channels;
   if (mode) o.mode = parse_presentation_mode(*mode, "mode");
   o.backend = backend;
   o.rate_hz = rate_hz;
@@ -167,16 +168,19 @@ mode              how stimuli reach the finger: 'display-plays' (a serial displa
                   plays them from its own finger sensor), 'host-streams' (the host streams the
                   output from the display's reported finger) or 'passive' (a simulated sweep, where
                   no finger exists) [None: what the display's HELLO allows, in that order]
+channels          output channels, one per actuator of a multi-actuator display ('null', 'audio'):
+                  presentation_channels(protocol's device) [1]
 
 Call pump() often (every ≤ 20 ms) from the loop that owns the window; close() (or the end of
 a with block) stops the backend.)doc")
       .def(py::init([](const std::string& backend, double rate_hz, double swipe_speed_mm_s, const std::string& audio_device,
-                       const std::string& response, const std::optional<std::string>& mode) {
+                       const std::string& response, const std::optional<std::string>& mode, std::size_t channels) {
              return std::make_unique<Presenter>(
-                 presenter_options(backend, rate_hz, swipe_speed_mm_s, audio_device, response, mode));
+                 presenter_options(backend, rate_hz, swipe_speed_mm_s, audio_device, response, mode, channels));
            }),
            py::arg("backend") = "null", py::kw_only(), py::arg("rate_hz") = 48000.0, py::arg("swipe_speed_mm_s") = 100.0,
-           py::arg("audio_device") = "", py::arg("response") = "limit", py::arg("mode") = py::none())
+           py::arg("audio_device") = "", py::arg("response") = "limit", py::arg("mode") = py::none(), py::arg("channels") = 1)
+      .def_property_readonly("channels", &Presenter::channels, "Output channels (one per actuator).")
       .def_property_readonly(
           "mode", [](const Presenter& p) { return std::string(to_string(p.mode())); },
           "The presentation mode in force: 'display-plays', 'host-streams' or 'passive'.")
@@ -295,6 +299,11 @@ later Session(..., resume=True) continues where it stopped.)doc")
                (a.session.finished() ? ", finished>" : ">");
       });
 
+  m.def(
+      "presentation_channels", [](const py::object& protocol) { return presentation_channels(protocol_of(protocol)); },
+      py::arg("protocol"),
+      "The output channels a session of `protocol` plays on: one per actuator of its device (1 without);\n"
+      "Presenter(channels=...).");
   m.def(
       "simulate_cohort",
       [](const std::shared_ptr<StoreHandle>& store, const py::object& protocol, const std::vector<std::string>& participants,

@@ -20,6 +20,8 @@ simulated_response() answers for a simulated participant. Presenter plays
 stimuli on a backend ('null', 'audio', 'serial:PATH'); Session.stimulus(i)
 gives a stimulus as a texel.Document for output of your own.
 simulate_cohort() runs simulated participants to the end.
+presentation_channels(protocol) is the Presenter's channels= for a protocol
+whose device has several actuators (one output channel each).
 """
 
 from . import _front, _texel
@@ -27,7 +29,8 @@ from . import _front, _texel
 Presenter = _texel.experiment.Presenter
 Session = _texel.experiment.Session
 simulate_cohort = _texel.experiment.simulate_cohort
+presentation_channels = _texel.experiment.presentation_channels
 
-__all__ = ["Presenter", "Session", "simulate_cohort"]
+__all__ = ["Presenter", "Session", "presentation_channels", "simulate_cohort"]
 
 globals().update(_front.apply(_texel.experiment, __name__, _front.pathlib.Path(__file__).with_suffix(".pyi"), {}))

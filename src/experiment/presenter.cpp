@@ -15,9 +15,12 @@
 #include <thread>
 
 #include "texel/detail/format.hpp"
+#include "texel/device.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/surface_maps.hpp"
+#include "texel/multichannel.hpp"
+#include "texel/multichannel_player.hpp"
 #include "texel/player.hpp"
 #include "texel/player2d.hpp"
 #include "texel/serial_link.hpp"
@@ -36,6 +39,27 @@ double finger_x(double t, double speed, double a, double b) {
   const double period = 2.0 * span / speed;
   const double phase = std::fmod(t, period);
   return phase < period / 2 ? a + speed * phase : b - speed * (phase - period / 2);
+}
+
+// A document plays on a presenter of as many channels as its device has
+// actuators, or of any number if it has one (presenter.hpp). Refused in one
+// line naming the device, its actuators and the fix.
+void check_channels(const Document& doc, std::size_t here) {
+  const std::size_t n = doc.device.channels();
+  if (n == here || n == 1) return;
+  throw InvalidArgument("the stimulus's device '" + doc.device.name + "' has " + std::to_string(n) +
+                        " actuators; this presenter plays " + std::to_string(here) + (here == 1 ? " channel" : " channels") +
+                        ": open it with channels " + std::to_string(n) +
+                        " (PresenterOptions::channels; the front ends take it from the protocol's device: "
+                        "presentation_channels)");
+}
+
+// The one map a one-channel display plays of `doc`: the document's own
+// surface, or, for a simultaneous document of one actuator, that actuator's
+// chain (its channel seed; the base seed's chain is none of its channels).
+std::shared_ptr<const Surface> one_channel_surface(const Document& doc) {
+  if (doc.playback && doc.playback->mode == ChannelMode::simultaneous) return prepare_channels(doc).front().surface;
+  return std::make_shared<const Surface>(prepare_surface(doc));
 }
 
 constexpr double finger_rate_hz = 1000.0;  // like a position sensor
@@ -203,7 +227,10 @@ struct Presenter::Display1D {
       return rendered.front();
     }
     // texel render's bytes: the document's surface encoded as u16le (round(a·65535)).
-    const Surface surface = prepare_surface(parse_document(document_json, "stimulus"));
+    const Document doc = parse_document(document_json, "stimulus");
+    check_channels(doc, 1);  // a serial display is one channel
+    const std::shared_ptr<const Surface> held = one_channel_surface(doc);
+    const Surface& surface = *held;
     const Grid& g = surface.grid();
     if (static_cast<std::uint64_t>(g.count) > info.max_samples)
       throw InvalidArgument("a stimulus map has " + std::to_string(g.count) + " samples; the display '" + info.name +
@@ -257,12 +284,37 @@ struct Presenter::Display1D {
   }
 };
 
-Presenter::Presenter(const PresenterOptions& options) : options_(options) {
+std::size_t presentation_channels(std::string_view device) { return load_device(device).channels(); }
+
+std::size_t presentation_channels(const Protocol& protocol) { return presentation_channels(protocol.device); }
+
+Presenter::Presenter(const PresenterOptions& options) : Presenter(options, nullptr) {}
+
+Presenter::Presenter(const PresenterOptions& options, std::unique_ptr<Backend> given) : options_(options) {
+  if (!(options_.channels >= 1 && options_.channels <= max_actuators))
+    throw InvalidArgument("channels is " + std::to_string(options_.channels) + "; allowed: 1 … " + std::to_string(max_actuators) +
+                          " (one per actuator of the display)");
   if (!(options_.swipe_speed_mm_s > 0 && options_.swipe_speed_mm_s <= 10000))
     throw InvalidArgument("swipe speed is " + std::to_string(options_.swipe_speed_mm_s) + "; allowed: 0 … 10000 mm/s");
   if (!(options_.finger_lead_s >= 0 && options_.finger_lead_s <= 0.1))
     throw InvalidArgument("finger lead is " + std::to_string(options_.finger_lead_s) + " s; allowed: 0 … 0.1 s");
-  const BackendChoice choice = parse_backend(options_.backend);
+  // A given backend is driven like a sound card (null's kind: no serial link of ours).
+  const BackendChoice choice = given ? BackendChoice{} : parse_backend(options_.backend);
+  if (given && given->serial_link())
+    throw InvalidArgument("a given backend is a serial display (" + given->describe() +
+                          "); give it by name, backend = serial:PATH");
+  if (given && given->channels() != options_.channels)
+    throw InvalidArgument("the given backend (" + given->describe() + ") has " + std::to_string(given->channels()) +
+                          " channel(s); the presenter plays " + std::to_string(options_.channels) + " (channels)");
+  const std::string channels_text = std::to_string(options_.channels);
+  if (options_.channels > 1 && choice.kind == BackendChoice::Kind::serial)
+    throw InvalidArgument("channels is " + channels_text + ", but backend " + options_.backend +
+                          " is a serial display: the serial protocol drives one plate (one channel); play a display of " +
+                          channels_text + " actuators on backend audio (or null)");
+  if (options_.channels > 1 && options_.finger == FingerSource::display)
+    throw InvalidArgument("channels is " + channels_text +
+                          ", but the participant strokes a 2-D display (finger display), which plays one channel; give "
+                          "channels 1");
   std::string sensor_path;
   if (options_.finger == FingerSource::display) {
     validate(options_.stroke_rules);
@@ -294,10 +346,19 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
   config.response_handling = options_.response_handling;
   config.response_limit_db = options_.response_limit_db;
   bo.rate_hz = config.rate_hz;
+  rate_hz_ = config.rate_hz;
   bo.baud = options_.baud;
-  player_ = std::make_unique<Player>(config);
+  bo.channels = options_.channels;
+  if (options_.channels == 1) {
+    player_ = std::make_unique<Player>(config);
+  } else {
+    // Every channel at rest (no map: silence) until the first show().
+    const std::vector<Channel> at_rest(options_.channels);
+    multi_ = std::make_unique<ChannelPlayer>(config, at_rest);
+    channel_responses_.resize(options_.channels);
+  }
   const PlayerMap blank_map(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f});
-  backend_ = make_backend(choice, bo, blank_map);
+  backend_ = given ? std::move(given) : make_backend(choice, bo, blank_map);
   if (options_.finger != FingerSource::display) {
     if (options_.finger == FingerSource::sensor)
       open_sensor(choice);
@@ -308,7 +369,7 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
       return;
     }
     pump();
-    backend_->start(*player_);
+    backend_->start(output());
     running_ = true;
     if (mode_ == PresentationMode::host_streams && display1d_) {
       Display1D& d = *display1d_;
@@ -316,8 +377,8 @@ Presenter::Presenter(const PresenterOptions& options) : options_(options) {
         Display1D& dd = *display1d_;
         std::lock_guard<std::mutex> lock(dd.mutex);
         for (const FingerReport& r : batch) {
-          const double t = dd.timeline.place(r.t_us, player_->time_s());
-          if (!player_->push(FingerSample{t, r.x_mm, r.touch})) ++dd.dropped;
+          const double t = dd.timeline.place(r.t_us, output().time_s());
+          if (!push(FingerSample{t, r.x_mm, r.touch})) ++dd.dropped;
           dd.record(r);
         }
       });
@@ -387,6 +448,7 @@ void Presenter::stop() {
     } catch (const std::exception&) {
     }
   if (player_) player_->collect();
+  if (multi_) multi_->collect();
   if (display_) display_->player.collect();
 }
 
@@ -402,28 +464,107 @@ void Presenter::show(const std::string& document_json) {
   // Participants switch back and forth among a trial's few stimuli, and a
   // reference recurs over many trials: keep the last few rendered maps (a
   // noise reference takes ~0.1 s to synthesise; copying its map, 0.1 ms).
+  play(cached(document_json));
+  ++shown_;
+}
+
+const Presenter::Prepared& Presenter::cached(const std::string& document_json) {
   auto it = std::find_if(cache_.begin(), cache_.end(), [&](const auto& e) { return e.first == document_json; });
   if (it == cache_.end()) {
-    // The map carries the document's device response (presenter.hpp).
-    cache_.emplace_front(document_json, PlayerMap::from_document(parse_document(document_json, "stimulus")));
+    cache_.emplace_front(document_json, prepare_stimulus(document_json));
     if (cache_.size() > cache_size) cache_.pop_back();
-    it = cache_.begin();
   } else {
     cache_.splice(cache_.begin(), cache_, it);
-    it = cache_.begin();
   }
-  const PlayerMap& m = *it->second;
-  last_response_ = m.response();
-  player_->set_map(
-      std::make_unique<const PlayerMap>(m.grid(), std::vector<float>(m.values().begin(), m.values().end()), m.response()));
-  ++shown_;
+  return cache_.front().second;
+}
+
+Presenter::Prepared Presenter::prepare_stimulus(const std::string& document_json) const {
+  const Document doc = parse_document(document_json, "stimulus");
+  check_channels(doc, options_.channels);
+  Prepared p;
+  if (!multi_) {
+    // The map carries the document's device response (presenter.hpp).
+    p.maps.push_back(PlayerMap::from_surface(*one_channel_surface(doc), doc.device.response));
+    return p;
+  }
+  // Each channel's map carries its actuator's response (Channel::response);
+  // a channel at rest plays a silent map carrying it, so what fades out is
+  // limited as that actuator needs.
+  const std::vector<Channel> plan = prepare_channels(doc);
+  for (std::size_t c = 0; c < options_.channels; ++c) {
+    const Channel& ch = plan[plan.size() == 1 ? 0 : c];
+    if (c > 0 && plan.size() == 1)
+      p.maps.push_back(std::make_unique<const PlayerMap>(*p.maps.front()));  // the same map on every channel
+    else if (ch.surface)
+      p.maps.push_back(PlayerMap::from_surface(*ch.surface, ch.response));
+    else
+      p.maps.push_back(
+          std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f}, ch.response));
+    p.offsets.push_back(ch.offset);
+  }
+  return p;
+}
+
+void Presenter::play(const Prepared& prepared) {
+  if (!multi_) {
+    const PlayerMap& m = *prepared.maps.front();
+    last_response_ = m.response();
+    player_->set_map(
+        std::make_unique<const PlayerMap>(m.grid(), std::vector<float>(m.values().begin(), m.values().end()), m.response()));
+    return;
+  }
+  // Exact copies (texel lines and all): the cached maps stay for the next switch.
+  std::vector<std::unique_ptr<const PlayerMap>> maps;
+  maps.reserve(prepared.maps.size());
+  for (std::size_t c = 0; c < prepared.maps.size(); ++c) {
+    maps.push_back(std::make_unique<const PlayerMap>(*prepared.maps[c]));
+    channel_responses_[c] = prepared.maps[c]->response();
+  }
+  deferred_maps_.clear();  // a later show supersedes one still waiting
+  const std::span<const double> now = multi_->offsets_mm();
+  const bool moved = !std::equal(now.begin(), now.end(), prepared.offsets.begin(), prepared.offsets.end(),
+                                 [](double a, Millimetres b) { return a == b.value(); });
+  if (moved) {
+    // Another actuator layout (the first stimulus, or another device): the
+    // new offsets apply to the samples pushed from now on, and the maps wait
+    // until the samples already queued with the old ones have played
+    // (passive: up to finger_lead_s; external: finger_lead_s), so the new
+    // maps never see the finger jump by an offset. A separate sensor's
+    // reader pushes under its mutex, and places reports at their arrival:
+    // nothing of it is queued ahead.
+    std::unique_lock<std::mutex> lock;
+    if (display1d_) lock = std::unique_lock<std::mutex>(display1d_->mutex);
+    multi_->set_offsets(prepared.offsets);
+    const bool queued = mode_ == PresentationMode::passive || options_.finger == FingerSource::external;
+    if (queued && next_finger_s_ > output().time_s()) {
+      deferred_maps_ = std::move(maps);
+      deferred_until_s_ = next_finger_s_;
+      return;
+    }
+  }
+  multi_->set_maps(std::move(maps));
+}
+
+void Presenter::swap_deferred() {
+  if (deferred_maps_.empty() || output().time_s() < deferred_until_s_) return;
+  multi_->set_maps(std::move(deferred_maps_));
+  deferred_maps_.clear();
 }
 
 void Presenter::show(std::unique_ptr<const PlayerMap> map) {
   if (mode_ == PresentationMode::display_plays)
     throw InvalidArgument("display-plays: the display is given documents (texel render's bytes), not prepared maps");
   if (map) last_response_ = map->response();
-  player_->set_map(std::move(map));
+  if (multi_ && map) {
+    Prepared p;
+    p.offsets.assign(options_.channels, Millimetres(0.0));
+    p.maps.push_back(std::move(map));
+    for (std::size_t c = 1; c < options_.channels; ++c) p.maps.push_back(std::make_unique<const PlayerMap>(*p.maps.front()));
+    play(p);
+  } else if (!multi_) {
+    player_->set_map(std::move(map));
+  }
   ++shown_;
 }
 
@@ -471,6 +612,18 @@ void Presenter::prepare(const Question& question) {
     std::lock_guard<std::mutex> lock(d.mutex);
     d.trace.clear();
     d.recording = true;
+  }
+  // The trial's stimuli prepared now, before onset: a stimulus the
+  // presenter cannot play (a device of another channel count) is refused
+  // before anything of the trial plays, and a switch then costs a copy.
+  // (More stimuli than the cache holds: checked only, rendered when shown.)
+  if (!display_ && mode_ != PresentationMode::display_plays) {
+    for (const auto& st : question.stimuli) {
+      if (question.stimuli.size() <= cache_size)
+        (void)cached(st.document_json);
+      else
+        check_channels(parse_document(st.document_json, "stimulus"), options_.channels);
+    }
   }
   simulated_trace_.clear();
   recording_ = true;
@@ -521,6 +674,15 @@ void Presenter::blank() {
   // A one-sample map at rest: the finger is off it, so the player fades out.
   // It carries the last stimulus's display response, so what fades out
   // during the crossfade is still limited as that display needs.
+  if (multi_) {
+    deferred_maps_.clear();  // a stimulus still waiting never plays
+    std::vector<std::unique_ptr<const PlayerMap>> maps;
+    for (const auto& response : channel_responses_)
+      maps.push_back(
+          std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f}, response));
+    multi_->set_maps(std::move(maps));
+    return;
+  }
   player_->set_map(
       std::make_unique<const PlayerMap>(Grid{Millimetres(0.0), Millimetres(1.0), 1}, std::vector<float>{0.0f}, last_response_));
 }
@@ -539,22 +701,30 @@ void Presenter::pump() {
     }
     return;
   }
+  if (multi_) swap_deferred();
   if (options_.finger == FingerSource::external || mode_ == PresentationMode::host_streams) {
-    player_->collect();
+    output().collect();
     return;
   }
-  const double horizon = player_->time_s() + finger_lead_s;
+  const double horizon = output().time_s() + finger_lead_s;
   while (next_finger_s_ <= horizon) {
     const FingerSample s{next_finger_s_, finger_x(next_finger_s_, options_.swipe_speed_mm_s, 10.0, 90.0), true};
-    if (!player_->push(s)) break;
+    if (!push(s)) break;
     // The simulated finger is the trial's trace (passive), kept at 100 Hz —
     // a known triangle sweep needs no more — and bounded at an hour.
     if (recording_ && std::llround(next_finger_s_ * finger_rate_hz) % 10 == 0 && simulated_trace_.size() < 360'000)
       simulated_trace_.push_back(s);
     next_finger_s_ += 1.0 / finger_rate_hz;
   }
-  player_->collect();
+  output().collect();
 }
+
+PlayerBase& Presenter::output() {
+  if (multi_) return *multi_;
+  return *player_;
+}
+
+bool Presenter::push(const FingerSample& sample) { return multi_ ? multi_->push(sample) : player_->push(sample); }
 
 void Presenter::choose_mode(const BackendChoice& choice) {
   const bool external = options_.finger == FingerSource::external;
@@ -664,6 +834,7 @@ Presenter::UploadCounts Presenter::upload_counts() const { return display1d_ ? d
 std::vector<std::string> Presenter::check(const Question& first) const {
   std::vector<std::string> out;
   if (display_ || first.stimuli.empty()) return out;
+  for (const auto& s : first.stimuli) check_channels(parse_document(s.document_json, "stimulus"), options_.channels);
   constexpr double swipe_mm_s = 100.0;  // the studies' typical swipe
   if (mode_ == PresentationMode::display_plays) {
     Display1D& d = *display1d_;
@@ -690,7 +861,7 @@ std::vector<std::string> Presenter::check(const Question& first) const {
   }
   if (mode_ != PresentationMode::host_streams) return out;
   // What the stream can carry: at rate R and speed v, spatial frequencies up to R / (2 v).
-  const double rate = player_->config().rate_hz;
+  const double rate = rate_hz_;
   const double limit = rate / (2.0 * swipe_mm_s);
   std::size_t texels = 0, above = 0;
   double highest = 0.0;
@@ -718,9 +889,9 @@ std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
   if (options_.finger != FingerSource::external || display_) return std::nullopt;
   // The player consumes samples in time order: a burst arriving within one
   // clock tick still gets strictly increasing stamps.
-  const double t = std::max(player_->time_s() + options_.finger_lead_s, next_finger_s_ + 1e-6);
+  const double t = std::max(output().time_s() + options_.finger_lead_s, next_finger_s_ + 1e-6);
   const FingerSample s{t, x_mm, touching};
-  if (!player_->push(s)) return std::nullopt;
+  if (!push(s)) return std::nullopt;
   next_finger_s_ = t;
   return s;
 }

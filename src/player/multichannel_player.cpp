@@ -2,6 +2,7 @@
 #include "texel/multichannel_player.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
@@ -37,6 +38,37 @@ bool ChannelPlayer::push(const FingerSample& s) {
     players_[c]->push(shifted);
   }
   return true;
+}
+
+void ChannelPlayer::set_maps(std::vector<std::unique_ptr<const PlayerMap>> maps, std::span<const Millimetres> offsets) {
+  const std::size_t n = players_.size();
+  if (maps.size() != n)
+    throw InvalidArgument("ChannelPlayer::set_maps: " + std::to_string(maps.size()) + " maps for " + std::to_string(n) +
+                          " channels; give one per channel");
+  for (std::size_t c = 0; c < n; ++c)
+    if (!maps[c])
+      throw InvalidArgument("ChannelPlayer::set_maps: channel " + std::to_string(c) +
+                            "'s map is null; a channel at rest is given a silent map");
+  if (!offsets.empty()) check_offsets(offsets);
+  // Checked first, so a refusal swaps nothing; then back to back, so the
+  // real-time thread sees the maps within one block of each other.
+  for (std::size_t c = 0; c < n; ++c) players_[c]->set_map(std::move(maps[c]));
+  for (std::size_t c = 0; c < offsets.size(); ++c) offsets_[c] = offsets[c].value();
+}
+
+void ChannelPlayer::set_offsets(std::span<const Millimetres> offsets) {
+  check_offsets(offsets);
+  for (std::size_t c = 0; c < offsets.size(); ++c) offsets_[c] = offsets[c].value();
+}
+
+void ChannelPlayer::check_offsets(std::span<const Millimetres> offsets) const {
+  if (offsets.size() != players_.size())
+    throw InvalidArgument("ChannelPlayer: " + std::to_string(offsets.size()) + " offsets for " + std::to_string(players_.size()) +
+                          " channels; give one per channel");
+  for (std::size_t c = 0; c < offsets.size(); ++c)
+    if (!(std::abs(offsets[c].value()) <= actuator_offset_mm_max))
+      throw InvalidArgument("ChannelPlayer: channel " + std::to_string(c) + "'s offset is " + detail::num(offsets[c].value()) +
+                            " mm; allowed: −50 … 50 mm");
 }
 
 std::size_t ChannelPlayer::collect() {

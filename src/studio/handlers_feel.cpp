@@ -18,6 +18,7 @@ experiment::PresenterOptions presenter_options(const ServiceOptions& o, bool nul
   po.audio_device = o.audio_device;
   po.finger = experiment::FingerSource::external;
   po.response_handling = parse_response_handling(o.response, "response");
+  po.channels = o.channels;
   return po;
 }
 

@@ -62,6 +62,30 @@
 // prepare() to take_trace() (display reports on the display's clock, or the
 // simulated finger), for the swipe measures.
 //
+// Multi-actuator displays (docs/rendering.md, docs/experiments.md
+// "Presentation"): PresenterOptions::channels = N > 1 opens the backend
+// (null, audio) with N channels and plays through a ChannelPlayer, one Player
+// per actuator. show() prepares each channel's map of the document
+// (prepare_channels: sequential, the one chain at every actuator's offset or
+// on one actuator; simultaneous, one chain per actuator), each carrying its
+// actuator's response, and swaps them in together (each channel crossfades;
+// a channel at rest gets silence); blank() silences every channel. Every
+// finger (simulated, external, a separate sensor) drives every channel,
+// shifted by each actuator's offset (the document's device's). Finger
+// samples are queued ahead of the player (the simulated sweep 50 ms, an
+// external finger finger_lead_s) with the offsets in force when pushed, so
+// when a show brings other offsets (the session's first stimulus, or a
+// document of another device) its maps wait in pump() until the samples
+// queued before it have played: that stimulus starts up to 50 ms later,
+// and its maps never see the finger jump by an offset. A
+// one-channel document (a device without actuators) plays on every channel
+// at offset 0, as a sequential document does. Refused in one line
+// (InvalidArgument): a document whose device has other than 1 or N channels
+// (at show(), check() and prepare(), so before its trial's onset); a serial
+// display or a 2-D display with N > 1 (the serial protocol drives one
+// plate). The front ends take N from the protocol's device
+// (presentation_channels).
+//
 // At rest on every exit: stop() (and the destructor, so an exception
 // unwinding past the presenter) SELECTs none on a serial display after the
 // stream has stopped, so the plate is never left driven.
@@ -76,6 +100,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -83,6 +108,10 @@
 #include "texel/experiment/session.hpp"
 #include "texel/experiment/strokes.hpp"
 #include "texel/sinks.hpp"
+
+namespace texel {
+class ChannelPlayer;
+}  // namespace texel
 
 namespace texel::experiment {
 
@@ -121,12 +150,32 @@ struct PresenterOptions {
   /// display's own — display-plays with slots and a sensor, host-streams with
   /// a sensor only or an external finger, passive without a finger.
   std::optional<PresentationMode> mode;
+  /// Output channels, one per actuator of a multi-actuator display
+  /// (DeviceProfile::actuators), 1 … 64 [1]. N > 1: null and audio only; a
+  /// stimulus's device must have N actuators or none (see the banner). The
+  /// front ends set it from the protocol's device: presentation_channels().
+  std::size_t channels = 1;
 };
+
+/// The output channels a session of `protocol` plays on: its device's
+/// actuators (DeviceProfile::channels(): 1 for a device without). What
+/// `texel experiment run`, the studio and Python put in
+/// PresenterOptions::channels. Throws InvalidArgument for an unknown device.
+std::size_t presentation_channels(const Protocol& protocol);
+/// The same for a device: a built-in name, a NAME.json on TEXEL_DEVICE_PATH
+/// or a profile's path (load_device).
+std::size_t presentation_channels(std::string_view device);
 
 class Presenter {
  public:
   /// Opens and starts the backend (throws InvalidArgument / IoError naming it).
   explicit Presenter(const PresenterOptions& options);
+  /// Plays through `backend` instead of opening options.backend: an output
+  /// the caller made (an application's own sound I/O, a test's recording
+  /// backend), driven like a sound card (passive, or external/sensor
+  /// fingers). Throws InvalidArgument unless backend->channels() equals
+  /// options.channels, or for a serial display's backend (give it by name).
+  Presenter(const PresenterOptions& options, std::unique_ptr<Backend> backend);
   ~Presenter();
   Presenter(const Presenter&) = delete;
   Presenter& operator=(const Presenter&) = delete;
@@ -143,7 +192,10 @@ class Presenter {
   /// rendered (switching then costs a copy; waits for a bitmap the preload
   /// is rendering rather than rendering it again) and its strokes cleared;
   /// display-plays uploads the stimuli into the display's slots (as many as
-  /// it holds). Starts the trial's finger trace (take_trace()).
+  /// it holds); otherwise (passive, host-streams) every stimulus's maps are
+  /// prepared into the cache, so a switch costs a copy and a stimulus of
+  /// another channel count is refused (InvalidArgument) before onset.
+  /// Starts the trial's finger trace (take_trace()).
   void prepare(const Question& question);
   /// The finger trace since prepare() (empty on a 2-D display, whose strokes
   /// are strokes()); recording stops until the next prepare().
@@ -155,7 +207,8 @@ class Presenter {
   /// host-streams at a rate that cannot carry the stimuli's finest texels at
   /// a 100 mm/s swipe (with the figures), display-plays with fewer slots than
   /// stimuli (what a switch costs). Throws InvalidArgument when a stimulus's
-  /// map is larger than the display holds.
+  /// map is larger than the display holds, or its device has other than 1
+  /// or channels() actuators.
   [[nodiscard]] std::vector<std::string> check(const Question& first) const;
   /// display-plays: maps uploaded, how many of them at a switch (the
   /// participant waited), and the time spent uploading (s).
@@ -187,8 +240,11 @@ class Presenter {
   [[nodiscard]] std::vector<IntervalStrokes> strokes(const Question& question) const;
   /// Plays a map prepared by the caller (PlayerMap::from_document, which
   /// carries the device's response), so a front end shared by several
-  /// threads can render outside its lock.
+  /// threads can render outside its lock. With several channels it plays
+  /// on every channel at offset 0 (a copy each).
   void show(std::unique_ptr<const PlayerMap> map);
+  /// Output channels (PresenterOptions::channels).
+  [[nodiscard]] std::size_t channels() const { return options_.channels; }
   /// Silence (between trials, during the working-memory matrix).
   void blank();
   /// Feeds the simulated finger ahead of the player (simulated mode) and
@@ -226,16 +282,36 @@ class Presenter {
   // The simulated finger's trace (passive), recorded between prepare() and take_trace().
   bool recording_ = false;
   std::vector<FingerSample> simulated_trace_;
+  // A stimulus prepared for show(): one map per channel (one on a
+  // one-channel presenter) and, with several, the actuators' offsets.
+  struct Prepared {
+    std::vector<std::unique_ptr<const PlayerMap>> maps;
+    std::vector<Millimetres> offsets;
+  };
   static constexpr std::size_t cache_size = 8;
-  std::list<std::pair<std::string, std::unique_ptr<const PlayerMap>>> cache_;  // most recent first
+  std::list<std::pair<std::string, Prepared>> cache_;  // most recent first
   PresenterOptions options_;
-  std::unique_ptr<Player> player_;
+  std::unique_ptr<Player> player_;        // one channel
+  std::unique_ptr<ChannelPlayer> multi_;  // channels > 1
   std::unique_ptr<Backend> backend_;
-  std::optional<FrequencyResponse> last_response_;  // of the last map shown (blank() keeps it)
-  double next_finger_s_ = 0.0;                      // simulated: next sample's time; external: newest sample's time
+  std::optional<FrequencyResponse> last_response_;                   // of the last map shown (blank() keeps it)
+  std::vector<std::optional<FrequencyResponse>> channel_responses_;  // channels > 1: of each channel's last map
+  // channels > 1: maps waiting (until the player's clock reaches
+  // deferred_until_s_) for the finger samples queued with the previous
+  // actuators' offsets to play out; swapped in by pump().
+  std::vector<std::unique_ptr<const PlayerMap>> deferred_maps_;
+  double deferred_until_s_ = 0.0;
+  double next_finger_s_ = 0.0;  // simulated: next sample's time; external: newest sample's time
   double period_s_ = 0.0;
+  double rate_hz_ = 0.0;  // the player's output rate (Hz)
   std::size_t shown_ = 0;
   bool running_ = false;
+  PlayerBase& output();                   // player_ or multi_
+  bool push(const FingerSample& sample);  // to every channel
+  Prepared prepare_stimulus(const std::string& document_json) const;
+  const Prepared& cached(const std::string& document_json);  // prepared once, most recent first
+  void play(const Prepared& prepared);
+  void swap_deferred();
   void choose_mode(const BackendChoice& choice);
   void open_sensor(const BackendChoice& choice);  // FingerSource::sensor
 };

@@ -36,6 +36,9 @@ struct ServiceOptions {
   /// document's display response, "limit" ([choice], the default) or "off"
   /// (experiment/presenter.hpp, docs/format.md "Frequency response").
   std::string response = "limit";
+  /// Output channels of the backend, one per actuator of a multi-actuator
+  /// display, 1 … 64 (PresenterOptions::channels; `texel studio --channels`).
+  std::size_t channels = 1;
   std::string protocols_dir;                 ///< shipped protocols offered in the experimenter view ("" = none)
   std::size_t max_message_bytes = 4u << 20;  ///< larger messages are refused
   double max_messages_per_s = 2000.0;        ///< per client, token bucket (burst = one second's worth)
