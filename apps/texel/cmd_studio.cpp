@@ -120,7 +120,8 @@ void register_studio(CLI::App& app) {
                   "display attenuates by 20 dB or more) or off")
       ->capture_default_str();
   cmd->add_option("--channels", args->channels,
-                  "output channels, one per actuator of a multi-actuator display (its device profile's actuators), 1 … 64")
+                  "output channels to open with, 1 … 64; a study or document on an actuator array re-opens the output with its "
+                  "device's actuators")
       ->capture_default_str();
   cmd->add_option("--web", args->web, "the built front end (default: <texel dir>/../web, built by make demo)");
   cmd->add_option("--protocols", args->protocols,

@@ -362,6 +362,13 @@ void on_experiment_start(State& s, Client& c, const Job& job) {
     if (!unfinished && o.resume)
       throw Reject{"not_found", "experiment.start: participant " + clipped(o.participant) + " has no unfinished " +
                                     protocol->name + " session to resume"};
+    {
+      // The presentation follows the protocol's device: a study on an
+      // actuator array re-opens the output with its channels, before anything
+      // is stored (a device that cannot is refused here).
+      std::lock_guard lock(s.feel_mutex);
+      presenter_channels(s, ex::presentation_channels(*protocol), "experiment.start: protocol " + protocol->name);
+    }
     try {
       s.active.emplace(ex::open_session(st, *protocol, o));
     } catch (const InvalidArgument&) {

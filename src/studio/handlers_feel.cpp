@@ -24,9 +24,25 @@ experiment::PresenterOptions presenter_options(const ServiceOptions& o, bool nul
 
 void on_feel_select(State& s, Client& c, const Job& job) {
   const Fields f(job.msg, job.type);
+  const Document doc = document_of(s, f.object("document"), "document");
+  if (doc.device.channels() > 1) {
+    // A document for an actuator array plays on its channels, each its own map
+    // (simultaneous texels, or the one chain at each actuator's offset).
+    std::lock_guard lock(s.feel_mutex);
+    if (s.active && !s.active->session.finished() && s.presenter->channels() != doc.device.channels())
+      throw Reject{"conflict", "feel.select: the document's device '" + doc.device.name + "' has " +
+                                   std::to_string(doc.device.channels()) + " actuators and the running study plays " +
+                                   std::to_string(s.presenter->channels()) + " channels"};
+    presenter_channels(s, doc.device.channels(), "feel.select: device '" + doc.device.name + "'");
+    device_to_presenter(s);
+    s.presenter->show(document_json(doc));
+    s.feel_map.reset();
+    send(c, reply("feel.selected", job.id));
+    return;
+  }
   // Rendered here, outside feel_mutex: finger samples keep flowing meanwhile.
   // The map carries the document's device response (presenter.hpp).
-  auto map = PlayerMap::from_document(document_of(s, f.object("document"), "document"));
+  auto map = PlayerMap::from_document(doc);
   auto kept = std::make_unique<const PlayerMap>(map->grid(), std::vector<float>(map->values().begin(), map->values().end()),
                                                 map->response());
   {

@@ -346,6 +346,33 @@ void reopen_presenter(State& s) {
   if (s.feel_map) s.presenter->show(copy_of(*s.feel_map));
 }
 
+}  // namespace
+
+void presenter_channels(State& s, std::size_t channels, const std::string& what) {
+  if (s.presenter_options.channels == channels && s.presenter->channels() == channels) return;
+  device_to_presenter(s);
+  experiment::PresenterOptions o = s.presenter_options;
+  o.channels = channels;
+  std::unique_ptr<experiment::Presenter> next;
+  // The device is one: the old Presenter lets go of it before the new one opens it.
+  s.presenter->blank();
+  s.presenter.reset();
+  try {
+    next = std::make_unique<experiment::Presenter>(o);
+  } catch (const std::exception& e) {
+    reopen_presenter(s);  // as it was
+    throw Reject{"invalid", what + ": it plays on " + std::to_string(channels) + " channels and the output " + s.options.backend +
+                                " cannot open them (" + e.what() + ")"};
+  }
+  s.presenter = std::move(next);
+  s.presenter_options = o;
+  s.device_error.clear();
+  s.device_description = s.presenter->describe();
+  if (s.feel_map) s.presenter->show(copy_of(*s.feel_map));
+}
+
+namespace {
+
 /// A serial display with a finger sensor starts reporting it (true); one
 /// without says no_sensor (false: the pad's pointer is the finger).
 bool asks_for_reports(SerialLink* link) {

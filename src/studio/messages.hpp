@@ -195,6 +195,13 @@ void pad_show(State& s, std::unique_ptr<const PlayerMap2D> map);
 std::optional<double> pad_push(State& s, std::uint64_t client, double t, double x, double y, bool touch);
 [[nodiscard]] double pad_time_s(const State& s);
 void pad_blank(State& s);
+/// Caller holds feel_mutex: the Presenter on the configured device with
+/// `channels` output channels (a study's device with N actuators, a
+/// multi-actuator document felt on the strip). Re-opens it when the count
+/// differs; a device that cannot open them is refused (Reject naming
+/// `what`, the count and the device's reason) and the Presenter stays as
+/// it was. The 2-D pad gives the device back first.
+void presenter_channels(State& s, std::size_t channels, const std::string& what);
 /// The Presenter's options for the configured device (or a null backend in its place).
 experiment::PresenterOptions presenter_options(const ServiceOptions& o, bool null_backend = false);
 

@@ -461,3 +461,57 @@ TEST(Surface2DStudio, ADisplaysOwnFingerDrivesThePadsPlayerAndThePadShowsIt) {
   EXPECT_FALSE(back["holds_device"].get<bool>());
   EXPECT_EQ(c.ask({{"type", "feel.state"}})["error"], "");
 }
+
+// The presentation follows the study's device (studio.md "Actuator arrays"):
+// a lab starts the studio once; starting the distributed-irregularity study
+// (pad-4, four actuators) re-opens the output with four channels, its
+// stimuli play, a one-channel study afterwards gets one channel back, and a
+// four-actuator document felt on the strip takes four again. An output that
+// cannot open them (a serial display drives one plate) refuses the start in
+// one line and stores nothing.
+TEST(Surface2DStudio, AStudyOnAnActuatorArrayOpensTheOutputWithItsChannels) {
+  texel::test_support::TempDir dir("studio-channels");
+  ServiceOptions o;
+  o.db_path = dir.at("s.db");
+  o.protocols_dir = std::string(TEXEL_TEST_SOURCE_DIR) + "/examples/protocols";
+  {
+    Service s(o);
+    Client c(s);
+    const auto backend = [&] { return c.ask({{"type", "feel.state"}})["backend"].get<std::string>(); };
+    EXPECT_EQ(backend().find("4 channels"), std::string::npos) << backend();
+    const json started = c.ask({{"type", "experiment.start"}, {"protocol", "distributed-irregularity"}, {"participant", "A1"}});
+    ASSERT_EQ(started["type"], "experiment.started") << started.dump();
+    EXPECT_NE(backend().find("4 channels"), std::string::npos) << backend();
+    const json q = c.ask({{"type", "experiment.current"}});
+    const int t = q["question"]["trial"];
+    for (int i = 0; i < 3; ++i)
+      EXPECT_EQ(c.ask({{"type", "experiment.select"}, {"trial", t}, {"stimulus", i}})["type"], "experiment.selected");
+    EXPECT_EQ(c.ask({{"type", "feel.state"}})["error"], "");
+    EXPECT_EQ(c.ask({{"type", "experiment.stop"}})["type"], "experiment.idle");
+    ASSERT_EQ(c.ask({{"type", "experiment.start"}, {"protocol", "texel-length"}, {"participant", "A1"}})["type"],
+              "experiment.started");
+    EXPECT_EQ(backend().find("4 channels"), std::string::npos) << backend();
+    EXPECT_EQ(c.ask({{"type", "experiment.stop"}})["type"], "experiment.idle");
+    const json array_document = {
+        {"format", "texel-document"},
+        {"version", 6},
+        {"device", "pad-4"},
+        {"texture", {{"kind", "texel"}, {"central_pitch_db", 6}, {"irregularity_db", 1}, {"texel_length_mm", 1}, {"seed", 3}}},
+        {"playback", {{"mode", "simultaneous"}}}};
+    EXPECT_EQ(c.ask({{"type", "feel.select"}, {"document", array_document}})["type"], "feel.selected");
+    EXPECT_NE(backend().find("4 channels"), std::string::npos) << backend();
+  }
+  DisplayRig rig;
+  o.backend = "serial:" + rig.path;
+  o.db_path = dir.at("serial.db");
+  Service s(o);
+  Client c(s);
+  const json refused = c.ask({{"type", "experiment.start"}, {"protocol", "distributed-irregularity"}, {"participant", "A2"}});
+  ASSERT_EQ(refused["type"], "error") << refused.dump();
+  EXPECT_NE(refused["message"].get<std::string>().find(
+                "experiment.start: protocol distributed-irregularity: it plays on 4 channels and the output serial:"),
+            std::string::npos)
+      << refused.dump();
+  EXPECT_EQ(c.ask({{"type", "experiment.list"}})["sessions"].size(), 0u);
+  EXPECT_NE(c.ask({{"type", "feel.state"}})["backend"].get<std::string>().find("serial"), std::string::npos);
+}
