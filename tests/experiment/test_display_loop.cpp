@@ -458,7 +458,9 @@ TEST(DisplayLoop, EveryExitLeavesTheDisplayAtRest) {
     const texel::DisplayStatus st = status_of(display.pty());
     EXPECT_EQ(st.selected, -1);
     EXPECT_EQ(st.amplitude, 0);
-    if (clean) EXPECT_NE(st.mode, 2) << "left in drive mode";
+    if (clean) {
+      EXPECT_NE(st.mode, 2) << "left in drive mode";
+    }
   };
   // 'q' after feeling texture 2.
   {
