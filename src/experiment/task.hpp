@@ -76,8 +76,7 @@ struct SessionCore {
   /// The same on a multi-actuator device, played `playback` ("sequential" on
   /// every channel, or "simultaneous"): a document of version 6, the first
   /// with "playback" (docs/format.md).
-  [[nodiscard]] std::string single_played(const nlohmann::json& texture, std::string_view playback,
-                                          double length_mm = 0.0) const;
+  [[nodiscard]] std::string single_played(const nlohmann::json& texture, std::string_view playback, double length_mm = 0.0) const;
   /// The matching layout: left texture beside right texture.
   [[nodiscard]] std::string halves(const nlohmann::json& left, const nlohmann::json& right) const;
   /// The encoder's perceptual position of a reference on the protocol's device (cached).

@@ -245,9 +245,9 @@ TEST(Presenter2D, TerminalRunStoresStrokesAndShowsNothingOfTheCondition) {
     return "until grep -q 'play .*stimulus=" + std::to_string(stimulus) + "' " + m +
            " 2>/dev/null; do sleep 0.05; done; sleep 0.9; ";
   };
-  const std::string cmd = "(" + felt(1) + "echo 2; " + felt(2) + "echo 3; " + felt(3) + "echo 'a 2') | " + std::string(TEXEL_CLI) +
-                          " experiment run " + tmp.at("p.json") + " --participant P01 --db " + tmp.at("s.db") +
-                          " --backend null --finger " + port + " --monitor " + tmp.at("m.txt") + " 2>&1";
+  const std::string cmd = "(" + felt(1) + "echo 2; " + felt(2) + "echo 3; " + felt(3) + "echo 'a 2') | " +
+                          std::string(TEXEL_CLI) + " experiment run " + tmp.at("p.json") + " --participant P01 --db " +
+                          tmp.at("s.db") + " --backend null --finger " + port + " --monitor " + tmp.at("m.txt") + " 2>&1";
   std::string screen;
   FILE* p = ::popen(cmd.c_str(), "r");
   ASSERT_NE(p, nullptr);
