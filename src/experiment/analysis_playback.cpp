@@ -95,7 +95,6 @@ Counts pooled(const std::vector<double>& shifts, const std::vector<const std::ma
 json playback_summary(const Study& study, const Rows& rows, const AnalysisOptions& o, std::string& text) {
   // level → participant → shift → (correct, trials); controls apart.
   std::map<double, std::map<std::string, std::map<double, std::pair<double, double>>>> by_level;
-  std::map<double, std::map<std::string, std::pair<double, double>>> arrangement_counts;  // level → arrangement → k, n
   std::map<double, std::pair<double, double>> controls;
   std::map<double, std::map<double, std::map<std::string, std::pair<double, double>>>> cells;  // level → shift → arrangement
   for (const TrialRow* r : rows) {
@@ -110,8 +109,6 @@ json playback_summary(const Study& study, const Rows& rows, const AnalysisOption
     c.first += ok, c.second += 1;
     auto& a = cells[level][r->intensity][r->condition];
     a.first += ok, a.second += 1;
-    auto& t = arrangement_counts[level][r->condition];
-    t.first += ok, t.second += 1;
   }
   json out = json::object();
   out["chance"] = chance;
@@ -193,8 +190,11 @@ json playback_summary(const Study& study, const Rows& rows, const AnalysisOption
       }
       lj["pse"] = std::move(pj);
     }
+    std::map<std::string, std::pair<double, double>> by_arrangement;  // over the shifts
+    for (const auto& [shift, arrangements] : cells[level])
+      for (const auto& [a, kn] : arrangements) by_arrangement[a].first += kn.first, by_arrangement[a].second += kn.second;
     json aj = json::object();
-    for (const auto& [a, kn] : arrangement_counts[level])
+    for (const auto& [a, kn] : by_arrangement)
       aj[a] = json{{"correct", kn.first}, {"trials", kn.second}, {"proportion", kn.first / kn.second}};
     lj["arrangements"] = std::move(aj);
     if (auto it = controls.find(level); it != controls.end()) {

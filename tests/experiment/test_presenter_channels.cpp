@@ -155,6 +155,12 @@ PlayerConfig vibration_config() {
   return config;
 }
 
+// The off-line multi-channel render of `doc` (`frames` frames per channel)
+// under `finger_s` seconds of the presenter's simulated finger.
+std::vector<float> offline_render(const std::string& doc, std::size_t frames, double finger_s) {
+  return render_trace_channels(prepare_channels(parse_document(doc)), vibration_config(), simulated_finger(finger_s), frames);
+}
+
 // The largest difference between the presenter's channels and the off-line
 // multi-channel render of the same document under the same finger, from
 // frame `from` on (before it the first show's fade-in and the offsets of
@@ -177,8 +183,7 @@ TEST(PresenterChannels, SimultaneousDocumentPlaysEachActuatorsOwnTexels) {
   Rig rig(4);
   rig.presenter->show(doc);
   const std::vector<float> out = rig.run(0.5);
-  const auto channels = prepare_channels(parse_document(doc));
-  const std::vector<float> reference = render_trace_channels(channels, vibration_config(), simulated_finger(0.6), out.size() / 4);
+  const std::vector<float> reference = offline_render(doc, out.size() / 4, 0.6);
   const std::size_t from = static_cast<std::size_t>(0.2 * rate);
   for (std::size_t c = 0; c < 4; ++c) {
     const float rms = channel_rms(out, 4, c, from);
@@ -214,8 +219,7 @@ TEST(PresenterChannels, FirstStimulusWaitsForTheFingerQueuedBeforeIt) {
   std::printf("onset at %.1f ms\n", 1e3 * static_cast<double>(onset) / rate);
   EXPECT_GE(onset, static_cast<std::size_t>(0.045 * rate));
   EXPECT_LE(onset, static_cast<std::size_t>(0.06 * rate));
-  const std::vector<float> reference =
-      render_trace_channels(prepare_channels(parse_document(doc)), vibration_config(), simulated_finger(0.4), out.size() / 4);
+  const std::vector<float> reference = offline_render(doc, out.size() / 4, 0.4);
   // After the 20 ms crossfade from silence and 40 ms of the DC blocker's settling.
   const std::size_t from = onset + static_cast<std::size_t>(0.06 * rate);
   for (std::size_t c = 0; c < 4; ++c) {
@@ -233,8 +237,7 @@ TEST(PresenterChannels, SequentialDocumentPlaysOneSignalShiftedByTheOffsets) {
   Rig rig(4);
   rig.presenter->show(doc);
   const std::vector<float> out = rig.run(0.5);
-  const auto channels = prepare_channels(parse_document(doc));
-  const std::vector<float> reference = render_trace_channels(channels, vibration_config(), simulated_finger(0.6), out.size() / 4);
+  const std::vector<float> reference = offline_render(doc, out.size() / 4, 0.6);
   const std::size_t from = static_cast<std::size_t>(0.2 * rate);
   for (std::size_t c = 0; c < 4; ++c) {
     EXPECT_GT(channel_rms(out, 4, c, from), 0.05f) << "channel " << c << " is not driven";
