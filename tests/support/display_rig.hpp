@@ -8,9 +8,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <pty.h>
 #include <unistd.h>
@@ -30,6 +32,26 @@ struct DisplayRig {
   std::atomic<bool> stop{false};
   std::thread thread;
 
+  /// One output update of the display: the amplitude it put out and how many
+  /// DRIVE values it had taken by then (so a test can tell one host step from
+  /// a burst of values that a loaded machine delivered at once).
+  struct Tick {
+    std::uint16_t amplitude = 0;
+    std::uint32_t drive_values = 0;
+  };
+  /// Starts logging every output update (from the display's own thread).
+  void start_log() {
+    const std::lock_guard lock(log_mutex_);
+    log_.clear();
+    logging_ = true;
+  }
+  /// Stops logging and returns the updates since start_log().
+  std::vector<Tick> take_log() {
+    const std::lock_guard lock(log_mutex_);
+    logging_ = false;
+    return std::move(log_);
+  }
+
   /// `sensor_2d`: the display's own 2-D finger sensor (none: positions from the host).
   explicit DisplayRig(std::function<bool(std::int32_t&, std::int32_t&, bool&)> sensor_2d = {})
       : DisplayRig(controller::Info{}, {}, std::move(sensor_2d)) {}
@@ -44,6 +66,10 @@ struct DisplayRig {
     hal = std::make_unique<controller::HostHal>(master);
     hal->sensor = std::move(sensor_1d);
     hal->sensor_2d = std::move(sensor_2d);
+    hal->tick_observer = [this](std::uint32_t, const controller::Status& st) {
+      const std::lock_guard lock(log_mutex_);
+      if (logging_ && log_.size() < max_log) log_.push_back({st.amplitude, st.drive_values});
+    };
     ctl = std::make_unique<SmallController>(*hal, info);
     thread = std::thread([this] { ctl->run([this] { return stop.load(); }); });
   }
@@ -57,6 +83,12 @@ struct DisplayRig {
     stop = true;
     if (thread.joinable()) thread.join();
   }
+
+ private:
+  static constexpr std::size_t max_log = 1u << 20;
+  std::mutex log_mutex_;
+  bool logging_ = false;
+  std::vector<Tick> log_;
 };
 
 }  // namespace texel::test_support

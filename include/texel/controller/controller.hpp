@@ -102,7 +102,8 @@ struct Status {
   std::int32_t y_nm = 0;  ///< a 2-D sensor's y (0 on a 1-D display)
   bool touch = false;
   std::uint32_t frames_ok = 0;
-  std::uint32_t frames_bad = 0;  ///< frames dropped unanswered: CRC and length errors, malformed streamed frames
+  std::uint32_t drive_values = 0;  ///< DRIVE frames taken (a local count; the STATUS reply does not carry it)
+  std::uint32_t frames_bad = 0;    ///< frames dropped unanswered: CRC and length errors, malformed streamed frames
   std::uint32_t nacks = 0;
   std::uint32_t link_errors = 0;         ///< times the link was found down
   std::uint32_t ticks = 0;               ///< output updates
@@ -397,6 +398,7 @@ class Controller {
       case Type::drive: {
         if (f.length != 2) return bad_stream(f);
         drive_ = serial::get_u16(p);
+        ++status_.drive_values;
         stream_us_ = hal_.micros();
         status_.mode = Mode::drive;
         return;
