@@ -1,7 +1,7 @@
 // Participant frames carry nothing the participant must not know (issue #37):
 // over a whole session of every task kind the participant page supports —
 // oddity (with drawn maps), two-alternative, match, guided, rating,
-// familiarisation, same-different, oddity-2d — every frame the participant
+// familiarisation, same-different (with each distractor), playback-oddity, oddity-2d — every frame the participant
 // screen receives is free of the block (names, index), the condition, seeds
 // (the protocol's, the session's, the stimuli's documents) and the
 // participant code, though all of them are readable in devtools otherwise.
@@ -16,7 +16,7 @@
 // protocol's mixed with the participant code).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
+import { spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -24,7 +24,17 @@ import { withStudio, paths } from './studio.mjs';
 import { control } from './participant-helpers.mjs';
 
 // One shipped protocol per task kind (texel-length-visual-practice: oddity with show_maps).
-const PROTOCOLS = ['texel-length-visual-practice', 'coarse-features', 'free-exploration', 'guided-exploration', 'quantization', 'working-memory', 'direction-independence'];
+const PROTOCOLS = [
+  'texel-length-visual-practice',
+  'coarse-features',
+  'free-exploration',
+  'guided-exploration',
+  'quantization',
+  'working-memory',
+  'working-memory-components',
+  'distributed-irregularity',
+  'direction-independence',
+];
 // What a participant types in the terminal for the first questions of each protocol (then q).
 const TERMINAL = {
   'texel-length-visual-practice': 'a 1\na 2\nq\n',
@@ -33,14 +43,43 @@ const TERMINAL = {
   'guided-exploration': 'a A\na unsure\nq\n',
   quantization: 'a 3\na 4\nq\n',
   'working-memory': 'a continue\na same\n5\nq\n',
+  'working-memory-components': 'a continue\na same\n5\nq\n',
+  'distributed-irregularity': 'a 1\na 2\nq\n',
 };
 
-/** Every string of a question's wording (the confidence and digit questions follow an answer: `answered`). */
-function wordingStrings(w, answered = true) {
-  const out = [w.choice_question, ...w.choice_labels, ...w.stimulus_names.slice(0, 1)];
+// The longer sessions are audited over their first questions (every distractor and condition comes up
+// within them, practice included); the others to their end.
+const QUESTIONS = { 'working-memory-components': 24, 'distributed-irregularity': 12 };
+
+/** Every string of a question's words: its prompt and wording (the confidence and digit questions follow an answer: `answered`). */
+function wordingStrings(q, answered = true) {
+  const w = q.wording;
+  const out = [q.prompt, w.choice_question, ...w.choice_labels, ...w.stimulus_names.slice(0, 1), w.sequence_instruction];
   for (const k of answered ? ['rating', 'confidence', 'recall'] : ['rating'])
     if (w[k]) out.push(w[k].question, w[k].min_label, w[k].max_label, `${w[k].min}`, `${w[k].max}`);
   return out.filter((x) => x);
+}
+
+/**
+ * `texel experiment run` for `name` as participant `code`, typing `input`: its output once it ends. The
+ * working-memory runs spend half a minute in their timed phases, so every run starts at the beginning
+ * and runs beside the studio's sessions.
+ */
+function terminalRun(name, code, input) {
+  const db = join(mkdtempSync(join(tmpdir(), 'texel-terminal-')), 't.db');
+  const child = spawn(paths.bin, ['experiment', 'run', join(paths.protocols, `${name}.json`), '--participant', code, '--db', db, '--backend', 'null']);
+  let stdout = '';
+  let stderr = '';
+  child.stdout.on('data', (d) => (stdout += d));
+  child.stderr.on('data', (d) => (stderr += d));
+  child.stdin.end(input);
+  const timer = setTimeout(() => child.kill('SIGKILL'), 240_000);
+  return new Promise((resolve) =>
+    child.on('close', (status) => {
+      clearTimeout(timer);
+      resolve({ stdout, stderr, status });
+    }),
+  );
 }
 
 const FORBIDDEN_KEYS = new Set(['block', 'block_index', 'trial_in_block', 'block_trials', 'condition', 'seed', 'participant', 'session', 'document', 'correct_answer', 'intensity']);
@@ -66,6 +105,7 @@ test('participant frames: no block, condition, seed or participant code over a w
     await p.goto(`${studio.url}#/participant`);
     await p.waitForSelector('[data-testid=waiting]');
     const tasksSeen = new Set();
+    const terminals = new Map(PROTOCOLS.filter((name) => TERMINAL[name]).map((name) => [name, terminalRun(name, `QZX${PROTOCOLS.indexOf(name)}K`, TERMINAL[name])]));
     for (const [n, name] of PROTOCOLS.entries()) {
       const proto = JSON.parse(readFileSync(join(paths.protocols, `${name}.json`), 'utf8'));
       const code = `QZX${n}K`;
@@ -73,7 +113,8 @@ test('participant frames: no block, condition, seed or participant code over a w
       const [, started] = await control(page, { type: 'experiment.stop' }, { type: 'experiment.start', protocol: name, participant: code, simulate: 'default' });
       assert.equal(started.type, 'experiment.started', JSON.stringify(started));
       // Answer every question as the simulated participant; the participant screen follows each push.
-      for (let guard = 0; guard < 5000; guard++) {
+      const limit = QUESTIONS[name] ?? 5000;
+      for (let guard = 0; guard < limit; guard++) {
         const [cur] = await control(page, { type: 'experiment.current' });
         if (cur.type !== 'experiment.question') break;
         tasksSeen.add(cur.question.task);
@@ -82,12 +123,13 @@ test('participant frames: no block, condition, seed or participant code over a w
         await p.waitForSelector(`.question[data-trial="${t}"]`, { timeout: 30_000 });
         const text = await p.locator('.participant').textContent();
         const w = cur.question.wording;
-        for (const x of [...wordingStrings(w), ...w.stimulus_names.map((n) => `Feel ${n}`)])
-          if (!cur.question.phases.length || !x.startsWith('Feel ')) assert.ok(text.includes(x), `${name}, trial ${t + 1}: the page does not say "${x}": ${text}`);
+        for (const x of [...wordingStrings(cur.question), ...w.stimulus_names.map((n) => `Feel ${n}`)])
+          // A timed question shows its phases one at a time: the sequence's words come in its phase (working-memory-components.test).
+          if (!cur.question.phases.length || !(x.startsWith('Feel ') || x === w.sequence_instruction)) assert.ok(text.includes(x), `${name}, trial ${t + 1}: the page does not say "${x}": ${text}`);
         const [a] = await control(page, { type: 'experiment.answer', trial: cur.question.trial, simulated: true });
         assert.ok(a.type !== 'error', JSON.stringify(a));
       }
-      await p.waitForSelector('[data-testid=thank-you]', { timeout: 60_000 });
+      if (!QUESTIONS[name]) await p.waitForSelector('[data-testid=thank-you]', { timeout: 60_000 });
       const questions = frames.filter((f) => f.includes('"experiment.question"'));
       assert.ok(questions.length > 0, `${name}: the participant screen received its questions`);
       // What must not reach the participant's screen, as this session has it.
@@ -111,28 +153,23 @@ test('participant frames: no block, condition, seed or participant code over a w
       const byTrial = new Map();
       for (const f of frames) {
         const m = JSON.parse(f);
-        if (m.type === 'experiment.question' && !byTrial.has(m.question.trial)) byTrial.set(m.question.trial, m.question.wording);
+        if (m.type === 'experiment.question' && !byTrial.has(m.question.trial)) byTrial.set(m.question.trial, m.question);
       }
-      if (TERMINAL[name]) {
-        const db = join(mkdtempSync(join(tmpdir(), 'texel-terminal-')), 't.db');
-        const r = spawnSync(paths.bin, ['experiment', 'run', join(paths.protocols, `${name}.json`), '--participant', code, '--db', db, '--backend', 'null'], {
-          input: TERMINAL[name],
-          encoding: 'utf8',
-          timeout: 120_000,
-        });
+      if (terminals.has(name)) {
+        const r = await terminals.get(name);
         const out = r.stdout;
         const shown = [...out.matchAll(/^Trial (\d+)/gm)].map((m) => Number(m[1]) - 1);
         assert.ok(shown.length > 0, `${name}: the terminal showed a question: ${out.slice(0, 2000)} ${r.stderr}`);
         for (const [n, t] of shown.entries()) {
-          const w = byTrial.get(t);
-          assert.ok(w, `${name}: the studio handed out trial ${t}`);
-          for (const text of wordingStrings(w, n < shown.length - 1)) assert.ok(out.includes(text), `${name}, trial ${t + 1}: the terminal does not say "${text}":\n${out}`);
+          const q = byTrial.get(t);
+          assert.ok(q, `${name}: the studio handed out trial ${t}`);
+          for (const text of wordingStrings(q, n < shown.length - 1)) assert.ok(out.includes(text), `${name}, trial ${t + 1}: the terminal does not say "${text}":\n${out}`);
         }
       }
       if (name === 'texel-length-visual-practice')
         assert.ok(frames.some((f) => f.includes('"map_f32"')), 'the visual practice draws its maps from the rendered maps');
     }
-    for (const t of ['oddity', 'two-alternative', 'match', 'guided', 'rating', 'familiarisation', 'same-different', 'oddity-2d'])
+    for (const t of ['oddity', 'two-alternative', 'match', 'guided', 'rating', 'familiarisation', 'same-different', 'playback-oddity', 'oddity-2d'])
       assert.ok(tasksSeen.has(t), `task kind ${t} was covered (${[...tasksSeen].join(', ')})`);
     assert.deepEqual(errors, []);
   });
