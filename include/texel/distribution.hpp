@@ -37,6 +37,11 @@ inline constexpr double central_pitch_db_max = 40.0;
 inline constexpr double irregularity_db_min = -60.0;  ///< moments; log needs >= 0 (see the constructor)
 inline constexpr double irregularity_db_max = 40.0;
 inline constexpr double quantization_db_max = 20.0;
+/// The band edges a document or device profile may state (cycles/mm):
+/// band_min in [band_cpm_min, band_cpm_max], band_max 0 (Nyquist) or up to
+/// band_cpm_max; on a grid band_min must also lie below the band's top.
+inline constexpr double band_cpm_min = 1e-12;
+inline constexpr double band_cpm_max = 1e12;
 
 struct PitchDistributionConfig {
   Decibels central_pitch{10.0};  ///< dB re 1 cpm; -20 … 19.7 dB on the reference device

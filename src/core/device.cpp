@@ -11,6 +11,7 @@
 #include "texel/detail/format.hpp"
 #include "texel/detail/json_fields.hpp"
 #include "texel/detail/lanes.hpp"
+#include "texel/distribution.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 
@@ -189,8 +190,8 @@ DeviceProfile parse_device_profile(std::string_view json_text, std::string_view 
     p.spacing = Millimetres(o.number("spacing_mm", 1e-9, 1e6));
     p.format = parse_sample_format(o.string("format"), "format");
     p.refresh = Hertz(o.number("refresh_hz", 1e-6, 1e9));
-    p.band_min = CyclesPerMm(o.number_or("band_min_cpm", 0.01, 1e-12, 1e12));
-    p.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, 1e12));
+    p.band_min = CyclesPerMm(o.number_or("band_min_cpm", 0.01, band_cpm_min, band_cpm_max));
+    p.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, band_cpm_max));
     if (o.has("layout")) {
       const auto& arr = o.raw("layout");
       if (!arr.is_array()) throw FormatError("layout must be an array of regions");

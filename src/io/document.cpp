@@ -195,8 +195,8 @@ void parse_texture(const json& j, const std::string& path, RegionSpec& region) {
   s.seed = o.uint64("seed");
   s.parameterization = enum_field(o, "parameterization", s.parameterization, parse_parameterization);
   s.out_of_band = enum_field(o, "out_of_band", s.out_of_band, parse_out_of_band);
-  s.band_min = CyclesPerMm(o.number_or("band_min_cpm", s.band_min.value(), 1e-12, 1e12));
-  s.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, 1e12));
+  s.band_min = CyclesPerMm(o.number_or("band_min_cpm", s.band_min.value(), band_cpm_min, band_cpm_max));
+  s.band_max = CyclesPerMm(o.number_or("band_max_cpm", 0.0, 0.0, band_cpm_max));
   s.quantization_db = o.number_or("quantization_db", 0.0, 0.0, quantization_db_max);
   s.phase = enum_field(o, "phase", s.phase, parse_phase_mode);
   s.fill = enum_field(o, "fill", s.fill, parse_fill);

@@ -154,7 +154,12 @@ ojson make_hello(const State& s) {
       // The coarse profiles' ranges as the document reader checks them (src/io/document.cpp).
       {"coarse_value", range(0.0, 1.0)},
       {"sine_period_mm", range(1e-9, 1e9)},
-      {"sine_phase_deg", range(-1e9, 1e9)}};
+      {"sine_phase_deg", range(-1e9, 1e9)},
+      // The renderable band's edges as the document reader takes them. On a device band_min must
+      // also lie below the band's top (device_limits); band_max is 0 (the grid's Nyquist
+      // frequency) or above band_min, and above the device's top it means that top.
+      {"band_min_cpm", range(band_cpm_min, band_cpm_max)},
+      {"band_max_cpm", range(0.0, band_cpm_max)}};
   // On a device, a Central Pitch must also lie in the renderable band: the texel
   // texture's band_min (default 0.01 cpm) up to the device's band top (its
   // band_max or Nyquist frequency) — PitchDistribution's rule, which allows
@@ -164,7 +169,10 @@ ojson make_hello(const State& s) {
     const DeviceProfile d = load_device(name);
     const double lo = std::max(central_pitch_db_min, 10.0 * std::log10(TexelSpec{}.band_min.value()));
     const double hi = std::min(central_pitch_db_max, 10.0 * std::log10(d.band_top().value()));
-    h["device_limits"].push_back({{"device", name}, {"central_pitch_db", range(lo, hi)}});
+    h["device_limits"].push_back(
+        {{"device", name},
+         {"central_pitch_db", range(lo, hi)},
+         {"band_min_cpm", ojson{{"min", band_cpm_min}, {"max", d.band_top().value()}, {"exclusive_max", true}}}});
   }
   return h;
 }

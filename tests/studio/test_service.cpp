@@ -303,10 +303,15 @@ TEST(Service, EveryStatedTextureLimitIsTheEngines) {
     json range;
   };
   const auto plain = [](const char* k) { return [k](json& t, double v) { t[k] = v; }; };
-  json pitch;
+  json pitch, band_min;
   for (const auto& d : hello["device_limits"])
-    if (d["device"] == "tpad") pitch = d["central_pitch_db"];
+    if (d["device"] == "tpad") {
+      pitch = d["central_pitch_db"];
+      band_min = d["band_min_cpm"];
+    }
   ASSERT_TRUE(pitch.is_object()) << hello["device_limits"].dump();
+  ASSERT_TRUE(band_min.is_object()) << hello["device_limits"].dump();
+  EXPECT_EQ(band_min["min"], lim["band_min_cpm"]["min"]);
   const double shortest = 19200 * 0.0053 / hello["limits"]["max_map_samples"].get<double>();
   std::vector<Case> cases{
       {"central_pitch_db (tpad)", plain("central_pitch_db"), pitch},
@@ -336,8 +341,17 @@ TEST(Service, EveryStatedTextureLimitIsTheEngines) {
          t["coarse"] = {{"kind", "sine"}, {"period_mm", 5}, {"phase_deg", v}};
        },
        lim["sine_phase_deg"]},
+      // A narrow distribution whose mean sits in the band, wherever its floor is.
+      {"band_min_cpm (tpad)",
+       [top = pitch["max"].get<double>()](json& t, double v) {
+         t["band_min_cpm"] = v;
+         t["central_pitch_db"] = std::clamp(10.0 * std::log10(std::max(v, 1e-300)), -40.0, top);
+         t["irregularity_db"] = -60;
+       },
+       band_min},
+      {"band_max_cpm", plain("band_max_cpm"), lim["band_max_cpm"]},
   };
-  ASSERT_EQ(lim.size(), 10u) << "a new limit needs its case here: " << lim.dump();
+  ASSERT_EQ(lim.size(), 12u) << "a new limit needs its case here: " << lim.dump();
   const auto design = [&](const Case& k, double v) {
     json doc = tpad_document();
     k.set(doc["texture"], v);
@@ -361,9 +375,16 @@ TEST(Service, EveryStatedTextureLimitIsTheEngines) {
     }
     if (k.range["max"].is_number()) {
       const double hi = k.range["max"];
-      const json at = design(k, hi);
-      EXPECT_EQ(at["type"], "design") << at.dump().substr(0, 300);
-      EXPECT_EQ(design(k, hi + std::max(hair, std::abs(hi) * 1e-9))["type"], "error");
+      const double above = hi + std::max(hair, std::abs(hi) * 1e-9);
+      if (k.range.value("exclusive_max", false)) {
+        EXPECT_EQ(design(k, hi)["type"], "error");
+        const json in = design(k, hi - std::max(hair, std::abs(hi) * 1e-9));
+        EXPECT_EQ(in["type"], "design") << in.dump().substr(0, 300);
+      } else {
+        const json at = design(k, hi);
+        EXPECT_EQ(at["type"], "design") << at.dump().substr(0, 300);
+      }
+      EXPECT_EQ(design(k, above)["type"], "error");
     }
     if (k.range["min"].is_null() && k.range["max"].is_null()) {
       const json lo = design(k, -1e300), hi = design(k, 1e300);

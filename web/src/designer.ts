@@ -20,6 +20,12 @@ interface TexelParams {
   seed: number;
   parameterization: 'moments' | 'log';
   quantization_db: number;
+  /** The renderable band and how a texel is laid (docs/format.md): the library's defaults unless set. */
+  out_of_band: 'redraw' | 'clamp';
+  band_min_cpm: number;
+  band_max_cpm: number;
+  phase: 'continuous' | 'reset';
+  fill: 'whole' | 'partial';
   coarse: 'constant' | 'sine' | 'points';
   coarse_value: number;
   sine_period_mm: number;
@@ -62,6 +68,11 @@ const defaults = (): TexelParams => ({
   seed: 1,
   parameterization: 'moments',
   quantization_db: 0,
+  out_of_band: 'redraw',
+  band_min_cpm: 0.01,
+  band_max_cpm: 0,
+  phase: 'continuous',
+  fill: 'whole',
   coarse: 'constant',
   coarse_value: 1,
   sine_period_mm: 5,
@@ -114,6 +125,13 @@ function texelTexture(t: TexelParams, extra: Record<string, unknown>): TexelText
     coarse_strength: t.coarse_strength,
     fine_strength: t.fine_strength,
   };
+  // The band and layout keys only where they differ from the library's defaults (the same texture either way).
+  const d = defaults();
+  if (t.out_of_band !== d.out_of_band) tex.out_of_band = t.out_of_band;
+  if (t.band_min_cpm !== d.band_min_cpm) tex.band_min_cpm = t.band_min_cpm;
+  if (t.band_max_cpm !== d.band_max_cpm) tex.band_max_cpm = t.band_max_cpm;
+  if (t.phase !== d.phase) tex.phase = t.phase;
+  if (t.fill !== d.fill) tex.fill = t.fill;
   let coarse: CoarseProfile;
   if (t.coarse === 'sine') coarse = { kind: 'sine', period_mm: t.sine_period_mm, phase_deg: t.sine_phase_deg };
   else if (t.coarse === 'points' && t.points.length) coarse = { kind: 'points', points: t.points };
@@ -168,7 +186,7 @@ function stateFromDocument(doc: TextureDocument, prev: DesignerState): DesignerS
 function applyTexel(s: DesignerState, t: TexelTexture): void {
   const known = new Set([
     'kind', 'central_pitch_db', 'irregularity_db', 'texel_length_mm', 'seed', 'parameterization',
-    'quantization_db', 'coarse', 'coarse_strength', 'fine_strength',
+    'quantization_db', 'coarse', 'coarse_strength', 'fine_strength', 'out_of_band', 'band_min_cpm', 'band_max_cpm', 'phase', 'fill',
   ]);
   s.extra = {};
   for (const [k, v] of Object.entries(t)) if (!known.has(k)) s.extra[k] = v;
@@ -179,6 +197,12 @@ function applyTexel(s: DesignerState, t: TexelTexture): void {
   p.seed = Number(t.seed ?? 1);
   p.parameterization = t.parameterization ?? 'moments';
   p.quantization_db = t.quantization_db ?? 0;
+  const d = defaults();
+  p.out_of_band = t.out_of_band ?? d.out_of_band;
+  p.band_min_cpm = t.band_min_cpm ?? d.band_min_cpm;
+  p.band_max_cpm = t.band_max_cpm ?? d.band_max_cpm;
+  p.phase = t.phase ?? d.phase;
+  p.fill = t.fill ?? d.fill;
   p.coarse_strength = t.coarse_strength ?? 0;
   p.fine_strength = t.fine_strength ?? 1;
   const c = t.coarse;
@@ -206,6 +230,7 @@ interface Rule {
   min: number | null;
   max: number | null;
   exclusiveMin?: boolean;
+  exclusiveMax?: boolean;
   integer?: boolean;
 }
 
@@ -213,7 +238,7 @@ interface Rule {
 export function rangeText(rule: Rule, unit: string): string {
   const u = unit ? ` ${unit}` : '';
   const { min, max } = rule;
-  if (min !== null && max !== null) return `${rule.exclusiveMin ? 'above ' : ''}${min} … ${max}${u}`;
+  if (min !== null && max !== null) return `${rule.exclusiveMin ? 'above ' : ''}${min} … ${rule.exclusiveMax ? 'below ' : ''}${max}${u}`;
   if (min !== null) return `${rule.exclusiveMin ? 'above' : 'at least'} ${min}${u}`;
   if (max !== null) return `at most ${max}${u}`;
   return 'any finite number';
@@ -231,7 +256,7 @@ export function parseTyped(text: string, rule: Rule, unit: string): { value: num
   const u = unit ? ` ${unit}` : '';
   if (rule.integer && !Number.isInteger(v)) return { error: `${t} is not a whole number` };
   const low = rule.min !== null && (rule.exclusiveMin ? v <= rule.min : v < rule.min);
-  if (low || (rule.max !== null && v > rule.max)) return { error: `${t}${u} is outside the allowed range ${rangeText(rule, unit)}` };
+  if (low || (rule.max !== null && (rule.exclusiveMax ? v >= rule.max : v > rule.max))) return { error: `${t}${u} is outside the allowed range ${rangeText(rule, unit)}` };
   return { value: v };
 }
 
@@ -303,7 +328,7 @@ function field(
     num.value = input.value;
     onValue(Number(input.value), false);
   });
-  const unitWord = unit.startsWith('dB') ? 'dB' : unit === 'mm' || unit === 'degrees' || unit === 'mm/s' ? unit : '';
+  const unitWord = unit.startsWith('dB') ? 'dB' : unit.startsWith('cycles/mm') ? 'cycles/mm' : unit === 'mm' || unit === 'degrees' || unit === 'mm/s' ? unit : '';
   // The range the engine accepts, stated at the field (its tooltip) as in its refusals.
   num.addEventListener('focus', () => (num.title = `Allowed: ${rangeText(rule(), unitWord)}`));
   const commit = () => {
@@ -547,7 +572,7 @@ export function mountDesigner(root: HTMLElement): void {
     flatWarn.textContent = flatWarn.hidden
       ? ''
       : `With ${L} mm texels, ${r.texels} whole texel${r.texels === 1 ? '' : 's'} cover the texture region; the last ${fmt(flat, 2)} mm of it are flat (no texel fits there). ` +
-        'A shorter texel length, or a length that divides the region, textures all of it.';
+        'A shorter texel length, a length that divides the region, or "a final partial texel" (Region end) textures all of it.';
     elapsedEl.textContent = r.elapsed_ms !== undefined ? `engine ${fmt(r.elapsed_ms, 1)} ms` : '';
     strip.setLength(r.grid.count * r.grid.spacing_mm);
     strip.setMap(values, r.grid.origin_mm, r.grid.spacing_mm);
@@ -591,14 +616,19 @@ export function mountDesigner(root: HTMLElement): void {
   // --- controls: each writes the store; render() shows the store in them
   const lim = (k: keyof NonNullable<HelloReply['texture_limits']>, fallback: Rule): (() => Rule) => () => {
     const r = hello?.texture_limits?.[k];
-    return r ? { min: r.min, max: r.max, exclusiveMin: r.exclusive_min } : fallback;
+    return r ? { min: r.min, max: r.max, exclusiveMin: r.exclusive_min, exclusiveMax: r.exclusive_max } : fallback;
   };
   // Central Pitch on a device lies in its renderable band too (hello's device_limits).
   const pitchRule = (): Rule => {
     const dev = store.get().device;
     const name = typeof dev === 'string' ? dev : dev.name;
     const d = hello?.device_limits.find((x) => x.device === name)?.central_pitch_db;
-    return d ? { min: d.min, max: d.max } : lim('central_pitch_db', { min: -40, max: 40 })();
+    const r = d ? { min: d.min, max: d.max } : lim('central_pitch_db', { min: -40, max: 40 })();
+    // The texture's own band narrows it (device_limits assume the default band_min of 0.01 cycles/mm).
+    const t = store.get().texel;
+    const lo = 10 * Math.log10(t.band_min_cpm);
+    const hi = t.band_max_cpm > 0 ? 10 * Math.log10(t.band_max_cpm) : Infinity;
+    return { min: Math.max(r.min ?? -Infinity, round(lo, 6)), max: Math.min(r.max ?? Infinity, hi === Infinity ? Infinity : round(hi, 6)) };
   };
   // Irregularity under the log parameterization is a dB of log-spread (>= 0).
   const irrRule = () => lim(store.get().texel.parameterization === 'log' ? 'irregularity_db_log' : 'irregularity_db', { min: -60, max: 40 })();
@@ -659,6 +689,26 @@ export function mountDesigner(root: HTMLElement): void {
   });
   const quant: FieldCtl = field('quantization', 'Quantization', { min: 0, max: 20, step: 0.5 }, lim('quantization_db', { min: 0, max: 20 }), t.quantization_db, 'dB, 0 = off',
     (v, typed) => commitTexel(() => quant, { quantization_db: v }, typed));
+  // The band's top on this device: the texture's band_max where set, else (and at most) the grid's Nyquist
+  // frequency — the renderer's rule; band_min must lie below it.
+  const bandMinRule = (): Rule => {
+    const dev = store.get().device;
+    const name = typeof dev === 'string' ? dev : dev.name;
+    const d = hello?.device_limits.find((x) => x.device === name)?.band_min_cpm;
+    const r: Rule = d ? { min: d.min, max: d.max, exclusiveMax: d.exclusive_max } : lim('band_min_cpm', { min: 1e-12, max: 1e12 })();
+    const own = store.get().texel.band_max_cpm;
+    return own > 0 && (r.max === null || own < r.max) ? { ...r, max: own, exclusiveMax: true } : r;
+  };
+  const oob = select('out-of-band', 'Draws outside the band', [['redraw', 'redrawn'], ['clamp', 'clamped to the edge']], t.out_of_band, (v) =>
+    setTexel({ out_of_band: v as TexelParams['out_of_band'] }));
+  const bandMin: FieldCtl = field('band-min', 'Lowest texel frequency', { min: 0.01, max: 5, step: 0.01 }, bandMinRule, t.band_min_cpm, 'cycles/mm',
+    (v, typed) => commitTexel(() => bandMin, { band_min_cpm: v }, typed));
+  const bandMax: FieldCtl = field('band-max', 'Highest texel frequency', { min: 0, max: 10, step: 0.1 }, lim('band_max_cpm', { min: 0, max: 1e12 }), t.band_max_cpm, 'cycles/mm, 0 = Nyquist',
+    (v, typed) => commitTexel(() => bandMax, { band_max_cpm: v }, typed));
+  const phaseSel = select('phase', 'Texel phase', [['continuous', 'continuous'], ['reset', 'reset (abrupt boundaries)']], t.phase, (v) =>
+    setTexel({ phase: v as TexelParams['phase'] }));
+  const fillSel = select('fill', 'Region end', [['whole', 'whole texels, then flat'], ['partial', 'a final partial texel']], t.fill, (v) =>
+    setTexel({ fill: v as TexelParams['fill'] }));
   const cStrength: FieldCtl = field('coarse-strength', 'Coarse strength C', { min: 0, max: 1, step: 0.01 }, lim('coarse_strength', { min: 0, max: 1 }), t.coarse_strength, '0…1',
     (v, typed) => commitTexel(() => cStrength, { coarse_strength: v }, typed));
   const fStrength: FieldCtl = field('fine-strength', 'Fine strength F', { min: 0, max: 1, step: 0.01 }, lim('fine_strength', { min: 0, max: 1 }), t.fine_strength, '0…1',
@@ -862,6 +912,11 @@ export function mountDesigner(root: HTMLElement): void {
     seedIn.value = String(t.seed);
     param.el.value = t.parameterization;
     quant.set(shown(t.quantization_db));
+    oob.el.value = t.out_of_band;
+    bandMin.set(shown(t.band_min_cpm));
+    bandMax.set(shown(t.band_max_cpm));
+    phaseSel.el.value = t.phase;
+    fillSel.el.value = t.fill;
     cStrength.set(shown(t.coarse_strength));
     fStrength.set(shown(t.fine_strength));
     constVal.set(shown(t.coarse_value));
@@ -1017,6 +1072,7 @@ export function mountDesigner(root: HTMLElement): void {
     h('fieldset', {}, h('legend', {}, 'Fine texture'), pitch.row, irr.row, length.row, flatWarn,
       h('div', { class: 'ctl' }, h('label', { for: 'seed' }, 'Seed ', h('span', { class: 'unit' }, '(whole number ≥ 0)')), h('div', { class: 'ctl-row' }, seedIn, newDraw), seedErr),
       param.row, quant.row, fStrength.row),
+    h('fieldset', {}, h('legend', {}, 'Band and texel layout'), bandMin.row, bandMax.row, oob.row, phaseSel.row, fillSel.row),
     h('fieldset', {}, h('legend', {}, 'Swipe speed'), speed.row, driveWarn),
     h('fieldset', {}, h('legend', {}, 'Coarse profile'), coarseSel.row, coarseParams, drawBtn, cStrength.row),
     h('fieldset', {}, h('legend', {}, 'Device and regions'), deviceSel.row, splitSel.row, refRow, h('div', { class: 'ctl-row' }, matchBtn), matchInfo, matchErr),

@@ -20,6 +20,11 @@ export interface TexelTexture {
   seed: number;
   parameterization?: 'moments' | 'log';
   quantization_db?: number;
+  out_of_band?: 'redraw' | 'clamp';
+  band_min_cpm?: number;
+  band_max_cpm?: number;
+  phase?: 'continuous' | 'reset';
+  fill?: 'whole' | 'partial';
   coarse?: CoarseProfile;
   coarse_strength?: number;
   fine_strength?: number;

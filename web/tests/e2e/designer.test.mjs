@@ -346,6 +346,41 @@ test('designer: ranges cover every shipped protocol', { timeout: 120_000 }, asyn
     // Three whole 26 mm texels on the tpad's 101.76 mm: the last 23.76 mm are flat, and the page says so (issue #37).
     assert.match(await page.textContent('[data-testid=flat-warning]'), /With 26 mm texels, 3 whole texels .* the last 23\.76 mm of it are flat/);
     assert.ok(await page.isVisible('[data-testid=flat-warning]'));
+    // The texel-length study's texture, made with the controls: its band floor, abrupt boundaries and whole texels
+    // (the designer had no band, phase or fill controls, so a shipped protocol's texture could not be reproduced).
+    const proto = JSON.parse(readFileSync(join(dir, 'texel-length-visual-practice.json'), 'utf8'));
+    const shipped = JSON.stringify(proto).match(/"band_min_cpm":([0-9.]+)/);
+    assert.ok(shipped, 'the protocol sets band_min_cpm');
+    let n1 = (await stats(page)).designsDrawn;
+    await typeInto(page, '#band-min-value', shipped[1]);
+    await nextDraw(page, n1);
+    n1 = (await stats(page)).designsDrawn;
+    await page.selectOption('#phase', 'reset');
+    await nextDraw(page, n1);
+    assert.equal(await page.inputValue('#fill'), 'whole');
+    const [docDl] = await Promise.all([page.waitForEvent('download'), page.click('[data-testid=export-document]')]);
+    const tex = JSON.parse(readFileSync(await docDl.path(), 'utf8')).texture;
+    assert.equal(tex.band_min_cpm, Number(shipped[1]));
+    assert.equal(tex.phase, 'reset');
+    assert.equal(tex.fill, 'whole');
+    // A Central Pitch below the band's floor is refused with the band's edge (0 dB = 1 cycle/mm).
+    await typeInto(page, '#central-pitch-value', '-1');
+    assert.match((await refusal(page, 'central-pitch')).text, /outside the allowed range 0 … /);
+    // A band floor of 0, or at the band's top (the tpad's Nyquist frequency), is refused with the renderer's rule.
+    await typeInto(page, '#band-min-value', '0');
+    assert.match((await refusal(page, 'band-min')).text, /outside the allowed range 1e-12 … below 94\.339\d* cycles\/mm/);
+    await typeInto(page, '#band-min-value', String(1 / (2 * 0.0053)));
+    assert.match((await refusal(page, 'band-min')).text, /outside the allowed range 1e-12 … below 94/);
+    // A final partial texel textures the region's end: no flat part, no warning.
+    n1 = (await stats(page)).designsDrawn;
+    await page.selectOption('#fill', 'partial');
+    await nextDraw(page, n1);
+    assert.equal(await page.isVisible('[data-testid=flat-warning]'), false, 'a partial last texel leaves nothing flat');
+    await page.locator('#fill').scrollIntoViewIfNeeded();
+    await screenshot(page, 'designer-band-layout');
+    n1 = (await stats(page)).designsDrawn;
+    await page.selectOption('#fill', 'whole');
+    await nextDraw(page, n1);
     // .hjif, as the CLI writes it.
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('[data-testid=export-hjif]')]);
     assert.equal(download.suggestedFilename(), 'texture.hjif');
