@@ -191,7 +191,13 @@ void run(const RunArgs& a) {
     oo.participant = a.participant;
     oo.resume = a.resume;
     oo.simulate = a.simulate;
-    started.emplace(ex::open_session(*opened, protocol_file, oo));
+    try {
+      started.emplace(ex::open_session(*opened, protocol_file, oo));
+    } catch (const ex::SessionConflict& e) {  // how to do the other thing, in this command's words
+      throw InvalidArgument(std::string(e.what()) + (e.kind() == ex::SessionConflict::Kind::unfinished_exists
+                                                         ? " (--resume)"
+                                                         : " (start one without --resume)"));
+    }
   } catch (const Error&) {
     opened.reset();
     monitor.close();

@@ -58,7 +58,13 @@ class PySession {
     o.participant = participant;
     o.resume = resume;
     o.simulate = std::move(simulate);
-    active_.emplace(open_session(store_->get(), protocol_of(protocol), o));
+    try {
+      active_.emplace(open_session(store_->get(), protocol_of(protocol), o));
+    } catch (const SessionConflict& e) {  // how to do the other thing, in Python's words
+      throw InvalidArgument(std::string(e.what()) + (e.kind() == SessionConflict::Kind::unfinished_exists
+                                                         ? " (Session(..., resume=True))"
+                                                         : " (start one with resume=False)"));
+    }
   }
 
   ActiveSession& active() {

@@ -269,13 +269,15 @@ ActiveSession open_session(Store& store, const Protocol& protocol, const OpenOpt
   SessionInfo info;
   if (o.resume) {
     if (!existing)
-      throw InvalidArgument("participant '" + o.participant + "' has no unfinished '" + protocol.name + "' session in " +
-                            store.path() + " to resume (start one without --resume)");
+      throw SessionConflict(SessionConflict::Kind::nothing_to_resume, "participant '" + o.participant + "' has no unfinished '" +
+                                                                          protocol.name + "' session in " + store.path() +
+                                                                          " to resume");
     info = *existing;
   } else if (existing) {
-    throw InvalidArgument("participant '" + o.participant + "' has an unfinished '" + protocol.name + "' session (id " +
-                          std::to_string(existing->id) + ", " + std::to_string(existing->trials_done) + " trials stored) in " +
-                          store.path() + "; resume it (--resume)");
+    throw SessionConflict(SessionConflict::Kind::unfinished_exists,
+                          "participant '" + o.participant + "' has an unfinished '" + protocol.name + "' session (id " +
+                              std::to_string(existing->id) + ", " + std::to_string(existing->trials_done) +
+                              " trials stored) in " + store.path() + "; resume it");
   }
   Protocol run = o.resume ? parse_protocol(info.protocol_json, store.path() + ": stored protocol") : protocol;
   const std::string simulate = o.simulate.value_or(o.resume ? info.simulate : std::string());

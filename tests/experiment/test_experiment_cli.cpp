@@ -248,6 +248,15 @@ TEST(ExperimentCli, ResumeContinuesAtTheNextTrialAndSecondWriterIsRefused) {
   ::kill(pid, SIGKILL);
   int st = 0;
   ::waitpid(pid, &st, 0);
+  // Starting anew beside the unfinished session is refused, and the refusal says how to resume (the CLI's flag).
+  const CliRun anew = run("experiment run " + proto + " --participant W1 --db " + db + " --simulate default");
+  EXPECT_EQ(anew.status, 2) << anew.out;
+  EXPECT_NE(anew.out.find("has an unfinished 'working-memory' session"), std::string::npos) << anew.out;
+  EXPECT_NE(anew.out.find("resume it (--resume)"), std::string::npos) << anew.out;
+  const CliRun nothing = run("experiment run " + proto + " --participant W2 --db " + db + " --simulate default --resume");
+  EXPECT_EQ(nothing.status, 2) << nothing.out;
+  EXPECT_NE(nothing.out.find("no unfinished 'working-memory' session"), std::string::npos) << nothing.out;
+  EXPECT_NE(nothing.out.find("(start one without --resume)"), std::string::npos) << nothing.out;
   const auto before = nlohmann::json::parse(run("experiment status --db " + db + " --json").out);
   const int stored = before["sessions"][0]["trials_done"].get<int>();
   const CliRun resumed = run("experiment run " + proto + " --participant W1 --db " + db + " --simulate default --resume --json");

@@ -54,8 +54,11 @@ def test_resume_continues_where_it_stopped(protocol, tmp_path):
     with texel.Store(db, mode="rw") as store, Presenter() as player:
         with Session(store, protocol, "P02", simulate="default") as s:
             run_plain_loop(s, player, stop_after=4)
-        with pytest.raises(texel.InvalidArgument):
+        with pytest.raises(texel.InvalidArgument, match=r"has an unfinished .* resume it \(Session\(\.\.\., resume=True\)\)") as e:
             Session(store, protocol, "P02")  # an unfinished session exists: resume it, explicitly
+        assert "--" not in str(e.value), "Python's error names Python's argument, not the CLI's flag"
+        with pytest.raises(texel.InvalidArgument, match=r"no unfinished .* \(start one with resume=False\)"):
+            Session(store, protocol, "P03", resume=True)
         with Session(store, protocol, "P02", resume=True) as s:
             assert s.trials_done == 4
             run_plain_loop(s, player)

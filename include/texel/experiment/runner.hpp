@@ -100,6 +100,20 @@ class AnswerRefused : public InvalidArgument {
   Refusal reason_;
 };
 
+/// open_session could not do what was asked: the participant already has an
+/// unfinished session of the protocol (a new one was asked for), or has none
+/// to resume. what() says so in the library's terms; each front door adds how
+/// to do the other in its own (the CLI's --resume, Python's resume=True).
+class SessionConflict : public InvalidArgument {
+ public:
+  enum class Kind { unfinished_exists, nothing_to_resume };
+  SessionConflict(Kind kind, const std::string& message) : InvalidArgument(message), kind_(kind) {}
+  [[nodiscard]] Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
+};
+
 /// The current question as handed to a screen.
 struct Handout {
   std::string token;
