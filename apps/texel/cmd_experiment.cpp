@@ -19,6 +19,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "experiment_terminal.hpp"
+#include "option_flags.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/analysis.hpp"
@@ -586,21 +587,14 @@ void register_experiment(CLI::App& app) {
     std::cerr << "wrote " << rows.size() << " trials to " << e->output << "\n";
   });
 
+  // The analysis options are the library's (AnalysisOptions, described by visit_options): flags, help and defaults
+  // come from there; only the inputs and outputs are this command's own.
   struct AnalyzeArgs {
     std::optional<std::string> db;
     std::optional<std::string> csv;
     std::optional<std::string> out_dir;
-    std::string format = "png";
-    std::size_t reversals = 6;
-    double level = 0.95;
-    std::string convergent = "last-presented";
-    std::string memory_rule = "source";
-    double errors_sd = 2.0;
-    double errors_sd_tolerance = 0.15;
-    bool include_unfinished = false;
-    double recall_chance = 1.0 / 9.0;
-    double accuracy_sd = 2.5;
-    std::string confidence_distance = "rater";
+    ex::AnalysisOptions options;
+    std::unique_ptr<DescribedFlags> flags;
     bool json = false;
   };
   auto an = std::make_shared<AnalyzeArgs>();
@@ -608,70 +602,23 @@ void register_experiment(CLI::App& app) {
   analyze_cmd->add_option("--db", an->db, "Session database");
   analyze_cmd->add_option("--csv", an->csv, "…or a CSV written by 'texel experiment export'");
   analyze_cmd->add_option("-o,--out", an->out_dir, "Folder for the figures (created if missing)");
-  analyze_cmd->add_option("--format", an->format, "Figure format: png or svg [png]");
-  analyze_cmd->add_option("--reversals", an->reversals, "Threshold = mean of the last K reversals [6]");
-  analyze_cmd->add_option("--level", an->level, "Confidence level of t-test intervals and ellipses, 0 … 1 [0.95]");
-  analyze_cmd->add_option("--convergent", an->convergent,
-                          "Staircase end value: last-presented (the source's final value) or next [last-presented]");
-  analyze_cmd->add_option("--memory-rule", an->memory_rule,
-                          "Working-memory outliers: source (errors > mean + k SD without more distraction errors), "
-                          "recall-accuracy (the earlier rule) or none [source]");
-  analyze_cmd->add_option("--memory-errors-sd", an->errors_sd, "Working memory, source rule: k [2]");
-  analyze_cmd->add_option("--memory-errors-sd-tolerance", an->errors_sd_tolerance,
-                          "Working memory, source rule: outlier from z >= k - this (\"near\" k SD; 0 = literal) [0.15]");
-  analyze_cmd->add_flag("--include-unfinished", an->include_unfinished,
-                        "Put procedures that stopped before their stopping rule into the group statistics (still reported "
-                        "\"not finished\")");
-  analyze_cmd->add_option("--memory-recall-chance", an->recall_chance,
-                          "Working memory, recall-accuracy rule: digit recall at or below this; negative = off [1/9]");
-  analyze_cmd->add_option("--memory-accuracy-sd", an->accuracy_sd,
-                          "Working memory, recall-accuracy rule: this many SD from the group's accuracy; 0 = off [2.5]");
-  analyze_cmd->add_option("--confidence-distance", an->confidence_distance,
-                          "Free exploration: confidence against the distance to the rater's match (the encoder's "
-                          "estimate) or to the group-mean match [rater]");
+  an->flags = std::make_unique<DescribedFlags>(analyze_cmd, an->options);
   analyze_cmd->add_flag("--json", an->json, "Print the summary as JSON");
   analyze_cmd->callback([an] {
     if (an->db.has_value() == an->csv.has_value()) throw InvalidArgument("analyze: give exactly one of --db FILE or --csv FILE");
-    if (an->format != "png" && an->format != "svg") throw InvalidArgument("--format is '" + an->format + "'; allowed: png, svg");
-    if (an->reversals < 1 || an->reversals > 1000)
-      throw InvalidArgument("--reversals is " + std::to_string(an->reversals) + "; allowed: 1 … 1000");
+    an->flags->apply();
     std::vector<ex::TrialRow> rows;
     if (an->db)
       rows = ex::Store::open(*an->db, ex::StoreMode::read_only).rows();
     else
       rows = ex::parse_trials_csv(read_file(*an->csv), *an->csv);
-    ex::AnalysisOptions o;
+    ex::AnalysisOptions o = an->options;
     if (an->out_dir) {
       std::error_code ec;
       std::filesystem::create_directories(*an->out_dir, ec);
       if (ec) throw IoError("--out " + *an->out_dir + ": cannot create the folder (" + ec.message() + ")");
       o.out_dir = *an->out_dir;
     }
-    o.format = an->format;
-    o.reversals_k = an->reversals;
-    if (!(an->level > 0 && an->level < 1))
-      throw InvalidArgument("--level is " + detail::num(an->level) + "; allowed: 0 … 1 (exclusive)");
-    o.level = an->level;
-    const auto one_of = [](const std::string& flag, const std::string& v, std::initializer_list<const char*> allowed) {
-      std::string list;
-      for (const char* name : allowed) {
-        if (v == name) return;
-        list += (list.empty() ? "" : ", ") + std::string(name);
-      }
-      throw InvalidArgument(flag + " is '" + v + "'; allowed: " + list);
-    };
-    one_of("--convergent", an->convergent, {"last-presented", "next"});
-    one_of("--memory-rule", an->memory_rule, {"source", "recall-accuracy", "none"});
-    one_of("--confidence-distance", an->confidence_distance, {"rater", "group-mean"});
-    if (!(an->errors_sd > 0)) throw InvalidArgument("--memory-errors-sd is " + detail::num(an->errors_sd) + "; allowed: > 0");
-    o.convergent = an->convergent;
-    o.memory_rule = an->memory_rule;
-    o.memory_errors_sd = an->errors_sd;
-    o.memory_errors_sd_tolerance = an->errors_sd_tolerance;
-    o.include_unfinished = an->include_unfinished;
-    o.memory_recall_chance = an->recall_chance;
-    o.memory_accuracy_sd = an->accuracy_sd;
-    o.confidence_distance = an->confidence_distance;
     const ex::AnalysisReport report = ex::analyze(rows, o);
     if (an->json)
       print_json(ordered_json::parse(report.summary));

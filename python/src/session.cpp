@@ -10,13 +10,18 @@
 // Response::from_json): the glue stays a few lines when the engine's structs
 // grow, and a dict is what a Python caller wants anyway.
 #include <chrono>
+#include <filesystem>
 #include <thread>
 
 #include "common.hpp"
+#include "options.hpp"
 #include "texel/error.hpp"
+#include "texel/experiment/analysis.hpp"
 #include "texel/experiment/presenter.hpp"
 #include "texel/experiment/protocol.hpp"
 #include "texel/experiment/runner.hpp"
+#include "texel/experiment/store.hpp"
+#include "texel/io.hpp"
 
 namespace texel::python {
 namespace {
@@ -317,6 +322,33 @@ later Session(..., resume=True) continues where it stopped.)doc")
       py::arg("store"), py::arg("protocol"), py::arg("participants"), py::kw_only(), py::arg("simulate") = "default",
       "Runs simulated participants through a protocol to the end (resuming unfinished ones), as\n"
       "`texel experiment cohort`; returns their session ids.");
+  m.def(
+      "analyze",
+      [](const std::optional<py::object>& db, const std::optional<py::object>& csv, const std::optional<py::object>& out_dir,
+         const py::kwargs& kwargs) {
+        if (db.has_value() == csv.has_value()) throw InvalidArgument("analyze: give exactly one of db= or csv=");
+        AnalysisOptions o;
+        set_options(o, kwargs, "analyze");
+        if (out_dir) o.out_dir = path_of(*out_dir);
+        const std::vector<TrialRow> rows = db ? Store::open(path_of(*db), StoreMode::read_only).rows()
+                                              : parse_trials_csv(read_file(path_of(*csv)), path_of(*csv));
+        if (!o.out_dir.empty()) std::filesystem::create_directories(o.out_dir);
+        const AnalysisReport report = analyze(rows, o);
+        py::dict r;
+        r["summary"] = py::module_::import("json").attr("loads")(report.summary);
+        r["text"] = report.text;
+        r["figures"] = report.figures;
+        r["tables"] = report.tables;
+        return r;
+      },
+      py::kw_only(), py::arg("db") = py::none(), py::arg("csv") = py::none(), py::arg("out_dir") = py::none(),
+      "Per-study summaries and figures of a session database (db=) or an exported CSV (csv=), as\n"
+      "`texel experiment analyze`; figures into out_dir when given. The options are the library's\n"
+      "(analysis_options() lists them with their defaults and ranges). Returns a dict: summary (the\n"
+      "JSON summary), text, figures and tables (paths written).");
+  m.def("analysis_options", &describe_options<AnalysisOptions>,
+        "The options of analyze(), as the library describes them: key, flag (the CLI's), help, default and\n"
+        "range or choices, in the CLI's order.");
 }
 
 }  // namespace texel::python

@@ -19,7 +19,9 @@ session; record() validates an answer and commits the trial;
 simulated_response() answers for a simulated participant. Presenter plays
 stimuli on a backend ('null', 'audio', 'serial:PATH'); Session.stimulus(i)
 gives a stimulus as a texel.Document for output of your own.
-simulate_cohort() runs simulated participants to the end.
+simulate_cohort() runs simulated participants to the end. analyze() summarises
+and draws a database's or export's studies as `texel experiment analyze`
+does, with the library's options (analysis_options() lists them).
 presentation_channels(protocol) is the Presenter's channels= for a protocol
 whose device has several actuators (one output channel each).
 """
@@ -30,7 +32,9 @@ Presenter = _texel.experiment.Presenter
 Session = _texel.experiment.Session
 simulate_cohort = _texel.experiment.simulate_cohort
 presentation_channels = _texel.experiment.presentation_channels
+analyze = _texel.experiment.analyze
+analysis_options = _texel.experiment.analysis_options
 
-__all__ = ["Presenter", "Session", "presentation_channels", "simulate_cohort"]
+__all__ = ["Presenter", "Session", "analysis_options", "analyze", "presentation_channels", "simulate_cohort"]
 
 globals().update(_front.apply(_texel.experiment, __name__, _front.pathlib.Path(__file__).with_suffix(".pyi"), {}))

@@ -50,3 +50,13 @@ class Session:
 def presentation_channels(protocol: _Protocol) -> int: ...
 def simulate_cohort(store: Store, protocol: _Protocol, participants: Sequence[str], *,
                     simulate: str = "default") -> list[int]: ...
+# The analysis options' defaults are the library's (AnalysisOptions, listed by analysis_options());
+# tests/python/test_options.py checks these against it.
+def analyze(*, db: Optional[Union[str, PathLike[str]]] = None, csv: Optional[Union[str, PathLike[str]]] = None,
+            out_dir: Optional[Union[str, PathLike[str]]] = None, format: Literal["png", "svg"] = "png",
+            reversals_k: int = 6, level: float = 0.95, convergent: Literal["last-presented", "next"] = "last-presented",
+            include_unfinished: bool = False, memory_rule: Literal["source", "recall-accuracy", "none"] = "source",
+            memory_errors_sd: float = 2.0, memory_errors_sd_tolerance: float = 0.15,
+            memory_recall_chance: float = 1.0 / 9.0, memory_accuracy_sd: float = 2.5,
+            confidence_distance: Literal["rater", "group-mean"] = "rater") -> dict[str, Any]: ...
+def analysis_options() -> list[dict[str, Any]]: ...

@@ -26,17 +26,28 @@ namespace texel::experiment {
 
 using namespace analysis_common;
 
+std::string_view to_string(FigureFormat f) { return choice_name(figure_formats, static_cast<int>(f)); }
+std::string_view to_string(ConvergentValue c) { return choice_name(convergent_values, static_cast<int>(c)); }
+std::string_view to_string(MemoryRule r) { return choice_name(memory_rules, static_cast<int>(r)); }
+std::string_view to_string(ConfidenceDistance d) { return choice_name(confidence_distances, static_cast<int>(d)); }
+
 namespace {
 
+// The rules visit_options states, for a C++ caller that fills the struct directly.
 void check_options(const AnalysisOptions& o) {
-  if (o.format != "png" && o.format != "svg") throw InvalidArgument("analysis format is '" + o.format + "'; allowed: png, svg");
-  if (o.reversals_k < 1) throw InvalidArgument("analysis reversals_k is 0; must be >= 1");
+  const auto known = [](std::span<const OptionChoice> choices, auto v, const char* key) {
+    if (choice_name(choices, static_cast<int>(v)).empty())
+      throw InvalidArgument(std::string("analysis ") + key + " is " + std::to_string(static_cast<int>(v)) +
+                            ", not one of its values");
+  };
+  known(figure_formats, o.format, "format");
+  known(convergent_values, o.convergent, "convergent");
+  known(memory_rules, o.memory_rule, "memory_rule");
+  known(confidence_distances, o.confidence_distance, "confidence_distance");
+  if (o.reversals_k < 1 || o.reversals_k > 1000)
+    throw InvalidArgument("analysis reversals_k is " + std::to_string(o.reversals_k) + "; allowed: 1 … 1000");
   if (!(o.level > 0 && o.level < 1))
     throw InvalidArgument("analysis level is " + texel::detail::num(o.level) + "; allowed (0, 1)");
-  if (o.convergent != "last-presented" && o.convergent != "next")
-    throw InvalidArgument("analysis convergent is '" + o.convergent + "'; allowed: last-presented, next");
-  if (o.memory_rule != "source" && o.memory_rule != "recall-accuracy" && o.memory_rule != "none")
-    throw InvalidArgument("analysis memory_rule is '" + o.memory_rule + "'; allowed: source, recall-accuracy, none");
   if (!(o.memory_errors_sd > 0) || !std::isfinite(o.memory_errors_sd))
     throw InvalidArgument("analysis memory_errors_sd is " + texel::detail::num(o.memory_errors_sd) + "; allowed > 0");
   if (!(o.memory_errors_sd_tolerance >= 0) || !(o.memory_errors_sd_tolerance < o.memory_errors_sd))
@@ -48,8 +59,6 @@ void check_options(const AnalysisOptions& o) {
   if (!(o.memory_accuracy_sd >= 0) || !std::isfinite(o.memory_accuracy_sd))
     throw InvalidArgument("analysis memory_accuracy_sd is " + texel::detail::num(o.memory_accuracy_sd) +
                           "; allowed >= 0 (0 = rule off)");
-  if (o.confidence_distance != "rater" && o.confidence_distance != "group-mean")
-    throw InvalidArgument("analysis confidence_distance is '" + o.confidence_distance + "'; allowed: rater, group-mean");
 }
 
 /// A CSV field: quoted when it holds a separator, a quote or a line break.

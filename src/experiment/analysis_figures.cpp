@@ -42,7 +42,8 @@ struct Writer {
   const AnalysisOptions& o;
   std::vector<std::string> paths;
   void save(const Figure& f, const std::string& name) {
-    const std::string path = (std::filesystem::path(o.out_dir) / (study + "-" + name + "." + o.format)).string();
+    const std::string path =
+        (std::filesystem::path(o.out_dir) / (study + "-" + name + "." + std::string(to_string(o.format)))).string();
     save_figure(f, path);
     paths.push_back(path);
   }

@@ -64,7 +64,7 @@ void matching_summary(const Rows& matches, const AnalysisOptions& o, json& out, 
   out["references"] = rj;
   json mj = json::array();
   std::vector<double> dist, conf;
-  const bool to_rater = o.confidence_distance == "rater";
+  const bool to_rater = o.confidence_distance == ConfidenceDistance::rater;
   for (const TrialRow* r : matches) {
     const auto [cp, ci] = centre[r->reference];
     const double d = std::hypot(r->pitch_db - cp, r->irregularity_db - ci);

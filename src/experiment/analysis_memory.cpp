@@ -274,8 +274,10 @@ json memory_summary(const std::string& study, const Rows& rows, const AnalysisOp
   json source_stats;
   const Excluded by_source = source_rule(people, o, source_stats);
   const Excluded by_recall = recall_accuracy_rule(people, o);
-  const Excluded& excluded = o.memory_rule == "source" ? by_source : o.memory_rule == "none" ? Excluded{} : by_recall;
-  out["outlier_rule"] = json{{"rule", o.memory_rule},
+  const Excluded& excluded = o.memory_rule == MemoryRule::source ? by_source
+                             : o.memory_rule == MemoryRule::none ? Excluded{}
+                                                                 : by_recall;
+  out["outlier_rule"] = json{{"rule", std::string(to_string(o.memory_rule))},
                              {"errors_sd", o.memory_errors_sd},
                              {"errors_sd_tolerance", o.memory_errors_sd_tolerance},
                              {"recall_chance", o.memory_recall_chance},
@@ -347,7 +349,7 @@ json memory_summary(const std::string& study, const Rows& rows, const AnalysisOp
   out["rules_compared"] = rules;
 
   text += study + ": " + std::to_string(people.size()) + " participants, " + std::to_string(excluded.size()) +
-          " excluded (rule: " + o.memory_rule + ")\n";
+          " excluded (rule: " + std::string(to_string(o.memory_rule)) + ")\n";
   for (const auto& [id, why] : excluded) text += "  excluded " + id + ": " + why + "\n";
   for (const auto& c : cj)
     text += "  " + c["condition"].get<std::string>() + ": " + fmt(val(c["accuracy"], "mean")) + " correct (SEM " +

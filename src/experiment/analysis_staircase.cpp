@@ -93,7 +93,7 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
   json out;
   out["variable"] = rows.empty() ? std::string() : rows.front()->variable;
   out["reversals_k"] = o.reversals_k;
-  out["convergent_rule"] = o.convergent;
+  out["convergent_rule"] = std::string(to_string(o.convergent));
   json runs = json::array(), unfinished = json::array();
   // Every run that stopped before its stopping rule is named first, so the
   // reader meets the warning before the numbers.
@@ -125,7 +125,8 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
     // The source's end value is the last one presented; "next" takes the one
     // computed after the last answer (falling back to the last presented
     // when it was not stored).
-    const double end_value = o.convergent == "next" && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
+    const double end_value =
+        o.convergent == ConvergentValue::next && std::isfinite(last.next_intensity) ? last.next_intensity : last.intensity;
     // A run that stopped before its stopping rule has an end value but no
     // convergent value: it is reported "not finished" and kept out of the
     // group statistics unless asked (AnalysisOptions::include_unfinished).
@@ -186,7 +187,7 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
   json bj = json::array();
   std::vector<stats::Observation> obs;
   std::map<std::string, std::map<std::string, double>> per_participant;  // group → participant → convergent
-  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + o.convergent + ")" +
+  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + std::string(to_string(o.convergent)) + ")" +
           (unfinished.empty() ? std::string() : ", " + std::to_string(unfinished.size()) + " not finished") + "\n" + run_text;
   for (const std::string& b : blocks.names) {
     std::vector<double> cv, tv;

@@ -653,7 +653,7 @@ void on_experiment_export(State& s, Client& c, const Job& job) {
     const TempDir dir;
     ex::AnalysisOptions o;
     o.out_dir = dir.path.string();
-    o.format = "png";
+    o.format = ex::FigureFormat::png;
     const ex::AnalysisReport report = ex::analyze(rows, o);
     for (const auto& fig : report.figures) {
       const std::filesystem::path p(fig);

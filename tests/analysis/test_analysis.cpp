@@ -261,7 +261,7 @@ TEST(Analysis, EmptyInputIsAnEmptySummary) {
 
 TEST(Analysis, BadOptionsThrowInvalidArgument) {
   AnalysisOptions o;
-  o.format = "jpg";
+  o.format = static_cast<FigureFormat>(7);  // not one of its values (a C++ caller casting)
   EXPECT_THROW(analyze({}, o), InvalidArgument);
   o = {};
   o.reversals_k = 0;
@@ -273,17 +273,51 @@ TEST(Analysis, BadOptionsThrowInvalidArgument) {
   o.memory_accuracy_sd = -1;
   EXPECT_THROW(analyze({}, o), InvalidArgument);
   o = {};
-  o.memory_rule = "z-score";
+  o.memory_rule = static_cast<MemoryRule>(7);
   EXPECT_THROW(analyze({}, o), InvalidArgument);
   o = {};
   o.memory_errors_sd = 0;
   EXPECT_THROW(analyze({}, o), InvalidArgument);
   o = {};
-  o.convergent = "mean";
+  o.convergent = static_cast<ConvergentValue>(7);
   EXPECT_THROW(analyze({}, o), InvalidArgument);
   o = {};
-  o.confidence_distance = "median";
+  o.confidence_distance = static_cast<ConfidenceDistance>(7);
   EXPECT_THROW(analyze({}, o), InvalidArgument);
+  o = {};
+  o.reversals_k = 1001;
+  EXPECT_THROW(analyze({}, o), InvalidArgument);
+}
+
+// Every option the front doors offer is described once, with the rule analyze() applies:
+// the description's own default is in range, and one step past each finite bound is refused.
+TEST(Analysis, TheOptionsDescriptionIsTheRuleAnalyzeApplies) {
+  const AnalysisOptions defaults;
+  int described = 0;
+  visit_options(defaults, [&](const auto& v, const texel::OptionSpec& spec) {
+    ++described;
+    using T = std::remove_cvref_t<decltype(v)>;
+    SCOPED_TRACE(std::string(spec.key));
+    if constexpr (std::is_enum_v<T>) {
+      EXPECT_FALSE(texel::choice_name(spec.choices, static_cast<int>(v)).empty());
+    } else if constexpr (!std::is_same_v<T, bool>) {
+      EXPECT_NO_THROW(texel::check_option_value(spec, static_cast<double>(v), spec.key));
+      for (const double edge : {spec.min, spec.max}) {
+        if (!std::isfinite(edge)) continue;
+        const double step = std::is_integral_v<T> ? 1.0 : 1e-3;
+        const double past = edge == spec.min ? edge - step : edge + step;
+        const bool excl = edge == spec.min ? spec.min_exclusive : spec.max_exclusive;
+        AnalysisOptions o;
+        visit_options(o, [&](auto& member, const texel::OptionSpec& s) {
+          if constexpr (std::is_same_v<std::remove_cvref_t<decltype(member)>, T>)
+            if (s.key == spec.key) member = static_cast<T>(excl ? edge : past);
+        });
+        EXPECT_THROW(analyze({}, o), InvalidArgument) << "past " << edge;
+        EXPECT_THROW(texel::check_option_value(spec, excl ? edge : past, spec.key), InvalidArgument);
+      }
+    }
+  });
+  EXPECT_EQ(described, 11);
 }
 
 TEST(Analysis, StudiesInSpecOrderAndOnlyThoseWithData) {
@@ -301,7 +335,7 @@ TEST(Analysis, StudiesInSpecOrderAndOnlyThoseWithData) {
 TEST(Analysis, TexelLengthConvergentValuesAndReversalMeans) {
   AnalysisOptions o;
   o.reversals_k = 2;
-  o.convergent = "next";  // the value computed after the last answer
+  o.convergent = ConvergentValue::next;  // the value computed after the last answer
   const json s = summary_of(analyze(texel_length_rows(), o))["texel-length"];
   EXPECT_EQ(s["participants"], 3);
   EXPECT_EQ(s["variable"], "texel_length_mm");
@@ -337,7 +371,7 @@ TEST(Analysis, TexelLengthConvergentValuesAndReversalMeans) {
 
 TEST(Analysis, CoarseFeaturesAnovaOverFineStrength) {
   AnalysisOptions o;
-  o.convergent = "next";  // the rows' stored convergent values
+  o.convergent = ConvergentValue::next;  // the rows' stored convergent values
   const json s = summary_of(analyze(coarse_rows(), o))["coarse-features"];
   ASSERT_EQ(s["blocks"].size(), 3u);
   EXPECT_DOUBLE_EQ(s["blocks"][2]["fine_strength"].get<double>(), 1.0);
@@ -387,7 +421,7 @@ TEST(Analysis, FreeExplorationConfidenceAgainstDistanceToTheRater) {
 
   // The switch: distance from the reference's mean match, as before.
   AnalysisOptions o;
-  o.confidence_distance = "group-mean";
+  o.confidence_distance = ConfidenceDistance::group_mean;
   const json g = summary_of(analyze(mapping_rows("free-exploration"), o))["free-exploration"];
   std::vector<double> dist, conf;
   for (const auto& m : g["matches"])
@@ -449,7 +483,7 @@ TEST(Analysis, GuidedMatchesAndSimilarityMatrix) {
 
 TEST(Analysis, WorkingMemoryOutlierRuleAndAnova) {
   AnalysisOptions old;
-  old.memory_rule = "recall-accuracy";
+  old.memory_rule = MemoryRule::recall_accuracy;
   const json s = summary_of(analyze(memory_rows(), old))["working-memory"];
   EXPECT_EQ(s["participants"].size(), 5u);
   EXPECT_EQ(s["included"], 4);
@@ -475,7 +509,7 @@ TEST(Analysis, WorkingMemoryOutlierRuleAndAnova) {
   off.memory_accuracy_sd = 0;
   EXPECT_EQ(summary_of(analyze(memory_rows(), off))["working-memory"]["included"], 5);
   AnalysisOptions none;
-  none.memory_rule = "none";
+  none.memory_rule = MemoryRule::none;
   EXPECT_EQ(summary_of(analyze(memory_rows(), none))["working-memory"]["included"], 5);
   // The source's rule (default): S05's 8 errors are within mean + 2 SD
   // (4.8 + 2 · 2.17), so nobody is excluded; the comparison names S05 under
@@ -610,7 +644,7 @@ TEST(Analysis, SvgFiguresOnRequest) {
   test_support::TempDir dir("texel-analysis");
   AnalysisOptions o;
   o.out_dir = dir.at("svg");
-  o.format = "svg";
+  o.format = FigureFormat::svg;
   const AnalysisReport r = analyze(memory_rows(), o);
   ASSERT_EQ(r.figures.size(), 2u);  // performance, errors trend
   for (const auto& f : r.figures) EXPECT_NE(read_file(f).find("</svg>"), std::string::npos) << f;
@@ -716,7 +750,7 @@ TEST(Analysis, WorkingMemorySourceRuleExcludesTheSourcesTwoOutliers) {
   EXPECT_NEAR(effect(old["rm_anova"], "spacing:distractor")["f"].get<double>(), 25.90349076, 1e-7);
   EXPECT_NEAR(effect(old["rm_anova"], "spacing:distractor")["p"].get<double>(), 0.000133206898, 1e-12);
   AnalysisOptions o;
-  o.memory_rule = "recall-accuracy";
+  o.memory_rule = MemoryRule::recall_accuracy;
   const json k = summary_of(analyze(source_memory_cohort(), o))["working-memory"];
   EXPECT_EQ(k["included"], 16);
   EXPECT_NEAR(k["effect_share"]["share"].get<double>(), 0.3941694915, 1e-9);
