@@ -38,6 +38,7 @@
 #include <thread>
 #include <utility>
 
+#include "texel/detail/shared_object.hpp"
 #include "texel/error.hpp"
 #include "texel/experiment/records.hpp"
 
@@ -49,6 +50,45 @@ bool is_postgres(std::string_view db) {
 
 namespace pg {
 namespace {
+
+// ---------------------------------------------------------------------------
+// libpq, opened on first use (dlopen), not linked: it brings Kerberos, LDAP,
+// SASL and GnuTLS, which every texel command would otherwise load at start-up
+// whether or not it touches a server. <libpq-fe.h> still gives the types.
+
+#ifndef TEXEL_LIBPQ_SONAME
+#error "TEXEL_LIBPQ_SONAME (libpq's shared object name) is set by src/experiment/CMakeLists.txt"
+#endif
+
+// clang-format off
+#define TEXEL_LIBPQ_FUNCTIONS(X) \
+  X(PQclear) \
+  X(PQconnectdbParams) \
+  X(PQconninfoFree) \
+  X(PQconninfoParse) \
+  X(PQerrorMessage) \
+  X(PQescapeIdentifier) \
+  X(PQexec) \
+  X(PQexecParams) \
+  X(PQfinish) \
+  X(PQfreemem) \
+  X(PQgetisnull) \
+  X(PQgetvalue) \
+  X(PQhost) \
+  X(PQntuples) \
+  X(PQresultErrorField) \
+  X(PQresultErrorMessage) \
+  X(PQresultStatus) \
+  X(PQsetNoticeProcessor) \
+  X(PQsslInUse) \
+  X(PQstatus) \
+  X(PQuser)
+// clang-format on
+
+/// libpq, opened when the first postgresql:// or service= store is opened
+/// (`libpq()`, from the caller's thread before a station's shipper starts);
+/// without it SQLite stores work and a server is an IoError naming libpq.
+TEXEL_SHARED_LIBRARY(LibPq, libpq, TEXEL_LIBPQ_SONAME, "PostgreSQL stores", TEXEL_LIBPQ_FUNCTIONS)
 
 // ---------------------------------------------------------------------------
 // The connection target.
@@ -74,10 +114,10 @@ Target parse_target(const std::string& db) {
   Target t;
   t.db = db;
   char* err = nullptr;
-  PQconninfoOption* opts = PQconninfoParse(db.c_str(), &err);
+  PQconninfoOption* opts = libpq().PQconninfoParse(db.c_str(), &err);
   if (!opts) {
     std::string why = err ? err : "not a connection URI";
-    PQfreemem(err);
+    libpq().PQfreemem(err);
     while (!why.empty() && std::isspace(static_cast<unsigned char>(why.back()))) why.pop_back();
     throw InvalidArgument("--db: not a valid PostgreSQL connection URI or service name (" + why + ")");
   }
@@ -95,7 +135,7 @@ Target parse_target(const std::string& db) {
     if (k == "sslmode") t.sslmode = v;
     if (k == "password" && !v.empty()) password = true;
   }
-  PQconninfoFree(opts);
+  libpq().PQconninfoFree(opts);
   if (password)
     throw InvalidArgument(
         "--db: the connection URI holds a password; refused (it would show in process lists and shell history): put it "
@@ -164,26 +204,26 @@ PGconn* connect(const Target& t, ConnectFailure& failure) {
   }
   keys.push_back(nullptr);
   values.push_back(nullptr);
-  PGconn* c = PQconnectdbParams(keys.data(), values.data(), 1);
-  if (c && PQstatus(c) == CONNECTION_OK) {
-    const char* host = PQhost(c);
-    if (!loopback_host(host ? host : "") && PQsslInUse(c) == 0) {
-      PQfinish(c);
+  PGconn* c = libpq().PQconnectdbParams(keys.data(), values.data(), 1);
+  if (c && libpq().PQstatus(c) == CONNECTION_OK) {
+    const char* host = libpq().PQhost(c);
+    if (!loopback_host(host ? host : "") && libpq().PQsslInUse(c) == 0) {
+      libpq().PQfinish(c);
       failure = {"the connection to " + std::string(host) + " is not encrypted; TLS is required unless the host is loopback",
                  false};
       return nullptr;
     }
-    PQsetNoticeProcessor(
+    libpq().PQsetNoticeProcessor(
         c, [](void*, const char*) {}, nullptr);
     return c;
   }
-  failure.why = trim(c ? PQerrorMessage(c) : "out of memory");
+  failure.why = trim(c ? libpq().PQerrorMessage(c) : "out of memory");
   failure.outage = is_outage(failure.why);
   if (failure.why.rfind("connection to server", 0) == 0) {
     // "connection to server at "h" (addr), port p failed: REASON": keep REASON.
     if (const auto f = failure.why.find("failed: "); f != std::string::npos) failure.why = failure.why.substr(f + 8);
   }
-  PQfinish(c);
+  libpq().PQfinish(c);
   return nullptr;
 }
 
@@ -194,18 +234,18 @@ class Result {
   Result(Result&& o) noexcept : r_(std::exchange(o.r_, nullptr)) {}
   Result(const Result&) = delete;
   Result& operator=(const Result&) = delete;
-  ~Result() { PQclear(r_); }
+  ~Result() { libpq().PQclear(r_); }
   [[nodiscard]] bool ok() const {
-    const auto s = r_ ? PQresultStatus(r_) : PGRES_FATAL_ERROR;
+    const auto s = r_ ? libpq().PQresultStatus(r_) : PGRES_FATAL_ERROR;
     return s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK;
   }
-  [[nodiscard]] int rows() const { return PQntuples(r_); }
-  [[nodiscard]] std::string text(int row, int col) const { return PQgetvalue(r_, row, col); }
-  [[nodiscard]] bool null(int row, int col) const { return PQgetisnull(r_, row, col) == 1; }
-  [[nodiscard]] std::int64_t i64(int row, int col) const { return std::strtoll(PQgetvalue(r_, row, col), nullptr, 10); }
-  [[nodiscard]] std::string error() const { return r_ ? trim(PQresultErrorMessage(r_)) : "out of memory"; }
+  [[nodiscard]] int rows() const { return libpq().PQntuples(r_); }
+  [[nodiscard]] std::string text(int row, int col) const { return libpq().PQgetvalue(r_, row, col); }
+  [[nodiscard]] bool null(int row, int col) const { return libpq().PQgetisnull(r_, row, col) == 1; }
+  [[nodiscard]] std::int64_t i64(int row, int col) const { return std::strtoll(libpq().PQgetvalue(r_, row, col), nullptr, 10); }
+  [[nodiscard]] std::string error() const { return r_ ? trim(libpq().PQresultErrorMessage(r_)) : "out of memory"; }
   [[nodiscard]] std::string sqlstate() const {
-    const char* s = r_ ? PQresultErrorField(r_, PG_DIAG_SQLSTATE) : nullptr;
+    const char* s = r_ ? libpq().PQresultErrorField(r_, PG_DIAG_SQLSTATE) : nullptr;
     return s ? s : "";
   }
 
@@ -214,11 +254,11 @@ class Result {
 };
 
 Result run(PGconn* c, const std::string& sql, const std::vector<std::string>& params = {}) {
-  if (params.empty()) return Result(PQexec(c, sql.c_str()));  // may hold several statements (migrations)
+  if (params.empty()) return Result(libpq().PQexec(c, sql.c_str()));  // may hold several statements (migrations)
   std::vector<const char*> v;
   v.reserve(params.size());
   for (const auto& p : params) v.push_back(p.c_str());
-  return Result(PQexecParams(c, sql.c_str(), static_cast<int>(v.size()), nullptr, v.data(), nullptr, nullptr, 0));
+  return Result(libpq().PQexecParams(c, sql.c_str(), static_cast<int>(v.size()), nullptr, v.data(), nullptr, nullptr, 0));
 }
 
 // The Texel schema's version on the server, 0 when there is none.
@@ -227,11 +267,11 @@ int server_version(PGconn* c, const std::string& label) {
   if (!ns.ok()) throw IoError(label + ": reading the schema failed (" + ns.error() + ")");
   if (ns.rows() == 0) return 0;
   Result m = run(c, "SELECT key, value FROM texel.meta WHERE key IN ('application', 'schema_version')");
-  if (!m.ok() && PQstatus(c) != CONNECTION_OK)
+  if (!m.ok() && libpq().PQstatus(c) != CONNECTION_OK)
     throw IoError(label + ": lost the server while reading the schema (" + m.error() + ")");
   if (!m.ok()) {
     if (m.sqlstate() == "42501")
-      throw IoError(label + ": the role " + std::string(PQuser(c)) +
+      throw IoError(label + ": the role " + std::string(libpq().PQuser(c)) +
                     " may not read the Texel schema (it is neither a station nor an analyst role: texel store init)");
     throw FormatError(label + " is not a Texel experiment database (" + m.error() + ")");
   }
@@ -451,9 +491,9 @@ bool valid_role(const std::string& r) {
 }
 
 std::string ident(PGconn* c, const std::string& name) {
-  char* q = PQescapeIdentifier(c, name.c_str(), name.size());
+  char* q = libpq().PQescapeIdentifier(c, name.c_str(), name.size());
   std::string out = q ? q : "";
-  PQfreemem(q);
+  libpq().PQfreemem(q);
   return out;
 }
 
@@ -477,11 +517,11 @@ class ReaderImpl final : public Reader {
     try {
       check_version(c_, t_.label);
     } catch (...) {
-      PQfinish(c_);
+      libpq().PQfinish(c_);
       throw;
     }
   }
-  ~ReaderImpl() override { PQfinish(c_); }
+  ~ReaderImpl() override { libpq().PQfinish(c_); }
   ReaderImpl(const ReaderImpl&) = delete;
   ReaderImpl& operator=(const ReaderImpl&) = delete;
 
@@ -521,7 +561,7 @@ class ReaderImpl final : public Reader {
     (void)query("BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY", {}, op);
     struct End {
       PGconn* c;
-      ~End() { PQclear(PQexec(c, "COMMIT")); }
+      ~End() { libpq().PQclear(libpq().PQexec(c, "COMMIT")); }
     } end{c_};
     Result t = query(
         "SELECT t.trial, t.question_json, t.response_json, t.state_json, t.row_json FROM texel.trials t JOIN texel.sessions s "
@@ -598,7 +638,7 @@ class ReaderImpl final : public Reader {
     std::lock_guard<std::mutex> hold(mu_);
     Result r = run(c_, sql, params);
     if (!r.ok()) {
-      if (PQstatus(c_) != CONNECTION_OK)
+      if (libpq().PQstatus(c_) != CONNECTION_OK)
         throw IoError(t_.label + ": " + op + " failed: the server went away (" + r.error() + ")");
       throw IoError(t_.label + ": " + op + " failed: " + r.error());
     }
@@ -778,7 +818,7 @@ class StationImpl final : public Station {
     }
     cv_.notify_all();
     if (thread_.joinable()) thread_.join();
-    if (pg_) PQfinish(pg_);
+    if (pg_) libpq().PQfinish(pg_);
   }
   StationImpl(const StationImpl&) = delete;
   StationImpl& operator=(const StationImpl&) = delete;
@@ -824,7 +864,7 @@ class StationImpl final : public Station {
 
   [[nodiscard]] std::string stations() override {
     std::lock_guard<std::mutex> io(io_mu_);
-    if (!pg_ || PQstatus(pg_) != CONNECTION_OK) throw IoError(t_.label + " is not reachable: " + status().last_error);
+    if (!pg_ || libpq().PQstatus(pg_) != CONNECTION_OK) throw IoError(t_.label + " is not reachable: " + status().last_error);
     return station_rows(pg_, t_.label);
   }
 
@@ -852,9 +892,9 @@ class StationImpl final : public Station {
  private:
   // Under io_mu_. `at_start`: a refusal throws; later it is reported.
   bool ensure_connected(bool at_start) {
-    if (pg_ && PQstatus(pg_) == CONNECTION_OK) return true;
+    if (pg_ && libpq().PQstatus(pg_) == CONNECTION_OK) return true;
     if (pg_) {
-      PQfinish(pg_);
+      libpq().PQfinish(pg_);
       pg_ = nullptr;
     }
     ConnectFailure f;
@@ -868,8 +908,8 @@ class StationImpl final : public Station {
       check_version(pg_, t_.label);
     } catch (const Error& e) {
       // The link dropping during the check is an outage like any other.
-      const bool outage = PQstatus(pg_) != CONNECTION_OK;
-      PQfinish(pg_);
+      const bool outage = libpq().PQstatus(pg_) != CONNECTION_OK;
+      libpq().PQfinish(pg_);
       pg_ = nullptr;
       set_error(e.what());
       if (at_start && !outage) throw;
@@ -888,19 +928,19 @@ class StationImpl final : public Station {
 
   void set_error(const std::string& why) {
     std::lock_guard<std::mutex> st(state_mu_);
-    state_.connected = pg_ && PQstatus(pg_) == CONNECTION_OK;
+    state_.connected = pg_ && libpq().PQstatus(pg_) == CONNECTION_OK;
     state_.last_error = why;
   }
 
   // A statement failed: a lost server closes the connection (reconnect on
   // the next pass); anything else is a refusal that stays reported.
   void failed(const Result& r, const std::string& op) {
-    if (pg_ && PQstatus(pg_) != CONNECTION_OK) {
-      PQfinish(pg_);
+    if (pg_ && libpq().PQstatus(pg_) != CONNECTION_OK) {
+      libpq().PQfinish(pg_);
       pg_ = nullptr;
       set_error("lost the server while " + op + " (" + r.error() + ")");
     } else {
-      PQclear(PQexec(pg_, "ROLLBACK"));
+      libpq().PQclear(libpq().PQexec(pg_, "ROLLBACK"));
       set_error(op + " refused by the server: " + r.error());
     }
   }
@@ -1212,13 +1252,13 @@ std::vector<std::string> init_postgres(const std::string& db, const std::vector<
   if (!c) throw IoError("cannot connect to " + t.label + ": " + f.why);
   struct Close {
     PGconn* c;
-    ~Close() { PQfinish(c); }
+    ~Close() { pg::libpq().PQfinish(c); }
   } close{c};
   std::vector<std::string> report;
   auto must = [&](const std::string& sql, const std::string& op) {
     pg::Result r = pg::run(c, sql);
     if (!r.ok()) {
-      PQclear(PQexec(c, "ROLLBACK"));
+      pg::libpq().PQclear(pg::libpq().PQexec(c, "ROLLBACK"));
       throw IoError(t.label + ": " + op + " failed: " + r.error());
     }
   };

@@ -2,10 +2,9 @@
 // texture signals through load_signal(). Each format is parsed from bytes
 // (decode_signal, so fuzzers and servers need no file); the file entry point
 // only bounds the file's size before reading it. Audio goes through
-// libsndfile's virtual I/O from memory, or sf_open on a path (no copy).
+// libsndfile's virtual I/O from memory, or sf_open on a path (no copy);
+// libsndfile is opened on the first audio file (texel/detail/sndfile.hpp).
 #include "texel/signal.hpp"
-
-#include <sndfile.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +12,7 @@
 #include <filesystem>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/sndfile.hpp"
 #include "texel/document.hpp"
 #include "texel/error.hpp"
 #include "texel/interchange.hpp"
@@ -130,7 +130,7 @@ sf_count_t mem_tell(void* u) { return static_cast<Memory*>(u)->at; }
 Recording read_open(SNDFILE* f, const SF_INFO& info, const SignalOptions& o, std::string_view origin) {
   struct Closer {
     SNDFILE* f;
-    ~Closer() { sf_close(f); }
+    ~Closer() { detail::sndfile().sf_close(f); }
   } closer{f};
   if (info.frames <= 0 || info.channels <= 0 || info.samplerate <= 0)
     throw FormatError(in_quotes(origin) + " holds no audio frames");
@@ -145,7 +145,7 @@ Recording read_open(SNDFILE* f, const SF_INFO& info, const SignalOptions& o, std
   const auto frames = static_cast<std::uint64_t>(info.frames);
   if (frames > o.max_samples || frames * channels > o.max_samples) too_many(origin, frames * channels, o);
   std::vector<double> all(frames * channels);
-  const sf_count_t got = sf_readf_double(f, all.data(), info.frames);
+  const sf_count_t got = detail::sndfile().sf_readf_double(f, all.data(), info.frames);
   if (got != info.frames) throw FormatError(in_quotes(origin) + ": truncated audio data");
   Recording r;
   r.rate = Hertz(info.samplerate);
@@ -408,8 +408,9 @@ Recording decode_recording(std::span<const std::byte> bytes, const SignalOptions
   Memory m{bytes};
   SF_VIRTUAL_IO io{mem_length, mem_seek, mem_read, mem_write, mem_tell};
   SF_INFO info{};
-  SNDFILE* f = sf_open_virtual(&io, SFM_READ, &info, &m);
-  if (!f) throw FormatError("cannot read " + in_quotes(origin) + " as audio: " + std::string(sf_strerror(nullptr)));
+  SNDFILE* f = detail::sndfile().sf_open_virtual(&io, SFM_READ, &info, &m);
+  if (!f)
+    throw FormatError("cannot read " + in_quotes(origin) + " as audio: " + std::string(detail::sndfile().sf_strerror(nullptr)));
   return read_open(f, info, o, origin);
 }
 
@@ -418,8 +419,9 @@ Recording read_recording(const std::string& path, const SignalOptions& o) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) (void)read_file(path);  // the IoError naming why
   SF_INFO info{};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (!f) throw FormatError("cannot read " + in_quotes(path) + " as audio: " + std::string(sf_strerror(nullptr)));
+  SNDFILE* f = detail::sndfile().sf_open(path.c_str(), SFM_READ, &info);
+  if (!f)
+    throw FormatError("cannot read " + in_quotes(path) + " as audio: " + std::string(detail::sndfile().sf_strerror(nullptr)));
   return read_open(f, info, o, path);
 }
 

@@ -11,13 +11,13 @@
 #include <thread>
 
 #include <portaudio.h>
-#include <sndfile.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "texel/detail/format.hpp"
 #include "texel/detail/realtime.hpp"
 #include "texel/detail/shared_object.hpp"
+#include "texel/detail/sndfile.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
 #include "texel/multichannel_player.hpp"
@@ -41,20 +41,21 @@ void write_wav(const std::string& path, std::span<const float> samples, std::siz
                           " channels; allowed: 1 … 64 channels and whole frames");
   check_writable(path);
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  const detail::SndFile& sf = detail::sndfile();  // opened here on the first WAV written
   SF_INFO info{};
   info.samplerate = static_cast<int>(std::lround(rate_hz));
   info.channels = static_cast<int>(channels);
   info.format = SF_FORMAT_WAV | (encoding == WavEncoding::pcm16   ? SF_FORMAT_PCM_16
                                  : encoding == WavEncoding::pcm24 ? SF_FORMAT_PCM_24
                                                                   : SF_FORMAT_FLOAT);
-  SNDFILE* f = sf_open(tmp.c_str(), SFM_WRITE, &info);
-  if (!f) throw IoError("cannot write '" + path + "': " + sf_strerror(nullptr));
+  SNDFILE* f = sf.sf_open(tmp.c_str(), SFM_WRITE, &info);
+  if (!f) throw IoError("cannot write '" + path + "': " + sf.sf_strerror(nullptr));
   // Clip rather than let libsndfile wrap out-of-range floats.
-  sf_command(f, SFC_SET_CLIPPING, nullptr, SF_TRUE);
+  sf.sf_command(f, SFC_SET_CLIPPING, nullptr, SF_TRUE);
   const sf_count_t n = static_cast<sf_count_t>(samples.size() / channels);  // frames
-  const sf_count_t written = n ? sf_writef_float(f, samples.data(), n) : 0;
-  const std::string err = written == n ? "" : sf_strerror(f);
-  if (sf_close(f) != 0 || written != n) {
+  const sf_count_t written = n ? sf.sf_writef_float(f, samples.data(), n) : 0;
+  const std::string err = written == n ? "" : sf.sf_strerror(f);
+  if (sf.sf_close(f) != 0 || written != n) {
     std::remove(tmp.c_str());
     throw IoError("cannot write '" + path + "': " + (err.empty() ? "write failed" : err));
   }

@@ -1,7 +1,7 @@
 // The drawing parts the figure layer (plot.cpp: layout, axes, legend,
-// encoders) shares with the series painters (series.cpp): the Cairo painter,
-// the data-to-pixel scale and a panel's plan. Internal to texel_plot; not
-// installed.
+// encoders) shares with the series painters (series.cpp): Cairo itself
+// (opened on first use), the Cairo painter, the data-to-pixel scale and a
+// panel's plan. Internal to texel_plot; not installed.
 #pragma once
 
 #include <algorithm>
@@ -11,12 +11,74 @@
 #include <utility>
 #include <vector>
 
+#include <cairo-svg.h>
 #include <cairo.h>
 
 #include "texel/detail/format.hpp"
+#include "texel/detail/shared_object.hpp"
 #include "texel/plot.hpp"
 
+#ifndef TEXEL_CAIRO_SONAME
+#error "TEXEL_CAIRO_SONAME (Cairo's shared object name) is set by src/CMakeLists.txt"
+#endif
+
 namespace texel::plot_detail {
+
+// Cairo is opened on first use (dlopen), not linked: with X11, fontconfig,
+// FreeType and pixman it is some twenty libraries that every texel command
+// would otherwise load at start-up, though only figures need it. <cairo.h>
+// and <cairo-svg.h> still give the types and constants.
+// clang-format off
+#define TEXEL_CAIRO_FUNCTIONS(X) \
+  X(cairo_arc) \
+  X(cairo_clip) \
+  X(cairo_create) \
+  X(cairo_destroy) \
+  X(cairo_fill) \
+  X(cairo_fill_preserve) \
+  X(cairo_font_extents) \
+  X(cairo_font_options_create) \
+  X(cairo_font_options_destroy) \
+  X(cairo_font_options_set_antialias) \
+  X(cairo_font_options_set_hint_metrics) \
+  X(cairo_font_options_set_hint_style) \
+  X(cairo_image_surface_create) \
+  X(cairo_line_to) \
+  X(cairo_move_to) \
+  X(cairo_new_sub_path) \
+  X(cairo_paint) \
+  X(cairo_rectangle) \
+  X(cairo_restore) \
+  X(cairo_rotate) \
+  X(cairo_save) \
+  X(cairo_select_font_face) \
+  X(cairo_set_antialias) \
+  X(cairo_set_dash) \
+  X(cairo_set_font_options) \
+  X(cairo_set_font_size) \
+  X(cairo_set_line_cap) \
+  X(cairo_set_line_join) \
+  X(cairo_set_line_width) \
+  X(cairo_set_source_rgb) \
+  X(cairo_set_source_rgba) \
+  X(cairo_show_text) \
+  X(cairo_status) \
+  X(cairo_status_to_string) \
+  X(cairo_stroke) \
+  X(cairo_surface_destroy) \
+  X(cairo_surface_finish) \
+  X(cairo_surface_flush) \
+  X(cairo_surface_status) \
+  X(cairo_surface_write_to_png_stream) \
+  X(cairo_svg_surface_create_for_stream) \
+  X(cairo_svg_surface_set_document_unit) \
+  X(cairo_text_extents) \
+  X(cairo_translate)
+// clang-format on
+
+/// Cairo, opened when the first figure is drawn (`cairo()`); without it the
+/// rest of Texel works and a figure is an IoError naming the library.
+TEXEL_SHARED_LIBRARY(Cairo, cairo, TEXEL_CAIRO_SONAME, "figures (PNG, SVG)", TEXEL_CAIRO_FUNCTIONS)
 
 inline constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
@@ -52,34 +114,35 @@ inline const Rgb grid_colour{0.88, 0.88, 0.88};
 class Painter {
  public:
   explicit Painter(cairo_t* cr) : cr_(cr) {
-    cairo_font_options_t* opts = cairo_font_options_create();
+    cairo_font_options_t* opts = cairo().cairo_font_options_create();
     // Unhinted metrics: text measures the same in PNG and SVG.
-    cairo_font_options_set_hint_metrics(opts, CAIRO_HINT_METRICS_OFF);
-    cairo_font_options_set_hint_style(opts, CAIRO_HINT_STYLE_SLIGHT);
-    cairo_font_options_set_antialias(opts, CAIRO_ANTIALIAS_GRAY);
-    cairo_set_font_options(cr_, opts);
-    cairo_font_options_destroy(opts);
-    cairo_set_antialias(cr_, CAIRO_ANTIALIAS_DEFAULT);
+    cairo().cairo_font_options_set_hint_metrics(opts, CAIRO_HINT_METRICS_OFF);
+    cairo().cairo_font_options_set_hint_style(opts, CAIRO_HINT_STYLE_SLIGHT);
+    cairo().cairo_font_options_set_antialias(opts, CAIRO_ANTIALIAS_GRAY);
+    cairo().cairo_set_font_options(cr_, opts);
+    cairo().cairo_font_options_destroy(opts);
+    cairo().cairo_set_antialias(cr_, CAIRO_ANTIALIAS_DEFAULT);
   }
   [[nodiscard]] cairo_t* cr() const { return cr_; }
 
-  void colour(Rgb c, double alpha = 1.0) const { cairo_set_source_rgba(cr_, c.r, c.g, c.b, alpha); }
+  void colour(Rgb c, double alpha = 1.0) const { cairo().cairo_set_source_rgba(cr_, c.r, c.g, c.b, alpha); }
 
   void font(double size_px, bool bold = false) const {
-    cairo_select_font_face(cr_, "sans-serif", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr_, size_px);
+    cairo().cairo_select_font_face(cr_, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
+                                   bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo().cairo_set_font_size(cr_, size_px);
   }
   /// Advance width of `s` in the current font, px.
   [[nodiscard]] double width(const std::string& s) const {
     if (s.empty()) return 0.0;
     cairo_text_extents_t e;
-    cairo_text_extents(cr_, s.c_str(), &e);
+    cairo().cairo_text_extents(cr_, s.c_str(), &e);
     return e.x_advance;
   }
   /// Line height of the current font, px.
   [[nodiscard]] double line_height() const {
     cairo_font_extents_t e;
-    cairo_font_extents(cr_, &e);
+    cairo().cairo_font_extents(cr_, &e);
     return e.height;
   }
   /// Draws `s` anchored at (x, y), rotated by `angle` radians about the anchor.
@@ -88,18 +151,18 @@ class Painter {
   void text(const std::string& s, double x, double y, HAlign h, VAlign v, double angle = 0.0) const {
     if (s.empty()) return;
     cairo_font_extents_t fe;
-    cairo_font_extents(cr_, &fe);
+    cairo().cairo_font_extents(cr_, &fe);
     const double w = width(s);
     const double dx = h == HAlign::left ? 0.0 : h == HAlign::centre ? -w / 2 : -w;
     const double dy = v == VAlign::top ? fe.ascent : v == VAlign::middle ? (fe.ascent - fe.descent) / 2 : -fe.descent;
-    cairo_save(cr_);
-    cairo_translate(cr_, x, y);
-    if (angle != 0.0) cairo_rotate(cr_, angle);
-    cairo_move_to(cr_, dx, dy);
-    cairo_show_text(cr_, s.c_str());
-    cairo_restore(cr_);
+    cairo().cairo_save(cr_);
+    cairo().cairo_translate(cr_, x, y);
+    if (angle != 0.0) cairo().cairo_rotate(cr_, angle);
+    cairo().cairo_move_to(cr_, dx, dy);
+    cairo().cairo_show_text(cr_, s.c_str());
+    cairo().cairo_restore(cr_);
   }
-  void rect(const Rect& r) const { cairo_rectangle(cr_, r.x, r.y, r.w, r.h); }
+  void rect(const Rect& r) const { cairo().cairo_rectangle(cr_, r.x, r.y, r.w, r.h); }
 
   /// `s` fitted into `max_w` px: the font shrinks down to 70 % of `size_px`,
   /// then the text is cut with an ellipsis. Selects the font it fits with.

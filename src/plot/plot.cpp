@@ -17,9 +17,6 @@
 #include <memory>
 #include <numbers>
 
-#include <cairo-svg.h>
-#include <cairo.h>
-
 #include "texel/detail/format.hpp"
 #include "texel/error.hpp"
 #include "texel/io.hpp"
@@ -244,10 +241,10 @@ void check_figure(const Figure& f, const std::string& name) {
 // -------------------------------------------------------------------- cairo
 
 struct SurfaceDeleter {
-  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
+  void operator()(cairo_surface_t* s) const { cairo().cairo_surface_destroy(s); }
 };
 struct ContextDeleter {
-  void operator()(cairo_t* c) const { cairo_destroy(c); }
+  void operator()(cairo_t* c) const { cairo().cairo_destroy(c); }
 };
 using SurfacePtr = std::unique_ptr<cairo_surface_t, SurfaceDeleter>;
 using ContextPtr = std::unique_ptr<cairo_t, ContextDeleter>;
@@ -590,35 +587,35 @@ void draw_axes(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Sca
   const auto snap = [](double v) { return std::floor(v) + 0.5; };
 
   // Grid at major ticks, behind everything.
-  cairo_set_line_width(cr, 1.0);
+  cairo().cairo_set_line_width(cr, 1.0);
   pa.colour(grid_colour);
   for (const auto& t : pp.xticks)
     if (t.major) {
       const double x = snap(xs(t.value));
-      cairo_move_to(cr, x, r.y);
-      cairo_line_to(cr, x, r.bottom());
+      cairo().cairo_move_to(cr, x, r.y);
+      cairo().cairo_line_to(cr, x, r.bottom());
     }
   for (const auto& t : pp.yticks)
     if (t.major) {
       const double y = snap(ys(t.value));
-      cairo_move_to(cr, r.x, y);
-      cairo_line_to(cr, r.right(), y);
+      cairo().cairo_move_to(cr, r.x, y);
+      cairo().cairo_line_to(cr, r.right(), y);
     }
-  cairo_stroke(cr);
+  cairo().cairo_stroke(cr);
 
   // Tick marks (outside the frame) and labels.
   pa.colour(frame_colour);
   for (const auto& t : pp.xticks) {
     const double x = snap(xs(t.value));
-    cairo_move_to(cr, x, snap(r.bottom()));
-    cairo_line_to(cr, x, snap(r.bottom()) + (t.major ? tick_len : tick_len * 0.6));
+    cairo().cairo_move_to(cr, x, snap(r.bottom()));
+    cairo().cairo_line_to(cr, x, snap(r.bottom()) + (t.major ? tick_len : tick_len * 0.6));
   }
   for (const auto& t : pp.yticks) {
     const double y = snap(ys(t.value));
-    cairo_move_to(cr, snap(r.x), y);
-    cairo_line_to(cr, snap(r.x) - (t.major ? tick_len : tick_len * 0.6), y);
+    cairo().cairo_move_to(cr, snap(r.x), y);
+    cairo().cairo_line_to(cr, snap(r.x) - (t.major ? tick_len : tick_len * 0.6), y);
   }
-  cairo_stroke(cr);
+  cairo().cairo_stroke(cr);
 
   pa.font(f.tick);
   const double tick_lh = pa.line_height();
@@ -657,10 +654,10 @@ void draw_axes(const PanelPlan& pp, const Painter& pa, const Fonts& f, const Sca
     pa.text(p.y.label, pp.cell.x + f.base * 0.6, r.y + r.h / 2, HAlign::centre, VAlign::top, -std::numbers::pi / 2);
 
   // Frame on top of the grid.
-  cairo_set_line_width(cr, 1.0);
+  cairo().cairo_set_line_width(cr, 1.0);
   pa.colour(frame_colour);
-  cairo_rectangle(cr, snap(r.x), snap(r.y), std::round(r.w), std::round(r.h));
-  cairo_stroke(cr);
+  cairo().cairo_rectangle(cr, snap(r.x), snap(r.y), std::round(r.w), std::round(r.h));
+  cairo().cairo_stroke(cr);
 }
 
 /// The heatmap's colour scale: a vertical bar right of the plot, its two
@@ -677,13 +674,13 @@ void draw_colour_bar(const PanelPlan& pp, const Painter& pa, const Fonts& f) {
     const double t0 = static_cast<double>(k) / steps;
     pa.colour(blues(t0 + 0.5 / steps));
     // Slight overlap so antialiased seams do not show.
-    cairo_rectangle(cr, bar.x, bar.bottom() - bar.h * (t0 + 1.0 / steps) - 0.5, bar.w, bar.h / steps + 1.0);
-    cairo_fill(cr);
+    cairo().cairo_rectangle(cr, bar.x, bar.bottom() - bar.h * (t0 + 1.0 / steps) - 0.5, bar.w, bar.h / steps + 1.0);
+    cairo().cairo_fill(cr);
   }
-  cairo_set_line_width(cr, 1.0);
+  cairo().cairo_set_line_width(cr, 1.0);
   pa.colour(frame_colour);
   pa.rect(bar);
-  cairo_stroke(cr);
+  cairo().cairo_stroke(cr);
   pa.font(f.tick);
   pa.colour(text_colour);
   pa.text(format_heat(pp.heat_hi, *h), bar.right() + 4, bar.y, HAlign::left, VAlign::top);
@@ -749,12 +746,12 @@ void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
   std::size_t best = hidden(box);
   for (const Rect& c : corners)
     if (const std::size_t h = hidden(c); h < best) best = h, box = c;
-  cairo_set_source_rgba(cr, 1, 1, 1, 0.88);
+  cairo().cairo_set_source_rgba(cr, 1, 1, 1, 0.88);
   pa.rect(box);
-  cairo_fill_preserve(cr);
+  cairo().cairo_fill_preserve(cr);
   pa.colour({0.75, 0.75, 0.75});
-  cairo_set_line_width(cr, 1.0);
-  cairo_stroke(cr);
+  cairo().cairo_set_line_width(cr, 1.0);
+  cairo().cairo_stroke(cr);
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const auto& e = entries[i];
     const double cy = box.y + pad * 0.6 + lh * (static_cast<double>(i) + 0.5);
@@ -762,24 +759,24 @@ void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
     switch (e.kind) {
       case Swatch::line:
         pa.colour(e.colour);
-        cairo_set_line_width(cr, 2.0);
-        cairo_move_to(cr, x0, cy);
-        cairo_line_to(cr, x0 + sw, cy);
-        cairo_stroke(cr);
+        cairo().cairo_set_line_width(cr, 2.0);
+        cairo().cairo_move_to(cr, x0, cy);
+        cairo().cairo_line_to(cr, x0 + sw, cy);
+        cairo().cairo_stroke(cr);
         break;
       case Swatch::stem:
         pa.colour(e.colour);
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x0 + sw / 2, cy, 3.0, 0, 2 * std::numbers::pi);
-        cairo_fill(cr);
+        cairo().cairo_new_sub_path(cr);
+        cairo().cairo_arc(cr, x0 + sw / 2, cy, 3.0, 0, 2 * std::numbers::pi);
+        cairo().cairo_fill(cr);
         break;
       case Swatch::bar:
         pa.colour(e.colour, 0.55);
-        cairo_rectangle(cr, x0, cy - lh * 0.3, sw, lh * 0.6);
-        cairo_fill_preserve(cr);
+        cairo().cairo_rectangle(cr, x0, cy - lh * 0.3, sw, lh * 0.6);
+        cairo().cairo_fill_preserve(cr);
         pa.colour(e.colour);
-        cairo_set_line_width(cr, 0.8);
-        cairo_stroke(cr);
+        cairo().cairo_set_line_width(cr, 0.8);
+        cairo().cairo_stroke(cr);
         break;
     }
     pa.colour(text_colour);
@@ -791,11 +788,11 @@ void draw_legend(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
 void draw_figure(const Painter& pa, const Figure& fig, const Rect& area) {
   cairo_t* cr = pa.cr();
   const Fonts f(fig.font_px);
-  cairo_save(cr);
+  cairo().cairo_save(cr);
   pa.rect(area);
-  cairo_clip(cr);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
+  cairo().cairo_clip(cr);
+  cairo().cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo().cairo_paint(cr);
 
   const double outer = f.base * 0.5;
   double top = area.y + outer;
@@ -807,7 +804,7 @@ void draw_figure(const Painter& pa, const Figure& fig, const Rect& area) {
   }
   const std::size_t n = fig.panels.size();
   if (n == 0) {
-    cairo_restore(cr);
+    cairo().cairo_restore(cr);
     return;
   }
   const auto cols = static_cast<std::size_t>(fig.columns);
@@ -859,7 +856,7 @@ void draw_figure(const Painter& pa, const Figure& fig, const Rect& area) {
     draw_colour_bar(pp, pa, f);
     draw_legend(pp, pa, f, xs, ys, line_px);
   }
-  cairo_restore(cr);
+  cairo().cairo_restore(cr);
 }
 
 /// Creates a surface of the format, runs `draw` on it and returns the bytes.
@@ -868,32 +865,32 @@ std::string encode(PlotFormat format, int width, int height, Draw&& draw) {
   std::string bytes;
   SurfacePtr surface;
   if (format == PlotFormat::png) {
-    surface.reset(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
+    surface.reset(cairo().cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
   } else {
-    surface.reset(cairo_svg_surface_create_for_stream(append_to_string, &bytes, width, height));
-    if (cairo_surface_status(surface.get()) == CAIRO_STATUS_SUCCESS)
-      cairo_svg_surface_set_document_unit(surface.get(), CAIRO_SVG_UNIT_PX);
+    surface.reset(cairo().cairo_svg_surface_create_for_stream(append_to_string, &bytes, width, height));
+    if (cairo().cairo_surface_status(surface.get()) == CAIRO_STATUS_SUCCESS)
+      cairo().cairo_svg_surface_set_document_unit(surface.get(), CAIRO_SVG_UNIT_PX);
   }
-  if (const auto st = cairo_surface_status(surface.get()); st != CAIRO_STATUS_SUCCESS)
+  if (const auto st = cairo().cairo_surface_status(surface.get()); st != CAIRO_STATUS_SUCCESS)
     throw IoError(std::string("cannot create a ") + std::to_string(width) + "×" + std::to_string(height) +
-                  " plot surface: " + cairo_status_to_string(st));
+                  " plot surface: " + cairo().cairo_status_to_string(st));
   {
-    ContextPtr cr(cairo_create(surface.get()));
-    cairo_set_source_rgb(cr.get(), 1, 1, 1);
-    cairo_paint(cr.get());
+    ContextPtr cr(cairo().cairo_create(surface.get()));
+    cairo().cairo_set_source_rgb(cr.get(), 1, 1, 1);
+    cairo().cairo_paint(cr.get());
     const Painter pa(cr.get());
     draw(pa);
-    if (const auto st = cairo_status(cr.get()); st != CAIRO_STATUS_SUCCESS)
-      throw IoError(std::string("cannot render plot: ") + cairo_status_to_string(st));
+    if (const auto st = cairo().cairo_status(cr.get()); st != CAIRO_STATUS_SUCCESS)
+      throw IoError(std::string("cannot render plot: ") + cairo().cairo_status_to_string(st));
   }
   if (format == PlotFormat::png) {
-    cairo_surface_flush(surface.get());
-    const auto st = cairo_surface_write_to_png_stream(surface.get(), append_to_string, &bytes);
-    if (st != CAIRO_STATUS_SUCCESS) throw IoError(std::string("cannot encode PNG: ") + cairo_status_to_string(st));
+    cairo().cairo_surface_flush(surface.get());
+    const auto st = cairo().cairo_surface_write_to_png_stream(surface.get(), append_to_string, &bytes);
+    if (st != CAIRO_STATUS_SUCCESS) throw IoError(std::string("cannot encode PNG: ") + cairo().cairo_status_to_string(st));
   } else {
-    cairo_surface_finish(surface.get());  // flushes the SVG into `bytes`
-    if (const auto st = cairo_surface_status(surface.get()); st != CAIRO_STATUS_SUCCESS)
-      throw IoError(std::string("cannot encode SVG: ") + cairo_status_to_string(st));
+    cairo().cairo_surface_finish(surface.get());  // flushes the SVG into `bytes`
+    if (const auto st = cairo().cairo_surface_status(surface.get()); st != CAIRO_STATUS_SUCCESS)
+      throw IoError(std::string("cannot encode SVG: ") + cairo().cairo_status_to_string(st));
   }
   return bytes;
 }

@@ -27,8 +27,8 @@ void draw_heatmap(const HeatmapSeries& heat, const PanelPlan& pp, const Painter&
       const double x0 = xs(cx - 0.5), x1 = xs(cx + 0.5), y0 = ys(cy + 0.5), y1 = ys(cy - 0.5);
       const double t = (v - pp.heat_lo) / (pp.heat_hi - pp.heat_lo);
       pa.colour(blues(t));
-      cairo_rectangle(cr, x0, y0, x1 - x0, y1 - y0);
-      cairo_fill(cr);
+      cairo().cairo_rectangle(cr, x0, y0, x1 - x0, y1 - y0);
+      cairo().cairo_fill(cr);
       if (h->decimals >= 0) {
         // Light text on the darker half of the scale keeps every value legible.
         pa.colour(t > 0.55 ? Rgb{1, 1, 1} : text_colour);
@@ -36,19 +36,19 @@ void draw_heatmap(const HeatmapSeries& heat, const PanelPlan& pp, const Painter&
       }
     }
   // White cell borders read as a table without a grid behind it.
-  cairo_set_line_width(cr, 1.0);
-  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo().cairo_set_line_width(cr, 1.0);
+  cairo().cairo_set_source_rgb(cr, 1, 1, 1);
   for (std::size_t c = 1; c < h->cols; ++c) {
     const double x = xs(static_cast<double>(c) - 0.5);
-    cairo_move_to(cr, x, r.y);
-    cairo_line_to(cr, x, r.bottom());
+    cairo().cairo_move_to(cr, x, r.y);
+    cairo().cairo_line_to(cr, x, r.bottom());
   }
   for (std::size_t k = 1; k < h->rows; ++k) {
     const double y = ys(static_cast<double>(k) - 0.5);
-    cairo_move_to(cr, r.x, y);
-    cairo_line_to(cr, r.right(), y);
+    cairo().cairo_move_to(cr, r.x, y);
+    cairo().cairo_line_to(cr, r.right(), y);
   }
-  cairo_stroke(cr);
+  cairo().cairo_stroke(cr);
 }
 
 /// Bars from the baseline (the bottom on a log axis), outlined when wide enough.
@@ -64,17 +64,17 @@ void draw_histograms(const PanelPlan& pp, const Painter& pa, const Scale& xs, co
     for (std::size_t b = 0; b < h.counts.size(); ++b) {
       const double x0 = xs(h.edges[b]), x1 = xs(h.edges[b + 1]), y1 = ys(h.counts[b]);
       if (std::isnan(x0) || std::isnan(x1) || std::isnan(y1) || h.counts[b] == 0) continue;
-      cairo_rectangle(cr, x0, std::min(y1, y_base), x1 - x0, std::abs(y_base - y1));
+      cairo().cairo_rectangle(cr, x0, std::min(y1, y_base), x1 - x0, std::abs(y_base - y1));
       outline = outline && x1 - x0 >= 3;
     }
     pa.colour(c, 0.55);
     if (outline) {
-      cairo_fill_preserve(cr);
+      cairo().cairo_fill_preserve(cr);
       pa.colour(c);
-      cairo_set_line_width(cr, 0.8);
-      cairo_stroke(cr);
+      cairo().cairo_set_line_width(cr, 0.8);
+      cairo().cairo_stroke(cr);
     } else {
-      cairo_fill(cr);
+      cairo().cairo_fill(cr);
     }
   }
 }
@@ -88,18 +88,18 @@ void draw_markers(const PanelPlan& pp, const Painter& pa, const Fonts& f, const 
     const double x = xs(m.x);
     if (std::isnan(x) || x < r.x - 1 || x > r.right() + 1) continue;
     pa.colour(m.colour);
-    cairo_set_line_width(cr, 1.2);
+    cairo().cairo_set_line_width(cr, 1.2);
     const double dash[] = {5.0, 3.0};
-    cairo_set_dash(cr, dash, m.dashed ? 2 : 0, 0);
-    cairo_move_to(cr, x, r.y);
-    cairo_line_to(cr, x, r.bottom());
-    cairo_stroke(cr);
-    cairo_set_dash(cr, nullptr, 0, 0);
+    cairo().cairo_set_dash(cr, dash, m.dashed ? 2 : 0, 0);
+    cairo().cairo_move_to(cr, x, r.y);
+    cairo().cairo_line_to(cr, x, r.bottom());
+    cairo().cairo_stroke(cr);
+    cairo().cairo_set_dash(cr, nullptr, 0, 0);
     if (!m.label.empty()) {
       const Rect b = marker_label_box(m, x, r, pa, f);  // also selects the font
-      cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
-      cairo_rectangle(cr, b.x - 2, b.y - 1, b.w + 4, b.h + 2);
-      cairo_fill(cr);
+      cairo().cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+      cairo().cairo_rectangle(cr, b.x - 2, b.y - 1, b.w + 4, b.h + 2);
+      cairo().cairo_fill(cr);
       pa.colour(m.colour);
       pa.text(m.label, b.x, b.y, HAlign::left, VAlign::top);
     }
@@ -114,7 +114,7 @@ void draw_boxes(const PanelPlan& pp, const Painter& pa, const Scale& xs, const S
   for (std::size_t i = 0; i < p.boxes.size(); ++i) {
     const auto& b = p.boxes[i];
     const Rgb c = pp.box_colours[i];
-    cairo_set_line_width(cr, 1.2);
+    cairo().cairo_set_line_width(cr, 1.2);
     for (std::size_t g = 0; g < b.groups.size(); ++g) {
       const BoxStats& st = pp.boxes[i][g];
       if (st.n == 0) continue;
@@ -128,47 +128,47 @@ void draw_boxes(const PanelPlan& pp, const Painter& pa, const Scale& xs, const S
       for (const double w : {st.whisker_low, st.whisker_high}) {
         const double yw = ys(w);
         if (std::isnan(yw)) continue;
-        cairo_move_to(cr, xm, w < st.q1 ? yq1 : yq3);
-        cairo_line_to(cr, xm, yw);
-        cairo_move_to(cr, xm - cap, yw);
-        cairo_line_to(cr, xm + cap, yw);
+        cairo().cairo_move_to(cr, xm, w < st.q1 ? yq1 : yq3);
+        cairo().cairo_line_to(cr, xm, yw);
+        cairo().cairo_move_to(cr, xm - cap, yw);
+        cairo().cairo_line_to(cr, xm + cap, yw);
       }
-      cairo_stroke(cr);
-      cairo_rectangle(cr, x0, std::min(yq1, yq3), x1 - x0, std::abs(yq1 - yq3));
+      cairo().cairo_stroke(cr);
+      cairo().cairo_rectangle(cr, x0, std::min(yq1, yq3), x1 - x0, std::abs(yq1 - yq3));
       pa.colour(c, 0.3);
-      cairo_fill_preserve(cr);
+      cairo().cairo_fill_preserve(cr);
       pa.colour(c);
-      cairo_stroke(cr);
-      cairo_set_line_width(cr, 2.2);
-      cairo_move_to(cr, x0, ymed);
-      cairo_line_to(cr, x1, ymed);
-      cairo_stroke(cr);
-      cairo_set_line_width(cr, 1.2);
+      cairo().cairo_stroke(cr);
+      cairo().cairo_set_line_width(cr, 2.2);
+      cairo().cairo_move_to(cr, x0, ymed);
+      cairo().cairo_line_to(cr, x1, ymed);
+      cairo().cairo_stroke(cr);
+      cairo().cairo_set_line_width(cr, 1.2);
       for (const double o : st.outliers) {
         const double yo = ys(o);
         if (std::isnan(yo)) continue;
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, xm, yo, 3.2, 0, 2 * std::numbers::pi);
+        cairo().cairo_new_sub_path(cr);
+        cairo().cairo_arc(cr, xm, yo, 3.2, 0, 2 * std::numbers::pi);
       }
-      cairo_stroke(cr);
+      cairo().cairo_stroke(cr);
       if (b.show_points) {
         pa.colour(c, 0.7);
         for (const double v : b.groups[g]) {
           const double yv = ys(v);
           if (std::isnan(yv)) continue;
-          cairo_new_sub_path(cr);
-          cairo_arc(cr, xm, yv, 1.8, 0, 2 * std::numbers::pi);
+          cairo().cairo_new_sub_path(cr);
+          cairo().cairo_arc(cr, xm, yv, 1.8, 0, 2 * std::numbers::pi);
         }
-        cairo_fill(cr);
+        cairo().cairo_fill(cr);
       }
       if (b.show_mean && std::isfinite(ys(st.mean))) {
         const double ym = ys(st.mean), d = 3.5;
         pa.colour(text_colour);
-        cairo_move_to(cr, xm - d, ym - d);
-        cairo_line_to(cr, xm + d, ym + d);
-        cairo_move_to(cr, xm - d, ym + d);
-        cairo_line_to(cr, xm + d, ym - d);
-        cairo_stroke(cr);
+        cairo().cairo_move_to(cr, xm - d, ym - d);
+        cairo().cairo_line_to(cr, xm + d, ym + d);
+        cairo().cairo_move_to(cr, xm - d, ym + d);
+        cairo().cairo_line_to(cr, xm + d, ym - d);
+        cairo().cairo_stroke(cr);
       }
     }
   }
@@ -184,9 +184,9 @@ void draw_lines(const PanelPlan& pp, const Painter& pa, const std::vector<Vertic
   constexpr std::size_t chunk = 512;
   for (std::size_t i = 0; i < p.lines.size(); ++i) {
     pa.colour(pp.line_colours[i]);
-    cairo_set_line_width(cr, p.lines[i].width_px);
+    cairo().cairo_set_line_width(cr, p.lines[i].width_px);
     const double dash[] = {6.0, 4.0};
-    cairo_set_dash(cr, dash, p.lines[i].dashed ? 2 : 0, 0);
+    cairo().cairo_set_dash(cr, dash, p.lines[i].dashed ? 2 : 0, 0);
     bool pen_down = false;
     std::size_t in_path = 0;
     for (const auto& [x, y] : line_px[i]) {
@@ -195,18 +195,18 @@ void draw_lines(const PanelPlan& pp, const Painter& pa, const std::vector<Vertic
         continue;
       }
       if (pen_down) {
-        cairo_line_to(cr, x, y);
+        cairo().cairo_line_to(cr, x, y);
         if (++in_path >= chunk) {
-          cairo_stroke(cr);
-          cairo_move_to(cr, x, y);
+          cairo().cairo_stroke(cr);
+          cairo().cairo_move_to(cr, x, y);
           in_path = 0;
         }
       } else {
-        cairo_move_to(cr, x, y);
+        cairo().cairo_move_to(cr, x, y);
       }
       pen_down = true;
     }
-    cairo_stroke(cr);
+    cairo().cairo_stroke(cr);
   }
 }
 
@@ -223,7 +223,7 @@ void draw_error_bars(const PanelPlan& pp, const Painter& pa, const Scale& xs, co
       std::vector<std::size_t> order(e.x.size());
       for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
       std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return e.x[a] < e.x[b]; });
-      cairo_set_line_width(cr, 1.5);
+      cairo().cairo_set_line_width(cr, 1.5);
       bool pen_down = false;
       for (const std::size_t k : order) {
         const double x = xs(e.x[k]), y = ys(e.y[k]);
@@ -231,12 +231,12 @@ void draw_error_bars(const PanelPlan& pp, const Painter& pa, const Scale& xs, co
           pen_down = false;
           continue;
         }
-        pen_down ? cairo_line_to(cr, x, y) : cairo_move_to(cr, x, y);
+        pen_down ? cairo().cairo_line_to(cr, x, y) : cairo().cairo_move_to(cr, x, y);
         pen_down = true;
       }
-      cairo_stroke(cr);
+      cairo().cairo_stroke(cr);
     }
-    cairo_set_line_width(cr, 1.3);
+    cairo().cairo_set_line_width(cr, 1.3);
     for (std::size_t k = 0; k < e.x.size(); ++k) {
       const double x = xs(e.x[k]), y = ys(e.y[k]);
       if (std::isnan(x) || std::isnan(y)) continue;
@@ -244,21 +244,21 @@ void draw_error_bars(const PanelPlan& pp, const Painter& pa, const Scale& xs, co
         const double lo = ys(e.y[k] - e.error[k]), hi = ys(e.y[k] + e.error[k]);
         const double ylo = std::isnan(lo) ? r.bottom() : lo;  // log axis: a bar below 0 runs off the plot
         if (!std::isnan(hi)) {
-          cairo_move_to(cr, x, ylo);
-          cairo_line_to(cr, x, hi);
-          cairo_move_to(cr, x - e.cap_px, hi);
-          cairo_line_to(cr, x + e.cap_px, hi);
+          cairo().cairo_move_to(cr, x, ylo);
+          cairo().cairo_line_to(cr, x, hi);
+          cairo().cairo_move_to(cr, x - e.cap_px, hi);
+          cairo().cairo_line_to(cr, x + e.cap_px, hi);
           if (!std::isnan(lo)) {
-            cairo_move_to(cr, x - e.cap_px, lo);
-            cairo_line_to(cr, x + e.cap_px, lo);
+            cairo().cairo_move_to(cr, x - e.cap_px, lo);
+            cairo().cairo_line_to(cr, x + e.cap_px, lo);
           }
-          cairo_stroke(cr);
+          cairo().cairo_stroke(cr);
         }
       }
       if (e.marker_radius_px > 0) {
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x, y, e.marker_radius_px, 0, 2 * std::numbers::pi);
-        cairo_fill(cr);
+        cairo().cairo_new_sub_path(cr);
+        cairo().cairo_arc(cr, x, y, e.marker_radius_px, 0, 2 * std::numbers::pi);
+        cairo().cairo_fill(cr);
       }
     }
   }
@@ -275,22 +275,22 @@ void draw_stems(const PanelPlan& pp, const Painter& pa, const Scale& xs, const S
     const double foot = ys.log ? (s.baseline > 0 ? std::min(ys(s.baseline), r.bottom()) : r.bottom())
                                : ys(std::clamp(s.baseline, pp.ylo, pp.yhi));
     pa.colour(c);
-    cairo_set_line_width(cr, 1.2);
+    cairo().cairo_set_line_width(cr, 1.2);
     for (std::size_t k = 0; k < s.x.size(); ++k) {
       const double x = xs(s.x[k]), y = ys(s.y[k]);
       if (std::isnan(x) || std::isnan(y) || x < r.x - 20 || x > r.right() + 20) continue;
       if (s.stems) {
-        cairo_move_to(cr, x, foot);
-        cairo_line_to(cr, x, y);
-        cairo_stroke(cr);
+        cairo().cairo_move_to(cr, x, foot);
+        cairo().cairo_line_to(cr, x, y);
+        cairo().cairo_stroke(cr);
       }
       if (s.marker_radius_px > 0) {
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x, y, s.marker_radius_px, 0, 2 * std::numbers::pi);
+        cairo().cairo_new_sub_path(cr);
+        cairo().cairo_arc(cr, x, y, s.marker_radius_px, 0, 2 * std::numbers::pi);
         pa.colour(c, 0.85);
-        cairo_fill_preserve(cr);
+        cairo().cairo_fill_preserve(cr);
         pa.colour(c);
-        cairo_stroke(cr);
+        cairo().cairo_stroke(cr);
       }
     }
   }
@@ -314,22 +314,22 @@ void draw_series(const PanelPlan& pp, const Painter& pa, const Fonts& f, const S
                  const std::vector<Vertices>& line_px) {
   cairo_t* cr = pa.cr();
   const Panel& p = *pp.panel;
-  cairo_save(cr);
+  cairo().cairo_save(cr);
   pa.rect(pp.plot);
-  cairo_clip(cr);
+  cairo().cairo_clip(cr);
   if (p.heatmap) draw_heatmap(*p.heatmap, pp, pa, f, xs, ys);
   draw_histograms(pp, pa, xs, ys);
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
+  cairo().cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  cairo().cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
   draw_markers(pp, pa, f, xs);
   draw_boxes(pp, pa, xs, ys);
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  cairo().cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   draw_lines(pp, pa, line_px);
-  cairo_set_dash(cr, nullptr, 0, 0);
+  cairo().cairo_set_dash(cr, nullptr, 0, 0);
   draw_error_bars(pp, pa, xs, ys);
   draw_stems(pp, pa, xs, ys);
   if (!p.notes.empty()) draw_notes(pp, pa, f, xs, ys);
-  cairo_restore(cr);
+  cairo().cairo_restore(cr);
 }
 
 }  // namespace texel::plot_detail

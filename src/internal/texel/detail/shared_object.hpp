@@ -31,7 +31,9 @@ F shared_function(void* handle, const char* soname, const char* name) {
 /// over the names the library's header declares) and `const Type& accessor()`,
 /// which opens SONAME and resolves them on its first call (thread-safe, once;
 /// a failure throws and the next call tries again). Use inside an unnamed
-/// namespace of the one file that calls the library:
+/// namespace of the one file that calls the library, or in an internal header
+/// when several files of Texel call it (the accessor is inline: one table per
+/// process, e.g. texel/detail/sndfile.hpp):
 ///   #define TEXEL_MATIO_FUNCTIONS(X) X(Mat_Open) X(Mat_Close)
 ///   TEXEL_SHARED_LIBRARY(Matio, matio, "libmatio.so.11", "MATLAB .mat files", TEXEL_MATIO_FUNCTIONS)
 ///   ... matio().Mat_Open(path, MAT_ACC_RDONLY) ...
@@ -42,7 +44,7 @@ F shared_function(void* handle, const char* soname, const char* name) {
   struct Type {                                                                 \
     LIST(TEXEL_SHARED_LIBRARY_POINTER)                                          \
   };                                                                            \
-  const Type& accessor() {                                                      \
+  inline const Type& accessor() {                                               \
     static const Type loaded = [] {                                             \
       const char* soname_ = SONAME;                                             \
       void* handle_ = ::texel::detail::open_shared_object(soname_, NEEDED_FOR); \
