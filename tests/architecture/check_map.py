@@ -81,6 +81,9 @@ def commands_in_sources(apps):
     """{command: file} of the top-level commands main.cpp registers."""
     main = read(os.path.join(apps, "main.cpp"))
     registered = set(re.findall(r"register_([a-z0-9_]+)\(app\)", main))
+    # main.cpp's command table: {"name", &texel::cli::register_x}; the name must be the command x adds.
+    table = dict(re.findall(r'\{\s*"([a-z0-9-]+)",\s*&texel::cli::register_([a-z0-9_]+)\s*\}', main))
+    registered |= set(table.values())
     found, problems = {}, []
     defined = set()
     for name in sorted(os.listdir(apps)):
@@ -98,6 +101,10 @@ def commands_in_sources(apps):
                 if command in found:
                     problems.append(f"command {command} is added in {found[command]} and {name}")
                 found[command] = name
+    adds = {command: function for command, function in table.items()}
+    for command, function in sorted(adds.items()):
+        if command not in found:
+            problems.append(f"main.cpp's command table names {command} for register_{function}, which adds no such command")
     for function in sorted(registered - defined):
         problems.append(f"main.cpp calls register_{function}(app), which no apps/texel/*.cpp defines as register_{function}(CLI::App& app)")
     return found, problems
