@@ -44,6 +44,7 @@ def main():
             "texel render": [texel, "render", "--device", "tpad", "--length", f"{samples * spacing:.4f}", "--seed", "3",
                              "-o", out],
             "texel --version (start-up)": [texel, "--version"],
+            "true (a do-nothing process)": ["true"],
         }
         results = {name: [measure(cmd) for _ in range(runs)] for name, cmd in cases.items()}
         size = os.path.getsize(out)
@@ -54,6 +55,10 @@ def main():
         wall = statistics.median(w for w, _ in rs)
         peak = max(m for _, m in rs)
         print(f"{name:28s} {wall * 1e3:9.1f} {peak:9.1f} {wall / base:10.1f}×")
+    startup = statistics.median(w for w, _ in results["texel --version (start-up)"])
+    floor = statistics.median(w for w, _ in results["true (a do-nothing process)"])
+    print(f"goal (issue #39): texel --version <= 10 ms: {'met' if startup <= 0.010 else 'NOT met'} "
+          f"({startup * 1e3:.1f} ms; a do-nothing process {floor * 1e3:.1f} ms, so {(startup - floor) * 1e3:.1f} ms of Texel's own)")
     render = statistics.median(w for w, _ in results["texel render"])
     peak = max(m for _, m in results["texel render"])
     print("(peak MiB is the child's ru_maxrss, which includes the forking Python's ~12 MiB before exec)")
