@@ -613,12 +613,7 @@ void register_experiment(CLI::App& app) {
     else
       rows = ex::parse_trials_csv(read_file(*an->csv), *an->csv);
     ex::AnalysisOptions o = an->options;
-    if (an->out_dir) {
-      std::error_code ec;
-      std::filesystem::create_directories(*an->out_dir, ec);
-      if (ec) throw IoError("--out " + *an->out_dir + ": cannot create the folder (" + ec.message() + ")");
-      o.out_dir = *an->out_dir;
-    }
+    if (an->out_dir) o.out_dir = *an->out_dir;  // created by analyze(), and removed again if it fails
     const ex::AnalysisReport report = ex::analyze(rows, o);
     if (an->json)
       print_json(ordered_json::parse(report.summary));

@@ -332,7 +332,6 @@ later Session(..., resume=True) continues where it stopped.)doc")
         if (out_dir) o.out_dir = path_of(*out_dir);
         const std::vector<TrialRow> rows = db ? Store::open(path_of(*db), StoreMode::read_only).rows()
                                               : parse_trials_csv(read_file(path_of(*csv)), path_of(*csv));
-        if (!o.out_dir.empty()) std::filesystem::create_directories(o.out_dir);
         const AnalysisReport report = analyze(rows, o);
         py::dict r;
         r["summary"] = py::module_::import("json").attr("loads")(report.summary);

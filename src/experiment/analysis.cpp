@@ -18,6 +18,8 @@
 #include <map>
 #include <set>
 
+#include <unistd.h>
+
 #include "analysis_common.hpp"
 #include "analysis_figures.hpp"
 #include "texel/io.hpp"
@@ -97,8 +99,9 @@ double memory_errors_limit(double mean, double sd, const AnalysisOptions& o) {
   return mean + (o.memory_errors_sd - o.memory_errors_sd_tolerance) * sd;
 }
 
-AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions& options) {
-  check_options(options);
+namespace {
+
+AnalysisReport analyze_into(const std::vector<TrialRow>& rows, const AnalysisOptions& options) {
   std::map<std::string, Rows> by_study;
   for (const TrialRow& r : rows)
     if (!r.practice) by_study[r.study].push_back(&r);
@@ -141,9 +144,6 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
       head["spread_vs_free_exploration"] = spread_comparison(summary["free-exploration"], head, options, report.text);
     summary[study] = std::move(head);
     if (!options.out_dir.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(options.out_dir, ec);
-      if (ec) throw IoError("cannot create figure directory '" + options.out_dir + "': " + ec.message());
       for (auto& f : analysis_figures::study_figures(st, summary[study], rs, options)) report.figures.push_back(std::move(f));
       if (st.design == StudyDesign::staircase) {
         const std::string path = (std::filesystem::path(options.out_dir) / (study + "-runs.csv")).string();
@@ -153,6 +153,52 @@ AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions&
     }
   }
   report.summary = summary.dump();
+  return report;
+}
+
+}  // namespace
+
+// Figures and tables are drawn into a hidden folder inside out_dir and moved
+// into out_dir only when every study has been summarised and drawn: a failure
+// (a library that cannot be opened, a full disk) leaves no figure of this run,
+// and no out_dir it created.
+AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions& options) {
+  check_options(options);
+  if (options.out_dir.empty()) return analyze_into(rows, options);
+  namespace fs = std::filesystem;
+  const fs::path out(options.out_dir);
+  std::error_code ec;
+  const bool existed = fs::exists(out, ec);
+  fs::create_directories(out, ec);
+  if (ec) throw IoError("cannot create figure directory '" + options.out_dir + "': " + ec.message());
+  const fs::path staging = out / (".texel-analysis-" + std::to_string(::getpid()));
+  fs::remove_all(staging, ec);
+  fs::create_directory(staging, ec);
+  if (ec) throw IoError("cannot write into figure directory '" + options.out_dir + "': " + ec.message());
+  const auto discard = [&] {
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    if (!existed) fs::remove(out, ignored);  // only if empty
+  };
+  AnalysisReport report;
+  try {
+    AnalysisOptions staged = options;
+    staged.out_dir = staging.string();
+    report = analyze_into(rows, staged);
+    for (auto* paths : {&report.figures, &report.tables})
+      for (std::string& p : *paths) {
+        const fs::path to = out / fs::path(p).filename();
+        fs::rename(p, to);
+        p = to.string();
+      }
+  } catch (const fs::filesystem_error& e) {
+    discard();
+    throw IoError("cannot write figures into '" + options.out_dir + "': " + e.code().message());
+  } catch (...) {
+    discard();
+    throw;
+  }
+  fs::remove(staging, ec);
   return report;
 }
 

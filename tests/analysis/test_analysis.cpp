@@ -1112,3 +1112,28 @@ TEST(Analysis, TheSourceRuleReproducesTheSourcesExclusionsFromItsOwnFigures) {
   bad.memory_errors_sd_tolerance = 2.0;
   EXPECT_THROW(analyze(memory_rows(), bad), InvalidArgument);
 }
+
+// Figures land in out_dir only when every one was drawn; nothing of the run is left otherwise.
+TEST(Analysis, FiguresAppearWholeOrNotAtAll) {
+  test_support::TempDir dir("texel-analysis");
+  AnalysisOptions o;
+  o.out_dir = dir.at("new/figures");
+  const AnalysisReport r = analyze(with_unfinished_run(), o);
+  ASSERT_FALSE(r.figures.empty());
+  for (const auto& f : r.figures) {
+    EXPECT_EQ(std::filesystem::path(f).parent_path(), std::filesystem::path(o.out_dir)) << f;
+    EXPECT_TRUE(std::filesystem::exists(f)) << f;
+  }
+  std::size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(o.out_dir)) {
+    EXPECT_EQ(e.path().filename().string().rfind(".texel-analysis-", 0), std::string::npos) << "the staging folder was left";
+    ++files;
+  }
+  EXPECT_EQ(files, r.figures.size() + r.tables.size());
+  // A folder that cannot be made (a file is in its way): one IoError, and the file untouched.
+  const std::string blocked = dir.at("blocked");
+  texel::write_file_atomic(blocked, "x");
+  o.out_dir = blocked + "/figures";
+  EXPECT_THROW(analyze(with_unfinished_run(), o), IoError);
+  EXPECT_EQ(read_file(blocked), "x");
+}

@@ -168,7 +168,9 @@ struct AnalysisReport {
 /// its summary ("<test>": {"skipped": "<reason>"}) instead of throwing.
 /// Throws InvalidArgument for bad options (format, reversals_k, level, the
 /// rule names and thresholds) and
-/// IoError if a figure cannot be written.
+/// IoError if a figure cannot be written. The figures and tables are drawn
+/// into a hidden folder inside out_dir and moved in only once all are drawn:
+/// a failure leaves none of this run's files, nor an out_dir it created.
 AnalysisReport analyze(const std::vector<TrialRow>& rows, const AnalysisOptions& options);
 
 /// The working-memory source rule's cut-off: a participant whose main-task
