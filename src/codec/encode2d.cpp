@@ -1,7 +1,9 @@
 // The 2-D encoder (docs/encoder.md "2-D inputs"): the plane's coarse/fine
 // split, straight scans encoded by the 1-D encoder, the correction through
 // the 2-D design by analysis-by-synthesis, the lattice of cell borders, and
-// the version-4 document.
+// the version-4 document. The raster helpers (encode2d_raster.cpp) and the
+// lattice detection (encode2d_lattice.cpp) are shared through
+// encode2d_parts.hpp; the result's JSON and files are encode2d_output.cpp.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "encode2d_parts.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/encode2d.hpp"
 #include "texel/error.hpp"
@@ -20,7 +23,8 @@
 namespace texel::codec {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using namespace encode2d_parts;
+
 /// The cosine law's spread in natural-log units (π/√12): the narrowest log
 /// spread a straight scan of a stationary isotropic field can have.
 constexpr double kCosineSigma = 0.9068996821171089;
@@ -35,10 +39,8 @@ constexpr double kNarrowScanOffsetDb = 2.3;
 constexpr int kCandidateSide = 1024;
 /// Directions a candidate (an isotropic design) is scanned along.
 constexpr int kCandidateDirections = 6;
-/// Samples tapered at each end of a scan line before lines are joined.
-constexpr std::size_t kTaper = 16;
 
-// --- small helpers -----------------------------------------------------------
+// --- log spread and Irregularity ------------------------------------------------
 
 double log_sigma(double p_db, double i_db, Parameterization param) {
   if (param == Parameterization::log) return i_db * std::log(10.0) / 10.0;
@@ -50,191 +52,7 @@ double irregularity_for_sigma(double p_db, double sigma, Parameterization param)
   return p_db + 10.0 * std::log10(std::sqrt(std::expm1(sigma * sigma)));
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-/// Mean over a (2r+1)² window clipped to the map, separable running sums.
-std::vector<double> box(const std::vector<double>& v, int w, int h, int r) {
-  std::vector<double> tmp(v.size()), out(v.size());
-  for (int j = 0; j < h; ++j) {
-    const double* row = v.data() + static_cast<std::size_t>(j) * w;
-    double* dst = tmp.data() + static_cast<std::size_t>(j) * w;
-    double sum = 0.0;
-    int lo = 0, hi = -1;  // window [lo, hi]
-    for (int i = 0; i < w; ++i) {
-      const int want_hi = std::min(w - 1, i + r), want_lo = std::max(0, i - r);
-      while (hi < want_hi) sum += row[++hi];
-      while (lo < want_lo) sum -= row[lo++];
-      dst[i] = sum / (hi - lo + 1);
-    }
-  }
-  for (int i = 0; i < w; ++i) {
-    double sum = 0.0;
-    int lo = 0, hi = -1;
-    for (int j = 0; j < h; ++j) {
-      const int want_hi = std::min(h - 1, j + r), want_lo = std::max(0, j - r);
-      while (hi < want_hi) sum += tmp[static_cast<std::size_t>(++hi) * w + i];
-      while (lo < want_lo) sum -= tmp[static_cast<std::size_t>(lo++) * w + i];
-      out[static_cast<std::size_t>(j) * w + i] = sum / (hi - lo + 1);
-    }
-  }
-  return out;
-}
-
-double bilinear(const std::vector<double>& v, int w, int h, double x, double y) {
-  x = std::clamp(x, 0.0, static_cast<double>(w - 1));
-  y = std::clamp(y, 0.0, static_cast<double>(h - 1));
-  const int i0 = std::min(static_cast<int>(x), std::max(w - 2, 0)), j0 = std::min(static_cast<int>(y), std::max(h - 2, 0));
-  const int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
-  const double fx = x - i0, fy = y - j0;
-  const auto at = [&](int i, int j) { return v[static_cast<std::size_t>(j) * w + i]; };
-  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) + fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
-}
-
-/// Lanczos-3 interpolation (6 × 6 taps, edges held): scans at any angle
-/// keep the grid's content up to near its Nyquist frequency, where bilinear
-/// interpolation would damp oblique scans and fake anisotropy.
-double lanczos3(const std::vector<double>& v, int w, int h, double x, double y) {
-  const auto kernel = [](double t) {
-    if (std::abs(t) < 1e-12) return 1.0;
-    if (std::abs(t) >= 3.0) return 0.0;
-    const double a = kPi * t;
-    return 3.0 * std::sin(a) * std::sin(a / 3.0) / (a * a);
-  };
-  const int i0 = static_cast<int>(std::floor(x)), j0 = static_cast<int>(std::floor(y));
-  double wx[6], wy[6], sx = 0.0, sy = 0.0;
-  for (int k = 0; k < 6; ++k) {
-    wx[k] = kernel(x - (i0 - 2 + k));
-    wy[k] = kernel(y - (j0 - 2 + k));
-    sx += wx[k];
-    sy += wy[k];
-  }
-  double sum = 0.0;
-  for (int b = 0; b < 6; ++b) {
-    const int j = std::clamp(j0 - 2 + b, 0, h - 1);
-    double row = 0.0;
-    for (int k = 0; k < 6; ++k) row += wx[k] * v[static_cast<std::size_t>(j) * w + std::clamp(i0 - 2 + k, 0, w - 1)];
-    sum += wy[b] * row;
-  }
-  return sum / (sx * sy);
-}
-
-// --- the plane's split -------------------------------------------------------
-
-/// Local mean and RMS of the amplitude over a window one boundary (or two
-/// fine periods, if longer) wide, each smoothed by a second pass of the same
-/// window (docs/encoder.md "2-D inputs" §1).
-struct Envelope {
-  std::vector<double> mean, rms;
-  int radius = 1;
-};
-
-Envelope envelope(const Raster2D& map, double boundary_mm) {
-  const int w = map.width, h = map.height;
-  const double p = map.pitch.value();
-  std::vector<double> a(map.values.begin(), map.values.end());
-  // RMS frequency along x (Rice: f = √(E[y′²] / E[y²]) / 2π) of the part
-  // above the boundary, y = a less its mean over a boundary-wide window (as
-  // the 1-D split's fine frequency is taken above 1/B).
-  const int rb = std::clamp(static_cast<int>(std::lround(0.5 * boundary_mm / p)), 1, std::max(1, std::min(w, h) / 8));
-  const std::vector<double> low = box(a, w, h, rb);
-  double var = 0.0, d2 = 0.0;
-  std::size_t nd = 0;
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * w + i;
-      const double v = a[k] - low[k];
-      var += v * v;
-      if (i + 1 < w) {
-        const double d = (a[k + 1] - low[k + 1] - v) / p;
-        d2 += d * d;
-        ++nd;
-      }
-    }
-  var /= static_cast<double>(a.size());
-  const double f_rms = var > 0.0 && nd > 0 ? std::sqrt(d2 / static_cast<double>(nd) / var) / (2.0 * kPi) : 1.0 / boundary_mm;
-  const double window = std::max(boundary_mm, 2.0 / std::max(f_rms, 1e-6));
-  Envelope e;
-  e.radius = std::clamp(static_cast<int>(std::lround(0.5 * window / p)), 1, std::max(1, std::min(w, h) / 8));
-  std::vector<double> sq(a.size());
-  for (std::size_t k = 0; k < a.size(); ++k) sq[k] = a[k] * a[k];
-  std::vector<double> m = box(a, w, h, e.radius), m2 = box(sq, w, h, e.radius);
-  std::vector<double> r(a.size());
-  for (std::size_t k = 0; k < a.size(); ++k) r[k] = std::sqrt(std::max(m2[k] - m[k] * m[k], 0.0));
-  e.mean = box(m, w, h, e.radius);
-  e.rms = box(r, w, h, e.radius);
-  return e;
-}
-
-/// (p99.9 − p0.1)/p99.9 of the smoothed local mean over the interior (a
-/// border of one window left out): the envelope's relative range,
-/// scale-free. The quantiles are that far out so a coarse feature covering
-/// a small part of a large map (a 10 mm disc on a tablet is under 1 % of
-/// it) still counts; the local mean is already smooth, and the candidate's
-/// own range, measured the same way, is the threshold's reference.
-double relative_range(const Envelope& e, int w, int h) {
-  std::vector<double> v;
-  const int b = std::min(2 * e.radius, std::min(w, h) / 4);
-  for (int j = b; j < h - b; ++j)
-    for (int i = b; i < w - b; ++i) v.push_back(e.mean[static_cast<std::size_t>(j) * w + i]);
-  if (v.empty()) v = e.mean;
-  const double hi = percentile(v, 0.999), lo = percentile(v, 0.001);
-  return hi > 0.0 ? (hi - lo) / hi : 0.0;
-}
-
-// --- scans -------------------------------------------------------------------
-
-/// Parallel straight lines across the map along `theta_deg`, Lanczos-3 at
-/// one pixel steps, each tapered at its ends and joined, until `total` samples.
-std::vector<double> scan_lines(const std::vector<double>& v, int w, int h, double theta_deg, std::size_t total, int& lines) {
-  const double th = theta_deg * kPi / 180.0;
-  const double ux = std::cos(th), uy = std::sin(th), nx = -uy, ny = ux;
-  const double cx = 0.5 * (w - 1), cy = 0.5 * (h - 1);
-  const auto clip = [&](double o, double& t0, double& t1) {
-    t0 = -1e18;
-    t1 = 1e18;
-    const double px = cx + o * nx, py = cy + o * ny;
-    for (const auto& [p0, d, hi] : {std::tuple{px, ux, w - 1.0}, std::tuple{py, uy, h - 1.0}}) {
-      if (std::abs(d) < 1e-12) {
-        if (p0 < 0.0 || p0 > hi) t1 = t0 - 1.0;
-        continue;
-      }
-      double a = (0.0 - p0) / d, b = (hi - p0) / d;
-      if (a > b) std::swap(a, b);
-      t0 = std::max(t0, a);
-      t1 = std::min(t1, b);
-    }
-  };
-  double t0 = 0, t1 = 0;
-  clip(0.0, t0, t1);
-  const double central = std::max(1.0, t1 - t0);
-  const double half_n = 0.5 * (std::abs(nx) * (w - 1) + std::abs(ny) * (h - 1));
-  const int max_lines = std::max(1, static_cast<int>(0.8 * half_n));  // lines at least 1.6 px apart
-  const int k_lines = std::clamp(static_cast<int>(std::ceil(static_cast<double>(total) / (0.8 * central))), 1, max_lines);
-  std::vector<double> out;
-  out.reserve(total);
-  lines = 0;
-  for (int k = 0; k < k_lines && out.size() < total; ++k) {
-    const double o = k_lines == 1 ? 0.0 : ((k + 0.5) / k_lines * 1.6 - 0.8) * half_n;
-    clip(o, t0, t1);
-    const auto n = static_cast<std::size_t>(std::max(0.0, std::floor(t1 - t0)));
-    if (n < 4 * kTaper) continue;
-    ++lines;
-    const double px = cx + o * nx, py = cy + o * ny;
-    for (std::size_t s = 0; s < n && out.size() < total; ++s) {
-      const double t = t0 + static_cast<double>(s);
-      double g = 1.0;
-      const std::size_t edge = std::min(s, n - 1 - s);
-      if (edge < kTaper) g = 0.5 - 0.5 * std::cos(kPi * (static_cast<double>(edge) + 0.5) / kTaper);
-      out.push_back(g * lanczos3(v, w, h, px + t * ux, py + t * uy));
-    }
-  }
-  return out;
-}
+// --- scans encoded by the 1-D encoder ----------------------------------------
 
 /// A zero-mean signal as the 1-D encoder's amplitude in [0, 1].
 Signal as_signal(const std::vector<double>& y, double spacing, std::string description) {
@@ -298,66 +116,6 @@ Analysis analyse(const Raster2D& map, const Encode2DConfig& cfg, int directions)
     a.mean_spread += d.percept.spread_db / directions;
   }
   return a;
-}
-
-// --- the lattice of cell borders ----------------------------------------------
-
-/// The cell size of a `cells` rendering: borders every L in x and y from the
-/// origin make the mean absolute step between neighbouring pixels larger
-/// there. Returns the L (µm steps, 2 pixels … 5 mm) whose border positions
-/// stand out most, if they stand out by more than `min_z` standard errors.
-std::optional<double> detect_lattice(const Raster2D& map, const std::vector<double>& fine, double min_z = 12.0) {
-  const int w = map.width, h = map.height;
-  const double p = map.pitch.value();
-  std::vector<double> gx(static_cast<std::size_t>(w - 1), 0.0), gy(static_cast<std::size_t>(h - 1), 0.0);
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      const double v = fine[static_cast<std::size_t>(j) * w + i];
-      if (i + 1 < w) gx[i] += std::abs(fine[static_cast<std::size_t>(j) * w + i + 1] - v) / h;
-      if (j + 1 < h) gy[j] += std::abs(fine[static_cast<std::size_t>(j + 1) * w + i] - v) / w;
-    }
-  std::vector<double> g = gx;
-  g.insert(g.end(), gy.begin(), gy.end());
-  const double mean = std::accumulate(g.begin(), g.end(), 0.0) / static_cast<double>(g.size());
-  double sd = 0.0;
-  for (double v : g) sd += (v - mean) * (v - mean);
-  sd = std::sqrt(sd / static_cast<double>(g.size()));
-  if (!(sd > 0.0)) return std::nullopt;
-  const double tol = TexelTexture::boundary_tolerance_mm;
-  double best_z = 0.0, best_l = 0.0, best_hi = 0.0;
-  const auto lo = static_cast<long>(std::ceil(2.0 * p * 1000.0)),
-             hi = static_cast<long>(std::floor(std::min(5.0, 0.25 * std::min(w, h) * p) * 1000.0));
-  for (long um = lo; um <= hi; ++um) {
-    const double L = static_cast<double>(um) / 1000.0;
-    double on = 0.0;
-    std::size_t n_on = 0;
-    const auto count = [&](const std::vector<double>& gv) {
-      for (std::size_t i = 0; i < gv.size(); ++i)
-        if (std::floor((static_cast<double>(i) * p + tol) / L) != std::floor((static_cast<double>(i + 1) * p + tol) / L)) {
-          on += gv[i];
-          ++n_on;
-        }
-    };
-    count(gx);
-    count(gy);
-    if (n_on < 4 || n_on * 2 > g.size()) continue;
-    const double off = (std::accumulate(g.begin(), g.end(), 0.0) - on) / static_cast<double>(g.size() - n_on);
-    const double z = (on / static_cast<double>(n_on) - off) / (sd / std::sqrt(static_cast<double>(n_on)));
-    if (z > best_z * (1.0 + 1e-12)) {
-      best_z = z;
-      best_l = L;
-      best_hi = L;
-    } else if (z >= best_z * (1.0 - 1e-12)) {
-      best_hi = L;  // the same border positions: the same lattice on this grid
-    }
-  }
-  if (best_z < min_z) return std::nullopt;
-  // Lengths that put the borders between the same pixels tie: the roundest of them.
-  for (double step : {0.25, 0.1, 0.05, 0.01, 0.005, 0.001}) {
-    const double r = std::ceil(best_l / step - 1e-9) * step;
-    if (r <= best_hi + 1e-12) return r;
-  }
-  return best_l;
 }
 
 // --- documents -----------------------------------------------------------------
@@ -504,22 +262,6 @@ Corrected correct(double p_in, double i_in, double spread_in, const Encode2DConf
     }
   }
   return c;
-}
-
-/// The direction (degrees in [0, 180)) along which the map changes most:
-/// the principal axis of its gradient's structure tensor (a grating's wave vector).
-double principal_direction(const std::vector<double>& v, int w, int h) {
-  double xx = 0.0, yy = 0.0, xy = 0.0;
-  for (int j = 0; j + 1 < h; ++j)
-    for (int i = 0; i + 1 < w; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * w + i;
-      const double gx = v[k + 1] - v[k], gy = v[k + static_cast<std::size_t>(w)] - v[k];
-      xx += gx * gx;
-      yy += gy * gy;
-      xy += gx * gy;
-    }
-  const double deg = 0.5 * std::atan2(2.0 * xy, xx - yy) * 180.0 / kPi;
-  return deg < 0.0 ? deg + 180.0 : deg;
 }
 
 void fill_spread(Encode2DResult& r, bool strongest_from_pitch) {
@@ -824,80 +566,6 @@ Encode2DResult encode_scans(const ScanBundle& bundle, const Encode2DConfig& conf
   r.document =
       surface_document(device, device_inline, w, h, pitch, r.spec, field, orientation, ConstantProfile{0.0}, description);
   return r;
-}
-
-void write_encoding2d(const Encode2DResult& result, const std::string& document_path) {
-  const std::string text = document_json(result.document);
-  std::optional<AtomicFile> image;
-  if (result.coarse_image && result.document.surface2d) {
-    const auto* im = std::get_if<Image2D>(&result.document.surface2d->regions.at(0).coarse);
-    if (!im) throw InvalidArgument("write_encoding2d: the result has a coarse image but its region names none");
-    const std::filesystem::path at = std::filesystem::path(document_path).parent_path() / im->path;
-    const Raster2D& img = *result.coarse_image;
-    image.emplace(at.string());
-    image->write(npy_header(static_cast<std::size_t>(img.height), static_cast<std::size_t>(img.width)));
-    std::vector<double> row(static_cast<std::size_t>(img.width));
-    for (int j = 0; j < img.height; ++j) {
-      for (int i = 0; i < img.width; ++i) row[static_cast<std::size_t>(i)] = img.at(i, j);
-      image->write(std::span<const std::byte>(reinterpret_cast<const std::byte*>(row.data()), row.size() * sizeof(double)));
-    }
-  }
-  AtomicFile doc(document_path);
-  doc.write(text);
-  if (image) image->commit();
-  try {
-    doc.commit();
-  } catch (...) {
-    if (image) std::filesystem::remove(image->path());
-    throw;
-  }
-}
-
-std::string to_json(const Encode2DResult& r) {
-  nlohmann::ordered_json j;
-  nlohmann::ordered_json e;
-  e["central_pitch_db"] = r.spec.central_pitch.value();
-  e["irregularity_db"] = r.spec.irregularity.value();
-  e["texel_length_mm"] = r.spec.texel_length.value();
-  e["parameterization"] = std::string(to_string(r.spec.parameterization));
-  e["seed"] = r.spec.seed;
-  e["coarse_strength"] = r.spec.coarse_strength;
-  e["fine_strength"] = r.spec.fine_strength;
-  e["field"] = std::string(to_string(r.field));
-  e["coarse"] = r.coarse;
-  j["method"] = r.method;
-  j["estimate"] = e;
-  nlohmann::ordered_json flags;
-  flags["irregularity_identifiable"] = r.irregularity_identifiable;
-  if (!r.irregularity_identifiable) flags["irregularity_bound_db"] = r.irregularity_bound_db;
-  flags["texel_length_detected"] = r.texel_length_detected;
-  flags["no_texture"] = r.no_texture;
-  flags["texture_rms"] = r.texture_rms;
-  j["flags"] = flags;
-  nlohmann::ordered_json a;
-  a["anisotropic"] = r.anisotropic;
-  a["central_pitch_spread_db"] = r.central_pitch_spread_db;
-  a["irregularity_spread_db"] = r.irregularity_spread_db;
-  a["strongest_direction_deg"] = r.strongest_direction_deg;
-  a["mean_central_pitch_db"] = r.mean_central_pitch_db;
-  a["mean_irregularity_db"] = r.mean_irregularity_db;
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (const auto& d : r.per_direction)
-    rows.push_back({{"direction_deg", d.direction_deg},
-                    {"central_pitch_db", d.central_pitch_db},
-                    {"irregularity_db", d.irregularity_db},
-                    {"pitch_db", d.percept.pitch_db},
-                    {"noisiness_db", d.percept.noisiness_db},
-                    {"spread_db", d.percept.spread_db},
-                    {"samples", d.samples},
-                    {"scans", d.scans}});
-  a["directions"] = rows;
-  j["anisotropy"] = a;
-  j["model"] = {{"version", r.model_version},
-                {"target", std::string(to_string(r.target))},
-                {"correction_rounds", r.correction_rounds},
-                {"correction_residual_db", r.correction_residual_db}};
-  return j.dump(2);
 }
 
 }  // namespace texel::codec

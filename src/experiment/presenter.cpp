@@ -1,4 +1,8 @@
-// Stimulus presentation through the player backends (presenter.hpp).
+// Stimulus presentation through the player backends (presenter.hpp): the
+// backend and mode, the stimuli prepared and shown, the finger (simulated,
+// a sensor or a display). The displays a participant touches are
+// presenter_displays.hpp / .cpp; the mode a display gets and the check of
+// the first question, presenter_modes.cpp.
 #include "texel/experiment/presenter.hpp"
 
 #include <algorithm>
@@ -14,6 +18,7 @@
 #include <span>
 #include <thread>
 
+#include "presenter_displays.hpp"
 #include "texel/detail/format.hpp"
 #include "texel/device.hpp"
 #include "texel/document.hpp"
@@ -29,17 +34,8 @@
 #include "texel/texture.hpp"
 
 namespace texel::experiment {
-namespace {
 
-// The simulated finger: to and fro over [a, b] at constant speed (a triangle
-// wave), touching throughout. Turns are sharp; the player's interpolation
-// and the vibration filters smooth them.
-double finger_x(double t, double speed, double a, double b) {
-  const double span = b - a;
-  const double period = 2.0 * span / speed;
-  const double phase = std::fmod(t, period);
-  return phase < period / 2 ? a + speed * phase : b - speed * (phase - period / 2);
-}
+namespace presenter_parts {
 
 // A document plays on a presenter of as many channels as its device has
 // actuators, or of any number if it has one (presenter.hpp). Refused in one
@@ -62,227 +58,26 @@ std::shared_ptr<const Surface> one_channel_surface(const Document& doc) {
   return std::make_shared<const Surface>(prepare_surface(doc));
 }
 
+}  // namespace presenter_parts
+
+using namespace presenter_parts;
+
+namespace {
+
+// The simulated finger: to and fro over [a, b] at constant speed (a triangle
+// wave), touching throughout. Turns are sharp; the player's interpolation
+// and the vibration filters smooth them.
+double finger_x(double t, double speed, double a, double b) {
+  const double span = b - a;
+  const double period = 2.0 * span / speed;
+  const double phase = std::fmod(t, period);
+  return phase < period / 2 ? a + speed * phase : b - speed * (phase - period / 2);
+}
+
 constexpr double finger_rate_hz = 1000.0;  // like a position sensor
 constexpr double finger_lead_s = 0.05;     // samples queued ahead of the player
 
 }  // namespace
-
-// ------------------------------------------------------------- 2-D display
-
-// The participant's finger on a 2-D display: the display's FINGER reports,
-// read on their own thread, queued into the Player2D at their place on the
-// player's clock and summarised per interval.
-struct Presenter::Display2D {
-  explicit Display2D(const PlayerConfig& config, const StrokeRules& r) : player(config), rules(r) {}
-  ~Display2D() { stop(); }
-
-  void start(SerialLink& l) {
-    link = &l;
-    reader.emplace(l, [this](std::span<const FingerReport> batch) {
-      std::lock_guard<std::mutex> lock(mutex);
-      for (const FingerReport& r : batch) {
-        const double t = timeline.place(r.t_us, player.time_s());
-        if (!player.push(FingerSample2D{t, r.x_mm, r.y_mm, r.touch})) ++dropped;
-        ++reports;
-        last_t = clock.seconds(r.t_us);
-        if (!current.empty()) recorders.at(current).add(last_t, r.x_mm, r.y_mm, r.touch);
-      }
-    });
-  }
-  void stop() {
-    if (reader) reader->stop();
-    maps.stop();
-  }
-  [[nodiscard]] bool running() const { return reader && !reader->stopping(); }
-  [[nodiscard]] std::string error() const { return reader ? reader->error() : std::string(); }
-
-  // Stops recording into the current interval (its stroke in progress ends).
-  void leave() {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (!current.empty()) recorders.at(current).add(last_t, 0.0, 0.0, false);
-    current.clear();
-  }
-  void enter(const std::string& label) {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (!current.empty()) recorders.at(current).add(last_t, 0.0, 0.0, false);
-    recorders.try_emplace(label, rules);
-    current = label;
-  }
-
-  SurfaceMaps maps;  // stopped in stop(), before the player goes
-  Player2D player;
-  StrokeRules rules;
-  SerialLink* link = nullptr;
-  std::unique_ptr<SerialLink> own_link;
-  ReportTimeline timeline;   // the reader's
-  ReportClock clock;         // the reader's
-  mutable std::mutex mutex;  // guards what follows (the reader thread writes it)
-  std::map<std::string, StrokeRecorder> recorders;
-  std::string current;  // the interval being recorded
-  double last_t = 0.0;
-  std::uint64_t reports = 0, dropped = 0;
-  std::optional<ReportReader> reader;  // last: stopped first
-};
-
-// --------------------------------------------------------- 1-D serial display
-
-// A 1-D serial display with a finger sensor: its reports (read on the
-// control thread by pump() in display-plays, where requests and reports
-// share the thread, or on their own thread in host-streams, where the
-// player takes them) become the trial's finger trace; in display-plays the
-// display's slots hold the trial's stimuli.
-struct Presenter::Display1D {
-  std::unique_ptr<SerialLink> own_link;  // FingerSource::sensor: the sensor's own link (the backend has another)
-  SerialLink* link = nullptr;
-  DisplayInfo info;
-  bool sensor = false;
-  std::uint32_t report_interval_us = 1000;
-  ReportClock clock;        // the display's t_us unwrapped (the trace's time)
-  ReportTimeline timeline;  // host-streams: the reports on the player's clock
-
-  // display-plays: which stimulus each slot holds (its document), and when it was last felt.
-  struct Slot {
-    std::string document;
-    std::uint64_t used = 0;
-  };
-  std::vector<Slot> slots;
-  int selected = -1;
-  std::uint64_t tick = 0;
-  // Rendered maps (u16 samples), most recent first: a reference recurs.
-  struct Rendered {
-    std::string document;
-    std::vector<std::uint16_t> samples;
-    std::uint32_t spacing_nm = 0;
-    std::int32_t origin_nm = 0;
-  };
-  std::list<Rendered> rendered;
-  UploadCounts uploads;
-
-  mutable std::mutex mutex;  // guards what follows (host-streams: the reader thread writes it)
-  bool recording = false;
-  std::vector<FingerSample> trace;
-  std::uint64_t reports = 0, dropped = 0;
-  double first_s = 0.0;
-  std::string error;
-  std::optional<ReportReader> reader;  // host-streams only; last: stopped first
-
-  // display-plays: nothing streams, so no stream watchdog covers the map the
-  // display plays under the finger. A display of revision 1.2 has its host
-  // watchdog armed (host_watchdog_ms) and fed from a thread of its own every
-  // keepalive_ms, whatever the control thread is doing (rendering, an
-  // upload, waiting for a key): when this host dies (kill -9) or hangs, the
-  // display rests by itself within host_watchdog_ms. Re-armed at every
-  // trial (a display that timed out disarms itself).
-  static constexpr std::uint32_t host_watchdog_ms = 200;
-  static constexpr auto keepalive_every = std::chrono::milliseconds(40);
-  bool host_watchdog = false;  // the display took HOST_WATCHDOG
-  std::mutex keepalive_mutex;
-  std::condition_variable_any keepalive_wake;
-  std::jthread keepalive;  // stopped before the link is rested or goes
-
-  void arm_host_watchdog() {
-    host_watchdog = link->arm_host_watchdog(host_watchdog_ms);
-    if (!host_watchdog || keepalive.joinable()) return;
-    keepalive = std::jthread([this](std::stop_token stop) {
-      std::unique_lock lock(keepalive_mutex);
-      while (!stop.stop_requested()) {
-        try {
-          link->keepalive();
-        } catch (const std::exception&) {
-          return;  // the link is gone: the display's watchdog rests it
-        }
-        keepalive_wake.wait_for(lock, stop, keepalive_every, [] { return false; });
-      }
-    });
-  }
-  void stop_keepalive() {
-    if (!keepalive.joinable()) return;
-    keepalive.request_stop();
-    keepalive.join();
-  }
-
-  void record(const FingerReport& r) {  // under mutex
-    ++reports;
-    // The display's own clock, unwrapped: its t_us at the first report plus the time since.
-    if (reports == 1) first_s = static_cast<double>(r.t_us) * 1e-6;
-    const double t = first_s + clock.seconds(r.t_us);
-    if (recording) trace.push_back(FingerSample{t, r.x_mm, r.touch});
-  }
-
-  // display-plays: drains the reports that arrived (control thread).
-  void drain() {
-    std::array<FingerReport, 256> buf;
-    for (;;) {
-      const std::size_t n = link->read_reports(buf, 0);
-      std::lock_guard<std::mutex> lock(mutex);
-      for (std::size_t i = 0; i < n; ++i) record(buf[i]);
-      if (n < buf.size()) return;
-    }
-  }
-
-  const Rendered& render(const std::string& document_json) {
-    auto it = std::find_if(rendered.begin(), rendered.end(), [&](const Rendered& r) { return r.document == document_json; });
-    if (it != rendered.end()) {
-      rendered.splice(rendered.begin(), rendered, it);
-      return rendered.front();
-    }
-    // texel render's bytes: the document's surface encoded as u16le (round(a·65535)).
-    const Document doc = parse_document(document_json, "stimulus");
-    check_channels(doc, 1);  // a serial display is one channel
-    const std::shared_ptr<const Surface> held = one_channel_surface(doc);
-    const Surface& surface = *held;
-    const Grid& g = surface.grid();
-    if (static_cast<std::uint64_t>(g.count) > info.max_samples)
-      throw InvalidArgument("a stimulus map has " + std::to_string(g.count) + " samples; the display '" + info.name +
-                            "' holds at most " + std::to_string(info.max_samples) +
-                            " (its HELLO): use a device profile the display can hold, or --mode host-streams");
-    const std::vector<std::byte> bytes = surface.render_native(SampleFormat::u16le);
-    Rendered r;
-    r.document = document_json;
-    r.samples.resize(bytes.size() / 2);
-    for (std::size_t i = 0; i < r.samples.size(); ++i)
-      r.samples[i] = static_cast<std::uint16_t>(std::to_integer<unsigned>(bytes[2 * i]) |
-                                                (std::to_integer<unsigned>(bytes[2 * i + 1]) << 8));
-    r.spacing_nm = static_cast<std::uint32_t>(std::lround(g.spacing.value() * 1e6));
-    r.origin_nm = static_cast<std::int32_t>(std::lround(g.origin.value() * 1e6));
-    rendered.push_front(std::move(r));
-    if (rendered.size() > 8) rendered.pop_back();
-    return rendered.front();
-  }
-
-  // The slot holding `document_json`, uploading it over the least recently
-  // felt slot that is not playing (or, with one slot, after SELECT none).
-  int hold(const std::string& document_json, bool at_switch) {
-    for (std::size_t k = 0; k < slots.size(); ++k)
-      if (slots[k].document == document_json) {
-        slots[k].used = ++tick;
-        return static_cast<int>(k);
-      }
-    const Rendered& r = render(document_json);
-    int victim = -1;
-    for (std::size_t k = 0; k < slots.size(); ++k)
-      if (static_cast<int>(k) != selected && (victim < 0 || slots[k].used < slots[static_cast<std::size_t>(victim)].used))
-        victim = static_cast<int>(k);
-    if (victim < 0) {  // one slot, playing: rest while it is replaced
-      select(-1);
-      victim = 0;
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    slots[static_cast<std::size_t>(victim)].document.clear();  // a failed upload leaves the slot unknown
-    link->upload_raw(static_cast<std::uint8_t>(victim), r.samples, r.spacing_nm, r.origin_nm);
-    uploads.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    ++uploads.uploads;
-    if (at_switch) ++uploads.at_switch;
-    slots[static_cast<std::size_t>(victim)] = Slot{document_json, ++tick};
-    return victim;
-  }
-
-  void select(int slot) {
-    if (slot == selected) return;
-    link->select(slot < 0 ? serial::no_map : static_cast<std::uint8_t>(slot));
-    selected = slot;
-  }
-};
 
 std::size_t presentation_channels(std::string_view device) { return load_device(device).channels(); }
 
@@ -726,91 +521,6 @@ PlayerBase& Presenter::output() {
 
 bool Presenter::push(const FingerSample& sample) { return multi_ ? multi_->push(sample) : player_->push(sample); }
 
-void Presenter::choose_mode(const BackendChoice& choice) {
-  const bool external = options_.finger == FingerSource::external;
-  if (choice.kind != BackendChoice::Kind::serial || external) {
-    // A sound card or no hardware: no map storage; a finger only if pushed from outside.
-    mode_ = options_.mode.value_or(external ? PresentationMode::host_streams : PresentationMode::passive);
-    if (mode_ == PresentationMode::display_plays)
-      throw InvalidArgument("--mode display-plays: " + backend_->describe() +
-                            " stores no maps; give a serial display that does (--backend serial:PATH)");
-    if (mode_ == PresentationMode::host_streams && !external)
-      throw InvalidArgument("--mode host-streams: " + backend_->describe() +
-                            " has no finger to stream from; give a display that senses it (--backend serial:PATH) or "
-                            "--mode passive");
-    if (mode_ == PresentationMode::passive && external)
-      throw InvalidArgument("mode passive: this presenter is given a finger (external); passive plays a simulated sweep");
-    return;
-  }
-  // A serial display: what its HELLO says it holds, and whether it senses the finger.
-  auto d = std::make_unique<Display1D>();
-  d->link = backend_->serial_link();
-  d->info = d->link->hello();
-  d->report_interval_us = options_.report_interval_us;
-  if (d->report_interval_us < serial::min_report_interval_us)
-    throw InvalidArgument("report interval is " + std::to_string(d->report_interval_us) +
-                          " µs; allowed >= " + std::to_string(serial::min_report_interval_us));
-  try {
-    d->link->start_reports(d->report_interval_us);
-    d->sensor = true;
-  } catch (const SerialError& e) {
-    if (e.code != serial::ErrorCode::no_sensor && e.code != serial::ErrorCode::unknown_type) throw;
-  }
-  const PresentationMode chosen = d->sensor
-                                      ? (d->info.slots >= 1 ? PresentationMode::display_plays : PresentationMode::host_streams)
-                                      : PresentationMode::passive;
-  mode_ = options_.mode.value_or(chosen);
-  const std::string who = "the display '" + d->info.name + "' on " + choice.serial_path;
-  auto refuse = [&](const std::string& why) {
-    if (d->sensor) try {
-        d->link->start_reports(0);
-      } catch (const Error&) {
-      }
-    throw InvalidArgument("--mode " + std::string(to_string(mode_)) + ": " + who + " " + why);
-  };
-  if (mode_ == PresentationMode::display_plays && d->info.slots < 1) refuse("stores no maps (0 slots in its HELLO)");
-  if (mode_ != PresentationMode::passive && !d->sensor)
-    refuse("does not sense the finger (it refused FINGER reports); give --mode passive for a passive hand");
-  if (mode_ == PresentationMode::passive && d->sensor)
-    refuse("senses the finger; passive would ignore the participant's exploration (give display-plays or host-streams)");
-  if (mode_ == PresentationMode::passive) return;  // streams the simulated sweep's drive, as before
-  d->slots.resize(static_cast<std::size_t>(std::max(0, d->info.slots)));
-  if (mode_ == PresentationMode::display_plays) d->arm_host_watchdog();
-  display1d_ = std::move(d);
-}
-
-void Presenter::open_sensor(const BackendChoice& choice) {
-  const std::string& f = options_.finger_display;
-  if (!f.starts_with("serial:") || f.size() <= 7)
-    throw InvalidArgument("finger sensor is '" + f + "'; allowed: serial:PATH (a display or strip that reports the finger)");
-  const std::string path = f.substr(7);
-  if (choice.kind == BackendChoice::Kind::serial && choice.serial_path == path)
-    throw InvalidArgument("--finger " + f +
-                          " is the backend's own display: a display with a sensor is its own finger (give no --finger)");
-  mode_ = options_.mode.value_or(PresentationMode::host_streams);
-  if (mode_ != PresentationMode::host_streams)
-    throw InvalidArgument("--mode " + std::string(to_string(mode_)) + ": with a separate finger sensor (" + f +
-                          ") the host streams the stimulus from its reports; give --mode host-streams or none");
-  if (options_.report_interval_us < serial::min_report_interval_us)
-    throw InvalidArgument("report interval is " + std::to_string(options_.report_interval_us) +
-                          " µs; allowed >= " + std::to_string(serial::min_report_interval_us));
-  auto d = std::make_unique<Display1D>();
-  d->own_link = std::make_unique<SerialLink>(path, options_.baud);
-  d->link = d->own_link.get();
-  d->info = d->link->hello();
-  d->report_interval_us = options_.report_interval_us;
-  try {
-    d->link->start_reports(d->report_interval_us);
-  } catch (const SerialError& e) {
-    if (e.code == serial::ErrorCode::no_sensor || e.code == serial::ErrorCode::unknown_type)
-      throw InvalidArgument("--finger " + f + ": the display '" + d->info.name +
-                            "' does not report the finger (it refused FINGER reports); give a sensor that does");
-    throw;
-  }
-  d->sensor = true;
-  display1d_ = std::move(d);
-}
-
 FingerTrace Presenter::take_trace() {
   FingerTrace t;
   t.mode = mode_;
@@ -830,60 +540,6 @@ FingerTrace Presenter::take_trace() {
 }
 
 Presenter::UploadCounts Presenter::upload_counts() const { return display1d_ ? display1d_->uploads : UploadCounts{}; }
-
-std::vector<std::string> Presenter::check(const Question& first) const {
-  std::vector<std::string> out;
-  if (display_ || first.stimuli.empty()) return out;
-  for (const auto& s : first.stimuli) check_channels(parse_document(s.document_json, "stimulus"), options_.channels);
-  constexpr double swipe_mm_s = 100.0;  // the studies' typical swipe
-  if (mode_ == PresentationMode::display_plays) {
-    Display1D& d = *display1d_;
-    std::uint64_t samples = 0;
-    std::vector<std::string> distinct;  // an oddity trial shows one texture twice
-    for (const auto& s : first.stimuli) {
-      const Document doc = parse_document(s.document_json, "stimulus");
-      samples = std::max<std::uint64_t>(samples, static_cast<std::uint64_t>(doc.device.samples));
-      if (std::find(distinct.begin(), distinct.end(), s.document_json) == distinct.end()) distinct.push_back(s.document_json);
-    }
-    if (samples > d.info.max_samples)
-      throw InvalidArgument("a stimulus map has " + std::to_string(samples) + " samples; the display '" + d.info.name +
-                            "' holds at most " + std::to_string(d.info.max_samples) + " (its HELLO)");
-    if (d.slots.size() < distinct.size()) {
-      // Each MAP_DATA frame carries up to 509 samples (1,032 bytes with framing) and waits for its ACK.
-      const double bytes = std::ceil(static_cast<double>(samples) / 509.0) * 1032.0;
-      const double s = bytes * 10.0 / static_cast<double>(options_.baud);
-      out.push_back("the display holds " + std::to_string(d.slots.size()) + " map(s) and a trial has " +
-                    std::to_string(distinct.size()) + " different stimuli: a switch to a stimulus not held uploads its " +
-                    std::to_string(samples) + " samples first (about " + detail::fixed(s * 1e3, 0) + " ms at " +
-                    std::to_string(options_.baud) + " baud; less on a USB link), during which the display is at rest");
-    }
-    return out;
-  }
-  if (mode_ != PresentationMode::host_streams) return out;
-  // What the stream can carry: at rate R and speed v, spatial frequencies up to R / (2 v).
-  const double rate = rate_hz_;
-  const double limit = rate / (2.0 * swipe_mm_s);
-  std::size_t texels = 0, above = 0;
-  double highest = 0.0;
-  for (const auto& s : first.stimuli) {
-    const Surface surface = prepare_surface(parse_document(s.document_json, "stimulus"));
-    for (const auto& r : surface.regions())
-      if (const auto* t = dynamic_cast<const TexelTexture*>(r.texture.get()))
-        for (const auto& texel : t->texels()) {
-          ++texels;
-          highest = std::max(highest, texel.frequency.value());
-          if (texel.frequency.value() > limit) ++above;
-        }
-  }
-  if (above > 0)
-    out.push_back("host-streams at " + detail::num(rate) + " Hz carries at most " + detail::fixed(limit, 2) + " cycles/mm at a " +
-                  detail::num(swipe_mm_s) + " mm/s swipe (" + detail::fixed(20.0 * std::log10(limit), 1) + " dB); " +
-                  detail::fixed(100.0 * static_cast<double>(above) / static_cast<double>(texels), 0) +
-                  " % of the first trial's texels lie above it (up to " + detail::fixed(highest, 2) +
-                  " cycles/mm): the display cannot render them this way; a display that stores maps plays them "
-                  "(display-plays)");
-  return out;
-}
 
 std::optional<FingerSample> Presenter::push_finger(double x_mm, bool touching) {
   if (options_.finger != FingerSource::external || display_) return std::nullopt;

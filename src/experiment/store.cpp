@@ -1,6 +1,7 @@
 // The durable session store over SQLite's C API (store.hpp,
-// docs/session-store.md). SQLite types stay in this file, behind three small
-// RAII wrappers (connection, statement, transaction).
+// docs/session-store.md). SQLite types stay behind three small RAII
+// wrappers (connection, statement, transaction: store_sqlite.hpp); the
+// schema's migrations are store_schema.cpp, the writer lock store_writer.cpp.
 //
 // Durability settings and where their guarantees are stated:
 //  * journal_mode=WAL (https://www.sqlite.org/wal.html): a commit appends to
@@ -39,305 +40,20 @@
 #include <utility>
 
 #include "store_pg.hpp"
+#include "store_sqlite.hpp"
 #include "texel/error.hpp"
 
 namespace texel::experiment {
 
+using namespace store_parts;
+
 namespace {
-
-constexpr int busy_timeout_ms = 5000;
-// PRAGMA application_id: 'T' 'X' 'E' 'X' — marks the file as a Texel
-// experiment database, so another application's SQLite file is refused.
-constexpr std::int64_t texel_application_id = 0x54584558;
-
-// Schema migrations, numbered: migrations[v] takes a database from schema
-// version v to v + 1, in one transaction that also sets user_version. A
-// released entry is never edited; a change to the schema appends one.
-// Version 0 is an empty file.
-const std::array<const char*, 2> migrations = {
-    // 0 → 1: the first schema.
-    R"sql(
-CREATE TABLE participants (
-  code       TEXT PRIMARY KEY CHECK (length(code) BETWEEN 1 AND 32),
-  created_at TEXT NOT NULL
-);
-CREATE TABLE sessions (
-  id             INTEGER PRIMARY KEY,
-  participant    TEXT NOT NULL REFERENCES participants(code),
-  protocol       TEXT NOT NULL,
-  study          TEXT NOT NULL,
-  protocol_json  TEXT NOT NULL,
-  seed           TEXT NOT NULL,
-  simulate       TEXT NOT NULL DEFAULT '',
-  status         TEXT NOT NULL DEFAULT 'running' CHECK (status IN ('running', 'finished')),
-  trials_planned INTEGER NOT NULL DEFAULT -1,
-  created_at     TEXT NOT NULL,
-  updated_at     TEXT NOT NULL
-);
-CREATE INDEX sessions_by_participant ON sessions(participant, protocol);
-CREATE TABLE trials (
-  session_id    INTEGER NOT NULL REFERENCES sessions(id),
-  trial         INTEGER NOT NULL CHECK (trial >= 0),
-  question_json TEXT NOT NULL,
-  response_json TEXT NOT NULL,
-  state_json    TEXT NOT NULL,
-  row_json      TEXT NOT NULL,
-  stored_at     TEXT NOT NULL,
-  PRIMARY KEY (session_id, trial)
-);
-CREATE TABLE events (
-  session_id INTEGER NOT NULL,
-  trial      INTEGER NOT NULL,
-  seq        INTEGER NOT NULL,
-  t_s        REAL NOT NULL,
-  kind       TEXT NOT NULL,
-  detail     TEXT NOT NULL,
-  at         TEXT NOT NULL,
-  PRIMARY KEY (session_id, trial, seq),
-  FOREIGN KEY (session_id, trial) REFERENCES trials(session_id, trial)
-);
-CREATE TABLE writers (
-  session_id    INTEGER PRIMARY KEY REFERENCES sessions(id),
-  pid           INTEGER NOT NULL,
-  process_start INTEGER NOT NULL,
-  host          TEXT NOT NULL,
-  acquired_at   TEXT NOT NULL
-);
-)sql",
-    // 1 → 2: the finger that explored each trial (finger_trace.hpp): its
-    // source, the presentation mode and the samples ("t_s,x_mm,touch" lines
-    // on the source's own clock). Trials stored before have no row here.
-    R"sql(
-CREATE TABLE finger_traces (
-  session_id INTEGER NOT NULL,
-  trial      INTEGER NOT NULL,
-  source     TEXT NOT NULL CHECK (source IN ('display', 'pointer', 'simulated')),
-  mode       TEXT NOT NULL CHECK (mode IN ('', 'display-plays', 'host-streams', 'passive')),
-  samples    INTEGER NOT NULL CHECK (samples >= 0),
-  trace      TEXT NOT NULL,
-  PRIMARY KEY (session_id, trial),
-  FOREIGN KEY (session_id, trial) REFERENCES trials(session_id, trial)
-);
-)sql",
-};
-static_assert(migrations.size() == Store::current_schema_version);
-
-std::string host_name() {
-  char buf[256] = {};
-  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
-  return buf;
-}
-
-// /proc/<pid>/stat: the state (field 3) and the start time in clock ticks
-// since boot (field 22). The start time tells a recycled pid from the writer.
-struct ProcStat {
-  bool readable = false;
-  char state = '?';
-  std::int64_t start = 0;
-};
-ProcStat proc_stat(std::int64_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  ProcStat s;
-  const auto close = text.rfind(')');  // the command name may hold spaces and parentheses
-  if (close == std::string::npos) return s;
-  std::istringstream rest(text.substr(close + 1));
-  std::string field;
-  // After ')': field 3 is the state; field 22 is 20 further on.
-  rest >> s.state;
-  for (int f = 4; f <= 22; ++f) {
-    if (!(rest >> field)) return s;
-  }
-  try {
-    s.start = std::stoll(field);
-  } catch (const std::exception&) {
-    return s;
-  }
-  s.readable = true;
-  return s;
-}
-
-// Our own start time; recomputed after a fork(), where the child inherits
-// the parent's cached value.
-std::int64_t own_start() {
-  static pid_t cached_pid = 0;
-  static std::int64_t start = 0;
-  if (cached_pid != ::getpid()) {
-    cached_pid = ::getpid();
-    start = proc_stat(cached_pid).start;
-  }
-  return start;
-}
-
-// Is `pid` (started at `start` ticks) still running on this machine? A
-// zombie counts as dead: it holds nothing and will never write again.
-bool process_alive(std::int64_t pid, std::int64_t start) {
-  if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) return false;
-  if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno != EPERM) return false;
-  const ProcStat s = proc_stat(pid);
-  if (!s.readable) return true;  // no /proc: trust kill()
-  if (s.state == 'Z' || s.state == 'X') return false;
-  return s.start == start;
-}
 
 bool valid_code(const std::string& code) {
   if (code.empty() || code.size() > 32) return false;
   for (const unsigned char c : code)
     if (!std::isalnum(c) && c != '_' && c != '.' && c != '-') return false;
   return true;
-}
-
-}  // namespace
-
-// ---------------------------------------------------------------------------
-// The connection and its wrappers.
-
-struct StoreConnection {
-  sqlite3* db = nullptr;
-  std::string path;
-  bool writable = false;
-  int version = 0;
-  // PostgreSQL (store_pg.hpp): a reader of the server (db is null), or a
-  // station whose db is its local journal.
-  std::shared_ptr<pg::Reader> reader;
-  std::shared_ptr<pg::Station> station;
-
-  StoreConnection() = default;
-  StoreConnection(const StoreConnection&) = delete;
-  StoreConnection& operator=(const StoreConnection&) = delete;
-  ~StoreConnection() {
-    if (db) sqlite3_close_v2(db);
-  }
-
-  // One line: the operation, the path and SQLite's reason, as the error
-  // family a caller can act on.
-  [[noreturn]] void fail(const std::string& op, int rc) const {
-    const std::string why = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
-    const int primary = rc & 0xff;
-    switch (primary) {
-      case SQLITE_NOTADB: throw FormatError(path + " is not a Texel experiment database (" + why + ")");
-      case SQLITE_CORRUPT: throw FormatError(path + " is corrupt (" + why + "); " + op + " refused");
-      case SQLITE_BUSY:
-      case SQLITE_LOCKED:
-        throw IoError(path + " is locked by another process (waited " + std::to_string(busy_timeout_ms / 1000) + " s): " + op +
-                      " refused");
-      case SQLITE_READONLY: throw IoError(path + " is read-only (" + why + "): " + op + " refused");
-      case SQLITE_CONSTRAINT: throw InvalidArgument(path + ": " + op + ": " + why);
-      default: throw IoError(path + ": " + op + " failed: " + why);
-    }
-  }
-};
-
-namespace {
-
-using StoreImpl = StoreConnection;
-
-class Stmt {
- public:
-  Stmt(const StoreImpl& s, const char* sql, std::string op) : s_(s), op_(std::move(op)) {
-    const int rc = sqlite3_prepare_v2(s.db, sql, -1, &st_, nullptr);
-    if (rc != SQLITE_OK) s.fail(op_, rc);
-  }
-  Stmt(const Stmt&) = delete;
-  Stmt& operator=(const Stmt&) = delete;
-  ~Stmt() { sqlite3_finalize(st_); }
-
-  Stmt& bind(int i, std::int64_t v) {
-    check(sqlite3_bind_int64(st_, i, v));
-    return *this;
-  }
-  Stmt& bind(int i, int v) { return bind(i, static_cast<std::int64_t>(v)); }
-  Stmt& bind(int i, double v) {
-    check(sqlite3_bind_double(st_, i, v));
-    return *this;
-  }
-  Stmt& bind(int i, const std::string& v) {
-    check(sqlite3_bind_text(st_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
-    return *this;
-  }
-  /// True while there is a row.
-  bool step() {
-    const int rc = sqlite3_step(st_);
-    if (rc == SQLITE_ROW) return true;
-    if (rc == SQLITE_DONE) return false;
-    s_.fail(op_, rc);
-  }
-  void run() {
-    while (step()) {
-    }
-  }
-  /// Ready to run again with new bindings.
-  void reset() {
-    sqlite3_reset(st_);
-    sqlite3_clear_bindings(st_);
-  }
-  [[nodiscard]] std::int64_t i64(int c) const { return sqlite3_column_int64(st_, c); }
-  [[nodiscard]] int i32(int c) const { return sqlite3_column_int(st_, c); }
-  [[nodiscard]] double dbl(int c) const { return sqlite3_column_double(st_, c); }
-  [[nodiscard]] std::string text(int c) const {
-    const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(st_, c));
-    return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(st_, c))) : std::string();
-  }
-
- private:
-  void check(int rc) const {
-    if (rc != SQLITE_OK) s_.fail(op_, rc);
-  }
-  const StoreImpl& s_;
-  std::string op_;
-  sqlite3_stmt* st_ = nullptr;
-};
-
-void exec(const StoreImpl& s, const char* sql, const std::string& op) {
-  char* err = nullptr;
-  const int rc = sqlite3_exec(s.db, sql, nullptr, nullptr, &err);
-  sqlite3_free(err);
-  if (rc != SQLITE_OK) s.fail(op, rc);
-}
-
-// BEGIN IMMEDIATE takes the write lock up front, so the checks made inside
-// the transaction (trial count, writer row) still hold at COMMIT.
-class Transaction {
- public:
-  Transaction(const StoreImpl& s, std::string op) : s_(s), op_(std::move(op)) { exec(s_, "BEGIN IMMEDIATE", op_); }
-  Transaction(const Transaction&) = delete;
-  Transaction& operator=(const Transaction&) = delete;
-  ~Transaction() {
-    if (!done_) sqlite3_exec(s_.db, "ROLLBACK", nullptr, nullptr, nullptr);
-  }
-  void commit() {
-    exec(s_, "COMMIT", op_);
-    done_ = true;
-  }
-
- private:
-  const StoreImpl& s_;
-  std::string op_;
-  bool done_ = false;
-};
-
-std::int64_t pragma_int(const StoreImpl& s, const char* sql, const std::string& op) {
-  Stmt st(s, sql, op);
-  return st.step() ? st.i64(0) : 0;
-}
-
-void migrate(StoreImpl& s) {
-  while (s.version < Store::current_schema_version) {
-    const int from = s.version;
-    Transaction tx(s, "migrating the schema from version " + std::to_string(from));
-    // Re-read inside the write lock: another process may have migrated meanwhile.
-    const auto v = static_cast<int>(pragma_int(s, "PRAGMA user_version", "reading the schema version"));
-    if (v != from) {
-      s.version = v;
-      continue;
-    }
-    exec(s, migrations[static_cast<std::size_t>(from)], "migrating the schema to version " + std::to_string(from + 1));
-    const std::string set =
-        "PRAGMA application_id = " + std::to_string(texel_application_id) + "; PRAGMA user_version = " + std::to_string(from + 1);
-    exec(s, set.c_str(), "setting the schema version");
-    tx.commit();
-    s.version = from + 1;
-  }
 }
 
 constexpr const char* session_columns =
@@ -359,10 +75,6 @@ SessionInfo read_session(const Stmt& st) {
   i.trials_done = st.i32(10);
   i.trials_planned = st.i32(11);
   return i;
-}
-
-std::string session_label(const SessionInfo& s) {
-  return "session " + std::to_string(s.id) + " (" + s.participant + ", " + s.protocol + ")";
 }
 
 }  // namespace
@@ -574,67 +286,6 @@ std::vector<std::string> Store::participants() const {
   return out;
 }
 
-WriterLock Store::acquire_writer(std::int64_t session_id) {
-  if (!impl_->writable || impl_->reader)
-    throw InvalidArgument(impl_->path + " is open read-only; cannot write session " + std::to_string(session_id));
-  const SessionInfo info = session(session_id);
-  const std::string op = "taking the writer lock of " + session_label(info);
-  Transaction tx(*impl_, op);
-  const std::string host = host_name();
-  {
-    Stmt st(*impl_, "SELECT pid, process_start, host, acquired_at FROM writers WHERE session_id = ?", op);
-    st.bind(1, session_id);
-    if (st.step()) {
-      const std::int64_t pid = st.i64(0), start = st.i64(1);
-      const std::string other_host = st.text(2), since = st.text(3);
-      if (other_host != host)
-        throw IoError(session_label(info) + " is being written by process " + std::to_string(pid) + " on host " + other_host +
-                      " since " + since +
-                      "; stop it first (a lock from another machine is not checked; if that run is gone, "
-                      "delete its row from the writers table)");
-      if (pid == ::getpid() && start == own_start())
-        throw IoError(session_label(info) + " is already being written by this process (since " + since + ")");
-      if (process_alive(pid, start))
-        throw IoError(session_label(info) + " is being written by process " + std::to_string(pid) + " since " + since +
-                      "; stop it first");
-      // Otherwise the row is left by a dead run (killed, crashed): take it over.
-    }
-  }
-  Stmt(*impl_,
-       "INSERT INTO writers(session_id, pid, process_start, host, acquired_at) VALUES (?, ?, ?, ?, ?) "
-       "ON CONFLICT(session_id) DO UPDATE SET pid = excluded.pid, process_start = excluded.process_start, "
-       "host = excluded.host, acquired_at = excluded.acquired_at",
-       op)
-      .bind(1, session_id)
-      .bind(2, static_cast<std::int64_t>(::getpid()))
-      .bind(3, own_start())
-      .bind(4, host)
-      .bind(5, utc_timestamp())
-      .run();
-  tx.commit();
-  WriterLock lock(impl_, session_id);
-  // A station also holds the study-wide lock (a refusal releases ours).
-  if (impl_->station) impl_->station->take_lease(info);
-  return lock;
-}
-
-namespace {
-
-// Inside a write transaction: is `lock` still this process's hold on its
-// session (not taken over by someone who judged us dead)?
-void check_lock(const StoreImpl& s, const std::shared_ptr<StoreImpl>& mine, const WriterLock& lock,
-                const std::shared_ptr<StoreImpl>& lock_impl, const std::string& op) {
-  if (!lock_impl) throw InvalidArgument(op + ": the writer lock was released or moved from");
-  if (lock_impl != mine) throw InvalidArgument(op + ": the writer lock belongs to another Store");
-  Stmt st(s, "SELECT pid, process_start FROM writers WHERE session_id = ?", op);
-  st.bind(1, lock.session_id());
-  if (!st.step() || st.i64(0) != ::getpid() || st.i64(1) != own_start())
-    throw IoError(s.path + ": " + op + ": this process no longer holds the writer lock of session " +
-                  std::to_string(lock.session_id()));
-}
-
-}  // namespace
-
 void Store::append_trial(const WriterLock& lock, const StoredTrial& t) {
   const std::int64_t sid = lock.session_id();
   const std::string op = "storing trial " + std::to_string(t.trial) + " of session " + std::to_string(sid);
@@ -780,35 +431,6 @@ std::vector<TrialRow> Store::rows(std::optional<std::int64_t> session_id) const 
     out.push_back(std::move(r));
   }
   return out;
-}
-
-// ---------------------------------------------------------------------------
-// WriterLock
-
-WriterLock::WriterLock(std::shared_ptr<StoreConnection> impl, std::int64_t session_id)
-    : impl_(std::move(impl)), session_id_(session_id) {}
-WriterLock::WriterLock(WriterLock&& o) noexcept : impl_(std::move(o.impl_)), session_id_(o.session_id_) {}
-WriterLock& WriterLock::operator=(WriterLock&& o) noexcept {
-  if (this != &o) {
-    WriterLock old(std::move(*this));
-    impl_ = std::move(o.impl_);
-    session_id_ = o.session_id_;
-  }
-  return *this;
-}
-WriterLock::~WriterLock() {
-  if (!impl_ || !impl_->db) return;
-  // Only our own row: if another process took the session over, leave it.
-  sqlite3_stmt* st = nullptr;
-  if (sqlite3_prepare_v2(impl_->db, "DELETE FROM writers WHERE session_id = ? AND pid = ? AND process_start = ?", -1, &st,
-                         nullptr) == SQLITE_OK) {
-    sqlite3_bind_int64(st, 1, session_id_);
-    sqlite3_bind_int64(st, 2, ::getpid());
-    sqlite3_bind_int64(st, 3, own_start());
-    sqlite3_step(st);  // a failure leaves a row that the next run recognises as dead
-  }
-  sqlite3_finalize(st);
-  if (impl_->station) impl_->station->release_lease(session_id_);
 }
 
 }  // namespace texel::experiment
