@@ -112,7 +112,7 @@ struct Client {
   double pointer_lag_ms = std::numeric_limits<double>::infinity();
 };
 
-struct Surface2DState;  // handlers_surface2d.cpp: the prepared 2-D surface and the 2-D pad's player
+struct Surface2DState;  // handlers_surface2d.hpp: the prepared 2-D surface and the 2-D pad's player
 std::shared_ptr<Surface2DState> make_surface2d_state();
 struct Strokes2DState;  // handlers_experiment.cpp: the participant's strokes of a 2-D trial
 std::shared_ptr<Strokes2DState> make_strokes2d_state();
