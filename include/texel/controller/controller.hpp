@@ -138,20 +138,14 @@ class Controller {
   /// One pass of the main loop: drains the serial port, answers frames and,
   /// when a refresh tick is due, updates the output. Never blocks.
   void poll() {
+    // A loop that fell behind by more than two ticks (a host that did not
+    // schedule it; a firmware's timer never does) first brings its output up
+    // to this moment — the watchdog included — so the frames it now drains,
+    // a STATUS request among them, meet the output as it is, not as it was
+    // before the gap.
+    if (static_cast<std::int32_t>(hal_.micros() - next_tick_us_) > static_cast<std::int32_t>(tick_offset_us(2))) step();
     drain_serial();
-    const std::uint32_t now = hal_.micros();
-    if (static_cast<std::int32_t>(now - next_tick_us_) >= 0) {
-      tick(now);
-      ++tick_count_;
-      next_tick_us_ = start_us_ + tick_offset_us(tick_count_);
-      if (static_cast<std::int32_t>(now - next_tick_us_) > 0) {
-        // Fell behind (host scheduling, a long map copy): skip the missed
-        // ticks instead of bursting through them.
-        const std::uint64_t behind = (static_cast<std::uint64_t>(now - next_tick_us_) * info_.refresh_mhz) / 1000000000ull + 1;
-        tick_count_ += behind;
-        next_tick_us_ = start_us_ + tick_offset_us(tick_count_);
-      }
-    }
+    if (static_cast<std::int32_t>(hal_.micros() - next_tick_us_) >= 0) step();
   }
 
   /// Runs poll() until should_stop() is true, idling between ticks.
@@ -181,6 +175,21 @@ class Controller {
     std::int32_t origin_nm = 0;
     std::uint16_t data[MaxSamples];
   };
+
+  // One output update at the time now, then the next tick's time; a loop that
+  // fell behind (host scheduling, a long map copy) skips the missed ticks
+  // instead of bursting through them.
+  void step() {
+    const std::uint32_t now = hal_.micros();
+    tick(now);
+    ++tick_count_;
+    next_tick_us_ = start_us_ + tick_offset_us(tick_count_);
+    if (static_cast<std::int32_t>(now - next_tick_us_) > 0) {
+      const std::uint64_t behind = (static_cast<std::uint64_t>(now - next_tick_us_) * info_.refresh_mhz) / 1000000000ull + 1;
+      tick_count_ += behind;
+      next_tick_us_ = start_us_ + tick_offset_us(tick_count_);
+    }
+  }
 
   [[nodiscard]] std::uint32_t tick_offset_us(std::uint64_t k) const {
     return static_cast<std::uint32_t>((k * 1000000000ull) / info_.refresh_mhz);
