@@ -187,8 +187,9 @@ json staircase_summary(const std::string& study, const Rows& rows, const Analysi
   json bj = json::array();
   std::vector<stats::Observation> obs;
   std::map<std::string, std::map<std::string, double>> per_participant;  // group → participant → convergent
-  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + std::string(to_string(o.convergent)) + ")" +
-          (unfinished.empty() ? std::string() : ", " + std::to_string(unfinished.size()) + " not finished") + "\n" + run_text;
+  text += study + ": " + std::to_string(runs.size()) + " staircase runs (end value: " + std::string(to_string(o.convergent)) +
+          ")" + (unfinished.empty() ? std::string() : ", " + std::to_string(unfinished.size()) + " not finished") + "\n" +
+          run_text;
   for (const std::string& b : blocks.names) {
     std::vector<double> cv, tv;
     for (const auto& [p, v] : conv[b]) {
