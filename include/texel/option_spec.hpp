@@ -8,8 +8,9 @@
 // default or a range changes in one place (docs/contributing.md).
 //
 // The library still validates the struct itself (a C++ caller fills it
-// directly); `min`/`max` here state that rule for the front doors, which
-// refuse a value outside it before calling.
+// directly), from the same description (check_option_value), so `min`/`max`
+// here are that rule; the front doors refuse a value outside it before
+// calling, naming the option their own way.
 #pragma once
 
 #include <limits>

@@ -35,32 +35,22 @@ std::string_view to_string(ConfidenceDistance d) { return choice_name(confidence
 
 namespace {
 
-// The rules visit_options states, for a C++ caller that fills the struct directly.
+// The rules visit_options states, applied from that description, for a C++
+// caller that fills the struct directly; and the one rule between two options.
 void check_options(const AnalysisOptions& o) {
-  const auto known = [](std::span<const OptionChoice> choices, auto v, const char* key) {
-    if (choice_name(choices, static_cast<int>(v)).empty())
-      throw InvalidArgument(std::string("analysis ") + key + " is " + std::to_string(static_cast<int>(v)) +
-                            ", not one of its values");
-  };
-  known(figure_formats, o.format, "format");
-  known(convergent_values, o.convergent, "convergent");
-  known(memory_rules, o.memory_rule, "memory_rule");
-  known(confidence_distances, o.confidence_distance, "confidence_distance");
-  if (o.reversals_k < 1 || o.reversals_k > 1000)
-    throw InvalidArgument("analysis reversals_k is " + std::to_string(o.reversals_k) + "; allowed: 1 … 1000");
-  if (!(o.level > 0 && o.level < 1))
-    throw InvalidArgument("analysis level is " + texel::detail::num(o.level) + "; allowed (0, 1)");
-  if (!(o.memory_errors_sd > 0) || !std::isfinite(o.memory_errors_sd))
-    throw InvalidArgument("analysis memory_errors_sd is " + texel::detail::num(o.memory_errors_sd) + "; allowed > 0");
-  if (!(o.memory_errors_sd_tolerance >= 0) || !(o.memory_errors_sd_tolerance < o.memory_errors_sd))
+  visit_options(o, [](const auto& v, const OptionSpec& spec) {
+    using T = std::remove_cvref_t<decltype(v)>;
+    const std::string name = "analysis " + std::string(spec.key);
+    if constexpr (std::is_enum_v<T>) {
+      if (choice_name(spec.choices, static_cast<int>(v)).empty())
+        throw InvalidArgument(name + " is " + std::to_string(static_cast<int>(v)) + ", not one of its values");
+    } else if constexpr (!std::is_same_v<T, bool>) {
+      check_option_value(spec, static_cast<double>(v), name);
+    }
+  });
+  if (!(o.memory_errors_sd_tolerance < o.memory_errors_sd))
     throw InvalidArgument("analysis memory_errors_sd_tolerance is " + texel::detail::num(o.memory_errors_sd_tolerance) +
-                          "; allowed 0 … memory_errors_sd (" + texel::detail::num(o.memory_errors_sd) + "), excluded");
-  if (!std::isfinite(o.memory_recall_chance) || o.memory_recall_chance >= 1)
-    throw InvalidArgument("analysis memory_recall_chance is " + texel::detail::num(o.memory_recall_chance) +
-                          "; allowed < 1 (negative = rule off)");
-  if (!(o.memory_accuracy_sd >= 0) || !std::isfinite(o.memory_accuracy_sd))
-    throw InvalidArgument("analysis memory_accuracy_sd is " + texel::detail::num(o.memory_accuracy_sd) +
-                          "; allowed >= 0 (0 = rule off)");
+                          "; allowed below memory_errors_sd (" + texel::detail::num(o.memory_errors_sd) + ")");
 }
 
 /// A CSV field: quoted when it holds a separator, a quote or a line break.
