@@ -23,20 +23,21 @@ struct EncodeArgs {
   std::vector<std::string> inputs;
   std::optional<std::string> output;
   SignalArgs input;
-  double boundary_mm = 1.0;
-  double texel_length_mm = 0.25;
-  std::uint64_t seed = 1;
-  std::string parameterization = "moments";
-  std::string fit = "least-squares";
-  int model = codec::PerceptualModel{}.version;
+  // The encoder's defaults are the library's (EncoderConfig{}, described by visit_options).
+  double boundary_mm = codec::EncoderConfig{}.boundary.value();
+  double texel_length_mm = codec::EncoderConfig{}.texel_length.value();
+  std::uint64_t seed = codec::EncoderConfig{}.seed;
+  std::string parameterization = std::string(to_string(codec::EncoderConfig{}.parameterization));
+  std::string fit = std::string(codec::to_string(codec::EncoderConfig{}.fit_method));
+  int model = codec::EncoderConfig{}.model.version;
   std::optional<double> weight_exponent;    ///< default: the model version's
   std::optional<double> sensitivity_scale;  ///< default: the model version's
   std::string no_texture = std::string(codec::to_string(codec::EncoderConfig{}.no_texture));
   std::string target = std::string(codec::to_string(codec::EncoderConfig{}.target));
   std::string display_response = std::string(codec::to_string(codec::PerceptualModel{}.display_response));
   double drawn_weight = codec::PerceptualModel{}.drawn_weight;
-  unsigned coarse_bits = 6;
-  std::optional<std::size_t> max_bytes;
+  unsigned coarse_bits = codec::EncoderConfig{}.coarse_bits;
+  std::optional<std::size_t> max_bytes = codec::EncoderConfig{}.max_bytes;
   bool json = false;
   bool report = false;
   bool estimate = false;  ///< estimate from samples even when the input holds Texel parameters
@@ -303,42 +304,26 @@ void register_encode(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Output bitstream (.texel); without it, only the estimates are printed");
   add_signal_options(*cmd, a->input);  // --swipe-speed also sets the model's temporal frequencies [100]
   const std::string g = "Encoder";
-  cmd->add_option("--boundary", a->boundary_mm, "Fine/coarse boundary, mm [1]")->group(g);
-  cmd->add_option("--texel-length", a->texel_length_mm, "Texel length of the encoding, mm [0.25]")->group(g);
-  cmd->add_option("--seed", a->seed, "Seed written to the bitstream [1]")->group(g);
-  cmd->add_option("--parameterization", a->parameterization, "moments | log [moments]")->group(g);
-  cmd->add_option("--model", a->model,
-                  "Perceptual model version: 2 (calibrated against people's matches), 3 (the felt band, weighed over a "
-                  "range of stroke speeds; a recording's content above 1 kHz at its speed is not felt) or 1 (the model "
-                  "before) [2]")
-      ->group(g);
+  const codec::EncoderConfig defaults;
+  const auto help = [&](std::string_view key) { return option_help(defaults, key); };
+  cmd->add_option("--boundary", a->boundary_mm, help("boundary_mm"))->group(g);
+  cmd->add_option("--texel-length", a->texel_length_mm, help("texel_length_mm"))->group(g);
+  cmd->add_option("--seed", a->seed, help("seed"))->group(g);
+  cmd->add_option("--parameterization", a->parameterization, help("parameterization"))->group(g);
+  cmd->add_option("--model", a->model, help("model"))->group(g);
   cmd->add_option("--weight-exponent", a->weight_exponent,
                   "Perceptual model: exponent of a component's felt weight [the model version's]")
       ->group(g);
   cmd->add_option("--sensitivity-scale", a->sensitivity_scale,
                   "Perceptual model: share of the threshold curve in the weighting, 0 … 1 [the model version's]")
       ->group(g);
-  cmd->add_option("--no-texture", a->no_texture,
-                  "An input without texture (variation RMS <= 2^-16): flag (encode a flat surface, say so) or refuse "
-                  "(exit 2) [flag]")
-      ->group(g);
-  cmd->add_option("--target", a->target,
-                  "What Central Pitch matches: felt (the model's felt pitch), centroid (the recording's log-spectral "
-                  "centroid, the decoded texture swiped at --swipe-speed) or automatic (centroid for .wav and time .csv "
-                  "recordings, felt for maps) [automatic]")
-      ->group(g);
-  cmd->add_option("--display-response", a->display_response,
-                  "Perceptual model: device (felt as the --device's frequency response passes it at the swipe speed) or "
-                  "flat (the texture as drawn) [device]")
-      ->group(g);
-  cmd->add_option("--drawn-weight", a->drawn_weight,
-                  "Perceptual model: weight of the texture as drawn beside the displayed one in the fit, >= 0 (0 = the "
-                  "display alone) [1]")
-      ->group(g);
-  cmd->add_option("--fit", a->fit, "Search of the perceptual fit: least-squares | simplex (slower) [least-squares]")->group(g);
-  cmd->add_option("--coarse-bits", a->coarse_bits, "Bits per coarse level, 1 … 16 [6]")->group(g);
-  cmd->add_option("--max-bytes", a->max_bytes, "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)")
-      ->group(g);
+  cmd->add_option("--no-texture", a->no_texture, help("no_texture"))->group(g);
+  cmd->add_option("--target", a->target, help("target"))->group(g);
+  cmd->add_option("--display-response", a->display_response, help("display_response"))->group(g);
+  cmd->add_option("--drawn-weight", a->drawn_weight, help("drawn_weight"))->group(g);
+  cmd->add_option("--fit", a->fit, help("fit"))->group(g);
+  cmd->add_option("--coarse-bits", a->coarse_bits, help("coarse_bits"))->group(g);
+  cmd->add_option("--max-bytes", a->max_bytes, help("max_bytes"))->group(g);
   const std::string g2 = "2-D inputs (a grey .png, a 2-D .npy or a .scans.json bundle -> a version-4 .texel.json)";
   cmd->add_option("--pitch", a->pitch_mm, "Pixel pitch of a 2-D map, mm (or --device with a bitmap); never guessed")->group(g2);
   cmd->add_option("--polarity", a->polarity,

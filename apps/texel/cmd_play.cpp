@@ -155,10 +155,10 @@ void run(const PlayArgs& a) {
       f.output = "amplitude";  // a friction display takes amplitudes
     config = player_config(f, 1000.0, doc.device.response);
   } else {
-    config = player_config(a.finger, 48000.0, doc.device.response);
+    config = player_config(a.finger, play_options().rate.value(), doc.device.response);
   }
   bo.rate_hz = config.rate_hz;
-  double duration = 5.0;
+  double duration = play_options().duration.value();
   // Everything from the command line is read and checked before the device opens.
   std::unique_ptr<PlayerBase> player;
   std::function<bool(double)> feed_until;  // queues the trace up to a time; false once it is all queued
@@ -322,7 +322,7 @@ void register_play(CLI::App& app) {
                   "--backend serial:PATH shares the link); plays until --duration or Ctrl-C");
   cmd->add_option("--report-interval", a->report_interval_us, "Finger report interval asked of the display (µs) [1000]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
-  add_player_options(*cmd, a->finger, a->device, a->texture);
+  add_player_options(*cmd, a->finger, play_options(), a->device, a->texture);
   add_surface2d_options(*cmd, a->surface);
   cmd->callback([a] { run(*a); });
 }

@@ -31,7 +31,6 @@ struct SwipeArgs {
   std::string output;
   std::optional<std::string> plot;
   std::string wav_format = "pcm16";
-  std::string band_limit = "on";
   std::optional<std::string> playback;
   std::optional<std::size_t> channel;
   bool json = false;
@@ -65,12 +64,8 @@ void run(const SwipeArgs& a) {
     }
     doc.playback = p;
   }
-  const PlayerConfig config = [&] {
-    PlayerConfig c = player_config(a.finger, 48000.0, doc.device.response);
-    c.band_limit = parse_band_limit(a.band_limit, "--band-limit");
-    return c;
-  }();
-  double duration = 2.0;
+  const PlayerConfig config = player_config(a.finger, SwipeOptions{}.rate.value(), doc.device.response);
+  double duration = SwipeOptions{}.duration.value();
   std::vector<float> positions, y_positions, out;
   double mean_speed = 0, sd_speed = 0, directional = 0, touched = 0;
   const auto frame_count = [&] {
@@ -202,11 +197,8 @@ void register_swipe(CLI::App& app) {
   cmd->add_option("--channel", a->channel, "Sequential playback on this one channel (0-based); the others at rest");
   cmd->add_option("--plot", a->plot, "Also draw position, output and its temporal spectrum (.png or .svg)");
   cmd->add_option("--wav-format", a->wav_format, "WAV sample encoding: pcm16, pcm24 or float [pcm16]");
-  cmd->add_option("--band-limit", a->band_limit,
-                  "on: no content above the drive's limit at the finger's speed (texels faded, docs/player.md); off: the "
-                  "map as sampled (aliases) [on]");
   cmd->add_flag("--json", a->json, "Print the summary as JSON");
-  add_player_options(*cmd, a->finger, a->device, a->texture);
+  add_player_options(*cmd, a->finger, SwipeOptions{}, a->device, a->texture);
   add_surface2d_options(*cmd, a->surface);
   cmd->callback([a] { run(*a); });
 }

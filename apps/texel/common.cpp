@@ -90,20 +90,22 @@ std::string flag_of_field(std::string_view field) {
 
 void add_texture_options(CLI::App& cmd, TextureOptions& o) {
   const std::string g = "Texture";
-  cmd.add_option("--central-pitch", o.central_pitch_db, "Central Pitch, dB re 1 cycle/mm (10 = 10 cpm) [10]")->group(g);
-  cmd.add_option("--irregularity", o.irregularity_db, "Irregularity, dB re 1 cycle/mm [-5]")->group(g);
-  cmd.add_option("--texel-length", o.texel_length_mm, "Texel length, mm [0.25]")->group(g);
-  cmd.add_option("--seed", o.seed, "Random seed, 0 … 2^64-1 [1]")->group(g);
-  cmd.add_option("--quantization", o.quantization_db, "Frequency quantization step, dB (0 = off) [0]")->group(g);
-  cmd.add_option("--phase", o.phase, "continuous | reset [continuous]")->group(g);
-  cmd.add_option("--parameterization", o.parameterization, "moments (mean/SD in cpm) | log (median, SD of 10·log10 f) [moments]")
-      ->group(g);
-  cmd.add_option("--out-of-band", o.out_of_band, "redraw | clamp draws outside the band [redraw]")->group(g);
-  cmd.add_option("--fill", o.fill, "whole (whole texels only) | partial (render a final partial texel) [whole]")->group(g);
-  cmd.add_option("--band-min", o.band_min_cpm, "Lowest texel frequency, cpm [0.01]")->group(g);
-  cmd.add_option("--band-max", o.band_max_cpm, "Highest texel frequency, cpm (0 = the grid's Nyquist) [0]")->group(g);
-  cmd.add_option("--coarse-strength", o.coarse_strength, "Coarse strength C, 0 … 1 [0]")->group(g);
-  cmd.add_option("--fine-strength", o.fine_strength, "Fine strength F, 0 … 1 [1]")->group(g);
+  // Help and defaults are the library's description (visit_options(TexelSpec)).
+  const TexelSpec defaults;
+  const auto help = [&](std::string_view key) { return option_help(defaults, key); };
+  cmd.add_option("--central-pitch", o.central_pitch_db, help("central_pitch_db"))->group(g);
+  cmd.add_option("--irregularity", o.irregularity_db, help("irregularity_db"))->group(g);
+  cmd.add_option("--texel-length", o.texel_length_mm, help("texel_length_mm"))->group(g);
+  cmd.add_option("--seed", o.seed, help("seed"))->group(g);
+  cmd.add_option("--quantization", o.quantization_db, help("quantization_db"))->group(g);
+  cmd.add_option("--phase", o.phase, help("phase"))->group(g);
+  cmd.add_option("--parameterization", o.parameterization, help("parameterization"))->group(g);
+  cmd.add_option("--out-of-band", o.out_of_band, help("out_of_band"))->group(g);
+  cmd.add_option("--fill", o.fill, help("fill"))->group(g);
+  cmd.add_option("--band-min", o.band_min_cpm, help("band_min_cpm"))->group(g);
+  cmd.add_option("--band-max", o.band_max_cpm, help("band_max_cpm"))->group(g);
+  cmd.add_option("--coarse-strength", o.coarse_strength, help("coarse_strength"))->group(g);
+  cmd.add_option("--fine-strength", o.fine_strength, help("fine_strength"))->group(g);
   cmd.add_option("--coarse-sine", o.coarse_sine_mm, "Coarse profile: sinusoid of this period, mm")->group(g);
   cmd.add_option("--coarse-phase", o.coarse_phase_deg, "Phase of the --coarse-sine profile, degrees [0]")->group(g);
   cmd.add_option("--coarse-profile", o.coarse_profile, "Coarse profile: CSV of position_mm,value rows")->group(g);

@@ -11,45 +11,41 @@
 
 namespace texel::cli {
 
-void add_player_options(CLI::App& cmd, FingerOptions& finger, DeviceOptions& device, TextureOptions& texture) {
-  add_finger_options(cmd, finger);
+void add_player_options(CLI::App& cmd, FingerOptions& finger, const SwipeOptions& defaults, DeviceOptions& device,
+                        TextureOptions& texture) {
+  add_finger_options(cmd, finger, defaults);
   add_device_options(cmd, device);
   add_texture_options(cmd, texture);
 }
 
-void add_finger_options(CLI::App& cmd, FingerOptions& o) {
-  cmd.add_option("--speed", o.speed_mm_s, "Swipe speed (mm/s) [100]");
-  cmd.add_option("--pattern", o.pattern, "Simulated swipe: constant (repeated one-way strokes) or back-and-forth [constant]");
+void add_finger_options(CLI::App& cmd, FingerOptions& o, const SwipeOptions& defaults) {
+  const auto help = [&](std::string_view key) { return option_help(defaults, key); };
+  cmd.add_option("--speed", o.speed_mm_s, help("speed_mm_s"));
+  cmd.add_option("--pattern", o.pattern, help("pattern"));
   cmd.add_option("--trace", o.trace, "Recorded finger trace, CSV of time_s,position_mm[,touch] (replaces the simulated swipe)");
-  cmd.add_option("--duration", o.duration_s, "Length (s) [swipe: 2, or the trace's; play: 5, or the trace's]");
-  cmd.add_option("--start", o.start_mm, "Where the simulated finger lands (mm) [0]");
-  cmd.add_option("--extent", o.extent_mm, "Travel of one stroke (mm) [to the end of the surface]");
-  cmd.add_option("--turn", o.turn_s, "Back-and-forth: time to stop and turn (s) [0.1]");
-  cmd.add_option("--rate", o.rate_hz,
-                 "Output rate (Hz) [48000; play to a serial display: 1000]; e.g. 8333 for the tpad's refresh rate");
-  cmd.add_option("--output", o.output,
-                 "amplitude (friction map value), vibration (zero-mean, band-limited) or carrier [vibration]");
-  cmd.add_option("--carrier", o.carrier_hz, "Carrier frequency for --output carrier (Hz) [250]");
-  cmd.add_option("--prediction", o.prediction_s,
-                 "Latency compensation: predict the finger this far ahead (s) [0; TPaD tablet: 0.02]");
-  cmd.add_option("--gain", o.gain, "Output gain, 0 … 1 [1]");
-  cmd.add_option("--response", o.response,
-                 "The display's frequency response (device profile): limit (never drive what the display attenuates by "
-                 "20 dB or more) or off [limit]");
+  cmd.add_option("--duration", o.duration_s, help("duration_s"));
+  cmd.add_option("--start", o.start_mm, help("start_mm"));
+  cmd.add_option("--extent", o.extent_mm, help("extent_mm"));
+  cmd.add_option("--turn", o.turn_s, help("turn_s"));
+  cmd.add_option("--rate", o.rate_hz, help("rate_hz"));
+  cmd.add_option("--output", o.output, help("output"));
+  cmd.add_option("--carrier", o.carrier_hz, help("carrier_hz"));
+  cmd.add_option("--prediction", o.prediction_s, help("prediction_s"));
+  cmd.add_option("--gain", o.gain, help("gain"));
+  cmd.add_option("--response", o.response, help("response"));
+  cmd.add_option("--band-limit", o.band_limit, help("band_limit"));
 }
 
 PlayerConfig player_config(const FingerOptions& o, double default_rate_hz, const FrequencyResponse& response) {
-  PlayerConfig c;
-  c.response = response;
-  c.response_handling = parse_response_handling(o.response, "--response");
-  c.rate_hz = o.rate_hz.value_or(default_rate_hz);
-  c.mode = parse_output_mode(o.output, "--output");
-  c.carrier_hz = o.carrier_hz;
-  c.prediction_s = o.prediction_s;
-  c.extrapolate_s = std::max(c.extrapolate_s, o.prediction_s);
-  c.gain = o.gain;
-  validate(c);
-  return c;
+  SwipeOptions s;
+  s.response = parse_response_handling(o.response, "--response");
+  s.rate = Hertz(o.rate_hz.value_or(default_rate_hz));
+  s.output = parse_output_mode(o.output, "--output");
+  s.carrier = Hertz(o.carrier_hz);
+  s.prediction = Seconds(o.prediction_s);
+  s.gain = o.gain;
+  s.band_limit = parse_band_limit(o.band_limit, "--band-limit");
+  return player_config(s, response);
 }
 
 std::vector<FingerSample> finger_trace(const FingerOptions& o, double surface_mm, double& duration_s) {
@@ -77,12 +73,14 @@ std::vector<FingerSample> finger_trace(const FingerOptions& o, double surface_mm
 
 void add_surface2d_options(CLI::App& cmd, Surface2DOptions& o) {
   const char* g = "2-D surface";
-  cmd.add_option("--path", o.path, "2-D finger path: line, circle or zigzag (switches to the 2-D player)")->group(g);
-  cmd.add_option("--angle", o.angle_deg, "Direction of a line or zigzag, degrees from +x [0]")->group(g);
-  cmd.add_option("--radius", o.radius_mm, "Circle radius (mm) [20]; the circle is centred on (--start, --start-y)")->group(g);
-  cmd.add_option("--leg", o.leg_mm, "Zigzag leg length (mm) [10]")->group(g);
-  cmd.add_option("--zigzag-angle", o.zigzag_deg, "Angle between zigzag legs, degrees [90]")->group(g);
-  cmd.add_option("--start-y", o.start_y_mm, "y where the 2-D finger lands (mm) [0]")->group(g);
+  const Path2DConfig path_defaults;
+  const auto help = [&](std::string_view key) { return option_help(path_defaults, key); };
+  cmd.add_option("--path", o.path, help("path") + " (switches to the 2-D player)")->group(g);
+  cmd.add_option("--angle", o.angle_deg, help("angle_deg"))->group(g);
+  cmd.add_option("--radius", o.radius_mm, help("radius_mm") + "; the circle is centred on (--start, --start-y)")->group(g);
+  cmd.add_option("--leg", o.leg_mm, help("leg_mm"))->group(g);
+  cmd.add_option("--zigzag-angle", o.zigzag_deg, help("zigzag_deg"))->group(g);
+  cmd.add_option("--start-y", o.start_y_mm, help("start_y_mm"))->group(g);
   cmd.add_option("--trace-2d", o.trace_2d, "Recorded 2-D finger trace, CSV of time_s,x_mm,y_mm[,touch]")->group(g);
   cmd.add_option("--coarse-raster", o.coarse_raster,
                  "2-D coarse profile c(x, y) in [0, 1]: .npy, rows along y; mixed by the document's coarse and fine strength")

@@ -15,26 +15,34 @@
 
 namespace texel::cli {
 
+/// The finger and output flags of `texel swipe` and `texel play`: the
+/// library's SwipeOptions (described once, texel/player.hpp), held as the CLI
+/// reads them (an unset --duration/--rate/--start/--extent is the command's
+/// default or the trace's).
 struct FingerOptions {
-  double speed_mm_s = 100.0;
-  std::string pattern = "constant";
+  double speed_mm_s = SwipeOptions{}.speed.value();
+  std::string pattern = std::string(to_string(SwipeOptions{}.pattern));
   std::optional<std::string> trace;
   std::optional<double> duration_s;
   std::optional<double> start_mm;
   std::optional<double> extent_mm;
-  double turn_s = 0.1;
+  double turn_s = SwipeOptions{}.turn.value();
   std::optional<double> rate_hz;
-  std::string output = "vibration";
-  double carrier_hz = 250.0;
-  double prediction_s = 0.0;
-  double gain = 1.0;
-  std::string response = "limit";  ///< how the display's frequency response is respected: limit | off
+  std::string output = std::string(to_string(SwipeOptions{}.output));
+  double carrier_hz = SwipeOptions{}.carrier.value();
+  double prediction_s = SwipeOptions{}.prediction.value();
+  double gain = SwipeOptions{}.gain;
+  std::string response = std::string(to_string(SwipeOptions{}.response));      ///< limit | off
+  std::string band_limit = std::string(to_string(SwipeOptions{}.band_limit));  ///< on | off
 };
 
-void add_finger_options(CLI::App& cmd, FingerOptions& o);
+/// The flags, their help and defaults from the library's description of
+/// `defaults` (SwipeOptions{} for swipe, play_options() for play).
+void add_finger_options(CLI::App& cmd, FingerOptions& o, const SwipeOptions& defaults);
 /// The option groups of a command that plays a texture (swipe, play): finger,
 /// device and texture, in that order.
-void add_player_options(CLI::App& cmd, FingerOptions& finger, DeviceOptions& device, TextureOptions& texture);
+void add_player_options(CLI::App& cmd, FingerOptions& finger, const SwipeOptions& defaults, DeviceOptions& device,
+                        TextureOptions& texture);
 
 /// The player configuration the options describe (validated); `response` is
 /// the display's (DeviceProfile::response of the document's device).
@@ -48,10 +56,10 @@ std::vector<FingerSample> finger_trace(const FingerOptions& o, double surface_mm
 /// friction bitmap. Any of these options switches the command to 2-D.
 struct Surface2DOptions {
   std::optional<std::string> path;  ///< line | circle | zigzag
-  double angle_deg = 0.0;
-  double radius_mm = 20.0;
-  double leg_mm = 10.0;
-  double zigzag_deg = 90.0;
+  double angle_deg = Path2DConfig{}.angle_deg;
+  double radius_mm = Path2DConfig{}.radius_mm;
+  double leg_mm = Path2DConfig{}.leg_mm;
+  double zigzag_deg = Path2DConfig{}.zigzag_deg;
   std::optional<double> start_y_mm;
   std::optional<std::string> trace_2d;       ///< CSV time_s,x_mm,y_mm[,touch]
   std::optional<std::string> coarse_raster;  ///< .npy coarse profile c(x, y)

@@ -13,24 +13,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "texel/detail/format.hpp"
 #include "texel/option_spec.hpp"
 
 namespace texel::cli {
-
-/// The default as a front door shows it: the spelling of an enumeration, the
-/// shortest exact number.
-template <class T>
-std::string default_text(const T& v, const OptionSpec& spec) {
-  if constexpr (std::is_enum_v<T>)
-    return std::string(choice_name(spec.choices, static_cast<int>(v)));
-  else if constexpr (std::is_same_v<T, bool>)
-    return v ? "on" : "off";
-  else if constexpr (std::is_integral_v<T>)
-    return std::to_string(v);
-  else
-    return detail::num(static_cast<double>(v));
-}
 
 class DescribedFlags {
  public:
@@ -40,7 +25,7 @@ class DescribedFlags {
   DescribedFlags(CLI::App* cmd, Options& options) {
     const Options defaults{};
     std::vector<std::string> shown;
-    visit_options(defaults, [&](const auto& v, const OptionSpec& spec) { shown.push_back(default_text(v, spec)); });
+    visit_options(defaults, [&](const auto& v, const OptionSpec& spec) { shown.push_back(option_default_text(v, spec)); });
     std::size_t i = 0;
     visit_options(options, [&](auto& member, const OptionSpec& spec) {
       using T = std::remove_cvref_t<decltype(member)>;

@@ -35,14 +35,17 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "texel/bitstream.hpp"
 #include "texel/document.hpp"
+#include "texel/option_spec.hpp"
 #include "texel/signal.hpp"
 #include "texel/units.hpp"
 
@@ -280,6 +283,62 @@ EncoderConfig::NoTexture parse_no_texture(std::string_view text, std::string_vie
 std::string_view to_string(EncoderConfig::Target t);
 /// "automatic", "felt" or "centroid"; errors name `field`.
 EncoderConfig::Target parse_target(std::string_view text, std::string_view field = "target");
+
+inline constexpr OptionChoice fit_methods[] = {{"least-squares", static_cast<int>(FitMethod::least_squares)},
+                                               {"simplex", static_cast<int>(FitMethod::simplex)}};
+inline constexpr OptionChoice no_texture_rules[] = {{"flag", static_cast<int>(EncoderConfig::NoTexture::flag)},
+                                                    {"refuse", static_cast<int>(EncoderConfig::NoTexture::refuse)}};
+inline constexpr OptionChoice encode_targets[] = {{"automatic", static_cast<int>(EncoderConfig::Target::automatic)},
+                                                  {"felt", static_cast<int>(EncoderConfig::Target::felt)},
+                                                  {"centroid", static_cast<int>(EncoderConfig::Target::centroid)}};
+inline constexpr OptionChoice display_responses[] = {{"device", static_cast<int>(PerceptualModel::Display::device)},
+                                                     {"flat", static_cast<int>(PerceptualModel::Display::flat)}};
+
+/// The encoder's options as every front door offers them (`texel encode`'s
+/// "Encoder" flags, Python's encode() keywords, C's texel_encode_options),
+/// described once (texel/option_spec.hpp); the defaults are EncoderConfig{}'s.
+/// Not here: how the input is read (device, spacing, region, channel, swipe
+/// speed: SignalOptions) and the model's calibrated parameters
+/// (weight_exponent, sensitivity_scale), whose defaults are each model
+/// version's (model_defaults) — `model` picks them.
+template <class Config, class Visit>
+requires std::is_same_v<std::remove_const_t<Config>, EncoderConfig>
+void visit_options(Config& c, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(c.boundary, OptionSpec{"boundary_mm", "boundary", "Fine/coarse boundary, mm", 0, inf, true});
+  visit(c.texel_length, OptionSpec{"texel_length_mm", "texel-length", "Texel length of the encoding, mm", 0.001, 65.535});
+  visit(c.seed, OptionSpec{"seed", "seed", "Seed written to the bitstream", 0});
+  visit(c.parameterization,
+        OptionSpec{"parameterization", "parameterization", "moments | log", -inf, inf, false, false, parameterizations});
+  visit(c.model.version, OptionSpec{"model", "model",
+                                    "Perceptual model version: 2 (calibrated against people's matches), 3 (the felt band, "
+                                    "weighed over a range of stroke speeds; a recording's content above 1 kHz at its speed "
+                                    "is not felt) or 1 (the model before)",
+                                    1, 3});
+  visit(c.no_texture, OptionSpec{"no_texture", "no-texture",
+                                 "An input without texture (variation RMS <= 2^-16): flag (encode a flat surface, say so) "
+                                 "or refuse (an error)",
+                                 -inf, inf, false, false, no_texture_rules});
+  visit(c.target, OptionSpec{"target", "target",
+                             "What Central Pitch matches: felt (the model's felt pitch), centroid (the recording's "
+                             "log-spectral centroid, the decoded texture swiped at the swipe speed) or automatic (centroid "
+                             "for .wav and time .csv recordings, felt for maps)",
+                             -inf, inf, false, false, encode_targets});
+  visit(c.model.display_response,
+        OptionSpec{"display_response", "display-response",
+                   "Perceptual model: device (felt as the device's frequency response passes it at the swipe speed) or "
+                   "flat (the texture as drawn)",
+                   -inf, inf, false, false, display_responses});
+  visit(c.model.drawn_weight, OptionSpec{"drawn_weight", "drawn-weight",
+                                         "Perceptual model: weight of the texture as drawn beside the displayed one in "
+                                         "the fit (0 = the display alone)",
+                                         0, 100});
+  visit(c.fit_method, OptionSpec{"fit", "fit", "Search of the perceptual fit: least-squares | simplex (slower)", -inf, inf, false,
+                                 false, fit_methods});
+  visit(c.coarse_bits, OptionSpec{"coarse_bits", "coarse-bits", "Bits per coarse level, 1 … 16", 1, 16});
+  visit(c.max_bytes,
+        OptionSpec{"max_bytes", "max-bytes", "Bit budget: largest bitstream, bytes (coarse precision and spacing adapt)", 1});
+}
 
 struct EncodeResult {
   Bitstream bitstream;

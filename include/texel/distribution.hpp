@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include "texel/option_spec.hpp"
 #include "texel/random.hpp"
 #include "texel/units.hpp"
 
@@ -23,6 +24,11 @@ namespace texel {
 
 enum class Parameterization { moments, log };
 enum class OutOfBand { redraw, clamp };
+/// Their spellings, for the options' descriptions (texel/option_spec.hpp).
+inline constexpr OptionChoice parameterizations[] = {{"moments", static_cast<int>(Parameterization::moments)},
+                                                     {"log", static_cast<int>(Parameterization::log)}};
+inline constexpr OptionChoice out_of_band_rules[] = {{"redraw", static_cast<int>(OutOfBand::redraw)},
+                                                     {"clamp", static_cast<int>(OutOfBand::clamp)}};
 
 std::string_view to_string(Parameterization p);
 std::string_view to_string(OutOfBand o);

@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include "texel/option_spec.hpp"
+
 namespace texel {
 
 /// One finger sample.
@@ -29,6 +31,8 @@ enum class SwipePattern {
 };
 std::string_view to_string(SwipePattern p);
 SwipePattern parse_swipe_pattern(std::string_view text, std::string_view field = "pattern");
+inline constexpr OptionChoice swipe_patterns[] = {{"constant", static_cast<int>(SwipePattern::constant)},
+                                                  {"back-and-forth", static_cast<int>(SwipePattern::back_and_forth)}};
 
 /// A simulated swipe.
 struct SwipeConfig {

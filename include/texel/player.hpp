@@ -115,10 +115,12 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "texel/device.hpp"
@@ -256,6 +258,100 @@ double response_limit_hz(const PlayerConfig& config);
 double response_limit_hz(const PlayerConfig& config, const FrequencyResponse& response) noexcept;
 /// Throws InvalidArgument naming the field, the value and the allowed range.
 void validate(const PlayerConfig& config);
+
+inline constexpr OptionChoice output_modes[] = {{"amplitude", static_cast<int>(OutputMode::amplitude)},
+                                                {"vibration", static_cast<int>(OutputMode::vibration)},
+                                                {"carrier", static_cast<int>(OutputMode::carrier)}};
+inline constexpr OptionChoice response_handlings[] = {{"limit", static_cast<int>(ResponseHandling::limit)},
+                                                      {"off", static_cast<int>(ResponseHandling::off)}};
+inline constexpr OptionChoice band_limits[] = {{"on", static_cast<int>(BandLimit::on)},
+                                               {"off", static_cast<int>(BandLimit::off)}};
+
+/// The player's options an embedder sets (C's texel_player_config), described
+/// once (texel/option_spec.hpp) with PlayerConfig{}'s defaults: amplitude
+/// out, as a friction display takes it. The rest of PlayerConfig (filters,
+/// ramps, queue) keeps its defaults at every front door.
+template <class Config, class Visit>
+requires std::is_same_v<std::remove_const_t<Config>, PlayerConfig>
+void visit_options(Config& c, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(c.rate_hz, OptionSpec{"rate_hz", "rate", "Output rate (Hz); 8333 for the tpad's refresh rate", 100, 384000});
+  visit(c.mode, OptionSpec{"output", "output", "amplitude (friction map value), vibration (zero-mean, band-limited) or carrier",
+                           -inf, inf, false, false, output_modes});
+  visit(c.gain, OptionSpec{"gain", "gain", "Output gain, 0 … 1", 0, 1});
+  visit(c.carrier_hz, OptionSpec{"carrier_hz", "carrier", "Carrier frequency of the carrier output (Hz), up to rate/2", 0});
+  visit(c.prediction_s, OptionSpec{"prediction_s", "prediction",
+                                   "Latency compensation: predict the finger this far ahead (s; TPaD tablet: "
+                                   "0.02)",
+                                   0, 0.1});
+  visit(c.response_handling,
+        OptionSpec{"response", "response",
+                   "The display's frequency response (device profile): limit (never drive what the display attenuates "
+                   "by response_limit_db or more) or off",
+                   -inf, inf, false, false, response_handlings});
+  visit(c.response_limit_db, OptionSpec{"response_limit_db", "response-limit",
+                                        "limit: the display's attenuation (dB) where driving stops, 3 … 60", 3, 60});
+}
+
+/// A texture played under a simulated finger as the front doors offer it:
+/// `texel swipe` and `texel play` (their finger and output flags), Python's
+/// swipe(); described once (visit_options below). A swipe renders what a
+/// finger feels, so its output is vibration where the embedded player's
+/// (PlayerConfig) is amplitude. `texel play` plays 5 s (play_options()).
+struct SwipeOptions {
+  MmPerSecond speed{100.0};                             ///< cruising speed, > 0
+  SwipePattern pattern = SwipePattern::constant;        ///< SwipeConfig::pattern
+  Millimetres start{0.0};                               ///< where the finger lands
+  Millimetres extent{0.0};                              ///< travel of one stroke; 0 = to the end of the surface
+  Seconds turn{0.1};                                    ///< back-and-forth: time to stop and turn
+  Seconds duration{2.0};                                ///< length of the output (a recorded trace: the trace's)
+  Hertz rate{48000.0};                                  ///< output rate (a serial display: its link's)
+  OutputMode output = OutputMode::vibration;            ///< PlayerConfig::mode
+  Hertz carrier{250.0};                                 ///< PlayerConfig::carrier_hz
+  Seconds prediction{0.0};                              ///< PlayerConfig::prediction_s
+  double gain = 1.0;                                    ///< PlayerConfig::gain
+  ResponseHandling response = ResponseHandling::limit;  ///< PlayerConfig::response_handling
+  BandLimit band_limit = BandLimit::on;                 ///< PlayerConfig::band_limit
+};
+/// `texel play`'s: SwipeOptions with a 5 s simulated finger.
+SwipeOptions play_options();
+/// The player configuration `o` describes (the rest PlayerConfig{}'s), for a
+/// display with `response`; validated (InvalidArgument naming the field).
+PlayerConfig player_config(const SwipeOptions& o, const FrequencyResponse& response);
+/// The simulated swipe `o` describes over a surface `surface_mm` long,
+/// sampled at 1 kHz; validated.
+SwipeConfig swipe_config(const SwipeOptions& o, Millimetres surface);
+
+template <class Options, class Visit>
+requires std::is_same_v<std::remove_const_t<Options>, SwipeOptions>
+void visit_options(Options& o, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(o.speed, OptionSpec{"speed_mm_s", "speed", "Swipe speed (mm/s)", 0, inf, true});
+  visit(o.pattern, OptionSpec{"pattern", "pattern", "Simulated swipe: constant (repeated one-way strokes) or back-and-forth",
+                              -inf, inf, false, false, swipe_patterns});
+  visit(o.start, OptionSpec{"start_mm", "start", "Where the simulated finger lands (mm)"});
+  visit(o.extent, OptionSpec{"extent_mm", "extent", "Travel of one stroke (mm); 0 = to the end of the surface", 0});
+  visit(o.turn, OptionSpec{"turn_s", "turn", "Back-and-forth: time to stop and turn (s)", 0});
+  visit(o.duration, OptionSpec{"duration_s", "duration", "Length (s); a recorded trace: the trace's", 0, 86400, true});
+  visit(o.rate, OptionSpec{"rate_hz", "rate",
+                           "Output rate (Hz); 8333 for the tpad's refresh rate; play to a serial display: its link's "
+                           "(1000)",
+                           100, 384000});
+  visit(o.output, OptionSpec{"output", "output", "amplitude (friction map value), vibration (zero-mean, band-limited) or carrier",
+                             -inf, inf, false, false, output_modes});
+  visit(o.carrier, OptionSpec{"carrier_hz", "carrier", "Carrier frequency of the carrier output (Hz), up to rate/2", 0});
+  visit(o.prediction, OptionSpec{"prediction_s", "prediction",
+                                 "Latency compensation: predict the finger this far ahead (s; TPaD tablet: 0.02)", 0, 0.1});
+  visit(o.gain, OptionSpec{"gain", "gain", "Output gain, 0 … 1", 0, 1});
+  visit(o.response, OptionSpec{"response", "response",
+                               "The display's frequency response (device profile): limit (never drive what the display "
+                               "attenuates by 20 dB or more) or off",
+                               -inf, inf, false, false, response_handlings});
+  visit(o.band_limit, OptionSpec{"band_limit", "band-limit",
+                                 "on: no content above the drive's limit at the finger's speed (texels faded, "
+                                 "docs/player.md); off: the map as sampled (aliases)",
+                                 -inf, inf, false, false, band_limits});
+}
 
 /// A command for process(): a finger sample or a parameter change.
 using PlayerEvent = player_parts::Event<FingerSample>;

@@ -47,10 +47,12 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "texel/player.hpp"
@@ -232,6 +234,30 @@ struct Path2DConfig {
   double duration_s = 1.0;   ///< > 0
   double rate_hz = 1000.0;   ///< sample rate, > 0
 };
+inline constexpr OptionChoice path_shapes[] = {{"line", static_cast<int>(Path2DShape::line)},
+                                               {"circle", static_cast<int>(Path2DShape::circle)},
+                                               {"zigzag", static_cast<int>(Path2DShape::zigzag)}};
+
+/// A simulated 2-D stroke's options (Python's simulate_path_2d(), C's
+/// texel_path2d_config; `texel swipe --path` and Python's swipe_2d() take the
+/// shape's from here and speed, duration and rate from SwipeOptions),
+/// described once (texel/option_spec.hpp). An empty flag: not a CLI flag.
+template <class Config, class Visit>
+requires std::is_same_v<std::remove_const_t<Config>, Path2DConfig>
+void visit_options(Config& c, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(c.shape, OptionSpec{"path", "path", "2-D finger path: line, circle or zigzag", -inf, inf, false, false, path_shapes});
+  visit(c.speed_mm_s, OptionSpec{"speed_mm_s", "speed", "Finger speed (mm/s)", 0, inf, true});
+  visit(c.angle_deg, OptionSpec{"angle_deg", "angle", "Direction of a line or zigzag, degrees from +x"});
+  visit(c.start_x_mm, OptionSpec{"start_x_mm", "start", "x where the finger lands (mm); a circle: its centre"});
+  visit(c.start_y_mm, OptionSpec{"start_y_mm", "start-y", "y where the finger lands (mm); a circle: its centre"});
+  visit(c.radius_mm, OptionSpec{"radius_mm", "radius", "Circle radius (mm)", 0, inf, true});
+  visit(c.leg_mm, OptionSpec{"leg_mm", "leg", "Zigzag leg length (mm)", 0, inf, true});
+  visit(c.zigzag_deg, OptionSpec{"zigzag_deg", "zigzag-angle", "Angle between zigzag legs, degrees", 0, 180, true, true});
+  visit(c.duration_s, OptionSpec{"duration_s", "", "Length of the stroke (s)", 0, inf, true});
+  visit(c.rate_hz, OptionSpec{"rate_hz", "", "Samples per second of the stroke", 0, inf, true});
+}
+
 /// Samples the path (touching throughout, a lifted sample at the end).
 std::vector<FingerSample2D> simulate_path_2d(const Path2DConfig& config);
 /// A CSV trace of time_s, x_mm, y_mm[, touch]; header optional; times

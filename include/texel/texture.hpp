@@ -16,15 +16,18 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "texel/coarse.hpp"
 #include "texel/distribution.hpp"
 #include "texel/grid.hpp"
+#include "texel/option_spec.hpp"
 #include "texel/units.hpp"
 
 namespace texel {
@@ -92,6 +95,42 @@ struct TexelSpec {
 /// the maximum). The studio's hello sends them.
 inline constexpr double texel_length_mm_min = 1e-6;
 inline constexpr double texel_length_mm_max = 1000.0;
+
+inline constexpr OptionChoice phase_modes[] = {{"continuous", static_cast<int>(PhaseMode::continuous)},
+                                               {"reset", static_cast<int>(PhaseMode::reset)}};
+inline constexpr OptionChoice fills[] = {{"whole", static_cast<int>(Fill::whole_texels)},
+                                         {"partial", static_cast<int>(Fill::partial_final_texel)}};
+
+/// The fine texture's options as every front door offers them (`texel
+/// render`/`swipe`/`play` flags, Python's render()/document() keywords, C's
+/// texel_params), described once (texel/option_spec.hpp); the defaults are
+/// TexelSpec{}'s, the studies'. The coarse profile is a value of its own
+/// kind (constant, sinusoid, points, …), not a scalar option: each front
+/// door builds it its own way (docs/format.md).
+template <class Spec, class Visit>
+requires std::is_same_v<std::remove_const_t<Spec>, TexelSpec>
+void visit_options(Spec& s, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(s.central_pitch, OptionSpec{"central_pitch_db", "central-pitch", "Central Pitch, dB re 1 cycle/mm (10 = 10 cpm)"});
+  visit(s.irregularity, OptionSpec{"irregularity_db", "irregularity", "Irregularity, dB re 1 cycle/mm"});
+  visit(s.texel_length, OptionSpec{"texel_length_mm", "texel-length", "Texel length, mm", 0, texel_length_mm_max, true});
+  visit(s.seed, OptionSpec{"seed", "seed", "Random seed, 0 … 2^64-1", 0});
+  visit(s.quantization_db,
+        OptionSpec{"quantization_db", "quantization", "Frequency quantization step, dB (0 = off)", 0, quantization_db_max});
+  visit(s.phase, OptionSpec{"phase", "phase", "Texel phase: continuous | reset", -inf, inf, false, false, phase_modes});
+  visit(s.parameterization,
+        OptionSpec{"parameterization", "parameterization", "moments (mean/SD in cpm) | log (median, SD of 10·log10 f)", -inf, inf,
+                   false, false, parameterizations});
+  visit(s.out_of_band, OptionSpec{"out_of_band", "out-of-band", "redraw | clamp draws outside the band", -inf, inf, false, false,
+                                  out_of_band_rules});
+  visit(s.fill, OptionSpec{"fill", "fill", "whole (whole texels only) | partial (render a final partial texel)", -inf, inf, false,
+                           false, fills});
+  visit(s.band_min, OptionSpec{"band_min_cpm", "band-min", "Lowest texel frequency, cpm", band_cpm_min, band_cpm_max});
+  visit(s.band_max,
+        OptionSpec{"band_max_cpm", "band-max", "Highest texel frequency, cpm (0 = the grid's Nyquist)", 0, band_cpm_max});
+  visit(s.coarse_strength, OptionSpec{"coarse_strength", "coarse-strength", "Coarse strength C, 0 … 1", 0, 1});
+  visit(s.fine_strength, OptionSpec{"fine_strength", "fine-strength", "Fine strength F, 0 … 1", 0, 1});
+}
 
 /// Validates every field; throws InvalidArgument naming field, value and range.
 void validate(const TexelSpec& spec);

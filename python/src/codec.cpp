@@ -227,11 +227,18 @@ Raises InvalidArgument when the source is sample data or not one Texel texture o
         return codec::encode(signal, c);
       },
       py::arg("source"), py::kw_only(), py::arg("device") = py::none(), py::arg("spacing_mm") = py::none(),
-      py::arg("swipe_speed_mm_s") = py::none(), py::arg("boundary_mm") = 1.0, py::arg("texel_length_mm") = 0.25,
-      py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("coarse_bits") = 6u,
-      py::arg("max_bytes") = py::none(), py::arg("fit") = "least-squares", py::arg("display_response") = "device",
-      py::arg("drawn_weight") = codec::PerceptualModel{}.drawn_weight, py::arg("model") = codec::PerceptualModel{}.version,
-      py::arg("no_texture") = "flag", py::arg("target") = std::string(codec::to_string(codec::EncoderConfig{}.target)),
+      py::arg("swipe_speed_mm_s") = py::none(),
+      // The encoder's defaults are the library's (EncoderConfig{}, described by visit_options).
+      py::arg("boundary_mm") = codec::EncoderConfig{}.boundary.value(),
+      py::arg("texel_length_mm") = codec::EncoderConfig{}.texel_length.value(), py::arg("seed") = codec::EncoderConfig{}.seed,
+      py::arg("parameterization") = std::string(to_string(codec::EncoderConfig{}.parameterization)),
+      py::arg("coarse_bits") = codec::EncoderConfig{}.coarse_bits, py::arg("max_bytes") = codec::EncoderConfig{}.max_bytes,
+      py::arg("fit") = std::string(codec::to_string(codec::EncoderConfig{}.fit_method)),
+      py::arg("display_response") = std::string(codec::to_string(codec::EncoderConfig{}.model.display_response)),
+      py::arg("drawn_weight") = codec::EncoderConfig{}.model.drawn_weight,
+      py::arg("model") = codec::EncoderConfig{}.model.version,
+      py::arg("no_texture") = std::string(codec::to_string(codec::EncoderConfig{}.no_texture)),
+      py::arg("target") = std::string(codec::to_string(codec::EncoderConfig{}.target)),
       R"doc(Encodes a texture signal into Texel parameters and a bitstream, as `texel encode`.
 
 source            a path (.bin .npy .csv .wav .texel.json .texel) or a 1-D array, read by

@@ -11,7 +11,12 @@
 #include <utility>
 
 #include "common.hpp"
+#include "options.hpp"
+#include "texel/codec.hpp"
 #include "texel/error.hpp"
+#include "texel/player.hpp"
+#include "texel/player2d.hpp"
+#include "texel/texture.hpp"
 
 namespace texel::python {
 namespace {
@@ -103,4 +108,24 @@ PYBIND11_MODULE(_texel, m) {
   register_surface2d(m);
   register_experiment(m);
   register_session(m);
+  // The options each operation takes, as the library describes them once
+  // (texel/option_spec.hpp): what the keyword arguments' defaults, the CLI's
+  // flags and C's *_default() structs are made from and tested against.
+  m.def(
+      "options",
+      [](const std::string& name) -> py::list {
+        if (name == "render") return texel::python::options_list(texel::TexelSpec{});
+        if (name == "encode") return texel::python::options_list(texel::codec::EncoderConfig{});
+        if (name == "swipe") return texel::python::options_list(texel::SwipeOptions{});
+        if (name == "play") return texel::python::options_list(texel::play_options());
+        if (name == "player") return texel::python::options_list(texel::PlayerConfig{});
+        if (name == "path_2d") return texel::python::options_list(texel::Path2DConfig{});
+        throw texel::InvalidArgument("options: '" + name +
+                                     "' is not an operation; allowed: render, encode, swipe, play, player, "
+                                     "path_2d (analysis: texel.experiment.analysis_options())");
+      },
+      py::arg("name"),
+      "The options of an operation as the library describes them: one dict per option with key (the\n"
+      "keyword), flag (the CLI's), help, default, default_text and range or choices. name: render (the\n"
+      "texture of render()/document()), encode, swipe, play, player (a real-time Player's) or path_2d.");
 }

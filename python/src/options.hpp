@@ -58,25 +58,39 @@ void set_options(Options& options, const py::kwargs& kwargs, const std::string& 
   }
 }
 
-/// The description as Python sees it: one dict per option (key, flag, help,
-/// default, and min/max/exclusive or choices) in the front doors' order.
+/// The description as Python sees it: one dict per option (key, flag,
+/// help, default, default_text, and min/max/exclusive or choices) in the
+/// front doors' order, the defaults those of `defaults`.
 template <class Options>
-py::list describe_options() {
-  const Options defaults{};
+py::list options_list(const Options& defaults) {
   py::list out;
   visit_options(defaults, [&](const auto& v, const OptionSpec& spec) {
     using T = std::remove_cvref_t<decltype(v)>;
     py::dict d;
     d["key"] = std::string(spec.key);
-    d["flag"] = "--" + std::string(spec.flag);
+    d["flag"] = spec.flag.empty() ? std::string() : "--" + std::string(spec.flag);
     d["help"] = std::string(spec.help);
+    d["default_text"] = option_default_text(v, spec);
     if constexpr (std::is_enum_v<T>) {
       d["default"] = std::string(choice_name(spec.choices, static_cast<int>(v)));
       py::list choices;
       for (const auto& c : spec.choices) choices.append(std::string(c.name));
       d["choices"] = choices;
     } else {
-      d["default"] = v;
+      if constexpr (is_optional_option<T>) {
+        if (v) {
+          if constexpr (is_quantity_option<typename T::value_type>)
+            d["default"] = v->value();
+          else
+            d["default"] = *v;
+        } else {
+          d["default"] = py::none();
+        }
+      } else if constexpr (is_quantity_option<T>) {
+        d["default"] = v.value();
+      } else {
+        d["default"] = v;
+      }
       if constexpr (!std::is_same_v<T, bool>) {
         d["min"] = spec.min;
         d["max"] = spec.max;

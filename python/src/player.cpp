@@ -53,19 +53,19 @@ std::vector<FingerSample> trace_of(const py::object& t_s, const py::object& x_mm
   return trace;
 }
 
+/// The player a swipe's keyword arguments describe (SwipeOptions, the
+/// library's; `texel swipe` makes it the same way).
 PlayerConfig player_config(double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain,
-                           const std::string& response, const Document& doc) {
-  PlayerConfig c;
-  c.response = doc.device.response;  // the display's, as `texel swipe` takes it
-  c.response_handling = parse_response_handling(response, "response");
-  c.rate_hz = rate_hz;
-  c.mode = parse_output_mode(output, "output");
-  c.carrier_hz = carrier_hz;
-  c.prediction_s = prediction_s;
-  c.extrapolate_s = std::max(c.extrapolate_s, prediction_s);
-  c.gain = gain;
-  validate(c);
-  return c;
+                           const std::string& response, const std::string& band_limit, const Document& doc) {
+  SwipeOptions o;
+  o.rate = Hertz(rate_hz);
+  o.output = parse_output_mode(output, "output");
+  o.carrier = Hertz(carrier_hz);
+  o.prediction = Seconds(prediction_s);
+  o.gain = gain;
+  o.response = parse_response_handling(response, "response");
+  o.band_limit = parse_band_limit(band_limit, "band_limit");
+  return texel::player_config(o, doc.device.response);  // the display's response, as `texel swipe` takes it
 }
 
 std::unique_ptr<const PlayerMap> map_of(const Document& doc) { return PlayerMap::from_surface(prepare_surface(doc)); }
@@ -162,13 +162,17 @@ Path2DConfig path_2d(const std::string& path, double speed_mm_s, double angle_de
   return p;
 }
 
-#define TEXEL_PATH_2D_ARGS                                                                                          \
-  py::arg("path") = "line", py::arg("speed_mm_s") = 100.0, py::arg("angle_deg") = 0.0, py::arg("start_x_mm") = 0.0, \
-  py::arg("start_y_mm") = 0.0, py::arg("radius_mm") = 20.0, py::arg("leg_mm") = 10.0, py::arg("zigzag_deg") = 90.0
+#define TEXEL_PATH_2D_ARGS                                                                                           \
+  py::arg("path") = std::string(to_string(Path2DConfig{}.shape)), py::arg("speed_mm_s") = Path2DConfig{}.speed_mm_s, \
+  py::arg("angle_deg") = Path2DConfig{}.angle_deg, py::arg("start_x_mm") = Path2DConfig{}.start_x_mm,                \
+  py::arg("start_y_mm") = Path2DConfig{}.start_y_mm, py::arg("radius_mm") = Path2DConfig{}.radius_mm,                \
+  py::arg("leg_mm") = Path2DConfig{}.leg_mm, py::arg("zigzag_deg") = Path2DConfig{}.zigzag_deg
 
-#define TEXEL_PLAYER_ARGS                                                                                                      \
-  py::arg("rate_hz") = 48000.0, py::arg("output") = "vibration", py::arg("carrier_hz") = 250.0, py::arg("prediction_s") = 0.0, \
-  py::arg("gain") = 1.0, py::arg("response") = "limit"
+#define TEXEL_PLAYER_ARGS                                                                                              \
+  py::arg("rate_hz") = SwipeOptions{}.rate.value(), py::arg("output") = std::string(to_string(SwipeOptions{}.output)), \
+  py::arg("carrier_hz") = SwipeOptions{}.carrier.value(), py::arg("prediction_s") = SwipeOptions{}.prediction.value(), \
+  py::arg("gain") = SwipeOptions{}.gain, py::arg("response") = std::string(to_string(SwipeOptions{}.response)),        \
+  py::arg("band_limit") = std::string(to_string(SwipeOptions{}.band_limit))
 
 }  // namespace
 
@@ -207,9 +211,9 @@ lead_in_s   lifted time before the finger lands (s) [0])doc");
       "render_trace",
       [](const Document& doc, const py::object& t_s, const py::object& x_mm, const py::object& touch, double duration_s,
          double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain,
-         const std::string& response) {
+         const std::string& response, const std::string& band_limit) {
         const auto trace = trace_of(t_s, x_mm, touch);
-        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, doc);
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, band_limit, doc);
         return play(*map_of(doc), c, trace, duration_s);
       },
       py::arg("document"), py::arg("t_s"), py::arg("x_mm"), py::arg("touch") = py::none(), py::kw_only(), py::arg("duration_s"),
@@ -226,32 +230,31 @@ prediction_s  latency compensation look-ahead (s) [0]
 gain          output gain 0 … 1 [1]
 response      the device's frequency response: 'limit' (never drive what the display attenuates by 20 dB or more)
               or 'off' ['limit']
+band_limit    'on': no content above the output's limit at the finger's speed (texels faded); 'off': the map
+              as sampled (aliases) ['on']
 
 Returns (output, positions_mm): float32 arrays of one value per output sample. The GIL is released.)doc");
   m.def(
       "swipe",
-      [](const Document& doc, double speed_mm_s, const std::string& pattern, std::optional<double> start_mm,
-         std::optional<double> extent_mm, double turn_s, double duration_s, double rate_hz, const std::string& output,
-         double carrier_hz, double prediction_s, double gain, const std::string& response) {
-        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, doc);
-        if (!(std::isfinite(speed_mm_s) && speed_mm_s > 0))
-          throw InvalidArgument("speed_mm_s is " + std::to_string(speed_mm_s) + "; it must be > 0 mm/s");
-        if (!(std::isfinite(duration_s) && duration_s > 0 && duration_s <= 86400))
-          throw InvalidArgument("duration_s is " + std::to_string(duration_s) + "; allowed > 0 … 86400 s");
+      [](const Document& doc, double speed_mm_s, const std::string& pattern, double start_mm, double extent_mm, double turn_s,
+         double duration_s, double rate_hz, const std::string& output, double carrier_hz, double prediction_s, double gain,
+         const std::string& response, const std::string& band_limit) {
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, band_limit, doc);
         const auto map = map_of(doc);
-        SwipeConfig s;
-        s.pattern = parse_swipe_pattern(pattern, "pattern");
-        s.speed_mm_s = speed_mm_s;
-        s.start_mm = start_mm.value_or(0.0);
-        s.extent_mm = extent_mm.value_or(0.0);
-        s.surface_mm = map->grid().length().value();
-        s.turn_s = turn_s;
-        s.duration_s = duration_s;
+        SwipeOptions o;
+        o.speed = MmPerSecond(speed_mm_s);
+        o.pattern = parse_swipe_pattern(pattern, "pattern");
+        o.start = Millimetres(start_mm);
+        o.extent = Millimetres(extent_mm);
+        o.turn = Seconds(turn_s);
+        o.duration = Seconds(duration_s);
+        const SwipeConfig s = swipe_config(o, map->grid().length());
         return play(*map, c, simulate_swipe(s), duration_s);
       },
-      py::arg("document"), py::kw_only(), py::arg("speed_mm_s") = 100.0, py::arg("pattern") = "constant",
-      py::arg("start_mm") = py::none(), py::arg("extent_mm") = py::none(), py::arg("turn_s") = 0.1, py::arg("duration_s") = 2.0,
-      TEXEL_PLAYER_ARGS,
+      py::arg("document"), py::kw_only(), py::arg("speed_mm_s") = SwipeOptions{}.speed.value(),
+      py::arg("pattern") = std::string(to_string(SwipeOptions{}.pattern)), py::arg("start_mm") = SwipeOptions{}.start.value(),
+      py::arg("extent_mm") = SwipeOptions{}.extent.value(), py::arg("turn_s") = SwipeOptions{}.turn.value(),
+      py::arg("duration_s") = SwipeOptions{}.duration.value(), TEXEL_PLAYER_ARGS,
       "What a finger feels under a simulated swipe over a document, exactly as `texel swipe DOC -o x.wav`\n"
       "(same options, same defaults; see simulate_swipe and render_trace). Returns (output, positions_mm).");
   // ------------------------------------------------------------ 2-D surfaces
@@ -262,7 +265,8 @@ Returns (output, positions_mm): float32 arrays of one value per output sample. T
         return trace_2d_numpy(simulate_path_2d(
             path_2d(path, speed_mm_s, angle_deg, start_x_mm, start_y_mm, radius_mm, leg_mm, zigzag_deg, duration_s, rate_hz)));
       },
-      py::kw_only(), TEXEL_PATH_2D_ARGS, py::arg("duration_s") = 1.0, py::arg("rate_hz") = 1000.0,
+      py::kw_only(), TEXEL_PATH_2D_ARGS, py::arg("duration_s") = Path2DConfig{}.duration_s,
+      py::arg("rate_hz") = Path2DConfig{}.rate_hz,
       R"doc(A simulated 2-D finger stroke at constant speed, as `texel swipe --path` simulates it: an (N, 4)
 float64 array of x_mm, y_mm, t_s, touch (1 while touching; the last sample is lifted), ready for
 render_trace_2d.
@@ -278,9 +282,9 @@ duration_s  length of the stroke (s) [1]; rate_hz its sample rate (Hz) [1000])do
       "render_trace_2d",
       [](const Document& doc, const py::object& trace, std::optional<double> duration_s, const std::string& mode,
          const std::string& path_at_lift, double rate_hz, const std::string& output, double carrier_hz, double prediction_s,
-         double gain, const std::string& response) {
+         double gain, const std::string& response, const std::string& band_limit) {
         const auto t = trace_2d_of(trace);
-        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, doc);
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, band_limit, doc);
         return play_2d(doc, mode, path_at_lift, c, t, duration_s.value_or(t.back().t_s));
       },
       py::arg("document"), py::arg("trace"), py::kw_only(), py::arg("duration_s") = py::none(), py::arg("mode") = "path",
@@ -303,14 +307,14 @@ Returns (output, x_mm, y_mm): float32 arrays of one value per output sample. The
       [](const Document& doc, const std::string& path, double speed_mm_s, double angle_deg, double start_x_mm, double start_y_mm,
          double radius_mm, double leg_mm, double zigzag_deg, double duration_s, const std::string& mode,
          const std::string& path_at_lift, double rate_hz, const std::string& output, double carrier_hz, double prediction_s,
-         double gain, const std::string& response) {
-        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, doc);
+         double gain, const std::string& response, const std::string& band_limit) {
+        const PlayerConfig c = player_config(rate_hz, output, carrier_hz, prediction_s, gain, response, band_limit, doc);
         const auto trace = simulate_path_2d(
             path_2d(path, speed_mm_s, angle_deg, start_x_mm, start_y_mm, radius_mm, leg_mm, zigzag_deg, duration_s, 1000.0));
         return play_2d(doc, mode, path_at_lift, c, trace, duration_s);
       },
-      py::arg("document"), py::kw_only(), TEXEL_PATH_2D_ARGS, py::arg("duration_s") = 2.0, py::arg("mode") = "path",
-      py::arg("path_at_lift") = "keep", TEXEL_PLAYER_ARGS,
+      py::arg("document"), py::kw_only(), TEXEL_PATH_2D_ARGS, py::arg("duration_s") = SwipeOptions{}.duration.value(),
+      py::arg("mode") = "path", py::arg("path_at_lift") = "keep", TEXEL_PLAYER_ARGS,
       "What a finger feels on a surface under a simulated 2-D stroke, exactly as\n"
       "`texel swipe DOC --path PATH -o x.wav` (same options, same defaults; see simulate_path_2d and\n"
       "render_trace_2d). Returns (output, x_mm, y_mm).");

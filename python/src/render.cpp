@@ -26,12 +26,16 @@ py::dtype dtype_of(SampleFormat f) {
 
 // The keyword arguments of a Texel texture, mirroring the document fields
 // (docs/format.md) with units in their names; defaults are TexelSpec's.
+// The defaults are the library's (TexelSpec{}, described by visit_options).
 #define TEXEL_SPEC_ARGS                                                                                                         \
-  py::arg("central_pitch_db") = 10.0, py::arg("irregularity_db") = -5.0, py::arg("texel_length_mm") = 0.25,                     \
-  py::arg("seed") = std::uint64_t{1}, py::arg("parameterization") = "moments", py::arg("out_of_band") = "redraw",               \
-  py::arg("band_min_cpm") = 0.01, py::arg("band_max_cpm") = 0.0, py::arg("quantization_db") = 0.0,                              \
-  py::arg("phase") = "continuous", py::arg("fill") = "whole", py::arg("coarse_strength") = 0.0, py::arg("fine_strength") = 1.0, \
-  py::arg("coarse") = py::none()
+  py::arg("central_pitch_db") = TexelSpec{}.central_pitch.value(),                                                              \
+  py::arg("irregularity_db") = TexelSpec{}.irregularity.value(), py::arg("texel_length_mm") = TexelSpec{}.texel_length.value(), \
+  py::arg("seed") = TexelSpec{}.seed, py::arg("parameterization") = std::string(to_string(TexelSpec{}.parameterization)),       \
+  py::arg("out_of_band") = std::string(to_string(TexelSpec{}.out_of_band)),                                                     \
+  py::arg("band_min_cpm") = TexelSpec{}.band_min.value(), py::arg("band_max_cpm") = TexelSpec{}.band_max.value(),               \
+  py::arg("quantization_db") = TexelSpec{}.quantization_db, py::arg("phase") = std::string(to_string(TexelSpec{}.phase)),       \
+  py::arg("fill") = std::string(to_string(TexelSpec{}.fill)), py::arg("coarse_strength") = TexelSpec{}.coarse_strength,         \
+  py::arg("fine_strength") = TexelSpec{}.fine_strength, py::arg("coarse") = py::none()
 
 TexelSpec make_spec(double central_pitch_db, double irregularity_db, double texel_length_mm, std::uint64_t seed,
                     const std::string& parameterization, const std::string& out_of_band, double band_min_cpm, double band_max_cpm,

@@ -345,9 +345,10 @@ later Session(..., resume=True) continues where it stopped.)doc")
       "`texel experiment analyze`; figures into out_dir when given. The options are the library's\n"
       "(analysis_options() lists them with their defaults and ranges). Returns a dict: summary (the\n"
       "JSON summary), text, figures and tables (paths written).");
-  m.def("analysis_options", &describe_options<AnalysisOptions>,
-        "The options of analyze(), as the library describes them: key, flag (the CLI's), help, default and\n"
-        "range or choices, in the CLI's order.");
+  m.def(
+      "analysis_options", [] { return options_list(AnalysisOptions{}); },
+      "The options of analyze(), as the library describes them: key, flag (the CLI's), help, default and\n"
+      "range or choices, in the CLI's order.");
 }
 
 }  // namespace texel::python

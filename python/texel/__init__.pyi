@@ -251,6 +251,10 @@ def magnitude_spectrum(samples: _Array, spacing_mm: float, *, window: str = "bla
                        remove_mean: bool = True) -> Spectrum: ...
 def analyse_spectrum(samples: _Array, spacing_mm: float) -> dict[str, Any]: ...
 
+# ----------------------------------------------------------------- options
+_Operation = Literal["render", "encode", "swipe", "play", "player", "path_2d"]
+def options(name: _Operation) -> list[dict[str, Any]]: ...
+
 # ------------------------------------------------------------------ player
 def simulate_swipe(*, speed_mm_s: float = 100.0, pattern: str = "constant", start_mm: float = 0.0,
                    extent_mm: float = 0.0, surface_mm: float = 0.0, turn_s: float = 0.1, duration_s: float = 1.0,
@@ -258,12 +262,12 @@ def simulate_swipe(*, speed_mm_s: float = 100.0, pattern: str = "constant", star
 def render_trace(document: Document, t_s: _Array, x_mm: _Array, touch: Optional[_Array] = None, *, duration_s: float,
                  rate_hz: float = 48000.0, output: str = "vibration", carrier_hz: float = 250.0,
                  prediction_s: float = 0.0,
-                 gain: float = 1.0, response: str = "limit") -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+                 gain: float = 1.0, response: str = "limit", band_limit: str = "on") -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
 def swipe(document: Document, *, speed_mm_s: float = 100.0, pattern: str = "constant",
-          start_mm: Optional[float] = None, extent_mm: Optional[float] = None, turn_s: float = 0.1,
+          start_mm: float = 0.0, extent_mm: float = 0.0, turn_s: float = 0.1,
           duration_s: float = 2.0, rate_hz: float = 48000.0, output: str = "vibration", carrier_hz: float = 250.0,
           prediction_s: float = 0.0,
-          gain: float = 1.0, response: str = "limit") -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+          gain: float = 1.0, response: str = "limit", band_limit: str = "on") -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
 def swipe_measures(t_s: _Array, x_mm: _Array, touch: Optional[_Array] = None, *,
                    still_below_mm_s: float = 0.0) -> dict[str, float]: ...
 
@@ -285,12 +289,12 @@ def simulate_path_2d(*, path: _Path2D = "line", speed_mm_s: float = 100.0, angle
 def render_trace_2d(document: Document, trace: _Array, *, duration_s: Optional[float] = None, mode: _Mode2D = "path",
                     path_at_lift: _AtLift = "keep", rate_hz: float = 48000.0, output: str = "vibration",
                     carrier_hz: float = 250.0, prediction_s: float = 0.0, gain: float = 1.0,
-                    response: str = "limit") -> tuple[_F32, _F32, _F32]: ...
+                    response: str = "limit", band_limit: str = "on") -> tuple[_F32, _F32, _F32]: ...
 def swipe_2d(document: Document, *, path: _Path2D = "line", speed_mm_s: float = 100.0, angle_deg: float = 0.0,
              start_x_mm: float = 0.0, start_y_mm: float = 0.0, radius_mm: float = 20.0, leg_mm: float = 10.0,
              zigzag_deg: float = 90.0, duration_s: float = 2.0, mode: _Mode2D = "path", path_at_lift: _AtLift = "keep",
              rate_hz: float = 48000.0, output: str = "vibration", carrier_hz: float = 250.0, prediction_s: float = 0.0,
-             gain: float = 1.0, response: str = "limit") -> tuple[_F32, _F32, _F32]: ...
+             gain: float = 1.0, response: str = "limit", band_limit: str = "on") -> tuple[_F32, _F32, _F32]: ...
 
 # -------------------------------------------------------------- procedures
 class Staircase:

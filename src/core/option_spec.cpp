@@ -7,6 +7,8 @@
 
 namespace texel {
 
+std::string option_number_text(double v) { return detail::num(v); }
+
 std::string allowed_text(const OptionSpec& spec) {
   if (!spec.choices.empty()) {
     std::string list;

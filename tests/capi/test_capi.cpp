@@ -24,6 +24,7 @@
 #include "texel/device.hpp"
 #include "texel/document.hpp"
 #include "texel/player.hpp"
+#include "texel/player2d.hpp"
 #include "texel/reference.hpp"
 #include "texel/signal.hpp"
 #include "texel/spectrum.hpp"
@@ -1028,3 +1029,61 @@ TEST(CApiEncode, FlagsNameTheModelAndAnInputWithoutTexture) {
 }
 
 }  // namespace
+
+// Issue 39: the C structs' defaults are the library's description of each
+// operation's options (visit_options, texel/option_spec.hpp) — the same
+// description the CLI's help and Python's keyword defaults are made from
+// (tests/python/test_front_door_defaults.py checks those and texel.h's
+// "[default]" comments). A default typed by hand into a *_default() fails
+// here. Every C field with a described counterpart is compared; enumerations
+// by value (texel.h's enumerators equal the library's).
+TEST(CApi, EveryDefaultIsTheLibrarysDescription) {
+  const auto d = [](const auto& defaults, std::string_view key) { return texel::option_default(defaults, key); };
+  const auto n = [](auto v) { return static_cast<double>(v); };
+
+  const texel::TexelSpec spec;
+  const texel_params p = texel_params_default();
+  EXPECT_EQ(n(p.central_pitch_db), d(spec, "central_pitch_db"));
+  EXPECT_EQ(n(p.irregularity_db), d(spec, "irregularity_db"));
+  EXPECT_EQ(n(p.texel_length_mm), d(spec, "texel_length_mm"));
+  EXPECT_EQ(n(p.seed), d(spec, "seed"));
+  EXPECT_EQ(n(p.parameterization), d(spec, "parameterization"));
+  EXPECT_EQ(n(p.quantization_db), d(spec, "quantization_db"));
+  EXPECT_EQ(n(p.coarse_strength), d(spec, "coarse_strength"));
+  EXPECT_EQ(n(p.fine_strength), d(spec, "fine_strength"));
+
+  const texel::codec::EncoderConfig enc;
+  const texel_encode_options e = texel_encode_options_default();
+  EXPECT_EQ(n(e.boundary_mm), d(enc, "boundary_mm"));
+  EXPECT_EQ(n(e.texel_length_mm), d(enc, "texel_length_mm"));
+  EXPECT_EQ(n(e.parameterization), d(enc, "parameterization"));
+  EXPECT_EQ(n(e.seed), d(enc, "seed"));
+  EXPECT_EQ(n(e.coarse_bits), d(enc, "coarse_bits"));
+  EXPECT_TRUE(std::isnan(d(enc, "max_bytes")) ? e.max_bytes == 0 : n(e.max_bytes) == d(enc, "max_bytes"));  // 0 = none
+  EXPECT_EQ(n(e.model_version), d(enc, "model"));
+  EXPECT_EQ(n(e.refuse_no_texture), d(enc, "no_texture"));  // flag (0) or refuse (1)
+  EXPECT_EQ(n(e.target), d(enc, "target"));
+
+  const texel::PlayerConfig player;
+  const texel_player_config c = texel_player_config_default();
+  EXPECT_EQ(n(c.rate_hz), d(player, "rate_hz"));
+  EXPECT_EQ(n(c.mode), d(player, "output"));
+  EXPECT_EQ(n(c.gain), d(player, "gain"));
+  EXPECT_EQ(n(c.carrier_hz), d(player, "carrier_hz"));
+  EXPECT_EQ(n(c.prediction_s), d(player, "prediction_s"));
+  EXPECT_EQ(n(c.response_handling), d(player, "response"));
+  EXPECT_EQ(n(c.response_limit_db), d(player, "response_limit_db"));
+
+  const texel::Path2DConfig path;
+  const texel_path2d_config q = texel_path2d_config_default();
+  EXPECT_EQ(n(q.shape), d(path, "path"));
+  EXPECT_EQ(n(q.speed_mm_s), d(path, "speed_mm_s"));
+  EXPECT_EQ(n(q.angle_deg), d(path, "angle_deg"));
+  EXPECT_EQ(n(q.start_x_mm), d(path, "start_x_mm"));
+  EXPECT_EQ(n(q.start_y_mm), d(path, "start_y_mm"));
+  EXPECT_EQ(n(q.radius_mm), d(path, "radius_mm"));
+  EXPECT_EQ(n(q.leg_mm), d(path, "leg_mm"));
+  EXPECT_EQ(n(q.zigzag_deg), d(path, "zigzag_deg"));
+  EXPECT_EQ(n(q.duration_s), d(path, "duration_s"));
+  EXPECT_EQ(n(q.rate_hz), d(path, "rate_hz"));
+}
