@@ -1,7 +1,7 @@
-// The PostgreSQL side of the session store (store_pg.cpp; docs/session-store.md
+// The PostgreSQL side of the session store (store_pg*.cpp; docs/session-store.md
 // "Many stations"): a reader of the server, and a station's shipper that
 // copies its local SQLite journal to the server in the background. libpq
-// types stay in store_pg.cpp.
+// types stay in store_pg*.cpp and store_pg_parts.hpp.
 #pragma once
 
 #include <cstdint>

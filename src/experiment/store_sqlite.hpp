@@ -161,6 +161,10 @@ void migrate(StoreImpl& s);
 
 // The writer lock (store_writer.cpp).
 
+/// This machine's host name ("unknown" if unreadable): the writer row's
+/// host, and a PostgreSQL station's (store_pg_station.cpp).
+std::string host_name();
+
 /// This process's start time (clock ticks since boot), the writer row's
 /// proof that a pid is still the process that wrote it.
 std::int64_t own_start();

@@ -16,13 +16,14 @@
 
 namespace texel::experiment {
 namespace store_parts {
-namespace {
 
 std::string host_name() {
   char buf[256] = {};
   if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
   return buf;
 }
+
+namespace {
 
 // /proc/<pid>/stat: the state (field 3) and the start time in clock ticks
 // since boot (field 22). The start time tells a recycled pid from the writer.
