@@ -1,5 +1,5 @@
-// The drawing parts the figure layer (plot.cpp: layout, axes, legend,
-// encoders) shares with the series painters (series.cpp): Cairo itself
+// The drawing parts the figure layer (plot.cpp and its parts: layout.cpp,
+// axes_legend.cpp, ticks.cpp, …) shares with the series painters (series.cpp): Cairo itself
 // (opened on first use), the Cairo painter, the data-to-pixel scale and a
 // panel's plan. Internal to texel_plot; not installed.
 #pragma once
