@@ -153,6 +153,13 @@ MatchResult SessionCore::position(const std::string& reference) const {
 
 double template_number(const Block& b, const char* key) { return b.texture.number(key).value_or(missing); }
 
+void ask_oddity(const Block& b, int odd, Question& q, TrialTruth& t) {
+  q.choices = {"1", "2", "3"};
+  q.wording.choice_question = "The odd one is";
+  t.correct_answer = std::to_string(odd + 1);
+  q.prompt = b.prompt.empty() ? "Feel the three textures (switch freely). Which one is different from the other two?" : b.prompt;
+}
+
 void require(bool ok, const std::string& msg) {
   if (!ok) throw InvalidArgument(msg);
 }

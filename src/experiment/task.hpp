@@ -158,6 +158,11 @@ const TaskType* find_task_type(std::string_view name);
 
 /// The common columns' helper: the numeric key of the block's texture.
 double template_number(const Block& b, const char* key);
+/// A three-interval oddity question's words and answer, one for every
+/// oddity task (threshold, 2-D oddity, playback oddity): choices "1" … "3",
+/// "The odd one is", the block's prompt or the source's; the correct answer
+/// is the odd interval's number (`odd` 0-based).
+void ask_oddity(const Block& b, int odd, Question& q, TrialTruth& t);
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& items);
 /// InvalidArgument(msg) unless ok.

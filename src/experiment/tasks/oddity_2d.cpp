@@ -275,11 +275,7 @@ class Oddity2DBlock : public TaskBlock {
       q.stimuli.push_back(std::move(stimulus));
       q.surfaces.push_back(std::move(surface));
     }
-    q.choices = {"1", "2", "3"};
-    q.wording.choice_question = "The odd one is";
-    t.correct_answer = std::to_string(odd + 1);
-    q.prompt =
-        b.prompt.empty() ? "Feel the three textures (switch freely). Which one is different from the other two?" : b.prompt;
+    ask_oddity(b, odd, q, t);
   }
 
   std::string answer(SessionCore& s, const Question&, const TrialTruth& t, const Response& r, TrialRow& row) override {

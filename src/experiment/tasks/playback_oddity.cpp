@@ -118,14 +118,10 @@ class PlaybackOddityBlock : public TaskBlock {
         break;
     }
     for (int i = 0; i < 3; ++i) q.stimuli.push_back({std::to_string(i + 1), i == odd ? odd_doc : pair_doc});
-    q.choices = {"1", "2", "3"};
-    q.wording.choice_question = "The odd one is";
-    t.correct_answer = std::to_string(odd + 1);
+    ask_oddity(b, odd, q, t);
     t.intensity = c.arrangement == Arrangement::control ? missing : c.shift;
     t.condition = std::string(to_string(c.arrangement));
     t.rendering = MatchResult{template_number(b, "central_pitch_db"), c.level};
-    q.prompt =
-        b.prompt.empty() ? "Feel the three textures (switch freely). Which one is different from the other two?" : b.prompt;
   }
 
   std::string answer(SessionCore& s, const Question&, const TrialTruth& t, const Response& r, TrialRow& row) override {

@@ -115,11 +115,7 @@ class ThresholdBlock : public TaskBlock {
     for (int i = 0; i < 3; ++i)
       q.stimuli.push_back(
           {std::to_string(i + 1), s.single(texel_texture(base, i == odd ? single_seed : pair_seed), b.display_mm)});
-    q.choices = {"1", "2", "3"};
-    q.wording.choice_question = "The odd one is";
-    t.correct_answer = std::to_string(odd + 1);
-    q.prompt =
-        b.prompt.empty() ? "Feel the three textures (switch freely). Which one is different from the other two?" : b.prompt;
+    ask_oddity(b, odd, q, t);
   }
 
   std::string answer(SessionCore& s, const Question&, const TrialTruth& t, const Response& r, TrialRow& row) override {
