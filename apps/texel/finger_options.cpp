@@ -58,17 +58,16 @@ std::vector<FingerSample> finger_trace(const FingerOptions& o, double surface_mm
     return trace;
   }
   duration_s = o.duration_s.value_or(duration_s);  // the caller passes its default
-  SwipeConfig s;
+  SwipeOptions s;
   s.pattern = parse_swipe_pattern(o.pattern, "--pattern");
-  s.speed_mm_s = o.speed_mm_s;
-  s.start_mm = o.start_mm.value_or(0.0);
-  s.extent_mm = o.extent_mm.value_or(0.0);
-  s.surface_mm = surface_mm;
-  s.turn_s = o.turn_s;
-  s.duration_s = duration_s;
   if (!(std::isfinite(o.speed_mm_s) && o.speed_mm_s > 0))
     throw InvalidArgument("--speed is " + detail::num(o.speed_mm_s) + "; it must be > 0 mm/s");
-  return simulate_swipe(s);
+  s.speed = MmPerSecond(o.speed_mm_s);
+  s.start = Millimetres(o.start_mm.value_or(0.0));
+  s.extent = Millimetres(o.extent_mm.value_or(0.0));
+  s.turn = Seconds(o.turn_s);
+  s.duration = Seconds(duration_s);
+  return simulate_swipe(swipe_config(s, Millimetres(surface_mm)));
 }
 
 void add_surface2d_options(CLI::App& cmd, Surface2DOptions& o) {

@@ -318,8 +318,8 @@ SwipeOptions play_options();
 /// The player configuration `o` describes (the rest PlayerConfig{}'s), for a
 /// display with `response`; validated (InvalidArgument naming the field).
 PlayerConfig player_config(const SwipeOptions& o, const FrequencyResponse& response);
-/// The simulated swipe `o` describes over a surface `surface_mm` long,
-/// sampled at 1 kHz; validated.
+/// The simulated swipe `o` describes over a surface `surface` long, sampled
+/// at 1 kHz (simulate_swipe validates it, naming the field).
 SwipeConfig swipe_config(const SwipeOptions& o, Millimetres surface);
 
 template <class Options, class Visit>
@@ -331,7 +331,7 @@ void visit_options(Options& o, Visit&& visit) {
                               -inf, inf, false, false, swipe_patterns});
   visit(o.start, OptionSpec{"start_mm", "start", "Where the simulated finger lands (mm)"});
   visit(o.extent, OptionSpec{"extent_mm", "extent", "Travel of one stroke (mm); 0 = to the end of the surface", 0});
-  visit(o.turn, OptionSpec{"turn_s", "turn", "Back-and-forth: time to stop and turn (s)", 0});
+  visit(o.turn, OptionSpec{"turn_s", "turn", "Back-and-forth: time to stop and turn (s)", 0, 10});
   visit(o.duration, OptionSpec{"duration_s", "duration", "Length (s); a recorded trace: the trace's", 0, 86400, true});
   visit(o.rate, OptionSpec{"rate_hz", "rate",
                            "Output rate (Hz); 8333 for the tpad's refresh rate; play to a serial display: its link's "

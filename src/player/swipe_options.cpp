@@ -5,7 +5,6 @@
 #include <string>
 
 #include "texel/error.hpp"
-#include "texel/option_spec.hpp"
 #include "texel/player.hpp"
 
 namespace texel {
@@ -33,12 +32,6 @@ PlayerConfig player_config(const SwipeOptions& o, const FrequencyResponse& respo
 }
 
 SwipeConfig swipe_config(const SwipeOptions& o, Millimetres surface) {
-  // The finger's own ranges, from the options' description.
-  visit_options(o, [](const auto& v, const OptionSpec& spec) {
-    if constexpr (is_quantity_option<decltype(v)>)
-      if (spec.key != "rate_hz" && spec.key != "carrier_hz" && spec.key != "prediction_s")
-        check_option_value(spec, v.value(), spec.key);
-  });
   SwipeConfig s;
   s.pattern = o.pattern;
   s.speed_mm_s = o.speed.value();

@@ -13,7 +13,6 @@ shows exactly those defaults:
 Nothing is changed; a default edited by hand in any of these fails here.
 The analysis options are checked the same way in test_options.py."""
 import inspect
-import math
 import pathlib
 import re
 
@@ -60,8 +59,7 @@ def _same_default(stated, described):
         return stated == described["default"]
     if isinstance(described["default"], bool):
         return stated is described["default"]
-    return isinstance(stated, (int, float)) and not isinstance(stated, bool) and math.isclose(
-        float(stated), float(described["default"]), rel_tol=0, abs_tol=0)
+    return isinstance(stated, (int, float)) and not isinstance(stated, bool) and float(stated) == float(described["default"])
 
 
 @pytest.mark.parametrize("name", sorted({*PYTHON, *CLI, "player"}))
